@@ -1,0 +1,44 @@
+// Every parameter of Neural Meshes (Ivrissimtzis, Jeong, Seidel), with the paper's defaults.
+// This is the one place the parameters are documented; flags, the proto and the README refer
+// here.
+#ifndef NEURALMESH_CORE_LEARNING_LEARNER_OPTIONS_H_
+#define NEURALMESH_CORE_LEARNING_LEARNER_OPTIONS_H_
+
+#include <cstdint>
+
+#include "absl/status/status.h"
+
+namespace neuralmesh {
+
+struct LearnerOptions {
+  // Basic Step (Section 2.1).
+  double alpha_w = 0.06;   // alpha_w, Eq. 1: how far the winner moves toward the sample, (0, 1].
+  double alpha_l = 0.06;   // alpha_L, Section 2.1: tangential Laplacian smoothing rate, [0, 1].
+  int c_l = 5;             // C_L, Section 2.1: smoothing iterations per Basic Step, >= 0.
+
+  // Connectivity changes (Section 2.2).
+  int c_vs = 100;          // C_vs, Section 2.2: Basic Steps between two vertex splits, >= 1.
+  double c_ec = 10;        // C_ec, Section 2.2: Step 3 runs every C_ec * v Basic Steps, > 0.
+  double alpha_sc = 0.95;  // alpha_sc, Section 2.2 / Eq. 4: signal counter decay, (0, 1).
+
+  // Topology changes (Section 2.3), run right after each Step 3.
+  bool remove_triangles = true;  // Step 4 on or off.
+  double alpha_r = 7;            // alpha_r, Eq. 2: remove triangles larger than alpha_r E(Area).
+  bool merge_boundaries = true;  // Step 5 on or off.
+  double alpha_m = 5;            // alpha_m, Eq. 3: merge boundaries closer than
+                                 // alpha_m sqrt(E(Area)) (Hausdorff distance).
+
+  // Splits per call of Step 2. The paper uses 1; Section 3.3 suggests more for speed on very
+  // large meshes at a negligible cost in quality.
+  int splits_per_step = 1;
+
+  // Seeds the learner's random number generator: a seed reproduces a run exactly.
+  uint64_t seed = 1;
+
+  // Returns INVALID_ARGUMENT naming the first parameter out of its range.
+  absl::Status Validate() const;
+};
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_LEARNING_LEARNER_OPTIONS_H_

@@ -1,0 +1,28 @@
+// A point set with optional per-point confidence weights and normals.
+#ifndef NEURALMESH_CORE_POINT_CLOUD_H_
+#define NEURALMESH_CORE_POINT_CLOUD_H_
+
+#include <vector>
+
+#include "absl/status/status.h"
+#include "core/mesh.h"
+
+namespace neuralmesh {
+
+struct PointCloud {
+  std::vector<Vec3f> positions;
+  std::vector<float> weights;   // Empty, or one non-negative weight per point (Section 4.1).
+  std::vector<Vec3f> normals;   // Empty, or one normal per point.
+
+  size_t size() const { return positions.size(); }
+  bool empty() const { return positions.empty(); }
+};
+
+// Checks that `cloud` is usable as a target space: every coordinate finite, weights and
+// normals either absent or one per point, weights finite and non-negative with a positive sum.
+// Returns INVALID_ARGUMENT with the first offending index otherwise.
+absl::Status ValidatePointCloud(const PointCloud& cloud);
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_POINT_CLOUD_H_

@@ -1,0 +1,31 @@
+// The target space P of the paper (Section 2.1): anything that returns one random point of the
+// surface to reconstruct per call. Every sampler answers in O(1), independent of the size of
+// its data, which is what makes the learner's speed independent of the input size.
+#ifndef NEURALMESH_CORE_SAMPLING_SAMPLER_H_
+#define NEURALMESH_CORE_SAMPLING_SAMPLER_H_
+
+#include "core/bounding_box.h"
+#include "core/mesh.h"
+#include "core/random.h"
+
+namespace neuralmesh {
+
+class Sampler {
+ public:
+  virtual ~Sampler() = default;
+
+  // Draws one point s of P using `rng`. Only called when !empty(). Deterministic for a given
+  // rng state and data. May be called from one thread while data is appended from another
+  // (see GrowingPointCloud).
+  virtual Vec3 Sample(Random& rng) const = 0;
+
+  // Whether there is nothing to sample yet.
+  virtual bool empty() const = 0;
+
+  // The bounding box of the data seen so far (the initial tetrahedron is built around it).
+  virtual BoundingBox Bounds() const = 0;
+};
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_SAMPLING_SAMPLER_H_

@@ -1,0 +1,34 @@
+// A plain indexed triangle mesh: the exchange format between the learner, file I/O, Draco,
+// the mesh report and the network. Unlike `Mesh` it may hold any triangle soup, including
+// non-manifold input read from a file.
+#ifndef NEURALMESH_CORE_TRIANGLE_MESH_H_
+#define NEURALMESH_CORE_TRIANGLE_MESH_H_
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/mesh.h"
+
+namespace neuralmesh {
+
+struct TriangleMesh {
+  std::vector<Vec3f> positions;
+  std::vector<std::array<uint32_t, 3>> faces;  // Counter-clockwise seen from outside.
+
+  bool empty() const { return positions.empty(); }
+};
+
+// Copies the live (not deleted) vertices and faces of `mesh`, renumbered densely in
+// handle order. O(v + f).
+TriangleMesh ToTriangleMesh(const Mesh& mesh);
+
+// Builds a half-edge mesh from `triangles`.
+// Returns INVALID_ARGUMENT when a face index is out of range or degenerate, or when the faces
+// do not form an orientable 2-manifold (with or without boundary).
+absl::StatusOr<Mesh> ToMesh(const TriangleMesh& triangles);
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_TRIANGLE_MESH_H_

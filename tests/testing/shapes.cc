@@ -1,0 +1,69 @@
+#include "tests/testing/shapes.h"
+
+#include <map>
+#include <utility>
+
+#include "gtest/gtest.h"
+
+namespace neuralmesh::testing {
+
+TriangleMesh Icosphere(int levels, double radius) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  TriangleMesh m;
+  const double raw[12][3] = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0},
+                             {0, -1, t}, {0, 1, t},  {0, -1, -t}, {0, 1, -t},
+                             {t, 0, -1}, {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  for (const auto& p : raw) m.positions.push_back(Vec3f(p[0], p[1], p[2]).normalized());
+  m.faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+             {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+             {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+             {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoint;
+    auto mid = [&](uint32_t a, uint32_t b) {
+      const auto key = std::minmax(a, b);
+      auto it = midpoint.find(key);
+      if (it != midpoint.end()) return it->second;
+      const uint32_t index = static_cast<uint32_t>(m.positions.size());
+      m.positions.push_back(((m.positions[a] + m.positions[b]) * 0.5f).normalized());
+      midpoint.emplace(key, index);
+      return index;
+    };
+    std::vector<std::array<uint32_t, 3>> faces;
+    for (const auto& f : m.faces) {
+      const uint32_t ab = mid(f[0], f[1]), bc = mid(f[1], f[2]), ca = mid(f[2], f[0]);
+      faces.push_back({f[0], ab, ca});
+      faces.push_back({f[1], bc, ab});
+      faces.push_back({f[2], ca, bc});
+      faces.push_back({ab, bc, ca});
+    }
+    m.faces = std::move(faces);
+  }
+  for (Vec3f& p : m.positions) p *= static_cast<float>(radius);
+  return m;
+}
+
+TriangleMesh GridPatch(int nx, int ny) {
+  TriangleMesh m;
+  for (int j = 0; j <= ny; ++j) {
+    for (int i = 0; i <= nx; ++i) {
+      m.positions.emplace_back(static_cast<float>(i) / nx, static_cast<float>(j) / ny, 0.f);
+    }
+  }
+  auto id = [&](int i, int j) { return static_cast<uint32_t>(j * (nx + 1) + i); };
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      m.faces.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.faces.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  }
+  return m;
+}
+
+Mesh MustToMesh(const TriangleMesh& triangles) {
+  auto mesh = ToMesh(triangles);
+  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  return mesh.ok() ? std::move(mesh).value() : Mesh();
+}
+
+}  // namespace neuralmesh::testing

@@ -1,0 +1,325 @@
+// Measures the reconstruction service over loopback (127.0.0.1, a real TCP port):
+//  1. ingest throughput: points per second through one UploadPoints stream;
+//  2. latency from the first batch to the first mesh (Reconstruct, median of 5);
+//  3. Draco encode time and bytes per vertex of every LOD milestone;
+//  4. learning Basic Steps per second with 1, 2 and 8 concurrent sessions, against the same
+//     learner run locally in this process (what the local CLI does).
+// Targets (issue): >= 10M points/s ingested; first mesh within 100 ms; <= 8 bytes per vertex
+// at 11-bit quantization; one session under the server >= 90% of the local learning rate.
+//
+//   build/bin/service-bench [--ingest_points=20000000] [--lod_target=20000] [--learn_seconds=3]
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
+#include "core/learning/learner.h"
+#include "core/sampling/growing_point_cloud.h"
+#include "core/sampling/implicit_surfaces.h"
+#include "core/sampling/sample_points.h"
+#include "neuralmesh/v1/reconstruction.grpc.pb.h"
+#include "server/proto_conversion.h"
+#include "server/server.h"
+
+ABSL_FLAG(int64_t, ingest_points, 20000000, "Points sent in the ingest measurement.");
+ABSL_FLAG(int64_t, batch_points, 1 << 18, "Points per batch in the ingest measurement.");
+ABSL_FLAG(int64_t, lod_target, 20000, "Target vertex count of the LOD measurement.");
+ABSL_FLAG(double, learn_seconds, 3.0, "Measurement window of the learning-rate measurement.");
+ABSL_FLAG(int, worker_threads, 2, "The server's learning threads.");
+
+namespace neuralmesh {
+namespace {
+
+using server::ReconstructionServer;
+using server::ServerOptions;
+
+PointCloud Torus(size_t n, uint64_t seed) {
+  auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4);
+  return SamplePoints(**torus, n, seed);
+}
+
+v1::PointBatch Batch(const PointCloud& cloud, size_t begin, size_t end) {
+  PointCloud part;
+  part.positions.assign(cloud.positions.begin() + begin, cloud.positions.begin() + end);
+  return server::PointCloudToPackedBatch(part);
+}
+
+std::string Create(v1::ReconstructionService::Stub& stub, uint64_t target,
+                   v1::FinalPass final_pass = v1::FINAL_PASS_AUTO) {
+  grpc::ClientContext context;
+  v1::CreateSessionRequest request;
+  request.mutable_config()->set_target_vertices(target);
+  request.mutable_config()->set_final_pass(final_pass);
+  v1::Session session;
+  grpc::Status status = stub.CreateSession(&context, request, &session);
+  if (!status.ok()) {
+    std::fprintf(stderr, "CreateSession: %s\n", status.error_message().c_str());
+    std::exit(1);
+  }
+  return session.session_id();
+}
+
+void Upload(v1::ReconstructionService::Stub& stub, const std::string& id,
+            const std::vector<v1::UploadPointsRequest>& requests) {
+  grpc::ClientContext context;
+  v1::UploadPointsResponse response;
+  auto writer = stub.UploadPoints(&context, &response);
+  for (size_t i = 0; i < requests.size(); ++i) {
+    if (i == 0) {
+      v1::UploadPointsRequest first = requests[0];
+      first.set_session_id(id);
+      writer->Write(first);
+    } else {
+      writer->Write(requests[i]);
+    }
+  }
+  writer->WritesDone();
+  grpc::Status status = writer->Finish();
+  if (!status.ok()) {
+    std::fprintf(stderr, "UploadPoints: %s\n", status.error_message().c_str());
+    std::exit(1);
+  }
+}
+
+v1::Session Get(v1::ReconstructionService::Stub& stub, const std::string& id) {
+  grpc::ClientContext context;
+  v1::GetSessionRequest request;
+  request.set_session_id(id);
+  v1::Session session;
+  stub.GetSession(&context, request, &session);
+  return session;
+}
+
+void Delete(v1::ReconstructionService::Stub& stub, const std::string& id) {
+  grpc::ClientContext context;
+  v1::DeleteSessionRequest request;
+  request.set_session_id(id);
+  v1::DeleteSessionResponse response;
+  stub.DeleteSession(&context, request, &response);
+}
+
+void MeasureIngest(v1::ReconstructionService::Stub& stub) {
+  const size_t total = static_cast<size_t>(absl::GetFlag(FLAGS_ingest_points));
+  const size_t batch = static_cast<size_t>(absl::GetFlag(FLAGS_batch_points));
+  const PointCloud source = Torus(std::min<size_t>(total, 1 << 20), 1);
+  std::vector<v1::UploadPointsRequest> requests;
+  for (size_t sent = 0; sent < total; sent += batch) {
+    const size_t n = std::min(batch, total - sent);
+    const size_t begin = sent % source.size();
+    const size_t end = std::min(begin + n, source.size());
+    v1::UploadPointsRequest request;
+    *request.mutable_batch() = Batch(source, begin, end);
+    requests.push_back(std::move(request));
+  }
+  size_t points = 0;
+  for (const auto& r : requests) points += r.batch().packed().positions().size() / 12;
+  // A small target: learning pauses quickly and leaves the cores to ingestion.
+  const std::string id = Create(stub, 1000);
+  const absl::Time start = absl::Now();
+  Upload(stub, id, requests);
+  const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
+  const v1::Session session = Get(stub, id);
+  std::printf("ingest: %zu points in %zu batches over one stream: %.3f s, %.1f M points/s "
+              "(%.0f MB/s); session holds %llu points   [target >= 10 M points/s]\n",
+              points, requests.size(), seconds, points / seconds / 1e6,
+              points * 12.0 / seconds / 1e6,
+              static_cast<unsigned long long>(session.learning().points_received()));
+  Delete(stub, id);
+}
+
+void MeasureFirstMesh(v1::ReconstructionService::Stub& stub) {
+  const PointCloud points = Torus(10000, 2);
+  std::vector<double> latencies;
+  for (int run = 0; run < 5; ++run) {
+    grpc::ClientContext context;
+    auto stream = stub.Reconstruct(&context);
+    v1::ReconstructRequest start;
+    start.mutable_start()->mutable_create()->mutable_config()->set_target_vertices(5000);
+    stream->Write(start);
+    v1::ReconstructResponse response;
+    if (!stream->Read(&response) || !response.has_session()) {
+      std::fprintf(stderr, "Reconstruct did not start\n");
+      std::exit(1);
+    }
+    const std::string id = response.session().session_id();
+    v1::ReconstructRequest request;
+    *request.mutable_points() = Batch(points, 0, points.size());
+    const absl::Time t0 = absl::Now();
+    stream->Write(request);
+    while (stream->Read(&response) && !response.has_update()) {
+    }
+    latencies.push_back(absl::ToDoubleMilliseconds(absl::Now() - t0));
+    context.TryCancel();
+    stream->Finish();
+    Delete(stub, id);
+  }
+  std::sort(latencies.begin(), latencies.end());
+  std::printf("first mesh: %.1f ms after the first batch of 10000 points (median of 5; "
+              "min %.1f, max %.1f)   [target <= 100 ms]\n",
+              latencies[2], latencies.front(), latencies.back());
+}
+
+// Returns the wall time from the upload to the final mesh and the Basic Steps taken.
+std::pair<double, uint64_t> MeasureLods(v1::ReconstructionService::Stub& stub,
+                                        const PointCloud& points) {
+  const uint64_t target = static_cast<uint64_t>(absl::GetFlag(FLAGS_lod_target));
+  const std::string id = Create(stub, target, v1::FINAL_PASS_CONTINUE);
+  std::vector<v1::MeshUpdate> updates;
+  std::thread watcher([&] {
+    grpc::ClientContext context;
+    v1::WatchSessionRequest request;
+    request.set_session_id(id);
+    auto reader = stub.WatchSession(&context, request);
+    v1::MeshUpdate update;
+    while (reader->Read(&update)) updates.push_back(update);
+    reader->Finish();
+  });
+  std::vector<v1::UploadPointsRequest> requests;
+  for (size_t b = 0; b < points.size(); b += 100000) {
+    v1::UploadPointsRequest r;
+    *r.mutable_batch() = Batch(points, b, std::min(points.size(), b + 100000));
+    requests.push_back(std::move(r));
+  }
+  const absl::Time start = absl::Now();
+  Upload(stub, id, requests);
+  {
+    grpc::ClientContext context;
+    v1::FinishSessionRequest request;
+    request.set_session_id(id);
+    v1::Session session;
+    stub.FinishSession(&context, request, &session);
+  }
+  watcher.join();
+  const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
+  std::printf("LODs (11-bit positions, Draco speed 5):\n");
+  std::printf("  %-9s %9s %9s %10s %8s %10s\n", "kind", "vertices", "faces", "bytes", "B/vert",
+              "encode ms");
+  for (const v1::MeshUpdate& u : updates) {
+    if (u.kind() == v1::UPDATE_KIND_REFRESH) continue;
+    std::printf("  %-9s %9llu %9llu %10zu %8.2f %10.2f\n",
+                u.kind() == v1::UPDATE_KIND_FINAL ? "final" : "milestone",
+                static_cast<unsigned long long>(u.vertex_count()),
+                static_cast<unsigned long long>(u.face_count()), u.draco_mesh().size(),
+                static_cast<double>(u.draco_mesh().size()) / u.vertex_count(),
+                u.encode_time_us() / 1000.0);
+  }
+  std::printf("  [target <= 8 bytes per vertex at 11 bits]\n");
+  const uint64_t steps = updates.empty() ? 0 : updates.back().learning().basic_steps();
+  Delete(stub, id);
+  return {seconds, steps};
+}
+
+void MeasureLearning(v1::ReconstructionService::Stub& stub, const PointCloud& points,
+                     double lod_wall_seconds, uint64_t lod_steps) {
+  const absl::Duration window = absl::Seconds(absl::GetFlag(FLAGS_learn_seconds));
+  const absl::Duration warmup = absl::Milliseconds(500);
+
+  // The same learner in this process, on the same points: what the local CLI runs.
+  double local_rate = 0;
+  double local_to_target = 0;
+  {
+    GrowingPointCloud cloud(points.size());
+    cloud.Append(points.positions);
+    auto learner = Learner::Create(LearnerOptions(), &cloud);
+    StopCriteria warm;
+    warm.time_budget = warmup;
+    (*learner)->Run(warm);
+    const uint64_t before = (*learner)->progress().basic_steps;
+    StopCriteria measure;
+    measure.time_budget = window;
+    const absl::Time start = absl::Now();
+    (*learner)->Run(measure);
+    local_rate = ((*learner)->progress().basic_steps - before) /
+                 absl::ToDoubleSeconds(absl::Now() - start);
+
+    auto fresh = Learner::Create(LearnerOptions(), &cloud);
+    StopCriteria to_target;
+    to_target.target_vertices = static_cast<size_t>(absl::GetFlag(FLAGS_lod_target));
+    const absl::Time t = absl::Now();
+    (*fresh)->Run(to_target);
+    local_to_target = absl::ToDoubleSeconds(absl::Now() - t);
+  }
+  std::printf("learning, local learner: %.0f Basic Steps/s; to %lld vertices in %.2f s\n",
+              local_rate, static_cast<long long>(absl::GetFlag(FLAGS_lod_target)),
+              local_to_target);
+  std::printf("learning, one server session to %lld vertices (upload, learning, snapshots, "
+              "encoding, final mesh): %.2f s, %.0f steps/s wall = %.0f%% of local\n",
+              static_cast<long long>(absl::GetFlag(FLAGS_lod_target)), lod_wall_seconds,
+              lod_steps / lod_wall_seconds, 100.0 * local_to_target / lod_wall_seconds);
+
+  std::vector<v1::UploadPointsRequest> requests;
+  for (size_t b = 0; b < points.size(); b += 100000) {
+    v1::UploadPointsRequest r;
+    *r.mutable_batch() = Batch(points, b, std::min(points.size(), b + 100000));
+    requests.push_back(std::move(r));
+  }
+  for (int sessions : {1, 2, 8}) {
+    std::vector<std::string> ids;
+    // Targets high enough that no session finishes inside the window.
+    for (int i = 0; i < sessions; ++i) ids.push_back(Create(stub, points.size() / 2));
+    for (const std::string& id : ids) Upload(stub, id, requests);
+    absl::SleepFor(warmup);
+    std::vector<uint64_t> before;
+    for (const std::string& id : ids) before.push_back(Get(stub, id).learning().basic_steps());
+    const absl::Time start = absl::Now();
+    absl::SleepFor(window);
+    double total = 0, least = 1e300, most = 0;
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const uint64_t after = Get(stub, ids[i]).learning().basic_steps();
+      const double rate = (after - before[i]) / absl::ToDoubleSeconds(absl::Now() - start);
+      total += rate;
+      least = std::min(least, rate);
+      most = std::max(most, rate);
+    }
+    std::printf("learning, %d concurrent session%s on %d worker threads: %.0f steps/s in total "
+                "(%.0f%% of local), per session %.0f..%.0f\n",
+                sessions, sessions > 1 ? "s" : "", absl::GetFlag(FLAGS_worker_threads), total,
+                100.0 * total / local_rate, least, most);
+    for (const std::string& id : ids) Delete(stub, id);
+  }
+  std::printf("  [target: one session >= 90%% of the local rate]\n");
+}
+
+}  // namespace
+}  // namespace neuralmesh
+
+int main(int argc, char** argv) {
+  absl::ParseCommandLine(argc, argv);
+  using namespace neuralmesh;
+  ServerOptions options;
+  options.address = "127.0.0.1:0";
+  options.worker_threads = absl::GetFlag(FLAGS_worker_threads);
+  options.limits.max_points_per_session =
+      std::max<size_t>(static_cast<size_t>(absl::GetFlag(FLAGS_ingest_points)), 1 << 22);
+  options.limits.max_batch_points = static_cast<size_t>(absl::GetFlag(FLAGS_batch_points));
+  absl::StatusOr<std::unique_ptr<ReconstructionServer>> server =
+      ReconstructionServer::Start(options);
+  if (!server.ok()) {
+    std::fprintf(stderr, "%s\n", server.status().ToString().c_str());
+    return 1;
+  }
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(64 << 20);
+  args.SetMaxSendMessageSize(64 << 20);
+  auto stub = v1::ReconstructionService::NewStub(
+      grpc::CreateCustomChannel((*server)->target(), grpc::InsecureChannelCredentials(), args));
+  std::printf("neuralmesh service benchmark over %s, %d worker threads, %u hardware threads\n",
+              (*server)->target().c_str(), options.worker_threads,
+              std::thread::hardware_concurrency());
+
+  MeasureIngest(*stub);
+  MeasureFirstMesh(*stub);
+  const PointCloud points = Torus(400000, 3);
+  const auto [lod_seconds, lod_steps] = MeasureLods(*stub, points);
+  MeasureLearning(*stub, points, lod_seconds, lod_steps);
+  (*server)->Shutdown();
+  return 0;
+}

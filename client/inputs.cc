@@ -1,0 +1,137 @@
+#include "client/inputs.h"
+
+#include <filesystem>
+#include <utility>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "client/builtin_shapes.h"
+#include "client/file_util.h"
+#include "core/io/mesh_io.h"
+#include "core/io/point_cloud_io.h"
+#include "core/sampling/mesh_sampler.h"
+#include "core/sampling/point_cloud_sampler.h"
+#include "core/sampling/sample_points.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh::client {
+namespace {
+
+const char* ModeName(SamplingMode mode) {
+  switch (mode) {
+    case SamplingMode::kUniform:
+      return "uniform";
+    case SamplingMode::kWeighted:
+      return "weighted";
+    case SamplingMode::kArea:
+      return "area";
+    case SamplingMode::kCurvature:
+      return "curvature";
+  }
+  return "uniform";
+}
+
+// Puts the role and the file in front of a reader's message, so that every error says which
+// argument it is about.
+absl::Status InFile(const absl::Status& status, absl::string_view role, const std::string& path) {
+  if (status.ok()) return status;
+  // The readers already quote the path; then the role alone is enough.
+  if (absl::StrContains(status.message(), absl::StrCat("'", path, "'"))) {
+    return absl::Status(status.code(), absl::StrCat(role, " ", status.message()));
+  }
+  return absl::Status(status.code(), absl::StrCat(role, " '", path, "': ", status.message()));
+}
+
+absl::StatusOr<PointCloud> ReadCloud(const std::string& path) {
+  NM_RETURN_IF_ERROR(CheckInputFile(path, "INPUT"));
+  absl::StatusOr<PointCloud> cloud = ReadPointCloud(path);
+  if (!cloud.ok()) return InFile(cloud.status(), "INPUT", path);
+  return cloud;
+}
+
+}  // namespace
+
+absl::StatusOr<SamplingMode> ParseSamplingMode(absl::string_view name) {
+  for (SamplingMode mode : {SamplingMode::kUniform, SamplingMode::kWeighted, SamplingMode::kArea,
+                            SamplingMode::kCurvature}) {
+    if (name == ModeName(mode)) return mode;
+  }
+  return absl::InvalidArgumentError(absl::StrCat(
+      "--sampling: unknown mode '", name, "'; use uniform, weighted, area or curvature"));
+}
+
+absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMode mode) {
+  TargetSpace target;
+  if (IsBuiltin(input)) {
+    if (mode != SamplingMode::kUniform) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "--sampling ", ModeName(mode), " does not apply to ", input,
+          " (a built-in surface is sampled uniformly by area)"));
+    }
+    NM_ASSIGN_OR_RETURN(target.sampler, MakeBuiltinSurface(input));
+    target.description = absl::StrCat("the implicit surface ", input);
+    return target;
+  }
+  if (mode == SamplingMode::kArea || mode == SamplingMode::kCurvature) {
+    NM_RETURN_IF_ERROR(CheckInputFile(input, "INPUT"));
+    absl::StatusOr<TriangleMesh> mesh = ReadMesh(input);
+    if (!mesh.ok()) return InFile(mesh.status(), "INPUT", input);
+    if (mesh->faces.empty()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "INPUT '", input, "' has no faces: --sampling ", ModeName(mode),
+          " needs a triangle mesh (use uniform or weighted for a point cloud)"));
+    }
+    const size_t faces = mesh->faces.size();
+    MeshSamplerOptions options;
+    options.mode =
+        mode == SamplingMode::kArea ? MeshSamplingMode::kArea : MeshSamplingMode::kCurvature;
+    absl::StatusOr<std::unique_ptr<Sampler>> sampler =
+        MeshSampler::Create(std::make_shared<const TriangleMesh>(*std::move(mesh)), options);
+    if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
+    target.sampler = *std::move(sampler);
+    target.description = absl::StrCat("the ", faces, " triangles of ", input, " (", ModeName(mode),
+                                      " sampling)");
+    return target;
+  }
+  NM_ASSIGN_OR_RETURN(PointCloud cloud, ReadCloud(input));
+  if (mode == SamplingMode::kWeighted && cloud.weights.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "INPUT '", input, "' has no per-point weights for --sampling weighted"));
+  }
+  const size_t points = cloud.size();
+  auto shared = std::make_shared<const PointCloud>(std::move(cloud));
+  absl::StatusOr<std::unique_ptr<Sampler>> sampler =
+      mode == SamplingMode::kWeighted ? WeightedPointCloudSampler::Create(shared)
+                                      : UniformPointCloudSampler::Create(shared);
+  if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
+  target.sampler = *std::move(sampler);
+  target.description = absl::StrCat(points, " points of ", input, " (", ModeName(mode),
+                                    " sampling)");
+  return target;
+}
+
+absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t builtin_points,
+                                               uint64_t seed) {
+  if (IsBuiltin(input)) {
+    if (builtin_points == 0) return absl::InvalidArgumentError("--points must be > 0");
+    NM_ASSIGN_OR_RETURN(const std::unique_ptr<ImplicitSurface> surface,
+                        MakeBuiltinSurface(input));
+    return SamplePoints(*surface, builtin_points, seed);
+  }
+  return ReadCloud(input);
+}
+
+absl::StatusOr<TriangleMesh> LoadMesh(const std::string& input, absl::string_view role) {
+  if (IsBuiltin(input)) return BuiltinReferenceMesh(input);
+  NM_RETURN_IF_ERROR(CheckInputFile(input, role));
+  absl::StatusOr<TriangleMesh> mesh = ReadMesh(input);
+  if (!mesh.ok()) return InFile(mesh.status(), role, input);
+  return mesh;
+}
+
+std::string InputStem(const std::string& input) {
+  if (IsBuiltin(input)) return input.substr(kBuiltinPrefix.size());
+  return std::filesystem::path(input).stem().string();
+}
+
+}  // namespace neuralmesh::client

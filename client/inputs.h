@@ -1,0 +1,59 @@
+// What the `neuralmesh` commands read: point clouds, meshes and the built-in implicit
+// surfaces (builtin:NAME), turned into the target space P of the learner (Section 2.1) or
+// into points to upload.
+#ifndef NEURALMESH_CLIENT_INPUTS_H_
+#define NEURALMESH_CLIENT_INPUTS_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "core/point_cloud.h"
+#include "core/sampling/sampler.h"
+#include "core/triangle_mesh.h"
+
+namespace neuralmesh::client {
+
+// How the target space is sampled.
+enum class SamplingMode {
+  kUniform,    // A point cloud, every point equally likely (Section 2.1).
+  kWeighted,   // A point cloud, in proportion to its per-point weights (Section 4.1).
+  kArea,       // A triangle mesh, area-uniform (remeshing, Section 4.1).
+  kCurvature,  // A triangle mesh, denser where it is curved (Section 4.1).
+};
+
+// Parses uniform|weighted|area|curvature; INVALID_ARGUMENT otherwise.
+absl::StatusOr<SamplingMode> ParseSamplingMode(absl::string_view name);
+
+// A target space and a line that describes it.
+struct TargetSpace {
+  std::unique_ptr<Sampler> sampler;
+  std::string description;  // "35947 points from bunny.ply (uniform)".
+};
+
+// The target space of `input`: builtin:NAME (its implicit surface; `mode` must be uniform),
+// a point cloud file (.ply .xyz .obj .off .drc; uniform or weighted), or a triangle mesh
+// file for area and curvature sampling. Returns NOT_FOUND for a missing file and
+// INVALID_ARGUMENT for an empty or malformed one, an unknown extension or builtin name, or a
+// sampling mode the input cannot provide; each message names the file.
+absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMode mode);
+
+// The points of `input` for upload: a point cloud file as read, or `builtin_points` samples
+// of a builtin:NAME surface drawn with `seed`. Errors as LoadTargetSpace.
+absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t builtin_points,
+                                               uint64_t seed);
+
+// A mesh to report on or compare: a mesh file, or for builtin:NAME the reference mesh of the
+// implicit surface. Errors as LoadTargetSpace; `role` names the argument in messages.
+absl::StatusOr<TriangleMesh> LoadMesh(const std::string& input, absl::string_view role);
+
+// A short name for output files: the file name without directory and extension, or NAME for
+// builtin:NAME.
+std::string InputStem(const std::string& input);
+
+}  // namespace neuralmesh::client
+
+#endif  // NEURALMESH_CLIENT_INPUTS_H_

@@ -1,0 +1,58 @@
+// The subcommands that work without a server: `reconstruct` (local learning), `stats` and
+// `eval`.
+#ifndef NEURALMESH_CLIENT_LOCAL_COMMANDS_H_
+#define NEURALMESH_CLIENT_LOCAL_COMMANDS_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/time/time.h"
+#include "client/inputs.h"
+#include "core/io/draco_codec.h"
+#include "core/learning/learner_options.h"
+
+namespace neuralmesh::client {
+
+struct LocalReconstructOptions {
+  std::string input;            // A point cloud or mesh file, or builtin:NAME.
+  std::string output;           // The final mesh; its extension picks the format.
+  size_t vertices = 0;          // Final vertex count, > 4.
+  std::vector<size_t> lods;     // Milestones below `vertices`, each written beside `output`.
+  LearnerOptions learner;
+  SamplingMode sampling = SamplingMode::kUniform;
+  absl::Duration time_budget = absl::InfiniteDuration();  // For the whole run.
+  uint64_t max_steps = 0;       // Basic Steps for the whole run; 0: no limit.
+  DracoOptions draco;           // For .drc outputs.
+  bool progress = false;        // Draw a progress bar on `err`.
+};
+
+// Learns the input's surface up to each LOD and then to `vertices`, writing each milestone
+// (OUTPUT stem + "_lod<N>" + extension) and the final mesh, and printing the figures of each
+// on `out`, then a summary line. When the time or step budget runs out first, the mesh
+// learned so far is written as OUTPUT and the summary says which budget stopped it.
+// Returns INVALID_ARGUMENT for invalid options, an unknown output extension or a bad input;
+// NOT_FOUND for a missing input; the writer's error when a file cannot be written.
+absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::ostream& out,
+                                 std::ostream& err);
+
+// Prints the mesh report of MESH (a mesh file or builtin:NAME), as text or JSON.
+absl::Status RunStats(const std::string& mesh, bool json, std::ostream& out);
+
+struct EvalOptions {
+  std::string mesh;       // The reconstruction.
+  std::string reference;  // A mesh file, or builtin:NAME for its implicit surface.
+  size_t samples = 0;     // Samples per surface; 0: GeometricErrorOptions' default.
+  uint64_t seed = 1;
+  bool json = false;
+};
+
+// Prints the geometric error of MESH against REFERENCE (core/analysis/geometric_error.h).
+absl::Status RunEval(const EvalOptions& options, std::ostream& out);
+
+}  // namespace neuralmesh::client
+
+#endif  // NEURALMESH_CLIENT_LOCAL_COMMANDS_H_

@@ -1,0 +1,130 @@
+// RunLocalReconstruct (declared in client/local_commands.h).
+#include <filesystem>
+#include <memory>
+#include <system_error>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/time/clock.h"
+#include "client/inputs.h"
+#include "client/local_commands.h"
+#include "client/lod_plan.h"
+#include "client/lod_table.h"
+#include "client/progress_bar.h"
+#include "core/analysis/mesh_report.h"
+#include "core/io/mesh_io.h"
+#include "core/learning/learner.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh::client {
+namespace {
+
+// Fails before any learning when OUTPUT could not be written afterwards.
+absl::Status CheckOutputPath(const std::string& output) {
+  if (output.empty()) return absl::InvalidArgumentError("-o OUTPUT is required");
+  if (!IsSupportedMeshExtension(output)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "OUTPUT '", output, "': unsupported mesh format; use .ply, .obj, .off, .stl or .drc"));
+  }
+  const std::filesystem::path parent = std::filesystem::path(output).parent_path();
+  std::error_code error;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, error)) {
+    return absl::NotFoundError(
+        absl::StrCat("the directory of OUTPUT, '", parent.string(), "', does not exist"));
+  }
+  return absl::OkStatus();
+}
+
+const char* StopReasonText(StopReason reason) {
+  switch (reason) {
+    case StopReason::kTargetReached:
+      return "target reached";
+    case StopReason::kStepBudget:
+      return "--max_steps reached";
+    case StopReason::kTimeBudget:
+      return "--time_budget used up";
+    case StopReason::kCancelled:
+      return "cancelled";
+    case StopReason::kObserver:
+      return "stopped";
+  }
+  return "stopped";
+}
+
+}  // namespace
+
+absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::ostream& out,
+                                 std::ostream& err) {
+  NM_RETURN_IF_ERROR(options.learner.Validate());
+  NM_RETURN_IF_ERROR(options.draco.Validate());
+  NM_RETURN_IF_ERROR(CheckOutputPath(options.output));
+  NM_ASSIGN_OR_RETURN(const std::vector<size_t> targets,
+                      LodTargets(options.lods, options.vertices));
+  NM_ASSIGN_OR_RETURN(const TargetSpace target, LoadTargetSpace(options.input, options.sampling));
+  NM_ASSIGN_OR_RETURN(std::unique_ptr<Learner> learner,
+                      Learner::Create(options.learner, target.sampler.get()));
+  out << "learning " << target.description << " to " << options.vertices << " vertices (seed "
+      << options.learner.seed << ")\n";
+
+  ProgressBar bar(err, options.progress, "learning", "vertices");
+  const absl::Time start = absl::Now();
+  const size_t final_vertices = targets.back();
+  bool header_printed = false;
+  StopReason reason = StopReason::kTargetReached;
+  for (size_t i = 0; i < targets.size(); ++i) {
+    StopCriteria stop;
+    stop.target_vertices = targets[i];
+    // A budget used up exactly at a milestone still ends with OUTPUT written below.
+    const uint64_t steps_done = learner->progress().basic_steps;
+    const absl::Duration time_left = options.time_budget - (absl::Now() - start);
+    if (options.max_steps > 0 && steps_done >= options.max_steps) {
+      reason = StopReason::kStepBudget;
+    } else if (time_left <= absl::ZeroDuration()) {
+      reason = StopReason::kTimeBudget;
+    } else {
+      if (options.max_steps > 0) stop.max_basic_steps = options.max_steps - steps_done;
+      stop.time_budget = time_left;
+      stop.observer = [&](const LearnerProgress& p) {
+        bar.Update(p.vertices, final_vertices,
+                   absl::StrFormat("%d basic steps", p.basic_steps));
+        return true;
+      };
+      NM_ASSIGN_OR_RETURN(reason, learner->Run(stop));
+    }
+    const bool last = i + 1 == targets.size() || reason != StopReason::kTargetReached;
+
+    const TriangleMesh mesh = learner->Snapshot();
+    LodFigures figures;
+    figures.kind = reason != StopReason::kTargetReached ? "stopped" : last ? "final" : "lod";
+    figures.path = last ? options.output : LodPath(options.output, targets[i]);
+    NM_RETURN_IF_ERROR(WriteMesh(mesh, figures.path, options.draco));
+    const MeshReport report = ComputeMeshReport(mesh);
+    figures.vertices = mesh.positions.size();
+    figures.faces = mesh.faces.size();
+    figures.valence6_percent = report.valence6_share;
+    figures.genus = report.genus;
+    figures.boundaries = report.boundary_loops;
+    figures.basic_steps = learner->progress().basic_steps;
+    figures.elapsed = absl::Now() - start;
+    bar.Clear();
+    if (!header_printed) {
+      PrintLodHeader(out);
+      header_printed = true;
+    }
+    PrintLodRow(figures, out);
+    if (last) break;
+  }
+  bar.Finish();
+
+  const LearnerProgress progress = learner->progress();
+  const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
+  out << absl::StrFormat(
+      "%s: %d vertices, %d faces, %d basic steps (%d splits, %d collapses) in %.2fs "
+      "(%.0f steps/s); wrote %s\n",
+      StopReasonText(reason), progress.vertices, progress.faces, progress.basic_steps,
+      progress.splits, progress.collapses, seconds,
+      seconds > 0 ? static_cast<double>(progress.basic_steps) / seconds : 0.0, options.output);
+  return absl::OkStatus();
+}
+
+}  // namespace neuralmesh::client

@@ -1,0 +1,267 @@
+// neuralmesh: Neural Meshes surface reconstruction (Ivrissimtzis, Jeong, Seidel) on the
+// command line, locally or through a neuralmesh-server. This file holds the flags and the
+// dispatch only; the commands live in the neuralmesh_client library.
+#include <cstdint>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "absl/flags/flag.h"
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "absl/time/time.h"
+#include "client/command_line.h"
+#include "client/inputs.h"
+#include "client/local_commands.h"
+#include "client/lod_plan.h"
+#include "client/progress_bar.h"
+#include "client/remote_commands.h"
+#include "core/io/draco_codec.h"
+#include "core/learning/learner_options.h"
+#include "core/status_macros.h"
+
+namespace {
+const neuralmesh::LearnerOptions kLearnerDefaults;
+const neuralmesh::DracoOptions kDracoDefaults;
+}  // namespace
+
+// Output and size.
+ABSL_FLAG(std::string, output, "",
+          "Local reconstruct: the mesh to write; the extension picks the format (.ply .obj .off "
+          ".stl .drc). LOD files go beside it as <stem>_lod<N><ext>.");
+ABSL_FLAG(uint64_t, vertices, 0,
+          "Vertex count of the final mesh (met exactly). Required for a local reconstruct; with "
+          "--server, 0 means one vertex per 2 points, at most 10000.");
+ABSL_FLAG(std::string, lod, "",
+          "Comma-separated vertex counts below --vertices at which a level of detail is "
+          "written, e.g. 1000,2000. With --server, empty means the server's 1-2-5 series.");
+
+// Learner parameters: defaults and ranges from core/learning/learner_options.h.
+ABSL_FLAG(uint64_t, seed, kLearnerDefaults.seed,
+          "Seed of every random choice: the learner, the points drawn from builtin:NAME for "
+          "upload, eval's surface samples. Equal seeds give identical output.");
+ABSL_FLAG(double, alpha_w, kLearnerDefaults.alpha_w,
+          "alpha_w (Eq. 1): how far the winner moves toward the sample, in (0, 1].");
+ABSL_FLAG(double, alpha_l, kLearnerDefaults.alpha_l,
+          "alpha_L (Section 2.1): tangential Laplacian smoothing rate, in [0, 1].");
+ABSL_FLAG(int32_t, c_l, kLearnerDefaults.c_l,
+          "C_L (Section 2.1): smoothing iterations per Basic Step, >= 0.");
+ABSL_FLAG(int32_t, c_vs, kLearnerDefaults.c_vs,
+          "C_vs (Section 2.2): Basic Steps between two vertex splits, >= 1.");
+ABSL_FLAG(double, c_ec, kLearnerDefaults.c_ec,
+          "C_ec (Section 2.2): the half-edge collapse step runs every C_ec * v Basic Steps, > 0.");
+ABSL_FLAG(double, alpha_sc, kLearnerDefaults.alpha_sc,
+          "alpha_sc (Section 2.2, Eq. 4): signal counter decay, in (0, 1).");
+ABSL_FLAG(double, alpha_r, kLearnerDefaults.alpha_r,
+          "alpha_r (Eq. 2): remove triangles larger than alpha_r E(Area).");
+ABSL_FLAG(double, alpha_m, kLearnerDefaults.alpha_m,
+          "alpha_m (Eq. 3): merge boundaries closer than alpha_m sqrt(E(Area)).");
+ABSL_FLAG(bool, remove_triangles, kLearnerDefaults.remove_triangles,
+          "Step 4 (Section 2.3): triangle removal on or off (--noremove_triangles).");
+ABSL_FLAG(bool, merge_boundaries, kLearnerDefaults.merge_boundaries,
+          "Step 5 (Section 2.3): boundary merging on or off (--nomerge_boundaries).");
+ABSL_FLAG(int32_t, splits_per_step, kLearnerDefaults.splits_per_step,
+          "Vertex splits per call of Step 2 (Section 3.3), >= 1.");
+
+// Local learning.
+ABSL_FLAG(std::string, sampling, "uniform",
+          "How INPUT is sampled: uniform or weighted (a point cloud; weighted uses its "
+          "per-point weights), area or curvature (a triangle mesh: remeshing, Section 4.1).");
+ABSL_FLAG(absl::Duration, time_budget, absl::InfiniteDuration(),
+          "Stop learning after this long (e.g. 30s, 2m) and write the mesh learned so far.");
+ABSL_FLAG(uint64_t, max_steps, 0,
+          "Stop learning after this many Basic Steps and write the mesh so far; 0: no limit.");
+ABSL_FLAG(int32_t, quantization_bits, kDracoDefaults.position_quantization_bits,
+          "Draco position quantization bits (1..30) for .drc meshes.");
+ABSL_FLAG(int32_t, encode_speed, kDracoDefaults.encode_speed,
+          "Draco encoder speed, 0 (smallest) .. 10 (fastest), for .drc meshes.");
+ABSL_FLAG(bool, progress, false,
+          "Draw progress bars on stderr even when it is not a terminal.");
+
+// Server.
+ABSL_FLAG(std::string, server, "",
+          "HOST:PORT of a neuralmesh-server; with reconstruct, learn there instead of locally.");
+ABSL_FLAG(std::string, out_dir, "",
+          "Directory for the meshes a server publishes: <stem>_lod<N>.drc per milestone and "
+          "<stem>.drc for the final mesh.");
+ABSL_FLAG(uint64_t, batch_size, 10000, "Points per uploaded batch.");
+ABSL_FLAG(uint64_t, points, 100000,
+          "Points sampled from a builtin:NAME input before it is uploaded.");
+ABSL_FLAG(bool, ply, false, "Also write each mesh received from the server as .ply.");
+ABSL_FLAG(absl::Duration, connect_timeout, absl::Seconds(5),
+          "How long to wait for the server to accept the connection.");
+
+// Reports.
+ABSL_FLAG(bool, json, false, "Print JSON instead of text.");
+ABSL_FLAG(std::string, reference, "",
+          "eval: the reference surface, a mesh file or builtin:NAME.");
+ABSL_FLAG(uint64_t, samples, 0,
+          "eval: area-uniform samples per surface; 0: the default of "
+          "core/analysis/geometric_error.h (200000).");
+
+namespace {
+
+using neuralmesh::client::ParsedArgs;
+using neuralmesh::client::Subcommand;
+
+absl::Status ExpectPositional(const ParsedArgs& args, size_t n, const std::string& names) {
+  if (args.positional.size() == n) return absl::OkStatus();
+  if (args.positional.size() < n) return absl::InvalidArgumentError("missing " + names);
+  return absl::InvalidArgumentError(
+      absl::StrCat("unexpected argument '", args.positional[n], "' (expected ", names, ")"));
+}
+
+neuralmesh::LearnerOptions LearnerFromFlags() {
+  neuralmesh::LearnerOptions o;
+  o.alpha_w = absl::GetFlag(FLAGS_alpha_w);
+  o.alpha_l = absl::GetFlag(FLAGS_alpha_l);
+  o.c_l = absl::GetFlag(FLAGS_c_l);
+  o.c_vs = absl::GetFlag(FLAGS_c_vs);
+  o.c_ec = absl::GetFlag(FLAGS_c_ec);
+  o.alpha_sc = absl::GetFlag(FLAGS_alpha_sc);
+  o.remove_triangles = absl::GetFlag(FLAGS_remove_triangles);
+  o.alpha_r = absl::GetFlag(FLAGS_alpha_r);
+  o.merge_boundaries = absl::GetFlag(FLAGS_merge_boundaries);
+  o.alpha_m = absl::GetFlag(FLAGS_alpha_m);
+  o.splits_per_step = absl::GetFlag(FLAGS_splits_per_step);
+  o.seed = absl::GetFlag(FLAGS_seed);
+  return o;
+}
+
+neuralmesh::DracoOptions DracoFromFlags() {
+  neuralmesh::DracoOptions o;
+  o.position_quantization_bits = absl::GetFlag(FLAGS_quantization_bits);
+  o.encode_speed = absl::GetFlag(FLAGS_encode_speed);
+  return o;
+}
+
+// Flags that only one of the two kinds of reconstruct accepts.
+absl::Status RejectFlags(const ParsedArgs& args, const std::vector<std::string>& flags,
+                         const std::string& why) {
+  for (const std::string& f : flags) {
+    if (args.Has(f)) return absl::InvalidArgumentError(absl::StrCat("--", f, " ", why));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status Reconstruct(const ParsedArgs& args) {
+  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "INPUT"));
+  NM_ASSIGN_OR_RETURN(const std::vector<size_t> lods,
+                      neuralmesh::client::ParseLodList(absl::GetFlag(FLAGS_lod)));
+  const bool progress = neuralmesh::client::ShowProgressOnStderr(absl::GetFlag(FLAGS_progress));
+  if (args.Has("server")) {
+    NM_RETURN_IF_ERROR(RejectFlags(
+        args, {"output", "sampling", "time_budget", "max_steps"},
+        "applies to a local reconstruct only (the server picks its own budget; use --out-dir)"));
+    neuralmesh::client::RemoteReconstructOptions o;
+    o.input = args.positional[0];
+    o.server = absl::GetFlag(FLAGS_server);
+    o.out_dir = absl::GetFlag(FLAGS_out_dir);
+    o.vertices = absl::GetFlag(FLAGS_vertices);
+    o.lods = lods;
+    o.learner = LearnerFromFlags();
+    o.draco = DracoFromFlags();
+    o.batch_size = absl::GetFlag(FLAGS_batch_size);
+    o.builtin_points = absl::GetFlag(FLAGS_points);
+    o.ply = absl::GetFlag(FLAGS_ply);
+    o.progress = progress;
+    o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
+    return neuralmesh::client::RunRemoteReconstruct(o, std::cout, std::cerr);
+  }
+  NM_RETURN_IF_ERROR(RejectFlags(args, {"out-dir", "batch-size", "points", "ply",
+                                        "connect_timeout"},
+                                 "needs --server (a local reconstruct writes -o OUTPUT)"));
+  if (!args.Has("vertices")) return absl::InvalidArgumentError("--vertices N is required");
+  neuralmesh::client::LocalReconstructOptions o;
+  o.input = args.positional[0];
+  o.output = absl::GetFlag(FLAGS_output);
+  o.vertices = absl::GetFlag(FLAGS_vertices);
+  o.lods = lods;
+  o.learner = LearnerFromFlags();
+  NM_ASSIGN_OR_RETURN(o.sampling,
+                      neuralmesh::client::ParseSamplingMode(absl::GetFlag(FLAGS_sampling)));
+  o.time_budget = absl::GetFlag(FLAGS_time_budget);
+  o.max_steps = absl::GetFlag(FLAGS_max_steps);
+  o.draco = DracoFromFlags();
+  o.progress = progress;
+  return neuralmesh::client::RunLocalReconstruct(o, std::cout, std::cerr);
+}
+
+absl::Status Stats(const ParsedArgs& args) {
+  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "MESH"));
+  return neuralmesh::client::RunStats(args.positional[0], absl::GetFlag(FLAGS_json), std::cout);
+}
+
+absl::Status Eval(const ParsedArgs& args) {
+  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "MESH"));
+  if (!args.Has("reference")) return absl::InvalidArgumentError("--reference REF is required");
+  neuralmesh::client::EvalOptions o;
+  o.mesh = args.positional[0];
+  o.reference = absl::GetFlag(FLAGS_reference);
+  o.samples = absl::GetFlag(FLAGS_samples);
+  o.seed = absl::GetFlag(FLAGS_seed);
+  o.json = absl::GetFlag(FLAGS_json);
+  return neuralmesh::client::RunEval(o, std::cout);
+}
+
+absl::Status Watch(const ParsedArgs& args) {
+  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "SESSION"));
+  neuralmesh::client::WatchOptions o;
+  o.session_id = args.positional[0];
+  o.server = absl::GetFlag(FLAGS_server);
+  o.out_dir = absl::GetFlag(FLAGS_out_dir);
+  o.ply = absl::GetFlag(FLAGS_ply);
+  o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
+  return neuralmesh::client::RunWatch(o, std::cout);
+}
+
+absl::Status Sessions(const ParsedArgs& args) {
+  NM_RETURN_IF_ERROR(ExpectPositional(args, 0, "no arguments"));
+  return neuralmesh::client::RunSessions(absl::GetFlag(FLAGS_server), absl::GetFlag(FLAGS_json),
+                                         std::cout, absl::GetFlag(FLAGS_connect_timeout));
+}
+
+std::vector<Subcommand> Commands() {
+  const std::vector<std::string> learner = {
+      "seed",   "alpha_w", "alpha_l",          "c_l",          "c_vs",
+      "c_ec",   "alpha_sc", "alpha_r",         "alpha_m",      "remove_triangles",
+      "merge_boundaries", "splits_per_step"};
+  std::vector<std::string> reconstruct = {"output", "vertices", "lod"};
+  reconstruct.insert(reconstruct.end(), learner.begin(), learner.end());
+  reconstruct.insert(reconstruct.end(),
+                     {"sampling", "time_budget", "max_steps", "quantization_bits",
+                      "encode_speed", "progress", "server", "out-dir", "batch-size", "points",
+                      "ply", "connect_timeout"});
+  return {
+      {"reconstruct",
+       "reconstruct INPUT -o OUTPUT --vertices N [flags]\n"
+       "       neuralmesh reconstruct INPUT --server HOST:PORT --out-dir DIR [--vertices N] "
+       "[--batch-size K] [--ply]",
+       "Learns a mesh of a point cloud, a mesh or a built-in surface, locally or on a server.",
+       "Learns a mesh of INPUT: a point cloud (.ply .xyz .obj .off .drc), a triangle mesh with\n"
+       "--sampling area|curvature, or builtin:sphere|torus|genus2. Locally it writes OUTPUT and\n"
+       "one OUTPUT_lod<N> file per --lod; with --server it uploads the points and saves each\n"
+       "mesh the server publishes into --out-dir. Prints the figures of every level.",
+       reconstruct, Reconstruct},
+      {"stats", "stats MESH [--json]", "Prints the mesh report of a mesh.",
+       "Prints the mesh report of MESH (a mesh file or builtin:NAME): counts, valences, genus,\n"
+       "boundaries, manifoldness.",
+       {"json"}, Stats},
+      {"eval", "eval MESH --reference REF [--json] [--samples N]",
+       "Prints the geometric error of a mesh against a reference surface.",
+       "Prints the geometric error (Chamfer, Hausdorff, normal consistency) of MESH against\n"
+       "REF, a mesh file or builtin:NAME (its dense reference tessellation).",
+       {"reference", "json", "samples", "seed"}, Eval},
+      {"watch", "watch SESSION --server HOST:PORT --out-dir DIR [--ply]",
+       "Watches a server session until it ends, saving every milestone and the final mesh.", "",
+       {"server", "out-dir", "ply", "connect_timeout"}, Watch},
+      {"sessions", "sessions --server HOST:PORT [--json]",
+       "Lists the sessions of a server.", "", {"server", "json", "connect_timeout"}, Sessions},
+  };
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return neuralmesh::client::RunCommandLine(argc, argv, Commands(), std::cout, std::cerr);
+}

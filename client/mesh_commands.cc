@@ -1,0 +1,61 @@
+// RunStats and RunEval (declared in client/local_commands.h).
+#include "absl/strings/str_format.h"
+#include "client/inputs.h"
+#include "client/local_commands.h"
+#include "core/analysis/geometric_error.h"
+#include "core/analysis/json_writer.h"
+#include "core/analysis/mesh_report.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh::client {
+
+absl::Status RunStats(const std::string& mesh_path, bool json, std::ostream& out) {
+  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(mesh_path, "MESH"));
+  const MeshReport report = ComputeMeshReport(mesh);
+  if (json) {
+    out << MeshReportToJson(report, 2) << "\n";
+  } else {
+    out << mesh_path << "\n" << MeshReportToText(report);
+  }
+  return absl::OkStatus();
+}
+
+absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
+  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(options.mesh, "MESH"));
+  NM_ASSIGN_OR_RETURN(const TriangleMesh reference, LoadMesh(options.reference, "--reference"));
+  GeometricErrorOptions error_options;
+  if (options.samples > 0) error_options.samples = options.samples;
+  error_options.seed = options.seed;
+  NM_ASSIGN_OR_RETURN(const GeometricError error,
+                      ComputeGeometricError(mesh, reference, error_options));
+  if (options.json) {
+    JsonWriter json(2);
+    json.BeginObject()
+        .Key("mesh").String(options.mesh)
+        .Key("reference").String(options.reference)
+        .Key("samples").Uint(error_options.samples)
+        .Key("chamfer_l1").Double(error.chamfer_l1)
+        .Key("hausdorff").Double(error.hausdorff)
+        .Key("normal_consistency").Double(error.normal_consistency)
+        .Key("accuracy").Double(error.accuracy)
+        .Key("completeness").Double(error.completeness)
+        .Key("diagonal").Double(error.diagonal)
+        .EndObject();
+    NM_ASSIGN_OR_RETURN(const std::string text, json.Finish());
+    out << text << "\n";
+    return absl::OkStatus();
+  }
+  out << absl::StrFormat(
+      "%s against %s (%d samples per surface; distances relative to the reference's\n"
+      "bounding-box diagonal %.6g)\n"
+      "  chamfer_l1          %.6g\n"
+      "  hausdorff           %.6g\n"
+      "  normal_consistency  %.6f\n"
+      "  accuracy            %.6g  (reconstruction -> reference)\n"
+      "  completeness        %.6g  (reference -> reconstruction)\n",
+      options.mesh, options.reference, error_options.samples, error.diagonal, error.chamfer_l1,
+      error.hausdorff, error.normal_consistency, error.accuracy, error.completeness);
+  return absl::OkStatus();
+}
+
+}  // namespace neuralmesh::client

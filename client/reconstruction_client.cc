@@ -1,0 +1,196 @@
+#include "client/reconstruction_client.h"
+
+#include <algorithm>
+#include <cstring>
+#include <utility>
+
+#include <grpcpp/create_channel.h>
+#include <grpcpp/security/credentials.h>
+
+#include "absl/strings/str_cat.h"
+#include "client/grpc_status.h"
+
+namespace neuralmesh::client {
+namespace {
+
+// The wire format is little-endian float32; copying the host's floats byte for byte is only
+// right on a little-endian host.
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "packing assumes little-endian");
+static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be three packed floats");
+
+template <typename T>
+std::string PackRange(const std::vector<T>& values, size_t begin, size_t end) {
+  std::string bytes((end - begin) * sizeof(T), '\0');
+  std::memcpy(bytes.data(), values.data() + begin, bytes.size());
+  return bytes;
+}
+
+gpr_timespec ToGprDeadline(absl::Duration timeout) {
+  return gpr_time_add(gpr_now(GPR_CLOCK_MONOTONIC),
+                      gpr_time_from_millis(absl::ToInt64Milliseconds(timeout), GPR_TIMESPAN));
+}
+
+}  // namespace
+
+v1::PointBatch PackPointBatch(const PointCloud& cloud, size_t begin, size_t end) {
+  v1::PointBatch batch;
+  v1::PackedPoints* packed = batch.mutable_packed();
+  packed->set_positions(PackRange(cloud.positions, begin, end));
+  if (!cloud.weights.empty()) packed->set_weights(PackRange(cloud.weights, begin, end));
+  if (!cloud.normals.empty()) packed->set_normals(PackRange(cloud.normals, begin, end));
+  return batch;
+}
+
+absl::StatusOr<std::unique_ptr<ReconstructionClient>> ReconstructionClient::Connect(
+    const std::string& address, const ClientOptions& options) {
+  if (address.empty()) return absl::InvalidArgumentError("empty server address");
+  std::shared_ptr<grpc::Channel> channel =
+      grpc::CreateChannel(address, grpc::InsecureChannelCredentials());
+  if (!channel->WaitForConnected(ToGprDeadline(options.connect_timeout))) {
+    return absl::UnavailableError(absl::StrCat("cannot reach a neuralmesh-server at ", address,
+                                               " within ", absl::FormatDuration(
+                                                               options.connect_timeout)));
+  }
+  auto client = std::make_unique<ReconstructionClient>(std::move(channel), options);
+  client->address_ = address;
+  return client;
+}
+
+ReconstructionClient::ReconstructionClient(std::shared_ptr<grpc::Channel> channel,
+                                           const ClientOptions& options)
+    : options_(options),
+      channel_(std::move(channel)),
+      stub_(v1::ReconstructionService::NewStub(channel_)) {}
+
+void ReconstructionClient::SetDeadline(grpc::ClientContext& context, absl::Duration timeout) {
+  if (timeout == absl::InfiniteDuration()) return;
+  context.set_deadline(ToGprDeadline(timeout));
+}
+
+absl::StatusOr<v1::Session> ReconstructionClient::CreateSession(const v1::SessionConfig& config,
+                                                                const std::string& name) {
+  grpc::ClientContext context;
+  SetDeadline(context, options_.call_timeout);
+  v1::CreateSessionRequest request;
+  *request.mutable_config() = config;
+  request.set_name(name);
+  v1::Session session;
+  const grpc::Status status = stub_->CreateSession(&context, request, &session);
+  if (!status.ok()) return FromGrpcStatus(status, "CreateSession");
+  return session;
+}
+
+absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
+    const std::string& session_id, const PointCloud& cloud, size_t batch_size,
+    const UploadProgress& progress) {
+  if (cloud.empty()) return absl::InvalidArgumentError("UploadPoints: no points to upload");
+  if (batch_size == 0) return absl::InvalidArgumentError("UploadPoints: batch size must be > 0");
+  grpc::ClientContext context;
+  v1::UploadPointsResponse response;
+  std::unique_ptr<grpc::ClientWriter<v1::UploadPointsRequest>> writer =
+      stub_->UploadPoints(&context, &response);
+  v1::UploadPointsRequest request;
+  request.set_session_id(session_id);
+  for (size_t begin = 0; begin < cloud.size(); begin += batch_size) {
+    const size_t end = std::min(cloud.size(), begin + batch_size);
+    *request.mutable_batch() = PackPointBatch(cloud, begin, end);
+    // A failed write means the call is over (the server rejected a batch or went away);
+    // Finish() below returns why.
+    if (!writer->Write(request)) break;
+    if (progress) progress(end, cloud.size());
+  }
+  writer->WritesDone();
+  const grpc::Status status = writer->Finish();
+  if (!status.ok()) return FromGrpcStatus(status, "UploadPoints");
+  return response;
+}
+
+absl::Status ReconstructionClient::Watch(const std::string& session_id, uint64_t after_sequence,
+                                         const UpdateCallback& on_update) {
+  grpc::ClientContext context;
+  v1::WatchSessionRequest request;
+  request.set_session_id(session_id);
+  request.set_after_sequence(after_sequence);
+  std::unique_ptr<grpc::ClientReader<v1::MeshUpdate>> reader =
+      stub_->WatchSession(&context, request);
+  v1::MeshUpdate update;
+  bool stopped = false;
+  while (reader->Read(&update)) {
+    if (!on_update(update)) {
+      stopped = true;
+      context.TryCancel();
+      break;
+    }
+  }
+  const grpc::Status status = reader->Finish();
+  if (stopped) return absl::OkStatus();
+  return FromGrpcStatus(status, "WatchSession");
+}
+
+absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& session_id) {
+  grpc::ClientContext context;
+  SetDeadline(context, options_.call_timeout);
+  v1::GetSessionRequest request;
+  request.set_session_id(session_id);
+  v1::Session session;
+  const grpc::Status status = stub_->GetSession(&context, request, &session);
+  if (!status.ok()) return FromGrpcStatus(status, "GetSession");
+  return session;
+}
+
+absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions() {
+  grpc::ClientContext context;
+  SetDeadline(context, options_.call_timeout);
+  v1::ListSessionsResponse response;
+  const grpc::Status status = stub_->ListSessions(&context, v1::ListSessionsRequest(), &response);
+  if (!status.ok()) return FromGrpcStatus(status, "ListSessions");
+  return std::vector<v1::Session>(response.sessions().begin(), response.sessions().end());
+}
+
+absl::StatusOr<v1::Session> ReconstructionClient::Finish(const std::string& session_id) {
+  grpc::ClientContext context;
+  SetDeadline(context, options_.call_timeout);
+  v1::FinishSessionRequest request;
+  request.set_session_id(session_id);
+  v1::Session session;
+  const grpc::Status status = stub_->FinishSession(&context, request, &session);
+  if (!status.ok()) return FromGrpcStatus(status, "FinishSession");
+  return session;
+}
+
+absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& session_id) {
+  grpc::ClientContext context;
+  SetDeadline(context, options_.call_timeout);
+  v1::CancelSessionRequest request;
+  request.set_session_id(session_id);
+  v1::Session session;
+  const grpc::Status status = stub_->CancelSession(&context, request, &session);
+  if (!status.ok()) return FromGrpcStatus(status, "CancelSession");
+  return session;
+}
+
+absl::Status ReconstructionClient::Delete(const std::string& session_id) {
+  grpc::ClientContext context;
+  SetDeadline(context, options_.call_timeout);
+  v1::DeleteSessionRequest request;
+  request.set_session_id(session_id);
+  v1::DeleteSessionResponse response;
+  return FromGrpcStatus(stub_->DeleteSession(&context, request, &response), "DeleteSession");
+}
+
+absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& session_id,
+                                                             v1::MeshVersion version, bool wait,
+                                                             absl::Duration timeout) {
+  grpc::ClientContext context;
+  SetDeadline(context, timeout);
+  v1::GetMeshRequest request;
+  request.set_session_id(session_id);
+  request.set_version(version);
+  request.set_wait(wait);
+  v1::MeshUpdate update;
+  const grpc::Status status = stub_->GetMesh(&context, request, &update);
+  if (!status.ok()) return FromGrpcStatus(status, "GetMesh");
+  return update;
+}
+
+}  // namespace neuralmesh::client

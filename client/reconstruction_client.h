@@ -1,0 +1,110 @@
+// A small typed client of the neuralmesh.v1 ReconstructionService
+// (proto/neuralmesh/v1/reconstruction.proto): one method per rpc, absl::Status results, point
+// clouds uploaded in batches, and session updates delivered to a callback.
+//
+//   NM_ASSIGN_OR_RETURN(auto client, ReconstructionClient::Connect("127.0.0.1:50051"));
+//   NM_ASSIGN_OR_RETURN(v1::Session s, client->CreateSession(config, "scan"));
+//   std::thread watcher([&] { client->Watch(s.session_id(), 0, on_update); });
+//   client->UploadPoints(s.session_id(), cloud, 10000, on_progress);
+//   client->Finish(s.session_id());
+//   watcher.join();
+//
+// Thread-safety: all methods may be called concurrently (gRPC stubs are thread-safe); a
+// typical client watches on one thread while it uploads on another.
+#ifndef NEURALMESH_CLIENT_RECONSTRUCTION_CLIENT_H_
+#define NEURALMESH_CLIENT_RECONSTRUCTION_CLIENT_H_
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <grpcpp/channel.h>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "core/point_cloud.h"
+#include "neuralmesh/v1/reconstruction.grpc.pb.h"
+
+namespace neuralmesh::client {
+
+namespace v1 = ::neuralmesh::v1;
+
+struct ClientOptions {
+  // How long Connect waits for the server to accept a connection.
+  absl::Duration connect_timeout = absl::Seconds(5);
+  // Deadline of each simple rpc (not of UploadPoints, Watch or a waiting GetMesh).
+  absl::Duration call_timeout = absl::Seconds(30);
+};
+
+class ReconstructionClient {
+ public:
+  // Opens an insecure channel to `address` ("host:port") and waits until it is connected.
+  // Returns UNAVAILABLE naming the address when no server answers within
+  // `options.connect_timeout`, INVALID_ARGUMENT for an empty address.
+  static absl::StatusOr<std::unique_ptr<ReconstructionClient>> Connect(
+      const std::string& address, const ClientOptions& options = {});
+
+  // Uses an existing channel (for example an in-process one in tests).
+  ReconstructionClient(std::shared_ptr<grpc::Channel> channel, const ClientOptions& options);
+
+  const std::string& address() const { return address_; }
+
+  // CreateSession. INVALID_ARGUMENT for an invalid config, RESOURCE_EXHAUSTED when the server
+  // is full.
+  absl::StatusOr<v1::Session> CreateSession(const v1::SessionConfig& config,
+                                            const std::string& name);
+
+  // Called after each batch is written, with the points written so far and the total.
+  using UploadProgress = std::function<void(uint64_t points_sent, uint64_t points_total)>;
+
+  // Streams `cloud` into the session in batches of at most `batch_size` points (packed
+  // float32, with the weights and normals the cloud carries). Returns the server's
+  // acknowledgement; on failure the server's status (the batches before the bad one stay
+  // accepted). INVALID_ARGUMENT for an empty cloud or a zero batch size.
+  absl::StatusOr<v1::UploadPointsResponse> UploadPoints(const std::string& session_id,
+                                                        const PointCloud& cloud,
+                                                        size_t batch_size,
+                                                        const UploadProgress& progress = {});
+
+  // Called with each published mesh; returning false ends the watch early.
+  using UpdateCallback = std::function<bool(const v1::MeshUpdate&)>;
+
+  // Watches the session, calling `on_update` for every update with a sequence number above
+  // `after_sequence`, until the stream ends. Returns OK when the stream ended with OK (after
+  // the final mesh) or `on_update` stopped it; otherwise the stream's status: CANCELLED (the
+  // session was cancelled), NOT_FOUND (deleted or unknown), ABORTED (learning failed),
+  // UNAVAILABLE (server gone).
+  absl::Status Watch(const std::string& session_id, uint64_t after_sequence,
+                     const UpdateCallback& on_update);
+
+  absl::StatusOr<v1::Session> GetSession(const std::string& session_id);
+  absl::StatusOr<std::vector<v1::Session>> ListSessions();
+  absl::StatusOr<v1::Session> Finish(const std::string& session_id);
+  absl::StatusOr<v1::Session> Cancel(const std::string& session_id);
+  absl::Status Delete(const std::string& session_id);
+
+  // GetMesh; with `wait`, blocks up to `timeout` until the mesh exists (DEADLINE_EXCEEDED
+  // after).
+  absl::StatusOr<v1::MeshUpdate> GetMesh(const std::string& session_id,
+                                         v1::MeshVersion version, bool wait,
+                                         absl::Duration timeout);
+
+ private:
+  // A context whose deadline is `timeout` from now (none when infinite).
+  static void SetDeadline(grpc::ClientContext& context, absl::Duration timeout);
+
+  std::string address_;
+  ClientOptions options_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::ReconstructionService::Stub> stub_;
+};
+
+// One batch of `cloud`, points [begin, end), as packed little-endian float32.
+v1::PointBatch PackPointBatch(const PointCloud& cloud, size_t begin, size_t end);
+
+}  // namespace neuralmesh::client
+
+#endif  // NEURALMESH_CLIENT_RECONSTRUCTION_CLIENT_H_

@@ -1,0 +1,220 @@
+#include "client/remote_commands.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <thread>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/synchronization/mutex.h"
+#include "absl/time/clock.h"
+#include "client/inputs.h"
+#include "client/lod_plan.h"
+#include "client/mesh_update_writer.h"
+#include "client/progress_bar.h"
+#include "client/proto_conversion.h"
+#include "client/reconstruction_client.h"
+#include "core/analysis/json_writer.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh::client {
+namespace {
+
+constexpr size_t kDefaultMaxVertices = 10000;
+constexpr double kDefaultPointsPerVertex = 2;  // SessionConfig.points_per_vertex's default.
+
+absl::StatusOr<std::unique_ptr<ReconstructionClient>> ConnectTo(const std::string& server,
+                                                                absl::Duration timeout) {
+  if (server.empty()) return absl::InvalidArgumentError("--server HOST:PORT is required");
+  ClientOptions options;
+  options.connect_timeout = timeout;
+  return ReconstructionClient::Connect(server, options);
+}
+
+BoundingBox BoundsOf(const PointCloud& cloud) {
+  BoundingBox box;
+  for (const Vec3f& p : cloud.positions) box.Extend(Vec3(p[0], p[1], p[2]));
+  return box;
+}
+
+std::string StateName(v1::SessionState state) {
+  std::string name = v1::SessionState_Name(state);
+  const std::string prefix = "SESSION_STATE_";
+  if (name.rfind(prefix, 0) == 0) name = name.substr(prefix.size());
+  return absl::AsciiStrToLower(name);
+}
+
+// The end of a watch as the user should read it.
+absl::Status ExplainWatchEnd(const absl::Status& status, const std::string& session_id) {
+  if (status.ok()) {
+    return absl::DataLossError(
+        absl::StrCat("the watch of session ", session_id, " ended before the final mesh"));
+  }
+  if (absl::IsCancelled(status)) {
+    return absl::CancelledError(absl::StrCat("session ", session_id, " was cancelled"));
+  }
+  if (absl::IsAborted(status)) {
+    return absl::AbortedError(
+        absl::StrCat("learning failed in session ", session_id, ": ", status.message()));
+  }
+  return status;
+}
+
+}  // namespace
+
+absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::ostream& out,
+                                  std::ostream& err) {
+  NM_RETURN_IF_ERROR(options.learner.Validate());
+  NM_RETURN_IF_ERROR(options.draco.Validate());
+  if (options.out_dir.empty()) return absl::InvalidArgumentError("--out-dir DIR is required");
+  if (options.batch_size == 0) return absl::InvalidArgumentError("--batch-size must be > 0");
+  NM_ASSIGN_OR_RETURN(const PointCloud cloud,
+                      LoadPointsForUpload(options.input, options.builtin_points,
+                                          options.learner.seed));
+  const size_t affordable =
+      static_cast<size_t>(std::floor(cloud.size() / kDefaultPointsPerVertex));
+  const size_t target =
+      options.vertices > 0 ? options.vertices : std::min(kDefaultMaxVertices, affordable);
+  NM_ASSIGN_OR_RETURN(const std::vector<size_t> milestones, LodTargets(options.lods, target));
+
+  v1::SessionConfig config;
+  *config.mutable_learner() = ToProto(options.learner);
+  config.set_target_vertices(target);
+  if (!options.lods.empty()) {
+    for (size_t m : milestones) config.add_lod_milestones(m);
+  }
+  *config.mutable_draco() = ToProto(options.draco);
+  // All points are known before the upload: one quantization cube for the whole session.
+  *config.mutable_bounds() = ToProto(BoundsOf(cloud));
+
+  NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
+                      ConnectTo(options.server, options.connect_timeout));
+  const std::string stem = InputStem(options.input);
+  NM_ASSIGN_OR_RETURN(const v1::Session session, client->CreateSession(config, stem));
+  const std::string& id = session.session_id();
+  const double points_per_vertex = session.config().has_points_per_vertex()
+                                       ? session.config().points_per_vertex().value()
+                                       : kDefaultPointsPerVertex;
+  const size_t reachable = std::min<size_t>(
+      target, static_cast<size_t>(std::floor(cloud.size() / points_per_vertex)));
+  out << "session " << id << " on " << client->address() << ": " << cloud.size()
+      << " points, target " << target << " vertices\n";
+  if (reachable < target) {
+    err << "note: " << cloud.size() << " points allow at most " << reachable
+        << " vertices at the server's " << points_per_vertex << " points per vertex\n";
+  }
+
+  // The watcher thread prints rows on `out` while this thread draws the upload bar on `err`;
+  // both go through `mu` so a row never lands in the middle of a bar.
+  absl::Mutex mu;
+  ProgressBar upload_bar(err, options.progress, "upload  ", "points");
+  ProgressBar learn_bar(err, options.progress, "learning", "vertices");
+  MeshUpdateWriter writer({options.out_dir, stem, options.ply}, out);
+  absl::Status write_status;
+  absl::Status watch_status;
+  std::thread watcher([&] {
+    watch_status = client->Watch(id, 0, [&](const v1::MeshUpdate& update) {
+      absl::MutexLock lock(&mu);
+      upload_bar.Clear();
+      learn_bar.Clear();
+      write_status = writer.Write(update);
+      learn_bar.Update(update.vertex_count(), reachable);
+      return write_status.ok();
+    });
+  });
+
+  absl::StatusOr<v1::UploadPointsResponse> uploaded =
+      client->UploadPoints(id, cloud, options.batch_size, [&](uint64_t sent, uint64_t total) {
+        absl::MutexLock lock(&mu);
+        upload_bar.Update(sent, total);
+      });
+  {
+    absl::MutexLock lock(&mu);
+    upload_bar.Finish();
+  }
+  absl::Status status = uploaded.status();
+  if (status.ok()) status = client->Finish(id).status();
+  if (!status.ok()) {
+    // Without a finished upload no final mesh can come: stop the server's work and the watch.
+    client->Cancel(id).IgnoreError();
+    watcher.join();
+    return status;
+  }
+  watcher.join();
+  learn_bar.Finish();
+  if (!write_status.ok()) {
+    client->Cancel(id).IgnoreError();
+    return write_status;
+  }
+  if (!writer.final_received()) return ExplainWatchEnd(watch_status, id);
+
+  const LodFigures& last = writer.saved().back();
+  out << absl::StrFormat(
+      "final mesh: %d vertices, %d faces, genus %d, %d boundaries, %.1f%% valence 6, "
+      "%d basic steps, %.2fs learning; %d files in %s\n",
+      last.vertices, last.faces, last.genus, last.boundaries, last.valence6_percent,
+      last.basic_steps, absl::ToDoubleSeconds(last.elapsed),
+      writer.saved().size() * (options.ply ? 2 : 1), options.out_dir);
+  return absl::OkStatus();
+}
+
+absl::Status RunWatch(const WatchOptions& options, std::ostream& out) {
+  if (options.session_id.empty()) return absl::InvalidArgumentError("missing SESSION id");
+  if (options.out_dir.empty()) return absl::InvalidArgumentError("--out-dir DIR is required");
+  NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
+                      ConnectTo(options.server, options.connect_timeout));
+  MeshUpdateWriter writer({options.out_dir, options.session_id, options.ply}, out);
+  absl::Status write_status;
+  const absl::Status watch_status =
+      client->Watch(options.session_id, 0, [&](const v1::MeshUpdate& update) {
+        write_status = writer.Write(update);
+        return write_status.ok();
+      });
+  NM_RETURN_IF_ERROR(write_status);
+  if (!writer.final_received()) return ExplainWatchEnd(watch_status, options.session_id);
+  return absl::OkStatus();
+}
+
+absl::Status RunSessions(const std::string& server, bool json, std::ostream& out,
+                         absl::Duration connect_timeout) {
+  NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
+                      ConnectTo(server, connect_timeout));
+  NM_ASSIGN_OR_RETURN(const std::vector<v1::Session> sessions, client->ListSessions());
+  if (json) {
+    JsonWriter writer(2);
+    writer.BeginArray();
+    for (const v1::Session& s : sessions) {
+      writer.BeginObject()
+          .Key("session_id").String(s.session_id())
+          .Key("name").String(s.name())
+          .Key("state").String(StateName(s.state()))
+          .Key("points_received").Uint(s.learning().points_received())
+          .Key("vertices").Uint(s.vertex_count())
+          .Key("faces").Uint(s.face_count())
+          .Key("target_vertices").Uint(s.config().target_vertices())
+          .Key("basic_steps").Uint(s.learning().basic_steps())
+          .Key("latest_sequence").Uint(s.latest_sequence())
+          .Key("watchers").Uint(s.watchers())
+          .Key("error").String(s.error())
+          .EndObject();
+    }
+    writer.EndArray();
+    NM_ASSIGN_OR_RETURN(const std::string text, writer.Finish());
+    out << text << "\n";
+    return absl::OkStatus();
+  }
+  out << absl::StrFormat("%-20s %-16s %-10s %10s %9s %9s %9s %8s\n", "session", "name", "state",
+                         "points", "vertices", "faces", "target", "updates");
+  for (const v1::Session& s : sessions) {
+    out << absl::StrFormat("%-20s %-16s %-10s %10d %9d %9d %9d %8d\n", s.session_id(), s.name(),
+                           StateName(s.state()), s.learning().points_received(),
+                           s.vertex_count(), s.face_count(), s.config().target_vertices(),
+                           s.latest_sequence());
+  }
+  out << sessions.size() << (sessions.size() == 1 ? " session\n" : " sessions\n");
+  return absl::OkStatus();
+}
+
+}  // namespace neuralmesh::client

@@ -1,0 +1,201 @@
+#include "core/analysis/json_writer.h"
+
+#include <charconv>
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+
+namespace neuralmesh {
+
+std::string JsonWriter::Quote(absl::string_view value) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(value.size() + 2);
+  out.push_back('"');
+  for (const char ch : value) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\b': out += "\\b"; break;
+      case '\f': out += "\\f"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (c < 0x20) {
+          out += "\\u00";
+          out.push_back(kHex[c >> 4]);
+          out.push_back(kHex[c & 0xf]);
+        } else {
+          out.push_back(ch);
+        }
+    }
+  }
+  out.push_back('"');
+  return out;
+}
+
+void JsonWriter::Fail(absl::string_view message) {
+  if (status_.ok()) {
+    status_ = absl::FailedPreconditionError(
+        absl::StrCat("JsonWriter: ", message, " after \"", text_, "\""));
+  }
+}
+
+void JsonWriter::NewLine(size_t depth) {
+  if (indent_ == 0) return;
+  text_.push_back('\n');
+  text_.append(depth * static_cast<size_t>(indent_), ' ');
+}
+
+bool JsonWriter::BeginValue() {
+  if (!status_.ok()) return false;
+  if (stack_.empty()) {
+    if (done_) {
+      Fail("a second top-level value");
+      return false;
+    }
+    return true;
+  }
+  Frame& frame = stack_.back();
+  if (frame.scope == Scope::kObject) {
+    if (!frame.has_key) {
+      Fail("a value without a key inside an object");
+      return false;
+    }
+    frame.has_key = false;
+    return true;
+  }
+  if (!frame.empty) text_.push_back(',');
+  frame.empty = false;
+  NewLine(stack_.size());
+  return true;
+}
+
+JsonWriter& JsonWriter::Key(absl::string_view key) {
+  if (!status_.ok()) return *this;
+  if (stack_.empty() || stack_.back().scope != Scope::kObject) {
+    Fail("a key outside an object");
+    return *this;
+  }
+  Frame& frame = stack_.back();
+  if (frame.has_key) {
+    Fail("two keys in a row");
+    return *this;
+  }
+  if (!frame.empty) text_.push_back(',');
+  frame.empty = false;
+  frame.has_key = true;
+  NewLine(stack_.size());
+  text_ += Quote(key);
+  text_ += indent_ > 0 ? ": " : ":";
+  return *this;
+}
+
+JsonWriter& JsonWriter::BeginObject() {
+  if (!BeginValue()) return *this;
+  text_.push_back('{');
+  stack_.push_back({Scope::kObject});
+  return *this;
+}
+
+JsonWriter& JsonWriter::BeginArray() {
+  if (!BeginValue()) return *this;
+  text_.push_back('[');
+  stack_.push_back({Scope::kArray});
+  return *this;
+}
+
+JsonWriter& JsonWriter::EndObject() {
+  if (!status_.ok()) return *this;
+  if (stack_.empty() || stack_.back().scope != Scope::kObject) {
+    Fail("EndObject without a matching BeginObject");
+    return *this;
+  }
+  if (stack_.back().has_key) {
+    Fail("EndObject right after a key");
+    return *this;
+  }
+  const bool empty = stack_.back().empty;
+  stack_.pop_back();
+  if (!empty) NewLine(stack_.size());
+  text_.push_back('}');
+  if (stack_.empty()) done_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::EndArray() {
+  if (!status_.ok()) return *this;
+  if (stack_.empty() || stack_.back().scope != Scope::kArray) {
+    Fail("EndArray without a matching BeginArray");
+    return *this;
+  }
+  const bool empty = stack_.back().empty;
+  stack_.pop_back();
+  if (!empty) NewLine(stack_.size());
+  text_.push_back(']');
+  if (stack_.empty()) done_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::String(absl::string_view value) {
+  if (!BeginValue()) return *this;
+  text_ += Quote(value);
+  if (stack_.empty()) done_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::Int(int64_t value) {
+  if (!BeginValue()) return *this;
+  absl::StrAppend(&text_, value);
+  if (stack_.empty()) done_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::Uint(uint64_t value) {
+  if (!BeginValue()) return *this;
+  absl::StrAppend(&text_, value);
+  if (stack_.empty()) done_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::Double(double value) {
+  if (!BeginValue()) return *this;
+  if (!std::isfinite(value)) {
+    // JSON has no NaN or infinity.
+    text_ += "null";
+  } else {
+    char buffer[32];
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+    text_.append(buffer, result.ptr);
+  }
+  if (stack_.empty()) done_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::Bool(bool value) {
+  if (!BeginValue()) return *this;
+  text_ += value ? "true" : "false";
+  if (stack_.empty()) done_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::Null() {
+  if (!BeginValue()) return *this;
+  text_ += "null";
+  if (stack_.empty()) done_ = true;
+  return *this;
+}
+
+absl::StatusOr<std::string> JsonWriter::Finish() const {
+  if (!status_.ok()) return status_;
+  if (!stack_.empty()) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("JsonWriter: ", stack_.size(), " unclosed object(s) or array(s)"));
+  }
+  if (!done_) return absl::FailedPreconditionError("JsonWriter: nothing written");
+  return text_;
+}
+
+}  // namespace neuralmesh

@@ -1,0 +1,360 @@
+#include "core/io/draco_codec.h"
+
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <new>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/status_macros.h"
+#include "draco/attributes/geometry_attribute.h"
+#include "draco/attributes/point_attribute.h"
+#include "draco/compression/config/compression_shared.h"
+#include "draco/compression/decode.h"
+#include "draco/compression/expert_encode.h"
+#include "draco/core/decoder_buffer.h"
+#include "draco/core/encoder_buffer.h"
+#include "draco/mesh/mesh.h"
+#include "draco/point_cloud/point_cloud.h"
+
+namespace neuralmesh {
+namespace {
+
+static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be three packed floats");
+
+absl::Status CheckRange(const char* field, int value, int lo, int hi) {
+  if (value < lo || value > hi) {
+    return absl::InvalidArgumentError(absl::StrCat("DracoOptions.", field, " is ", value,
+                                                   "; it must be in [", lo, ", ", hi, "]"));
+  }
+  return absl::OkStatus();
+}
+
+bool IsFinite(const Vec3f& p) {
+  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+}
+
+// Checks that every position is finite and, with a fixed box, that it quantizes to a grid
+// index inside [0, 2^bits - 1]. A quarter step of slack lets callers use a box computed in
+// float arithmetic whose far corner rounded just below the farthest point.
+absl::Status CheckPositions(const std::vector<Vec3f>& positions, const DracoOptions& options) {
+  for (size_t i = 0; i < positions.size(); ++i) {
+    if (!IsFinite(positions[i])) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("vertex ", i, " has a non-finite coordinate"));
+    }
+  }
+  if (!options.quantization_box.has_value()) return absl::OkStatus();
+  const QuantizationBox& box = *options.quantization_box;
+  const double max_index = std::ldexp(1.0, options.position_quantization_bits) - 1.0;
+  const double cells_per_unit = max_index / box.range;
+  for (size_t i = 0; i < positions.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const double t = (double{positions[i][c]} - double{box.origin[c]}) * cells_per_unit;
+      if (t < -0.25 || t > max_index + 0.25) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "vertex ", i, " (", positions[i][0], ", ", positions[i][1], ", ", positions[i][2],
+            ") lies outside the quantization box with origin (", box.origin[0], ", ",
+            box.origin[1], ", ", box.origin[2], ") and range ", box.range));
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+// Adds a per-point float attribute with identity mapping and copies `count` values into it.
+int AddFloatAttribute(draco::PointCloud& geometry, draco::GeometryAttribute::Type type,
+                      int components, const float* values, size_t count) {
+  draco::GeometryAttribute layout;
+  layout.Init(type, nullptr, static_cast<uint8_t>(components), draco::DT_FLOAT32,
+              /*normalized=*/false, sizeof(float) * components, /*byte_offset=*/0);
+  const int id = geometry.AddAttribute(layout, /*identity_mapping=*/true,
+                                       static_cast<uint32_t>(count));
+  geometry.attribute(id)->buffer()->Write(0, values, count * components * sizeof(float));
+  return id;
+}
+
+void SetPositionQuantization(draco::ExpertEncoder& encoder, int attribute_id,
+                             const DracoOptions& options) {
+  if (options.quantization_box.has_value()) {
+    const QuantizationBox& box = *options.quantization_box;
+    const float origin[3] = {box.origin[0], box.origin[1], box.origin[2]};
+    encoder.SetAttributeExplicitQuantization(attribute_id, options.position_quantization_bits,
+                                             3, origin, box.range);
+  } else {
+    encoder.SetAttributeQuantization(attribute_id, options.position_quantization_bits);
+  }
+}
+
+absl::StatusOr<std::string> RunEncoder(draco::ExpertEncoder& encoder, const char* what) {
+  draco::EncoderBuffer buffer;
+  const draco::Status status = encoder.EncodeToBuffer(&buffer);
+  if (!status.ok()) {
+    return absl::InternalError(
+        absl::StrCat("Draco failed to encode the ", what, ": ", status.error_msg_string()));
+  }
+  return std::string(buffer.data(), buffer.size());
+}
+
+// Decodes `bytes` as the given geometry type. Draco sizes its arrays from counts in the
+// stream; a corrupt count can make an allocation throw, which must not escape this module.
+template <typename Geometry>
+absl::StatusOr<std::unique_ptr<Geometry>> DecodeDraco(std::string_view bytes) {
+  if (bytes.empty()) return absl::InvalidArgumentError("no Draco data: the buffer is empty");
+  draco::DecoderBuffer buffer;
+  buffer.Init(bytes.data(), bytes.size());
+  const auto type = draco::Decoder::GetEncodedGeometryType(&buffer);
+  if (!type.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("not valid Draco data: ", type.status().error_msg_string()));
+  }
+  constexpr bool kWantMesh = std::is_same_v<Geometry, draco::Mesh>;
+  if (kWantMesh && type.value() != draco::TRIANGULAR_MESH) {
+    return absl::InvalidArgumentError(
+        "the Draco data holds a point cloud, not a triangle mesh");
+  }
+  buffer.Init(bytes.data(), bytes.size());
+  draco::Decoder decoder;
+  try {
+    if constexpr (kWantMesh) {
+      auto result = decoder.DecodeMeshFromBuffer(&buffer);
+      if (!result.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("corrupt or truncated Draco mesh: ",
+                                                       result.status().error_msg_string()));
+      }
+      return std::move(result).value();
+    } else {
+      auto result = decoder.DecodePointCloudFromBuffer(&buffer);
+      if (!result.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("corrupt or truncated Draco data: ",
+                                                       result.status().error_msg_string()));
+      }
+      return std::move(result).value();
+    }
+  } catch (const std::bad_alloc&) {
+    return absl::InvalidArgumentError(
+        "corrupt Draco data: it declares more elements than can be allocated");
+  } catch (const std::length_error&) {
+    return absl::InvalidArgumentError(
+        "corrupt Draco data: it declares more elements than can be allocated");
+  }
+}
+
+absl::StatusOr<const draco::PointAttribute*> PositionAttribute(
+    const draco::PointCloud& geometry) {
+  const draco::PointAttribute* positions =
+      geometry.GetNamedAttribute(draco::GeometryAttribute::POSITION);
+  if (positions == nullptr) {
+    return absl::InvalidArgumentError("the Draco data has no position attribute");
+  }
+  if (positions->num_components() < 1 || positions->num_components() > 4) {
+    return absl::InvalidArgumentError(absl::StrCat("the Draco position attribute has ",
+                                                   int{positions->num_components()},
+                                                   " components; expected 3"));
+  }
+  return positions;
+}
+
+absl::StatusOr<Vec3f> ReadVec3(const draco::PointAttribute& attribute,
+                               draco::AttributeValueIndex index, const char* what) {
+  Vec3f value;
+  if (!attribute.ConvertValue<float, 3>(index, value.data())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot read Draco ", what, " value ", index.value()));
+  }
+  if (!IsFinite(value)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("Draco ", what, " value ", index.value(), " is not finite"));
+  }
+  return value;
+}
+
+}  // namespace
+
+absl::Status DracoOptions::Validate() const {
+  NM_RETURN_IF_ERROR(
+      CheckRange("position_quantization_bits", position_quantization_bits, 1, 30));
+  NM_RETURN_IF_ERROR(CheckRange("normal_quantization_bits", normal_quantization_bits, 2, 30));
+  NM_RETURN_IF_ERROR(CheckRange("weight_quantization_bits", weight_quantization_bits, 1, 30));
+  NM_RETURN_IF_ERROR(CheckRange("encode_speed", encode_speed, 0, 10));
+  NM_RETURN_IF_ERROR(CheckRange("decode_speed", decode_speed, 0, 10));
+  if (quantization_box.has_value()) {
+    const QuantizationBox& box = *quantization_box;
+    if (!IsFinite(box.origin)) {
+      return absl::InvalidArgumentError(
+          "DracoOptions.quantization_box.origin has a non-finite coordinate");
+    }
+    if (!std::isfinite(box.range) || box.range <= 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("DracoOptions.quantization_box.range is ", box.range,
+                       "; it must be finite and positive"));
+    }
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(box.origin[c] + box.range)) {
+        return absl::InvalidArgumentError(
+            "DracoOptions.quantization_box.origin + range overflows a float");
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOptions& options) {
+  NM_RETURN_IF_ERROR(options.Validate());
+  if (mesh.positions.empty()) {
+    return absl::InvalidArgumentError("cannot encode an empty mesh (no vertices)");
+  }
+  if (mesh.faces.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the mesh has ", mesh.positions.size(),
+                     " vertices but no faces; encode it with EncodePointCloud"));
+  }
+  NM_RETURN_IF_ERROR(CheckPositions(mesh.positions, options));
+  const size_t num_vertices = mesh.positions.size();
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    for (uint32_t v : mesh.faces[f]) {
+      if (v >= num_vertices) {
+        return absl::InvalidArgumentError(absl::StrCat("face ", f, " uses vertex ", v,
+                                                       " but the mesh has only ",
+                                                       num_vertices, " vertices"));
+      }
+    }
+  }
+
+  draco::Mesh geometry;
+  geometry.set_num_points(static_cast<uint32_t>(num_vertices));
+  const int position_id =
+      AddFloatAttribute(geometry, draco::GeometryAttribute::POSITION, 3,
+                        mesh.positions.front().data(), num_vertices);
+  geometry.SetNumFaces(mesh.faces.size());
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    draco::Mesh::Face face;
+    for (int k = 0; k < 3; ++k) face[k] = draco::PointIndex(mesh.faces[f][k]);
+    geometry.SetFace(draco::FaceIndex(static_cast<uint32_t>(f)), face);
+  }
+
+  draco::ExpertEncoder encoder(geometry);
+  encoder.SetSpeedOptions(options.encode_speed, options.decode_speed);
+  encoder.SetEncodingMethod(draco::MESH_EDGEBREAKER_ENCODING);
+  SetPositionQuantization(encoder, position_id, options);
+  return RunEncoder(encoder, "mesh");
+}
+
+absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud,
+                                             const DracoOptions& options) {
+  NM_RETURN_IF_ERROR(options.Validate());
+  if (cloud.empty()) return absl::InvalidArgumentError("cannot encode an empty point cloud");
+  NM_RETURN_IF_ERROR(ValidatePointCloud(cloud));
+  NM_RETURN_IF_ERROR(CheckPositions(cloud.positions, options));
+
+  const size_t n = cloud.size();
+  draco::PointCloud geometry;
+  geometry.set_num_points(static_cast<uint32_t>(n));
+  const int position_id = AddFloatAttribute(geometry, draco::GeometryAttribute::POSITION, 3,
+                                            cloud.positions.front().data(), n);
+  int normal_id = -1;
+  if (!cloud.normals.empty()) {
+    normal_id = AddFloatAttribute(geometry, draco::GeometryAttribute::NORMAL, 3,
+                                  cloud.normals.front().data(), n);
+  }
+  int weight_id = -1;
+  if (!cloud.weights.empty()) {
+    weight_id = AddFloatAttribute(geometry, draco::GeometryAttribute::GENERIC, 1,
+                                  cloud.weights.data(), n);
+  }
+
+  draco::ExpertEncoder encoder(geometry);
+  encoder.SetSpeedOptions(options.encode_speed, options.decode_speed);
+  // Every attribute is quantized, so the kd-tree coder always applies below speed 10.
+  encoder.SetEncodingMethod(options.encode_speed == 10 ? draco::POINT_CLOUD_SEQUENTIAL_ENCODING
+                                                       : draco::POINT_CLOUD_KD_TREE_ENCODING);
+  SetPositionQuantization(encoder, position_id, options);
+  if (normal_id >= 0) encoder.SetAttributeQuantization(normal_id, options.normal_quantization_bits);
+  if (weight_id >= 0) encoder.SetAttributeQuantization(weight_id, options.weight_quantization_bits);
+  return RunEncoder(encoder, "point cloud");
+}
+
+absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes) {
+  NM_ASSIGN_OR_RETURN(std::unique_ptr<draco::Mesh> geometry, DecodeDraco<draco::Mesh>(bytes));
+  NM_ASSIGN_OR_RETURN(const draco::PointAttribute* positions, PositionAttribute(*geometry));
+  if (positions->size() == 0 || geometry->num_faces() == 0) {
+    return absl::InvalidArgumentError("the Draco mesh is empty");
+  }
+  TriangleMesh mesh;
+  mesh.positions.reserve(positions->size());
+  for (draco::AttributeValueIndex i(0); i < static_cast<uint32_t>(positions->size()); ++i) {
+    NM_ASSIGN_OR_RETURN(Vec3f p, ReadVec3(*positions, i, "position"));
+    mesh.positions.push_back(p);
+  }
+  // Faces index points; a point may differ from another only in a non-position attribute
+  // (e.g. a texture seam), so faces are mapped to position values, which merges such points.
+  mesh.faces.reserve(geometry->num_faces());
+  for (draco::FaceIndex f(0); f < geometry->num_faces(); ++f) {
+    const draco::Mesh::Face& face = geometry->face(f);
+    std::array<uint32_t, 3> triangle;
+    for (int k = 0; k < 3; ++k) {
+      if (face[k].value() >= geometry->num_points()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("Draco face ", f.value(), " uses a point out of range"));
+      }
+      triangle[k] = positions->mapped_index(face[k]).value();
+      if (triangle[k] >= mesh.positions.size()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("Draco face ", f.value(), " maps to a position out of range"));
+      }
+    }
+    mesh.faces.push_back(triangle);
+  }
+  return mesh;
+}
+
+absl::StatusOr<PointCloud> DecodePointCloud(std::string_view bytes) {
+  NM_ASSIGN_OR_RETURN(std::unique_ptr<draco::PointCloud> geometry,
+                      DecodeDraco<draco::PointCloud>(bytes));
+  NM_ASSIGN_OR_RETURN(const draco::PointAttribute* positions, PositionAttribute(*geometry));
+  const uint32_t n = geometry->num_points();
+  if (n == 0) return absl::InvalidArgumentError("the Draco point cloud is empty");
+  const draco::PointAttribute* normals =
+      geometry->GetNamedAttribute(draco::GeometryAttribute::NORMAL);
+  const draco::PointAttribute* weights = nullptr;
+  for (int i = 0; i < geometry->num_attributes(); ++i) {
+    const draco::PointAttribute* attribute = geometry->attribute(i);
+    if (attribute->attribute_type() == draco::GeometryAttribute::GENERIC &&
+        attribute->num_components() == 1) {
+      weights = attribute;
+      break;
+    }
+  }
+
+  PointCloud cloud;
+  cloud.positions.reserve(n);
+  if (normals != nullptr) cloud.normals.reserve(n);
+  if (weights != nullptr) cloud.weights.reserve(n);
+  for (draco::PointIndex i(0); i < n; ++i) {
+    NM_ASSIGN_OR_RETURN(Vec3f p, ReadVec3(*positions, positions->mapped_index(i), "position"));
+    cloud.positions.push_back(p);
+    if (normals != nullptr) {
+      NM_ASSIGN_OR_RETURN(Vec3f normal, ReadVec3(*normals, normals->mapped_index(i), "normal"));
+      cloud.normals.push_back(normal);
+    }
+    if (weights != nullptr) {
+      float w = 0;
+      if (!weights->ConvertValue<float, 1>(weights->mapped_index(i), &w)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("cannot read the Draco weight of point ", i.value()));
+      }
+      cloud.weights.push_back(w);
+    }
+  }
+  const absl::Status valid = ValidatePointCloud(cloud);
+  if (!valid.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the decoded Draco point cloud is invalid: ", valid.message()));
+  }
+  return cloud;
+}
+
+}  // namespace neuralmesh

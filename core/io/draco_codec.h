@@ -1,0 +1,76 @@
+// Draco compression of triangle meshes and point clouds behind one typed wrapper: callers never
+// see Draco's types or its string-keyed options.
+//
+// Meshes are encoded with Edgebreaker, point clouds with the kd-tree coder (the sequential
+// coder at encode_speed 10, which keeps the point order). Positions are quantized
+// uniformly: with b bits, a coordinate decodes to within range / (2^b - 1) / 2 of its input,
+// where range is the edge of the quantization cube (the largest side of the bounding box, or
+// QuantizationBox::range).
+//
+// Draco may reorder vertices and faces. Edgebreaker keeps only vertices that some face uses,
+// and splits non-manifold vertices into copies at the same position.
+#ifndef NEURALMESH_CORE_IO_DRACO_CODEC_H_
+#define NEURALMESH_CORE_IO_DRACO_CODEC_H_
+
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/mesh.h"
+#include "core/point_cloud.h"
+#include "core/triangle_mesh.h"
+
+namespace neuralmesh {
+
+// An axis-aligned cube [origin, origin + range]^3 that positions are quantized against.
+struct QuantizationBox {
+  Vec3f origin{0.0f, 0.0f, 0.0f};  // The cube's minimum corner.
+  float range = 0;                 // Edge length; must be finite and positive.
+};
+
+struct DracoOptions {
+  int position_quantization_bits = 11;  // 1..30.
+  int normal_quantization_bits = 10;    // 2..30; point-cloud normals (octahedral coding).
+  int weight_quantization_bits = 16;    // 1..30; point weights, against their own min..max.
+  int encode_speed = 5;                 // 0 (smallest output) .. 10 (fastest).
+  int decode_speed = 5;                 // 0 .. 10.
+  // When set, positions are quantized against this fixed cube instead of each geometry's own
+  // bounding box, so successive meshes of one session share one grid (no jitter, no cracks):
+  // the same input position always decodes to bit-identical floats. Every position must lie
+  // inside the cube (encoding returns INVALID_ARGUMENT otherwise; nothing is clamped).
+  std::optional<QuantizationBox> quantization_box;
+
+  // Returns INVALID_ARGUMENT naming the first field that is out of range.
+  absl::Status Validate() const;
+};
+
+// Encodes `mesh` (positions and faces) with Edgebreaker.
+// Returns INVALID_ARGUMENT when `options` is invalid, the mesh has no vertices or no faces, a
+// face index is out of range, a coordinate is not finite, or a position lies outside
+// `options.quantization_box`; INTERNAL if Draco fails for another reason.
+absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOptions& options);
+
+// Encodes the positions of `cloud`, its normals when present and its weights (as a generic
+// one-component attribute) when present.
+// Returns INVALID_ARGUMENT when `options` is invalid, the cloud is empty, fails
+// ValidatePointCloud, or has a position outside `options.quantization_box`; INTERNAL if Draco
+// fails for another reason.
+absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud,
+                                             const DracoOptions& options);
+
+// Decodes a Draco mesh: one position per distinct position value and the triangles.
+// Returns INVALID_ARGUMENT when `bytes` is not a valid Draco mesh (corrupt, truncated, a point
+// cloud, no position attribute, non-finite positions).
+absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes);
+
+// Decodes a Draco point cloud, or the points of a Draco mesh; restores normals (the NORMAL
+// attribute) and weights (the first one-component GENERIC attribute) when present.
+// Returns INVALID_ARGUMENT when `bytes` is not valid Draco data, has no positions, or decodes
+// to a cloud that fails ValidatePointCloud.
+absl::StatusOr<PointCloud> DecodePointCloud(std::string_view bytes);
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_IO_DRACO_CODEC_H_

@@ -1,0 +1,35 @@
+// Fixed-width little- and big-endian scalars for the binary formats (PLY, STL).
+#ifndef NEURALMESH_CORE_IO_INTERNAL_BINARY_H_
+#define NEURALMESH_CORE_IO_INTERNAL_BINARY_H_
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+namespace neuralmesh::io_internal {
+
+inline constexpr bool kHostIsBigEndian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
+
+// Reads a T stored at `p` (no alignment needed) in big- or little-endian byte order.
+template <typename T>
+T LoadScalar(const char* p, bool big_endian) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, p, sizeof(T));
+  if (big_endian != kHostIsBigEndian) std::reverse(bytes, bytes + sizeof(T));
+  T value;
+  std::memcpy(&value, bytes, sizeof(T));
+  return value;
+}
+
+// Appends `value` to `out` in little-endian byte order.
+template <typename T>
+void AppendLittleEndian(T value, std::string* out) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  if (kHostIsBigEndian) std::reverse(bytes, bytes + sizeof(T));
+  out->append(bytes, sizeof(T));
+}
+
+}  // namespace neuralmesh::io_internal
+
+#endif  // NEURALMESH_CORE_IO_INTERNAL_BINARY_H_

@@ -1,0 +1,73 @@
+#include "core/io/internal/file_util.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+
+namespace neuralmesh::io_internal {
+
+std::string LowercaseExtension(absl::string_view path) {
+  const size_t slash = path.find_last_of('/');
+  const absl::string_view name = slash == absl::string_view::npos ? path : path.substr(slash + 1);
+  const size_t dot = name.find_last_of('.');
+  if (dot == absl::string_view::npos || dot == 0) return "";
+  return absl::AsciiStrToLower(std::string(name.substr(dot)));
+}
+
+FileFormat FormatFromPath(absl::string_view path) {
+  const std::string extension = LowercaseExtension(path);
+  if (extension == ".ply") return FileFormat::kPly;
+  if (extension == ".obj") return FileFormat::kObj;
+  if (extension == ".off") return FileFormat::kOff;
+  if (extension == ".stl") return FileFormat::kStl;
+  if (extension == ".drc") return FileFormat::kDraco;
+  if (extension == ".xyz" || extension == ".txt" || extension == ".pts") return FileFormat::kXyz;
+  return FileFormat::kUnknown;
+}
+
+absl::StatusOr<std::string> ReadFileContents(const std::string& path) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    return absl::NotFoundError(absl::StrCat("cannot open '", path, "': ", std::strerror(errno)));
+  }
+  std::string contents;
+  char chunk[1 << 16];
+  size_t got = 0;
+  while ((got = std::fread(chunk, 1, sizeof(chunk), file)) > 0) contents.append(chunk, got);
+  // fread on a directory fails with EISDIR; report it like any other unreadable file.
+  const bool failed = std::ferror(file) != 0;
+  const int error = errno;
+  std::fclose(file);
+  if (failed) {
+    return absl::NotFoundError(absl::StrCat("cannot read '", path, "': ", std::strerror(error)));
+  }
+  if (contents.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat("'", path, "' is empty"));
+  }
+  return contents;
+}
+
+absl::Status WriteFileContents(const std::string& path, absl::string_view contents) {
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr) {
+    return absl::ErrnoToStatus(errno, absl::StrCat("cannot write '", path, "'"));
+  }
+  const size_t written = std::fwrite(contents.data(), 1, contents.size(), file);
+  int error = written == contents.size() ? 0 : errno;
+  if (std::fclose(file) != 0 && error == 0) error = errno;
+  if (written != contents.size() || error != 0) {
+    std::remove(path.c_str());
+    return absl::ErrnoToStatus(error != 0 ? error : EIO, absl::StrCat("cannot write '", path, "'"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status WithPath(const absl::Status& status, const std::string& path) {
+  if (status.ok()) return status;
+  return absl::Status(status.code(), absl::StrCat("'", path, "': ", status.message()));
+}
+
+}  // namespace neuralmesh::io_internal

@@ -1,0 +1,35 @@
+// The common currency of the format readers and writers: what a reader extracts from a file
+// before it becomes a TriangleMesh or a PointCloud, and a non-owning view that writers format.
+#ifndef NEURALMESH_CORE_IO_INTERNAL_GEOMETRY_DATA_H_
+#define NEURALMESH_CORE_IO_INTERNAL_GEOMETRY_DATA_H_
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "absl/types/span.h"
+#include "core/mesh.h"
+
+namespace neuralmesh::io_internal {
+
+// Whether a reader parses faces (for a mesh) or skips them (for a point cloud). Skipped faces
+// are not validated, so a point cloud can be read from a file with broken faces.
+enum class FaceHandling { kSkip, kRead };
+
+struct ParsedGeometry {
+  std::vector<Vec3f> positions;                // All finite.
+  std::vector<Vec3f> normals;                  // Empty or one per position.
+  std::vector<float> weights;                  // Empty or one per position.
+  std::vector<std::array<uint32_t, 3>> faces;  // Polygons fan-triangulated; indices in range.
+};
+
+struct GeometryView {
+  absl::Span<const Vec3f> positions;
+  absl::Span<const Vec3f> normals;  // Empty or one per position.
+  absl::Span<const float> weights;  // Empty or one per position.
+  absl::Span<const std::array<uint32_t, 3>> faces;
+};
+
+}  // namespace neuralmesh::io_internal
+
+#endif  // NEURALMESH_CORE_IO_INTERNAL_GEOMETRY_DATA_H_

@@ -1,0 +1,142 @@
+#include "core/io/internal/obj.h"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/io/internal/text.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh::io_internal {
+namespace {
+
+constexpr const char* kAxisNames[3] = {"x", "y", "z"};
+
+absl::Status ParseVertex(const std::vector<absl::string_view>& tokens, int line,
+                         ParsedGeometry* out) {
+  if (tokens.size() < 4) {
+    return LineError(line, absl::StrCat("expected 'v x y z', found ", tokens.size() - 1,
+                                        " coordinates"));
+  }
+  Vec3f p;
+  for (int c = 0; c < 3; ++c) {
+    if (!ParseFloat(tokens[1 + c], &p[c])) {
+      return LineError(line, absl::StrCat("expected a number for coordinate ", kAxisNames[c],
+                                          " of a vertex, found ", Quoted(tokens[1 + c])));
+    }
+  }
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+    return LineError(line, "vertex has a non-finite coordinate");
+  }
+  out->positions.push_back(p);
+  return absl::OkStatus();
+}
+
+// Resolves the vertex part of one face reference ("7", "7/2", "7/2/5", "7//5", "-1").
+// Positive indices may refer to vertices defined later; they are checked at the end.
+absl::StatusOr<int64_t> ParseReference(absl::string_view reference, int line,
+                                       size_t num_vertices) {
+  absl::string_view parts[3];
+  int num_parts = 0;
+  for (size_t start = 0;;) {
+    const size_t slash = reference.find('/', start);
+    if (num_parts == 3) {
+      return LineError(line, absl::StrCat("malformed face reference ", Quoted(reference),
+                                          "; expected v, v/vt, v/vt/vn or v//vn"));
+    }
+    parts[num_parts++] = reference.substr(start, slash - start);
+    if (slash == absl::string_view::npos) break;
+    start = slash + 1;
+  }
+  int64_t index = 0;
+  if (!ParseInt64(parts[0], &index)) {
+    return LineError(line, absl::StrCat("expected a vertex index in face reference ",
+                                        Quoted(reference)));
+  }
+  // Texture and normal indices are ignored but must be integers when present.
+  for (int k = 1; k < num_parts; ++k) {
+    int64_t ignored = 0;
+    if (!parts[k].empty() && !ParseInt64(parts[k], &ignored)) {
+      return LineError(line, absl::StrCat("malformed face reference ", Quoted(reference)));
+    }
+  }
+  if (index == 0) return LineError(line, "face index 0 is invalid; OBJ indices start at 1");
+  if (index < 0) {
+    const int64_t resolved = static_cast<int64_t>(num_vertices) + index;
+    if (resolved < 0) {
+      return LineError(line, absl::StrCat("relative face index ", index, " points before the ",
+                                          "first vertex; only ", num_vertices,
+                                          " vertices precede it"));
+    }
+    return resolved;
+  }
+  if (index > static_cast<int64_t>(std::numeric_limits<uint32_t>::max())) {
+    return LineError(line, absl::StrCat("face index ", index, " is too large"));
+  }
+  return index - 1;
+}
+
+}  // namespace
+
+absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling faces) {
+  ParsedGeometry out;
+  LineCursor cursor(data);
+  absl::string_view line;
+  std::vector<absl::string_view> tokens;
+  std::vector<uint32_t> polygon;
+  int64_t largest_index = -1;
+  int largest_index_line = 0;
+  while (cursor.Next(&line)) {
+    const int n = cursor.line_number();
+    SplitWhitespace(StripHashComment(line), &tokens);
+    if (tokens.empty()) continue;
+    if (tokens[0] == "v") {
+      NM_RETURN_IF_ERROR(ParseVertex(tokens, n, &out));
+    } else if (tokens[0] == "f" && faces == FaceHandling::kRead) {
+      if (tokens.size() < 4) {
+        return LineError(n, absl::StrCat("a face needs at least 3 vertices, found ",
+                                         tokens.size() - 1));
+      }
+      polygon.clear();
+      for (size_t k = 1; k < tokens.size(); ++k) {
+        NM_ASSIGN_OR_RETURN(const int64_t index,
+                            ParseReference(tokens[k], n, out.positions.size()));
+        if (index > largest_index) {
+          largest_index = index;
+          largest_index_line = n;
+        }
+        polygon.push_back(static_cast<uint32_t>(index));
+      }
+      for (size_t c = 1; c + 1 < polygon.size(); ++c) {
+        out.faces.push_back({polygon[0], polygon[c], polygon[c + 1]});
+      }
+    }
+  }
+  if (largest_index >= static_cast<int64_t>(out.positions.size())) {
+    return LineError(largest_index_line,
+                     absl::StrCat("face uses vertex ", largest_index + 1, " but the file has ",
+                                  out.positions.size(), " vertices"));
+  }
+  return out;
+}
+
+std::string FormatObj(const GeometryView& geometry) {
+  std::string out = "# written by neuralmesh\n";
+  out.reserve(geometry.positions.size() * 32 + geometry.faces.size() * 24);
+  for (const Vec3f& p : geometry.positions) {
+    out += "v";
+    for (int c = 0; c < 3; ++c) {
+      out += ' ';
+      AppendFloat(p[c], &out);
+    }
+    out += '\n';
+  }
+  for (const auto& face : geometry.faces) {
+    absl::StrAppend(&out, "f ", face[0] + 1, " ", face[1] + 1, " ", face[2] + 1, "\n");
+  }
+  return out;
+}
+
+}  // namespace neuralmesh::io_internal

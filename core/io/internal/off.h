@@ -1,0 +1,26 @@
+// The Object File Format (OFF) of Geomview, with its COFF, NOFF and STOFF variants.
+#ifndef NEURALMESH_CORE_IO_INTERNAL_OFF_H_
+#define NEURALMESH_CORE_IO_INTERNAL_OFF_H_
+
+#include <string>
+#include "absl/strings/string_view.h"
+
+#include "absl/status/statusor.h"
+#include "core/io/internal/geometry_data.h"
+
+namespace neuralmesh::io_internal {
+
+// Parses an ASCII OFF file: a keyword ([ST][C][N]OFF), the counts "vertices faces [edges]"
+// (on the keyword line or the next), one vertex per line ("x y z", then "nx ny nz" for NOFF,
+// then colors or texture coordinates, which are ignored), then with FaceHandling::kRead one
+// polygon per line ("n i_1 ... i_n [color]", 0-based), fan-triangulated. '#' starts a comment.
+// Returns INVALID_ARGUMENT "line N: ..." for a bad keyword or count, a malformed or missing
+// vertex or face line, a non-finite coordinate or an out-of-range index.
+absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling faces);
+
+// Formats the positions and faces of `geometry` as ASCII OFF.
+std::string FormatOff(const GeometryView& geometry);
+
+}  // namespace neuralmesh::io_internal
+
+#endif  // NEURALMESH_CORE_IO_INTERNAL_OFF_H_

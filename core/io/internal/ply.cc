@@ -1,0 +1,555 @@
+#include "core/io/internal/ply.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "core/io/internal/binary.h"
+#include "core/io/internal/text.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh::io_internal {
+namespace {
+
+enum class PlyFormat { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
+enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
+
+struct PlyProperty {
+  std::string name;
+  PlyType type = PlyType::kFloat32;  // The item type of a list.
+  bool is_list = false;
+  PlyType count_type = PlyType::kUint8;
+};
+
+struct PlyElement {
+  std::string name;
+  uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+  int line = 0;  // Where the header declares it.
+};
+
+struct PlyHeader {
+  PlyFormat format = PlyFormat::kAscii;
+  std::vector<PlyElement> elements;
+  size_t body_offset = 0;  // First byte after the end_header line.
+  int body_line = 0;       // Number of the first line after end_header.
+};
+
+// Face indices are stored as uint32_t; the largest index must fit, with one value to spare.
+constexpr uint64_t kMaxVertices = std::numeric_limits<uint32_t>::max();
+
+bool ParseType(absl::string_view name, PlyType* type) {
+  if (name == "char" || name == "int8") *type = PlyType::kInt8;
+  else if (name == "uchar" || name == "uint8") *type = PlyType::kUint8;
+  else if (name == "short" || name == "int16") *type = PlyType::kInt16;
+  else if (name == "ushort" || name == "uint16") *type = PlyType::kUint16;
+  else if (name == "int" || name == "int32") *type = PlyType::kInt32;
+  else if (name == "uint" || name == "uint32") *type = PlyType::kUint32;
+  else if (name == "float" || name == "float32") *type = PlyType::kFloat32;
+  else if (name == "double" || name == "float64") *type = PlyType::kFloat64;
+  else return false;
+  return true;
+}
+
+size_t TypeSize(PlyType type) {
+  switch (type) {
+    case PlyType::kInt8:
+    case PlyType::kUint8:
+      return 1;
+    case PlyType::kInt16:
+    case PlyType::kUint16:
+      return 2;
+    case PlyType::kInt32:
+    case PlyType::kUint32:
+    case PlyType::kFloat32:
+      return 4;
+    case PlyType::kFloat64:
+      return 8;
+  }
+  return 0;
+}
+
+bool IsIntegral(PlyType type) { return type != PlyType::kFloat32 && type != PlyType::kFloat64; }
+
+constexpr char kTypeNames[] = "char, uchar, short, ushort, int, uint, float, double";
+
+absl::Status ParseProperty(const std::vector<absl::string_view>& tokens, int line,
+                           PlyElement* element) {
+  PlyProperty property;
+  if (tokens.size() >= 2 && tokens[1] == "list") {
+    if (tokens.size() != 5) {
+      return LineError(line, "expected 'property list <count type> <item type> <name>'");
+    }
+    property.is_list = true;
+    if (!ParseType(tokens[2], &property.count_type) || !IsIntegral(property.count_type)) {
+      return LineError(line, absl::StrCat("expected an integer list count type, found ",
+                                          Quoted(tokens[2])));
+    }
+    if (!ParseType(tokens[3], &property.type)) {
+      return LineError(line, absl::StrCat("unknown property type ", Quoted(tokens[3]),
+                                          "; expected one of ", kTypeNames));
+    }
+    property.name = std::string(tokens[4]);
+  } else {
+    if (tokens.size() != 3) return LineError(line, "expected 'property <type> <name>'");
+    if (!ParseType(tokens[1], &property.type)) {
+      return LineError(line, absl::StrCat("unknown property type ", Quoted(tokens[1]),
+                                          "; expected one of ", kTypeNames));
+    }
+    property.name = std::string(tokens[2]);
+  }
+  element->properties.push_back(std::move(property));
+  return absl::OkStatus();
+}
+
+absl::StatusOr<PlyHeader> ParseHeader(absl::string_view data) {
+  LineCursor cursor(data);
+  absl::string_view line;
+  std::vector<absl::string_view> tokens;
+  if (cursor.Next(&line)) SplitWhitespace(line, &tokens);
+  if (tokens.size() != 1 || tokens[0] != "ply") {
+    return LineError(1, absl::StrCat("not a PLY file: expected 'ply', found ",
+                                     Quoted(line.substr(0, 16))));
+  }
+  PlyHeader header;
+  bool have_format = false;
+  while (cursor.Next(&line)) {
+    const int n = cursor.line_number();
+    SplitWhitespace(line, &tokens);
+    if (tokens.empty()) continue;
+    const absl::string_view key = tokens[0];
+    if (key == "comment" || key == "obj_info") continue;
+    if (key == "format") {
+      if (tokens.size() != 3) return LineError(n, "expected 'format <kind> 1.0'");
+      if (tokens[1] == "ascii") header.format = PlyFormat::kAscii;
+      else if (tokens[1] == "binary_little_endian") header.format = PlyFormat::kBinaryLittleEndian;
+      else if (tokens[1] == "binary_big_endian") header.format = PlyFormat::kBinaryBigEndian;
+      else {
+        return LineError(n, absl::StrCat("unknown PLY format ", Quoted(tokens[1]),
+                                         "; expected ascii, binary_little_endian or "
+                                         "binary_big_endian"));
+      }
+      if (tokens[2] != "1.0") {
+        return LineError(n, absl::StrCat("unsupported PLY version ", Quoted(tokens[2]),
+                                         "; expected 1.0"));
+      }
+      have_format = true;
+    } else if (key == "element") {
+      int64_t count = -1;
+      if (tokens.size() != 3 || !ParseInt64(tokens[2], &count) || count < 0) {
+        return LineError(n, "expected 'element <name> <non-negative count>'");
+      }
+      header.elements.push_back({std::string(tokens[1]), static_cast<uint64_t>(count), {}, n});
+    } else if (key == "property") {
+      if (header.elements.empty()) return LineError(n, "'property' before any 'element'");
+      NM_RETURN_IF_ERROR(ParseProperty(tokens, n, &header.elements.back()));
+    } else if (key == "end_header") {
+      if (!have_format) return LineError(n, "the header has no 'format' line");
+      header.body_offset = cursor.offset();
+      header.body_line = n + 1;
+      return header;
+    } else {
+      return LineError(n, absl::StrCat("unexpected header keyword ", Quoted(key),
+                                       "; expected format, element, property, comment or "
+                                       "end_header"));
+    }
+  }
+  return LineError(cursor.line_number(), "the header has no 'end_header' line");
+}
+
+// Reads values from a binary body. Every read is bounds-checked against the data.
+class BinaryBody {
+ public:
+  BinaryBody(absl::string_view data, size_t offset, bool big_endian)
+      : data_(data), offset_(offset), big_endian_(big_endian) {}
+
+  // Rejects a count that the remaining bytes cannot hold, before anything is allocated.
+  absl::Status BeginElement(const PlyElement& element) {
+    uint64_t min_size = 0;
+    for (const PlyProperty& p : element.properties) {
+      min_size += TypeSize(p.is_list ? p.count_type : p.type);
+    }
+    const uint64_t remaining = data_.size() - offset_;
+    if (min_size > 0 && element.count > remaining / min_size) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "byte ", offset_, ": the header declares ", element.count, " '", element.name,
+          "' elements of at least ", min_size, " bytes each, but only ", remaining,
+          " bytes follow"));
+    }
+    return absl::OkStatus();
+  }
+  absl::Status BeginRecord(const PlyElement&, uint64_t) {
+    record_start_ = offset_;
+    return absl::OkStatus();
+  }
+  absl::Status EndRecord(const PlyElement&, uint64_t) { return absl::OkStatus(); }
+  std::string Where() const { return absl::StrCat("byte ", record_start_); }
+
+  absl::Status Read(PlyType type, const PlyElement& element, uint64_t index,
+                    const PlyProperty& property, double* value) {
+    const size_t size = TypeSize(type);
+    if (data_.size() - offset_ < size) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "byte ", offset_, ": the data ends inside ", element.name, " ", index,
+          " (property '", property.name, "'); the file is truncated"));
+    }
+    const char* p = data_.data() + offset_;
+    offset_ += size;
+    switch (type) {
+      case PlyType::kInt8: *value = LoadScalar<int8_t>(p, big_endian_); break;
+      case PlyType::kUint8: *value = LoadScalar<uint8_t>(p, big_endian_); break;
+      case PlyType::kInt16: *value = LoadScalar<int16_t>(p, big_endian_); break;
+      case PlyType::kUint16: *value = LoadScalar<uint16_t>(p, big_endian_); break;
+      case PlyType::kInt32: *value = LoadScalar<int32_t>(p, big_endian_); break;
+      case PlyType::kUint32: *value = LoadScalar<uint32_t>(p, big_endian_); break;
+      case PlyType::kFloat32: *value = LoadScalar<float>(p, big_endian_); break;
+      case PlyType::kFloat64: *value = LoadScalar<double>(p, big_endian_); break;
+    }
+    return absl::OkStatus();
+  }
+
+ private:
+  absl::string_view data_;
+  size_t offset_;
+  size_t record_start_ = 0;
+  bool big_endian_;
+};
+
+// Reads values from an ASCII body: one element per line, blank lines skipped.
+class AsciiBody {
+ public:
+  AsciiBody(absl::string_view data, size_t offset, int first_line)
+      : cursor_(data.substr(offset)), first_line_(first_line) {}
+
+  absl::Status BeginElement(const PlyElement& element) {
+    // Each element with properties takes at least one character.
+    if (!element.properties.empty() && element.count > cursor_.remaining()) {
+      return LineError(Line(), absl::StrCat("the header declares ", element.count, " '",
+                                            element.name, "' elements but only ",
+                                            cursor_.remaining(), " bytes follow"));
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status BeginRecord(const PlyElement& element, uint64_t index) {
+    absl::string_view line;
+    do {
+      if (!cursor_.Next(&line)) {
+        return LineError(Line(), absl::StrCat("the file ends after ", index, " of the ",
+                                              element.count, " '", element.name,
+                                              "' elements the header declares"));
+      }
+      SplitWhitespace(line, &tokens_);
+    } while (tokens_.empty());
+    next_ = 0;
+    return absl::OkStatus();
+  }
+
+  absl::Status EndRecord(const PlyElement& element, uint64_t index) {
+    if (next_ < tokens_.size()) {
+      return LineError(Line(), absl::StrCat(element.name, " ", index, " has ", tokens_.size(),
+                                            " values, more than its properties take"));
+    }
+    return absl::OkStatus();
+  }
+
+  std::string Where() const { return absl::StrCat("line ", Line()); }
+
+  absl::Status Read(PlyType type, const PlyElement& element, uint64_t index,
+                    const PlyProperty& property, double* value) {
+    if (next_ >= tokens_.size()) {
+      return LineError(Line(), absl::StrCat(element.name, " ", index,
+                                            " has too few values: property '", property.name,
+                                            "' is missing"));
+    }
+    const absl::string_view token = tokens_[next_++];
+    if (!ParseDouble(token, value)) {
+      return LineError(Line(), absl::StrCat("expected a number for property '", property.name,
+                                            "' of ", element.name, " ", index, ", found ",
+                                            Quoted(token)));
+    }
+    if (IsIntegral(type) && std::floor(*value) != *value) {
+      return LineError(Line(), absl::StrCat("expected an integer for property '",
+                                            property.name, "' of ", element.name, " ", index,
+                                            ", found ", Quoted(token)));
+    }
+    return absl::OkStatus();
+  }
+
+ private:
+  int Line() const { return first_line_ - 1 + std::max(cursor_.line_number(), 1); }
+
+  LineCursor cursor_;
+  int first_line_;
+  std::vector<absl::string_view> tokens_;
+  size_t next_ = 0;
+};
+
+// Reads a list length; binary signed types can hold negative values.
+template <typename Body>
+absl::Status ReadListCount(Body& body, const PlyElement& element, uint64_t index,
+                           const PlyProperty& property, uint64_t* count) {
+  double value = 0;
+  NM_RETURN_IF_ERROR(body.Read(property.count_type, element, index, property, &value));
+  if (value < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(body.Where(), ": list '", property.name,
+                                                   "' of ", element.name, " ", index,
+                                                   " has negative length ", value));
+  }
+  *count = static_cast<uint64_t>(value);
+  return absl::OkStatus();
+}
+
+template <typename Body>
+absl::Status SkipProperty(Body& body, const PlyElement& element, uint64_t index,
+                          const PlyProperty& property) {
+  double ignored = 0;
+  if (!property.is_list) return body.Read(property.type, element, index, property, &ignored);
+  uint64_t count = 0;
+  NM_RETURN_IF_ERROR(ReadListCount(body, element, index, property, &count));
+  // Each read consumes data or fails, so a bogus count stops at the end of the data.
+  for (uint64_t k = 0; k < count; ++k) {
+    NM_RETURN_IF_ERROR(body.Read(property.type, element, index, property, &ignored));
+  }
+  return absl::OkStatus();
+}
+
+template <typename Body>
+absl::Status SkipElement(Body& body, const PlyElement& element) {
+  if (element.properties.empty()) return absl::OkStatus();
+  for (uint64_t i = 0; i < element.count; ++i) {
+    NM_RETURN_IF_ERROR(body.BeginRecord(element, i));
+    for (const PlyProperty& property : element.properties) {
+      NM_RETURN_IF_ERROR(SkipProperty(body, element, i, property));
+    }
+    NM_RETURN_IF_ERROR(body.EndRecord(element, i));
+  }
+  return absl::OkStatus();
+}
+
+enum Role { kOther, kX, kY, kZ, kNx, kNy, kNz, kWeight };
+
+// Assigns a role to each vertex property; fails when x, y or z is missing.
+absl::StatusOr<std::vector<Role>> VertexRoles(const PlyElement& element, bool* has_normals,
+                                              bool* has_weights) {
+  std::vector<Role> roles(element.properties.size(), kOther);
+  auto find = [&](absl::string_view name) -> int {
+    for (size_t i = 0; i < element.properties.size(); ++i) {
+      const PlyProperty& p = element.properties[i];
+      if (!p.is_list && roles[i] == kOther && absl::EqualsIgnoreCase(p.name, name)) {
+        return static_cast<int>(i);
+      }
+    }
+    return -1;
+  };
+  const char* axes[3] = {"x", "y", "z"};
+  for (int c = 0; c < 3; ++c) {
+    const int i = find(axes[c]);
+    if (i < 0) {
+      return LineError(element.line, absl::StrCat("element 'vertex' has no scalar property '",
+                                                  axes[c], "'"));
+    }
+    roles[i] = static_cast<Role>(kX + c);
+  }
+  const int nx = find("nx"), ny = find("ny"), nz = find("nz");
+  *has_normals = nx >= 0 && ny >= 0 && nz >= 0;
+  if (*has_normals) {
+    roles[nx] = kNx;
+    roles[ny] = kNy;
+    roles[nz] = kNz;
+  }
+  *has_weights = false;
+  for (const char* name : {"confidence", "weight", "quality", "intensity", "scalar"}) {
+    const int i = find(name);
+    if (i >= 0) {
+      roles[i] = kWeight;
+      *has_weights = true;
+      break;
+    }
+  }
+  return roles;
+}
+
+template <typename Body>
+absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry* out) {
+  if (element.count > kMaxVertices) {
+    return LineError(element.line, absl::StrCat("the header declares ", element.count,
+                                                " vertices; at most ", kMaxVertices,
+                                                " are supported"));
+  }
+  bool has_normals = false, has_weights = false;
+  NM_ASSIGN_OR_RETURN(std::vector<Role> roles, VertexRoles(element, &has_normals, &has_weights));
+  // BeginElement has bounded the count by the remaining bytes.
+  out->positions.reserve(element.count);
+  if (has_normals) out->normals.reserve(element.count);
+  if (has_weights) out->weights.reserve(element.count);
+  double values[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  for (uint64_t i = 0; i < element.count; ++i) {
+    NM_RETURN_IF_ERROR(body.BeginRecord(element, i));
+    for (size_t k = 0; k < element.properties.size(); ++k) {
+      const PlyProperty& property = element.properties[k];
+      if (roles[k] == kOther) {
+        NM_RETURN_IF_ERROR(SkipProperty(body, element, i, property));
+      } else {
+        NM_RETURN_IF_ERROR(body.Read(property.type, element, i, property, &values[roles[k]]));
+      }
+    }
+    NM_RETURN_IF_ERROR(body.EndRecord(element, i));
+    const Vec3f p(static_cast<float>(values[kX]), static_cast<float>(values[kY]),
+                  static_cast<float>(values[kZ]));
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          body.Where(), ": vertex ", i, " has a non-finite coordinate (", values[kX], ", ",
+          values[kY], ", ", values[kZ], ")"));
+    }
+    out->positions.push_back(p);
+    if (has_normals) {
+      const Vec3f n(static_cast<float>(values[kNx]), static_cast<float>(values[kNy]),
+                    static_cast<float>(values[kNz]));
+      if (!std::isfinite(n[0]) || !std::isfinite(n[1]) || !std::isfinite(n[2])) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(body.Where(), ": vertex ", i, " has a non-finite normal"));
+      }
+      out->normals.push_back(n);
+    }
+    if (has_weights) out->weights.push_back(static_cast<float>(values[kWeight]));
+  }
+  return absl::OkStatus();
+}
+
+// `num_vertices` is 0 when the vertex element has not been read yet (it is checked later).
+template <typename Body>
+absl::Status ReadFaces(Body& body, const PlyElement& element, size_t num_vertices,
+                       ParsedGeometry* out) {
+  int indices = -1;
+  for (size_t k = 0; k < element.properties.size(); ++k) {
+    const PlyProperty& p = element.properties[k];
+    if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
+      indices = static_cast<int>(k);
+      break;
+    }
+  }
+  if (indices < 0) {
+    return LineError(element.line,
+                     "element 'face' has no 'vertex_indices' (or 'vertex_index') list property");
+  }
+  out->faces.reserve(element.count);
+  std::vector<uint32_t> polygon;
+  for (uint64_t i = 0; i < element.count; ++i) {
+    NM_RETURN_IF_ERROR(body.BeginRecord(element, i));
+    for (size_t k = 0; k < element.properties.size(); ++k) {
+      const PlyProperty& property = element.properties[k];
+      if (static_cast<int>(k) != indices) {
+        NM_RETURN_IF_ERROR(SkipProperty(body, element, i, property));
+        continue;
+      }
+      uint64_t count = 0;
+      NM_RETURN_IF_ERROR(ReadListCount(body, element, i, property, &count));
+      if (count < 3) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            body.Where(), ": face ", i, " has ", count, " vertices; a face needs at least 3"));
+      }
+      polygon.clear();
+      for (uint64_t c = 0; c < count; ++c) {
+        double value = 0;
+        NM_RETURN_IF_ERROR(body.Read(property.type, element, i, property, &value));
+        if (!(value >= 0) || std::floor(value) != value ||
+            (num_vertices > 0 && value >= static_cast<double>(num_vertices)) ||
+            value >= static_cast<double>(kMaxVertices)) {
+          return absl::InvalidArgumentError(absl::StrCat(
+              body.Where(), ": face ", i, " uses vertex index ", value,
+              num_vertices > 0 ? absl::StrCat("; the file has ", num_vertices, " vertices")
+                               : std::string(" which is not a valid index")));
+        }
+        polygon.push_back(static_cast<uint32_t>(value));
+      }
+      for (size_t c = 1; c + 1 < polygon.size(); ++c) {
+        out->faces.push_back({polygon[0], polygon[c], polygon[c + 1]});
+      }
+    }
+    NM_RETURN_IF_ERROR(body.EndRecord(element, i));
+  }
+  return absl::OkStatus();
+}
+
+template <typename Body>
+absl::StatusOr<ParsedGeometry> ReadBody(const PlyHeader& header, Body& body,
+                                        FaceHandling faces) {
+  ParsedGeometry out;
+  bool have_vertices = false;
+  bool faces_before_vertices = false;
+  for (const PlyElement& element : header.elements) {
+    NM_RETURN_IF_ERROR(body.BeginElement(element));
+    if (element.name == "vertex") {
+      if (have_vertices) return LineError(element.line, "a second 'vertex' element");
+      NM_RETURN_IF_ERROR(ReadVertices(body, element, &out));
+      have_vertices = true;
+    } else if (element.name == "face" && faces == FaceHandling::kRead) {
+      faces_before_vertices = !have_vertices;
+      NM_RETURN_IF_ERROR(ReadFaces(body, element, out.positions.size(), &out));
+    } else {
+      NM_RETURN_IF_ERROR(SkipElement(body, element));
+    }
+  }
+  if (!have_vertices) return absl::InvalidArgumentError("the PLY header has no 'vertex' element");
+  if (faces_before_vertices || out.positions.empty()) {
+    for (size_t f = 0; f < out.faces.size(); ++f) {
+      for (uint32_t v : out.faces[f]) {
+        if (v >= out.positions.size()) {
+          return absl::InvalidArgumentError(absl::StrCat("triangle ", f, " uses vertex ", v,
+                                                         "; the file has ",
+                                                         out.positions.size(), " vertices"));
+        }
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces) {
+  NM_ASSIGN_OR_RETURN(const PlyHeader header, ParseHeader(data));
+  if (header.format == PlyFormat::kAscii) {
+    AsciiBody body(data, header.body_offset, header.body_line);
+    return ReadBody(header, body, faces);
+  }
+  BinaryBody body(data, header.body_offset, header.format == PlyFormat::kBinaryBigEndian);
+  return ReadBody(header, body, faces);
+}
+
+std::string FormatPly(const GeometryView& geometry) {
+  const bool normals = !geometry.normals.empty();
+  const bool weights = !geometry.weights.empty();
+  std::string out = absl::StrCat(
+      "ply\nformat binary_little_endian 1.0\ncomment written by neuralmesh\nelement vertex ",
+      geometry.positions.size(), "\nproperty float x\nproperty float y\nproperty float z\n");
+  if (normals) out += "property float nx\nproperty float ny\nproperty float nz\n";
+  if (weights) out += "property float confidence\n";
+  if (!geometry.faces.empty()) {
+    absl::StrAppend(&out, "element face ", geometry.faces.size(),
+                    "\nproperty list uchar uint vertex_indices\n");
+  }
+  out += "end_header\n";
+  const size_t vertex_size = 4 * (3 + (normals ? 3 : 0) + (weights ? 1 : 0));
+  out.reserve(out.size() + geometry.positions.size() * vertex_size + geometry.faces.size() * 13);
+  for (size_t i = 0; i < geometry.positions.size(); ++i) {
+    for (int c = 0; c < 3; ++c) AppendLittleEndian(geometry.positions[i][c], &out);
+    if (normals) {
+      for (int c = 0; c < 3; ++c) AppendLittleEndian(geometry.normals[i][c], &out);
+    }
+    if (weights) AppendLittleEndian(geometry.weights[i], &out);
+  }
+  for (const auto& face : geometry.faces) {
+    out.push_back(3);
+    for (uint32_t v : face) AppendLittleEndian(v, &out);
+  }
+  return out;
+}
+
+}  // namespace neuralmesh::io_internal

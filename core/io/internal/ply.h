@@ -1,0 +1,30 @@
+// The PLY format (Turk 1994): ASCII, binary little-endian and binary big-endian bodies.
+#ifndef NEURALMESH_CORE_IO_INTERNAL_PLY_H_
+#define NEURALMESH_CORE_IO_INTERNAL_PLY_H_
+
+#include <string>
+#include "absl/strings/string_view.h"
+
+#include "absl/status/statusor.h"
+#include "core/io/internal/geometry_data.h"
+
+namespace neuralmesh::io_internal {
+
+// Parses a PLY file held in `data`. Reads the 'vertex' element's x, y, z (any scalar type),
+// nx, ny, nz when all three are present, and as weights the first scalar property named
+// confidence, weight, quality, intensity or scalar (case-insensitive). With FaceHandling::kRead
+// the 'face' element's 'vertex_indices' (or 'vertex_index') lists are fan-triangulated.
+// Every other element and property, lists included, is skipped.
+// Returns INVALID_ARGUMENT naming the line (header, ASCII body) or byte offset (binary body) and
+// what was expected, for a malformed header, a count larger than the remaining data could
+// hold, missing or malformed values, non-finite coordinates or out-of-range face indices.
+absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces);
+
+// Formats `geometry` as binary little-endian PLY: float x, y, z, then float nx, ny, nz and a
+// float 'confidence' when present, and a 'face' element (uchar count, uint indices) when there
+// are faces.
+std::string FormatPly(const GeometryView& geometry);
+
+}  // namespace neuralmesh::io_internal
+
+#endif  // NEURALMESH_CORE_IO_INTERNAL_PLY_H_

@@ -1,0 +1,84 @@
+#include "core/io/internal/text.h"
+
+#include <charconv>
+#include <cmath>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+
+namespace neuralmesh::io_internal {
+namespace {
+
+bool IsSpace(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';
+}
+
+}  // namespace
+
+bool LineCursor::Next(absl::string_view* line) {
+  if (offset_ >= text_.size()) return false;
+  const size_t end = text_.find('\n', offset_);
+  const size_t stop = end == absl::string_view::npos ? text_.size() : end;
+  absl::string_view result = text_.substr(offset_, stop - offset_);
+  if (!result.empty() && result.back() == '\r') result.remove_suffix(1);
+  offset_ = end == absl::string_view::npos ? text_.size() : end + 1;
+  ++line_number_;
+  *line = result;
+  return true;
+}
+
+void SplitWhitespace(absl::string_view line, std::vector<absl::string_view>* tokens) {
+  tokens->clear();
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && IsSpace(line[i])) ++i;
+    const size_t start = i;
+    while (i < line.size() && !IsSpace(line[i])) ++i;
+    if (i > start) tokens->push_back(line.substr(start, i - start));
+  }
+}
+
+absl::string_view StripHashComment(absl::string_view line) {
+  const size_t hash = line.find('#');
+  return hash == absl::string_view::npos ? line : line.substr(0, hash);
+}
+
+bool ParseDouble(absl::string_view token, double* value) {
+  // SimpleAtod trims surrounding whitespace; tokens never hold any, and an empty token is not
+  // a number.
+  return !token.empty() && absl::SimpleAtod(token, value);
+}
+
+bool ParseFloat(absl::string_view token, float* value) {
+  double wide = 0;
+  if (!ParseDouble(token, &wide)) return false;
+  *value = static_cast<float>(wide);
+  return true;
+}
+
+bool ParseInt64(absl::string_view token, int64_t* value) {
+  return !token.empty() && absl::SimpleAtoi(token, value);
+}
+
+std::string Quoted(absl::string_view token) {
+  constexpr size_t kMaxShown = 40;
+  std::string shown;
+  for (size_t i = 0; i < token.size() && i < kMaxShown; ++i) {
+    const unsigned char c = static_cast<unsigned char>(token[i]);
+    shown.push_back(c >= 0x20 && c < 0x7f ? static_cast<char>(c) : '?');
+  }
+  if (token.size() > kMaxShown) shown += "...";
+  return absl::StrCat("'", shown, "'");
+}
+
+absl::Status LineError(int line, absl::string_view message) {
+  return absl::InvalidArgumentError(absl::StrCat("line ", line, ": ", message));
+}
+
+void AppendFloat(float value, std::string* out) {
+  char buffer[32];
+  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  out->append(buffer, result.ptr);
+}
+
+}  // namespace neuralmesh::io_internal

@@ -1,0 +1,146 @@
+#include "core/io/mesh_io.h"
+
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
+#include "core/io/internal/file_util.h"
+#include "core/io/internal/geometry_data.h"
+#include "core/io/internal/obj.h"
+#include "core/io/internal/off.h"
+#include "core/io/internal/ply.h"
+#include "core/io/internal/stl.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh {
+namespace {
+
+using io_internal::FileFormat;
+
+constexpr char kSupported[] = ".ply, .obj, .off, .stl, .drc";
+
+absl::StatusOr<FileFormat> MeshFormat(const std::string& path) {
+  const FileFormat format = io_internal::FormatFromPath(path);
+  if (format == FileFormat::kUnknown || format == FileFormat::kXyz) {
+    const std::string extension = io_internal::LowercaseExtension(path);
+    return absl::InvalidArgumentError(absl::StrCat(
+        "'", path, "': ",
+        extension.empty() ? std::string("no file extension")
+                          : absl::StrCat("unsupported mesh file extension '", extension, "'"),
+        "; supported: ", kSupported));
+  }
+  return format;
+}
+
+absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data) {
+  absl::StatusOr<io_internal::ParsedGeometry> parsed;
+  switch (format) {
+    case FileFormat::kPly:
+      parsed = io_internal::ParsePly(data, io_internal::FaceHandling::kRead);
+      break;
+    case FileFormat::kObj:
+      parsed = io_internal::ParseObj(data, io_internal::FaceHandling::kRead);
+      break;
+    case FileFormat::kOff:
+      parsed = io_internal::ParseOff(data, io_internal::FaceHandling::kRead);
+      break;
+    case FileFormat::kStl:
+      parsed = io_internal::ParseStl(data);
+      break;
+    case FileFormat::kDraco:
+      return DecodeMesh(std::string_view(data.data(), data.size()));
+    case FileFormat::kXyz:
+    case FileFormat::kUnknown:
+      return absl::InternalError("not a mesh format");
+  }
+  if (!parsed.ok()) return parsed.status();
+  TriangleMesh mesh;
+  mesh.positions = std::move(parsed->positions);
+  mesh.faces = std::move(parsed->faces);
+  return mesh;
+}
+
+absl::Status CheckWritable(const TriangleMesh& mesh, FileFormat format) {
+  if (mesh.positions.empty()) return absl::InvalidArgumentError("the mesh is empty");
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    const Vec3f& p = mesh.positions[i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("vertex ", i, " has a non-finite coordinate"));
+    }
+  }
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    for (uint32_t v : mesh.faces[f]) {
+      if (v >= mesh.positions.size()) {
+        return absl::InvalidArgumentError(absl::StrCat("face ", f, " uses vertex ", v,
+                                                       " but the mesh has ",
+                                                       mesh.positions.size(), " vertices"));
+      }
+    }
+  }
+  if (mesh.faces.empty() && (format == FileFormat::kStl || format == FileFormat::kDraco)) {
+    return absl::InvalidArgumentError(
+        "the mesh has no faces, and this format stores only triangles");
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+bool IsSupportedMeshExtension(std::string_view path) {
+  const FileFormat format = io_internal::FormatFromPath(absl::string_view(path.data(), path.size()));
+  return format != FileFormat::kUnknown && format != FileFormat::kXyz;
+}
+
+absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path) {
+  NM_ASSIGN_OR_RETURN(const FileFormat format, MeshFormat(path));
+  NM_ASSIGN_OR_RETURN(const std::string data, io_internal::ReadFileContents(path));
+  absl::StatusOr<TriangleMesh> mesh = ParseMesh(format, data);
+  if (!mesh.ok()) return io_internal::WithPath(mesh.status(), path);
+  if (mesh->positions.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat("'", path, "' contains no vertices"));
+  }
+  return mesh;
+}
+
+absl::Status WriteMesh(const TriangleMesh& mesh, const std::string& path,
+                       const DracoOptions& draco) {
+  NM_ASSIGN_OR_RETURN(const FileFormat format, MeshFormat(path));
+  const absl::Status writable = CheckWritable(mesh, format);
+  if (!writable.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot write '", path, "': ", writable.message()));
+  }
+  const io_internal::GeometryView view{mesh.positions, {}, {}, mesh.faces};
+  std::string data;
+  switch (format) {
+    case FileFormat::kPly:
+      data = io_internal::FormatPly(view);
+      break;
+    case FileFormat::kObj:
+      data = io_internal::FormatObj(view);
+      break;
+    case FileFormat::kOff:
+      data = io_internal::FormatOff(view);
+      break;
+    case FileFormat::kStl:
+      data = io_internal::FormatStl(view);
+      break;
+    case FileFormat::kDraco: {
+      absl::StatusOr<std::string> encoded = EncodeMesh(mesh, draco);
+      if (!encoded.ok()) {
+        return absl::Status(encoded.status().code(), absl::StrCat("cannot write '", path, "': ",
+                                                                  encoded.status().message()));
+      }
+      data = *std::move(encoded);
+      break;
+    }
+    case FileFormat::kXyz:
+    case FileFormat::kUnknown:
+      return absl::InternalError("not a mesh format");
+  }
+  return io_internal::WriteFileContents(path, data);
+}
+
+}  // namespace neuralmesh

@@ -1,0 +1,45 @@
+// Reads and writes triangle meshes as PLY, OBJ, OFF, STL and Draco files, chosen by the
+// file-name extension (case-insensitive).
+#ifndef NEURALMESH_CORE_IO_MESH_IO_H_
+#define NEURALMESH_CORE_IO_MESH_IO_H_
+
+#include <string>
+#include <string_view>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/io/draco_codec.h"
+#include "core/triangle_mesh.h"
+
+namespace neuralmesh {
+
+// True when ReadMesh and WriteMesh handle the extension of `path`: .ply, .obj, .off, .stl,
+// .drc.
+bool IsSupportedMeshExtension(std::string_view path);
+
+// Reads the mesh at `path`:
+//   .ply  ASCII or binary (either byte order); 'vertex' x, y, z and 'face' vertex_indices.
+//   .obj  'v' and 'f' lines (v, v/vt, v/vt/vn, v//vn; negative indices count back).
+//   .off  OFF, COFF, NOFF, STOFF.
+//   .stl  binary or ASCII; identical vertex positions are merged.
+//   .drc  a Draco mesh (see draco_codec.h: positions are quantized, order may change).
+// Polygons are fan-triangulated. A file may hold vertices and no faces.
+// Returns NOT_FOUND when the file cannot be opened or read; INVALID_ARGUMENT for an
+// unsupported extension (listing the supported ones), an empty file, a file with no vertices,
+// or malformed content (the message gives the line or byte offset and what was expected),
+// including non-finite coordinates and out-of-range face indices.
+absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path);
+
+// Writes `mesh` to `path`, replacing any file there: binary little-endian .ply, .obj, .off,
+// binary .stl, or .drc encoded with `draco`.
+// Returns INVALID_ARGUMENT for an unsupported extension, an empty mesh, a non-finite
+// coordinate, a face index out of range, a mesh without faces for .stl or .drc, or invalid
+// `draco` options (including positions outside its quantization box); otherwise the status of
+// the write ("cannot write 'path': reason", e.g. NOT_FOUND for a missing directory,
+// PERMISSION_DENIED).
+absl::Status WriteMesh(const TriangleMesh& mesh, const std::string& path,
+                       const DracoOptions& draco = {});
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_IO_MESH_IO_H_

@@ -1,0 +1,119 @@
+#include "core/io/point_cloud_io.h"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
+#include "core/io/internal/file_util.h"
+#include "core/io/internal/geometry_data.h"
+#include "core/io/internal/obj.h"
+#include "core/io/internal/off.h"
+#include "core/io/internal/ply.h"
+#include "core/io/internal/xyz.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh {
+namespace {
+
+using io_internal::FileFormat;
+
+bool IsReadable(FileFormat format) {
+  return format != FileFormat::kUnknown && format != FileFormat::kStl;
+}
+
+bool IsWritable(FileFormat format) {
+  return format == FileFormat::kPly || format == FileFormat::kXyz ||
+         format == FileFormat::kDraco;
+}
+
+absl::Status UnsupportedExtension(const std::string& path, const char* supported) {
+  const std::string extension = io_internal::LowercaseExtension(path);
+  return absl::InvalidArgumentError(absl::StrCat(
+      "'", path, "': ",
+      extension.empty() ? std::string("no file extension")
+                        : absl::StrCat("unsupported point cloud file extension '", extension, "'"),
+      "; supported: ", supported));
+}
+
+absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view data) {
+  absl::StatusOr<io_internal::ParsedGeometry> parsed;
+  switch (format) {
+    case FileFormat::kPly:
+      parsed = io_internal::ParsePly(data, io_internal::FaceHandling::kSkip);
+      break;
+    case FileFormat::kXyz:
+      parsed = io_internal::ParseXyz(data);
+      break;
+    case FileFormat::kObj:
+      parsed = io_internal::ParseObj(data, io_internal::FaceHandling::kSkip);
+      break;
+    case FileFormat::kOff:
+      parsed = io_internal::ParseOff(data, io_internal::FaceHandling::kSkip);
+      break;
+    case FileFormat::kDraco:
+      return DecodePointCloud(std::string_view(data.data(), data.size()));
+    case FileFormat::kStl:
+    case FileFormat::kUnknown:
+      return absl::InternalError("not a point cloud format");
+  }
+  if (!parsed.ok()) return parsed.status();
+  PointCloud cloud;
+  cloud.positions = std::move(parsed->positions);
+  cloud.normals = std::move(parsed->normals);
+  cloud.weights = std::move(parsed->weights);
+  return cloud;
+}
+
+}  // namespace
+
+bool IsReadablePointCloudExtension(std::string_view path) {
+  return IsReadable(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
+}
+
+bool IsWritablePointCloudExtension(std::string_view path) {
+  return IsWritable(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
+}
+
+absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path) {
+  const FileFormat format = io_internal::FormatFromPath(path);
+  if (!IsReadable(format)) {
+    return UnsupportedExtension(path, ".ply, .xyz, .txt, .pts, .obj, .off, .drc");
+  }
+  NM_ASSIGN_OR_RETURN(const std::string data, io_internal::ReadFileContents(path));
+  absl::StatusOr<PointCloud> cloud = ParsePointCloud(format, data);
+  if (!cloud.ok()) return io_internal::WithPath(cloud.status(), path);
+  if (cloud->empty()) {
+    return absl::InvalidArgumentError(absl::StrCat("'", path, "' contains no points"));
+  }
+  NM_RETURN_IF_ERROR(io_internal::WithPath(ValidatePointCloud(*cloud), path));
+  return cloud;
+}
+
+absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
+                             const DracoOptions& draco) {
+  const FileFormat format = io_internal::FormatFromPath(path);
+  if (!IsWritable(format)) return UnsupportedExtension(path, ".ply, .xyz, .txt, .pts, .drc");
+  absl::Status valid = cloud.empty() ? absl::InvalidArgumentError("the point cloud is empty")
+                                     : ValidatePointCloud(cloud);
+  if (!valid.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot write '", path, "': ", valid.message()));
+  }
+  const io_internal::GeometryView view{cloud.positions, cloud.normals, cloud.weights, {}};
+  std::string data;
+  if (format == FileFormat::kPly) {
+    data = io_internal::FormatPly(view);
+  } else if (format == FileFormat::kXyz) {
+    data = io_internal::FormatXyz(view);
+  } else {
+    absl::StatusOr<std::string> encoded = EncodePointCloud(cloud, draco);
+    if (!encoded.ok()) {
+      return absl::Status(encoded.status().code(), absl::StrCat("cannot write '", path, "': ",
+                                                                encoded.status().message()));
+    }
+    data = *std::move(encoded);
+  }
+  return io_internal::WriteFileContents(path, data);
+}
+
+}  // namespace neuralmesh

@@ -1,0 +1,48 @@
+// Reads and writes point clouds (positions, optional normals and weights) in PLY, XYZ, OBJ, OFF
+// and Draco files, chosen by the file-name extension (case-insensitive).
+#ifndef NEURALMESH_CORE_IO_POINT_CLOUD_IO_H_
+#define NEURALMESH_CORE_IO_POINT_CLOUD_IO_H_
+
+#include <string>
+#include <string_view>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/io/draco_codec.h"
+#include "core/point_cloud.h"
+
+namespace neuralmesh {
+
+// True when ReadPointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .obj,
+// .off, .drc.
+bool IsReadablePointCloudExtension(std::string_view path);
+
+// True when WritePointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .drc.
+bool IsWritablePointCloudExtension(std::string_view path);
+
+// Reads the points at `path`; faces in the file are skipped without being checked:
+//   .ply  ASCII or binary (either byte order): 'vertex' x, y, z of any scalar type; nx, ny, nz
+//         when all present; the first of confidence, weight, quality, intensity, scalar as
+//         weights.
+//   .xyz, .txt, .pts  "x y z [nx ny nz] [w]" lines, '#' comments (see internal/xyz.h).
+//   .obj  the 'v' lines ('vn' is ignored: OBJ normals belong to face corners).
+//   .off  the vertices of OFF, COFF, NOFF (with normals), STOFF.
+//   .drc  a Draco point cloud, or the points of a Draco mesh.
+// Returns NOT_FOUND when the file cannot be opened or read; INVALID_ARGUMENT for an
+// unsupported extension (listing the supported ones), an empty file, a file with no points,
+// malformed content (the message gives the line or byte offset and what was expected), or a
+// cloud that fails ValidatePointCloud (e.g. negative weights).
+absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path);
+
+// Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
+// nx, ny, nz, confidence as present), "x y z [nx ny nz] [w]" text for .xyz/.txt/.pts, or .drc
+// encoded with `draco`.
+// Returns INVALID_ARGUMENT for an unsupported extension, an empty cloud, a cloud that fails
+// ValidatePointCloud, or invalid `draco` options; otherwise the status of the write ("cannot
+// write 'path': reason").
+absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
+                             const DracoOptions& draco = {});
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_IO_POINT_CLOUD_IO_H_

@@ -1,0 +1,289 @@
+#include "core/learning/boundary_merging.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <tuple>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/learning/triangle_removal.h"
+
+namespace neuralmesh {
+namespace {
+
+using VertexLoop = std::vector<Mesh::VertexHandle>;
+using Triangle = std::array<Mesh::VertexHandle, 3>;
+
+struct BoundaryLoop {
+  // The from-vertex of each boundary half-edge, in half-edge order: vertices[i] ->
+  // vertices[i + 1] is a boundary half-edge.
+  VertexLoop vertices;
+  Vec3 box_min;
+  Vec3 box_max;
+};
+
+std::vector<BoundaryLoop> CollectBoundaryLoops(const Mesh& mesh) {
+  std::vector<BoundaryLoop> loops;
+  std::vector<bool> visited(mesh.n_halfedges(), false);
+  for (auto start : mesh.halfedges()) {
+    if (visited[start.idx()] || !mesh.is_boundary(start)) continue;
+    BoundaryLoop loop;
+    loop.box_min = Vec3(std::numeric_limits<double>::infinity());
+    loop.box_max = Vec3(-std::numeric_limits<double>::infinity());
+    auto h = start;
+    do {
+      visited[h.idx()] = true;
+      const auto vh = mesh.from_vertex_handle(h);
+      loop.vertices.push_back(vh);
+      loop.box_min.minimize(mesh.point(vh));
+      loop.box_max.maximize(mesh.point(vh));
+      h = mesh.next_halfedge_handle(h);
+    } while (h != start);
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+// A lower bound on the Hausdorff distance of two point sets from their bounding boxes: the
+// point of A with the largest x is at least max_x(A) - max_x(B) away from every point of B,
+// and likewise for each side and axis in both directions.
+double HausdorffLowerBound(const BoundaryLoop& a, const BoundaryLoop& b) {
+  double bound = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    bound = std::max(bound, std::abs(a.box_max[axis] - b.box_max[axis]));
+    bound = std::max(bound, std::abs(a.box_min[axis] - b.box_min[axis]));
+  }
+  return bound;
+}
+
+// The squared directed Hausdorff distance max_p min_q |p - q|^2 from `from` to `to`, or
+// nullopt as soon as it reaches `limit_squared`. The inner search stops once a point of `to`
+// is closer than the running maximum, since that p can no longer raise it.
+std::optional<double> DirectedHausdorffSquared(const Mesh& mesh, const VertexLoop& from,
+                                               const VertexLoop& to, double limit_squared) {
+  double running_max = 0;
+  for (auto p : from) {
+    const Vec3& pp = mesh.point(p);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (auto q : to) {
+      nearest = std::min(nearest, (pp - mesh.point(q)).sqrnorm());
+      if (nearest <= running_max) break;
+    }
+    running_max = std::max(running_max, nearest);
+    if (running_max >= limit_squared) return std::nullopt;
+  }
+  return running_max;
+}
+
+// The symmetric Hausdorff distance of the vertex sets, or nullopt when it is >= `limit`.
+std::optional<double> HausdorffBelow(const Mesh& mesh, const VertexLoop& a, const VertexLoop& b,
+                                     double limit) {
+  const double limit_squared = limit * limit;
+  const auto ab = DirectedHausdorffSquared(mesh, a, b, limit_squared);
+  if (!ab) return std::nullopt;
+  const auto ba = DirectedHausdorffSquared(mesh, b, a, limit_squared);
+  if (!ba) return std::nullopt;
+  return std::sqrt(std::max(*ab, *ba));
+}
+
+// 4 sqrt(3) area / (sum of squared edge lengths): 1 when equilateral, 0 when degenerate.
+double TriangleQuality(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  const double squared_lengths = (p1 - p0).sqrnorm() + (p2 - p1).sqrnorm() + (p0 - p2).sqrnorm();
+  if (squared_lengths <= 0) return 0;
+  return 2 * std::sqrt(3.0) * OpenMesh::cross(p1 - p0, p2 - p0).norm() / squared_lengths;
+}
+
+// Plans the strip between loop `a` (boundary half-edges a[i] -> a[i+1]) and loop `b`
+// (b[j] -> b[j+1]). Returns the faces in the order they must be added, or nullopt when no
+// legal strip exists. O(|a| |b| + sum of the valences of a).
+//
+// The walk runs over a[0..n] forward and c[0..m] = b backward, both rotated to start at the
+// closest pair of vertices that is not already an edge. State (i, k) means the current cross
+// edge joins a[i mod n] and c[k mod m]; the walk goes from (0, 0) to (n, m), which is the
+// first cross edge again. A state is allowed when its pair is not an edge of the mesh and the
+// walk cannot have joined that pair before. Since i and k never decrease, a pair can repeat
+// only where the walk wraps: (n, k) against (0, k) and (i, m) against (i, 0). We rule that
+// out by deciding the first move: if it advances on A, no (0, k > 0) is visited, so only
+// (i < n, m) and (n, 0) are forbidden (B is consumed last); symmetrically if it advances on B.
+// For each choice a table of the states from which (n, m) can still be reached lets the
+// greedy choice of the better triangle never run into a dead end.
+std::optional<std::vector<Triangle>> PlanStrip(const Mesh& mesh, const VertexLoop& a,
+                                               const VertexLoop& b) {
+  const int n = static_cast<int>(a.size());
+  const int m = static_cast<int>(b.size());
+
+  // linked[i * m + j]: a[i] and b[j] are already joined by an edge.
+  std::unordered_map<int, int> index_in_b;
+  for (int j = 0; j < m; ++j) index_in_b.emplace(b[j].idx(), j);
+  std::vector<char> linked(static_cast<size_t>(n) * m, 0);
+  for (int i = 0; i < n; ++i) {
+    for (auto neighbour : mesh.vv_range(a[i])) {
+      const auto it = index_in_b.find(neighbour.idx());
+      if (it != index_in_b.end()) linked[static_cast<size_t>(i) * m + it->second] = 1;
+    }
+  }
+
+  // The tiling starts at the two closest vertices, one on each loop (Section 2.3).
+  int start_a = -1;
+  int start_b = -1;
+  double closest = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < m; ++j) {
+      if (linked[static_cast<size_t>(i) * m + j]) continue;
+      const double d = (mesh.point(a[i]) - mesh.point(b[j])).sqrnorm();
+      if (d < closest) {
+        closest = d;
+        start_a = i;
+        start_b = j;
+      }
+    }
+  }
+  if (start_a < 0) return std::nullopt;
+  auto walk_a = [&](int i) { return (start_a + i) % n; };       // Index into a.
+  auto walk_c = [&](int k) { return (start_b + m - k % m) % m; };  // Index into b.
+  auto vertex_a = [&](int i) { return a[walk_a(i)]; };
+  auto vertex_c = [&](int k) { return b[walk_c(k)]; };
+
+  const size_t width = static_cast<size_t>(m) + 1;
+  auto reachable_table = [&](bool a_first) {
+    auto allowed = [&](int i, int k) {
+      if ((i == 0 && k == 0) || (i == n && k == m)) return true;
+      if (linked[static_cast<size_t>(walk_a(i)) * m + walk_c(k)]) return false;
+      if (a_first) return !(i == 0 || (k == m && i < n) || (i == n && k == 0));
+      return !(k == 0 || (i == n && k < m) || (k == m && i == 0));
+    };
+    std::vector<char> reach((static_cast<size_t>(n) + 1) * width, 0);
+    for (int i = n; i >= 0; --i) {
+      for (int k = m; k >= 0; --k) {
+        reach[i * width + k] =
+            allowed(i, k) && ((i == n && k == m) || (i < n && reach[(i + 1) * width + k]) ||
+                              (k < m && reach[i * width + k + 1]));
+      }
+    }
+    return reach;
+  };
+  auto point = [&](Mesh::VertexHandle vh) -> const Vec3& { return mesh.point(vh); };
+  auto quality_a = [&](int i, int k) {  // Advance on A from (i, k).
+    return TriangleQuality(point(vertex_a(i)), point(vertex_a(i + 1)), point(vertex_c(k)));
+  };
+  auto quality_b = [&](int i, int k) {  // Advance on B from (i, k).
+    return TriangleQuality(point(vertex_c(k + 1)), point(vertex_c(k)), point(vertex_a(i)));
+  };
+
+  const std::vector<char> reach_a_first = reachable_table(true);
+  const std::vector<char> reach_b_first = reachable_table(false);
+  const bool can_a_first = reach_a_first[width];  // State (1, 0).
+  const bool can_b_first = reach_b_first[1];      // State (0, 1).
+  if (!can_a_first && !can_b_first) return std::nullopt;
+  const std::vector<char>& reach =
+      can_a_first && (!can_b_first || quality_a(0, 0) >= quality_b(0, 0)) ? reach_a_first
+                                                                          : reach_b_first;
+
+  std::vector<Triangle> strip;
+  strip.reserve(n + m);
+  int i = 0;
+  int k = 0;
+  while (i < n || k < m) {
+    // -1 marks a move into a dead end; a triangle's quality is >= 0.
+    const double move_a = i < n && reach[(i + 1) * width + k] ? quality_a(i, k) : -1;
+    const double move_b = k < m && reach[i * width + k + 1] ? quality_b(i, k) : -1;
+    // Ties advance the loop that is behind in relative progress.
+    const bool advance_a = move_a != move_b
+                               ? move_a > move_b
+                               : static_cast<int64_t>(i + 1) * m <= static_cast<int64_t>(k + 1) * n;
+    if (advance_a) {
+      strip.push_back({vertex_a(i), vertex_a(i + 1), vertex_c(k)});
+      ++i;
+    } else {
+      strip.push_back({vertex_c(k + 1), vertex_c(k), vertex_a(i)});
+      ++k;
+    }
+  }
+  return strip;
+}
+
+// Adds the planned faces; if OpenMesh refuses one, deletes those already added (their new
+// edges go with them, and no vertex can become isolated: each keeps its old faces) and
+// returns false, leaving the mesh as it was up to deleted-marked elements.
+bool AddStrip(Mesh& mesh, const std::vector<Triangle>& strip, const VertexLoop& a,
+              const VertexLoop& b) {
+  std::vector<Mesh::FaceHandle> added;
+  added.reserve(strip.size());
+  for (const Triangle& t : strip) {
+    const Mesh::FaceHandle fh = mesh.add_face(t[0], t[1], t[2]);
+    if (fh.is_valid()) {
+      added.push_back(fh);
+      continue;
+    }
+    for (auto it = added.rbegin(); it != added.rend(); ++it) {
+      mesh.delete_face(*it, /*_delete_isolated_vertices=*/false);
+    }
+    for (auto vh : a) mesh.adjust_outgoing_halfedge(vh);
+    for (auto vh : b) mesh.adjust_outgoing_halfedge(vh);
+    return false;
+  }
+  return true;
+}
+
+struct CandidatePair {
+  double distance;
+  size_t first;
+  size_t second;
+};
+
+}  // namespace
+
+absl::Status BoundaryMergingOptions::Validate() const {
+  if (!std::isfinite(alpha_m) || alpha_m < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("alpha_m (Eq. 3) must be finite and non-negative, got ", alpha_m));
+  }
+  return absl::OkStatus();
+}
+
+BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOptions& options,
+                                           double mean_area) {
+  BoundaryMergingResult result;
+  const std::vector<BoundaryLoop> loops = CollectBoundaryLoops(mesh);
+  if (loops.size() < 2) return result;
+  if (mean_area <= 0) mean_area = MeanTriangleArea(mesh);
+  const double limit = options.alpha_m * std::sqrt(mean_area);
+  if (!(limit > 0)) return result;
+
+  std::vector<CandidatePair> candidates;
+  for (size_t x = 0; x < loops.size(); ++x) {
+    for (size_t y = x + 1; y < loops.size(); ++y) {
+      if (HausdorffLowerBound(loops[x], loops[y]) >= limit) continue;
+      const auto distance = HausdorffBelow(mesh, loops[x].vertices, loops[y].vertices, limit);
+      if (distance) candidates.push_back({*distance, x, y});
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const CandidatePair& l, const CandidatePair& r) {
+              return std::tie(l.distance, l.first, l.second) <
+                     std::tie(r.distance, r.first, r.second);
+            });
+
+  // Merging two loops only touches their own boundary half-edges and edges between their
+  // vertices, so the other loops collected above stay valid.
+  std::vector<bool> merged(loops.size(), false);
+  for (const CandidatePair& pair : candidates) {
+    if (merged[pair.first] || merged[pair.second]) continue;
+    const VertexLoop& a = loops[pair.first].vertices;
+    const VertexLoop& b = loops[pair.second].vertices;
+    const auto strip = PlanStrip(mesh, a, b);
+    if (!strip || !AddStrip(mesh, *strip, a, b)) continue;
+    merged[pair.first] = merged[pair.second] = true;
+    ++result.merges;
+    result.added_faces += strip->size();
+  }
+  return result;
+}
+
+}  // namespace neuralmesh

@@ -1,0 +1,79 @@
+// Step 5 of Neural Meshes: boundary merging (Ivrissimtzis, Jeong, Seidel, "Neural Meshes:
+// Statistical Learning Methods in Surface Reconstruction", Section 2 Step 5, Eq. 3, and
+// Section 2.3). Two boundary loops that have come close are sewn together with a strip of
+// triangles: within one component this creates a handle (genus + 1), across two components
+// it joins them.
+//
+//   E <- E(Area) (given, or the mean area of the live faces)
+//   L <- the boundary loops of the mesh
+//   for every pair (A, B) of loops:                                       (box prefilter first)
+//     H(A, B) <- symmetric Hausdorff distance of their VERTEX SETS         (Section 2.3)
+//     keep (A, B) if H(A, B) < alpha_m * sqrt(E)                           (Eq. 3)
+//   for the kept pairs, closest first, skipping loops already merged in this call:
+//     plan a strip: start at the closest vertex pair (a_0, c_0) not already joined by an
+//       edge, and walk A along its boundary half-edges and B against them; at each step add
+//       the better of the two triangles
+//         (a_i, a_i+1, c_k)    advance on A, using A's boundary half-edge a_i -> a_i+1
+//         (c_k+1, c_k, a_i)    advance on B, using B's boundary half-edge c_k+1 -> c_k
+//       among those from which the walk can still finish, until both loops are consumed and
+//       the strip closes on (a_0, c_0)
+//     if a plan exists, add its |A| + |B| faces (undo them all if OpenMesh refuses one)
+//
+// Orientation: a new face sharing a boundary edge must traverse it in the direction of the
+// boundary half-edge (the existing face owns the opposite half-edge). Both triangle kinds
+// above contain the half-edge c_k -> a_i of the current cross edge, and leave the next cross
+// edge as a_i+1 -> c_k or a_i -> c_k+1, which the next triangle uses reversed; so the strip is
+// consistently oriented with both sides exactly when A is walked forward and B backward.
+// Geometrically this is the same sense of rotation: two facing tube ends carry opposite
+// boundary half-edge directions.
+//
+// Quality of a triangle (the paper: "how close it is to be equilateral"):
+// q = 4 sqrt(3) area / (l0^2 + l1^2 + l2^2), 1 for an equilateral triangle and 0 for a
+// degenerate one; cheap, scale-free and without trigonometry. Ties advance the loop that is
+// behind in relative progress.
+//
+// Legality: the walk never creates an edge that already exists (two loops of one thin
+// component are often joined by edges) nor the same cross edge twice (possible only where it
+// wraps around; the loop not advanced by the first triangle is consumed last, which excludes
+// it). A table of the states from which the walk can still finish steers the greedy choice,
+// so a strip is found whenever one of this kind exists, and a pair is skipped, untouched,
+// only when none does. Every step is then legal for OpenMesh: it uses one free boundary
+// half-edge of a loop, and cross edges that are either new or the free side of an earlier
+// one. Loops never share a vertex and have at least 3 vertices, since every boundary vertex
+// of a valid mesh has exactly one boundary gap and there are no double edges.
+// Foldovers created by the strip are left to the learner's Laplacian smoothing (Section 2.3).
+#ifndef NEURALMESH_CORE_LEARNING_BOUNDARY_MERGING_H_
+#define NEURALMESH_CORE_LEARNING_BOUNDARY_MERGING_H_
+
+#include <cstddef>
+
+#include "absl/status/status.h"
+#include "core/mesh.h"
+
+namespace neuralmesh {
+
+struct BoundaryMergingOptions {
+  double alpha_m = 5;  // alpha_m, Eq. 3: merge loops closer than alpha_m sqrt(E(Area)), >= 0.
+
+  // Returns INVALID_ARGUMENT unless alpha_m is finite and non-negative.
+  absl::Status Validate() const;
+};
+
+struct BoundaryMergingResult {
+  size_t merges = 0;       // Pairs of loops sewn together.
+  size_t added_faces = 0;  // Faces of all strips; no vertex is ever added or removed.
+};
+
+// Step 5 (Eq. 3): merges every pair of boundary loops of `mesh` whose vertex sets are closer
+// than options.alpha_m * sqrt(mean_area) in Hausdorff distance, closest pair first, each loop
+// at most once per call. `mean_area` is E(Area) (for example TriangleRemovalResult::mean_area);
+// pass <= 0 to compute it from the live faces. `options` must be valid (Validate()).
+// Works on meshes with deleted elements, adds elements without garbage collection, and leaves
+// the mesh passing ValidateMesh after each merge. O(h) to find the loops, plus O(|A| |B|)
+// per pair that passes a bounding-box lower bound on H and per merge.
+BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOptions& options,
+                                           double mean_area);
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_LEARNING_BOUNDARY_MERGING_H_

@@ -1,0 +1,260 @@
+#include "core/learning/learner.h"
+
+#include <chrono>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/learning/half_edge_collapse.h"
+#include "core/learning/initial_mesh.h"
+#include "core/learning/signal_counters.h"
+#include "core/learning/tangential_smoothing.h"
+#include "core/learning/vertex_octree.h"
+#include "core/learning/vertex_split.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+absl::Duration Since(Clock::time_point start) {
+  return absl::FromChrono(Clock::now() - start);
+}
+
+}  // namespace
+
+class Learner::Impl {
+ public:
+  Impl(const LearnerOptions& options, const Sampler* target)
+      : options_(options),
+        target_(target),
+        rng_(options.seed),
+        mesh_(MakeInitialTetrahedron(target->Bounds())),
+        octree_(target->Bounds()),
+        counters_(options.alpha_sc) {
+    mesh_.add_property(last_win_);
+    for (auto v : mesh_.vertices()) {
+      octree_.Insert(v.idx(), mesh_.point(v));
+      counters_.Add(v.idx(), 1.0, 0);
+      mesh_.property(last_win_, v) = 0;
+    }
+    live_vertices_ = mesh_.n_vertices();
+    next_connectivity_step_ = ConnectivityInterval();
+  }
+
+  void Step() {
+    const bool timed = timings_on_;
+    Clock::time_point t0;
+    if (timed) t0 = Clock::now();
+
+    // Basic Step (Section 2.1).
+    const Vec3 s = target_->Sample(rng_);
+    const int winner = octree_.Nearest(s);
+    const Mesh::VertexHandle w(winner);
+    Clock::time_point t1;
+    if (timed) {
+      t1 = Clock::now();
+      timings_.winner_search += absl::FromChrono(t1 - t0);
+    }
+    Vec3& pw = mesh_.point(w);
+    pw = (1.0 - options_.alpha_w) * pw + options_.alpha_w * s;  // Eq. 1
+    octree_.Move(winner, pw);
+    smoother_.Smooth(mesh_, w, options_.alpha_l, options_.c_l);
+    for (auto q : smoother_.moved()) octree_.Move(q.idx(), mesh_.point(q));
+    if (timed) timings_.smoothing += Since(t1);
+
+    ++step_;
+    counters_.RecordWin(winner, step_);
+    mesh_.property(last_win_, w) = step_;
+
+    if (step_ % static_cast<uint64_t>(options_.c_vs) == 0) {
+      Clock::time_point t2;
+      if (timed) t2 = Clock::now();
+      for (int i = 0; i < options_.splits_per_step; ++i) SplitMostActive();
+      if (timed) timings_.split += Since(t2);
+    }
+    if (step_ >= next_connectivity_step_) ConnectivityAndTopology();
+  }
+
+  absl::StatusOr<StopReason> Run(const StopCriteria& stop) {
+    if (stop.target_vertices == 0 && stop.max_basic_steps == 0 &&
+        stop.time_budget == absl::InfiniteDuration() && stop.cancel == nullptr &&
+        !stop.observer) {
+      return absl::InvalidArgumentError(
+          "no stop criterion: set a target vertex count, a step or time budget, a cancel flag "
+          "or an observer");
+    }
+    const uint64_t poll = std::max<uint64_t>(1, stop.poll_interval);
+    const Clock::time_point start = Clock::now();
+    const uint64_t first_step = step_;
+    auto finish = [&](StopReason reason) -> absl::StatusOr<StopReason> {
+      if (stop.observer) stop.observer(Progress());
+      return reason;
+    };
+    if (stop.target_vertices > 0 && live_vertices_ >= stop.target_vertices) {
+      return finish(StopReason::kTargetReached);
+    }
+    while (true) {
+      for (uint64_t i = 0; i < poll; ++i) {
+        if (target_->empty()) {
+          return absl::FailedPreconditionError("the target space has no points to sample");
+        }
+        Step();
+        if (stop.target_vertices > 0 && live_vertices_ >= stop.target_vertices) {
+          return finish(StopReason::kTargetReached);
+        }
+        if (stop.max_basic_steps > 0 && step_ - first_step >= stop.max_basic_steps) {
+          return finish(StopReason::kStepBudget);
+        }
+      }
+      if (stop.cancel != nullptr && stop.cancel->load(std::memory_order_relaxed)) {
+        return finish(StopReason::kCancelled);
+      }
+      if (stop.time_budget != absl::InfiniteDuration() && Since(start) >= stop.time_budget) {
+        return finish(StopReason::kTimeBudget);
+      }
+      if (stop.observer && !stop.observer(Progress())) return StopReason::kObserver;
+    }
+  }
+
+  LearnerProgress Progress() const {
+    LearnerProgress p = progress_;
+    p.basic_steps = step_;
+    p.vertices = live_vertices_;
+    p.faces = mesh_.n_faces() - deleted_faces_;
+    return p;
+  }
+
+  const Mesh& mesh() const { return mesh_; }
+  const LearnerOptions& options() const { return options_; }
+  size_t num_vertices() const { return live_vertices_; }
+  void EnableTimings(bool on) { timings_on_ = on; }
+  LearnerTimings timings() const { return timings_; }
+
+ private:
+  uint64_t ConnectivityInterval() const {
+    return static_cast<uint64_t>(std::ceil(options_.c_ec * static_cast<double>(live_vertices_)));
+  }
+
+  // Step 2: split the most active vertex; its counter is shared in proportion to F_v (Eq. 5-6).
+  void SplitMostActive() {
+    const int id = counters_.MostActive(
+        [this](int v) { return CanSplitVertex(mesh_, Mesh::VertexHandle(v)); });
+    if (id < 0) return;
+    const Mesh::VertexHandle v(id);
+    const double counter = counters_.Value(id, step_);
+    const Mesh::VertexHandle v0 = SplitVertex(mesh_, v);
+    if (!v0.is_valid()) return;
+    ++live_vertices_;
+    ++progress_.splits;
+    const double f1 = VoronoiAreaEstimate(mesh_, v);
+    const double f0 = VoronoiAreaEstimate(mesh_, v0);
+    const double share0 = (f0 + f1) > 0 ? f0 / (f0 + f1) : 0.5;
+    counters_.Set(id, counter * (1 - share0), step_);
+    counters_.Add(v0.idx(), counter * share0, step_);
+    // The new vertex counts as active: it must get a chance to win before Step 3 judges it.
+    mesh_.property(last_win_, v0) = step_;
+    octree_.Insert(v0.idx(), mesh_.point(v0));
+  }
+
+  // Step 3, then Steps 4 and 5, every C_ec v Basic Steps (Sections 2.2, 2.3).
+  void ConnectivityAndTopology() {
+    Clock::time_point t0 = Clock::now();
+    counters_.Flush();
+    CollapseInactive();
+    timings_.collapse += Since(t0);
+    ++progress_.connectivity_calls;
+    last_connectivity_step_ = step_;
+    next_connectivity_step_ = step_ + std::max<uint64_t>(1, ConnectivityInterval());
+    CollectGarbageIfWorthIt();
+  }
+
+  void CollapseInactive() {
+    const size_t n = mesh_.n_vertices();
+    for (size_t i = 0; i < n; ++i) {
+      const Mesh::VertexHandle v(static_cast<int>(i));
+      if (mesh_.status(v).deleted()) continue;
+      if (mesh_.property(last_win_, v) > last_connectivity_step_) continue;
+      const Mesh::HalfedgeHandle h = BestCollapse(mesh_, v, live_vertices_);
+      if (!h.is_valid()) continue;
+      mesh_.collapse(h);
+      ForgetVertex(v);
+      ++progress_.collapses;
+    }
+    RecountDeletedFaces();
+  }
+
+  void ForgetVertex(Mesh::VertexHandle v) {
+    octree_.Remove(v.idx());
+    counters_.Remove(v.idx());
+    --live_vertices_;
+  }
+
+  void RecountDeletedFaces() {
+    size_t deleted = 0;
+    for (auto f : mesh_.all_faces()) deleted += mesh_.status(f).deleted() ? 1 : 0;
+    deleted_faces_ = deleted;
+  }
+
+  // Deleted elements are only marked; compact when they outnumber the live ones. Handles
+  // change, so the octree and the counters are rebuilt: O(v), like the step that got here.
+  void CollectGarbageIfWorthIt() {
+    if (mesh_.n_vertices() < 2 * live_vertices_ + 64) return;
+    OpenMesh::VPropHandleT<double> counter;
+    mesh_.add_property(counter);
+    for (auto v : mesh_.vertices()) mesh_.property(counter, v) = counters_.Value(v.idx(), step_);
+    mesh_.garbage_collection();
+    counters_.Clear();
+    octree_ = VertexOctree(target_->Bounds());
+    for (auto v : mesh_.vertices()) {
+      octree_.Insert(v.idx(), mesh_.point(v));
+      counters_.Add(v.idx(), mesh_.property(counter, v), step_);
+    }
+    mesh_.remove_property(counter);
+    deleted_faces_ = 0;
+  }
+
+  LearnerOptions options_;
+  const Sampler* target_;
+  Random rng_;
+  Mesh mesh_;
+  VertexOctree octree_;
+  SignalCounters counters_;
+  OneRingSmoother smoother_;
+  OpenMesh::VPropHandleT<uint64_t> last_win_;
+  uint64_t step_ = 0;
+  uint64_t last_connectivity_step_ = 0;
+  uint64_t next_connectivity_step_ = 0;
+  size_t live_vertices_ = 0;
+  size_t deleted_faces_ = 0;
+  LearnerProgress progress_;
+  bool timings_on_ = false;
+  LearnerTimings timings_;
+};
+
+absl::StatusOr<std::unique_ptr<Learner>> Learner::Create(const LearnerOptions& options,
+                                                         const Sampler* target) {
+  NM_RETURN_IF_ERROR(options.Validate());
+  if (target == nullptr) return absl::InvalidArgumentError("no target sampler given");
+  if (target->empty()) {
+    return absl::FailedPreconditionError("the target space is empty: there is nothing to learn");
+  }
+  return std::unique_ptr<Learner>(new Learner(std::make_unique<Impl>(options, target)));
+}
+
+Learner::Learner(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Learner::~Learner() = default;
+
+absl::StatusOr<StopReason> Learner::Run(const StopCriteria& stop) { return impl_->Run(stop); }
+void Learner::Step() { impl_->Step(); }
+const Mesh& Learner::mesh() const { return impl_->mesh(); }
+const LearnerOptions& Learner::options() const { return impl_->options(); }
+LearnerProgress Learner::progress() const { return impl_->Progress(); }
+size_t Learner::num_vertices() const { return impl_->num_vertices(); }
+void Learner::EnableTimings(bool on) { impl_->EnableTimings(on); }
+LearnerTimings Learner::timings() const { return impl_->timings(); }
+TriangleMesh Learner::Snapshot() const { return ToTriangleMesh(impl_->mesh()); }
+
+}  // namespace neuralmesh

@@ -1,0 +1,32 @@
+#include "core/learning/learner_options.h"
+
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+
+namespace neuralmesh {
+namespace {
+
+absl::Status OutOfRange(const char* name, double value, const char* range) {
+  return absl::InvalidArgumentError(
+      absl::StrCat(name, " = ", value, " is out of range; it must be in ", range));
+}
+
+}  // namespace
+
+absl::Status LearnerOptions::Validate() const {
+  if (!(alpha_w > 0 && alpha_w <= 1)) return OutOfRange("alpha_w", alpha_w, "(0, 1]");
+  if (!(alpha_l >= 0 && alpha_l <= 1)) return OutOfRange("alpha_l", alpha_l, "[0, 1]");
+  if (c_l < 0 || c_l > 100) return OutOfRange("c_l", c_l, "[0, 100]");
+  if (c_vs < 1 || c_vs > 1000000) return OutOfRange("c_vs", c_vs, "[1, 1000000]");
+  if (!(c_ec > 0 && c_ec <= 1e6)) return OutOfRange("c_ec", c_ec, "(0, 1e6]");
+  if (!(alpha_sc > 0 && alpha_sc < 1)) return OutOfRange("alpha_sc", alpha_sc, "(0, 1)");
+  if (!(alpha_r > 0 && std::isfinite(alpha_r))) return OutOfRange("alpha_r", alpha_r, "(0, inf)");
+  if (!(alpha_m > 0 && std::isfinite(alpha_m))) return OutOfRange("alpha_m", alpha_m, "(0, inf)");
+  if (splits_per_step < 1 || splits_per_step > 1000) {
+    return OutOfRange("splits_per_step", splits_per_step, "[1, 1000]");
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace neuralmesh

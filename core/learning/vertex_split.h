@@ -1,0 +1,30 @@
+// Step 2's vertex split (Section 2.2, Fig. 1).
+//
+//   e = (v, u) <- the longest edge at v
+//   inside:   walk the star of v both ways from e, equally (k and k or k+1 edges), to e1, e2
+//             that halve the star; the new vertex takes the half around e
+//   boundary: cut the fan in the middle; the new vertex takes the half holding e and the
+//             boundary edge on that side (a vertex of valence <= 4 is never split)
+//   the new vertex is placed at the midpoint of e
+#ifndef NEURALMESH_CORE_LEARNING_VERTEX_SPLIT_H_
+#define NEURALMESH_CORE_LEARNING_VERTEX_SPLIT_H_
+
+#include "core/mesh.h"
+
+namespace neuralmesh {
+
+// Whether the paper allows splitting `v`: not a boundary vertex of valence <= 4 (Section 2.2),
+// and not an isolated or deleted vertex.
+bool CanSplitVertex(const Mesh& mesh, Mesh::VertexHandle v);
+
+// Splits `v` and returns the new vertex, or an invalid handle when !CanSplitVertex. Keeps the
+// mesh a valid manifold. O(valence).
+Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v);
+
+// F_v = l_v^2 with l_v the mean length of the edges at v (Eq. 5-6): the stand-in for the area of
+// v's restricted Voronoi cell by which a split divides the signal counter.
+double VoronoiAreaEstimate(const Mesh& mesh, Mesh::VertexHandle v);
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_LEARNING_VERTEX_SPLIT_H_

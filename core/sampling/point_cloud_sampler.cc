@@ -1,0 +1,68 @@
+#include "core/sampling/point_cloud_sampler.h"
+
+#include <utility>
+
+#include "core/status_macros.h"
+
+namespace neuralmesh {
+namespace {
+
+absl::Status CheckUsable(const std::shared_ptr<const PointCloud>& cloud) {
+  if (cloud == nullptr) return absl::InvalidArgumentError("the point cloud is null");
+  if (cloud->empty()) return absl::InvalidArgumentError("the point cloud has no points");
+  return ValidatePointCloud(*cloud);
+}
+
+BoundingBox BoundsOf(const PointCloud& cloud) {
+  BoundingBox box;
+  for (const Vec3f& p : cloud.positions) box.Extend(Vec3(p));
+  return box;
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<Sampler>> UniformPointCloudSampler::Create(
+    std::shared_ptr<const PointCloud> cloud) {
+  NM_RETURN_IF_ERROR(CheckUsable(cloud));
+  const BoundingBox bounds = BoundsOf(*cloud);
+  return std::unique_ptr<Sampler>(new UniformPointCloudSampler(std::move(cloud), bounds));
+}
+
+UniformPointCloudSampler::UniformPointCloudSampler(std::shared_ptr<const PointCloud> cloud,
+                                                   const BoundingBox& bounds)
+    : cloud_(std::move(cloud)), bounds_(bounds) {}
+
+Vec3 UniformPointCloudSampler::Sample(Random& rng) const {
+  return Vec3(cloud_->positions[rng.NextIndex(cloud_->positions.size())]);
+}
+
+absl::StatusOr<std::unique_ptr<Sampler>> WeightedPointCloudSampler::Create(
+    std::shared_ptr<const PointCloud> cloud) {
+  NM_RETURN_IF_ERROR(CheckUsable(cloud));
+  if (cloud->weights.empty()) {
+    return absl::InvalidArgumentError("the point cloud has no weights to sample by");
+  }
+  NM_ASSIGN_OR_RETURN(AliasTable table, AliasTable::Create(cloud->weights));
+  const BoundingBox bounds = BoundsOf(*cloud);
+  return std::unique_ptr<Sampler>(
+      new WeightedPointCloudSampler(std::move(cloud), std::move(table), bounds));
+}
+
+WeightedPointCloudSampler::WeightedPointCloudSampler(std::shared_ptr<const PointCloud> cloud,
+                                                     AliasTable table,
+                                                     const BoundingBox& bounds)
+    : cloud_(std::move(cloud)), table_(std::move(table)), bounds_(bounds) {}
+
+Vec3 WeightedPointCloudSampler::Sample(Random& rng) const {
+  return Vec3(cloud_->positions[table_.Draw(rng)]);
+}
+
+absl::StatusOr<std::unique_ptr<Sampler>> MakePointCloudSampler(
+    std::shared_ptr<const PointCloud> cloud) {
+  if (cloud != nullptr && !cloud->weights.empty()) {
+    return WeightedPointCloudSampler::Create(std::move(cloud));
+  }
+  return UniformPointCloudSampler::Create(std::move(cloud));
+}
+
+}  // namespace neuralmesh

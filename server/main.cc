@@ -1,0 +1,95 @@
+// neuralmesh-server: serves neuralmesh.v1.ReconstructionService (with grpc.health.v1 and
+// server reflection) until SIGTERM or SIGINT, then shuts down gracefully: every open stream
+// ends with UNAVAILABLE and the process exits.
+#include <pthread.h>
+#include <signal.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "absl/strings/str_cat.h"
+#include "absl/time/time.h"
+#include "server/server.h"
+
+ABSL_FLAG(std::string, host, "127.0.0.1",
+          "Address to listen on; 0.0.0.0 for every IPv4 interface, [::] for every interface.");
+ABSL_FLAG(int, port, 50051, "Port to listen on; 0 picks a free one (printed at start).");
+ABSL_FLAG(int, worker_threads, 0,
+          "Learning threads shared by all sessions in time slices; 0: one per core.");
+ABSL_FLAG(int, encoder_threads, 1, "Threads that Draco-encode the published meshes.");
+ABSL_FLAG(absl::Duration, time_slice, absl::Milliseconds(20),
+          "Learning time a session gets per turn on a worker thread.");
+ABSL_FLAG(int, max_sessions, 64, "Sessions held at once, in any state.");
+ABSL_FLAG(int64_t, max_points_per_session, int64_t{1} << 26,
+          "Points one session accepts in total.");
+ABSL_FLAG(int64_t, max_batch_points, int64_t{1} << 22, "Points one batch may hold.");
+ABSL_FLAG(int, max_message_bytes, 64 << 20,
+          "Largest gRPC message accepted or sent, in bytes.");
+ABSL_FLAG(absl::Duration, idle_timeout, absl::Minutes(30),
+          "Delete sessions that had no open stream and no activity (calls, learning) for this "
+          "long; 'inf' never does.");
+ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(5),
+          "On SIGTERM/SIGINT, how long calls may take to end before they are cancelled.");
+
+int main(int argc, char** argv) {
+  absl::SetProgramUsageMessage(
+      "Serves Neural Meshes surface reconstruction over gRPC (neuralmesh.v1).\n"
+      "Usage: neuralmesh-server [--host=127.0.0.1] [--port=50051] [flags]");
+  absl::ParseCommandLine(argc, argv);
+
+  // Block the shutdown signals in every thread (gRPC's and ours inherit this mask) and take
+  // them synchronously on one thread below.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  neuralmesh::server::ServerOptions options;
+  options.address =
+      absl::StrCat(absl::GetFlag(FLAGS_host), ":", absl::GetFlag(FLAGS_port));
+  const int workers = absl::GetFlag(FLAGS_worker_threads);
+  options.worker_threads =
+      workers > 0 ? workers : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options.encoder_threads = absl::GetFlag(FLAGS_encoder_threads);
+  options.time_slice = absl::GetFlag(FLAGS_time_slice);
+  options.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
+  const int max_sessions = absl::GetFlag(FLAGS_max_sessions);
+  const int64_t max_points = absl::GetFlag(FLAGS_max_points_per_session);
+  const int64_t max_batch = absl::GetFlag(FLAGS_max_batch_points);
+  if (max_sessions < 1 || max_points < 4 || max_batch < 1) {
+    std::fprintf(stderr,
+                 "neuralmesh-server: --max_sessions and --max_batch_points must be at least 1, "
+                 "--max_points_per_session at least 4\n");
+    return 2;
+  }
+  options.limits.max_sessions = static_cast<size_t>(max_sessions);
+  options.limits.max_points_per_session = static_cast<size_t>(max_points);
+  options.limits.max_batch_points = static_cast<size_t>(max_batch);
+  options.limits.idle_timeout = absl::GetFlag(FLAGS_idle_timeout);
+
+  absl::StatusOr<std::unique_ptr<neuralmesh::server::ReconstructionServer>> server =
+      neuralmesh::server::ReconstructionServer::Start(options);
+  if (!server.ok()) {
+    std::fprintf(stderr, "neuralmesh-server: %s\n", server.status().ToString().c_str());
+    return 1;
+  }
+  std::printf("neuralmesh-server listening on %s:%d (%d worker threads)\n",
+              absl::GetFlag(FLAGS_host).c_str(), (*server)->port(), options.worker_threads);
+  std::fflush(stdout);
+
+  int signal_number = 0;
+  sigwait(&signals, &signal_number);
+  std::printf("neuralmesh-server: %s received, shutting down\n",
+              signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
+  std::fflush(stdout);
+  (*server)->Shutdown(absl::GetFlag(FLAGS_shutdown_grace));
+  server->reset();
+  std::printf("neuralmesh-server: stopped\n");
+  return 0;
+}

@@ -1,0 +1,765 @@
+#include "server/reconstruction_service.h"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "absl/synchronization/mutex.h"
+#include "server/grpc_status.h"
+#include "server/proto_conversion.h"
+#include "server/update_channel.h"
+
+namespace neuralmesh::server {
+namespace {
+
+// Locks shared by every reactor below, in this order: the registry's (AbortAll) or the update
+// channel's (OnUpdate/OnClose) lock, then the reactor's own mutex. A reactor never calls into
+// the registry, the channel or a session while it holds its own mutex, and calls
+// StartWrite/Finish only with its mutex held, which is safe because gRPC never runs a reaction
+// inline from StartWrite or Finish.
+
+absl::Status Unavailable() { return absl::UnavailableError("the server is shutting down"); }
+
+grpc::ServerUnaryReactor* FinishUnary(grpc::CallbackServerContext* context,
+                                      const absl::Status& status) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  reactor->Finish(ToGrpcStatus(status));
+  return reactor;
+}
+
+// Prefixes a batch error with where it happened and what was kept, keeping its code.
+absl::Status BatchError(const absl::Status& status, uint64_t batch_index, uint64_t points,
+                        uint64_t batches) {
+  return absl::Status(
+      status.code(),
+      absl::StrCat("batch ", batch_index, " rejected: ", status.message(), " (this call had ",
+                   batches, " batches with ", points,
+                   " points accepted before; the session keeps them)"));
+}
+
+// Resolves and ingests one batch into `session`. Returns the point count of the batch.
+absl::StatusOr<size_t> Ingest(Session& session, const v1::PointBatch& batch,
+                              size_t max_batch_points, uint64_t* total) {
+  absl::StatusOr<PointCloud> cloud = PointBatchFromProto(batch, max_batch_points);
+  if (!cloud.ok()) return cloud.status();
+  absl::StatusOr<size_t> running = session.AddPoints(*cloud);
+  if (!running.ok()) return running.status();
+  *total = *running;
+  return cloud->size();
+}
+
+// ---------------------------------------------------------------------------------------------
+// WatchSession: server-to-client stream, latest wins.
+//
+// Flow control. gRPC allows one outstanding write per stream, and a watcher may read slower
+// than the session publishes. The reactor therefore holds at most two updates: the one being
+// written (`in_flight_`, kept alive until OnWriteDone) and the newest one not yet written
+// (`pending_`). The update channel calls OnUpdate on the publishing thread (the encoder); if no
+// write is in flight the update is written at once, otherwise it replaces `pending_`, so the
+// updates in between are skipped and the publisher never waits. OnWriteDone starts the write
+// of `pending_` if there is one. Updates carry increasing sequence numbers; nothing older than
+// the last one written is ever sent (a reconnecting watcher passes after_sequence).
+//
+// The end of the stream: the channel's OnClose (OK after the final mesh, CANCELLED, NOT_FOUND
+// when deleted, INTERNAL when learning failed), Abort from the registry at shutdown
+// (UNAVAILABLE, dropping `pending_`), or the client going away (OnCancel, or a failed write).
+// The status is remembered in `end_` and Finish is called once no write is in flight, so the
+// final mesh is always written before OK. OnDone unsubscribes (after which the channel never
+// calls again), unregisters and deletes the reactor.
+class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
+                           public UpdateSubscriber,
+                           public LiveReactor {
+ public:
+  WatchReactor(SessionManager* manager, ReactorRegistry* reactors,
+               const v1::WatchSessionRequest& request)
+      : reactors_(reactors) {
+    registered_ = reactors_->Add(this);
+    if (!registered_) {
+      EndNow(Unavailable());
+      return;
+    }
+    absl::StatusOr<std::shared_ptr<Session>> session = manager->Get(request.session_id());
+    if (!session.ok()) {
+      EndNow(session.status());
+      return;
+    }
+    session_ = *std::move(session);
+    session_->AddStream();
+    {
+      absl::MutexLock lock(&mu_);
+      last_sent_ = request.after_sequence();
+    }
+    // May call OnUpdate/OnClose right away (the latest mesh, a closed session).
+    handle_ = session_->updates().Subscribe(this, request.after_sequence());
+  }
+
+  void OnUpdate(const MeshUpdatePtr& update) override {
+    absl::MutexLock lock(&mu_);
+    pending_ = update;
+    MaybeWriteLocked();
+  }
+
+  void OnClose(const absl::Status& status) override {
+    absl::MutexLock lock(&mu_);
+    if (!end_.has_value()) end_ = status;
+    MaybeWriteLocked();
+  }
+
+  void Abort(const absl::Status& status) override {
+    absl::MutexLock lock(&mu_);
+    pending_.reset();
+    end_ = status;
+    MaybeWriteLocked();
+  }
+
+  void OnWriteDone(bool ok) override {
+    absl::MutexLock lock(&mu_);
+    writing_ = false;
+    in_flight_.reset();
+    if (!ok) {
+      // The client is gone; nothing more can be written.
+      pending_.reset();
+      if (!end_.has_value()) end_ = absl::CancelledError("the watcher went away");
+    }
+    MaybeWriteLocked();
+  }
+
+  void OnCancel() override {
+    absl::MutexLock lock(&mu_);
+    cancelled_ = true;
+    pending_.reset();
+    if (!end_.has_value()) end_ = absl::CancelledError("the watcher cancelled the call");
+    MaybeWriteLocked();
+  }
+
+  void OnDone() override {
+    if (session_ != nullptr) {
+      session_->updates().Unsubscribe(handle_);
+      session_->RemoveStream();
+    }
+    if (registered_) reactors_->Remove(this);
+    delete this;
+  }
+
+ private:
+  void EndNow(const absl::Status& status) {
+    absl::MutexLock lock(&mu_);
+    end_ = status;
+    MaybeWriteLocked();
+  }
+
+  void MaybeWriteLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+    if (writing_ || finished_) return;
+    if (pending_ != nullptr && !cancelled_) {
+      if (pending_->sequence() > last_sent_) {
+        in_flight_ = std::move(pending_);
+        pending_.reset();
+        last_sent_ = in_flight_->sequence();
+        writing_ = true;
+        StartWrite(in_flight_.get());
+        return;
+      }
+      pending_.reset();
+    }
+    if (end_.has_value()) {
+      finished_ = true;
+      Finish(ToGrpcStatus(*end_));
+    }
+  }
+
+  ReactorRegistry* const reactors_;
+  bool registered_ = false;
+  std::shared_ptr<Session> session_;  // Set in the constructor, read in OnDone.
+  uint64_t handle_ = 0;
+
+  absl::Mutex mu_;
+  MeshUpdatePtr in_flight_ ABSL_GUARDED_BY(mu_);
+  MeshUpdatePtr pending_ ABSL_GUARDED_BY(mu_);
+  uint64_t last_sent_ ABSL_GUARDED_BY(mu_) = 0;
+  std::optional<absl::Status> end_ ABSL_GUARDED_BY(mu_);
+  bool writing_ ABSL_GUARDED_BY(mu_) = false;
+  bool finished_ ABSL_GUARDED_BY(mu_) = false;
+  bool cancelled_ ABSL_GUARDED_BY(mu_) = false;
+};
+
+// ---------------------------------------------------------------------------------------------
+// UploadPoints: client-to-server stream.
+//
+// Flow control. One read is outstanding at a time: OnReadDone ingests the batch (unpacking,
+// validation and the append into the point cloud, all proportional to the batch) and only then
+// starts the next read, so a client that sends faster than the session appends is held back by
+// gRPC's flow-control window instead of filling server memory. Learning runs on the worker
+// pool meanwhile; the append never waits for it.
+//
+// The end: the client half-closes (OnReadDone(false)) and gets the counts with OK; a bad batch
+// finishes the call at once with its status (the batches before it stay in the session); Abort
+// at shutdown finishes with UNAVAILABLE while a read is outstanding, which gRPC completes
+// with OnReadDone(false), after which no read is started again.
+class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsRequest>,
+                            public LiveReactor {
+ public:
+  UploadReactor(SessionManager* manager, ReactorRegistry* reactors,
+                v1::UploadPointsResponse* response)
+      : manager_(manager), reactors_(reactors), response_(response) {
+    registered_ = reactors_->Add(this);
+    if (!registered_) {
+      FinishOnce(Unavailable());
+      return;
+    }
+    StartRead(&request_);
+  }
+
+  void OnReadDone(bool ok) override {
+    {
+      absl::MutexLock lock(&mu_);
+      if (finished_) return;
+    }
+    if (!ok) {
+      if (session_ == nullptr) {
+        FinishOnce(absl::InvalidArgumentError(
+            "the upload carried no message; the first one must name a session"));
+        return;
+      }
+      {
+        absl::MutexLock lock(&mu_);
+        if (finished_) return;
+        response_->set_session_id(session_->id());
+        response_->set_points_accepted(points_);
+        response_->set_batches_accepted(batches_);
+        response_->set_total_points(total_);
+      }
+      FinishOnce(absl::OkStatus());
+      return;
+    }
+    if (absl::Status status = HandleRequest(); !status.ok()) {
+      FinishOnce(status);
+      return;
+    }
+    absl::MutexLock lock(&mu_);
+    if (!finished_) StartRead(&request_);
+  }
+
+  void Abort(const absl::Status& status) override {
+    absl::MutexLock lock(&mu_);
+    FinishLocked(status);
+  }
+
+  void OnDone() override {
+    if (session_ != nullptr) session_->RemoveStream();
+    if (registered_) reactors_->Remove(this);
+    delete this;
+  }
+
+ private:
+  absl::Status HandleRequest() {
+    const uint64_t index = batches_ + rejected_;
+    if (session_ == nullptr) {
+      if (request_.session_id().empty()) {
+        return absl::InvalidArgumentError("the first message must set session_id");
+      }
+      absl::StatusOr<std::shared_ptr<Session>> session = manager_->Get(request_.session_id());
+      if (!session.ok()) return session.status();
+      session_ = *std::move(session);
+      session_->AddStream();
+    } else if (!request_.session_id().empty() && request_.session_id() != session_->id()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "message ", index, " names session \"", request_.session_id(),
+          "\" but this call uploads into \"", session_->id(), "\""));
+    }
+    uint64_t total = 0;
+    absl::StatusOr<size_t> accepted =
+        Ingest(*session_, request_.batch(), manager_->limits().max_batch_points, &total);
+    if (!accepted.ok()) {
+      ++rejected_;
+      return BatchError(accepted.status(), index, points_, batches_);
+    }
+    absl::MutexLock lock(&mu_);
+    points_ += *accepted;
+    ++batches_;
+    total_ = total;
+    return absl::OkStatus();
+  }
+
+  void FinishOnce(const absl::Status& status) {
+    absl::MutexLock lock(&mu_);
+    FinishLocked(status);
+  }
+
+  void FinishLocked(const absl::Status& status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+    if (finished_) return;
+    finished_ = true;
+    Finish(ToGrpcStatus(status));
+  }
+
+  SessionManager* const manager_;
+  ReactorRegistry* const reactors_;
+  v1::UploadPointsResponse* const response_;
+  bool registered_ = false;
+  // Read-side state: touched only by the constructor and OnReadDone, which gRPC serialises.
+  v1::UploadPointsRequest request_;
+  std::shared_ptr<Session> session_;
+  uint64_t rejected_ = 0;
+
+  absl::Mutex mu_;
+  bool finished_ ABSL_GUARDED_BY(mu_) = false;
+  uint64_t points_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t batches_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t total_ ABSL_GUARDED_BY(mu_) = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Reconstruct: bidirectional stream, points in and meshes out.
+//
+// Flow control, reads. As in UploadPoints: one outstanding read; the next read starts after the
+// batch is ingested, so gRPC's window paces a fast sender.
+//
+// Flow control, writes. Three kinds of response compete for the one outstanding write: the
+// session (once, first), acknowledgements and mesh updates. Acknowledgements carry running
+// totals and updates are snapshots, so for both only the newest matters: the reactor keeps
+// one pending acknowledgement and one pending update, each replaced by a newer one while a
+// write is in flight (latest wins, as in WatchSession), and alternates between the two kinds
+// when both wait so neither starves. The response being written lives in `out_` until
+// OnWriteDone. Memory per call is therefore bounded by two responses however slowly the
+// client reads, and neither ingestion nor learning ever waits for the writer.
+//
+// The end: when the client half-closes, the session is finished (no more points) and the call
+// waits for the channel to close after the final mesh, then finishes with OK. A bad batch, a
+// failed start, the session being cancelled or deleted, Abort at shutdown or the client going
+// away set `end_`; Finish follows as soon as no write is in flight. An outstanding read is
+// completed by gRPC with OnReadDone(false) after Finish; no read starts after it.
+class ReconstructReactor final
+    : public grpc::ServerBidiReactor<v1::ReconstructRequest, v1::ReconstructResponse>,
+      public UpdateSubscriber,
+      public LiveReactor {
+ public:
+  ReconstructReactor(SessionManager* manager, ReactorRegistry* reactors)
+      : manager_(manager), reactors_(reactors) {
+    registered_ = reactors_->Add(this);
+    if (!registered_) {
+      End(Unavailable());
+      return;
+    }
+    StartRead(&request_);
+  }
+
+  void OnReadDone(bool ok) override {
+    {
+      absl::MutexLock lock(&mu_);
+      if (finished_ || end_.has_value()) return;
+    }
+    if (!ok) {
+      HalfClosed();
+      return;
+    }
+    absl::Status status = session_ == nullptr ? Start() : Points();
+    if (!status.ok()) {
+      End(status);
+      return;
+    }
+    absl::MutexLock lock(&mu_);
+    if (!finished_ && !end_.has_value()) StartRead(&request_);
+  }
+
+  void OnUpdate(const MeshUpdatePtr& update) override {
+    absl::MutexLock lock(&mu_);
+    if (update->sequence() <= last_update_) return;
+    pending_update_ = update;
+    MaybeWriteLocked();
+  }
+
+  void OnClose(const absl::Status& status) override { End(status); }
+
+  void Abort(const absl::Status& status) override {
+    absl::MutexLock lock(&mu_);
+    pending_update_.reset();
+    pending_ack_.reset();
+    pending_session_.reset();
+    end_ = status;
+    MaybeWriteLocked();
+  }
+
+  void OnWriteDone(bool ok) override {
+    absl::MutexLock lock(&mu_);
+    writing_ = false;
+    out_.Clear();
+    if (!ok) {
+      pending_update_.reset();
+      pending_ack_.reset();
+      pending_session_.reset();
+      if (!end_.has_value()) end_ = absl::CancelledError("the client went away");
+    }
+    MaybeWriteLocked();
+  }
+
+  void OnCancel() override {
+    absl::MutexLock lock(&mu_);
+    pending_update_.reset();
+    pending_ack_.reset();
+    pending_session_.reset();
+    if (!end_.has_value()) end_ = absl::CancelledError("the client cancelled the call");
+    MaybeWriteLocked();
+  }
+
+  void OnDone() override {
+    if (session_ != nullptr) {
+      if (subscribed_) session_->updates().Unsubscribe(handle_);
+      session_->RemoveStream();
+    }
+    if (registered_) reactors_->Remove(this);
+    delete this;
+  }
+
+ private:
+  // The first request: create or attach, then subscribe to the session's meshes.
+  absl::Status Start() {
+    if (request_.kind_case() != v1::ReconstructRequest::kStart) {
+      return absl::InvalidArgumentError(
+          "the first request must be a ReconstructStart (create or attach a session)");
+    }
+    const v1::ReconstructStart& start = request_.start();
+    std::shared_ptr<Session> session;
+    switch (start.target_case()) {
+      case v1::ReconstructStart::kCreate: {
+        absl::StatusOr<SessionConfig> config =
+            SessionConfigFromProto(start.create().config());
+        if (!config.ok()) return config.status();
+        absl::StatusOr<std::shared_ptr<Session>> created =
+            manager_->Create(*std::move(config), start.create().name());
+        if (!created.ok()) return created.status();
+        session = *std::move(created);
+        break;
+      }
+      case v1::ReconstructStart::kSessionId: {
+        absl::StatusOr<std::shared_ptr<Session>> found = manager_->Get(start.session_id());
+        if (!found.ok()) return found.status();
+        session = *std::move(found);
+        const v1::SessionState state = session->state();
+        if (state != v1::SESSION_STATE_COLLECTING && state != v1::SESSION_STATE_LEARNING) {
+          return absl::FailedPreconditionError(
+              absl::StrCat("session ", session->id(), " is ", v1::SessionState_Name(state),
+                           " and accepts no more points"));
+        }
+        break;
+      }
+      case v1::ReconstructStart::TARGET_NOT_SET:
+        return absl::InvalidArgumentError(
+            "ReconstructStart must set either create or session_id");
+    }
+    session_ = std::move(session);
+    session_->AddStream();
+    v1::Session proto = session_->ToProto();  // Before mu_: ToProto takes the channel's lock.
+    {
+      absl::MutexLock lock(&mu_);
+      pending_session_ = std::move(proto);
+      MaybeWriteLocked();
+    }
+    handle_ = session_->updates().Subscribe(this, 0);
+    subscribed_ = true;
+    return absl::OkStatus();
+  }
+
+  absl::Status Points() {
+    const uint64_t index = batches_ + rejected_ + 1;  // Request 0 was the start.
+    if (request_.kind_case() != v1::ReconstructRequest::kPoints) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("request ", index, " is not a point batch; only the first request ",
+                       "may be a ReconstructStart"));
+    }
+    uint64_t total = 0;
+    absl::StatusOr<size_t> accepted =
+        Ingest(*session_, request_.points(), manager_->limits().max_batch_points, &total);
+    if (!accepted.ok()) {
+      ++rejected_;
+      return BatchError(accepted.status(), index, points_, batches_);
+    }
+    points_ += *accepted;
+    ++batches_;
+    v1::PointsAck ack;
+    ack.set_batches_accepted(batches_);
+    ack.set_points_accepted(points_);
+    ack.set_total_points(total);
+    absl::MutexLock lock(&mu_);
+    pending_ack_ = std::move(ack);
+    MaybeWriteLocked();
+    return absl::OkStatus();
+  }
+
+  // No more points from this client: finish the session and wait for its final mesh.
+  void HalfClosed() {
+    if (session_ == nullptr) {
+      End(absl::InvalidArgumentError("the request stream ended before its ReconstructStart"));
+      return;
+    }
+    absl::Status status = session_->Finish();
+    if (!status.ok()) {
+      // Finished by someone else meanwhile: the final mesh comes all the same.
+      const v1::SessionState state = session_->state();
+      if (state != v1::SESSION_STATE_FINISHING && state != v1::SESSION_STATE_FINISHED) {
+        End(status);
+      }
+    }
+  }
+
+  void End(const absl::Status& status) {
+    absl::MutexLock lock(&mu_);
+    if (!end_.has_value()) end_ = status;
+    MaybeWriteLocked();
+  }
+
+  void MaybeWriteLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+    if (writing_ || finished_) return;
+    const bool failed = end_.has_value() && !end_->ok();
+    if (!failed) {
+      if (pending_session_.has_value()) {
+        *out_.mutable_session() = *std::move(pending_session_);
+        pending_session_.reset();
+      } else if (pending_ack_.has_value() &&
+                 (pending_update_ == nullptr || last_was_update_)) {
+        *out_.mutable_ack() = *std::move(pending_ack_);
+        pending_ack_.reset();
+        last_was_update_ = false;
+      } else if (pending_update_ != nullptr) {
+        *out_.mutable_update() = *pending_update_;
+        last_update_ = pending_update_->sequence();
+        pending_update_.reset();
+        last_was_update_ = true;
+      }
+      if (out_.kind_case() != v1::ReconstructResponse::KIND_NOT_SET) {
+        writing_ = true;
+        StartWrite(&out_);
+        return;
+      }
+    }
+    if (end_.has_value()) {
+      finished_ = true;
+      Finish(ToGrpcStatus(*end_));
+    }
+  }
+
+  SessionManager* const manager_;
+  ReactorRegistry* const reactors_;
+  bool registered_ = false;
+  // Read-side state: touched by the constructor and OnReadDone (serialised by gRPC), and by
+  // OnDone after every other reaction.
+  v1::ReconstructRequest request_;
+  std::shared_ptr<Session> session_;
+  uint64_t handle_ = 0;
+  bool subscribed_ = false;
+  uint64_t points_ = 0;
+  uint64_t batches_ = 0;
+  uint64_t rejected_ = 0;
+
+  absl::Mutex mu_;
+  v1::ReconstructResponse out_ ABSL_GUARDED_BY(mu_);
+  std::optional<v1::Session> pending_session_ ABSL_GUARDED_BY(mu_);
+  std::optional<v1::PointsAck> pending_ack_ ABSL_GUARDED_BY(mu_);
+  MeshUpdatePtr pending_update_ ABSL_GUARDED_BY(mu_);
+  uint64_t last_update_ ABSL_GUARDED_BY(mu_) = 0;
+  bool last_was_update_ ABSL_GUARDED_BY(mu_) = false;
+  std::optional<absl::Status> end_ ABSL_GUARDED_BY(mu_);
+  bool writing_ ABSL_GUARDED_BY(mu_) = false;
+  bool finished_ ABSL_GUARDED_BY(mu_) = false;
+};
+
+// ---------------------------------------------------------------------------------------------
+// GetMesh with wait: a unary call that finishes when the requested mesh is published.
+//
+// The reactor subscribes to the session's channel; the first update that matches (any for
+// LATEST, the final one for FINAL) is copied into the response and finishes the call. The
+// channel closing without it, the client's deadline or cancellation (OnCancel) and Abort at
+// shutdown finish it with the matching status. Nothing is written before Finish, so there is
+// no flow control beyond that.
+class GetMeshReactor final : public grpc::ServerUnaryReactor,
+                             public UpdateSubscriber,
+                             public LiveReactor {
+ public:
+  GetMeshReactor(std::shared_ptr<Session> session, ReactorRegistry* reactors,
+                 v1::MeshVersion version, v1::MeshUpdate* response)
+      : session_(std::move(session)),
+        reactors_(reactors),
+        version_(version),
+        response_(response) {
+    registered_ = reactors_->Add(this);
+    if (!registered_) {
+      FinishOnce(Unavailable());
+      return;
+    }
+    session_->AddStream();
+    streaming_ = true;
+    handle_ = session_->updates().Subscribe(this, 0);
+  }
+
+  void OnUpdate(const MeshUpdatePtr& update) override {
+    if (version_ == v1::MESH_VERSION_FINAL && update->kind() != v1::UPDATE_KIND_FINAL) return;
+    absl::MutexLock lock(&mu_);
+    if (finished_) return;
+    *response_ = *update;
+    FinishLocked(absl::OkStatus());
+  }
+
+  void OnClose(const absl::Status& status) override {
+    absl::Status result = status;
+    if (status.ok()) {
+      result = absl::FailedPreconditionError("the session finished without a mesh");
+    } else if (status.code() == absl::StatusCode::kCancelled ||
+               status.code() == absl::StatusCode::kInternal) {
+      result = absl::FailedPreconditionError(
+          absl::StrCat("the requested mesh will not come: ", status.message()));
+    }
+    FinishOnce(result);
+  }
+
+  void Abort(const absl::Status& status) override { FinishOnce(status); }
+
+  void OnCancel() override {
+    FinishOnce(absl::CancelledError("the call was cancelled or its deadline passed"));
+  }
+
+  void OnDone() override {
+    if (streaming_) {
+      session_->updates().Unsubscribe(handle_);
+      session_->RemoveStream();
+    }
+    if (registered_) reactors_->Remove(this);
+    delete this;
+  }
+
+ private:
+  void FinishOnce(const absl::Status& status) {
+    absl::MutexLock lock(&mu_);
+    FinishLocked(status);
+  }
+  void FinishLocked(const absl::Status& status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+    if (finished_) return;
+    finished_ = true;
+    Finish(ToGrpcStatus(status));
+  }
+
+  const std::shared_ptr<Session> session_;
+  ReactorRegistry* const reactors_;
+  const v1::MeshVersion version_;
+  v1::MeshUpdate* const response_;
+  bool registered_ = false;
+  bool streaming_ = false;
+  uint64_t handle_ = 0;
+
+  absl::Mutex mu_;
+  bool finished_ ABSL_GUARDED_BY(mu_) = false;
+};
+
+}  // namespace
+
+ReconstructionService::ReconstructionService(SessionManager* manager, ReactorRegistry* reactors)
+    : manager_(manager), reactors_(reactors) {}
+
+grpc::ServerUnaryReactor* ReconstructionService::CreateSession(
+    grpc::CallbackServerContext* context, const v1::CreateSessionRequest* request,
+    v1::Session* response) {
+  absl::StatusOr<SessionConfig> config = SessionConfigFromProto(request->config());
+  if (!config.ok()) return FinishUnary(context, config.status());
+  absl::StatusOr<std::shared_ptr<Session>> session =
+      manager_->Create(*std::move(config), request->name());
+  if (!session.ok()) return FinishUnary(context, session.status());
+  *response = (*session)->ToProto();
+  return FinishUnary(context, absl::OkStatus());
+}
+
+grpc::ServerReadReactor<v1::UploadPointsRequest>* ReconstructionService::UploadPoints(
+    grpc::CallbackServerContext* context, v1::UploadPointsResponse* response) {
+  return new UploadReactor(manager_, reactors_, response);
+}
+
+grpc::ServerWriteReactor<v1::MeshUpdate>* ReconstructionService::WatchSession(
+    grpc::CallbackServerContext* context, const v1::WatchSessionRequest* request) {
+  return new WatchReactor(manager_, reactors_, *request);
+}
+
+grpc::ServerBidiReactor<v1::ReconstructRequest, v1::ReconstructResponse>*
+ReconstructionService::Reconstruct(grpc::CallbackServerContext* context) {
+  return new ReconstructReactor(manager_, reactors_);
+}
+
+grpc::ServerUnaryReactor* ReconstructionService::GetSession(
+    grpc::CallbackServerContext* context, const v1::GetSessionRequest* request,
+    v1::Session* response) {
+  absl::StatusOr<std::shared_ptr<Session>> session = manager_->Get(request->session_id());
+  if (!session.ok()) return FinishUnary(context, session.status());
+  *response = (*session)->ToProto();
+  return FinishUnary(context, absl::OkStatus());
+}
+
+grpc::ServerUnaryReactor* ReconstructionService::ListSessions(
+    grpc::CallbackServerContext* context, const v1::ListSessionsRequest* request,
+    v1::ListSessionsResponse* response) {
+  for (const std::shared_ptr<Session>& session : manager_->List()) {
+    *response->add_sessions() = session->ToProto();
+  }
+  return FinishUnary(context, absl::OkStatus());
+}
+
+grpc::ServerUnaryReactor* ReconstructionService::FinishSession(
+    grpc::CallbackServerContext* context, const v1::FinishSessionRequest* request,
+    v1::Session* response) {
+  absl::StatusOr<std::shared_ptr<Session>> session = manager_->Get(request->session_id());
+  if (!session.ok()) return FinishUnary(context, session.status());
+  if (absl::Status status = (*session)->Finish(); !status.ok()) {
+    return FinishUnary(context, status);
+  }
+  *response = (*session)->ToProto();
+  return FinishUnary(context, absl::OkStatus());
+}
+
+grpc::ServerUnaryReactor* ReconstructionService::CancelSession(
+    grpc::CallbackServerContext* context, const v1::CancelSessionRequest* request,
+    v1::Session* response) {
+  absl::StatusOr<std::shared_ptr<Session>> session = manager_->Get(request->session_id());
+  if (!session.ok()) return FinishUnary(context, session.status());
+  if (absl::Status status = (*session)->Cancel("cancelled by a CancelSession call");
+      !status.ok()) {
+    return FinishUnary(context, status);
+  }
+  *response = (*session)->ToProto();
+  return FinishUnary(context, absl::OkStatus());
+}
+
+grpc::ServerUnaryReactor* ReconstructionService::DeleteSession(
+    grpc::CallbackServerContext* context, const v1::DeleteSessionRequest* request,
+    v1::DeleteSessionResponse* response) {
+  return FinishUnary(context, manager_->Delete(request->session_id()));
+}
+
+grpc::ServerUnaryReactor* ReconstructionService::GetMesh(grpc::CallbackServerContext* context,
+                                                         const v1::GetMeshRequest* request,
+                                                         v1::MeshUpdate* response) {
+  absl::StatusOr<std::shared_ptr<Session>> session = manager_->Get(request->session_id());
+  if (!session.ok()) return FinishUnary(context, session.status());
+  const bool final = request->version() == v1::MESH_VERSION_FINAL;
+  if (request->version() != v1::MESH_VERSION_LATEST && !final) {
+    return FinishUnary(context, absl::InvalidArgumentError(absl::StrCat(
+                                    "version has the unknown value ", request->version())));
+  }
+  MeshUpdatePtr latest = (*session)->updates().latest();
+  if (latest != nullptr && (!final || latest->kind() == v1::UPDATE_KIND_FINAL)) {
+    *response = *latest;
+    return FinishUnary(context, absl::OkStatus());
+  }
+  if (request->wait()) {
+    return new GetMeshReactor(*std::move(session), reactors_, request->version(), response);
+  }
+  const v1::SessionState state = (*session)->state();
+  return FinishUnary(context,
+                     absl::FailedPreconditionError(absl::StrCat(
+                         "session ", request->session_id(), " is ", v1::SessionState_Name(state),
+                         final ? " and has no final mesh" : " and has published no mesh yet",
+                         state == v1::SESSION_STATE_COLLECTING ||
+                                 state == v1::SESSION_STATE_LEARNING ||
+                                 state == v1::SESSION_STATE_FINISHING
+                             ? "; set wait to wait for it"
+                             : "")));
+}
+
+}  // namespace neuralmesh::server

@@ -1,0 +1,134 @@
+#include "server/server.h"
+
+#include <utility>
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/security/server_credentials.h>
+#include <grpcpp/server_builder.h>
+#include <grpcpp/support/channel_arguments.h>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
+
+namespace neuralmesh::server {
+namespace {
+
+constexpr char kServiceName[] = "neuralmesh.v1.ReconstructionService";
+
+}  // namespace
+
+ReconstructionServer::ReconstructionServer(const ServerOptions& options) : options_(options) {}
+
+absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Start(
+    const ServerOptions& options) {
+  if (options.worker_threads < 1 || options.encoder_threads < 1) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("worker_threads (", options.worker_threads, ") and encoder_threads (",
+                     options.encoder_threads, ") must be at least 1"));
+  }
+  if (options.time_slice <= absl::ZeroDuration()) {
+    return absl::InvalidArgumentError("time_slice must be positive");
+  }
+  if (options.max_message_bytes < 1024) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_message_bytes is ", options.max_message_bytes,
+                     "; it must be at least 1024"));
+  }
+  if (options.limits.max_sessions < 1 || options.limits.max_points_per_session < 4 ||
+      options.limits.max_batch_points < 1) {
+    return absl::InvalidArgumentError(
+        "max_sessions, max_batch_points must be at least 1 and max_points_per_session at "
+        "least 4");
+  }
+  if (options.limits.idle_timeout <= absl::ZeroDuration()) {
+    return absl::InvalidArgumentError("idle_timeout must be positive");
+  }
+
+  std::unique_ptr<ReconstructionServer> server(new ReconstructionServer(options));
+  server->pool_ = std::make_unique<WorkerPool>(options.worker_threads, options.time_slice);
+  server->encoder_ = std::make_unique<Executor>(options.encoder_threads);
+  server->reactors_ = std::make_unique<ReactorRegistry>();
+  server->manager_ = std::make_unique<SessionManager>(options.limits, server->pool_.get(),
+                                                      server->encoder_.get());
+  server->service_ =
+      std::make_unique<ReconstructionService>(server->manager_.get(), server->reactors_.get());
+
+  // Both switches are process-wide and must be set before the builder is created.
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+
+  grpc::ServerBuilder builder;
+  if (!options.address.empty()) {
+    builder.AddListeningPort(options.address, grpc::InsecureServerCredentials(),
+                             &server->port_);
+  }
+  builder.SetMaxReceiveMessageSize(options.max_message_bytes);
+  builder.SetMaxSendMessageSize(options.max_message_bytes);
+  builder.RegisterService(server->service_.get());
+  server->server_ = builder.BuildAndStart();
+  if (server->server_ == nullptr || (!options.address.empty() && server->port_ == 0)) {
+    server->server_.reset();
+    return absl::UnavailableError(
+        absl::StrCat("cannot listen on \"", options.address, "\" (in use or not local?)"));
+  }
+  grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
+  if (health != nullptr) {
+    health->SetServingStatus(true);
+    health->SetServingStatus(kServiceName, true);
+  }
+  return server;
+}
+
+ReconstructionServer::~ReconstructionServer() { Shutdown(); }
+
+std::string ReconstructionServer::target() const {
+  absl::string_view address = options_.address;
+  const size_t colon = address.rfind(':');
+  absl::string_view host = colon == absl::string_view::npos ? address : address.substr(0, colon);
+  if (host.empty() || host == "0.0.0.0" || host == "[::]") host = "127.0.0.1";
+  return absl::StrCat(host, ":", port_);
+}
+
+std::shared_ptr<grpc::Channel> ReconstructionServer::InProcessChannel() {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(options_.max_message_bytes);
+  args.SetMaxSendMessageSize(options_.max_message_bytes);
+  return server_->InProcessChannel(args);
+}
+
+void ReconstructionServer::Shutdown(absl::Duration grace) {
+  {
+    absl::MutexLock lock(&shutdown_mu_);
+    if (shutting_down_) return;
+    shutting_down_ = true;
+  }
+  if (server_ != nullptr) {
+    if (grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService()) {
+      health->SetServingStatus(false);
+      health->SetServingStatus(kServiceName, false);
+    }
+  }
+  const absl::Status unavailable = absl::UnavailableError("the server is shutting down");
+  // Sessions first: their channels close, which ends watchers and Reconstruct calls.
+  if (manager_ != nullptr) manager_->Shutdown(unavailable);
+  // Then every remaining live reactor (uploads, waiting GetMesh calls).
+  if (reactors_ != nullptr) reactors_->AbortAll(unavailable);
+  if (server_ != nullptr) {
+    // Returns once every call is done, cancelling those still running after the grace period.
+    server_->Shutdown(absl::ToChronoTime(absl::Now() + grace));
+    server_->Wait();
+  }
+  if (pool_ != nullptr) pool_->Shutdown();
+  if (encoder_ != nullptr) encoder_->Shutdown();
+  absl::MutexLock lock(&shutdown_mu_);
+  shut_down_ = true;
+}
+
+void ReconstructionServer::Wait() {
+  absl::MutexLock lock(&shutdown_mu_);
+  auto done = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(shutdown_mu_) { return shut_down_; };
+  shutdown_mu_.Await(absl::Condition(&done));
+}
+
+}  // namespace neuralmesh::server

@@ -1,0 +1,81 @@
+// The neuralmesh gRPC server: the reconstruction service plus the standard health service
+// (grpc.health.v1.Health) and server reflection, on a bounded learning pool.
+#ifndef NEURALMESH_SERVER_SERVER_H_
+#define NEURALMESH_SERVER_SERVER_H_
+
+#include <memory>
+#include <string>
+
+#include <grpcpp/channel.h>
+#include <grpcpp/server.h>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
+#include "server/executor.h"
+#include "server/reactor_registry.h"
+#include "server/reconstruction_service.h"
+#include "server/session_manager.h"
+#include "server/worker_pool.h"
+
+namespace neuralmesh::server {
+
+struct ServerOptions {
+  // host:port to listen on ("127.0.0.1:0" picks a free port); empty: in-process only.
+  std::string address = "127.0.0.1:0";
+  int worker_threads = 2;                            // Learning threads, shared by all sessions.
+  int encoder_threads = 1;                           // Draco encoding threads.
+  absl::Duration time_slice = absl::Milliseconds(20);  // Learning per session per turn.
+  int max_message_bytes = 64 << 20;                  // Both directions.
+  SessionLimits limits;
+};
+
+class ReconstructionServer {
+ public:
+  // Builds and starts the server. INVALID_ARGUMENT for bad options; UNAVAILABLE when the
+  // address cannot be bound.
+  static absl::StatusOr<std::unique_ptr<ReconstructionServer>> Start(
+      const ServerOptions& options);
+  ~ReconstructionServer();  // Shutdown with a 5 s grace period.
+
+  ReconstructionServer(const ReconstructionServer&) = delete;
+  ReconstructionServer& operator=(const ReconstructionServer&) = delete;
+
+  // The bound port (0 when in-process only) and "host:port" to dial.
+  int port() const { return port_; }
+  std::string target() const;
+
+  // A channel into the server without a socket (tests of the logic, in-process callers).
+  std::shared_ptr<grpc::Channel> InProcessChannel();
+
+  // Ends every open stream with UNAVAILABLE, stops accepting calls, cancels the calls still
+  // running after `grace`, then stops learning and encoding. Idempotent; thread-safe.
+  void Shutdown(absl::Duration grace = absl::Seconds(5)) ABSL_LOCKS_EXCLUDED(shutdown_mu_);
+
+  // Blocks until Shutdown has completed.
+  void Wait() ABSL_LOCKS_EXCLUDED(shutdown_mu_);
+
+  SessionManager& sessions() { return *manager_; }
+  ReactorRegistry& reactors() { return *reactors_; }
+
+ private:
+  explicit ReconstructionServer(const ServerOptions& options);
+
+  const ServerOptions options_;
+  std::unique_ptr<WorkerPool> pool_;
+  std::unique_ptr<Executor> encoder_;
+  std::unique_ptr<ReactorRegistry> reactors_;
+  std::unique_ptr<SessionManager> manager_;
+  std::unique_ptr<ReconstructionService> service_;
+  std::unique_ptr<grpc::Server> server_;  // Destroyed first.
+  int port_ = 0;
+
+  absl::Mutex shutdown_mu_;
+  bool shutting_down_ ABSL_GUARDED_BY(shutdown_mu_) = false;
+  bool shut_down_ ABSL_GUARDED_BY(shutdown_mu_) = false;
+};
+
+}  // namespace neuralmesh::server
+
+#endif  // NEURALMESH_SERVER_SERVER_H_

@@ -1,0 +1,537 @@
+#include "server/session.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/analysis/mesh_report.h"
+#include "server/proto_conversion.h"
+
+namespace neuralmesh::server {
+namespace {
+
+// How often (in Basic Steps) the learner looks at the clock and the cancel flag: about a
+// tenth of a millisecond of learning, small against the slice.
+constexpr uint64_t kPollInterval = 128;
+// The arrival sample keeps at most this many points (thinned 2x whenever it overflows).
+constexpr size_t kMaxArrivalSample = size_t{1} << 16;
+constexpr int kCoverageGrid = 8;
+constexpr double kCoverageThreshold = 0.9;
+constexpr size_t kMinCoverageSample = 256;
+
+BoundingBox BoundsOf(absl::Span<const Vec3f> positions) {
+  BoundingBox box;
+  for (const Vec3f& p : positions) box.Extend(Vec3(p[0], p[1], p[2]));
+  return box;
+}
+
+bool CubeContains(const QuantizationBox& box, const BoundingBox& bounds) {
+  for (int c = 0; c < 3; ++c) {
+    if (bounds.min[c] < box.origin[c] || bounds.max[c] > double{box.origin[c]} + box.range) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool IsSpatiallyBiased(absl::Span<const Vec3f> arrival_sample) {
+  if (arrival_sample.size() < kMinCoverageSample) return true;
+  const BoundingBox bounds = BoundsOf(arrival_sample);
+  std::array<double, 3> inverse_cell;
+  for (int c = 0; c < 3; ++c) {
+    const double extent = bounds.max[c] - bounds.min[c];
+    inverse_cell[c] = extent > 0 ? kCoverageGrid / extent : 0.0;
+  }
+  auto cell_of = [&](const Vec3f& p) {
+    int index = 0;
+    for (int c = 0; c < 3; ++c) {
+      const int i = std::clamp(static_cast<int>((p[c] - bounds.min[c]) * inverse_cell[c]), 0,
+                               kCoverageGrid - 1);
+      index = index * kCoverageGrid + i;
+    }
+    return index;
+  };
+  std::vector<bool> reached(kCoverageGrid * kCoverageGrid * kCoverageGrid, false);
+  const size_t half = arrival_sample.size() / 2;
+  for (size_t i = 0; i < half; ++i) reached[cell_of(arrival_sample[i])] = true;
+  size_t covered = 0;
+  for (const Vec3f& p : arrival_sample) covered += reached[cell_of(p)] ? 1 : 0;
+  return static_cast<double>(covered) < kCoverageThreshold * arrival_sample.size();
+}
+
+QuantizationBox QuantizationCube(const BoundingBox& bounds, double enlarge) {
+  const Vec3 center = bounds.center();
+  double edge = 0;
+  for (int c = 0; c < 3; ++c) edge = std::max(edge, bounds.max[c] - bounds.min[c]);
+  edge = edge > 0 ? edge * enlarge : 1.0;
+  QuantizationBox box;
+  box.range = static_cast<float>(edge);
+  for (int c = 0; c < 3; ++c) box.origin[c] = static_cast<float>(center[c] - edge / 2);
+  return box;
+}
+
+QuantizationBox GrowQuantizationCube(QuantizationBox box, const BoundingBox& bounds) {
+  while (!CubeContains(box, bounds)) {
+    for (int c = 0; c < 3; ++c) box.origin[c] -= box.range / 2;
+    box.range *= 2;
+  }
+  return box;
+}
+
+Session::Session(std::string id, std::string name, SessionConfig config, size_t max_points,
+                 WorkerPool* pool, Executor* encoder)
+    : id_(std::move(id)),
+      name_(std::move(name)),
+      config_(std::move(config)),
+      create_time_(absl::Now()),
+      pool_(pool),
+      encoder_(encoder),
+      points_(max_points) {
+  absl::MutexLock lock(&mu_);
+  last_activity_ = create_time_;
+  learning_.set_allowed_vertices(0);
+}
+
+Session::~Session() = default;
+
+bool Session::AcceptsPointsLocked() const {
+  return state_ == v1::SESSION_STATE_COLLECTING || state_ == v1::SESSION_STATE_LEARNING;
+}
+
+size_t Session::AllowedVerticesLocked() const {
+  if (final_vertices_ > 0) return final_vertices_;
+  const double bound = std::floor(static_cast<double>(points_.size()) / config_.points_per_vertex);
+  return std::min(config_.target_vertices, static_cast<size_t>(bound));
+}
+
+absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch) {
+  size_t total = 0;
+  {
+    absl::MutexLock ingest(&ingest_mu_);
+    {
+      absl::MutexLock lock(&mu_);
+      if (!AcceptsPointsLocked()) {
+        return absl::FailedPreconditionError(
+            absl::StrCat("session ", id_, " is ", v1::SessionState_Name(state_),
+                         " and accepts no more points"));
+      }
+      last_activity_ = absl::Now();
+    }
+    const size_t first_index = points_.size();
+    if (absl::Status status = points_.Append(batch); !status.ok()) {
+      return absl::Status(status.code(),
+                          absl::StrCat(status.message(), "; the session keeps its ",
+                                       first_index, " points accepted before"));
+    }
+    RecordArrivalSampleLocked(batch.positions, first_index);
+    total = points_.size();
+
+    // Quantization: the first data fixes the cube; later data outside it grows the cube.
+    const BoundingBox batch_bounds = BoundsOf(batch.positions);
+    absl::MutexLock lock(&mu_);
+    if (!has_box_) {
+      has_box_ = true;
+      box_ = config_.bounds.has_value() ? QuantizationCube(*config_.bounds, 1.1)
+                                        : QuantizationCube(batch_bounds, 2.0);
+    }
+    if (!CubeContains(box_, batch_bounds)) {
+      box_ = GrowQuantizationCube(box_, batch_bounds);
+      ++epoch_;
+    }
+    learning_.set_points_received(total);
+    learning_.set_allowed_vertices(AllowedVerticesLocked());
+  }
+  Wake();
+  return total;
+}
+
+void Session::RecordArrivalSampleLocked(absl::Span<const Vec3f> positions, size_t first_index) {
+  // Keep the points whose arrival index is a multiple of the stride; entry j then holds point
+  // j * stride, and thinning keeps the even entries.
+  size_t i = (first_index + arrival_stride_ - 1) / arrival_stride_ * arrival_stride_;
+  for (; i < first_index + positions.size(); i += arrival_stride_) {
+    arrival_sample_.push_back(positions[i - first_index]);
+    if (arrival_sample_.size() >= kMaxArrivalSample) {
+      size_t kept = 0;
+      for (size_t j = 0; j < arrival_sample_.size(); j += 2) {
+        arrival_sample_[kept++] = arrival_sample_[j];
+      }
+      arrival_sample_.resize(kept);
+      arrival_stride_ *= 2;
+      // The next kept index is the next multiple of the new stride after i.
+      i = i / arrival_stride_ * arrival_stride_;
+    }
+  }
+}
+
+absl::Status Session::Finish() {
+  {
+    absl::MutexLock ingest(&ingest_mu_);
+    absl::MutexLock lock(&mu_);
+    last_activity_ = absl::Now();
+    if (!AcceptsPointsLocked()) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "session ", id_, " is ", v1::SessionState_Name(state_), " and cannot finish"));
+    }
+    const size_t final_vertices = AllowedVerticesLocked();
+    if (final_vertices < kMinTargetVertices) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "session ", id_, " has ", points_.size(), " points; finishing needs at least ",
+          static_cast<size_t>(std::ceil(kMinTargetVertices * config_.points_per_vertex)),
+          " (4 vertices at points_per_vertex ", config_.points_per_vertex, ")"));
+    }
+    final_vertices_ = final_vertices;
+    state_ = v1::SESSION_STATE_FINISHING;
+    learning_.set_allowed_vertices(final_vertices_);
+  }
+  Wake();
+  return absl::OkStatus();
+}
+
+absl::Status Session::Cancel(absl::string_view reason) {
+  {
+    absl::MutexLock lock(&mu_);
+    last_activity_ = absl::Now();
+    if (state_ == v1::SESSION_STATE_CANCELLED) return absl::OkStatus();
+    if (state_ == v1::SESSION_STATE_FINISHED || state_ == v1::SESSION_STATE_FAILED) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "session ", id_, " is ", v1::SessionState_Name(state_), " and cannot be cancelled"));
+    }
+    state_ = v1::SESSION_STATE_CANCELLED;
+    error_ = std::string(reason);
+    cancel_.store(true);
+  }
+  updates_.Close(absl::CancelledError(absl::StrCat("session ", id_, " was cancelled: ", reason)));
+  Wake();  // Lets the pool drop the session at its next slice.
+  return absl::OkStatus();
+}
+
+void Session::Terminate(const absl::Status& status) {
+  {
+    absl::MutexLock lock(&mu_);
+    if (state_ != v1::SESSION_STATE_FINISHED && state_ != v1::SESSION_STATE_FAILED &&
+        state_ != v1::SESSION_STATE_CANCELLED) {
+      state_ = v1::SESSION_STATE_CANCELLED;
+      error_ = std::string(status.message());
+    }
+    cancel_.store(true);
+    encode_queue_.clear();
+  }
+  updates_.Close(status);
+}
+
+void Session::Fail(const absl::Status& status) {
+  {
+    absl::MutexLock lock(&mu_);
+    if (state_ == v1::SESSION_STATE_CANCELLED || state_ == v1::SESSION_STATE_FINISHED) return;
+    state_ = v1::SESSION_STATE_FAILED;
+    error_ = std::string(status.message());
+    cancel_.store(true);
+  }
+  updates_.Close(absl::InternalError(
+      absl::StrCat("learning failed in session ", id_, ": ", status.message())));
+}
+
+v1::SessionState Session::state() const {
+  absl::MutexLock lock(&mu_);
+  return state_;
+}
+
+void Session::AddStream() {
+  absl::MutexLock lock(&mu_);
+  ++open_streams_;
+  last_activity_ = absl::Now();
+}
+
+void Session::RemoveStream() {
+  absl::MutexLock lock(&mu_);
+  --open_streams_;
+  last_activity_ = absl::Now();
+}
+
+void Session::Touch() {
+  absl::MutexLock lock(&mu_);
+  last_activity_ = absl::Now();
+}
+
+bool Session::IdleSince(absl::Time now, absl::Duration timeout) const {
+  absl::MutexLock lock(&mu_);
+  return open_streams_ == 0 && now - last_activity_ >= timeout;
+}
+
+v1::Session Session::ToProto() const {
+  v1::Session out;
+  out.set_session_id(id_);
+  out.set_name(name_);
+  *out.mutable_config() = SessionConfigToProto(config_);
+  out.set_create_time_us(absl::ToUnixMicros(create_time_));
+  if (MeshUpdatePtr latest = updates_.latest(); latest != nullptr) {
+    out.set_vertex_count(latest->vertex_count());
+    out.set_face_count(latest->face_count());
+    out.set_latest_sequence(latest->sequence());
+  }
+  out.set_watchers(static_cast<uint32_t>(updates_.subscribers()));
+  absl::MutexLock lock(&mu_);
+  out.set_state(state_);
+  *out.mutable_learning() = learning_;
+  if (next_milestone_ < config_.lod_milestones.size()) {
+    out.set_next_milestone(config_.lod_milestones[next_milestone_]);
+  }
+  if (has_box_) *out.mutable_quantization_box() = QuantizationBoxToProto(box_);
+  out.set_error(error_);
+  return out;
+}
+
+void Session::Wake() {
+  if (pool_ != nullptr) pool_->Wake(shared_from_this());
+}
+
+void Session::UpdateLearningState() {
+  const LearnerProgress progress = learner_->progress();
+  absl::MutexLock lock(&mu_);
+  const uint64_t steps = discarded_.basic_steps + progress.basic_steps;
+  learning_.set_basic_steps(steps);
+  learning_.set_splits(discarded_.splits + progress.splits);
+  learning_.set_collapses(discarded_.collapses + progress.collapses);
+  learning_.set_learning_seconds(absl::ToDoubleSeconds(learning_time_));
+  learning_.set_steps_per_second(learning_time_ > absl::ZeroDuration()
+                                     ? steps / absl::ToDoubleSeconds(learning_time_)
+                                     : 0.0);
+  learning_.set_relearning(relearning_);
+  last_activity_ = absl::Now();
+}
+
+SliceResult Session::RunSlice(absl::Time deadline) {
+  while (true) {
+    if (cancel_.load()) return {SliceResult::kDone};
+    size_t allowed = 0;
+    bool finishing = false;
+    size_t milestone_index = 0;
+    {
+      absl::MutexLock lock(&mu_);
+      if (state_ != v1::SESSION_STATE_COLLECTING && state_ != v1::SESSION_STATE_LEARNING &&
+          state_ != v1::SESSION_STATE_FINISHING) {
+        return {SliceResult::kDone};
+      }
+      allowed = AllowedVerticesLocked();
+      finishing = state_ == v1::SESSION_STATE_FINISHING;
+      milestone_index = next_milestone_;
+    }
+
+    if (finishing && !final_pass_decided_) {
+      final_pass_decided_ = true;
+      bool relearn = false;
+      if (learner_ != nullptr) {
+        if (config_.final_pass == FinalPass::kRelearn) {
+          relearn = true;
+        } else if (config_.final_pass == FinalPass::kAuto) {
+          absl::MutexLock ingest(&ingest_mu_);
+          relearn = IsSpatiallyBiased(arrival_sample_);
+        }
+      }
+      if (relearn) {
+        const LearnerProgress progress = learner_->progress();
+        discarded_.basic_steps += progress.basic_steps;
+        discarded_.splits += progress.splits;
+        discarded_.collapses += progress.collapses;
+        learner_.reset();
+        relearning_ = true;
+      }
+    }
+
+    if (learner_ == nullptr) {
+      if (allowed < kMinTargetVertices) return {SliceResult::kIdle};
+      absl::StatusOr<std::unique_ptr<Learner>> learner = Learner::Create(config_.learner, &points_);
+      if (!learner.ok()) {
+        Fail(learner.status());
+        return {SliceResult::kDone};
+      }
+      learner_ = *std::move(learner);
+      absl::MutexLock lock(&mu_);
+      if (state_ == v1::SESSION_STATE_COLLECTING) state_ = v1::SESSION_STATE_LEARNING;
+    }
+
+    const std::vector<size_t>& milestones = config_.lod_milestones;
+    const size_t vertices = learner_->num_vertices();
+
+    // A milestone reached is published as such, unless it is the final count (published as
+    // the final mesh below). While relearning, the watchers have seen these counts already.
+    if (!relearning_ && milestone_index < milestones.size() &&
+        vertices >= milestones[milestone_index] &&
+        !(finishing && milestones[milestone_index] >= allowed)) {
+      TakeSnapshot(v1::UPDATE_KIND_MILESTONE, milestones[milestone_index],
+                   static_cast<uint32_t>(milestone_index));
+      absl::MutexLock lock(&mu_);
+      ++next_milestone_;
+      continue;
+    }
+
+    if (vertices >= allowed) {
+      if (finishing) {
+        uint32_t lod_index = static_cast<uint32_t>(
+            std::lower_bound(milestones.begin(), milestones.end(), allowed) -
+            milestones.begin());
+        TakeSnapshot(v1::UPDATE_KIND_FINAL, allowed, lod_index);
+        {
+          absl::MutexLock lock(&mu_);
+          next_milestone_ = milestones.size();
+        }
+        learner_.reset();  // The final mesh is copied; free the learner's memory.
+        return {SliceResult::kDone};
+      }
+      // Paused for lack of points: show the mesh as it is, at most once per refresh interval.
+      const uint64_t steps = learner_->progress().basic_steps;
+      if (config_.refresh_interval == absl::ZeroDuration() || steps == last_publish_steps_) {
+        return {SliceResult::kIdle};
+      }
+      const absl::Time due = last_publish_time_ + config_.refresh_interval;
+      if (absl::Now() < due) return {SliceResult::kIdle, due};
+      const size_t heading = milestone_index < milestones.size() ? milestones[milestone_index]
+                                                                 : config_.target_vertices;
+      TakeSnapshot(v1::UPDATE_KIND_REFRESH, heading, static_cast<uint32_t>(milestone_index));
+      return {SliceResult::kIdle};
+    }
+
+    absl::Time now = absl::Now();
+    if (now >= deadline) return {SliceResult::kMore};
+    size_t goal = allowed;
+    if (!relearning_ && milestone_index < milestones.size()) {
+      goal = std::min(goal, milestones[milestone_index]);
+    }
+    const bool refreshing = !relearning_ && config_.refresh_interval > absl::ZeroDuration();
+    absl::Time stop_at = deadline;
+    if (refreshing && last_publish_time_ != absl::InfinitePast()) {
+      const absl::Time due = last_publish_time_ + config_.refresh_interval;
+      if (now >= due && learner_->progress().basic_steps != last_publish_steps_) {
+        const size_t heading = milestone_index < milestones.size()
+                                   ? milestones[milestone_index]
+                                   : config_.target_vertices;
+        TakeSnapshot(v1::UPDATE_KIND_REFRESH, heading, static_cast<uint32_t>(milestone_index));
+        continue;
+      }
+      stop_at = std::min(stop_at, due);
+    }
+
+    StopCriteria stop;
+    stop.target_vertices = goal;
+    stop.time_budget = std::max(stop_at - now, absl::Microseconds(100));
+    stop.cancel = &cancel_;
+    stop.poll_interval = kPollInterval;
+    const absl::Time run_start = absl::Now();
+    absl::StatusOr<StopReason> reason = learner_->Run(stop);
+    learning_time_ += absl::Now() - run_start;
+    if (!reason.ok()) {
+      Fail(reason.status());
+      return {SliceResult::kDone};
+    }
+    UpdateLearningState();
+  }
+}
+
+void Session::TakeSnapshot(v1::UpdateKind kind, size_t milestone, uint32_t lod_index) {
+  Snapshot snapshot;
+  snapshot.mesh = learner_->Snapshot();
+  snapshot.kind = kind;
+  snapshot.lod_milestone = milestone;
+  snapshot.lod_index = lod_index;
+  snapshot.taken = absl::Now();
+  last_publish_time_ = snapshot.taken;
+  last_publish_steps_ = learner_->progress().basic_steps;
+  UpdateLearningState();
+  absl::MutexLock lock(&mu_);
+  snapshot.learning = learning_;
+  snapshot.state = kind == v1::UPDATE_KIND_FINAL ? v1::SESSION_STATE_FINISHED : state_;
+  snapshot.box = box_;
+  snapshot.epoch = epoch_;
+  // A refresh that the encoder has not started yet is replaced by the newer one; milestones
+  // and the final mesh are never dropped (there are few of them).
+  if (kind == v1::UPDATE_KIND_REFRESH && !encode_queue_.empty() &&
+      encode_queue_.back().kind == v1::UPDATE_KIND_REFRESH) {
+    encode_queue_.back() = std::move(snapshot);
+  } else {
+    encode_queue_.push_back(std::move(snapshot));
+  }
+  if (!encoding_) ScheduleEncodeLocked();
+}
+
+void Session::ScheduleEncodeLocked() {
+  encoding_ = true;
+  std::shared_ptr<Session> self = shared_from_this();
+  if (!encoder_->Schedule([self] { self->EncodeNext(); })) encoding_ = false;
+}
+
+void Session::EncodeNext() {
+  Snapshot snapshot;
+  {
+    absl::MutexLock lock(&mu_);
+    if (encode_queue_.empty()) {
+      encoding_ = false;
+      return;
+    }
+    snapshot = std::move(encode_queue_.front());
+    encode_queue_.pop_front();
+  }
+  absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> update = Encode(snapshot);
+  if (!update.ok()) {
+    Fail(update.status());
+  } else if (snapshot.kind == v1::UPDATE_KIND_FINAL) {
+    bool finished = false;
+    {
+      absl::MutexLock lock(&mu_);
+      if (state_ == v1::SESSION_STATE_FINISHING) {
+        state_ = v1::SESSION_STATE_FINISHED;
+        finished = true;
+      }
+    }
+    if (finished) {
+      updates_.Publish(*std::move(update));
+      updates_.Close(absl::OkStatus());
+    }
+  } else {
+    updates_.Publish(*std::move(update));
+  }
+  // One snapshot per task, so that sessions take turns on the encoder threads.
+  absl::MutexLock lock(&mu_);
+  if (encode_queue_.empty()) {
+    encoding_ = false;
+  } else {
+    ScheduleEncodeLocked();
+  }
+}
+
+absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Session::Encode(Snapshot& snapshot) const {
+  auto update = std::make_shared<v1::MeshUpdate>();
+  update->set_session_id(id_);
+  update->set_kind(snapshot.kind);
+  update->set_lod_milestone(snapshot.lod_milestone);
+  update->set_lod_index(snapshot.lod_index);
+  update->set_vertex_count(snapshot.mesh.positions.size());
+  update->set_face_count(snapshot.mesh.faces.size());
+  *update->mutable_report() = MeshReportToProto(ComputeMeshReport(snapshot.mesh));
+  *update->mutable_learning() = snapshot.learning;
+  update->set_state(snapshot.state);
+  *update->mutable_quantization_box() = QuantizationBoxToProto(snapshot.box);
+  update->set_quantization_epoch(snapshot.epoch);
+  update->set_snapshot_time_us(absl::ToUnixMicros(snapshot.taken));
+
+  // Early coarse meshes (the initial tetrahedron encloses the data) may reach outside the
+  // cube; clamping them keeps one grid for the whole session.
+  const QuantizationBox& box = snapshot.box;
+  for (Vec3f& p : snapshot.mesh.positions) {
+    for (int c = 0; c < 3; ++c) p[c] = std::clamp(p[c], box.origin[c], box.origin[c] + box.range);
+  }
+  DracoOptions options = config_.draco;
+  options.quantization_box = box;
+  const absl::Time start = absl::Now();
+  absl::StatusOr<std::string> bytes = EncodeMesh(snapshot.mesh, options);
+  if (!bytes.ok()) return bytes.status();
+  update->set_encode_time_us(absl::ToInt64Microseconds(absl::Now() - start));
+  update->set_draco_mesh(*std::move(bytes));
+  return update;
+}
+
+}  // namespace neuralmesh::server

@@ -1,0 +1,189 @@
+// One reconstruction session: a growing point cloud, the Neural Mesh learner that learns from
+// it while it grows, and the channel its meshes are published on.
+//
+// Threads:
+//  * Ingestion (AddPoints) runs on gRPC threads, concurrently with learning: the point cloud
+//    takes appends while the learner samples it.
+//  * Learning runs in time slices on the WorkerPool (RunSlice); the pool runs one slice of a
+//    session at a time, so the learner and the members marked "learning thread" below are
+//    touched by one thread at a time without a lock (the pool's mutex orders the slices).
+//  * Snapshots are copied on the learning thread and encoded (Draco, mesh report) on the
+//    encoder Executor, one at a time per session so sequence numbers follow learning order.
+//
+// Learning follows the data: the mesh may have at most
+//   allowed = min(target, floor(points_received / points_per_vertex))
+// vertices (after Finish: the final count, the same bound frozen). The learner is created once
+// allowed >= 4, with its initial tetrahedron around the points received so far. A slice runs
+// the learner toward min(next milestone, allowed); at a milestone it snapshots; between
+// milestones it snapshots every refresh interval; when it reaches `allowed` it pauses (one more
+// refresh snapshot) until more points arrive.
+#ifndef NEURALMESH_SERVER_SESSION_H_
+#define NEURALMESH_SERVER_SESSION_H_
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
+#include "absl/types/span.h"
+#include "core/io/draco_codec.h"
+#include "core/learning/learner.h"
+#include "core/point_cloud.h"
+#include "core/sampling/growing_point_cloud.h"
+#include "core/triangle_mesh.h"
+#include "neuralmesh/v1/reconstruction.pb.h"
+#include "server/executor.h"
+#include "server/session_config.h"
+#include "server/update_channel.h"
+#include "server/worker_pool.h"
+
+namespace neuralmesh::server {
+
+// Whether points arrived in a spatially biased order (region after region). `arrival_sample`
+// holds points in arrival order, sampled uniformly over that order. Over a coarse 8x8x8 grid
+// on the sample's bounds, counts the share of all sample points whose cell also holds a point
+// of the first half of the sample: biased when below 90%. Random order gives nearly 100%; a
+// scan, about 50%. Samples of fewer than 256 points count as biased (relearning them is cheap).
+bool IsSpatiallyBiased(absl::Span<const Vec3f> arrival_sample);
+
+// The cube all meshes of a session are quantized against, from the first data: the bounding
+// cube of `bounds` scaled by `enlarge` about its centre (a degenerate box gets edge 1).
+QuantizationBox QuantizationCube(const BoundingBox& bounds, double enlarge);
+
+// `box` grown 2x about its centre until it contains `bounds`.
+QuantizationBox GrowQuantizationCube(QuantizationBox box, const BoundingBox& bounds);
+
+class Session : public Schedulable, public std::enable_shared_from_this<Session> {
+ public:
+  // `config` must have passed ResolveSessionConfig. `pool` and `encoder` must outlive every
+  // slice and encoding task of the session (the server shuts them down before it lets go).
+  Session(std::string id, std::string name, SessionConfig config, size_t max_points,
+          WorkerPool* pool, Executor* encoder);
+  ~Session() override;
+
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  const std::string& id() const { return id_; }
+  const std::string& name() const { return name_; }
+  const SessionConfig& config() const { return config_; }
+  absl::Time create_time() const { return create_time_; }
+
+  // Appends one batch, all or nothing, and wakes the learner. Returns the session's running
+  // total. FAILED_PRECONDITION when the session no longer accepts points (finishing, finished,
+  // cancelled, failed); INVALID_ARGUMENT for non-finite values or mismatched weights/normals;
+  // RESOURCE_EXHAUSTED when the session's point limit would be exceeded.
+  absl::StatusOr<size_t> AddPoints(const PointCloud& batch) ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
+
+  // No more points: learn to the final vertex count and publish the final mesh.
+  // FAILED_PRECONDITION when already finishing, finished, cancelled or failed, or when the
+  // points received are too few for the initial tetrahedron.
+  absl::Status Finish() ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
+
+  // Stops learning; watchers end with CANCELLED and `reason`. Cancelling a cancelled session is
+  // a no-op. FAILED_PRECONDITION when finished or failed.
+  absl::Status Cancel(absl::string_view reason) ABSL_LOCKS_EXCLUDED(mu_);
+
+  // Ends the session for good (deletion, server shutdown): cancels learning if it still runs and
+  // ends every watcher with `status`.
+  void Terminate(const absl::Status& status) ABSL_LOCKS_EXCLUDED(mu_);
+
+  v1::SessionState state() const ABSL_LOCKS_EXCLUDED(mu_);
+  size_t points_received() const { return points_.size(); }
+  v1::Session ToProto() const ABSL_LOCKS_EXCLUDED(mu_);
+
+  // The session's mesh updates (latest wins).
+  UpdateChannel& updates() { return updates_; }
+
+  // Open streams (watchers, uploads) keep a session from idling out.
+  void AddStream() ABSL_LOCKS_EXCLUDED(mu_);
+  void RemoveStream() ABSL_LOCKS_EXCLUDED(mu_);
+  // Records activity now (any RPC on the session, any learning slice).
+  void Touch() ABSL_LOCKS_EXCLUDED(mu_);
+  // Whether nothing happened for `timeout` and no stream is open.
+  bool IdleSince(absl::Time now, absl::Duration timeout) const ABSL_LOCKS_EXCLUDED(mu_);
+
+  SliceResult RunSlice(absl::Time deadline) override ABSL_LOCKS_EXCLUDED(mu_);
+
+ private:
+  // A mesh copied on the learning thread, waiting for the encoder.
+  struct Snapshot {
+    TriangleMesh mesh;
+    v1::UpdateKind kind = v1::UPDATE_KIND_UNSPECIFIED;
+    size_t lod_milestone = 0;
+    uint32_t lod_index = 0;
+    v1::LearningState learning;
+    v1::SessionState state = v1::SESSION_STATE_UNSPECIFIED;
+    QuantizationBox box;
+    uint32_t epoch = 0;
+    absl::Time taken;
+  };
+
+  bool AcceptsPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  size_t AllowedVerticesLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void RecordArrivalSampleLocked(absl::Span<const Vec3f> positions, size_t first_index)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(ingest_mu_);
+  // Updates the learning counters after a Run (learning thread).
+  void UpdateLearningState() ABSL_LOCKS_EXCLUDED(mu_);
+  // Copies the mesh and hands it to the encoder (learning thread).
+  void TakeSnapshot(v1::UpdateKind kind, size_t milestone, uint32_t lod_index)
+      ABSL_LOCKS_EXCLUDED(mu_);
+  void ScheduleEncodeLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void EncodeNext() ABSL_LOCKS_EXCLUDED(mu_);
+  absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Encode(Snapshot& snapshot) const;
+  void Fail(const absl::Status& status) ABSL_LOCKS_EXCLUDED(mu_);
+  void Wake();
+
+  const std::string id_;
+  const std::string name_;
+  const SessionConfig config_;
+  const absl::Time create_time_;
+  WorkerPool* const pool_;
+  Executor* const encoder_;
+
+  GrowingPointCloud points_;
+  UpdateChannel updates_;
+  std::atomic<bool> cancel_{false};  // Polled by the learner.
+
+  // Serialises ingestion with Finish, so the final count sees every accepted batch, and keeps
+  // the arrival sample in arrival order. Acquired before mu_.
+  absl::Mutex ingest_mu_ ABSL_ACQUIRED_BEFORE(mu_);
+  std::vector<Vec3f> arrival_sample_ ABSL_GUARDED_BY(ingest_mu_);
+  size_t arrival_stride_ ABSL_GUARDED_BY(ingest_mu_) = 1;
+
+  mutable absl::Mutex mu_;
+  v1::SessionState state_ ABSL_GUARDED_BY(mu_) = v1::SESSION_STATE_COLLECTING;
+  std::string error_ ABSL_GUARDED_BY(mu_);
+  size_t final_vertices_ ABSL_GUARDED_BY(mu_) = 0;  // Set by Finish.
+  size_t next_milestone_ ABSL_GUARDED_BY(mu_) = 0;  // Index into config_.lod_milestones.
+  bool has_box_ ABSL_GUARDED_BY(mu_) = false;
+  QuantizationBox box_ ABSL_GUARDED_BY(mu_);
+  uint32_t epoch_ ABSL_GUARDED_BY(mu_) = 0;
+  v1::LearningState learning_ ABSL_GUARDED_BY(mu_);
+  std::deque<Snapshot> encode_queue_ ABSL_GUARDED_BY(mu_);
+  bool encoding_ ABSL_GUARDED_BY(mu_) = false;
+  int open_streams_ ABSL_GUARDED_BY(mu_) = 0;
+  absl::Time last_activity_ ABSL_GUARDED_BY(mu_);
+
+  // Learning thread only (see the file comment).
+  std::unique_ptr<Learner> learner_;
+  bool final_pass_decided_ = false;
+  bool relearning_ = false;
+  LearnerProgress discarded_;  // Counters of learners discarded for a relearn.
+  absl::Duration learning_time_;
+  absl::Time last_publish_time_ = absl::InfinitePast();
+  uint64_t last_publish_steps_ = 0;
+};
+
+}  // namespace neuralmesh::server
+
+#endif  // NEURALMESH_SERVER_SESSION_H_

@@ -1,0 +1,61 @@
+// The configuration of one reconstruction session, in domain types (the proto's
+// neuralmesh.v1.SessionConfig with every default resolved).
+#ifndef NEURALMESH_SERVER_SESSION_CONFIG_H_
+#define NEURALMESH_SERVER_SESSION_CONFIG_H_
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/time/time.h"
+#include "core/bounding_box.h"
+#include "core/io/draco_codec.h"
+#include "core/learning/learner_options.h"
+
+namespace neuralmesh::server {
+
+// What happens to the incrementally learned mesh at finish (neuralmesh.v1.FinalPass).
+enum class FinalPass {
+  kAuto,      // Relearn when the arrival order was spatially biased (see NeedsRelearn).
+  kRelearn,   // Always relearn from scratch on the complete point set.
+  kContinue,  // Always continue the incremental mesh.
+};
+
+inline constexpr size_t kMinTargetVertices = 4;  // The initial tetrahedron.
+inline constexpr size_t kMaxLodMilestones = 256;
+inline constexpr absl::Duration kDefaultRefreshInterval = absl::Milliseconds(250);
+inline constexpr absl::Duration kMinRefreshInterval = absl::Milliseconds(10);
+inline constexpr double kDefaultPointsPerVertex = 2.0;
+
+struct SessionConfig {
+  LearnerOptions learner;       // The paper's parameters.
+  size_t target_vertices = 0;   // The final vertex count, >= 4.
+  // Publication milestones, strictly increasing, ending with target_vertices once resolved.
+  // Empty before ResolveSessionConfig: the 1-2-5 series.
+  std::vector<size_t> lod_milestones;
+  // Wall time between two republications while learning; zero disables them.
+  absl::Duration refresh_interval = kDefaultRefreshInterval;
+  // Draco settings; quantization_box is chosen by the session, never by the client.
+  DracoOptions draco;
+  // Points received per allowed vertex (> 0): vertices <= floor(points / points_per_vertex).
+  double points_per_vertex = kDefaultPointsPerVertex;
+  // Where the data lies, if the client knows; seeds the quantization box.
+  std::optional<BoundingBox> bounds;
+  FinalPass final_pass = FinalPass::kAuto;
+};
+
+// 10, 20, 50, 100, 200, 500, ... below `target`, then `target` itself.
+std::vector<size_t> DefaultLodMilestones(size_t target);
+
+// Validates `config` and fills in the milestones (the default series when empty, the target
+// appended when missing). INVALID_ARGUMENT naming the first offending field: a target below 4
+// or unreachable within `max_points_per_session` points, milestones not strictly increasing,
+// below 4, above the target or more than 256 of them, a refresh interval between 0 and 10 ms,
+// points_per_vertex not finite and positive, bounds not finite or inverted, and whatever
+// LearnerOptions::Validate and DracoOptions::Validate reject.
+absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& config);
+
+}  // namespace neuralmesh::server
+
+#endif  // NEURALMESH_SERVER_SESSION_CONFIG_H_

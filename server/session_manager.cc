@@ -1,0 +1,155 @@
+#include "server/session_manager.h"
+
+#include <algorithm>
+#include <utility>
+
+#include "absl/random/random.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh::server {
+namespace {
+
+constexpr size_t kMaxNameBytes = 256;
+
+}  // namespace
+
+SessionManager::SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder)
+    : limits_(limits), pool_(pool), encoder_(encoder) {
+  {
+    absl::MutexLock lock(&mu_);
+    absl::BitGen gen;
+    id_state_ = absl::Uniform<uint64_t>(gen);
+  }
+  if (limits_.idle_timeout != absl::InfiniteDuration()) {
+    reaper_ = std::thread([this] { ReaperLoop(); });
+  }
+}
+
+SessionManager::~SessionManager() {
+  Shutdown(absl::UnavailableError("the server is shutting down"));
+}
+
+std::string SessionManager::NewIdLocked() {
+  // SplitMix64 over a random start: unpredictable enough for a label, unique per server.
+  while (true) {
+    uint64_t z = (id_state_ += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    z ^= z >> 31;
+    std::string id = absl::StrFormat("s-%016x", z);
+    if (sessions_.count(id) == 0) return id;
+  }
+}
+
+absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(SessionConfig config,
+                                                                std::string name) {
+  if (name.size() > kMaxNameBytes) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("name has ", name.size(), " bytes; at most 256 are allowed"));
+  }
+  NM_RETURN_IF_ERROR(ResolveSessionConfig(limits_.max_points_per_session, config));
+  absl::MutexLock lock(&mu_);
+  if (shutdown_) return absl::UnavailableError("the server is shutting down");
+  if (sessions_.size() >= limits_.max_sessions) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "the server holds its maximum of ", limits_.max_sessions,
+        " sessions; delete finished or cancelled ones first"));
+  }
+  std::string id = NewIdLocked();
+  auto session = std::make_shared<Session>(id, std::move(name), std::move(config),
+                                           limits_.max_points_per_session, pool_, encoder_);
+  sessions_.emplace(id, session);
+  order_.emplace(created_++, id);
+  return session;
+}
+
+absl::StatusOr<std::shared_ptr<Session>> SessionManager::Get(absl::string_view id) const {
+  if (id.empty()) return absl::InvalidArgumentError("session_id is empty");
+  std::shared_ptr<Session> session;
+  {
+    absl::MutexLock lock(&mu_);
+    auto it = sessions_.find(std::string(id));
+    if (it == sessions_.end()) {
+      return absl::NotFoundError(absl::StrCat("no session with id \"", id, "\""));
+    }
+    session = it->second;
+  }
+  session->Touch();
+  return session;
+}
+
+std::vector<std::shared_ptr<Session>> SessionManager::List() const {
+  absl::MutexLock lock(&mu_);
+  std::vector<std::shared_ptr<Session>> out;
+  out.reserve(order_.size());
+  for (const auto& [index, id] : order_) out.push_back(sessions_.at(id));
+  return out;
+}
+
+absl::Status SessionManager::Delete(absl::string_view id) {
+  if (id.empty()) return absl::InvalidArgumentError("session_id is empty");
+  std::shared_ptr<Session> session;
+  {
+    absl::MutexLock lock(&mu_);
+    auto it = sessions_.find(std::string(id));
+    if (it == sessions_.end()) {
+      return absl::NotFoundError(absl::StrCat("no session with id \"", id, "\""));
+    }
+    session = std::move(it->second);
+    sessions_.erase(it);
+    for (auto o = order_.begin(); o != order_.end(); ++o) {
+      if (o->second == session->id()) {
+        order_.erase(o);
+        break;
+      }
+    }
+  }
+  session->Terminate(absl::NotFoundError(absl::StrCat("session ", id, " was deleted")));
+  return absl::OkStatus();
+}
+
+size_t SessionManager::ReapIdle(absl::Time now) {
+  std::vector<std::string> idle;
+  {
+    absl::MutexLock lock(&mu_);
+    for (const auto& [id, session] : sessions_) {
+      if (session->IdleSince(now, limits_.idle_timeout)) idle.push_back(id);
+    }
+  }
+  size_t reaped = 0;
+  for (const std::string& id : idle) {
+    if (Delete(id).ok()) ++reaped;
+  }
+  return reaped;
+}
+
+void SessionManager::ReaperLoop() {
+  const absl::Duration period =
+      std::clamp(limits_.idle_timeout / 4, absl::Milliseconds(10), absl::Seconds(10));
+  while (true) {
+    {
+      absl::MutexLock lock(&mu_);
+      auto stop = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return shutdown_; };
+      mu_.AwaitWithTimeout(absl::Condition(&stop), period);
+      if (shutdown_) return;
+    }
+    ReapIdle(absl::Now());
+  }
+}
+
+void SessionManager::Shutdown(const absl::Status& status) {
+  std::map<std::string, std::shared_ptr<Session>> sessions;
+  {
+    absl::MutexLock lock(&mu_);
+    if (shutdown_) return;
+    shutdown_ = true;
+    sessions.swap(sessions_);
+    order_.clear();
+  }
+  if (reaper_.joinable()) reaper_.join();
+  for (auto& [id, session] : sessions) session->Terminate(status);
+}
+
+}  // namespace neuralmesh::server

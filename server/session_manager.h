@@ -1,0 +1,90 @@
+// The registry of sessions: creation under the server's limits, lookup, listing, deletion and
+// the idle-session reaper.
+#ifndef NEURALMESH_SERVER_SESSION_MANAGER_H_
+#define NEURALMESH_SERVER_SESSION_MANAGER_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
+#include "server/executor.h"
+#include "server/session.h"
+#include "server/session_config.h"
+#include "server/worker_pool.h"
+
+namespace neuralmesh::server {
+
+struct SessionLimits {
+  size_t max_sessions = 64;                // Sessions held at once, in any state.
+  size_t max_points_per_session = 1u << 26;  // 67M points.
+  size_t max_batch_points = 1u << 22;      // 4M points per batch.
+  // Sessions without an open stream and without activity (RPCs, learning) for this long are
+  // deleted. InfiniteDuration: never.
+  absl::Duration idle_timeout = absl::Minutes(30);
+};
+
+class SessionManager {
+ public:
+  // `pool` and `encoder` must outlive the manager's sessions' work (see Session).
+  SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder);
+  ~SessionManager();  // Calls Shutdown().
+
+  SessionManager(const SessionManager&) = delete;
+  SessionManager& operator=(const SessionManager&) = delete;
+
+  // Validates `config` (ResolveSessionConfig) and creates a session. INVALID_ARGUMENT for an
+  // invalid configuration or a name longer than 256 bytes; RESOURCE_EXHAUSTED at max_sessions;
+  // UNAVAILABLE after Shutdown.
+  absl::StatusOr<std::shared_ptr<Session>> Create(SessionConfig config, std::string name)
+      ABSL_LOCKS_EXCLUDED(mu_);
+
+  // NOT_FOUND for an unknown id (INVALID_ARGUMENT for an empty one). Counts as activity.
+  absl::StatusOr<std::shared_ptr<Session>> Get(absl::string_view id) const
+      ABSL_LOCKS_EXCLUDED(mu_);
+
+  // Every session, oldest first.
+  std::vector<std::shared_ptr<Session>> List() const ABSL_LOCKS_EXCLUDED(mu_);
+
+  // Removes the session; its watchers end with NOT_FOUND. NOT_FOUND when unknown.
+  absl::Status Delete(absl::string_view id) ABSL_LOCKS_EXCLUDED(mu_);
+
+  // Deletes the sessions idle at `now` (see SessionLimits::idle_timeout); returns how many.
+  size_t ReapIdle(absl::Time now) ABSL_LOCKS_EXCLUDED(mu_);
+
+  // Stops the reaper and terminates every session with `status` (their streams end with it).
+  // Idempotent.
+  void Shutdown(const absl::Status& status) ABSL_LOCKS_EXCLUDED(mu_);
+
+  const SessionLimits& limits() const { return limits_; }
+
+ private:
+  void ReaperLoop() ABSL_LOCKS_EXCLUDED(mu_);
+  std::string NewIdLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+
+  const SessionLimits limits_;
+  WorkerPool* const pool_;
+  Executor* const encoder_;
+
+  mutable absl::Mutex mu_;
+  bool shutdown_ ABSL_GUARDED_BY(mu_) = false;
+  uint64_t created_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t id_state_ ABSL_GUARDED_BY(mu_);
+  // Keyed by id; `order_` keeps creation order for List.
+  std::map<std::string, std::shared_ptr<Session>> sessions_ ABSL_GUARDED_BY(mu_);
+  std::map<uint64_t, std::string> order_ ABSL_GUARDED_BY(mu_);
+  std::thread reaper_;
+};
+
+}  // namespace neuralmesh::server
+
+#endif  // NEURALMESH_SERVER_SESSION_MANAGER_H_

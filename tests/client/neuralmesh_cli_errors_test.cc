@@ -1,0 +1,166 @@
+// The command line's answers to bad input: build/bin/neuralmesh must exit non-zero with a
+// message on stderr that names the problem.
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "gtest/gtest.h"
+#include "tests/client/subprocess.h"
+
+namespace neuralmesh::testing {
+namespace {
+
+class CliErrorsTest : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = MakeTempDir("cli_errors"); }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::string WriteFile(const std::string& name, const std::string& contents) {
+    const std::string path = dir_ + "/" + name;
+    std::ofstream(path, std::ios::binary) << contents;
+    return path;
+  }
+
+  // Runs the command, expects failure, and returns stderr.
+  std::string ExpectFailure(const std::vector<std::string>& args) {
+    const RunResult run = RunNeuralmesh(args);
+    EXPECT_NE(run.exit_code, 0) << "expected a failure:\n" << run.Describe();
+    EXPECT_NE(run.exit_code, 127) << run.Describe();
+    EXPECT_NE(run.exit_code, 128 + 11) << "crashed:\n" << run.Describe();
+    return run.err;
+  }
+
+  std::string Output() const { return dir_ + "/out.ply"; }
+
+  std::string dir_;
+};
+
+TEST_F(CliErrorsTest, MissingInputFile) {
+  const std::string missing = dir_ + "/nothing_here.ply";
+  const std::string err =
+      ExpectFailure({"reconstruct", missing, "-o", Output(), "--vertices", "100"});
+  EXPECT_TRUE(absl::StrContains(err, missing) && absl::StrContains(err, "does not exist"))
+      << err;
+}
+
+TEST_F(CliErrorsTest, EmptyInputFile) {
+  const std::string empty = WriteFile("empty.xyz", "");
+  const std::string err = ExpectFailure({"reconstruct", empty, "-o", Output(), "--vertices", "100"});
+  EXPECT_TRUE(absl::StrContains(err, empty) && absl::StrContains(err, "empty")) << err;
+}
+
+TEST_F(CliErrorsTest, MalformedPlyNamesTheLine) {
+  const std::string bad = WriteFile("bad.ply", "this is not a ply file\n");
+  const std::string err = ExpectFailure({"reconstruct", bad, "-o", Output(), "--vertices", "100"});
+  EXPECT_TRUE(absl::StrContains(err, bad)) << err;
+  EXPECT_TRUE(absl::StrContains(err, "line 1")) << err;
+}
+
+TEST_F(CliErrorsTest, MalformedXyzNamesTheLine) {
+  const std::string bad = WriteFile("bad.xyz", "0 0 0\n1 1 1\n1 banana 2\n");
+  const std::string err = ExpectFailure({"reconstruct", bad, "-o", Output(), "--vertices", "100"});
+  EXPECT_TRUE(absl::StrContains(err, bad)) << err;
+  EXPECT_TRUE(absl::StrContains(err, "line 3")) << err;
+}
+
+TEST_F(CliErrorsTest, UnknownInputExtension) {
+  const std::string odd = WriteFile("points.foo", "0 0 0\n");
+  const std::string err = ExpectFailure({"reconstruct", odd, "-o", Output(), "--vertices", "100"});
+  EXPECT_TRUE(absl::StrContains(err, ".foo")) << err;
+}
+
+TEST_F(CliErrorsTest, UnknownOutputExtension) {
+  const std::string err = ExpectFailure(
+      {"reconstruct", "builtin:sphere", "-o", dir_ + "/out.xyz", "--vertices", "100"});
+  EXPECT_TRUE(absl::StrContains(err, "out.xyz") && absl::StrContains(err, ".ply")) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/out.xyz"));
+}
+
+TEST_F(CliErrorsTest, LearnerParameterOutOfRange) {
+  const std::string err = ExpectFailure(
+      {"reconstruct", "builtin:sphere", "-o", Output(), "--vertices", "100", "--alpha_w", "2"});
+  EXPECT_TRUE(absl::StrContains(err, "alpha_w")) << err;
+  EXPECT_FALSE(std::filesystem::exists(Output())) << "nothing may be written";
+}
+
+TEST_F(CliErrorsTest, NonNumericFlagValue) {
+  const std::string err =
+      ExpectFailure({"reconstruct", "builtin:sphere", "-o", Output(), "--vertices", "many"});
+  EXPECT_TRUE(absl::StrContains(err, "--vertices") && absl::StrContains(err, "many")) << err;
+}
+
+TEST_F(CliErrorsTest, UnknownFlag) {
+  const std::string err = ExpectFailure(
+      {"reconstruct", "builtin:sphere", "-o", Output(), "--vertices", "100", "--alpha_z", "1"});
+  EXPECT_TRUE(absl::StrContains(err, "unknown flag --alpha_z")) << err;
+}
+
+TEST_F(CliErrorsTest, FlagOfAnotherCommand) {
+  const std::string err = ExpectFailure({"stats", Output(), "--vertices", "10"});
+  EXPECT_TRUE(absl::StrContains(err, "--vertices") && absl::StrContains(err, "stats")) << err;
+}
+
+TEST_F(CliErrorsTest, MissingVertices) {
+  const std::string err = ExpectFailure({"reconstruct", "builtin:sphere", "-o", Output()});
+  EXPECT_TRUE(absl::StrContains(err, "--vertices")) << err;
+}
+
+TEST_F(CliErrorsTest, LodNotBelowVertices) {
+  const std::string err = ExpectFailure(
+      {"reconstruct", "builtin:sphere", "-o", Output(), "--vertices", "100", "--lod", "50,150"});
+  EXPECT_TRUE(absl::StrContains(err, "--lod") && absl::StrContains(err, "150")) << err;
+}
+
+TEST_F(CliErrorsTest, UnknownBuiltin) {
+  const std::string err =
+      ExpectFailure({"reconstruct", "builtin:cube", "-o", Output(), "--vertices", "100"});
+  EXPECT_TRUE(absl::StrContains(err, "builtin:cube") && absl::StrContains(err, "builtin:torus"))
+      << err;
+}
+
+TEST_F(CliErrorsTest, UnknownSamplingMode) {
+  const std::string err = ExpectFailure({"reconstruct", "builtin:sphere", "-o", Output(),
+                                         "--vertices", "100", "--sampling", "gaussian"});
+  EXPECT_TRUE(absl::StrContains(err, "gaussian")) << err;
+}
+
+TEST_F(CliErrorsTest, MeshSamplingOfAPointCloud) {
+  const std::string cloud =
+      WriteFile("cloud.off", "OFF\n4 0 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
+  const std::string err = ExpectFailure(
+      {"reconstruct", cloud, "-o", Output(), "--vertices", "100", "--sampling", "area"});
+  EXPECT_TRUE(absl::StrContains(err, "no faces")) << err;
+}
+
+TEST_F(CliErrorsTest, StatsOfAMissingFile) {
+  const std::string err = ExpectFailure({"stats", dir_ + "/absent.off"});
+  EXPECT_TRUE(absl::StrContains(err, "absent.off")) << err;
+}
+
+TEST_F(CliErrorsTest, EvalWithoutReference) {
+  const std::string err = ExpectFailure({"eval", Output()});
+  EXPECT_TRUE(absl::StrContains(err, "--reference")) << err;
+}
+
+TEST_F(CliErrorsTest, EvalAgainstAnEmptyReference) {
+  const std::string mesh = WriteFile("tri.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const std::string empty = WriteFile("empty.obj", "");
+  const std::string err = ExpectFailure({"eval", mesh, "--reference", empty});
+  EXPECT_TRUE(absl::StrContains(err, empty) && absl::StrContains(err, "empty")) << err;
+}
+
+TEST_F(CliErrorsTest, UnknownCommand) {
+  const std::string err = ExpectFailure({"reconstrukt"});
+  EXPECT_TRUE(absl::StrContains(err, "unknown command 'reconstrukt'")) << err;
+}
+
+TEST_F(CliErrorsTest, RemoteFlagWithoutServer) {
+  const std::string err = ExpectFailure(
+      {"reconstruct", "builtin:sphere", "--out-dir", dir_, "--vertices", "100"});
+  EXPECT_TRUE(absl::StrContains(err, "--server")) << err;
+}
+
+}  // namespace
+}  // namespace neuralmesh::testing

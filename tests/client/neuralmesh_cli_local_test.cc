@@ -1,0 +1,169 @@
+// End-to-end tests of the local subcommands of build/bin/neuralmesh (client/main.cc), run as
+// a subprocess: reconstruct, stats and eval on the built-in sphere.
+#include <filesystem>
+#include <string>
+
+#include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_split.h"
+#include "gtest/gtest.h"
+#include "tests/client/subprocess.h"
+
+namespace neuralmesh::testing {
+namespace {
+
+// The value of "key": in the JSON `text` (numbers, booleans), or "" when absent.
+std::string JsonValue(const std::string& text, const std::string& key) {
+  const size_t at = text.find("\"" + key + "\":");
+  if (at == std::string::npos) return "";
+  size_t begin = at + key.size() + 3;
+  while (begin < text.size() && text[begin] == ' ') ++begin;
+  const size_t end = text.find_first_of(",\n}", begin);
+  return text.substr(begin, end - begin);
+}
+
+class LocalCliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(MakeTempDir("cli_local"));
+    output_ = new std::string(*dir_ + "/sphere.ply");
+    reconstruct_ = new RunResult(RunNeuralmesh({"reconstruct", "builtin:sphere", "-o", *output_,
+                                                "--vertices", "500", "--lod", "100,250",
+                                                "--seed", "3"}));
+  }
+  static void TearDownTestSuite() {
+    std::filesystem::remove_all(*dir_);
+    delete reconstruct_;
+    delete output_;
+    delete dir_;
+  }
+
+  static std::string* dir_;
+  static std::string* output_;
+  static RunResult* reconstruct_;
+};
+
+std::string* LocalCliTest::dir_ = nullptr;
+std::string* LocalCliTest::output_ = nullptr;
+RunResult* LocalCliTest::reconstruct_ = nullptr;
+
+TEST_F(LocalCliTest, ReconstructWritesTheMeshAndEveryLod) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  for (const std::string& path :
+       {*output_, *dir_ + "/sphere_lod100.ply", *dir_ + "/sphere_lod250.ply"}) {
+    EXPECT_TRUE(std::filesystem::exists(path)) << path << " was not written";
+    EXPECT_GT(std::filesystem::file_size(path), 0u) << path << " is empty";
+  }
+}
+
+TEST_F(LocalCliTest, ReconstructPrintsOneRowPerLevelAndASummary) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  int rows = 0;
+  for (absl::string_view line : absl::StrSplit(reconstruct_->out, '\n')) {
+    const bool lod = absl::StartsWith(line, "lod ") || absl::StartsWith(line, "final ");
+    if (!lod) continue;
+    ++rows;
+    EXPECT_TRUE(absl::StrContains(line, "sphere")) << "row without its file: " << line;
+  }
+  EXPECT_EQ(rows, 3) << "expected rows for 100, 250 and 500 vertices:\n" << reconstruct_->out;
+  EXPECT_TRUE(absl::StrContains(reconstruct_->out, "target reached: 500 vertices"))
+      << "missing summary line:\n" << reconstruct_->out;
+}
+
+TEST_F(LocalCliTest, StatsReportsAClosedGenusZeroMeshOfTheRequestedSize) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  const RunResult stats = RunNeuralmesh({"stats", *output_, "--json"});
+  ASSERT_EQ(stats.exit_code, 0) << stats.Describe();
+  EXPECT_EQ(JsonValue(stats.out, "vertices"), "500") << stats.out;
+  EXPECT_EQ(JsonValue(stats.out, "closed"), "true") << stats.out;
+  EXPECT_EQ(JsonValue(stats.out, "genus"), "0") << stats.out;
+  EXPECT_EQ(JsonValue(stats.out, "boundary_loops"), "0") << stats.out;
+}
+
+TEST_F(LocalCliTest, StatsPrintsTextByDefault) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  const RunResult stats = RunNeuralmesh({"stats", *dir_ + "/sphere_lod100.ply"});
+  ASSERT_EQ(stats.exit_code, 0) << stats.Describe();
+  EXPECT_TRUE(absl::StrContains(stats.out, "genus")) << stats.out;
+  EXPECT_TRUE(absl::StrContains(stats.out, "100")) << stats.out;
+}
+
+TEST_F(LocalCliTest, EvalAgainstTheBuiltinSphereGivesASmallChamferDistance) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  const RunResult eval = RunNeuralmesh(
+      {"eval", *output_, "--reference", "builtin:sphere", "--json", "--samples", "20000"});
+  ASSERT_EQ(eval.exit_code, 0) << eval.Describe();
+  double chamfer = -1;
+  ASSERT_TRUE(absl::SimpleAtod(JsonValue(eval.out, "chamfer_l1"), &chamfer)) << eval.out;
+  // Relative to the diagonal (2 sqrt 3) of the unit sphere's box; 500 vertices land within
+  // about 0.3% of it.
+  EXPECT_GT(chamfer, 0.0) << eval.out;
+  EXPECT_LT(chamfer, 0.01) << "the 500-vertex sphere is far from the unit sphere:\n" << eval.out;
+}
+
+TEST_F(LocalCliTest, TheSameSeedGivesByteIdenticalFiles) {
+  for (const std::string ext : {".ply", ".drc"}) {
+    const std::string a = *dir_ + "/seeded_a" + ext;
+    const std::string b = *dir_ + "/seeded_b" + ext;
+    for (const std::string& path : {a, b}) {
+      const RunResult run = RunNeuralmesh({"reconstruct", "builtin:torus", "-o", path,
+                                           "--vertices", "300", "--lod", "120", "--seed", "11"});
+      ASSERT_EQ(run.exit_code, 0) << run.Describe();
+    }
+    EXPECT_EQ(ReadWholeFile(a), ReadWholeFile(b)) << ext << " outputs of one seed differ";
+    EXPECT_EQ(ReadWholeFile(*dir_ + "/seeded_a_lod120" + ext),
+              ReadWholeFile(*dir_ + "/seeded_b_lod120" + ext))
+        << ext << " LOD outputs of one seed differ";
+  }
+}
+
+TEST_F(LocalCliTest, AStepBudgetStopsEarlyAndStillWritesTheOutput) {
+  const std::string path = *dir_ + "/budget.off";
+  const RunResult run = RunNeuralmesh({"reconstruct", "builtin:sphere", "-o", path, "--vertices",
+                                       "5000", "--max_steps", "20000"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(std::filesystem::exists(path)) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "--max_steps reached")) << run.out;
+}
+
+TEST_F(LocalCliTest, ReconstructsAPointCloudFileAndRemeshesAMesh) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  // The 500-vertex sphere serves as a point cloud (its vertices) and as a mesh to remesh.
+  const std::string from_points = *dir_ + "/from_points.obj";
+  const RunResult points = RunNeuralmesh(
+      {"reconstruct", *output_, "-o", from_points, "--vertices", "100"});
+  EXPECT_EQ(points.exit_code, 0) << points.Describe();
+  EXPECT_TRUE(std::filesystem::exists(from_points)) << points.Describe();
+
+  const std::string remeshed = *dir_ + "/remeshed.stl";
+  const RunResult remesh = RunNeuralmesh({"reconstruct", *output_, "-o", remeshed, "--vertices",
+                                          "200", "--sampling", "curvature"});
+  EXPECT_EQ(remesh.exit_code, 0) << remesh.Describe();
+  EXPECT_TRUE(std::filesystem::exists(remeshed)) << remesh.Describe();
+}
+
+TEST(LocalCliHelpTest, HelpDocumentsEveryReconstructFlag) {
+  const RunResult help = RunNeuralmesh({"reconstruct", "--help"});
+  ASSERT_EQ(help.exit_code, 0) << help.Describe();
+  for (const char* flag :
+       {"--output", "--vertices", "--seed", "--lod", "--alpha_w", "--alpha_l", "--c_l", "--c_vs",
+        "--c_ec", "--alpha_sc", "--alpha_r", "--alpha_m", "--remove_triangles",
+        "--merge_boundaries", "--splits_per_step", "--sampling", "--time_budget", "--max_steps",
+        "--quantization_bits", "--encode_speed", "--progress", "--server", "--out-dir",
+        "--batch-size", "--ply"}) {
+    EXPECT_TRUE(absl::StrContains(help.out, std::string(flag) + "\n") ||
+                absl::StrContains(help.out, std::string(flag) + ","))
+        << flag << " is not documented:\n" << help.out;
+  }
+}
+
+TEST(LocalCliHelpTest, NoArgumentsListsTheCommandsAndFails) {
+  const RunResult run = RunNeuralmesh({});
+  EXPECT_NE(run.exit_code, 0);
+  for (const char* command : {"reconstruct", "stats", "eval", "watch", "sessions"}) {
+    EXPECT_TRUE(absl::StrContains(run.err, command)) << command << " not listed:\n" << run.err;
+  }
+}
+
+}  // namespace
+}  // namespace neuralmesh::testing

@@ -1,0 +1,141 @@
+// End-to-end tests of the remote subcommands of build/bin/neuralmesh against a real
+// neuralmesh-server on 127.0.0.1, both run as subprocesses.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_split.h"
+#include "gtest/gtest.h"
+#include "tests/client/subprocess.h"
+#include "tests/client/test_server.h"
+
+namespace neuralmesh::testing {
+namespace {
+
+// The vertex counts of the table rows whose first column is `kind`.
+std::vector<uint64_t> RowVertices(const std::string& out, absl::string_view kind) {
+  std::vector<uint64_t> vertices;
+  for (absl::string_view line : absl::StrSplit(out, '\n')) {
+    std::vector<absl::string_view> columns = absl::StrSplit(line, ' ', absl::SkipEmpty());
+    uint64_t v = 0;
+    if (columns.size() > 2 && columns[0] == kind && absl::SimpleAtoi(columns[1], &v)) {
+      vertices.push_back(v);
+    }
+  }
+  return vertices;
+}
+
+class RemoteCliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    std::string error;
+    server_ = TestServer::Start({}, &error).release();
+    *start_error_ = error;
+    dir_ = new std::string(MakeTempDir("cli_remote"));
+    if (server_ != nullptr) {
+      reconstruct_ = new RunResult(RunNeuralmesh(
+          {"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir",
+           *dir_ + "/out", "--vertices", "400", "--points", "4000", "--lod", "100,200",
+           "--batch-size", "500", "--ply"}));
+    }
+  }
+  static void TearDownTestSuite() {
+    delete server_;
+    delete reconstruct_;
+    std::filesystem::remove_all(*dir_);
+    delete dir_;
+  }
+
+  void SetUp() override {
+    ASSERT_NE(server_, nullptr) << *start_error_;
+    ASSERT_NE(reconstruct_, nullptr);
+  }
+
+  static TestServer* server_;
+  static std::string* start_error_;
+  static std::string* dir_;
+  static RunResult* reconstruct_;
+};
+
+TestServer* RemoteCliTest::server_ = nullptr;
+std::string* RemoteCliTest::start_error_ = new std::string;
+std::string* RemoteCliTest::dir_ = nullptr;
+RunResult* RemoteCliTest::reconstruct_ = nullptr;
+
+TEST_F(RemoteCliTest, ReconstructWritesIncreasingLodsAndTheFinalMesh) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  const std::vector<uint64_t> lods = RowVertices(reconstruct_->out, "lod");
+  ASSERT_FALSE(lods.empty()) << reconstruct_->out;
+  for (size_t i = 1; i < lods.size(); ++i) {
+    EXPECT_GT(lods[i], lods[i - 1]) << "LOD rows out of order:\n" << reconstruct_->out;
+  }
+  EXPECT_EQ(RowVertices(reconstruct_->out, "final"), std::vector<uint64_t>{400})
+      << reconstruct_->out;
+  for (uint64_t v : lods) {
+    const std::string base = *dir_ + "/out/sphere_lod" + std::to_string(v);
+    EXPECT_TRUE(std::filesystem::exists(base + ".drc")) << base << ".drc missing";
+    EXPECT_TRUE(std::filesystem::exists(base + ".ply")) << base << ".ply missing";
+  }
+  EXPECT_TRUE(std::filesystem::exists(*dir_ + "/out/sphere.drc"));
+  EXPECT_TRUE(std::filesystem::exists(*dir_ + "/out/sphere.ply"));
+}
+
+TEST_F(RemoteCliTest, TheFinalMeshIsAClosedSphere) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  const RunResult stats = RunNeuralmesh({"stats", *dir_ + "/out/sphere.drc", "--json"});
+  ASSERT_EQ(stats.exit_code, 0) << stats.Describe();
+  EXPECT_TRUE(absl::StrContains(stats.out, "\"closed\": true")) << stats.out;
+  EXPECT_TRUE(absl::StrContains(stats.out, "\"genus\": 0")) << stats.out;
+}
+
+TEST_F(RemoteCliTest, SessionsListsTheFinishedSession) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  const RunResult sessions = RunNeuralmesh({"sessions", "--server", server_->address()});
+  ASSERT_EQ(sessions.exit_code, 0) << sessions.Describe();
+  EXPECT_TRUE(absl::StrContains(sessions.out, "sphere")) << sessions.out;
+  EXPECT_TRUE(absl::StrContains(sessions.out, "finished")) << sessions.out;
+
+  const RunResult json = RunNeuralmesh({"sessions", "--server", server_->address(), "--json"});
+  ASSERT_EQ(json.exit_code, 0) << json.Describe();
+  EXPECT_TRUE(absl::StrContains(json.out, "\"state\": \"finished\"")) << json.out;
+}
+
+TEST_F(RemoteCliTest, WatchingAFinishedSessionSavesItsFinalMesh) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  const std::string out = reconstruct_->out;
+  const size_t at = out.find("session ");
+  ASSERT_NE(at, std::string::npos) << out;
+  const std::string id = out.substr(at + 8, out.find(' ', at + 8) - (at + 8));
+  const RunResult watch =
+      RunNeuralmesh({"watch", id, "--server", server_->address(), "--out-dir", *dir_ + "/w"});
+  ASSERT_EQ(watch.exit_code, 0) << watch.Describe();
+  EXPECT_TRUE(std::filesystem::exists(*dir_ + "/w/" + id + ".drc")) << watch.Describe();
+}
+
+TEST_F(RemoteCliTest, WatchingAnUnknownSessionFails) {
+  const RunResult watch = RunNeuralmesh(
+      {"watch", "no-such-session", "--server", server_->address(), "--out-dir", *dir_ + "/x"});
+  EXPECT_NE(watch.exit_code, 0) << watch.Describe();
+  EXPECT_TRUE(absl::StrContains(watch.err, "no-such-session")) << watch.err;
+}
+
+TEST(RemoteCliUnreachableTest, AnUnreachableServerFailsClearly) {
+  const std::string address = "127.0.0.1:" + std::to_string(PickFreePort());
+  const std::string dir = MakeTempDir("cli_unreachable");
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"reconstruct", "builtin:sphere", "--server", address,
+                                 "--out-dir", dir, "--connect_timeout", "1s"},
+        std::vector<std::string>{"sessions", "--server", address, "--connect_timeout", "1s"}}) {
+    const RunResult run = RunNeuralmesh(args);
+    EXPECT_NE(run.exit_code, 0) << run.Describe();
+    EXPECT_TRUE(absl::StrContains(run.err, "cannot reach") &&
+                absl::StrContains(run.err, address))
+        << run.err;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace neuralmesh::testing

@@ -1,0 +1,188 @@
+// Tests of client/reconstruction_client.h against a real neuralmesh-server on 127.0.0.1
+// (started as a subprocess, port 0).
+#include "client/reconstruction_client.h"
+
+#include <cstring>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/io/draco_codec.h"
+#include "core/sampling/implicit_surfaces.h"
+#include "core/sampling/sample_points.h"
+#include "gtest/gtest.h"
+#include "tests/client/subprocess.h"
+#include "tests/client/test_server.h"
+
+namespace neuralmesh::client {
+namespace {
+
+using ::neuralmesh::testing::TestServer;
+
+PointCloud SpherePoints(size_t n) {
+  auto sphere = MakeSphere(Vec3(0, 0, 0), 1.0);
+  EXPECT_TRUE(sphere.ok()) << sphere.status();
+  return SamplePoints(**sphere, n, /*seed=*/5);
+}
+
+v1::SessionConfig SmallConfig(uint64_t target) {
+  v1::SessionConfig config;
+  config.set_target_vertices(target);
+  config.add_lod_milestones(target / 4);
+  config.add_lod_milestones(target / 2);
+  config.add_lod_milestones(target);
+  return config;
+}
+
+class ReconstructionClientTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    std::string error;
+    server_ = TestServer::Start({}, &error).release();
+    if (server_ == nullptr) *start_error_ = error;
+  }
+  static void TearDownTestSuite() {
+    delete server_;
+    server_ = nullptr;
+  }
+
+  void SetUp() override {
+    ASSERT_NE(server_, nullptr) << *start_error_;
+    absl::StatusOr<std::unique_ptr<ReconstructionClient>> client =
+        ReconstructionClient::Connect(server_->address());
+    ASSERT_TRUE(client.ok()) << client.status();
+    client_ = *std::move(client);
+  }
+
+  static TestServer* server_;
+  static std::string* start_error_;
+  std::unique_ptr<ReconstructionClient> client_;
+};
+
+TestServer* ReconstructionClientTest::server_ = nullptr;
+std::string* ReconstructionClientTest::start_error_ = new std::string;
+
+TEST_F(ReconstructionClientTest, UploadWatchAndFinishDeliverTheFinalMesh) {
+  absl::StatusOr<v1::Session> session = client_->CreateSession(SmallConfig(200), "sphere");
+  ASSERT_TRUE(session.ok()) << session.status();
+  const std::string id = session->session_id();
+  EXPECT_FALSE(id.empty());
+
+  std::vector<v1::MeshUpdate> updates;
+  absl::Status watch_status;
+  std::thread watcher([&] {
+    watch_status = client_->Watch(id, 0, [&](const v1::MeshUpdate& update) {
+      updates.push_back(update);
+      return true;
+    });
+  });
+
+  std::vector<uint64_t> progress;
+  const PointCloud cloud = SpherePoints(2000);
+  absl::StatusOr<v1::UploadPointsResponse> uploaded = client_->UploadPoints(
+      id, cloud, 300, [&](uint64_t sent, uint64_t total) {
+        EXPECT_EQ(total, 2000u);
+        progress.push_back(sent);
+      });
+  ASSERT_TRUE(uploaded.ok()) << uploaded.status();
+  EXPECT_EQ(uploaded->points_accepted(), 2000u);
+  EXPECT_EQ(uploaded->batches_accepted(), 7u) << "2000 points in batches of 300";
+  EXPECT_EQ(uploaded->total_points(), 2000u);
+  EXPECT_EQ(progress, (std::vector<uint64_t>{300, 600, 900, 1200, 1500, 1800, 2000}));
+
+  absl::StatusOr<v1::Session> finished = client_->Finish(id);
+  ASSERT_TRUE(finished.ok()) << finished.status();
+  watcher.join();
+  ASSERT_TRUE(watch_status.ok()) << watch_status;
+
+  ASSERT_FALSE(updates.empty());
+  for (size_t i = 1; i < updates.size(); ++i) {
+    EXPECT_GT(updates[i].sequence(), updates[i - 1].sequence()) << "update " << i;
+  }
+  const v1::MeshUpdate& last = updates.back();
+  EXPECT_EQ(last.kind(), v1::UPDATE_KIND_FINAL);
+  EXPECT_EQ(last.vertex_count(), 200u);
+  absl::StatusOr<TriangleMesh> mesh = DecodeMesh(last.draco_mesh());
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->faces.size(), last.face_count());
+
+  absl::StatusOr<v1::MeshUpdate> final_mesh =
+      client_->GetMesh(id, v1::MESH_VERSION_FINAL, /*wait=*/true, absl::Seconds(30));
+  ASSERT_TRUE(final_mesh.ok()) << final_mesh.status();
+  EXPECT_EQ(final_mesh->sequence(), last.sequence());
+
+  absl::StatusOr<v1::Session> state = client_->GetSession(id);
+  ASSERT_TRUE(state.ok()) << state.status();
+  EXPECT_EQ(state->state(), v1::SESSION_STATE_FINISHED);
+
+  absl::StatusOr<std::vector<v1::Session>> sessions = client_->ListSessions();
+  ASSERT_TRUE(sessions.ok()) << sessions.status();
+  bool listed = false;
+  for (const v1::Session& s : *sessions) listed = listed || s.session_id() == id;
+  EXPECT_TRUE(listed) << "ListSessions misses " << id;
+}
+
+TEST_F(ReconstructionClientTest, CancelThenDeleteRemovesTheSession) {
+  absl::StatusOr<v1::Session> session = client_->CreateSession(SmallConfig(100), "doomed");
+  ASSERT_TRUE(session.ok()) << session.status();
+  const std::string id = session->session_id();
+  ASSERT_TRUE(client_->UploadPoints(id, SpherePoints(500), 250).ok());
+
+  absl::StatusOr<v1::Session> cancelled = client_->Cancel(id);
+  ASSERT_TRUE(cancelled.ok()) << cancelled.status();
+  EXPECT_EQ(cancelled->state(), v1::SESSION_STATE_CANCELLED);
+  const absl::Status watch = client_->Watch(id, 0, [](const v1::MeshUpdate&) { return true; });
+  EXPECT_TRUE(absl::IsCancelled(watch)) << watch;
+
+  ASSERT_TRUE(client_->Delete(id).ok());
+  EXPECT_TRUE(absl::IsNotFound(client_->GetSession(id).status()));
+  EXPECT_TRUE(absl::IsNotFound(client_->Delete(id)));
+}
+
+TEST_F(ReconstructionClientTest, StatusesKeepTheServersCodeAndNameTheCall) {
+  const absl::Status unknown = client_->GetSession("no-such-session").status();
+  EXPECT_TRUE(absl::IsNotFound(unknown)) << unknown;
+  EXPECT_NE(unknown.message().find("GetSession"), absl::string_view::npos) << unknown;
+
+  v1::SessionConfig invalid;  // No target_vertices.
+  const absl::Status rejected = client_->CreateSession(invalid, "invalid").status();
+  EXPECT_TRUE(absl::IsInvalidArgument(rejected)) << rejected;
+}
+
+TEST_F(ReconstructionClientTest, UploadRejectsAnEmptyCloudAndAZeroBatchSize) {
+  EXPECT_TRUE(absl::IsInvalidArgument(client_->UploadPoints("any", PointCloud(), 10).status()));
+  EXPECT_TRUE(absl::IsInvalidArgument(client_->UploadPoints("any", SpherePoints(10), 0).status()));
+}
+
+TEST(ReconstructionClientConnectTest, NoServerGivesUnavailable) {
+  ClientOptions options;
+  options.connect_timeout = absl::Milliseconds(500);
+  const std::string address = "127.0.0.1:" + std::to_string(testing::PickFreePort());
+  absl::StatusOr<std::unique_ptr<ReconstructionClient>> client =
+      ReconstructionClient::Connect(address, options);
+  ASSERT_FALSE(client.ok());
+  EXPECT_TRUE(absl::IsUnavailable(client.status())) << client.status();
+  EXPECT_NE(client.status().message().find(address), absl::string_view::npos) << client.status();
+}
+
+TEST(PackPointBatchTest, PacksLittleEndianFloatsOfTheRange) {
+  PointCloud cloud;
+  cloud.positions = {Vec3f(1, 2, 3), Vec3f(4, 5, 6), Vec3f(7, 8, 9)};
+  cloud.weights = {0.5f, 1.5f, 2.5f};
+  const v1::PointBatch batch = PackPointBatch(cloud, 1, 3);
+  ASSERT_TRUE(batch.has_packed());
+  ASSERT_EQ(batch.packed().positions().size(), 2 * 12u);
+  ASSERT_EQ(batch.packed().weights().size(), 2 * 4u);
+  EXPECT_TRUE(batch.packed().normals().empty());
+  float first[3];
+  std::memcpy(first, batch.packed().positions().data(), sizeof(first));
+  EXPECT_EQ(first[0], 4.0f);
+  EXPECT_EQ(first[2], 6.0f);
+  float weight;
+  std::memcpy(&weight, batch.packed().weights().data() + 4, sizeof(weight));
+  EXPECT_EQ(weight, 2.5f);
+}
+
+}  // namespace
+}  // namespace neuralmesh::client

@@ -1,0 +1,150 @@
+#include "core/analysis/json_writer.h"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "gtest/gtest.h"
+#include "tests/core/analysis/json_parse_for_test.h"
+
+namespace neuralmesh {
+namespace {
+
+using ::neuralmesh::testing::JsonTestParser;
+using ::neuralmesh::testing::JsonValue;
+
+TEST(JsonWriterTest, WritesCompactNestedDocument) {
+  JsonWriter json;
+  json.BeginObject()
+      .Key("name").String("bunny")
+      .Key("count").Uint(12)
+      .Key("delta").Int(-3)
+      .Key("ok").Bool(true)
+      .Key("nothing").Null()
+      .Key("list").BeginArray().Int(1).Int(2).BeginObject().EndObject().BeginArray().EndArray()
+      .EndArray()
+      .EndObject();
+  const absl::StatusOr<std::string> text = json.Finish();
+  ASSERT_TRUE(text.ok()) << "a well-formed sequence of calls was rejected: " << text.status();
+  EXPECT_EQ(*text,
+            R"({"name":"bunny","count":12,"delta":-3,"ok":true,"nothing":null,)"
+            R"("list":[1,2,{},[]]})")
+      << "compact output differs from the expected text";
+}
+
+TEST(JsonWriterTest, IndentedOutputParsesToSameValues) {
+  JsonWriter json(2);
+  json.BeginObject().Key("a").BeginArray().Uint(1).Uint(2).EndArray().Key("b").String("x")
+      .EndObject();
+  const absl::StatusOr<std::string> text = json.Finish();
+  ASSERT_TRUE(text.ok()) << text.status();
+  EXPECT_EQ(*text, "{\n  \"a\": [\n    1,\n    2\n  ],\n  \"b\": \"x\"\n}")
+      << "indented layout differs from the expected text";
+  const std::optional<JsonValue> parsed = JsonTestParser::Parse(*text);
+  ASSERT_TRUE(parsed.has_value()) << "indented output is not valid JSON: " << *text;
+  ASSERT_NE(parsed->Find("a"), nullptr) << "member \"a\" lost";
+  EXPECT_EQ(parsed->Find("a")->items.size(), 2u) << "array \"a\" lost elements";
+}
+
+TEST(JsonWriterTest, EscapesQuotesBackslashesAndControlCharacters) {
+  const std::string nasty = std::string("q\"b\\s/n\nt\tr\rb\bf\fz") + '\x01' + "\x7f" +
+                            "\xc3\xa9";  // UTF-8 e-acute passes through.
+  EXPECT_EQ(JsonWriter::Quote(nasty),
+            "\"q\\\"b\\\\s/n\\nt\\tr\\rb\\bf\\fz\\u0001\x7f\xc3\xa9\"")
+      << "Quote() escaped something wrongly";
+  JsonWriter json;
+  json.BeginObject().Key(nasty).String(nasty).EndObject();
+  const absl::StatusOr<std::string> text = json.Finish();
+  ASSERT_TRUE(text.ok()) << text.status();
+  const std::optional<JsonValue> parsed = JsonTestParser::Parse(*text);
+  ASSERT_TRUE(parsed.has_value()) << "escaped output is not valid JSON: " << *text;
+  ASSERT_EQ(parsed->members.size(), 1u) << "expected one member";
+  EXPECT_EQ(parsed->members[0].first, nasty) << "key did not round-trip";
+  EXPECT_EQ(parsed->members[0].second.text, nasty) << "string value did not round-trip";
+}
+
+TEST(JsonWriterTest, DoublesRoundTripAndNonFiniteBecomesNull) {
+  const double values[] = {0.0, 1.0, -2.5, 0.1, 1.0 / 3.0, 1e-300, 6.02214076e23,
+                           std::numeric_limits<double>::max()};
+  JsonWriter json;
+  json.BeginArray();
+  for (double v : values) json.Double(v);
+  json.Double(std::numeric_limits<double>::quiet_NaN());
+  json.Double(std::numeric_limits<double>::infinity());
+  json.EndArray();
+  const absl::StatusOr<std::string> text = json.Finish();
+  ASSERT_TRUE(text.ok()) << text.status();
+  const std::optional<JsonValue> parsed = JsonTestParser::Parse(*text);
+  ASSERT_TRUE(parsed.has_value()) << "double output is not valid JSON: " << *text;
+  const size_t n = sizeof(values) / sizeof(values[0]);
+  ASSERT_EQ(parsed->items.size(), n + 2) << "wrong number of array elements in " << *text;
+  for (size_t i = 0; i < n; ++i) {
+    EXPECT_EQ(parsed->items[i].number, values[i])
+        << "double " << i << " did not round-trip exactly: " << parsed->items[i].text;
+  }
+  EXPECT_EQ(parsed->items[1].text, "1") << "1.0 should print in its shortest form";
+  EXPECT_EQ(parsed->items[3].text, "0.1") << "0.1 should print in its shortest form";
+  EXPECT_EQ(parsed->items[n].type, JsonValue::Type::kNull) << "NaN must become null";
+  EXPECT_EQ(parsed->items[n + 1].type, JsonValue::Type::kNull) << "inf must become null";
+}
+
+TEST(JsonWriterTest, TopLevelScalarIsADocument) {
+  JsonWriter json;
+  json.String("alone");
+  const absl::StatusOr<std::string> text = json.Finish();
+  ASSERT_TRUE(text.ok()) << "a lone scalar is valid JSON but was rejected: " << text.status();
+  EXPECT_EQ(*text, "\"alone\"") << "lone scalar written wrongly";
+}
+
+TEST(JsonWriterTest, RejectsMisuse) {
+  {
+    JsonWriter json;
+    json.BeginObject().Uint(1).EndObject();
+    EXPECT_EQ(json.Finish().status().code(), absl::StatusCode::kFailedPrecondition)
+        << "a value without a key inside an object was accepted";
+  }
+  {
+    JsonWriter json;
+    json.BeginArray().Key("k").Uint(1).EndArray();
+    EXPECT_EQ(json.Finish().status().code(), absl::StatusCode::kFailedPrecondition)
+        << "a key inside an array was accepted";
+  }
+  {
+    JsonWriter json;
+    json.BeginObject().Key("a").Key("b").Uint(1).EndObject();
+    EXPECT_EQ(json.Finish().status().code(), absl::StatusCode::kFailedPrecondition)
+        << "two keys in a row were accepted";
+  }
+  {
+    JsonWriter json;
+    json.BeginObject().Key("a").EndObject();
+    EXPECT_EQ(json.Finish().status().code(), absl::StatusCode::kFailedPrecondition)
+        << "a key without a value was accepted";
+  }
+  {
+    JsonWriter json;
+    json.BeginArray().EndObject();
+    EXPECT_EQ(json.Finish().status().code(), absl::StatusCode::kFailedPrecondition)
+        << "EndObject closing an array was accepted";
+  }
+  {
+    JsonWriter json;
+    json.BeginObject().EndObject().BeginObject().EndObject();
+    EXPECT_EQ(json.Finish().status().code(), absl::StatusCode::kFailedPrecondition)
+        << "two top-level values were accepted";
+  }
+  {
+    JsonWriter json;
+    json.BeginObject().Key("a").BeginArray();
+    EXPECT_EQ(json.Finish().status().code(), absl::StatusCode::kFailedPrecondition)
+        << "unclosed containers were accepted";
+  }
+  {
+    JsonWriter json;
+    EXPECT_EQ(json.Finish().status().code(), absl::StatusCode::kFailedPrecondition)
+        << "an empty document was accepted";
+  }
+}
+
+}  // namespace
+}  // namespace neuralmesh

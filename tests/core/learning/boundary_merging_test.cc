@@ -1,0 +1,381 @@
+#include "core/learning/boundary_merging.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/learning/triangle_removal.h"
+#include "core/mesh_validation.h"
+#include "core/random.h"
+#include "gtest/gtest.h"
+#include "tests/testing/shapes.h"
+
+namespace neuralmesh {
+namespace {
+
+using testing::Icosphere;
+using testing::MustToMesh;
+
+// Appends an open tube around the z axis: `rings` rings of `around` vertices from z0 to z1,
+// the first vertex of each ring at angle `phase`, faces counter-clockwise seen from outside.
+void AppendTube(TriangleMesh& out, int around, int rings, double radius, double z0, double z1,
+                double phase) {
+  const uint32_t base = static_cast<uint32_t>(out.positions.size());
+  for (int r = 0; r < rings; ++r) {
+    const double z = z0 + (z1 - z0) * r / (rings - 1);
+    for (int j = 0; j < around; ++j) {
+      const double a = phase + 2 * M_PI * j / around;
+      out.positions.emplace_back(static_cast<float>(radius * std::cos(a)),
+                                 static_cast<float>(radius * std::sin(a)), static_cast<float>(z));
+    }
+  }
+  auto id = [&](int r, int j) { return base + static_cast<uint32_t>(r * around + j % around); };
+  for (int r = 0; r + 1 < rings; ++r) {
+    for (int j = 0; j < around; ++j) {
+      out.faces.push_back({id(r, j), id(r, j + 1), id(r + 1, j + 1)});
+      out.faces.push_back({id(r, j), id(r + 1, j + 1), id(r + 1, j)});
+    }
+  }
+}
+
+// A torus (radii 3 and 1 around the z axis) with a slice cut out: `rings` rings of `around`
+// vertices at angles 0 .. 2 pi - gap around the axis, faces counter-clockwise from outside.
+TriangleMesh BentTube(int rings, int around, double gap) {
+  TriangleMesh out;
+  for (int i = 0; i < rings; ++i) {
+    const double u = (2 * M_PI - gap) * i / (rings - 1);
+    for (int j = 0; j < around; ++j) {
+      const double v = 2 * M_PI * j / around;
+      const double w = 3 + std::cos(v);
+      out.positions.emplace_back(static_cast<float>(w * std::cos(u)),
+                                 static_cast<float>(w * std::sin(u)),
+                                 static_cast<float>(std::sin(v)));
+    }
+  }
+  auto id = [&](int i, int j) { return static_cast<uint32_t>(i * around + j % around); };
+  for (int i = 0; i + 1 < rings; ++i) {
+    for (int j = 0; j < around; ++j) {
+      out.faces.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      out.faces.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  }
+  return out;
+}
+
+struct Counts {
+  size_t vertices = 0;
+  size_t edges = 0;
+  size_t faces = 0;
+  size_t boundary_loops = 0;
+  size_t components = 0;
+  long euler() const {
+    return static_cast<long>(vertices) - static_cast<long>(edges) + static_cast<long>(faces);
+  }
+};
+
+Counts Count(const Mesh& mesh) {
+  Counts c;
+  for (auto vh : mesh.vertices()) (void)vh, ++c.vertices;
+  for (auto eh : mesh.edges()) (void)eh, ++c.edges;
+  for (auto fh : mesh.faces()) (void)fh, ++c.faces;
+  std::vector<bool> seen(mesh.n_halfedges(), false);
+  for (auto start : mesh.halfedges()) {
+    if (seen[start.idx()] || !mesh.is_boundary(start)) continue;
+    ++c.boundary_loops;
+    auto h = start;
+    do {
+      seen[h.idx()] = true;
+      h = mesh.next_halfedge_handle(h);
+    } while (h != start);
+  }
+  std::vector<bool> reached(mesh.n_faces(), false);
+  for (auto seed : mesh.faces()) {
+    if (reached[seed.idx()]) continue;
+    ++c.components;
+    std::vector<Mesh::FaceHandle> stack = {seed};
+    reached[seed.idx()] = true;
+    while (!stack.empty()) {
+      const auto fh = stack.back();
+      stack.pop_back();
+      for (auto neighbour : mesh.ff_range(fh)) {
+        if (reached[neighbour.idx()]) continue;
+        reached[neighbour.idx()] = true;
+        stack.push_back(neighbour);
+      }
+    }
+  }
+  return c;
+}
+
+// Independent of the half-edge structure: in the exported triangles no directed edge may
+// appear twice, and every edge with two faces must be used in both directions.
+std::string OrientationProblem(const Mesh& mesh) {
+  const TriangleMesh triangles = ToTriangleMesh(mesh);
+  std::map<std::pair<uint32_t, uint32_t>, int> directed;
+  for (const auto& f : triangles.faces) {
+    for (int k = 0; k < 3; ++k) ++directed[{f[k], f[(k + 1) % 3]}];
+  }
+  for (const auto& [edge, count] : directed) {
+    if (count > 1) return "a directed edge is used by two faces";
+  }
+  return "";
+}
+
+// Whether every face's normal points away from the z axis (tubes built by AppendTube).
+bool FacesPointAwayFromTheAxis(const Mesh& mesh) {
+  for (auto fh : mesh.faces()) {
+    std::vector<Vec3> p;
+    for (auto vh : mesh.fv_range(fh)) p.push_back(mesh.point(vh));
+    const Vec3 normal = OpenMesh::cross(p[1] - p[0], p[2] - p[0]);
+    const Vec3 centre = (p[0] + p[1] + p[2]) / 3.0;
+    if (normal[0] * centre[0] + normal[1] * centre[1] <= 0) return false;
+  }
+  return true;
+}
+
+TEST(BoundaryMergingTest, OptionsValidate) {
+  EXPECT_TRUE(BoundaryMergingOptions{}.Validate().ok()) << "the paper's alpha_m = 5 is valid";
+  EXPECT_TRUE(BoundaryMergingOptions{0}.Validate().ok()) << "alpha_m = 0 (never merge) is valid";
+  EXPECT_FALSE(BoundaryMergingOptions{-1}.Validate().ok()) << "negative alpha_m accepted";
+  EXPECT_FALSE(BoundaryMergingOptions{INFINITY}.Validate().ok()) << "infinite alpha_m accepted";
+}
+
+TEST(BoundaryMergingTest, FacingTubesBecomeOneTube) {
+  TriangleMesh shape;
+  AppendTube(shape, 12, 7, 1.0, 0.0, 3.0, 0.0);
+  AppendTube(shape, 12, 7, 1.0, 3.2, 6.2, 0.1);
+  Mesh mesh = MustToMesh(shape);
+  const Counts before = Count(mesh);
+  ASSERT_EQ(before.boundary_loops, 4u) << "two open tubes have four rims";
+  ASSERT_EQ(before.components, 2u) << "two tubes";
+
+  const BoundaryMergingResult result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 0);
+  EXPECT_EQ(result.merges, 1u) << "only the facing rims are close";
+  EXPECT_EQ(result.added_faces, 24u) << "a strip between two 12-gons has 24 faces";
+  const Counts after = Count(mesh);
+  EXPECT_EQ(after.boundary_loops, 2u) << "the merged tube keeps its two outer rims";
+  EXPECT_EQ(after.components, 1u) << "the tubes must be joined";
+  EXPECT_EQ(after.vertices, before.vertices) << "merging adds no vertex";
+  EXPECT_EQ(OrientationProblem(mesh), "") << "the strip must be oriented like both tubes";
+  EXPECT_TRUE(FacesPointAwayFromTheAxis(mesh)) << "the strip must face outward, not twist";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+TEST(BoundaryMergingTest, LoopsWithDifferentVertexCountsMerge) {
+  TriangleMesh shape;
+  AppendTube(shape, 12, 7, 1.0, 0.0, 3.0, 0.0);
+  AppendTube(shape, 17, 7, 1.0, 3.2, 6.2, 0.3);
+  Mesh mesh = MustToMesh(shape);
+
+  const BoundaryMergingResult result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 0);
+  EXPECT_EQ(result.merges, 1u) << "the facing 12- and 17-gon rims must merge";
+  EXPECT_EQ(result.added_faces, 29u) << "the strip uses each of the 12 + 17 rim edges once";
+  const Counts after = Count(mesh);
+  EXPECT_EQ(after.boundary_loops, 2u) << "two outer rims must remain";
+  EXPECT_EQ(after.components, 1u) << "the tubes must be joined";
+  EXPECT_EQ(OrientationProblem(mesh), "") << "the strip must be oriented like both tubes";
+  EXPECT_TRUE(FacesPointAwayFromTheAxis(mesh)) << "the strip must face outward, not twist";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+TEST(BoundaryMergingTest, BentTubeClosesIntoATorus) {
+  // 24 rings over 23/24 of the full turn: the cut is as wide as one ring spacing.
+  Mesh mesh = MustToMesh(BentTube(24, 12, 2 * M_PI / 24));
+  const Counts before = Count(mesh);
+  ASSERT_EQ(before.boundary_loops, 2u) << "an open bent tube has two rims";
+  ASSERT_EQ(before.euler(), 0) << "a tube is an annulus";
+
+  const BoundaryMergingResult result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 0);
+  EXPECT_EQ(result.merges, 1u) << "the two ends of the tube must merge";
+  EXPECT_EQ(result.added_faces, 24u) << "a strip between two 12-gons has 24 faces";
+  const Counts after = Count(mesh);
+  EXPECT_EQ(after.boundary_loops, 0u) << "the torus must be closed";
+  EXPECT_EQ(after.euler(), 0) << "V - E + F of a torus is 0 (genus 1)";
+  EXPECT_EQ(after.components, 1u) << "one torus";
+  EXPECT_EQ(OrientationProblem(mesh), "") << "the strip must be oriented like the tube";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+TEST(BoundaryMergingTest, DistantLoopsAreLeftAlone) {
+  TriangleMesh shape;
+  AppendTube(shape, 12, 7, 1.0, 0.0, 3.0, 0.0);
+  AppendTube(shape, 12, 7, 1.0, 8.0, 11.0, 0.0);
+  Mesh mesh = MustToMesh(shape);
+  const Counts before = Count(mesh);
+
+  const BoundaryMergingResult result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 0);
+  EXPECT_EQ(result.merges, 0u) << "rims 5 apart exceed 5 sqrt(E(Area)) ~ 1.8";
+  EXPECT_EQ(result.added_faces, 0u) << "nothing may be added";
+  const Counts after = Count(mesh);
+  EXPECT_EQ(after.faces, before.faces) << "faces changed";
+  EXPECT_EQ(after.boundary_loops, 4u) << "boundaries changed";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+TEST(BoundaryMergingTest, ThresholdFollowsTheGivenMeanArea) {
+  TriangleMesh shape;
+  AppendTube(shape, 12, 7, 1.0, 0.0, 3.0, 0.0);
+  AppendTube(shape, 12, 7, 1.0, 3.2, 6.2, 0.0);
+  Mesh mesh = MustToMesh(shape);
+  // The rims are 0.2 apart; with E(Area) = 1e-4 the threshold is 5 * 0.01 = 0.05.
+  const BoundaryMergingResult result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 1e-4);
+  EXPECT_EQ(result.merges, 0u) << "the caller's E(Area) must set the threshold";
+  EXPECT_EQ(Count(mesh).boundary_loops, 4u) << "boundaries changed";
+}
+
+// Tube A's top rim is close to both tube B's bottom rim (0.1) and to the bottom rim of the
+// wider, longer tube C around B (about 0.32), and B's bottom rim is close to C's (about 0.22):
+// only the closest pair merges, and each of its rims only once.
+TEST(BoundaryMergingTest, ClosestPairFirstAndEachLoopOnce) {
+  TriangleMesh shape;
+  AppendTube(shape, 12, 7, 1.0, 0.0, 3.0, 0.0);   // A
+  AppendTube(shape, 12, 7, 1.0, 3.1, 6.1, 0.0);   // B
+  AppendTube(shape, 12, 7, 1.1, 3.3, 9.3, 0.2);   // C, around B
+  Mesh mesh = MustToMesh(shape);
+  const Counts before = Count(mesh);
+
+  const BoundaryMergingResult result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 0);
+  EXPECT_EQ(result.merges, 1u) << "A's top rim may merge once, with the closest rim (B's)";
+  const Counts after = Count(mesh);
+  EXPECT_EQ(after.boundary_loops, before.boundary_loops - 2) << "one merge removes two rims";
+  EXPECT_EQ(after.components, 2u) << "A and B joined, C alone";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+// Two holes cut into one sphere by Step 4, merged by Step 5 on the same mesh with its
+// deleted elements: the sphere gains a handle.
+TEST(BoundaryMergingTest, TwoHolesOfOneSphereMakeAHandle) {
+  Mesh mesh = MustToMesh(Icosphere(2));
+  mesh.set_point(Mesh::VertexHandle(0), mesh.point(Mesh::VertexHandle(0)) * 10.0);
+  mesh.set_point(Mesh::VertexHandle(3), mesh.point(Mesh::VertexHandle(3)) * 10.0);
+  const TriangleRemovalResult removal = RemoveLargeTriangles(mesh, TriangleRemovalOptions{});
+  ASSERT_EQ(removal.removed_faces, 10u) << "both spikes must be removed";
+  ASSERT_EQ(Count(mesh).boundary_loops, 2u) << "two holes";
+  ASSERT_EQ(Count(mesh).euler(), 0) << "a sphere with two holes";
+
+  // The holes are on opposite sides, about 2 apart: alpha_m = 20 reaches across.
+  const BoundaryMergingResult result =
+      MergeCloseBoundaries(mesh, BoundaryMergingOptions{20}, removal.mean_area);
+  EXPECT_EQ(result.merges, 1u) << "the two holes must merge";
+  EXPECT_EQ(result.added_faces, 10u) << "a strip between two pentagons has 10 faces";
+  const Counts after = Count(mesh);
+  EXPECT_EQ(after.boundary_loops, 0u) << "the surface must be closed";
+  EXPECT_EQ(after.euler(), 0) << "a sphere with a handle has V - E + F = 0";
+  EXPECT_EQ(after.components, 1u) << "still one surface";
+  EXPECT_EQ(OrientationProblem(mesh), "") << "the strip must be oriented like the sphere";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+// A thin annulus: every triangle joins the outer and the inner triangle, so each inner vertex
+// is already joined to two of the three outer ones. A strip needs 5 distinct edges between
+// the loops but only 3 pairs are free: the merge must be refused and the mesh left as it was.
+TEST(BoundaryMergingTest, MergeThatWouldDuplicateEdgesIsRefused) {
+  TriangleMesh shape;
+  for (int k = 0; k < 3; ++k) {
+    const double a = 2 * M_PI * k / 3;
+    shape.positions.emplace_back(static_cast<float>(2 * std::cos(a)),
+                                 static_cast<float>(2 * std::sin(a)), 0.f);
+  }
+  for (int k = 0; k < 3; ++k) {
+    const double a = 2 * M_PI * k / 3 + M_PI / 3;
+    shape.positions.emplace_back(static_cast<float>(0.5 * std::cos(a)),
+                                 static_cast<float>(0.5 * std::sin(a)), 0.f);
+  }
+  for (uint32_t k = 0; k < 3; ++k) {
+    shape.faces.push_back({k, (k + 1) % 3, 3 + k});
+    shape.faces.push_back({3 + k, (k + 1) % 3, 3 + (k + 1) % 3});
+  }
+  Mesh mesh = MustToMesh(shape);
+  ASSERT_EQ(Count(mesh).boundary_loops, 2u) << "an annulus has two boundary loops";
+
+  const BoundaryMergingResult result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 0);
+  EXPECT_EQ(result.merges, 0u) << "no strip exists without duplicating an edge";
+  EXPECT_EQ(result.added_faces, 0u) << "nothing may be added";
+  EXPECT_EQ(Count(mesh).faces, 6u) << "faces changed";
+  EXPECT_EQ(Count(mesh).boundary_loops, 2u) << "boundaries changed";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+// 200 seeds of three kinds of jittered cases; every result must pass ValidateMesh.
+//  0: two coaxial tubes of 4..20 vertices around, radii and gap (even overlap) at random:
+//     the facing rims must merge into one tube.
+//  1: a bent tube with a random cut: it must close into a torus.
+//  2: a sphere with random spikes, cut by Step 4, then merged by Step 5 with a random alpha_m.
+TEST(BoundaryMergingTest, RandomCasesStayValid) {
+  for (uint64_t seed = 1; seed <= 200; ++seed) {
+    Random random(seed);
+    auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * random.NextDouble(); };
+    auto jitter = [&](Mesh& mesh, double amount) {
+      for (auto vh : mesh.vertices()) {
+        mesh.set_point(vh, mesh.point(vh) + amount * Vec3(uniform(-1, 1), uniform(-1, 1),
+                                                          uniform(-1, 1)));
+      }
+    };
+    const int kind = static_cast<int>(seed % 3);
+    Mesh mesh;
+    if (kind == 0) {
+      const int n1 = 4 + static_cast<int>(random.NextIndex(17));
+      const int n2 = 4 + static_cast<int>(random.NextIndex(17));
+      const double length = 6;
+      const double gap = uniform(-0.3, 0.5);
+      TriangleMesh shape;
+      AppendTube(shape, n1, 13, uniform(0.8, 1.2), 0, length, uniform(0, 2 * M_PI));
+      AppendTube(shape, n2, 13, uniform(0.8, 1.2), length + gap, 2 * length + gap,
+                 uniform(0, 2 * M_PI));
+      mesh = MustToMesh(shape);
+      jitter(mesh, 0.05);
+      // A threshold below the tube length: only the facing rims can be close enough.
+      const double alpha_m = 0.9 * length / std::sqrt(MeanTriangleArea(mesh));
+      const BoundaryMergingResult result =
+          MergeCloseBoundaries(mesh, BoundaryMergingOptions{alpha_m}, 0);
+      EXPECT_EQ(result.merges, 1u) << "seed " << seed << ": facing rims did not merge";
+      EXPECT_EQ(result.added_faces, static_cast<size_t>(n1 + n2))
+          << "seed " << seed << ": a strip uses each rim edge once";
+      const Counts after = Count(mesh);
+      EXPECT_EQ(after.components, 1u) << "seed " << seed << ": tubes not joined";
+      EXPECT_EQ(after.boundary_loops, 2u) << "seed " << seed << ": rims left";
+    } else if (kind == 1) {
+      const int rings = 8 + static_cast<int>(random.NextIndex(23));
+      const int around = 3 + static_cast<int>(random.NextIndex(10));
+      mesh = MustToMesh(BentTube(rings, around, 2 * M_PI / rings * uniform(0.3, 1.5)));
+      jitter(mesh, 0.03);
+      const BoundaryMergingResult result =
+          MergeCloseBoundaries(mesh, BoundaryMergingOptions{100}, 0);
+      EXPECT_EQ(result.merges, 1u) << "seed " << seed << ": the tube ends did not merge";
+      const Counts after = Count(mesh);
+      EXPECT_EQ(after.boundary_loops, 0u) << "seed " << seed << ": torus not closed";
+      EXPECT_EQ(after.euler(), 0) << "seed " << seed << ": not a torus";
+    } else {
+      mesh = MustToMesh(Icosphere(1 + static_cast<int>(random.NextIndex(2))));
+      jitter(mesh, 0.02);
+      const int spikes = 1 + static_cast<int>(random.NextIndex(6));
+      for (int s = 0; s < spikes; ++s) {
+        const Mesh::VertexHandle vh(static_cast<int>(random.NextIndex(mesh.n_vertices())));
+        mesh.set_point(vh, mesh.point(vh) * uniform(2, 10));
+      }
+      const TriangleRemovalResult removal =
+          RemoveLargeTriangles(mesh, TriangleRemovalOptions{uniform(2, 8)});
+      const absl::Status removed_status = ValidateMesh(mesh);
+      ASSERT_TRUE(removed_status.ok()) << "seed " << seed << " after removal: " << removed_status;
+      const Counts before = Count(mesh);
+      const BoundaryMergingResult result = MergeCloseBoundaries(
+          mesh, BoundaryMergingOptions{uniform(1, 100)}, removal.mean_area);
+      const Counts after = Count(mesh);
+      EXPECT_EQ(after.boundary_loops, before.boundary_loops - 2 * result.merges)
+          << "seed " << seed << ": each merge must close two loops";
+      EXPECT_EQ(after.euler(), before.euler())
+          << "seed " << seed << ": a strip adds as many edges as faces";
+      EXPECT_EQ(after.faces, before.faces + result.added_faces)
+          << "seed " << seed << ": added faces miscounted";
+    }
+    const absl::Status status = ValidateMesh(mesh);
+    ASSERT_TRUE(status.ok()) << "seed " << seed << " (kind " << kind << "): " << status;
+    EXPECT_EQ(OrientationProblem(mesh), "") << "seed " << seed << ": inconsistent orientation";
+  }
+}
+
+}  // namespace
+}  // namespace neuralmesh

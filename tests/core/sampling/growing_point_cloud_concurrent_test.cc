@@ -1,0 +1,168 @@
+// One thread appends batches to a GrowingPointCloud while others sample it: every sample must
+// be a completely written point and sizes must only grow. Also run under ThreadSanitizer
+// (label "concurrency").
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/random.h"
+#include "core/sampling/growing_point_cloud.h"
+#include "gtest/gtest.h"
+
+namespace neuralmesh {
+namespace {
+
+constexpr int kTotalPoints = 200000;
+constexpr int kReaders = 2;
+
+// Point i is (i, 2i, -i): a torn or unwritten point breaks the pattern.
+Vec3f PointFor(int i) { return Vec3f(static_cast<float>(i), 2.f * i, -1.f * i); }
+
+// Batch sizes vary (and straddle the 65536-point chunks); fixed so the test is repeatable.
+std::vector<int> BatchStarts() {
+  std::vector<int> starts;
+  Random rng(17);
+  for (int start = 0; start < kTotalPoints;) {
+    starts.push_back(start);
+    start = std::min(kTotalPoints, start + 1 + static_cast<int>(rng.NextIndex(4000)));
+  }
+  starts.push_back(kTotalPoints);
+  return starts;
+}
+
+struct ReaderReport {
+  long samples = 0;
+  long failures = 0;
+  std::string first_failure;
+
+  void Fail(const std::string& what) {
+    if (failures++ == 0) first_failure = what;
+  }
+};
+
+// Samples until `done`, checking each sample against the pattern, the size and the box.
+// `allowed(i)` says whether point i may be drawn at all (weight zero may not).
+template <typename Allowed>
+void Read(const GrowingPointCloud& cloud, const std::atomic<bool>& done, uint64_t seed,
+          Allowed allowed, ReaderReport* report) {
+  Random rng(seed);
+  size_t last_size = 0;
+  long round = 0;
+  while (!done.load(std::memory_order_acquire)) {
+    const size_t size_before = cloud.size();
+    if (size_before < last_size) {
+      report->Fail(absl::StrCat("size went down from ", last_size, " to ", size_before));
+    }
+    last_size = size_before;
+    if (size_before == 0) continue;
+    const Vec3 p = cloud.Sample(rng);
+    ++report->samples;
+    const size_t size_after = cloud.size();
+    const double x = p[0];
+    const long i = std::lround(x);
+    if (x != static_cast<double>(i) || p[1] != 2 * x || p[2] != -x) {
+      report->Fail(absl::StrCat("sample (", p[0], ", ", p[1], ", ", p[2],
+                                ") is not a fully written point"));
+    } else if (i < 0 || static_cast<size_t>(i) >= size_after) {
+      report->Fail(absl::StrCat("sample ", i, " is beyond the size ", size_after));
+    } else if (!allowed(static_cast<int>(i))) {
+      report->Fail(absl::StrCat("point ", i, " of weight zero was drawn"));
+    }
+    if (!cloud.Bounds().Contains(p)) {
+      report->Fail(absl::StrCat("sample ", i, " lies outside Bounds()"));
+    }
+    if (++round % 5000 == 0) {
+      const PointCloud copy = cloud.Copy();
+      for (size_t k = 0; k < copy.size(); ++k) {
+        if (copy.positions[k] != PointFor(static_cast<int>(k))) {
+          report->Fail(absl::StrCat("Copy() point ", k, " is wrong"));
+          break;
+        }
+      }
+      if (!copy.weights.empty() && copy.weights.size() != copy.size()) {
+        report->Fail("Copy() has a weight count that does not match");
+      }
+    }
+  }
+}
+
+void ExpectClean(const std::vector<ReaderReport>& reports) {
+  for (size_t r = 0; r < reports.size(); ++r) {
+    EXPECT_EQ(reports[r].failures, 0) << "reader " << r << ": " << reports[r].first_failure;
+    EXPECT_GT(reports[r].samples, 0) << "reader " << r << " never sampled";
+  }
+}
+
+TEST(GrowingPointCloudConcurrentTest, ReadersOnlySeeFullyWrittenPoints) {
+  GrowingPointCloud cloud;
+  const std::vector<int> starts = BatchStarts();
+  std::atomic<bool> done{false};
+  std::vector<ReaderReport> reports(kReaders);
+  std::vector<std::thread> readers;
+  for (int r = 0; r < kReaders; ++r) {
+    readers.emplace_back(
+        [&, r] { Read(cloud, done, 100 + r, [](int) { return true; }, &reports[r]); });
+  }
+  absl::Status writer_status;
+  for (size_t b = 0; b + 1 < starts.size() && writer_status.ok(); ++b) {
+    std::vector<Vec3f> batch;
+    for (int i = starts[b]; i < starts[b + 1]; ++i) batch.push_back(PointFor(i));
+    writer_status = cloud.Append(batch);
+  }
+  done.store(true, std::memory_order_release);
+  for (std::thread& reader : readers) reader.join();
+
+  EXPECT_TRUE(writer_status.ok()) << writer_status;
+  EXPECT_EQ(cloud.size(), static_cast<size_t>(kTotalPoints)) << "every batch should be in";
+  ExpectClean(reports);
+}
+
+// Weights switch on halfway through: the earlier points are given weight 1 while readers
+// sample, and points whose index is a multiple of 7 in weighted batches weigh zero.
+TEST(GrowingPointCloudConcurrentTest, WeightsArrivingMidwayStayConsistent) {
+  GrowingPointCloud cloud;
+  const std::vector<int> starts = BatchStarts();
+  const size_t first_weighted = starts.size() / 2;
+  // Odd batches from the middle on carry weights; the others do not (weight 1).
+  std::vector<bool> weighted_point(kTotalPoints, false);
+  for (size_t b = first_weighted; b + 1 < starts.size(); b += 2) {
+    for (int i = starts[b]; i < starts[b + 1]; ++i) weighted_point[i] = true;
+  }
+  auto allowed = [&weighted_point](int i) { return !(weighted_point[i] && i % 7 == 0); };
+
+  std::atomic<bool> done{false};
+  std::vector<ReaderReport> reports(kReaders);
+  std::vector<std::thread> readers;
+  for (int r = 0; r < kReaders; ++r) {
+    readers.emplace_back([&, r] { Read(cloud, done, 200 + r, allowed, &reports[r]); });
+  }
+  absl::Status writer_status;
+  for (size_t b = 0; b + 1 < starts.size() && writer_status.ok(); ++b) {
+    std::vector<Vec3f> batch;
+    std::vector<float> weights;
+    for (int i = starts[b]; i < starts[b + 1]; ++i) {
+      batch.push_back(PointFor(i));
+      if (weighted_point[i]) weights.push_back(i % 7 == 0 ? 0.0f : 1.0f + i % 3);
+    }
+    writer_status = cloud.Append(batch, weights);
+  }
+  done.store(true, std::memory_order_release);
+  for (std::thread& reader : readers) reader.join();
+
+  EXPECT_TRUE(writer_status.ok()) << writer_status;
+  ASSERT_EQ(cloud.size(), static_cast<size_t>(kTotalPoints)) << "every batch should be in";
+  const PointCloud copy = cloud.Copy();
+  ASSERT_EQ(copy.weights.size(), copy.size()) << "weights were switched on";
+  for (int i = 0; i < kTotalPoints; ++i) {
+    const float expected = !weighted_point[i] ? 1.0f : i % 7 == 0 ? 0.0f : 1.0f + i % 3;
+    ASSERT_EQ(copy.weights[i], expected) << "weight of point " << i;
+  }
+  ExpectClean(reports);
+}
+
+}  // namespace
+}  // namespace neuralmesh

@@ -1,0 +1,128 @@
+#include "server/proto_conversion.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/io/draco_codec.h"
+
+namespace neuralmesh::server {
+namespace {
+
+using ::testing::HasSubstr;
+
+PointCloud ThreePoints() {
+  PointCloud cloud;
+  cloud.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
+  return cloud;
+}
+
+TEST(PointBatchFromProtoTest, UnpacksPositionsWeightsAndNormals) {
+  PointCloud cloud = ThreePoints();
+  cloud.weights = {1, 2, 3};
+  cloud.normals = {Vec3f(0, 0, 1), Vec3f(0, 0, 1), Vec3f(0, 0, 1)};
+  absl::StatusOr<PointCloud> back = PointBatchFromProto(PointCloudToPackedBatch(cloud), 100);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->positions, cloud.positions);
+  EXPECT_EQ(back->weights, cloud.weights);
+  EXPECT_EQ(back->normals, cloud.normals);
+}
+
+TEST(PointBatchFromProtoTest, RejectsMalformedBatchesSayingWhatIsWrong) {
+  struct Case {
+    const char* what;
+    v1::PointBatch batch;
+    absl::StatusCode code;
+    const char* message;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"no encoding", v1::PointBatch(), absl::StatusCode::kInvalidArgument,
+                   "no points"});
+  {
+    v1::PointBatch b;
+    b.mutable_packed();
+    cases.push_back({"empty positions", b, absl::StatusCode::kInvalidArgument, "no points"});
+  }
+  {
+    v1::PointBatch b = PointCloudToPackedBatch(ThreePoints());
+    b.mutable_packed()->mutable_positions()->push_back('x');
+    cases.push_back({"ragged positions", b, absl::StatusCode::kInvalidArgument,
+                     "not a multiple of 12"});
+  }
+  {
+    v1::PointBatch b = PointCloudToPackedBatch(ThreePoints());
+    b.mutable_packed()->set_weights(std::string(8, '\0'));
+    cases.push_back({"weights for two of three points", b, absl::StatusCode::kInvalidArgument,
+                     "PackedPoints.weights has 8 bytes"});
+  }
+  {
+    v1::PointBatch b = PointCloudToPackedBatch(ThreePoints());
+    b.mutable_packed()->set_normals(std::string(24, '\0'));
+    cases.push_back({"normals for two of three points", b, absl::StatusCode::kInvalidArgument,
+                     "PackedPoints.normals has 24 bytes"});
+  }
+  {
+    v1::PointBatch b;
+    b.set_draco_point_cloud("DRACO this is not");
+    cases.push_back({"corrupt Draco", b, absl::StatusCode::kInvalidArgument,
+                     "draco_point_cloud"});
+  }
+  for (const Case& c : cases) {
+    absl::StatusOr<PointCloud> result = PointBatchFromProto(c.batch, 100);
+    EXPECT_EQ(result.status().code(), c.code) << c.what << ": " << result.status();
+    EXPECT_THAT(std::string(result.status().message()), HasSubstr(c.message)) << c.what;
+  }
+}
+
+TEST(PointBatchFromProtoTest, OversizedBatchIsResourceExhausted) {
+  absl::StatusOr<PointCloud> result = PointBatchFromProto(PointCloudToPackedBatch(ThreePoints()), 2);
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted) << result.status();
+  EXPECT_THAT(std::string(result.status().message()), HasSubstr("at most 2"));
+}
+
+TEST(PointBatchFromProtoTest, DecodesDracoPointClouds) {
+  PointCloud cloud = ThreePoints();
+  cloud.weights = {1, 2, 4};
+  absl::StatusOr<std::string> bytes = EncodePointCloud(cloud, DracoOptions());
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  v1::PointBatch batch;
+  batch.set_draco_point_cloud(*bytes);
+  absl::StatusOr<PointCloud> back = PointBatchFromProto(batch, 100);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->size(), 3u);
+  EXPECT_EQ(back->weights.size(), 3u) << "weights travel as a generic attribute";
+}
+
+TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
+  v1::SessionConfig proto;
+  proto.set_target_vertices(500);
+  absl::StatusOr<SessionConfig> config = SessionConfigFromProto(proto);
+  ASSERT_TRUE(config.ok());
+  EXPECT_EQ(config->learner.alpha_w, LearnerOptions().alpha_w) << "paper default";
+  EXPECT_EQ(config->refresh_interval, kDefaultRefreshInterval);
+  EXPECT_EQ(config->points_per_vertex, kDefaultPointsPerVertex);
+  EXPECT_FALSE(config->bounds.has_value());
+
+  proto.mutable_learner()->mutable_alpha_l()->set_value(0);  // A valid zero, not "unset".
+  proto.mutable_learner()->mutable_remove_triangles()->set_value(false);
+  proto.mutable_refresh_interval_ms()->set_value(0);
+  proto.mutable_draco()->mutable_position_quantization_bits()->set_value(14);
+  config = SessionConfigFromProto(proto);
+  ASSERT_TRUE(config.ok());
+  EXPECT_EQ(config->learner.alpha_l, 0.0);
+  EXPECT_FALSE(config->learner.remove_triangles);
+  EXPECT_EQ(config->refresh_interval, absl::ZeroDuration()) << "0 turns refreshes off";
+  EXPECT_EQ(config->draco.position_quantization_bits, 14);
+
+  // The echo has every field set and reads back to the same configuration.
+  v1::SessionConfig echo = SessionConfigToProto(*config);
+  EXPECT_TRUE(echo.learner().has_alpha_w());
+  absl::StatusOr<SessionConfig> again = SessionConfigFromProto(echo);
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->learner.alpha_l, 0.0);
+  EXPECT_EQ(again->draco.position_quantization_bits, 14);
+}
+
+}  // namespace
+}  // namespace neuralmesh::server

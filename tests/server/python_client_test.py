@@ -1,0 +1,188 @@
+#!/usr/bin/env python3
+"""A neuralmesh.v1 client in Python, against the .proto only (not our C++ client).
+
+Generates stubs with Debian's python3-grpc-tools into a temporary directory, then, against a
+running server: checks the health service and server reflection, creates a session, uploads a
+sphere in batches (client streaming), watches it (server streaming), finishes it, fetches the
+final mesh, checks that a NaN batch is rejected with INVALID_ARGUMENT, and runs one
+Reconstruct call (bidirectional). Exits 0 on success.
+
+Usage: python_client_test.py --target=127.0.0.1:PORT --proto_root=proto
+"""
+import argparse
+import math
+import os
+import random
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+
+
+def generate_stubs(proto_root, out_dir):
+    import grpc_tools
+    well_known = os.path.join(os.path.dirname(grpc_tools.__file__), "_proto")
+    command = [sys.executable, "-m", "grpc_tools.protoc", "-I", proto_root, "-I", well_known,
+               "--python_out", out_dir, "--grpc_python_out", out_dir,
+               os.path.join(proto_root, "neuralmesh", "v1", "reconstruction.proto")]
+    subprocess.run(command, check=True)
+    # Python packages for the generated module path neuralmesh/v1/.
+    for package in ("neuralmesh", os.path.join("neuralmesh", "v1")):
+        open(os.path.join(out_dir, package, "__init__.py"), "a").close()
+    sys.path.insert(0, out_dir)
+
+
+def sphere_points(n, seed):
+    rng = random.Random(seed)
+    out = bytearray()
+    for _ in range(n):
+        z = rng.uniform(-1.0, 1.0)
+        phi = rng.uniform(0.0, 2.0 * math.pi)
+        s = math.sqrt(1.0 - z * z)
+        out += struct.pack("<3f", s * math.cos(phi), s * math.sin(phi), z)
+    return bytes(out)
+
+
+def check(condition, message):
+    if not condition:
+        print("FAILED: " + message, file=sys.stderr)
+        sys.exit(1)
+
+
+def raw_unary(channel, method, request_bytes):
+    call = channel.unary_unary(method, request_serializer=lambda b: b,
+                               response_deserializer=lambda b: b)
+    return call(request_bytes, timeout=10)
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--target", required=True)
+    parser.add_argument("--proto_root", required=True)
+    args = parser.parse_args()
+
+    out_dir = tempfile.mkdtemp(prefix="nm_py_")
+    generate_stubs(args.proto_root, out_dir)
+    import grpc
+    from neuralmesh.v1 import reconstruction_pb2 as pb
+    from neuralmesh.v1 import reconstruction_pb2_grpc as pb_grpc
+
+    channel = grpc.insecure_channel(args.target, options=[
+        ("grpc.max_receive_message_length", 64 << 20)])
+    grpc.channel_ready_future(channel).result(timeout=10)
+
+    # grpc.health.v1.Health/Check with an empty request: status SERVING (field 1 = 1).
+    check(raw_unary(channel, "/grpc.health.v1.Health/Check", b"") == b"\x08\x01",
+          "health check is not SERVING")
+    # Server reflection: list_services (field 7) names our service.
+    reflect = channel.stream_stream(
+        "/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo",
+        request_serializer=lambda b: b, response_deserializer=lambda b: b)
+    answers = list(reflect(iter([b"\x3a\x00"]), timeout=10))
+    check(any(b"neuralmesh.v1.ReconstructionService" in a for a in answers),
+          "reflection does not list neuralmesh.v1.ReconstructionService")
+
+    stub = pb_grpc.ReconstructionServiceStub(channel)
+    config = pb.SessionConfig(target_vertices=300)
+    config.refresh_interval_ms.value = 50
+    config.learner.alpha_w.value = 0.06
+    session = stub.CreateSession(pb.CreateSessionRequest(config=config, name="python"),
+                                 timeout=10)
+    check(session.session_id.startswith("s-"), "unexpected session id " + session.session_id)
+    check(session.config.learner.c_vs.value == 100, "defaults are not echoed")
+    sid = session.session_id
+
+    updates = []
+    errors = []
+
+    def watch():
+        try:
+            for update in stub.WatchSession(pb.WatchSessionRequest(session_id=sid), timeout=120):
+                updates.append(update)
+        except grpc.RpcError as e:  # Recorded and checked below.
+            errors.append(e)
+
+    watcher = threading.Thread(target=watch)
+    watcher.start()
+
+    points = sphere_points(6000, 1)
+    batches = [points[i:i + 12 * 600] for i in range(0, len(points), 12 * 600)]
+
+    def requests():
+        for index, chunk in enumerate(batches):
+            yield pb.UploadPointsRequest(
+                session_id=sid if index == 0 else "",
+                batch=pb.PointBatch(packed=pb.PackedPoints(positions=chunk)))
+
+    ack = stub.UploadPoints(requests(), timeout=60)
+    check(ack.total_points == 6000 and ack.batches_accepted == 10,
+          "upload acknowledged %d points in %d batches" % (ack.total_points,
+                                                           ack.batches_accepted))
+
+    # A NaN batch is rejected with INVALID_ARGUMENT and the session keeps its points.
+    nan_batch = struct.pack("<6f", 0.0, 0.0, 0.0, float("nan"), 0.0, 0.0)
+    try:
+        stub.UploadPoints(iter([pb.UploadPointsRequest(
+            session_id=sid, batch=pb.PointBatch(packed=pb.PackedPoints(positions=nan_batch)))]),
+            timeout=10)
+        check(False, "a NaN batch was accepted")
+    except grpc.RpcError as e:
+        check(e.code() == grpc.StatusCode.INVALID_ARGUMENT,
+              "NaN batch gave %s: %s" % (e.code(), e.details()))
+    check(stub.GetSession(pb.GetSessionRequest(session_id=sid)).learning.points_received == 6000,
+          "the rejected batch changed the session")
+
+    stub.FinishSession(pb.FinishSessionRequest(session_id=sid), timeout=10)
+    final = stub.GetMesh(pb.GetMeshRequest(session_id=sid, version=pb.MESH_VERSION_FINAL,
+                                           wait=True), timeout=120)
+    watcher.join(timeout=120)
+    check(not errors, "watch failed: %s" % errors)
+    check(final.kind == pb.UPDATE_KIND_FINAL and final.vertex_count == 300,
+          "final mesh has %d vertices" % final.vertex_count)
+    check(final.draco_mesh[:5] == b"DRACO", "the mesh is not Draco data")
+    check(len(updates) >= 2 and updates[-1].sequence == final.sequence,
+          "the watcher did not end with the final mesh")
+    check(all(a.sequence < b.sequence for a, b in zip(updates, updates[1:])),
+          "sequence numbers do not increase")
+
+    # The reference Draco decoder reads the final mesh.
+    drc = os.path.join(out_dir, "final.drc")
+    obj = os.path.join(out_dir, "final.obj")
+    with open(drc, "wb") as f:
+        f.write(final.draco_mesh)
+    subprocess.run(["draco_decoder", "-i", drc, "-o", obj], check=True,
+                   stdout=subprocess.DEVNULL)
+    with open(obj) as f:
+        faces = sum(1 for line in f if line.startswith("f "))
+    check(faces == final.face_count, "draco_decoder read %d faces, expected %d" %
+          (faces, final.face_count))
+
+    # Reconstruct: points in, meshes out, in one bidirectional call.
+    def stream():
+        yield pb.ReconstructRequest(start=pb.ReconstructStart(
+            create=pb.CreateSessionRequest(config=pb.SessionConfig(target_vertices=100))))
+        for chunk in batches[:4]:
+            yield pb.ReconstructRequest(points=pb.PointBatch(
+                packed=pb.PackedPoints(positions=chunk)))
+
+    responses = list(stub.Reconstruct(stream(), timeout=120))
+    check(responses[0].WhichOneof("kind") == "session", "Reconstruct did not start with a session")
+    check(responses[-1].WhichOneof("kind") == "update" and
+          responses[-1].update.kind == pb.UPDATE_KIND_FINAL and
+          responses[-1].update.vertex_count == 100, "Reconstruct did not end with the final mesh")
+
+    listed = stub.ListSessions(pb.ListSessionsRequest(), timeout=10)
+    check(len(listed.sessions) == 2, "ListSessions returned %d sessions" % len(listed.sessions))
+    stub.DeleteSession(pb.DeleteSessionRequest(session_id=sid), timeout=10)
+    try:
+        stub.GetSession(pb.GetSessionRequest(session_id=sid), timeout=10)
+        check(False, "a deleted session was found")
+    except grpc.RpcError as e:
+        check(e.code() == grpc.StatusCode.NOT_FOUND, "deleted session gave %s" % e.code())
+    print("python client: OK (%d updates, final %d vertices, %d faces)" %
+          (len(updates), final.vertex_count, final.face_count))
+
+
+if __name__ == "__main__":
+    main()

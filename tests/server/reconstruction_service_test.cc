@@ -1,0 +1,533 @@
+// The service's logic over an in-process channel (no sockets).
+#include "server/reconstruction_service.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/io/draco_codec.h"
+#include "tests/server/server_test_support.h"
+
+namespace neuralmesh::server {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::Batch;
+using testing::CreateRequest;
+using testing::InProcessStub;
+using testing::MustCreate;
+using testing::StartServer;
+using testing::TorusPoints;
+
+class ReconstructionServiceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ServerOptions options;
+    options.limits.max_batch_points = 5000;
+    options.limits.max_sessions = 16;
+    server_ = StartServer(/*listen=*/false, options);
+    ASSERT_NE(server_, nullptr);
+    stub_ = InProcessStub(*server_);
+  }
+  void TearDown() override { server_->Shutdown(absl::Seconds(2)); }
+
+  v1::UploadPointsRequest Request(const std::string& id, v1::PointBatch batch) {
+    v1::UploadPointsRequest request;
+    request.set_session_id(id);
+    *request.mutable_batch() = std::move(batch);
+    return request;
+  }
+
+  grpc::Status UploadOne(const v1::UploadPointsRequest& request,
+                         v1::UploadPointsResponse* response = nullptr) {
+    v1::UploadPointsResponse ignored;
+    return testing::UploadOne(*stub_, request, response != nullptr ? response : &ignored);
+  }
+
+  std::unique_ptr<ReconstructionServer> server_;
+  std::unique_ptr<v1::ReconstructionService::Stub> stub_;
+};
+
+TEST_F(ReconstructionServiceTest, CreateGetListAndDelete) {
+  const std::string id = MustCreate(*stub_, CreateRequest(500));
+  ASSERT_FALSE(id.empty());
+  grpc::Status status;
+  v1::Session session = testing::GetSession(*stub_, id, &status);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(session.state(), v1::SESSION_STATE_COLLECTING);
+  EXPECT_EQ(session.name(), "test");
+  EXPECT_DOUBLE_EQ(session.config().learner().alpha_w().value(), 0.06)
+      << "unset options echo the paper's defaults";
+  EXPECT_EQ(session.config().lod_milestones_size(), 6) << "10 20 50 100 200 500";
+  EXPECT_EQ(session.config().draco().position_quantization_bits().value(), 11);
+
+  grpc::ClientContext list_context;
+  v1::ListSessionsResponse list;
+  ASSERT_TRUE(stub_->ListSessions(&list_context, v1::ListSessionsRequest(), &list).ok());
+  ASSERT_EQ(list.sessions_size(), 1);
+  EXPECT_EQ(list.sessions(0).session_id(), id);
+
+  grpc::ClientContext delete_context;
+  v1::DeleteSessionRequest del;
+  del.set_session_id(id);
+  v1::DeleteSessionResponse deleted;
+  ASSERT_TRUE(stub_->DeleteSession(&delete_context, del, &deleted).ok());
+  testing::GetSession(*stub_, id, &status);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  grpc::ClientContext again;
+  EXPECT_EQ(stub_->DeleteSession(&again, del, &deleted).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(ReconstructionServiceTest, InvalidOptionsAreInvalidArgumentNamingTheField) {
+  struct Case {
+    const char* what;
+    v1::CreateSessionRequest request;
+    const char* field;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"target below 4", CreateRequest(3), "target_vertices"});
+  {
+    v1::CreateSessionRequest r = CreateRequest(100);
+    r.mutable_config()->mutable_learner()->mutable_alpha_w()->set_value(0);
+    cases.push_back({"alpha_w = 0", r, "alpha_w"});
+  }
+  {
+    v1::CreateSessionRequest r = CreateRequest(100);
+    r.mutable_config()->mutable_learner()->mutable_alpha_w()->set_value(1.01);
+    cases.push_back({"alpha_w > 1", r, "alpha_w"});
+  }
+  {
+    v1::CreateSessionRequest r = CreateRequest(100);
+    r.mutable_config()->add_lod_milestones(50);
+    r.mutable_config()->add_lod_milestones(20);
+    cases.push_back({"milestones decreasing", r, "lod_milestones"});
+  }
+  {
+    v1::CreateSessionRequest r = CreateRequest(100);
+    r.mutable_config()->mutable_draco()->mutable_position_quantization_bits()->set_value(31);
+    cases.push_back({"31 quantization bits", r, "position_quantization_bits"});
+  }
+  {
+    v1::CreateSessionRequest r = CreateRequest(100);
+    r.mutable_config()->mutable_points_per_vertex()->set_value(-1);
+    cases.push_back({"negative points_per_vertex", r, "points_per_vertex"});
+  }
+  for (const Case& c : cases) {
+    grpc::ClientContext context;
+    v1::Session session;
+    grpc::Status status = stub_->CreateSession(&context, c.request, &session);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << c.what;
+    EXPECT_THAT(status.error_message(), HasSubstr(c.field)) << c.what;
+  }
+}
+
+TEST_F(ReconstructionServiceTest, MaxSessionsIsResourceExhausted) {
+  for (int i = 0; i < 16; ++i) MustCreate(*stub_, CreateRequest(100));
+  grpc::ClientContext context;
+  v1::Session session;
+  grpc::Status status = stub_->CreateSession(&context, CreateRequest(100), &session);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("maximum of 16 sessions"));
+}
+
+TEST_F(ReconstructionServiceTest, EveryBadInputGetsItsStatusAndTheSessionGoesOn) {
+  const std::string id = MustCreate(*stub_, CreateRequest(200));
+  const PointCloud points = TorusPoints(4000, 11);
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(UploadOne(Request(id, Batch(points, 0, 1000)), &response).ok());
+  EXPECT_EQ(response.total_points(), 1000u);
+
+  struct Case {
+    const char* what;
+    v1::UploadPointsRequest request;
+    grpc::StatusCode code;
+    const char* message;
+  };
+  std::vector<Case> cases;
+  {
+    PointCloud bad;
+    bad.positions = {Vec3f(0, 0, 0), Vec3f(std::nanf(""), 0, 0)};
+    cases.push_back({"NaN coordinate", Request(id, testing::Batch(bad, 0, 2)),
+                     grpc::StatusCode::INVALID_ARGUMENT, "batch 0 rejected"});
+    bad.positions[1] = Vec3f(0, INFINITY, 0);
+    cases.push_back({"infinite coordinate", Request(id, testing::Batch(bad, 0, 2)),
+                     grpc::StatusCode::INVALID_ARGUMENT, "1000 points accepted before"});
+  }
+  {
+    v1::PointBatch batch = Batch(points, 1000, 1010);
+    batch.mutable_packed()->set_weights(std::string(9 * 4, '\0'));
+    cases.push_back({"weights of the wrong length", Request(id, batch),
+                     grpc::StatusCode::INVALID_ARGUMENT, "weights has 36 bytes"});
+  }
+  {
+    v1::PointBatch batch = Batch(points, 1000, 1010);
+    batch.mutable_packed()->mutable_positions()->resize(10 * 12 - 4);
+    cases.push_back({"positions not a multiple of 12", Request(id, batch),
+                     grpc::StatusCode::INVALID_ARGUMENT, "multiple of 12"});
+  }
+  {
+    v1::PointBatch batch;
+    batch.mutable_packed();
+    cases.push_back({"empty batch", Request(id, batch), grpc::StatusCode::INVALID_ARGUMENT,
+                     "no points"});
+  }
+  cases.push_back({"oversized batch", Request(id, Batch(TorusPoints(6000, 12), 0, 6000)),
+                   grpc::StatusCode::RESOURCE_EXHAUSTED, "at most 5000"});
+  {
+    v1::PointBatch batch;
+    batch.set_draco_point_cloud(std::string("DRACO\x02\x02\x00\x00garbage", 16));
+    cases.push_back({"corrupt Draco", Request(id, batch), grpc::StatusCode::INVALID_ARGUMENT,
+                     "draco_point_cloud"});
+  }
+  cases.push_back({"unknown session", Request("s-nope", Batch(points, 0, 10)),
+                   grpc::StatusCode::NOT_FOUND, "s-nope"});
+  cases.push_back({"no session id", Request("", Batch(points, 0, 10)),
+                   grpc::StatusCode::INVALID_ARGUMENT, "session_id"});
+
+  for (const Case& c : cases) {
+    grpc::Status status = UploadOne(c.request);
+    EXPECT_EQ(status.error_code(), c.code) << c.what << ": " << status.error_message();
+    EXPECT_THAT(status.error_message(), HasSubstr(c.message)) << c.what;
+    EXPECT_EQ(testing::GetSession(*stub_, id).learning().points_received(), 1000u)
+        << c.what << " changed the session";
+  }
+
+  // A stream whose later batch is bad keeps the batches before it.
+  {
+    grpc::ClientContext context;
+    auto writer = stub_->UploadPoints(&context, &response);
+    writer->Write(Request(id, Batch(points, 1000, 1500)));
+    v1::UploadPointsRequest bad = Request("", Batch(points, 1500, 1510));
+    bad.mutable_batch()->mutable_packed()->mutable_positions()->resize(7);
+    writer->Write(bad);
+    writer->WritesDone();
+    grpc::Status status = writer->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("batch 1 rejected"));
+    EXPECT_THAT(status.error_message(), HasSubstr("1 batches with 500 points accepted before"));
+  }
+  EXPECT_EQ(testing::GetSession(*stub_, id).learning().points_received(), 1500u);
+
+  // Draco point clouds are accepted like packed ones.
+  {
+    PointCloud part;
+    part.positions.assign(points.positions.begin() + 1500, points.positions.begin() + 4000);
+    absl::StatusOr<std::string> draco = EncodePointCloud(part, DracoOptions());
+    ASSERT_TRUE(draco.ok());
+    v1::PointBatch batch;
+    batch.set_draco_point_cloud(*draco);
+    ASSERT_TRUE(UploadOne(Request(id, batch), &response).ok());
+    EXPECT_EQ(response.total_points(), 4000u);
+  }
+
+  ASSERT_TRUE(testing::Finish(*stub_, id).ok());
+  v1::MeshUpdate final_mesh;
+  grpc::Status status = testing::WaitFinal(*stub_, id, &final_mesh);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(final_mesh.vertex_count(), 200u) << "the session went on to its target";
+
+  status = UploadOne(Request(id, Batch(points, 0, 10)));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << "finished session";
+  EXPECT_THAT(status.error_message(), HasSubstr("FINISHED"));
+  EXPECT_EQ(testing::Finish(*stub_, id).error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+
+  const std::string cancelled = MustCreate(*stub_, CreateRequest(200));
+  grpc::ClientContext cancel_context;
+  v1::CancelSessionRequest cancel;
+  cancel.set_session_id(cancelled);
+  v1::Session session;
+  ASSERT_TRUE(stub_->CancelSession(&cancel_context, cancel, &session).ok());
+  EXPECT_EQ(session.state(), v1::SESSION_STATE_CANCELLED);
+  status = UploadOne(Request(cancelled, Batch(points, 0, 10)));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << "cancelled session";
+  EXPECT_EQ(testing::Finish(*stub_, "s-unknown").error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(ReconstructionServiceTest, WatchersJoinLateLeaveEarlyAndReadSlowly) {
+  const std::string id = MustCreate(*stub_, CreateRequest(1000, /*refresh_ms=*/10));
+  const PointCloud points = TorusPoints(20000, 13);
+
+  std::vector<v1::MeshUpdate> early_updates, slow_updates;
+  grpc::Status early_status, slow_status, leaver_status;
+  std::thread early([&] { early_status = testing::WatchAll(*stub_, id, &early_updates); });
+  std::thread slow([&] {
+    grpc::ClientContext context;
+    v1::WatchSessionRequest request;
+    request.set_session_id(id);
+    auto reader = stub_->WatchSession(&context, request);
+    v1::MeshUpdate update;
+    while (reader->Read(&update)) {
+      slow_updates.push_back(update);
+      absl::SleepFor(absl::Milliseconds(150));  // Much slower than the refreshes.
+    }
+    slow_status = reader->Finish();
+  });
+  int leaver_reads = 0;
+  std::thread leaver([&] {
+    grpc::ClientContext context;
+    v1::WatchSessionRequest request;
+    request.set_session_id(id);
+    auto reader = stub_->WatchSession(&context, request);
+    v1::MeshUpdate update;
+    while (reader->Read(&update)) {
+      if (++leaver_reads == 2) context.TryCancel();
+    }
+    leaver_status = reader->Finish();
+  });
+
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(testing::Upload(*stub_, id, points, 20, &response).ok());
+  EXPECT_EQ(response.total_points(), 20000u);
+  EXPECT_EQ(response.batches_accepted(), 20u);
+
+  // A late watcher gets the latest mesh at once.
+  v1::Session before = testing::GetSession(*stub_, id);
+  ASSERT_GT(before.latest_sequence(), 0u) << "meshes should have been published by now";
+  {
+    grpc::ClientContext context;
+    v1::WatchSessionRequest request;
+    request.set_session_id(id);
+    auto reader = stub_->WatchSession(&context, request);
+    v1::MeshUpdate first;
+    ASSERT_TRUE(reader->Read(&first));
+    EXPECT_GE(first.sequence(), before.latest_sequence())
+        << "a late watcher starts from the latest mesh, not from the beginning";
+    context.TryCancel();
+    reader->Finish();
+  }
+
+  ASSERT_TRUE(testing::Finish(*stub_, id).ok());
+  early.join();
+  slow.join();
+  leaver.join();
+
+  ASSERT_TRUE(early_status.ok()) << early_status.error_message();
+  ASSERT_FALSE(early_updates.empty());
+  EXPECT_EQ(early_updates.back().kind(), v1::UPDATE_KIND_FINAL);
+  for (size_t i = 1; i < early_updates.size(); ++i) {
+    EXPECT_GT(early_updates[i].sequence(), early_updates[i - 1].sequence());
+  }
+
+  ASSERT_TRUE(slow_status.ok()) << "a slow watcher still ends normally: "
+                                << slow_status.error_message();
+  ASSERT_FALSE(slow_updates.empty());
+  EXPECT_EQ(slow_updates.back().kind(), v1::UPDATE_KIND_FINAL)
+      << "the final mesh always reaches a slow watcher";
+  EXPECT_EQ(slow_updates.back().sequence(), early_updates.back().sequence());
+  bool skipped = false;
+  for (size_t i = 1; i < slow_updates.size(); ++i) {
+    EXPECT_GT(slow_updates[i].sequence(), slow_updates[i - 1].sequence());
+    skipped |= slow_updates[i].sequence() > slow_updates[i - 1].sequence() + 1;
+  }
+  if (early_updates.back().sequence() > slow_updates.size() + 2) {
+    EXPECT_TRUE(skipped) << "a slow watcher skips to the newest update";
+  }
+
+  EXPECT_EQ(leaver_status.error_code(), grpc::StatusCode::CANCELLED);
+  EXPECT_EQ(leaver_reads, 2);
+  EXPECT_EQ(testing::GetSession(*stub_, id).watchers(), 0u) << "every watcher unsubscribed";
+}
+
+TEST_F(ReconstructionServiceTest, ReconstructDoesEverythingInOneCall) {
+  const PointCloud points = TorusPoints(4000, 14);
+  grpc::ClientContext context;
+  auto stream = stub_->Reconstruct(&context);
+  v1::ReconstructRequest start;
+  *start.mutable_start()->mutable_create() = CreateRequest(300);
+  ASSERT_TRUE(stream->Write(start));
+  for (size_t b = 0; b < 8; ++b) {
+    v1::ReconstructRequest request;
+    *request.mutable_points() = Batch(points, b * 500, (b + 1) * 500);
+    ASSERT_TRUE(stream->Write(request));
+  }
+  stream->WritesDone();
+
+  std::vector<v1::ReconstructResponse> responses;
+  v1::ReconstructResponse response;
+  while (stream->Read(&response)) responses.push_back(response);
+  grpc::Status status = stream->Finish();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(responses.size(), 3u);
+  EXPECT_EQ(responses.front().kind_case(), v1::ReconstructResponse::kSession);
+  uint64_t last_total = 0;
+  for (const auto& r : responses) {
+    if (r.has_ack()) last_total = r.ack().total_points();
+  }
+  EXPECT_EQ(last_total, 4000u) << "the last acknowledgement carries the running total";
+  ASSERT_TRUE(responses.back().has_update());
+  EXPECT_EQ(responses.back().update().kind(), v1::UPDATE_KIND_FINAL);
+  EXPECT_EQ(responses.back().update().vertex_count(), 300u);
+}
+
+TEST_F(ReconstructionServiceTest, ReconstructRejectsABadBatchAndTheSessionStays) {
+  const PointCloud points = TorusPoints(2000, 15);
+  grpc::ClientContext context;
+  auto stream = stub_->Reconstruct(&context);
+  v1::ReconstructRequest start;
+  *start.mutable_start()->mutable_create() = CreateRequest(100);
+  ASSERT_TRUE(stream->Write(start));
+  v1::ReconstructRequest good;
+  *good.mutable_points() = Batch(points, 0, 1000);
+  ASSERT_TRUE(stream->Write(good));
+  v1::ReconstructRequest bad = good;
+  bad.mutable_points()->mutable_packed()->mutable_positions()->resize(13);
+  stream->Write(bad);
+  stream->WritesDone();
+  std::string id;
+  v1::ReconstructResponse response;
+  while (stream->Read(&response)) {
+    if (response.has_session()) id = response.session().session_id();
+  }
+  grpc::Status status = stream->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("batch 2 rejected"));
+  ASSERT_FALSE(id.empty());
+  v1::Session session = testing::GetSession(*stub_, id);
+  EXPECT_EQ(session.learning().points_received(), 1000u) << "the good batch stays";
+  EXPECT_NE(session.state(), v1::SESSION_STATE_FINISHING) << "an error does not finish it";
+
+  // The first request must be a start.
+  grpc::ClientContext context2;
+  auto stream2 = stub_->Reconstruct(&context2);
+  stream2->Write(good);
+  stream2->WritesDone();
+  while (stream2->Read(&response)) {
+  }
+  EXPECT_EQ(stream2->Finish().error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+}
+
+TEST_F(ReconstructionServiceTest, GetMeshLatestFinalAndWaiting) {
+  const std::string id = MustCreate(*stub_, CreateRequest(200));
+  grpc::ClientContext context;
+  v1::GetMeshRequest request;
+  request.set_session_id(id);
+  v1::MeshUpdate mesh;
+  grpc::Status status = stub_->GetMesh(&context, request, &mesh);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(status.error_message(), HasSubstr("no mesh yet"));
+
+  // A waiting call for the final mesh returns once the session finishes.
+  v1::MeshUpdate final_mesh;
+  grpc::Status final_status;
+  std::thread waiter([&] { final_status = testing::WaitFinal(*stub_, id, &final_mesh); });
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(testing::Upload(*stub_, id, TorusPoints(2000, 16), 4, &response).ok());
+  ASSERT_TRUE(testing::Finish(*stub_, id).ok());
+  waiter.join();
+  ASSERT_TRUE(final_status.ok()) << final_status.error_message();
+  EXPECT_EQ(final_mesh.kind(), v1::UPDATE_KIND_FINAL);
+
+  grpc::ClientContext latest_context;
+  ASSERT_TRUE(stub_->GetMesh(&latest_context, request, &mesh).ok());
+  EXPECT_EQ(mesh.sequence(), final_mesh.sequence()) << "after finishing, latest is final";
+
+  // Waiting for a final mesh that cannot come.
+  const std::string other = MustCreate(*stub_, CreateRequest(200));
+  grpc::Status cancelled_status;
+  std::thread waiter2([&] {
+    v1::MeshUpdate unused;
+    cancelled_status = testing::WaitFinal(*stub_, other, &unused);
+  });
+  absl::SleepFor(absl::Milliseconds(100));
+  grpc::ClientContext cancel_context;
+  v1::CancelSessionRequest cancel;
+  cancel.set_session_id(other);
+  v1::Session session;
+  ASSERT_TRUE(stub_->CancelSession(&cancel_context, cancel, &session).ok());
+  waiter2.join();
+  EXPECT_EQ(cancelled_status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+
+  // A deadline ends the wait.
+  const std::string third = MustCreate(*stub_, CreateRequest(200));
+  v1::MeshUpdate unused;
+  status = testing::WaitFinal(*stub_, third, &unused, absl::Milliseconds(200));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+}
+
+TEST_F(ReconstructionServiceTest, CancelAndDeleteEndWatchers) {
+  const std::string id = MustCreate(*stub_, CreateRequest(100000));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(testing::Upload(*stub_, id, TorusPoints(20000, 17), 4, &response).ok());
+  std::vector<v1::MeshUpdate> updates;
+  grpc::Status watch_status;
+  std::thread watcher([&] { watch_status = testing::WatchAll(*stub_, id, &updates); });
+  absl::SleepFor(absl::Milliseconds(200));
+  grpc::ClientContext context;
+  v1::CancelSessionRequest cancel;
+  cancel.set_session_id(id);
+  v1::Session session;
+  ASSERT_TRUE(stub_->CancelSession(&context, cancel, &session).ok());
+  watcher.join();
+  EXPECT_EQ(watch_status.error_code(), grpc::StatusCode::CANCELLED)
+      << watch_status.error_message();
+  grpc::ClientContext again;
+  EXPECT_TRUE(stub_->CancelSession(&again, cancel, &session).ok()) << "cancel is idempotent";
+
+  const std::string id2 = MustCreate(*stub_, CreateRequest(100000));
+  ASSERT_TRUE(testing::Upload(*stub_, id2, TorusPoints(20000, 18), 4, &response).ok());
+  std::thread watcher2([&] { watch_status = testing::WatchAll(*stub_, id2, &updates); });
+  absl::SleepFor(absl::Milliseconds(200));
+  grpc::ClientContext delete_context;
+  v1::DeleteSessionRequest del;
+  del.set_session_id(id2);
+  v1::DeleteSessionResponse deleted;
+  ASSERT_TRUE(stub_->DeleteSession(&delete_context, del, &deleted).ok());
+  watcher2.join();
+  EXPECT_EQ(watch_status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(watch_status.error_message(), HasSubstr("deleted"));
+}
+
+TEST_F(ReconstructionServiceTest, ShutdownEndsEveryOpenStream) {
+  const std::string id = MustCreate(*stub_, CreateRequest(100000));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(testing::Upload(*stub_, id, TorusPoints(20000, 19), 2, &response).ok());
+
+  grpc::Status watch_status, upload_status, bidi_status, wait_status;
+  std::vector<v1::MeshUpdate> updates;
+  std::thread watcher([&] { watch_status = testing::WatchAll(*stub_, id, &updates); });
+  std::thread uploader([&] {  // An upload that never half-closes.
+    grpc::ClientContext context;
+    v1::UploadPointsResponse r;
+    auto writer = stub_->UploadPoints(&context, &r);
+    v1::UploadPointsRequest request;
+    request.set_session_id(id);
+    *request.mutable_batch() = Batch(TorusPoints(100, 20), 0, 100);
+    writer->Write(request);
+    upload_status = writer->Finish();
+  });
+  std::thread bidi([&] {  // A Reconstruct call that never half-closes.
+    grpc::ClientContext context;
+    auto stream = stub_->Reconstruct(&context);
+    v1::ReconstructRequest start;
+    *start.mutable_start()->mutable_create() = CreateRequest(100000);
+    stream->Write(start);
+    v1::ReconstructResponse r;
+    while (stream->Read(&r)) {
+    }
+    bidi_status = stream->Finish();
+  });
+  std::thread waiter([&] {
+    v1::MeshUpdate unused;
+    wait_status = testing::WaitFinal(*stub_, id, &unused);
+  });
+  absl::SleepFor(absl::Milliseconds(300));
+  const absl::Time start = absl::Now();
+  server_->Shutdown(absl::Seconds(10));
+  watcher.join();
+  uploader.join();
+  bidi.join();
+  waiter.join();
+  EXPECT_LT(absl::Now() - start, absl::Seconds(5)) << "shutdown must not wait for clients";
+  EXPECT_EQ(watch_status.error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_EQ(upload_status.error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_EQ(bidi_status.error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_EQ(wait_status.error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_EQ(server_->reactors().size(), 0u) << "every reactor is gone";
+}
+
+}  // namespace
+}  // namespace neuralmesh::server

@@ -1,0 +1,246 @@
+// End to end over a real 127.0.0.1 port: a torus streamed in 100 batches, every mesh decoded
+// by the Draco library and by Debian's draco_decoder, the health service, and the
+// neuralmesh-server binary shutting down on SIGTERM during open streams.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <grpcpp/generic/generic_stub.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/synchronization/notification.h"
+#include "core/analysis/geometric_error.h"
+#include "core/io/draco_codec.h"
+#include "tests/server/server_test_support.h"
+
+namespace neuralmesh::server {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Decodes `draco` with the draco_decoder binary; returns the face count of the OBJ it writes,
+// or -1 when the decoder fails.
+int DecodeWithReferenceDecoder(const std::string& draco, const fs::path& dir, int index) {
+  const fs::path input = dir / absl::StrCat("mesh", index, ".drc");
+  const fs::path output = dir / absl::StrCat("mesh", index, ".obj");
+  {
+    std::ofstream out(input, std::ios::binary);
+    out.write(draco.data(), static_cast<std::streamsize>(draco.size()));
+  }
+  const std::string command = absl::StrCat("draco_decoder -i ", input.string(), " -o ",
+                                           output.string(), " > /dev/null 2>&1");
+  if (std::system(command.c_str()) != 0) return -1;
+  std::ifstream in(output);
+  std::string line;
+  int faces = 0;
+  while (std::getline(in, line)) faces += line.rfind("f ", 0) == 0 ? 1 : 0;
+  return faces;
+}
+
+TEST(ServerEndToEndTest, TorusInAHundredBatchesOverLoopback) {
+  ASSERT_EQ(std::system("command -v draco_decoder > /dev/null"), 0)
+      << "Debian's draco package (draco_decoder) is required";
+  std::unique_ptr<ReconstructionServer> server = testing::StartServer(/*listen=*/true);
+  ASSERT_NE(server, nullptr);
+  ASSERT_GT(server->port(), 0);
+  auto stub = testing::NetworkStub(*server);
+
+  auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4);
+  ASSERT_TRUE(torus.ok());
+  const PointCloud points = SamplePoints(**torus, 40000, 21);
+  const std::string id = testing::MustCreate(*stub, testing::CreateRequest(2000));
+
+  std::vector<v1::MeshUpdate> updates;
+  grpc::Status watch_status;
+  std::thread watcher([&] { watch_status = testing::WatchAll(*stub, id, &updates); });
+  v1::UploadPointsResponse response;
+  grpc::Status upload = testing::Upload(*stub, id, points, 100, &response);
+  ASSERT_TRUE(upload.ok()) << upload.error_message();
+  EXPECT_EQ(response.batches_accepted(), 100u);
+  EXPECT_EQ(response.total_points(), 40000u);
+  ASSERT_TRUE(testing::Finish(*stub, id).ok());
+  watcher.join();
+  ASSERT_TRUE(watch_status.ok()) << watch_status.error_message();
+
+  // At least four milestone meshes with increasing vertex counts, then the final one.
+  std::vector<uint64_t> counts;
+  for (const v1::MeshUpdate& u : updates) {
+    if (u.kind() == v1::UPDATE_KIND_MILESTONE || u.kind() == v1::UPDATE_KIND_FINAL) {
+      counts.push_back(u.vertex_count());
+    }
+  }
+  ASSERT_GE(counts.size(), 4u);
+  for (size_t i = 1; i < counts.size(); ++i) {
+    EXPECT_GT(counts[i], counts[i - 1]) << "milestone vertex counts must increase";
+  }
+  ASSERT_EQ(updates.back().kind(), v1::UPDATE_KIND_FINAL);
+  EXPECT_EQ(updates.back().vertex_count(), 2000u);
+
+  const fs::path dir = fs::temp_directory_path() / absl::StrCat("nm_e2e_", getpid());
+  fs::create_directories(dir);
+  for (size_t i = 0; i < updates.size(); ++i) {
+    const v1::MeshUpdate& u = updates[i];
+    absl::StatusOr<TriangleMesh> mesh = DecodeMesh(u.draco_mesh());
+    ASSERT_TRUE(mesh.ok()) << "update " << u.sequence() << ": " << mesh.status();
+    EXPECT_EQ(mesh->faces.size(), u.face_count()) << "update " << u.sequence();
+    EXPECT_EQ(DecodeWithReferenceDecoder(u.draco_mesh(), dir, static_cast<int>(i)),
+              static_cast<int>(u.face_count()))
+        << "draco_decoder cannot decode update " << u.sequence();
+    EXPECT_EQ(u.quantization_epoch(), 0u);
+  }
+  fs::remove_all(dir);
+
+  // The final mesh is close to the true torus.
+  absl::StatusOr<TriangleMesh> final_mesh = DecodeMesh(updates.back().draco_mesh());
+  ASSERT_TRUE(final_mesh.ok());
+  GeometricErrorOptions options;
+  options.samples = 50000;
+  options.threads = 1;
+  absl::StatusOr<GeometricError> error =
+      ComputeGeometricError(*final_mesh, (*torus)->ReferenceMesh(20), options);
+  ASSERT_TRUE(error.ok()) << error.status();
+  EXPECT_LT(error->chamfer_l1, 0.01) << "the final mesh is too far from the torus";
+  EXPECT_LT(testing::MaxVertexDistance(*final_mesh, **torus), 0.1);
+  const double bytes_per_vertex =
+      static_cast<double>(updates.back().draco_mesh().size()) / updates.back().vertex_count();
+  EXPECT_LE(bytes_per_vertex, 8.0) << "11-bit quantization should stay within 8 B/vertex";
+  std::printf("final mesh: %llu vertices, genus %d, chamfer %.5f, %.2f bytes/vertex\n",
+              static_cast<unsigned long long>(updates.back().vertex_count()),
+              updates.back().report().genus(), error->chamfer_l1, bytes_per_vertex);
+}
+
+TEST(ServerEndToEndTest, HealthServiceReportsServing) {
+  std::unique_ptr<ReconstructionServer> server = testing::StartServer(/*listen=*/true);
+  ASSERT_NE(server, nullptr);
+  auto channel = grpc::CreateChannel(server->target(), grpc::InsecureChannelCredentials());
+  grpc::GenericStub generic(channel);
+  for (const std::string service : {"", "neuralmesh.v1.ReconstructionService"}) {
+    // grpc.health.v1.HealthCheckRequest{service}: field 1, length-delimited.
+    std::string request_bytes;
+    if (!service.empty()) {
+      request_bytes = absl::StrCat(std::string(1, '\x0a'),
+                                   std::string(1, static_cast<char>(service.size())), service);
+    }
+    grpc::Slice slice(request_bytes);
+    grpc::ByteBuffer request(&slice, 1);
+    grpc::ByteBuffer response;
+    grpc::ClientContext context;
+    absl::Notification done;
+    grpc::Status status;
+    generic.UnaryCall(&context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &request,
+                      &response, [&](grpc::Status s) {
+                        status = s;
+                        done.Notify();
+                      });
+    done.WaitForNotification();
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    std::vector<grpc::Slice> slices;
+    ASSERT_TRUE(response.Dump(&slices).ok());
+    std::string bytes;
+    for (const grpc::Slice& s : slices) bytes += std::string(s.begin(), s.end());
+    EXPECT_EQ(bytes, std::string("\x08\x01", 2)) << "status SERVING for \"" << service << "\"";
+  }
+}
+
+// Starts build/bin/neuralmesh-server on a picked port and returns its pid and port.
+struct Child {
+  pid_t pid = -1;
+  int port = 0;
+};
+
+Child StartServerBinary() {
+  const char* bin_dir = std::getenv("NEURALMESH_BIN_DIR");
+  const std::string binary =
+      absl::StrCat(bin_dir != nullptr ? bin_dir : "build/bin", "/neuralmesh-server");
+  int pipe_fds[2];
+  if (pipe(pipe_fds) != 0) return {};
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(pipe_fds[1], STDOUT_FILENO);
+    close(pipe_fds[0]);
+    close(pipe_fds[1]);
+    execl(binary.c_str(), binary.c_str(), "--host=127.0.0.1", "--port=0", "--worker_threads=2",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(pipe_fds[1]);
+  Child child;
+  child.pid = pid;
+  FILE* out = fdopen(pipe_fds[0], "r");
+  char line[512];
+  if (out != nullptr && std::fgets(line, sizeof(line), out) != nullptr) {
+    const char* colon = std::strrchr(line, ':');
+    if (colon != nullptr) child.port = std::atoi(colon + 1);
+  }
+  // Keep draining the child's output so that it never blocks on a full pipe.
+  std::thread([out] {
+    char buffer[512];
+    while (out != nullptr && std::fgets(buffer, sizeof(buffer), out) != nullptr) {
+    }
+    if (out != nullptr) std::fclose(out);
+  }).detach();
+  return child;
+}
+
+TEST(ServerEndToEndTest, BinaryShutsDownOnSigtermDuringOpenStreams) {
+  Child child = StartServerBinary();
+  ASSERT_GT(child.pid, 0);
+  ASSERT_GT(child.port, 0) << "the server did not print its port";
+  auto stub = v1::ReconstructionService::NewStub(grpc::CreateChannel(
+      absl::StrCat("127.0.0.1:", child.port), grpc::InsecureChannelCredentials()));
+  const std::string id = testing::MustCreate(*stub, testing::CreateRequest(100000));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(testing::Upload(*stub, id, testing::TorusPoints(20000, 22), 4, &response).ok());
+
+  grpc::Status watch_status, upload_status;
+  std::vector<v1::MeshUpdate> updates;
+  std::thread watcher([&] { watch_status = testing::WatchAll(*stub, id, &updates); });
+  std::thread uploader([&] {
+    grpc::ClientContext context;
+    v1::UploadPointsResponse r;
+    auto writer = stub->UploadPoints(&context, &r);
+    v1::UploadPointsRequest request;
+    request.set_session_id(id);
+    *request.mutable_batch() = testing::Batch(testing::TorusPoints(100, 23), 0, 100);
+    writer->Write(request);
+    upload_status = writer->Finish();  // Never half-closed: only the shutdown ends it.
+  });
+  absl::SleepFor(absl::Milliseconds(500));
+  const absl::Time start = absl::Now();
+  ASSERT_EQ(kill(child.pid, SIGTERM), 0);
+  int wstatus = 0;
+  pid_t waited = 0;
+  while ((waited = waitpid(child.pid, &wstatus, WNOHANG)) == 0 &&
+         absl::Now() - start < absl::Seconds(20)) {
+    absl::SleepFor(absl::Milliseconds(20));
+  }
+  if (waited == 0) {
+    kill(child.pid, SIGKILL);
+    waitpid(child.pid, &wstatus, 0);
+    FAIL() << "the server did not exit within 20 s of SIGTERM";
+  }
+  watcher.join();
+  uploader.join();
+  EXPECT_TRUE(WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0) << "exit status " << wstatus;
+  EXPECT_LT(absl::Now() - start, absl::Seconds(6));
+  EXPECT_EQ(watch_status.error_code(), grpc::StatusCode::UNAVAILABLE)
+      << watch_status.error_message();
+  EXPECT_EQ(upload_status.error_code(), grpc::StatusCode::UNAVAILABLE)
+      << upload_status.error_message();
+  EXPECT_FALSE(updates.empty()) << "the watcher saw meshes before the shutdown";
+}
+
+}  // namespace
+}  // namespace neuralmesh::server

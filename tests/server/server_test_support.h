@@ -1,0 +1,172 @@
+// Helpers shared by the server tests: test servers, shapes as point batches, and synchronous
+// calls that collect a whole stream.
+#ifndef NEURALMESH_TESTS_SERVER_SERVER_TEST_SUPPORT_H_
+#define NEURALMESH_TESTS_SERVER_SERVER_TEST_SUPPORT_H_
+
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/point_cloud.h"
+#include "core/random.h"
+#include "core/sampling/implicit_surfaces.h"
+#include "core/sampling/sample_points.h"
+#include "neuralmesh/v1/reconstruction.grpc.pb.h"
+#include "server/proto_conversion.h"
+#include "server/server.h"
+
+namespace neuralmesh::server::testing {
+
+// A server on 127.0.0.1 with a picked port, or in-process only when `listen` is false.
+inline std::unique_ptr<ReconstructionServer> StartServer(bool listen, ServerOptions options = {}) {
+  options.address = listen ? "127.0.0.1:0" : "";
+  absl::StatusOr<std::unique_ptr<ReconstructionServer>> server =
+      ReconstructionServer::Start(options);
+  EXPECT_TRUE(server.ok()) << "the test server did not start: " << server.status();
+  return server.ok() ? *std::move(server) : nullptr;
+}
+
+inline std::unique_ptr<v1::ReconstructionService::Stub> InProcessStub(
+    ReconstructionServer& server) {
+  return v1::ReconstructionService::NewStub(server.InProcessChannel());
+}
+
+inline std::unique_ptr<v1::ReconstructionService::Stub> NetworkStub(
+    ReconstructionServer& server) {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(64 << 20);
+  return v1::ReconstructionService::NewStub(
+      grpc::CreateCustomChannel(server.target(), grpc::InsecureChannelCredentials(), args));
+}
+
+// Area-uniform points of a torus (R = 1, r = 0.4) or a sphere (r = 1) around the origin.
+inline PointCloud TorusPoints(size_t n, uint64_t seed) {
+  auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4);
+  EXPECT_TRUE(torus.ok());
+  return SamplePoints(**torus, n, seed);
+}
+inline PointCloud SpherePoints(size_t n, uint64_t seed) {
+  auto sphere = MakeSphere(Vec3(0, 0, 0), 1.0);
+  EXPECT_TRUE(sphere.ok());
+  return SamplePoints(**sphere, n, seed);
+}
+
+// Points [begin, end) of `cloud` as a packed batch.
+inline v1::PointBatch Batch(const PointCloud& cloud, size_t begin, size_t end) {
+  PointCloud part;
+  part.positions.assign(cloud.positions.begin() + begin, cloud.positions.begin() + end);
+  if (!cloud.weights.empty()) {
+    part.weights.assign(cloud.weights.begin() + begin, cloud.weights.begin() + end);
+  }
+  if (!cloud.normals.empty()) {
+    part.normals.assign(cloud.normals.begin() + begin, cloud.normals.begin() + end);
+  }
+  return PointCloudToPackedBatch(part);
+}
+
+inline v1::CreateSessionRequest CreateRequest(uint64_t target, uint32_t refresh_ms = 250) {
+  v1::CreateSessionRequest request;
+  request.mutable_config()->set_target_vertices(target);
+  request.mutable_config()->mutable_refresh_interval_ms()->set_value(refresh_ms);
+  request.set_name("test");
+  return request;
+}
+
+inline std::string MustCreate(v1::ReconstructionService::Stub& stub,
+                              const v1::CreateSessionRequest& request) {
+  grpc::ClientContext context;
+  v1::Session session;
+  grpc::Status status = stub.CreateSession(&context, request, &session);
+  EXPECT_TRUE(status.ok()) << "CreateSession failed: " << status.error_message();
+  return session.session_id();
+}
+
+// Uploads `cloud` in `batches` equal batches through one UploadPoints call.
+inline grpc::Status Upload(v1::ReconstructionService::Stub& stub, const std::string& id,
+                           const PointCloud& cloud, size_t batches,
+                           v1::UploadPointsResponse* response) {
+  grpc::ClientContext context;
+  auto writer = stub.UploadPoints(&context, response);
+  const size_t n = cloud.size();
+  for (size_t b = 0; b < batches; ++b) {
+    v1::UploadPointsRequest request;
+    if (b == 0) request.set_session_id(id);
+    *request.mutable_batch() = Batch(cloud, n * b / batches, n * (b + 1) / batches);
+    if (!writer->Write(request)) break;
+  }
+  writer->WritesDone();
+  return writer->Finish();
+}
+
+// Sends one raw request through its own UploadPoints call.
+inline grpc::Status UploadOne(v1::ReconstructionService::Stub& stub,
+                              const v1::UploadPointsRequest& request,
+                              v1::UploadPointsResponse* response) {
+  grpc::ClientContext context;
+  auto writer = stub.UploadPoints(&context, response);
+  writer->Write(request);
+  writer->WritesDone();
+  return writer->Finish();
+}
+
+inline v1::Session GetSession(v1::ReconstructionService::Stub& stub, const std::string& id,
+                              grpc::Status* status_out = nullptr) {
+  grpc::ClientContext context;
+  v1::GetSessionRequest request;
+  request.set_session_id(id);
+  v1::Session session;
+  grpc::Status status = stub.GetSession(&context, request, &session);
+  if (status_out != nullptr) *status_out = status;
+  return session;
+}
+
+inline grpc::Status Finish(v1::ReconstructionService::Stub& stub, const std::string& id) {
+  grpc::ClientContext context;
+  v1::FinishSessionRequest request;
+  request.set_session_id(id);
+  v1::Session session;
+  return stub.FinishSession(&context, request, &session);
+}
+
+inline grpc::Status WaitFinal(v1::ReconstructionService::Stub& stub, const std::string& id,
+                              v1::MeshUpdate* update, absl::Duration timeout = absl::Seconds(60)) {
+  grpc::ClientContext context;
+  context.set_deadline(absl::ToChronoTime(absl::Now() + timeout));
+  v1::GetMeshRequest request;
+  request.set_session_id(id);
+  request.set_version(v1::MESH_VERSION_FINAL);
+  request.set_wait(true);
+  return stub.GetMesh(&context, request, update);
+}
+
+// Reads a whole WatchSession stream.
+inline grpc::Status WatchAll(v1::ReconstructionService::Stub& stub, const std::string& id,
+                             std::vector<v1::MeshUpdate>* updates,
+                             absl::Duration timeout = absl::Seconds(60)) {
+  grpc::ClientContext context;
+  context.set_deadline(absl::ToChronoTime(absl::Now() + timeout));
+  v1::WatchSessionRequest request;
+  request.set_session_id(id);
+  auto reader = stub.WatchSession(&context, request);
+  v1::MeshUpdate update;
+  while (reader->Read(&update)) updates->push_back(update);
+  return reader->Finish();
+}
+
+// Largest distance from the mesh's vertices to `surface`.
+inline double MaxVertexDistance(const TriangleMesh& mesh, const ImplicitSurface& surface) {
+  double worst = 0;
+  for (const Vec3f& p : mesh.positions) {
+    worst = std::max(worst, surface.Distance(Vec3(p[0], p[1], p[2])));
+  }
+  return worst;
+}
+
+}  // namespace neuralmesh::server::testing
+
+#endif  // NEURALMESH_TESTS_SERVER_SERVER_TEST_SUPPORT_H_

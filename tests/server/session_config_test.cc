@@ -1,0 +1,92 @@
+#include "server/session_config.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace neuralmesh::server {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+TEST(DefaultLodMilestonesTest, OneTwoFiveSeriesUpToTheTarget) {
+  EXPECT_THAT(DefaultLodMilestones(2000), ElementsAre(10, 20, 50, 100, 200, 500, 1000, 2000))
+      << "the default schedule is the 1-2-5 series below the target, then the target";
+  EXPECT_THAT(DefaultLodMilestones(1500), ElementsAre(10, 20, 50, 100, 200, 500, 1000, 1500));
+  EXPECT_THAT(DefaultLodMilestones(4), ElementsAre(4)) << "a tiny target is its only milestone";
+  EXPECT_THAT(DefaultLodMilestones(10), ElementsAre(10));
+  EXPECT_THAT(DefaultLodMilestones(11), ElementsAre(10, 11));
+}
+
+SessionConfig Valid() {
+  SessionConfig config;
+  config.target_vertices = 1000;
+  return config;
+}
+
+TEST(ResolveSessionConfigTest, FillsDefaultMilestonesAndAppendsTheTarget) {
+  SessionConfig config = Valid();
+  ASSERT_TRUE(ResolveSessionConfig(1 << 20, config).ok());
+  EXPECT_THAT(config.lod_milestones, ElementsAre(10, 20, 50, 100, 200, 500, 1000));
+
+  config = Valid();
+  config.lod_milestones = {50, 300};
+  ASSERT_TRUE(ResolveSessionConfig(1 << 20, config).ok());
+  EXPECT_THAT(config.lod_milestones, ElementsAre(50, 300, 1000))
+      << "the target ends every schedule";
+}
+
+TEST(ResolveSessionConfigTest, RejectsInvalidOptionsNamingTheField) {
+  struct Case {
+    const char* what;
+    void (*mutate)(SessionConfig&);
+    const char* message;
+  };
+  const Case cases[] = {
+      {"target below 4", [](SessionConfig& c) { c.target_vertices = 3; }, "target_vertices"},
+      {"alpha_w zero", [](SessionConfig& c) { c.learner.alpha_w = 0; }, "alpha_w"},
+      {"alpha_w above 1", [](SessionConfig& c) { c.learner.alpha_w = 1.5; }, "alpha_w"},
+      {"milestones not increasing", [](SessionConfig& c) { c.lod_milestones = {100, 50}; },
+       "lod_milestones[1]"},
+      {"milestone above target", [](SessionConfig& c) { c.lod_milestones = {2000}; },
+       "lod_milestones[0]"},
+      {"milestone below 4", [](SessionConfig& c) { c.lod_milestones = {2}; },
+       "lod_milestones[0]"},
+      {"points_per_vertex zero", [](SessionConfig& c) { c.points_per_vertex = 0; },
+       "points_per_vertex"},
+      {"refresh too short", [](SessionConfig& c) { c.refresh_interval = absl::Milliseconds(3); },
+       "refresh_interval_ms"},
+      {"quantization bits", [](SessionConfig& c) { c.draco.position_quantization_bits = 0; },
+       "position_quantization_bits"},
+      {"inverted bounds",
+       [](SessionConfig& c) {
+         BoundingBox b;
+         b.min = Vec3(1, 0, 0);
+         b.max = Vec3(0, 1, 1);
+         c.bounds = b;
+       },
+       "inverted"},
+  };
+  for (const Case& c : cases) {
+    SessionConfig config = Valid();
+    c.mutate(config);
+    absl::Status status = ResolveSessionConfig(1 << 20, config);
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << c.what << ": " << status;
+    EXPECT_THAT(std::string(status.message()), HasSubstr(c.message))
+        << c.what << ": the message should name the field";
+  }
+}
+
+TEST(ResolveSessionConfigTest, RejectsATargetThePointLimitCannotReach) {
+  SessionConfig config = Valid();
+  config.target_vertices = 1000;
+  config.points_per_vertex = 2;
+  absl::Status status = ResolveSessionConfig(1999, config);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+  EXPECT_THAT(std::string(status.message()), HasSubstr("more than this server accepts"));
+  config = Valid();
+  EXPECT_TRUE(ResolveSessionConfig(2000, config).ok()) << "exactly reachable is fine";
+}
+
+}  // namespace
+}  // namespace neuralmesh::server

@@ -1,0 +1,308 @@
+#include "server/session.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "absl/synchronization/mutex.h"
+#include "core/analysis/geometric_error.h"
+#include "core/io/draco_codec.h"
+#include "core/sampling/implicit_surfaces.h"
+#include "core/sampling/sample_points.h"
+
+namespace neuralmesh::server {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Records every update and the close of a session's channel.
+class Recorder : public UpdateSubscriber {
+ public:
+  void OnUpdate(const MeshUpdatePtr& update) override {
+    absl::MutexLock lock(&mu_);
+    updates_.push_back(update);
+  }
+  void OnClose(const absl::Status& status) override {
+    absl::MutexLock lock(&mu_);
+    closed_ = status;
+  }
+  // Waits for the close; returns its status (DEADLINE_EXCEEDED after `timeout`).
+  absl::Status AwaitClose(absl::Duration timeout = absl::Seconds(60)) {
+    absl::MutexLock lock(&mu_);
+    auto done = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return closed_.has_value(); };
+    if (!mu_.AwaitWithTimeout(absl::Condition(&done), timeout)) {
+      return absl::DeadlineExceededError("the session did not end");
+    }
+    return *closed_;
+  }
+  // Waits until an update satisfies `pred`.
+  MeshUpdatePtr AwaitUpdate(std::function<bool(const v1::MeshUpdate&)> pred,
+                            absl::Duration timeout = absl::Seconds(30)) {
+    absl::MutexLock lock(&mu_);
+    auto found = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+      for (const auto& u : updates_) {
+        if (pred(*u)) return true;
+      }
+      return false;
+    };
+    if (!mu_.AwaitWithTimeout(absl::Condition(&found), timeout)) return nullptr;
+    for (const auto& u : updates_) {
+      if (pred(*u)) return u;
+    }
+    return nullptr;
+  }
+  std::vector<MeshUpdatePtr> updates() {
+    absl::MutexLock lock(&mu_);
+    return updates_;
+  }
+
+ private:
+  absl::Mutex mu_;
+  std::vector<MeshUpdatePtr> updates_ ABSL_GUARDED_BY(mu_);
+  std::optional<absl::Status> closed_ ABSL_GUARDED_BY(mu_);
+};
+
+class SessionTest : public ::testing::Test {
+ protected:
+  std::shared_ptr<Session> NewSession(SessionConfig config, size_t max_points = 1 << 22) {
+    absl::Status status = ResolveSessionConfig(max_points, config);
+    EXPECT_TRUE(status.ok()) << status;
+    auto session = std::make_shared<Session>("s-test", "test", std::move(config), max_points,
+                                             &pool_, &encoder_);
+    handles_.push_back(session->updates().Subscribe(&recorder_, 0));
+    return session;
+  }
+
+  static PointCloud Slice(const PointCloud& cloud, size_t begin, size_t end) {
+    PointCloud part;
+    part.positions.assign(cloud.positions.begin() + begin, cloud.positions.begin() + end);
+    return part;
+  }
+
+  // Stops the threads before the recorder they publish to goes away.
+  void TearDown() override {
+    pool_.Shutdown();
+    encoder_.Shutdown();
+  }
+
+  WorkerPool pool_{2, absl::Milliseconds(10)};
+  Executor encoder_{1};
+  Recorder recorder_;
+  std::vector<uint64_t> handles_;
+};
+
+PointCloud Torus(size_t n, uint64_t seed) {
+  auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4);
+  return SamplePoints(**torus, n, seed);
+}
+
+TEST_F(SessionTest, PublishesMilestonesWithGrowingVertexCountsThenTheFinalMesh) {
+  SessionConfig config;
+  config.target_vertices = 300;
+  auto session = NewSession(config);
+  const PointCloud points = Torus(6000, 1);
+  for (size_t b = 0; b < 10; ++b) {
+    ASSERT_TRUE(session->AddPoints(Slice(points, b * 600, (b + 1) * 600)).ok());
+  }
+  ASSERT_TRUE(session->Finish().ok());
+  EXPECT_TRUE(recorder_.AwaitClose().ok()) << "the session ends with OK after the final mesh";
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_FINISHED);
+
+  std::vector<MeshUpdatePtr> updates = recorder_.updates();
+  ASSERT_GE(updates.size(), 4u);
+  std::vector<uint64_t> milestones;
+  for (size_t i = 0; i < updates.size(); ++i) {
+    EXPECT_EQ(updates[i]->sequence(), i + 1) << "sequence numbers count the published meshes";
+    if (updates[i]->kind() == v1::UPDATE_KIND_MILESTONE) {
+      EXPECT_EQ(updates[i]->vertex_count(), updates[i]->lod_milestone())
+          << "a milestone mesh has exactly the milestone's vertex count";
+      milestones.push_back(updates[i]->lod_milestone());
+    }
+    absl::StatusOr<TriangleMesh> mesh = DecodeMesh(updates[i]->draco_mesh());
+    ASSERT_TRUE(mesh.ok()) << "update " << i << " does not decode: " << mesh.status();
+  }
+  EXPECT_EQ(milestones, std::vector<uint64_t>({10, 20, 50, 100, 200}));
+  const v1::MeshUpdate& last = *updates.back();
+  EXPECT_EQ(last.kind(), v1::UPDATE_KIND_FINAL);
+  EXPECT_EQ(last.vertex_count(), 300u) << "the final mesh meets the target exactly";
+  EXPECT_EQ(last.state(), v1::SESSION_STATE_FINISHED);
+  EXPECT_EQ(last.learning().points_received(), 6000u);
+  EXPECT_GT(last.learning().steps_per_second(), 0);
+}
+
+TEST_F(SessionTest, TheMeshNeverOutgrowsThePointsReceivedAndGrowsWithMore) {
+  SessionConfig config;
+  config.target_vertices = 1000;
+  config.points_per_vertex = 4;
+  config.refresh_interval = absl::Milliseconds(10);
+  auto session = NewSession(config);
+  const PointCloud points = Torus(4000, 2);
+  ASSERT_TRUE(session->AddPoints(Slice(points, 0, 400)).ok());
+  // 400 points at 4 per vertex allow 100 vertices: learning pauses there.
+  MeshUpdatePtr at_cap =
+      recorder_.AwaitUpdate([](const v1::MeshUpdate& u) { return u.vertex_count() == 100; });
+  ASSERT_NE(at_cap, nullptr) << "learning should reach the 100 vertices 400 points allow";
+  absl::SleepFor(absl::Milliseconds(100));
+  for (const MeshUpdatePtr& u : recorder_.updates()) {
+    EXPECT_LE(u->vertex_count(), 100u) << "more vertices than 400 points support";
+  }
+  EXPECT_EQ(session->ToProto().learning().allowed_vertices(), 100u);
+
+  ASSERT_TRUE(session->AddPoints(Slice(points, 400, 2000)).ok());
+  MeshUpdatePtr grown =
+      recorder_.AwaitUpdate([](const v1::MeshUpdate& u) { return u.vertex_count() >= 500; });
+  ASSERT_NE(grown, nullptr) << "more points must let the mesh grow to 500 vertices";
+  for (const MeshUpdatePtr& u : recorder_.updates()) EXPECT_LE(u->vertex_count(), 500u);
+}
+
+TEST_F(SessionTest, BadBatchesAreRejectedAndTheSessionKeepsItsPoints) {
+  SessionConfig config;
+  config.target_vertices = 50;
+  auto session = NewSession(config, /*max_points=*/1000);
+  const PointCloud points = Torus(1000, 3);
+  ASSERT_TRUE(session->AddPoints(Slice(points, 0, 300)).ok());
+
+  PointCloud nan = Slice(points, 300, 310);
+  nan.positions[4][1] = std::nanf("");
+  absl::StatusOr<size_t> result = session->AddPoints(nan);
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument) << result.status();
+  EXPECT_THAT(std::string(result.status().message()), HasSubstr("300 points accepted before"));
+
+  PointCloud inf = Slice(points, 300, 310);
+  inf.positions[0][0] = INFINITY;
+  EXPECT_EQ(session->AddPoints(inf).status().code(), absl::StatusCode::kInvalidArgument);
+
+  PointCloud mismatched = Slice(points, 300, 310);
+  mismatched.weights = {1, 2};
+  EXPECT_EQ(session->AddPoints(mismatched).status().code(), absl::StatusCode::kInvalidArgument);
+
+  result = session->AddPoints(Slice(points, 0, 800));  // 300 + 800 > 1000.
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted) << result.status();
+
+  EXPECT_EQ(session->points_received(), 300u) << "rejected batches add nothing";
+  ASSERT_TRUE(session->AddPoints(Slice(points, 300, 600)).ok()) << "the session goes on";
+  ASSERT_TRUE(session->Finish().ok());
+  EXPECT_TRUE(recorder_.AwaitClose().ok());
+  EXPECT_EQ(session->AddPoints(Slice(points, 0, 10)).status().code(),
+            absl::StatusCode::kFailedPrecondition)
+      << "a finished session takes no points";
+  EXPECT_EQ(session->Finish().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(session->Cancel("late").code(), absl::StatusCode::kFailedPrecondition);
+}
+
+TEST_F(SessionTest, FinishNeedsPointsForATetrahedron) {
+  SessionConfig config;
+  config.target_vertices = 100;
+  auto session = NewSession(config);
+  ASSERT_TRUE(session->AddPoints(Slice(Torus(7, 4), 0, 7)).ok());
+  absl::Status status = session->Finish();
+  EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition) << status;
+  EXPECT_THAT(std::string(status.message()), HasSubstr("at least 8"));
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_COLLECTING) << "still collecting";
+}
+
+TEST_F(SessionTest, CancelStopsLearningAndEndsWatchersWithCancelled) {
+  SessionConfig config;
+  config.target_vertices = 200000;
+  auto session = NewSession(config);
+  ASSERT_TRUE(session->AddPoints(Torus(400000, 5)).ok());
+  ASSERT_NE(recorder_.AwaitUpdate([](const v1::MeshUpdate& u) { return true; }), nullptr);
+  ASSERT_TRUE(session->Cancel("test").ok());
+  EXPECT_EQ(recorder_.AwaitClose(absl::Seconds(5)).code(), absl::StatusCode::kCancelled);
+  EXPECT_TRUE(session->Cancel("again").ok()) << "cancelling twice is a no-op";
+  EXPECT_EQ(session->Finish().code(), absl::StatusCode::kFailedPrecondition);
+  const uint64_t steps = session->ToProto().learning().basic_steps();
+  absl::SleepFor(absl::Milliseconds(100));
+  EXPECT_EQ(session->ToProto().learning().basic_steps(), steps) << "learning goes on";
+  EXPECT_EQ(session->ToProto().error(), "test");
+}
+
+TEST_F(SessionTest, AllMeshesShareOneQuantizationBoxUntilDataFallsOutside) {
+  SessionConfig config;
+  config.target_vertices = 200;
+  auto session = NewSession(config);
+  const PointCloud points = Torus(4000, 6);
+  for (size_t b = 0; b < 4; ++b) {
+    ASSERT_TRUE(session->AddPoints(Slice(points, b * 1000, (b + 1) * 1000)).ok());
+  }
+  ASSERT_NE(recorder_.AwaitUpdate([](const v1::MeshUpdate& u) { return u.vertex_count() >= 100; }),
+            nullptr);
+  std::vector<MeshUpdatePtr> updates = recorder_.updates();
+  for (const MeshUpdatePtr& u : updates) {
+    EXPECT_EQ(u->quantization_epoch(), 0u);
+    EXPECT_EQ(u->quantization_box().SerializeAsString(),
+              updates.front()->quantization_box().SerializeAsString())
+        << "every mesh of the epoch is quantized against the first box";
+  }
+  // The first batch spans about [-1.4, 1.4]^2 x [-0.4, 0.4]; its cube is enlarged 2x.
+  EXPECT_NEAR(updates.front()->quantization_box().range(), 5.6, 0.3);
+
+  PointCloud far;
+  far.positions = {Vec3f(10, 0, 0)};
+  ASSERT_TRUE(session->AddPoints(far).ok());
+  const v1::Session proto = session->ToProto();
+  EXPECT_GE(proto.quantization_box().origin_x() + proto.quantization_box().range(), 10.0f)
+      << "the cube grows to hold data outside it";
+}
+
+TEST(IsSpatiallyBiasedTest, RandomOrderIsNotBiasedAScanIs) {
+  const PointCloud random = Torus(20000, 7);
+  EXPECT_FALSE(IsSpatiallyBiased(random.positions));
+  std::vector<Vec3f> scan = random.positions;
+  std::sort(scan.begin(), scan.end(),
+            [](const Vec3f& a, const Vec3f& b) { return std::atan2(a[1], a[0]) < std::atan2(b[1], b[0]); });
+  EXPECT_TRUE(IsSpatiallyBiased(scan)) << "points sorted by angle arrive region after region";
+  EXPECT_TRUE(IsSpatiallyBiased(absl::MakeSpan(scan).subspan(0, 100)))
+      << "too few points to tell count as biased";
+}
+
+TEST_F(SessionTest, ScanOrderEndsAsGoodAsRandomOrder) {
+  auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4);
+  const PointCloud random = SamplePoints(**torus, 20000, 8);
+  PointCloud scan = random;
+  std::sort(scan.positions.begin(), scan.positions.end(), [](const Vec3f& a, const Vec3f& b) {
+    return std::atan2(a[1], a[0]) < std::atan2(b[1], b[0]);
+  });
+
+  auto run = [&](const PointCloud& cloud) -> TriangleMesh {
+    Recorder recorder;
+    SessionConfig config;
+    config.target_vertices = 1000;
+    EXPECT_TRUE(ResolveSessionConfig(1 << 20, config).ok());
+    auto session =
+        std::make_shared<Session>("s", "", config, size_t{1} << 20, &pool_, &encoder_);
+    const uint64_t handle = session->updates().Subscribe(&recorder, 0);
+    for (size_t b = 0; b < 50; ++b) {
+      EXPECT_TRUE(session->AddPoints(Slice(cloud, b * 400, (b + 1) * 400)).ok());
+      absl::SleepFor(absl::Milliseconds(2));  // Let learning follow the scan.
+    }
+    EXPECT_TRUE(session->Finish().ok());
+    EXPECT_TRUE(recorder.AwaitClose().ok());
+    session->updates().Unsubscribe(handle);
+    absl::StatusOr<TriangleMesh> mesh = DecodeMesh(recorder.updates().back()->draco_mesh());
+    EXPECT_TRUE(mesh.ok());
+    return mesh.ok() ? *mesh : TriangleMesh();
+  };
+  const TriangleMesh from_random = run(random);
+  const TriangleMesh from_scan = run(scan);
+  const TriangleMesh reference = (*torus)->ReferenceMesh(16);
+  GeometricErrorOptions options;
+  options.samples = 20000;
+  options.threads = 1;
+  absl::StatusOr<GeometricError> random_error =
+      ComputeGeometricError(from_random, reference, options);
+  absl::StatusOr<GeometricError> scan_error = ComputeGeometricError(from_scan, reference, options);
+  ASSERT_TRUE(random_error.ok() && scan_error.ok());
+  EXPECT_LT(scan_error->chamfer_l1, 1.25 * random_error->chamfer_l1 + 1e-3)
+      << "scan order: " << scan_error->chamfer_l1 << ", random order: "
+      << random_error->chamfer_l1;
+  EXPECT_LT(scan_error->hausdorff, 2 * random_error->hausdorff + 0.01);
+}
+
+}  // namespace
+}  // namespace neuralmesh::server

@@ -1,8 +1,8 @@
 #include "client/builtin_shapes.h"
 
 #include "absl/strings/match.h"
-#include "absl/strings/strip.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::client {
@@ -21,9 +21,8 @@ absl::StatusOr<const Builtin*> FindBuiltin(absl::string_view input) {
   for (const Builtin& b : kBuiltins) {
     if (b.name == name) return &b;
   }
-  return absl::InvalidArgumentError(
-      absl::StrCat("unknown built-in shape '", input,
-                   "'; use builtin:sphere, builtin:torus or builtin:genus2"));
+  return absl::InvalidArgumentError(absl::StrCat(
+      "unknown built-in shape '", input, "'; use builtin:sphere, builtin:torus or builtin:genus2"));
 }
 
 }  // namespace

@@ -101,12 +101,12 @@ absl::StatusOr<ParsedArgs> ParseSubcommandArgs(const Subcommand& command,
     }
     if (flag == nullptr) {
       if (absl::FindCommandLineFlag(name) != nullptr) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("flag ", arg, " does not apply to `", command.name,
-                         "` (see neuralmesh ", command.name, " --help)"));
+        return absl::InvalidArgumentError(absl::StrCat("flag ", arg, " does not apply to `",
+                                                       command.name, "` (see neuralmesh ",
+                                                       command.name, " --help)"));
       }
-      return absl::InvalidArgumentError(absl::StrCat("unknown flag ", arg, " (see neuralmesh ",
-                                                     command.name, " --help)"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("unknown flag ", arg, " (see neuralmesh ", command.name, " --help)"));
     }
     const std::string shown = "--" + accepted[name];
     if (!has_value) {
@@ -120,11 +120,10 @@ absl::StatusOr<ParsedArgs> ParseSubcommandArgs(const Subcommand& command,
     }
     std::string error;
     if (!flag->ParseFrom(value, &error)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("invalid value '", value, "' for flag ", shown,
-                       flag->IsOfType<absl::Duration>() ? " (expected a duration such as 30s, 2m)"
-                                                        : "",
-                       ": ", error));
+      return absl::InvalidArgumentError(absl::StrCat(
+          "invalid value '", value, "' for flag ", shown,
+          flag->IsOfType<absl::Duration>() ? " (expected a duration such as 30s, 2m)" : "", ": ",
+          error));
     }
     parsed.flags_given.insert(name);
   }

@@ -30,9 +30,9 @@ struct ParsedArgs {
 
 struct Subcommand {
   std::string name;
-  std::string usage;    // Shown after "usage: neuralmesh ", e.g. "stats MESH [--json]".
-  std::string summary;      // One line for the command list.
-  std::string description;  // A paragraph for the command's --help.
+  std::string usage;               // Shown after "usage: neuralmesh ", e.g. "stats MESH [--json]".
+  std::string summary;             // One line for the command list.
+  std::string description;         // A paragraph for the command's --help.
   std::vector<std::string> flags;  // Canonical names of the flags this subcommand accepts.
   // Runs the subcommand once its flags are set. Its status becomes the exit code.
   std::function<absl::Status(const ParsedArgs&)> run;

@@ -56,17 +56,17 @@ absl::StatusOr<SamplingMode> ParseSamplingMode(absl::string_view name) {
                             SamplingMode::kCurvature}) {
     if (name == ModeName(mode)) return mode;
   }
-  return absl::InvalidArgumentError(absl::StrCat(
-      "--sampling: unknown mode '", name, "'; use uniform, weighted, area or curvature"));
+  return absl::InvalidArgumentError(absl::StrCat("--sampling: unknown mode '", name,
+                                                 "'; use uniform, weighted, area or curvature"));
 }
 
 absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMode mode) {
   TargetSpace target;
   if (IsBuiltin(input)) {
     if (mode != SamplingMode::kUniform) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "--sampling ", ModeName(mode), " does not apply to ", input,
-          " (a built-in surface is sampled uniformly by area)"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("--sampling ", ModeName(mode), " does not apply to ", input,
+                       " (a built-in surface is sampled uniformly by area)"));
     }
     NM_ASSIGN_OR_RETURN(target.sampler, MakeBuiltinSurface(input));
     target.description = absl::StrCat("the implicit surface ", input);
@@ -77,9 +77,9 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
     absl::StatusOr<TriangleMesh> mesh = ReadMesh(input);
     if (!mesh.ok()) return InFile(mesh.status(), "INPUT", input);
     if (mesh->faces.empty()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "INPUT '", input, "' has no faces: --sampling ", ModeName(mode),
-          " needs a triangle mesh (use uniform or weighted for a point cloud)"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("INPUT '", input, "' has no faces: --sampling ", ModeName(mode),
+                       " needs a triangle mesh (use uniform or weighted for a point cloud)"));
     }
     const size_t faces = mesh->faces.size();
     MeshSamplerOptions options;
@@ -89,24 +89,24 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
         MeshSampler::Create(std::make_shared<const TriangleMesh>(*std::move(mesh)), options);
     if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
     target.sampler = *std::move(sampler);
-    target.description = absl::StrCat("the ", faces, " triangles of ", input, " (", ModeName(mode),
-                                      " sampling)");
+    target.description =
+        absl::StrCat("the ", faces, " triangles of ", input, " (", ModeName(mode), " sampling)");
     return target;
   }
   NM_ASSIGN_OR_RETURN(PointCloud cloud, ReadCloud(input));
   if (mode == SamplingMode::kWeighted && cloud.weights.empty()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "INPUT '", input, "' has no per-point weights for --sampling weighted"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("INPUT '", input, "' has no per-point weights for --sampling weighted"));
   }
   const size_t points = cloud.size();
   auto shared = std::make_shared<const PointCloud>(std::move(cloud));
-  absl::StatusOr<std::unique_ptr<Sampler>> sampler =
-      mode == SamplingMode::kWeighted ? WeightedPointCloudSampler::Create(shared)
-                                      : UniformPointCloudSampler::Create(shared);
+  absl::StatusOr<std::unique_ptr<Sampler>> sampler = mode == SamplingMode::kWeighted
+                                                         ? WeightedPointCloudSampler::Create(shared)
+                                                         : UniformPointCloudSampler::Create(shared);
   if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
   target.sampler = *std::move(sampler);
-  target.description = absl::StrCat(points, " points of ", input, " (", ModeName(mode),
-                                    " sampling)");
+  target.description =
+      absl::StrCat(points, " points of ", input, " (", ModeName(mode), " sampling)");
   return target;
 }
 
@@ -114,8 +114,7 @@ absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t 
                                                uint64_t seed) {
   if (IsBuiltin(input)) {
     if (builtin_points == 0) return absl::InvalidArgumentError("--points must be > 0");
-    NM_ASSIGN_OR_RETURN(const std::unique_ptr<ImplicitSurface> surface,
-                        MakeBuiltinSurface(input));
+    NM_ASSIGN_OR_RETURN(const std::unique_ptr<ImplicitSurface> surface, MakeBuiltinSurface(input));
     return SamplePoints(*surface, builtin_points, seed);
   }
   return ReadCloud(input);

@@ -18,22 +18,24 @@
 namespace neuralmesh::client {
 
 struct LocalReconstructOptions {
-  std::string input;            // A point cloud or mesh file, or builtin:NAME.
-  std::string output;           // The final mesh; its extension picks the format.
-  size_t vertices = 0;          // Final vertex count, > 4.
-  std::vector<size_t> lods;     // Milestones below `vertices`, each written beside `output`.
+  std::string input;         // A point cloud or mesh file, or builtin:NAME.
+  std::string output;        // The final mesh; its extension picks the format.
+  size_t vertices = 0;       // Final vertex count, > 4.
+  std::vector<size_t> lods;  // Milestones below `vertices`, each written beside `output`.
   LearnerOptions learner;
   SamplingMode sampling = SamplingMode::kUniform;
   absl::Duration time_budget = absl::InfiniteDuration();  // For the whole run.
-  uint64_t max_steps = 0;       // Basic Steps for the whole run; 0: no limit.
-  DracoOptions draco;           // For .drc outputs.
-  bool progress = false;        // Draw a progress bar on `err`.
+  uint64_t max_steps = 0;  // Basic Steps for the whole run; 0: no limit.
+  DracoOptions draco;      // For .drc outputs.
+  bool progress = false;   // Draw a progress bar on `err`.
 };
 
 // Learns the input's surface up to each LOD and then to `vertices`, writing each milestone
 // (OUTPUT stem + "_lod<N>" + extension) and the final mesh, and printing the figures of each
 // on `out`, then a summary line. When the time or step budget runs out first, the mesh
 // learned so far is written as OUTPUT and the summary says which budget stopped it.
+// A first SIGINT or SIGTERM stops learning at a consistent state; the mesh so far is written
+// as OUTPUT and CANCELLED returned.
 // Returns INVALID_ARGUMENT for invalid options, an unknown output extension or a bad input;
 // NOT_FOUND for a missing input; the writer's error when a file cannot be written.
 absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::ostream& out,

@@ -7,6 +7,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "client/inputs.h"
+#include "client/interrupt.h"
 #include "client/local_commands.h"
 #include "client/lod_plan.h"
 #include "client/lod_table.h"
@@ -46,7 +47,7 @@ const char* StopReasonText(StopReason reason) {
     case StopReason::kCancelled:
       return "cancelled";
     case StopReason::kObserver:
-      return "stopped";
+      return "interrupted";
   }
   return "stopped";
 }
@@ -66,6 +67,8 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
   out << "learning " << target.description << " to " << options.vertices << " vertices (seed "
       << options.learner.seed << ")\n";
 
+  // Ctrl-C stops learning at a consistent state; the mesh so far is still written.
+  InterruptScope interrupt;
   ProgressBar bar(err, options.progress, "learning", "vertices");
   const absl::Time start = absl::Now();
   const size_t final_vertices = targets.back();
@@ -85,9 +88,8 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
       if (options.max_steps > 0) stop.max_basic_steps = options.max_steps - steps_done;
       stop.time_budget = time_left;
       stop.observer = [&](const LearnerProgress& p) {
-        bar.Update(p.vertices, final_vertices,
-                   absl::StrFormat("%d basic steps", p.basic_steps));
-        return true;
+        bar.Update(p.vertices, final_vertices, absl::StrFormat("%d basic steps", p.basic_steps));
+        return !InterruptScope::interrupted();
       };
       NM_ASSIGN_OR_RETURN(reason, learner->Run(stop));
     }
@@ -124,6 +126,10 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
       StopReasonText(reason), progress.vertices, progress.faces, progress.basic_steps,
       progress.splits, progress.collapses, seconds,
       seconds > 0 ? static_cast<double>(progress.basic_steps) / seconds : 0.0, options.output);
+  if (reason == StopReason::kObserver) {
+    return absl::CancelledError(
+        absl::StrCat("interrupted; the mesh learned so far is in ", options.output));
+  }
   return absl::OkStatus();
 }
 

@@ -41,12 +41,12 @@ absl::StatusOr<std::vector<size_t>> LodTargets(const std::vector<size_t>& lods,
   std::vector<size_t> targets;
   for (size_t lod : lods) {
     if (lod <= kInitialVertices) {
-      return absl::InvalidArgumentError(absl::StrCat("--lod: ", lod, " must be more than ",
-                                                     kInitialVertices, " vertices"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("--lod: ", lod, " must be more than ", kInitialVertices, " vertices"));
     }
     if (lod >= final_vertices) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "--lod: ", lod, " is not below --vertices ", final_vertices));
+      return absl::InvalidArgumentError(
+          absl::StrCat("--lod: ", lod, " is not below --vertices ", final_vertices));
     }
     targets.push_back(lod);
   }

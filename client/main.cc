@@ -75,8 +75,7 @@ ABSL_FLAG(int32_t, quantization_bits, kDracoDefaults.position_quantization_bits,
           "Draco position quantization bits (1..30) for .drc meshes.");
 ABSL_FLAG(int32_t, encode_speed, kDracoDefaults.encode_speed,
           "Draco encoder speed, 0 (smallest) .. 10 (fastest), for .drc meshes.");
-ABSL_FLAG(bool, progress, false,
-          "Draw progress bars on stderr even when it is not a terminal.");
+ABSL_FLAG(bool, progress, false, "Draw progress bars on stderr even when it is not a terminal.");
 
 // Server.
 ABSL_FLAG(std::string, server, "",
@@ -93,8 +92,7 @@ ABSL_FLAG(absl::Duration, connect_timeout, absl::Seconds(5),
 
 // Reports.
 ABSL_FLAG(bool, json, false, "Print JSON instead of text.");
-ABSL_FLAG(std::string, reference, "",
-          "eval: the reference surface, a mesh file or builtin:NAME.");
+ABSL_FLAG(std::string, reference, "", "eval: the reference surface, a mesh file or builtin:NAME.");
 ABSL_FLAG(uint64_t, samples, 0,
           "eval: area-uniform samples per surface; 0: the default of "
           "core/analysis/geometric_error.h (200000).");
@@ -168,8 +166,8 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
     return neuralmesh::client::RunRemoteReconstruct(o, std::cout, std::cerr);
   }
-  NM_RETURN_IF_ERROR(RejectFlags(args, {"out-dir", "batch-size", "points", "ply",
-                                        "connect_timeout"},
+  NM_RETURN_IF_ERROR(RejectFlags(args,
+                                 {"out-dir", "batch-size", "points", "ply", "connect_timeout"},
                                  "needs --server (a local reconstruct writes -o OUTPUT)"));
   if (!args.Has("vertices")) return absl::InvalidArgumentError("--vertices N is required");
   neuralmesh::client::LocalReconstructOptions o;
@@ -222,16 +220,14 @@ absl::Status Sessions(const ParsedArgs& args) {
 }
 
 std::vector<Subcommand> Commands() {
-  const std::vector<std::string> learner = {
-      "seed",   "alpha_w", "alpha_l",          "c_l",          "c_vs",
-      "c_ec",   "alpha_sc", "alpha_r",         "alpha_m",      "remove_triangles",
-      "merge_boundaries", "splits_per_step"};
-  std::vector<std::string> reconstruct = {"output", "vertices", "lod"};
-  reconstruct.insert(reconstruct.end(), learner.begin(), learner.end());
-  reconstruct.insert(reconstruct.end(),
-                     {"sampling", "time_budget", "max_steps", "quantization_bits",
-                      "encode_speed", "progress", "server", "out-dir", "batch-size", "points",
-                      "ply", "connect_timeout"});
+  // clang-format off
+  const std::vector<std::string> reconstruct = {
+      "output", "vertices", "lod", "seed", "alpha_w", "alpha_l", "c_l", "c_vs", "c_ec",
+      "alpha_sc", "alpha_r", "alpha_m", "remove_triangles", "merge_boundaries",
+      "splits_per_step", "sampling", "time_budget", "max_steps", "quantization_bits",
+      "encode_speed", "progress", "server", "out-dir", "batch-size", "points", "ply",
+      "connect_timeout"};
+  // clang-format on
   return {
       {"reconstruct",
        "reconstruct INPUT -o OUTPUT --vertices N [flags]\n"
@@ -243,20 +239,32 @@ std::vector<Subcommand> Commands() {
        "one OUTPUT_lod<N> file per --lod; with --server it uploads the points and saves each\n"
        "mesh the server publishes into --out-dir. Prints the figures of every level.",
        reconstruct, Reconstruct},
-      {"stats", "stats MESH [--json]", "Prints the mesh report of a mesh.",
+      {"stats",
+       "stats MESH [--json]",
+       "Prints the mesh report of a mesh.",
        "Prints the mesh report of MESH (a mesh file or builtin:NAME): counts, valences, genus,\n"
        "boundaries, manifoldness.",
-       {"json"}, Stats},
-      {"eval", "eval MESH --reference REF [--json] [--samples N]",
+       {"json"},
+       Stats},
+      {"eval",
+       "eval MESH --reference REF [--json] [--samples N]",
        "Prints the geometric error of a mesh against a reference surface.",
        "Prints the geometric error (Chamfer, Hausdorff, normal consistency) of MESH against\n"
        "REF, a mesh file or builtin:NAME (its dense reference tessellation).",
-       {"reference", "json", "samples", "seed"}, Eval},
-      {"watch", "watch SESSION --server HOST:PORT --out-dir DIR [--ply]",
-       "Watches a server session until it ends, saving every milestone and the final mesh.", "",
-       {"server", "out-dir", "ply", "connect_timeout"}, Watch},
-      {"sessions", "sessions --server HOST:PORT [--json]",
-       "Lists the sessions of a server.", "", {"server", "json", "connect_timeout"}, Sessions},
+       {"reference", "json", "samples", "seed"},
+       Eval},
+      {"watch",
+       "watch SESSION --server HOST:PORT --out-dir DIR [--ply]",
+       "Watches a server session until it ends, saving every milestone and the final mesh.",
+       "",
+       {"server", "out-dir", "ply", "connect_timeout"},
+       Watch},
+      {"sessions",
+       "sessions --server HOST:PORT [--json]",
+       "Lists the sessions of a server.",
+       "",
+       {"server", "json", "connect_timeout"},
+       Sessions},
   };
 }
 

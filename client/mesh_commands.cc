@@ -30,17 +30,17 @@ absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
                       ComputeGeometricError(mesh, reference, error_options));
   if (options.json) {
     JsonWriter json(2);
-    json.BeginObject()
-        .Key("mesh").String(options.mesh)
-        .Key("reference").String(options.reference)
-        .Key("samples").Uint(error_options.samples)
-        .Key("chamfer_l1").Double(error.chamfer_l1)
-        .Key("hausdorff").Double(error.hausdorff)
-        .Key("normal_consistency").Double(error.normal_consistency)
-        .Key("accuracy").Double(error.accuracy)
-        .Key("completeness").Double(error.completeness)
-        .Key("diagonal").Double(error.diagonal)
-        .EndObject();
+    json.BeginObject();
+    json.Key("mesh").String(options.mesh);
+    json.Key("reference").String(options.reference);
+    json.Key("samples").Uint(error_options.samples);
+    json.Key("chamfer_l1").Double(error.chamfer_l1);
+    json.Key("hausdorff").Double(error.hausdorff);
+    json.Key("normal_consistency").Double(error.normal_consistency);
+    json.Key("accuracy").Double(error.accuracy);
+    json.Key("completeness").Double(error.completeness);
+    json.Key("diagonal").Double(error.diagonal);
+    json.EndObject();
     NM_ASSIGN_OR_RETURN(const std::string text, json.Finish());
     out << text << "\n";
     return absl::OkStatus();

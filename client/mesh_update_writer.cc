@@ -51,8 +51,8 @@ absl::Status MeshUpdateWriter::Write(const v1::MeshUpdate& update) {
     std::error_code error;
     std::filesystem::create_directories(options_.out_dir, error);
     if (error) {
-      return absl::PermissionDeniedError(absl::StrCat("cannot create --out-dir ",
-                                                      options_.out_dir, ": ", error.message()));
+      return absl::PermissionDeniedError(
+          absl::StrCat("cannot create --out-dir ", options_.out_dir, ": ", error.message()));
     }
     const std::string name =
         is_final ? options_.stem : absl::StrCat(options_.stem, "_lod", update.vertex_count());
@@ -62,8 +62,8 @@ absl::Status MeshUpdateWriter::Write(const v1::MeshUpdate& update) {
     if (options_.ply) {
       absl::StatusOr<TriangleMesh> mesh = DecodeMesh(update.draco_mesh());
       if (!mesh.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("update ", update.sequence(),
-                                                       ": ", mesh.status().message()));
+        return absl::InvalidArgumentError(
+            absl::StrCat("update ", update.sequence(), ": ", mesh.status().message()));
       }
       NM_RETURN_IF_ERROR(WriteMesh(*mesh, base.string() + ".ply"));
     }

@@ -1,11 +1,11 @@
 #include "client/reconstruction_client.h"
 
+#include <grpcpp/create_channel.h>
+#include <grpcpp/security/credentials.h>
+
 #include <algorithm>
 #include <cstring>
 #include <utility>
-
-#include <grpcpp/create_channel.h>
-#include <grpcpp/security/credentials.h>
 
 #include "absl/strings/str_cat.h"
 #include "client/grpc_status.h"
@@ -48,8 +48,8 @@ absl::StatusOr<std::unique_ptr<ReconstructionClient>> ReconstructionClient::Conn
       grpc::CreateChannel(address, grpc::InsecureChannelCredentials());
   if (!channel->WaitForConnected(ToGprDeadline(options.connect_timeout))) {
     return absl::UnavailableError(absl::StrCat("cannot reach a neuralmesh-server at ", address,
-                                               " within ", absl::FormatDuration(
-                                                               options.connect_timeout)));
+                                               " within ",
+                                               absl::FormatDuration(options.connect_timeout)));
   }
   auto client = std::make_unique<ReconstructionClient>(std::move(channel), options);
   client->address_ = address;

@@ -14,13 +14,13 @@
 #ifndef NEURALMESH_CLIENT_RECONSTRUCTION_CLIENT_H_
 #define NEURALMESH_CLIENT_RECONSTRUCTION_CLIENT_H_
 
+#include <grpcpp/channel.h>
+
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <grpcpp/channel.h>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -65,8 +65,7 @@ class ReconstructionClient {
   // acknowledgement; on failure the server's status (the batches before the bad one stay
   // accepted). INVALID_ARGUMENT for an empty cloud or a zero batch size.
   absl::StatusOr<v1::UploadPointsResponse> UploadPoints(const std::string& session_id,
-                                                        const PointCloud& cloud,
-                                                        size_t batch_size,
+                                                        const PointCloud& cloud, size_t batch_size,
                                                         const UploadProgress& progress = {});
 
   // Called with each published mesh; returning false ends the watch early.
@@ -88,9 +87,8 @@ class ReconstructionClient {
 
   // GetMesh; with `wait`, blocks up to `timeout` until the mesh exists (DEADLINE_EXCEEDED
   // after).
-  absl::StatusOr<v1::MeshUpdate> GetMesh(const std::string& session_id,
-                                         v1::MeshVersion version, bool wait,
-                                         absl::Duration timeout);
+  absl::StatusOr<v1::MeshUpdate> GetMesh(const std::string& session_id, v1::MeshVersion version,
+                                         bool wait, absl::Duration timeout);
 
  private:
   // A context whose deadline is `timeout` from now (none when infinite).

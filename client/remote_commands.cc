@@ -9,8 +9,10 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/synchronization/mutex.h"
+#include "absl/synchronization/notification.h"
 #include "absl/time/clock.h"
 #include "client/inputs.h"
+#include "client/interrupt.h"
 #include "client/lod_plan.h"
 #include "client/mesh_update_writer.h"
 #include "client/progress_bar.h"
@@ -70,11 +72,10 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   NM_RETURN_IF_ERROR(options.draco.Validate());
   if (options.out_dir.empty()) return absl::InvalidArgumentError("--out-dir DIR is required");
   if (options.batch_size == 0) return absl::InvalidArgumentError("--batch-size must be > 0");
-  NM_ASSIGN_OR_RETURN(const PointCloud cloud,
-                      LoadPointsForUpload(options.input, options.builtin_points,
-                                          options.learner.seed));
-  const size_t affordable =
-      static_cast<size_t>(std::floor(cloud.size() / kDefaultPointsPerVertex));
+  NM_ASSIGN_OR_RETURN(
+      const PointCloud cloud,
+      LoadPointsForUpload(options.input, options.builtin_points, options.learner.seed));
+  const size_t affordable = static_cast<size_t>(std::floor(cloud.size() / kDefaultPointsPerVertex));
   const size_t target =
       options.vertices > 0 ? options.vertices : std::min(kDefaultMaxVertices, affordable);
   NM_ASSIGN_OR_RETURN(const std::vector<size_t> milestones, LodTargets(options.lods, target));
@@ -92,13 +93,16 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ConnectTo(options.server, options.connect_timeout));
   const std::string stem = InputStem(options.input);
+  // From here on Ctrl-C cancels the session (see `canceller` below), so that the server does
+  // not keep learning for nobody; the upload and the watch then end with the server's answer.
+  InterruptScope interrupt;
   NM_ASSIGN_OR_RETURN(const v1::Session session, client->CreateSession(config, stem));
   const std::string& id = session.session_id();
   const double points_per_vertex = session.config().has_points_per_vertex()
                                        ? session.config().points_per_vertex().value()
                                        : kDefaultPointsPerVertex;
-  const size_t reachable = std::min<size_t>(
-      target, static_cast<size_t>(std::floor(cloud.size() / points_per_vertex)));
+  const size_t reachable =
+      std::min<size_t>(target, static_cast<size_t>(std::floor(cloud.size() / points_per_vertex)));
   out << "session " << id << " on " << client->address() << ": " << cloud.size()
       << " points, target " << target << " vertices\n";
   if (reachable < target) {
@@ -125,6 +129,22 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     });
   });
 
+  absl::Notification done;
+  bool interrupted = false;
+  std::thread canceller([&] {
+    while (!done.WaitForNotificationWithTimeout(absl::Milliseconds(100))) {
+      if (InterruptScope::interrupted()) {
+        interrupted = true;
+        client->Cancel(id).IgnoreError();
+        return;
+      }
+    }
+  });
+  const auto stop_canceller = [&] {
+    done.Notify();
+    canceller.join();
+  };
+
   absl::StatusOr<v1::UploadPointsResponse> uploaded =
       client->UploadPoints(id, cloud, options.batch_size, [&](uint64_t sent, uint64_t total) {
         absl::MutexLock lock(&mu);
@@ -139,11 +159,14 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   if (!status.ok()) {
     // Without a finished upload no final mesh can come: stop the server's work and the watch.
     client->Cancel(id).IgnoreError();
-    watcher.join();
-    return status;
   }
   watcher.join();
+  stop_canceller();
   learn_bar.Finish();
+  if (interrupted) {
+    return absl::CancelledError(absl::StrCat("interrupted; session ", id, " cancelled"));
+  }
+  NM_RETURN_IF_ERROR(status);
   if (!write_status.ok()) {
     client->Cancel(id).IgnoreError();
     return write_status;
@@ -153,10 +176,10 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   const LodFigures& last = writer.saved().back();
   out << absl::StrFormat(
       "final mesh: %d vertices, %d faces, genus %d, %d boundaries, %.1f%% valence 6, "
-      "%d basic steps, %.2fs learning; %d files in %s\n",
+      "%d basic steps, %.2fs learning; files written to %s: %d\n",
       last.vertices, last.faces, last.genus, last.boundaries, last.valence6_percent,
-      last.basic_steps, absl::ToDoubleSeconds(last.elapsed),
-      writer.saved().size() * (options.ply ? 2 : 1), options.out_dir);
+      last.basic_steps, absl::ToDoubleSeconds(last.elapsed), options.out_dir,
+      writer.saved().size() * (options.ply ? 2 : 1));
   return absl::OkStatus();
 }
 
@@ -186,19 +209,19 @@ absl::Status RunSessions(const std::string& server, bool json, std::ostream& out
     JsonWriter writer(2);
     writer.BeginArray();
     for (const v1::Session& s : sessions) {
-      writer.BeginObject()
-          .Key("session_id").String(s.session_id())
-          .Key("name").String(s.name())
-          .Key("state").String(StateName(s.state()))
-          .Key("points_received").Uint(s.learning().points_received())
-          .Key("vertices").Uint(s.vertex_count())
-          .Key("faces").Uint(s.face_count())
-          .Key("target_vertices").Uint(s.config().target_vertices())
-          .Key("basic_steps").Uint(s.learning().basic_steps())
-          .Key("latest_sequence").Uint(s.latest_sequence())
-          .Key("watchers").Uint(s.watchers())
-          .Key("error").String(s.error())
-          .EndObject();
+      writer.BeginObject();
+      writer.Key("session_id").String(s.session_id());
+      writer.Key("name").String(s.name());
+      writer.Key("state").String(StateName(s.state()));
+      writer.Key("points_received").Uint(s.learning().points_received());
+      writer.Key("vertices").Uint(s.vertex_count());
+      writer.Key("faces").Uint(s.face_count());
+      writer.Key("target_vertices").Uint(s.config().target_vertices());
+      writer.Key("basic_steps").Uint(s.learning().basic_steps());
+      writer.Key("latest_sequence").Uint(s.latest_sequence());
+      writer.Key("watchers").Uint(s.watchers());
+      writer.Key("error").String(s.error());
+      writer.EndObject();
     }
     writer.EndArray();
     NM_ASSIGN_OR_RETURN(const std::string text, writer.Finish());
@@ -209,9 +232,8 @@ absl::Status RunSessions(const std::string& server, bool json, std::ostream& out
                          "points", "vertices", "faces", "target", "updates");
   for (const v1::Session& s : sessions) {
     out << absl::StrFormat("%-20s %-16s %-10s %10d %9d %9d %9d %8d\n", s.session_id(), s.name(),
-                           StateName(s.state()), s.learning().points_received(),
-                           s.vertex_count(), s.face_count(), s.config().target_vertices(),
-                           s.latest_sequence());
+                           StateName(s.state()), s.learning().points_received(), s.vertex_count(),
+                           s.face_count(), s.config().target_vertices(), s.latest_sequence());
   }
   out << sessions.size() << (sessions.size() == 1 ? " session\n" : " sessions\n");
   return absl::OkStatus();

@@ -17,24 +17,25 @@
 namespace neuralmesh::client {
 
 struct RemoteReconstructOptions {
-  std::string input;    // A point cloud file or builtin:NAME.
-  std::string server;   // host:port.
-  std::string out_dir;  // Where the LOD files go.
-  size_t vertices = 0;  // Final vertex count; 0: one vertex per 2 points, at most 10000.
-  std::vector<size_t> lods;    // Milestones; empty: the server's 1-2-5 series.
+  std::string input;         // A point cloud file or builtin:NAME.
+  std::string server;        // host:port.
+  std::string out_dir;       // Where the LOD files go.
+  size_t vertices = 0;       // Final vertex count; 0: one vertex per 2 points, at most 10000.
+  std::vector<size_t> lods;  // Milestones; empty: the server's 1-2-5 series.
   LearnerOptions learner;
-  DracoOptions draco;          // Quantization bits and encode speed of the server's meshes.
-  size_t batch_size = 10000;   // Points per uploaded batch.
+  DracoOptions draco;              // Quantization bits and encode speed of the server's meshes.
+  size_t batch_size = 10000;       // Points per uploaded batch.
   size_t builtin_points = 100000;  // Points sampled from a builtin:NAME input.
-  bool ply = false;            // Also write each LOD as .ply.
-  bool progress = false;       // Draw progress bars on `err`.
+  bool ply = false;                // Also write each LOD as .ply.
+  bool progress = false;           // Draw progress bars on `err`.
   absl::Duration connect_timeout = absl::Seconds(5);
 };
 
 // Creates a session, watches it while the input streams up in batches, finishes it and
 // writes every LOD milestone (<stem>_lod<N>.drc) and the final mesh (<stem>.drc) into
 // out_dir, printing each update's figures on `out`. Returns OK only when the final mesh
-// arrived; otherwise the first error (the session is cancelled when the upload fails).
+// arrived; otherwise the first error (the session is cancelled when the upload fails). A
+// first SIGINT or SIGTERM cancels the session and returns CANCELLED.
 absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::ostream& out,
                                   std::ostream& err);
 

@@ -1,5 +1,6 @@
 #include "server/server.h"
 
+#include <algorithm>
 #include <utility>
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
@@ -15,6 +16,8 @@ namespace neuralmesh::server {
 namespace {
 
 constexpr char kServiceName[] = "neuralmesh.v1.ReconstructionService";
+// How long unary calls may take to finish once the streams are gone.
+constexpr absl::Duration kUnaryGrace = absl::Milliseconds(200);
 
 }  // namespace
 
@@ -115,8 +118,11 @@ void ReconstructionServer::Shutdown(absl::Duration grace) {
   // Then every remaining live reactor (uploads, waiting GetMesh calls).
   if (reactors_ != nullptr) reactors_->AbortAll(unavailable);
   if (server_ != nullptr) {
-    // Returns once every call is done, cancelling those still running after the grace period.
-    server_->Shutdown(absl::ToChronoTime(absl::Now() + grace));
+    // The aborted reactors finish at once; give them the grace period to reach OnDone. What is
+    // left then are unary calls (which finish inline) and idle client connections, which gRPC
+    // would otherwise wait for until the deadline: a short one closes them.
+    reactors_->AwaitEmpty(absl::Now() + grace);
+    server_->Shutdown(absl::ToChronoTime(absl::Now() + std::min(grace, kUnaryGrace)));
     server_->Wait();
   }
   if (pool_ != nullptr) pool_->Shutdown();

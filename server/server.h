@@ -49,8 +49,9 @@ class ReconstructionServer {
   // A channel into the server without a socket (tests of the logic, in-process callers).
   std::shared_ptr<grpc::Channel> InProcessChannel();
 
-  // Ends every open stream with UNAVAILABLE, stops accepting calls, cancels the calls still
-  // running after `grace`, then stops learning and encoding. Idempotent; thread-safe.
+  // Ends every open stream with UNAVAILABLE and waits up to `grace` for them to close, then
+  // stops gRPC (unary calls still running get 200 ms more, idle connections are closed), then
+  // stops learning and encoding. Idempotent; thread-safe.
   void Shutdown(absl::Duration grace = absl::Seconds(5)) ABSL_LOCKS_EXCLUDED(shutdown_mu_);
 
   // Blocks until Shutdown has completed.

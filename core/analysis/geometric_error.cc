@@ -77,9 +77,8 @@ struct QueryPoints {
   std::vector<Vec3> vertices;
 };
 
-absl::StatusOr<QueryPoints> MakeQueryPoints(const TriangleMesh& mesh,
-                                            const FaceGeometry& geometry, size_t count,
-                                            uint64_t seed, absl::string_view name) {
+absl::StatusOr<QueryPoints> MakeQueryPoints(const TriangleMesh& mesh, const FaceGeometry& geometry,
+                                            size_t count, uint64_t seed, absl::string_view name) {
   const size_t n = mesh.faces.size();
   std::vector<double> cumulative(n);
   double total = 0.0;
@@ -99,8 +98,8 @@ absl::StatusOr<QueryPoints> MakeQueryPoints(const TriangleMesh& mesh,
   for (size_t i = 0; i < count; ++i) {
     // upper_bound never lands on a zero-area face: its cumulative value equals the previous.
     const double target = rng.NextDouble() * total;
-    size_t f = static_cast<size_t>(
-        std::upper_bound(cumulative.begin(), cumulative.end(), target) - cumulative.begin());
+    size_t f = static_cast<size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), target) -
+                                   cumulative.begin());
     if (f >= n) f = last_positive;  // target rounded up to total.
     const auto& t = mesh.faces[f];
     // Uniform in the triangle: sqrt warps the first coordinate (Osada et al. 2002).
@@ -171,8 +170,8 @@ SampleStats MeasureSamples(const QueryPoints& query, const Surface& other, int t
 // The largest distance from `vertices` to the other surface, or `at_least` if none is
 // larger. Queries may stop at any surface point within `at_least`, which cannot raise the
 // maximum; the result is still exact.
-double MaxVertexDistance(const std::vector<Vec3>& vertices, const Surface& other,
-                         double at_least, int threads) {
+double MaxVertexDistance(const std::vector<Vec3>& vertices, const Surface& other, double at_least,
+                         int threads) {
   TriangleTree::BatchOptions batch;
   batch.threads = threads;
   batch.radius = at_least;
@@ -223,9 +222,8 @@ absl::StatusOr<GeometricError> ComputeGeometricError(const TriangleMesh& reconst
   } else {
     prepare_reconstruction();
   }
-  const absl::Status reference_status =
-      PrepareSurface(reference, options.samples, options.seed ^ kReferenceStream, "reference",
-                     reference_surface);
+  const absl::Status reference_status = PrepareSurface(
+      reference, options.samples, options.seed ^ kReferenceStream, "reference", reference_surface);
   if (helper.joinable()) helper.join();
   NM_RETURN_IF_ERROR(reconstruction_status);
   NM_RETURN_IF_ERROR(reference_status);

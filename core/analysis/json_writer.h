@@ -58,8 +58,8 @@ class JsonWriter {
   enum class Scope { kObject, kArray };
   struct Frame {
     Scope scope;
-    bool empty = true;        // No member or element written yet.
-    bool has_key = false;     // Inside an object: a key waits for its value.
+    bool empty = true;     // No member or element written yet.
+    bool has_key = false;  // Inside an object: a key waits for its value.
   };
 
   // Checks that a value may start here and writes the separator before it.

@@ -53,10 +53,10 @@ class UnionFind {
 // Undirected edges numbered from their lower endpoint, with per-edge face and direction
 // counts. Half-edge (f, k) runs from faces[f][k] to faces[f][(k + 1) % 3]; its id is 3f + k.
 struct EdgeTable {
-  std::vector<uint32_t> v0, v1;        // v0 < v1.
-  std::vector<uint32_t> face_count;    // Faces containing the edge.
-  std::vector<uint32_t> forward_count; // Of those, the ones that run v0 -> v1.
-  std::vector<size_t> of_halfedge;     // Half-edge id -> edge id.
+  std::vector<uint32_t> v0, v1;         // v0 < v1.
+  std::vector<uint32_t> face_count;     // Faces containing the edge.
+  std::vector<uint32_t> forward_count;  // Of those, the ones that run v0 -> v1.
+  std::vector<size_t> of_halfedge;      // Half-edge id -> edge id.
 };
 
 // Corners grouped by vertex (counting sort): corners of v are
@@ -207,9 +207,9 @@ MeshReport ComputeMeshReport(const TriangleMesh& mesh) {
 
   // Per-vertex link analysis. Scratch arrays are indexed by the neighbour's local number.
   std::fill(stamp.begin(), stamp.end(), kNoVertex);
-  std::vector<uint32_t> degree;   // Link degree = faces around v containing the neighbour.
-  std::vector<size_t> edge_of;    // Edge joining v and the neighbour.
-  std::vector<size_t> pending;    // Per link component: an unpaired boundary edge.
+  std::vector<uint32_t> degree;  // Link degree = faces around v containing the neighbour.
+  std::vector<size_t> edge_of;   // Edge joining v and the neighbour.
+  std::vector<size_t> pending;   // Per link component: an unpaired boundary edge.
   std::vector<size_t> leftover;
   UnionFind link;
   size_t interior_count[kValenceShareColumns] = {0, 0, 0, 0, 0, 0, 0};
@@ -371,9 +371,8 @@ std::string MeshReportToText(const MeshReport& r) {
   std::string out;
   absl::StrAppendFormat(&out, "%-22s %10u  (%u isolated)\n", "vertices", r.vertices,
                         r.isolated_vertices);
-  absl::StrAppendFormat(&out, "%-22s %10u  (%u degenerate, %u duplicate, %u invalid)\n",
-                        "faces", r.faces, r.degenerate_faces, r.duplicate_faces,
-                        r.invalid_faces);
+  absl::StrAppendFormat(&out, "%-22s %10u  (%u degenerate, %u duplicate, %u invalid)\n", "faces",
+                        r.faces, r.degenerate_faces, r.duplicate_faces, r.invalid_faces);
   absl::StrAppendFormat(&out, "%-22s %10u  (%u boundary, %u non-manifold, %u misoriented)\n",
                         "edges", r.edges, r.boundary_edges, r.non_manifold_edges,
                         r.misoriented_edges);
@@ -400,8 +399,8 @@ std::string MeshReportToText(const MeshReport& r) {
   absl::StrAppendFormat(&out, "%-22s %10s\n", "oriented", yes_no(r.oriented));
   absl::StrAppendFormat(&out, "%-22s %10s\n", "closed", yes_no(r.closed));
   absl::StrAppendFormat(&out, "%-22s %7d %7d %7d %7d %7d %7d %7s\n",
-                        absl::StrCat("valence (", r.interior_vertices, " interior)"), 4, 5, 6,
-                        7, 8, 9, "other");
+                        absl::StrCat("valence (", r.interior_vertices, " interior)"), 4, 5, 6, 7, 8,
+                        9, "other");
   absl::StrAppendFormat(&out, "%-22s", "share %");
   for (double share : r.valence_share) absl::StrAppendFormat(&out, " %7.1f", share);
   out += "\n";
@@ -409,8 +408,8 @@ std::string MeshReportToText(const MeshReport& r) {
 }
 
 std::string MeshReportToJson(const MeshReport& r, int indent) {
-  static constexpr const char* kColumns[kValenceShareColumns] = {"4", "5", "6", "7",
-                                                                 "8", "9", "other"};
+  static constexpr const char* kColumns[] = {"4", "5", "6", "7", "8", "9", "other"};
+  static_assert(sizeof(kColumns) / sizeof(kColumns[0]) == kValenceShareColumns);
   JsonWriter json(indent);
   json.BeginObject();
   json.Key("vertices").Uint(r.vertices);

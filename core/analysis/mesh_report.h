@@ -50,7 +50,7 @@ struct MeshReport {
   // construction and would skew the distribution of an open mesh. All zero when there is no
   // interior vertex.
   double valence_share[kValenceShareColumns] = {0, 0, 0, 0, 0, 0, 0};
-  double valence6_share = 0.0;  // = valence_share[2].
+  double valence6_share = 0.0;   // = valence_share[2].
   size_t interior_vertices = 0;  // The denominator of the shares.
 
   // Boundary edges lie in exactly one face. At every vertex they are paired within the fans
@@ -68,15 +68,15 @@ struct MeshReport {
   // manifold; -1 when manifold() or oriented is false.
   int genus = 0;
 
-  bool closed = true;           // No boundary edge.
-  bool edge_manifold = true;    // Every edge in one or two faces.
-  bool vertex_manifold = true;  // Every vertex's faces form one fan (disc or half-disc); a
-                                // vertex on a non-manifold edge is not manifold either.
-  bool oriented = true;         // Every edge in two faces is used in opposite directions.
-                                // Edges in three or more faces are not judged here.
-  size_t non_manifold_edges = 0;      // Edges in three or more faces.
-  size_t non_manifold_vertices = 0;   // Vertices whose faces do not form one fan.
-  size_t misoriented_edges = 0;       // Edges in two faces used in the same direction.
+  bool closed = true;                // No boundary edge.
+  bool edge_manifold = true;         // Every edge in one or two faces.
+  bool vertex_manifold = true;       // Every vertex's faces form one fan (disc or half-disc); a
+                                     // vertex on a non-manifold edge is not manifold either.
+  bool oriented = true;              // Every edge in two faces is used in opposite directions.
+                                     // Edges in three or more faces are not judged here.
+  size_t non_manifold_edges = 0;     // Edges in three or more faces.
+  size_t non_manifold_vertices = 0;  // Vertices whose faces do not form one fan.
+  size_t misoriented_edges = 0;      // Edges in two faces used in the same direction.
 
   // Edge and vertex manifold, with no degenerate or invalid face.
   bool manifold() const {

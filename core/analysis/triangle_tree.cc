@@ -23,8 +23,7 @@ Vec3 ToVec3(const Vec3f& v) { return Vec3(v[0], v[1], v[2]); }
 struct Box {
   float lo[3] = {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
                  std::numeric_limits<float>::infinity()};
-  float hi[3] = {-std::numeric_limits<float>::infinity(),
-                 -std::numeric_limits<float>::infinity(),
+  float hi[3] = {-std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
                  -std::numeric_limits<float>::infinity()};
   void Extend(const float* p) {
     for (int i = 0; i < 3; ++i) {
@@ -103,9 +102,8 @@ absl::StatusOr<TriangleTree> TriangleTree::Build(const TriangleMesh& mesh) {
   for (size_t f = 0; f < n; ++f) {
     for (uint32_t v : mesh.faces[f]) {
       if (v >= num_positions) {
-        return absl::InvalidArgumentError(absl::StrCat("TriangleTree: face ", f,
-                                                       " refers to vertex ", v, " of only ",
-                                                       num_positions));
+        return absl::InvalidArgumentError(absl::StrCat(
+            "TriangleTree: face ", f, " refers to vertex ", v, " of only ", num_positions));
       }
     }
   }
@@ -155,10 +153,9 @@ absl::StatusOr<TriangleTree> TriangleTree::Build(const TriangleMesh& mesh) {
       if (centroids.hi[i] - centroids.lo[i] > centroids.hi[axis] - centroids.lo[axis]) axis = i;
     }
     const uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
-                     [axis](const Item& x, const Item& y) {
-                       return x.centroid[axis] < y.centroid[axis];
-                     });
+    std::nth_element(
+        items.begin() + begin, items.begin() + mid, items.begin() + end,
+        [axis](const Item& x, const Item& y) { return x.centroid[axis] < y.centroid[axis]; });
     const uint32_t left = self(self, begin, mid);
     const uint32_t right = self(self, mid, end);
     for (uint32_t child : {left, right}) {
@@ -239,7 +236,7 @@ std::vector<TriangleTree::ClosestPointResult> TriangleTree::ClosestPoints(
 
   constexpr size_t kBlock = 1024;
   size_t workers = options.threads > 0 ? static_cast<size_t>(options.threads)
-                               : std::max(1u, std::thread::hardware_concurrency());
+                                       : std::max(1u, std::thread::hardware_concurrency());
   workers = std::min(workers, (points.size() + kBlock - 1) / kBlock);
   // Blocks are handed out dynamically because query cost varies across space; each result
   // slot is written by exactly one thread, so the output does not depend on the schedule.

@@ -1,5 +1,6 @@
 #include "core/io/draco_codec.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -18,6 +19,8 @@
 #include "draco/core/decoder_buffer.h"
 #include "draco/core/encoder_buffer.h"
 #include "draco/mesh/mesh.h"
+#include "draco/metadata/geometry_metadata.h"
+#include "draco/metadata/metadata_decoder.h"
 #include "draco/point_cloud/point_cloud.h"
 
 namespace neuralmesh {
@@ -43,8 +46,7 @@ bool IsFinite(const Vec3f& p) {
 absl::Status CheckPositions(const std::vector<Vec3f>& positions, const DracoOptions& options) {
   for (size_t i = 0; i < positions.size(); ++i) {
     if (!IsFinite(positions[i])) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("vertex ", i, " has a non-finite coordinate"));
+      return absl::InvalidArgumentError(absl::StrCat("vertex ", i, " has a non-finite coordinate"));
     }
   }
   if (!options.quantization_box.has_value()) return absl::OkStatus();
@@ -57,8 +59,8 @@ absl::Status CheckPositions(const std::vector<Vec3f>& positions, const DracoOpti
       if (t < -0.25 || t > max_index + 0.25) {
         return absl::InvalidArgumentError(absl::StrCat(
             "vertex ", i, " (", positions[i][0], ", ", positions[i][1], ", ", positions[i][2],
-            ") lies outside the quantization box with origin (", box.origin[0], ", ",
-            box.origin[1], ", ", box.origin[2], ") and range ", box.range));
+            ") lies outside the quantization box with origin (", box.origin[0], ", ", box.origin[1],
+            ", ", box.origin[2], ") and range ", box.range));
       }
     }
   }
@@ -71,8 +73,8 @@ int AddFloatAttribute(draco::PointCloud& geometry, draco::GeometryAttribute::Typ
   draco::GeometryAttribute layout;
   layout.Init(type, nullptr, static_cast<uint8_t>(components), draco::DT_FLOAT32,
               /*normalized=*/false, sizeof(float) * components, /*byte_offset=*/0);
-  const int id = geometry.AddAttribute(layout, /*identity_mapping=*/true,
-                                       static_cast<uint32_t>(count));
+  const int id =
+      geometry.AddAttribute(layout, /*identity_mapping=*/true, static_cast<uint32_t>(count));
   geometry.attribute(id)->buffer()->Write(0, values, count * components * sizeof(float));
   return id;
 }
@@ -82,8 +84,8 @@ void SetPositionQuantization(draco::ExpertEncoder& encoder, int attribute_id,
   if (options.quantization_box.has_value()) {
     const QuantizationBox& box = *options.quantization_box;
     const float origin[3] = {box.origin[0], box.origin[1], box.origin[2]};
-    encoder.SetAttributeExplicitQuantization(attribute_id, options.position_quantization_bits,
-                                             3, origin, box.range);
+    encoder.SetAttributeExplicitQuantization(attribute_id, options.position_quantization_bits, 3,
+                                             origin, box.range);
   } else {
     encoder.SetAttributeQuantization(attribute_id, options.position_quantization_bits);
   }
@@ -97,6 +99,46 @@ absl::StatusOr<std::string> RunEncoder(draco::ExpertEncoder& encoder, const char
         absl::StrCat("Draco failed to encode the ", what, ": ", status.error_msg_string()));
   }
   return std::string(buffer.data(), buffer.size());
+}
+
+// Draco sizes a point cloud's arrays from the point count in the stream without comparing it
+// with the data that follows, so a few corrupt bytes can demand gigabytes (one 120-byte buffer
+// made Draco 1.5.5 fill 8 GB before giving up). The count cannot be bounded tightly either:
+// kd-tree and entropy coding store a million identical points in under 200 bytes. So any count
+// up to kAlwaysAllowedPoints passes, and larger ones need a byte per kMaxPointsPerByte points.
+// Mesh streams need no such check: Draco validates their counts.
+constexpr uint64_t kAlwaysAllowedPoints = uint64_t{1} << 20;
+constexpr uint64_t kMaxPointsPerByte = 256;
+
+absl::Status CheckDeclaredPointCount(std::string_view bytes) {
+  draco::DecoderBuffer buffer;
+  buffer.Init(bytes.data(), bytes.size());
+  char magic[5];
+  uint8_t major = 0, minor = 0, type = 0, method = 0;
+  uint16_t flags = 0;
+  // Whatever fails to parse here fails in Draco too, with its own message.
+  if (!buffer.Decode(magic, sizeof(magic)) || !buffer.Decode(&major) || !buffer.Decode(&minor) ||
+      !buffer.Decode(&type) || !buffer.Decode(&method) || !buffer.Decode(&flags) ||
+      type != draco::POINT_CLOUD) {
+    return absl::OkStatus();
+  }
+  const uint16_t version = DRACO_BITSTREAM_VERSION(major, minor);
+  buffer.set_bitstream_version(version);
+  if (version >= DRACO_BITSTREAM_VERSION(1, 3) && (flags & METADATA_FLAG_MASK) != 0) {
+    draco::GeometryMetadata metadata;
+    draco::MetadataDecoder metadata_decoder;
+    if (!metadata_decoder.DecodeGeometryMetadata(&buffer, &metadata)) return absl::OkStatus();
+  }
+  int32_t stored_count = 0;
+  if (!buffer.Decode(&stored_count)) return absl::OkStatus();
+  // The sequential decoder reads the count as unsigned.
+  const uint64_t count = static_cast<uint32_t>(stored_count);
+  const uint64_t limit = std::max<uint64_t>(kAlwaysAllowedPoints, kMaxPointsPerByte * bytes.size());
+  if (count > limit) {
+    return absl::InvalidArgumentError(absl::StrCat("corrupt Draco data: it declares ", count,
+                                                   " points in only ", bytes.size(), " bytes"));
+  }
+  return absl::OkStatus();
 }
 
 // Decodes `bytes` as the given geometry type. Draco sizes its arrays from counts in the
@@ -113,24 +155,24 @@ absl::StatusOr<std::unique_ptr<Geometry>> DecodeDraco(std::string_view bytes) {
   }
   constexpr bool kWantMesh = std::is_same_v<Geometry, draco::Mesh>;
   if (kWantMesh && type.value() != draco::TRIANGULAR_MESH) {
-    return absl::InvalidArgumentError(
-        "the Draco data holds a point cloud, not a triangle mesh");
+    return absl::InvalidArgumentError("the Draco data holds a point cloud, not a triangle mesh");
   }
+  NM_RETURN_IF_ERROR(CheckDeclaredPointCount(bytes));
   buffer.Init(bytes.data(), bytes.size());
   draco::Decoder decoder;
   try {
     if constexpr (kWantMesh) {
       auto result = decoder.DecodeMeshFromBuffer(&buffer);
       if (!result.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("corrupt or truncated Draco mesh: ",
-                                                       result.status().error_msg_string()));
+        return absl::InvalidArgumentError(
+            absl::StrCat("corrupt or truncated Draco mesh: ", result.status().error_msg_string()));
       }
       return std::move(result).value();
     } else {
       auto result = decoder.DecodePointCloudFromBuffer(&buffer);
       if (!result.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("corrupt or truncated Draco data: ",
-                                                       result.status().error_msg_string()));
+        return absl::InvalidArgumentError(
+            absl::StrCat("corrupt or truncated Draco data: ", result.status().error_msg_string()));
       }
       return std::move(result).value();
     }
@@ -143,8 +185,7 @@ absl::StatusOr<std::unique_ptr<Geometry>> DecodeDraco(std::string_view bytes) {
   }
 }
 
-absl::StatusOr<const draco::PointAttribute*> PositionAttribute(
-    const draco::PointCloud& geometry) {
+absl::StatusOr<const draco::PointAttribute*> PositionAttribute(const draco::PointCloud& geometry) {
   const draco::PointAttribute* positions =
       geometry.GetNamedAttribute(draco::GeometryAttribute::POSITION);
   if (positions == nullptr) {
@@ -175,8 +216,7 @@ absl::StatusOr<Vec3f> ReadVec3(const draco::PointAttribute& attribute,
 }  // namespace
 
 absl::Status DracoOptions::Validate() const {
-  NM_RETURN_IF_ERROR(
-      CheckRange("position_quantization_bits", position_quantization_bits, 1, 30));
+  NM_RETURN_IF_ERROR(CheckRange("position_quantization_bits", position_quantization_bits, 1, 30));
   NM_RETURN_IF_ERROR(CheckRange("normal_quantization_bits", normal_quantization_bits, 2, 30));
   NM_RETURN_IF_ERROR(CheckRange("weight_quantization_bits", weight_quantization_bits, 1, 30));
   NM_RETURN_IF_ERROR(CheckRange("encode_speed", encode_speed, 0, 10));
@@ -188,9 +228,9 @@ absl::Status DracoOptions::Validate() const {
           "DracoOptions.quantization_box.origin has a non-finite coordinate");
     }
     if (!std::isfinite(box.range) || box.range <= 0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("DracoOptions.quantization_box.range is ", box.range,
-                       "; it must be finite and positive"));
+      return absl::InvalidArgumentError(absl::StrCat("DracoOptions.quantization_box.range is ",
+                                                     box.range,
+                                                     "; it must be finite and positive"));
     }
     for (int c = 0; c < 3; ++c) {
       if (!std::isfinite(box.origin[c] + box.range)) {
@@ -217,18 +257,16 @@ absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOpti
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     for (uint32_t v : mesh.faces[f]) {
       if (v >= num_vertices) {
-        return absl::InvalidArgumentError(absl::StrCat("face ", f, " uses vertex ", v,
-                                                       " but the mesh has only ",
-                                                       num_vertices, " vertices"));
+        return absl::InvalidArgumentError(absl::StrCat(
+            "face ", f, " uses vertex ", v, " but the mesh has only ", num_vertices, " vertices"));
       }
     }
   }
 
   draco::Mesh geometry;
   geometry.set_num_points(static_cast<uint32_t>(num_vertices));
-  const int position_id =
-      AddFloatAttribute(geometry, draco::GeometryAttribute::POSITION, 3,
-                        mesh.positions.front().data(), num_vertices);
+  const int position_id = AddFloatAttribute(geometry, draco::GeometryAttribute::POSITION, 3,
+                                            mesh.positions.front().data(), num_vertices);
   geometry.SetNumFaces(mesh.faces.size());
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     draco::Mesh::Face face;
@@ -243,8 +281,7 @@ absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOpti
   return RunEncoder(encoder, "mesh");
 }
 
-absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud,
-                                             const DracoOptions& options) {
+absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const DracoOptions& options) {
   NM_RETURN_IF_ERROR(options.Validate());
   if (cloud.empty()) return absl::InvalidArgumentError("cannot encode an empty point cloud");
   NM_RETURN_IF_ERROR(ValidatePointCloud(cloud));
@@ -262,8 +299,8 @@ absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud,
   }
   int weight_id = -1;
   if (!cloud.weights.empty()) {
-    weight_id = AddFloatAttribute(geometry, draco::GeometryAttribute::GENERIC, 1,
-                                  cloud.weights.data(), n);
+    weight_id =
+        AddFloatAttribute(geometry, draco::GeometryAttribute::GENERIC, 1, cloud.weights.data(), n);
   }
 
   draco::ExpertEncoder encoder(geometry);

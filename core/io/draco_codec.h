@@ -57,8 +57,7 @@ absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOpti
 // Returns INVALID_ARGUMENT when `options` is invalid, the cloud is empty, fails
 // ValidatePointCloud, or has a position outside `options.quantization_box`; INTERNAL if Draco
 // fails for another reason.
-absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud,
-                                             const DracoOptions& options);
+absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const DracoOptions& options);
 
 // Decodes a Draco mesh: one position per distinct position value and the triangles.
 // Returns INVALID_ARGUMENT when `bytes` is not a valid Draco mesh (corrupt, truncated, a point

@@ -66,16 +66,15 @@ absl::Status CheckWritable(const TriangleMesh& mesh, FileFormat format) {
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     const Vec3f& p = mesh.positions[i];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("vertex ", i, " has a non-finite coordinate"));
+      return absl::InvalidArgumentError(absl::StrCat("vertex ", i, " has a non-finite coordinate"));
     }
   }
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     for (uint32_t v : mesh.faces[f]) {
       if (v >= mesh.positions.size()) {
         return absl::InvalidArgumentError(absl::StrCat("face ", f, " uses vertex ", v,
-                                                       " but the mesh has ",
-                                                       mesh.positions.size(), " vertices"));
+                                                       " but the mesh has ", mesh.positions.size(),
+                                                       " vertices"));
       }
     }
   }
@@ -89,7 +88,8 @@ absl::Status CheckWritable(const TriangleMesh& mesh, FileFormat format) {
 }  // namespace
 
 bool IsSupportedMeshExtension(std::string_view path) {
-  const FileFormat format = io_internal::FormatFromPath(absl::string_view(path.data(), path.size()));
+  const FileFormat format =
+      io_internal::FormatFromPath(absl::string_view(path.data(), path.size()));
   return format != FileFormat::kUnknown && format != FileFormat::kXyz;
 }
 
@@ -130,8 +130,9 @@ absl::Status WriteMesh(const TriangleMesh& mesh, const std::string& path,
     case FileFormat::kDraco: {
       absl::StatusOr<std::string> encoded = EncodeMesh(mesh, draco);
       if (!encoded.ok()) {
-        return absl::Status(encoded.status().code(), absl::StrCat("cannot write '", path, "': ",
-                                                                  encoded.status().message()));
+        return absl::Status(
+            encoded.status().code(),
+            absl::StrCat("cannot write '", path, "': ", encoded.status().message()));
       }
       data = *std::move(encoded);
       break;

@@ -22,8 +22,7 @@ bool IsReadable(FileFormat format) {
 }
 
 bool IsWritable(FileFormat format) {
-  return format == FileFormat::kPly || format == FileFormat::kXyz ||
-         format == FileFormat::kDraco;
+  return format == FileFormat::kPly || format == FileFormat::kXyz || format == FileFormat::kDraco;
 }
 
 absl::Status UnsupportedExtension(const std::string& path, const char* supported) {
@@ -96,8 +95,7 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
   absl::Status valid = cloud.empty() ? absl::InvalidArgumentError("the point cloud is empty")
                                      : ValidatePointCloud(cloud);
   if (!valid.ok()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("cannot write '", path, "': ", valid.message()));
+    return absl::InvalidArgumentError(absl::StrCat("cannot write '", path, "': ", valid.message()));
   }
   const io_internal::GeometryView view{cloud.positions, cloud.normals, cloud.weights, {}};
   std::string data;
@@ -108,8 +106,8 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
   } else {
     absl::StatusOr<std::string> encoded = EncodePointCloud(cloud, draco);
     if (!encoded.ok()) {
-      return absl::Status(encoded.status().code(), absl::StrCat("cannot write '", path, "': ",
-                                                                encoded.status().message()));
+      return absl::Status(encoded.status().code(),
+                          absl::StrCat("cannot write '", path, "': ", encoded.status().message()));
     }
     data = *std::move(encoded);
   }

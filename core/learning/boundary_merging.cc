@@ -101,7 +101,7 @@ double TriangleQuality(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
 
 // Plans the strip between loop `a` (boundary half-edges a[i] -> a[i+1]) and loop `b`
 // (b[j] -> b[j+1]). Returns the faces in the order they must be added, or nullopt when no
-// legal strip exists. O(|a| |b| + sum of the valences of a).
+// legal strip of this kind exists. O(|a| |b| + sum of the valences of a).
 //
 // The walk runs over a[0..n] forward and c[0..m] = b backward, both rotated to start at the
 // closest pair of vertices that is not already an edge. State (i, k) means the current cross
@@ -129,7 +129,8 @@ std::optional<std::vector<Triangle>> PlanStrip(const Mesh& mesh, const VertexLoo
     }
   }
 
-  // The tiling starts at the two closest vertices, one on each loop (Section 2.3).
+  // The tiling starts at the two closest vertices, one on each loop (Section 2.3), that are
+  // not already joined by an edge.
   int start_a = -1;
   int start_b = -1;
   double closest = std::numeric_limits<double>::infinity();
@@ -145,7 +146,7 @@ std::optional<std::vector<Triangle>> PlanStrip(const Mesh& mesh, const VertexLoo
     }
   }
   if (start_a < 0) return std::nullopt;
-  auto walk_a = [&](int i) { return (start_a + i) % n; };       // Index into a.
+  auto walk_a = [&](int i) { return (start_a + i) % n; };          // Index into a.
   auto walk_c = [&](int k) { return (start_b + m - k % m) % m; };  // Index into b.
   auto vertex_a = [&](int i) { return a[walk_a(i)]; };
   auto vertex_c = [&](int k) { return b[walk_c(k)]; };
@@ -264,11 +265,10 @@ BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOpti
       if (distance) candidates.push_back({*distance, x, y});
     }
   }
-  std::sort(candidates.begin(), candidates.end(),
-            [](const CandidatePair& l, const CandidatePair& r) {
-              return std::tie(l.distance, l.first, l.second) <
-                     std::tie(r.distance, r.first, r.second);
-            });
+  std::sort(
+      candidates.begin(), candidates.end(), [](const CandidatePair& l, const CandidatePair& r) {
+        return std::tie(l.distance, l.first, l.second) < std::tie(r.distance, r.first, r.second);
+      });
 
   // Merging two loops only touches their own boundary half-edges and edges between their
   // vertices, so the other loops collected above stay valid.

@@ -6,10 +6,12 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/learning/boundary_merging.h"
 #include "core/learning/half_edge_collapse.h"
 #include "core/learning/initial_mesh.h"
 #include "core/learning/signal_counters.h"
 #include "core/learning/tangential_smoothing.h"
+#include "core/learning/triangle_removal.h"
 #include "core/learning/vertex_octree.h"
 #include "core/learning/vertex_split.h"
 #include "core/status_macros.h"
@@ -166,6 +168,26 @@ class Learner::Impl {
     CollapseInactive();
     timings_.collapse += Since(t0);
     ++progress_.connectivity_calls;
+    double mean_area = 0;
+    if (options_.remove_triangles) {
+      t0 = Clock::now();
+      TriangleRemovalOptions removal;
+      removal.alpha_r = options_.alpha_r;
+      const TriangleRemovalResult removed = RemoveLargeTriangles(mesh_, removal);
+      for (auto v : removed.removed_vertices) ForgetVertex(v);
+      progress_.removed_triangles += removed.removed_faces;
+      mean_area = removed.mean_area;
+      timings_.removal += Since(t0);
+    }
+    if (options_.merge_boundaries) {
+      t0 = Clock::now();
+      BoundaryMergingOptions merging;
+      merging.alpha_m = options_.alpha_m;
+      const BoundaryMergingResult merged = MergeCloseBoundaries(mesh_, merging, mean_area);
+      progress_.merged_boundaries += merged.merges;
+      timings_.merging += Since(t0);
+    }
+    RecountDeletedFaces();
     last_connectivity_step_ = step_;
     next_connectivity_step_ = step_ + std::max<uint64_t>(1, ConnectivityInterval());
     CollectGarbageIfWorthIt();
@@ -183,7 +205,6 @@ class Learner::Impl {
       ForgetVertex(v);
       ++progress_.collapses;
     }
-    RecountDeletedFaces();
   }
 
   void ForgetVertex(Mesh::VertexHandle v) {

@@ -105,8 +105,7 @@ TriangleRemovalResult RemoveLargeTriangles(Mesh& mesh, const TriangleRemovalOpti
   std::priority_queue<Entry> seeds;     // Large faces away from any boundary: they open one.
   std::unordered_map<int, std::pair<State, double>> large;  // Face index -> (state, area).
   auto enqueue = [&](int index, double area) {
-    const State state =
-        mesh.is_boundary(Mesh::FaceHandle(index)) ? State::kFrontier : State::kSeed;
+    const State state = mesh.is_boundary(Mesh::FaceHandle(index)) ? State::kFrontier : State::kSeed;
     large[index] = {state, area};
     (state == State::kFrontier ? frontier : seeds).emplace(area, index);
   };

@@ -24,7 +24,8 @@ constexpr int kMaxResolution = 128;
 // The surface in local coordinates q = (p - center) / scale, where every constant below lives.
 class LocalGenusTwo {
  public:
-  explicit LocalGenusTwo(double thickness) : thickness_(thickness) {}
+  explicit LocalGenusTwo(double thickness)
+      : thickness_(thickness), half_extent_(ExactHalfExtent(thickness)) {}
 
   double Value(const Vec3& q) const {
     const double g = Lemniscate(q);
@@ -43,7 +44,6 @@ class LocalGenusTwo {
   // tenth of the thickness, whichever is larger, so it cannot jump across the tube. Stops when
   // the first-order distance estimate |f| / |grad f| is at round-off level.
   Vec3 Project(Vec3 q, int max_steps) const {
-    const Vec3 half = HalfExtent();
     for (int step = 0; step < max_steps; ++step) {
       const double f = Value(q);
       const Vec3 gradient = Gradient(q);
@@ -57,7 +57,7 @@ class LocalGenusTwo {
       Vec3 move = gradient * (f / g2);
       const double length = move.norm();
       Vec3 outside;
-      for (int a = 0; a < 3; ++a) outside[a] = std::max(0.0, std::abs(q[a]) - half[a]);
+      for (int a = 0; a < 3; ++a) outside[a] = std::max(0.0, std::abs(q[a]) - half_extent_[a]);
       const double max_step = std::max(0.1 * thickness_, outside.norm());
       if (length > max_step) move *= max_step / length;
       q -= move;
@@ -84,18 +84,20 @@ class LocalGenusTwo {
     return best;
   }
 
-  // The exact extent of the zero set: |z| <= thickness, and in the plane the region
-  // |g| <= thickness reaches x^2 = (1 + sqrt(1 + 4 t)) / 2 (on y = 0) and
-  // y^2 = (1 + 4 t) / 8 (at x^2 = (3 - 4 t) / 8).
-  Vec3 HalfExtent() const {
-    const double t = thickness_;
-    return Vec3(std::sqrt((1.0 + std::sqrt(1.0 + 4.0 * t)) / 2.0),
-                std::sqrt((1.0 + 4.0 * t) / 8.0), t);
-  }
+  // Half the size of the zero set's bounding box, which is centred on the origin.
+  const Vec3& HalfExtent() const { return half_extent_; }
 
   double thickness() const { return thickness_; }
 
  private:
+  // |z| <= t, and in the plane the region |g| <= t reaches x^2 = (1 + sqrt(1 + 4 t)) / 2 (on
+  // y = 0, since g grows with y^2) and y^2 = (1 + 4 t) / 8 (where g = t, at
+  // x^2 = (3 - 4 t) / 8).
+  static Vec3 ExactHalfExtent(double t) {
+    return Vec3(std::sqrt((1.0 + std::sqrt(1.0 + 4.0 * t)) / 2.0),
+                std::sqrt((1.0 + 4.0 * t) / 8.0), t);
+  }
+
   static double Lemniscate(const Vec3& q) {
     const double x2 = q[0] * q[0];
     const double y2 = q[1] * q[1];
@@ -103,6 +105,7 @@ class LocalGenusTwo {
   }
 
   const double thickness_;
+  const Vec3 half_extent_;
 };
 
 // Marching tetrahedra on a grid with cubic cells fitted around the surface, then every vertex
@@ -186,8 +189,8 @@ double MeshArea(const TriangleMesh& mesh) {
   double area = 0;
   for (const auto& f : mesh.faces) {
     const Vec3 a(mesh.positions[f[0]]);
-    area += 0.5 * OpenMesh::cross(Vec3(mesh.positions[f[1]]) - a, Vec3(mesh.positions[f[2]]) - a)
-                      .norm();
+    area += 0.5 *
+            OpenMesh::cross(Vec3(mesh.positions[f[1]]) - a, Vec3(mesh.positions[f[2]]) - a).norm();
   }
   return area;
 }

@@ -40,8 +40,8 @@ void GrowingPointCloud::Store(std::vector<std::unique_ptr<T[]>>& chunks, size_t 
 }
 
 template <typename T>
-void GrowingPointCloud::Fill(std::vector<std::unique_ptr<T[]>>& chunks, size_t begin,
-                             size_t end, const T& value) {
+void GrowingPointCloud::Fill(std::vector<std::unique_ptr<T[]>>& chunks, size_t begin, size_t end,
+                             const T& value) {
   for (size_t i = begin; i < end;) {
     std::unique_ptr<T[]>& chunk = chunks[i >> kChunkBits];
     if (chunk == nullptr) chunk.reset(new T[kChunkSize]);
@@ -75,8 +75,8 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
   float batch_max_weight = 0.0f;
   for (size_t i = 0; i < weights.size(); ++i) {
     if (!std::isfinite(weights[i]) || weights[i] < 0) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "weight ", i, " of the batch is ", weights[i], "; weights must be finite and >= 0"));
+      return absl::InvalidArgumentError(absl::StrCat("weight ", i, " of the batch is ", weights[i],
+                                                     "; weights must be finite and >= 0"));
     }
     batch_max_weight = std::max(batch_max_weight, weights[i]);
   }
@@ -88,13 +88,13 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
   }
   if (n == 0) return absl::OkStatus();
 
-  absl::MutexLock lock(&append_mu_);
+  std::lock_guard<std::mutex> lock(append_mu_);
   // Only this thread changes size_, so a relaxed load sees the latest value.
   const size_t old_size = size_.load(std::memory_order_relaxed);
   if (n > max_points_ - old_size) {
     return absl::ResourceExhaustedError(absl::StrCat("appending ", n, " points to ", old_size,
-                                                     " would exceed the capacity of ",
-                                                     max_points_, " points"));
+                                                     " would exceed the capacity of ", max_points_,
+                                                     " points"));
   }
   if (old_size == 0 && !weights.empty() && batch_max_weight == 0.0f) {
     return absl::InvalidArgumentError(
@@ -134,7 +134,7 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
   }
   max_weight_.store(max_weight, std::memory_order_release);
   {
-    absl::MutexLock bounds_lock(&bounds_mu_);
+    std::lock_guard<std::mutex> bounds_lock(bounds_mu_);
     bounds_.Extend(batch_bounds);
   }
   size_.store(old_size + n, std::memory_order_release);
@@ -159,7 +159,7 @@ Vec3 GrowingPointCloud::Sample(Random& rng) const {
 }
 
 BoundingBox GrowingPointCloud::Bounds() const {
-  absl::MutexLock lock(&bounds_mu_);
+  std::lock_guard<std::mutex> lock(bounds_mu_);
   return bounds_;
 }
 

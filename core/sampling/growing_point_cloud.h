@@ -20,11 +20,10 @@
 #include <atomic>
 #include <cstddef>
 #include <memory>
+#include <mutex>
 #include <vector>
 
-#include "absl/base/thread_annotations.h"
 #include "absl/status/status.h"
-#include "absl/synchronization/mutex.h"
 #include "absl/types/span.h"
 #include "core/bounding_box.h"
 #include "core/mesh.h"
@@ -100,7 +99,7 @@ class GrowingPointCloud : public Sampler {
   // Directories of chunk pointers, sized once for max_points_. An entry is written (by the
   // appending thread, under append_mu_) before the first release store of size_ or of the
   // matching has_* flag that makes any of its points visible, and never changes afterwards, so
-  // readers read entries without a lock. Not ABSL_GUARDED_BY for that reason.
+  // readers read entries without a lock.
   std::vector<std::unique_ptr<Vec3f[]>> position_chunks_;
   std::vector<std::unique_ptr<float[]>> weight_chunks_;
   std::vector<std::unique_ptr<Vec3f[]>> normal_chunks_;
@@ -113,10 +112,13 @@ class GrowingPointCloud : public Sampler {
   // The largest weight stored so far, raised before size_ publishes the points that carry it.
   std::atomic<float> max_weight_{0.0f};
 
-  absl::Mutex append_mu_;
+  // std::mutex rather than absl::Mutex: Debian's Abseil is not built with ThreadSanitizer,
+  // which then cannot see the hand-offs of an absl::Mutex and reports false races; it does
+  // understand std::mutex (pthreads).
+  std::mutex append_mu_;  // Serialises Append.
 
-  mutable absl::Mutex bounds_mu_;
-  BoundingBox bounds_ ABSL_GUARDED_BY(bounds_mu_);
+  mutable std::mutex bounds_mu_;
+  BoundingBox bounds_;  // Guarded by bounds_mu_.
 };
 
 }  // namespace neuralmesh

@@ -25,13 +25,12 @@ bool IsFinite(const Vec3& v) {
 // The unit icosahedron, faces counter-clockwise seen from outside.
 void Icosahedron(std::vector<Vec3>* vertices, std::vector<std::array<uint32_t, 3>>* faces) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  *vertices = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+  *vertices = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
                {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
   for (Vec3& v : *vertices) v.normalize();
-  *faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-            {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-            {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-            {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  *faces = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+            {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+            {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
 }
 
 class Sphere final : public ImplicitSurface {
@@ -140,7 +139,8 @@ class Torus final : public ImplicitSurface {
     const int nu = std::max(3, static_cast<int>(std::lround(around)));
     TriangleMesh mesh;
     for (int i = 0; i < nu; ++i) {
-      for (int j = 0; j < nv; ++j) mesh.positions.emplace_back(Point(kTwoPi * i / nu, kTwoPi * j / nv));
+      for (int j = 0; j < nv; ++j)
+        mesh.positions.emplace_back(Point(kTwoPi * i / nu, kTwoPi * j / nv));
     }
     auto id = [&](int i, int j) { return static_cast<uint32_t>((i % nu) * nv + (j % nv)); };
     for (int i = 0; i < nu; ++i) {
@@ -174,8 +174,7 @@ absl::StatusOr<std::unique_ptr<ImplicitSurface>> MakeSphere(const Vec3& center, 
   return std::make_unique<Sphere>(center, radius);
 }
 
-absl::StatusOr<std::unique_ptr<ImplicitSurface>> MakeTorus(const Vec3& center,
-                                                           double major_radius,
+absl::StatusOr<std::unique_ptr<ImplicitSurface>> MakeTorus(const Vec3& center, double major_radius,
                                                            double minor_radius) {
   if (!IsFinite(center) || !std::isfinite(major_radius) || !std::isfinite(minor_radius) ||
       !(minor_radius > 0) || !(minor_radius < major_radius)) {

@@ -55,8 +55,7 @@ absl::StatusOr<std::unique_ptr<ImplicitSurface>> MakeSphere(const Vec3& center, 
 // around the axis: about 16 n^2 R / r vertices, genus 1; n at most 2048, and the segments
 // around the axis at most 2^28 / (4n).
 // Returns INVALID_ARGUMENT unless all values are finite and 0 < r < R.
-absl::StatusOr<std::unique_ptr<ImplicitSurface>> MakeTorus(const Vec3& center,
-                                                           double major_radius,
+absl::StatusOr<std::unique_ptr<ImplicitSurface>> MakeTorus(const Vec3& center, double major_radius,
                                                            double minor_radius);
 
 // A smooth closed surface of genus 2: a tube around the lemniscate of Bernoulli

@@ -96,8 +96,8 @@ absl::StatusOr<TriangleMesh> MarchingTetrahedra(const std::function<double(const
       return absl::InvalidArgumentError(absl::StrCat("cell count ", a, " is ", cells[a]));
     }
   }
-  if (box.empty() || !(box.min[0] < box.max[0] && box.min[1] < box.max[1] &&
-                       box.min[2] < box.max[2])) {
+  if (box.empty() ||
+      !(box.min[0] < box.max[0] && box.min[1] < box.max[1] && box.min[2] < box.max[2])) {
     return absl::InvalidArgumentError("the grid's box is empty or flat");
   }
   const std::array<int64_t, 3> n = {int64_t{cells[0]} + 1, int64_t{cells[1]} + 1,
@@ -123,12 +123,12 @@ absl::StatusOr<TriangleMesh> MarchingTetrahedra(const std::function<double(const
           return absl::InvalidArgumentError(
               absl::StrCat("f is not finite at grid point (", i, ", ", j, ", ", k, ")"));
         }
-        const bool on_boundary = i == 0 || j == 0 || k == 0 || i == n[0] - 1 ||
-                                 j == n[1] - 1 || k == n[2] - 1;
+        const bool on_boundary =
+            i == 0 || j == 0 || k == 0 || i == n[0] - 1 || j == n[1] - 1 || k == n[2] - 1;
         if (on_boundary && v < 0) {
-          return absl::InvalidArgumentError(absl::StrCat(
-              "f < 0 at boundary grid point (", i, ", ", j, ", ", k,
-              "): the surface leaves the box and would not be closed"));
+          return absl::InvalidArgumentError(
+              absl::StrCat("f < 0 at boundary grid point (", i, ", ", j, ", ", k,
+                           "): the surface leaves the box and would not be closed"));
         }
         values[id(i, j, k)] = v;
       }
@@ -142,8 +142,8 @@ absl::StatusOr<TriangleMesh> MarchingTetrahedra(const std::function<double(const
   // One vertex per grid edge, shared by every tetrahedron around that edge; computed from the
   // inside end so that it does not depend on which tetrahedron asks first.
   auto vertex_on = [&](int64_t in, const Vec3& p_in, int64_t out, const Vec3& p_out) {
-    const uint64_t key = (static_cast<uint64_t>(std::min(in, out)) << 32) |
-                         static_cast<uint64_t>(std::max(in, out));
+    const uint64_t key =
+        (static_cast<uint64_t>(std::min(in, out)) << 32) | static_cast<uint64_t>(std::max(in, out));
     const auto [it, inserted] =
         edge_vertex.emplace(key, static_cast<uint32_t>(mesh.positions.size()));
     if (inserted) {

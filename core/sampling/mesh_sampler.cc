@@ -17,7 +17,7 @@ namespace {
 struct EdgeFaces {
   uint32_t first_face = 0;
   uint32_t second_face = 0;
-  bool first_runs_low_to_high = false;   // Whether the first face walks the edge min -> max.
+  bool first_runs_low_to_high = false;  // Whether the first face walks the edge min -> max.
   bool second_runs_low_to_high = false;
   int count = 0;
 };
@@ -116,8 +116,8 @@ absl::Status MeshSamplerOptions::Validate() const {
     return absl::InvalidArgumentError("mode is not a MeshSamplingMode");
   }
   if (!std::isfinite(curvature_epsilon) || curvature_epsilon <= 0) {
-    return absl::InvalidArgumentError(absl::StrCat("curvature_epsilon is ", curvature_epsilon,
-                                                   "; it must be finite and > 0"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("curvature_epsilon is ", curvature_epsilon, "; it must be finite and > 0"));
   }
   return absl::OkStatus();
 }

@@ -49,8 +49,7 @@ absl::StatusOr<std::unique_ptr<Sampler>> WeightedPointCloudSampler::Create(
 }
 
 WeightedPointCloudSampler::WeightedPointCloudSampler(std::shared_ptr<const PointCloud> cloud,
-                                                     AliasTable table,
-                                                     const BoundingBox& bounds)
+                                                     AliasTable table, const BoundingBox& bounds)
     : cloud_(std::move(cloud)), table_(std::move(table)), bounds_(bounds) {}
 
 Vec3 WeightedPointCloudSampler::Sample(Random& rng) const {

@@ -41,13 +41,13 @@ TEST_F(CliErrorsTest, MissingInputFile) {
   const std::string missing = dir_ + "/nothing_here.ply";
   const std::string err =
       ExpectFailure({"reconstruct", missing, "-o", Output(), "--vertices", "100"});
-  EXPECT_TRUE(absl::StrContains(err, missing) && absl::StrContains(err, "does not exist"))
-      << err;
+  EXPECT_TRUE(absl::StrContains(err, missing) && absl::StrContains(err, "does not exist")) << err;
 }
 
 TEST_F(CliErrorsTest, EmptyInputFile) {
   const std::string empty = WriteFile("empty.xyz", "");
-  const std::string err = ExpectFailure({"reconstruct", empty, "-o", Output(), "--vertices", "100"});
+  const std::string err =
+      ExpectFailure({"reconstruct", empty, "-o", Output(), "--vertices", "100"});
   EXPECT_TRUE(absl::StrContains(err, empty) && absl::StrContains(err, "empty")) << err;
 }
 
@@ -127,8 +127,7 @@ TEST_F(CliErrorsTest, UnknownSamplingMode) {
 }
 
 TEST_F(CliErrorsTest, MeshSamplingOfAPointCloud) {
-  const std::string cloud =
-      WriteFile("cloud.off", "OFF\n4 0 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
+  const std::string cloud = WriteFile("cloud.off", "OFF\n4 0 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
   const std::string err = ExpectFailure(
       {"reconstruct", cloud, "-o", Output(), "--vertices", "100", "--sampling", "area"});
   EXPECT_TRUE(absl::StrContains(err, "no faces")) << err;
@@ -157,8 +156,8 @@ TEST_F(CliErrorsTest, UnknownCommand) {
 }
 
 TEST_F(CliErrorsTest, RemoteFlagWithoutServer) {
-  const std::string err = ExpectFailure(
-      {"reconstruct", "builtin:sphere", "--out-dir", dir_, "--vertices", "100"});
+  const std::string err =
+      ExpectFailure({"reconstruct", "builtin:sphere", "--out-dir", dir_, "--vertices", "100"});
   EXPECT_TRUE(absl::StrContains(err, "--server")) << err;
 }
 

@@ -27,9 +27,9 @@ class LocalCliTest : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new std::string(MakeTempDir("cli_local"));
     output_ = new std::string(*dir_ + "/sphere.ply");
-    reconstruct_ = new RunResult(RunNeuralmesh({"reconstruct", "builtin:sphere", "-o", *output_,
-                                                "--vertices", "500", "--lod", "100,250",
-                                                "--seed", "3"}));
+    reconstruct_ =
+        new RunResult(RunNeuralmesh({"reconstruct", "builtin:sphere", "-o", *output_, "--vertices",
+                                     "500", "--lod", "100,250", "--seed", "3"}));
   }
   static void TearDownTestSuite() {
     std::filesystem::remove_all(*dir_);
@@ -67,7 +67,8 @@ TEST_F(LocalCliTest, ReconstructPrintsOneRowPerLevelAndASummary) {
   }
   EXPECT_EQ(rows, 3) << "expected rows for 100, 250 and 500 vertices:\n" << reconstruct_->out;
   EXPECT_TRUE(absl::StrContains(reconstruct_->out, "target reached: 500 vertices"))
-      << "missing summary line:\n" << reconstruct_->out;
+      << "missing summary line:\n"
+      << reconstruct_->out;
 }
 
 TEST_F(LocalCliTest, StatsReportsAClosedGenusZeroMeshOfTheRequestedSize) {
@@ -106,8 +107,8 @@ TEST_F(LocalCliTest, TheSameSeedGivesByteIdenticalFiles) {
     const std::string a = *dir_ + "/seeded_a" + ext;
     const std::string b = *dir_ + "/seeded_b" + ext;
     for (const std::string& path : {a, b}) {
-      const RunResult run = RunNeuralmesh({"reconstruct", "builtin:torus", "-o", path,
-                                           "--vertices", "300", "--lod", "120", "--seed", "11"});
+      const RunResult run = RunNeuralmesh({"reconstruct", "builtin:torus", "-o", path, "--vertices",
+                                           "300", "--lod", "120", "--seed", "11"});
       ASSERT_EQ(run.exit_code, 0) << run.Describe();
     }
     EXPECT_EQ(ReadWholeFile(a), ReadWholeFile(b)) << ext << " outputs of one seed differ";
@@ -117,10 +118,22 @@ TEST_F(LocalCliTest, TheSameSeedGivesByteIdenticalFiles) {
   }
 }
 
+TEST_F(LocalCliTest, TheProgressBarIsDrawnOnlyOnATerminalOrWithProgress) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  EXPECT_TRUE(reconstruct_->err.empty()) << "stderr is a file here, so no bar:\n"
+                                         << reconstruct_->err;
+  const RunResult run = RunNeuralmesh({"reconstruct", "builtin:sphere", "-o",
+                                       *dir_ + "/progress.ply", "--vertices", "200", "--progress"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.err, "learning [")) << run.err;
+  EXPECT_TRUE(absl::StrContains(run.err, "200/200 vertices")) << run.err;
+  EXPECT_FALSE(absl::StrContains(run.out, "learning [")) << "the bar belongs on stderr";
+}
+
 TEST_F(LocalCliTest, AStepBudgetStopsEarlyAndStillWritesTheOutput) {
   const std::string path = *dir_ + "/budget.off";
-  const RunResult run = RunNeuralmesh({"reconstruct", "builtin:sphere", "-o", path, "--vertices",
-                                       "5000", "--max_steps", "20000"});
+  const RunResult run = RunNeuralmesh(
+      {"reconstruct", "builtin:sphere", "-o", path, "--vertices", "5000", "--max_steps", "20000"});
   ASSERT_EQ(run.exit_code, 0) << run.Describe();
   EXPECT_TRUE(std::filesystem::exists(path)) << run.Describe();
   EXPECT_TRUE(absl::StrContains(run.out, "--max_steps reached")) << run.out;
@@ -130,30 +143,66 @@ TEST_F(LocalCliTest, ReconstructsAPointCloudFileAndRemeshesAMesh) {
   ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
   // The 500-vertex sphere serves as a point cloud (its vertices) and as a mesh to remesh.
   const std::string from_points = *dir_ + "/from_points.obj";
-  const RunResult points = RunNeuralmesh(
-      {"reconstruct", *output_, "-o", from_points, "--vertices", "100"});
+  const RunResult points =
+      RunNeuralmesh({"reconstruct", *output_, "-o", from_points, "--vertices", "100"});
   EXPECT_EQ(points.exit_code, 0) << points.Describe();
   EXPECT_TRUE(std::filesystem::exists(from_points)) << points.Describe();
 
   const std::string remeshed = *dir_ + "/remeshed.stl";
-  const RunResult remesh = RunNeuralmesh({"reconstruct", *output_, "-o", remeshed, "--vertices",
-                                          "200", "--sampling", "curvature"});
+  const RunResult remesh = RunNeuralmesh(
+      {"reconstruct", *output_, "-o", remeshed, "--vertices", "200", "--sampling", "curvature"});
   EXPECT_EQ(remesh.exit_code, 0) << remesh.Describe();
   EXPECT_TRUE(std::filesystem::exists(remeshed)) << remesh.Describe();
+}
+
+TEST_F(LocalCliTest, AnInterruptWritesTheMeshLearnedSoFar) {
+  const std::string path = *dir_ + "/interrupted.ply";
+  BackgroundProcess run("neuralmesh",
+                        {"reconstruct", "builtin:sphere", "-o", path, "--vertices", "1000000"});
+  // Interrupt once learning has begun (the first line is printed before it starts).
+  for (int i = 0; i < 200 && !absl::StrContains(run.Stdout(), "learning"); ++i) {
+    usleep(20 * 1000);
+  }
+  usleep(300 * 1000);
+  const int exit_code = run.SignalAndWait(SIGINT);
+  EXPECT_EQ(exit_code, 1) << run.Stderr();
+  EXPECT_TRUE(absl::StrContains(run.Stderr(), "interrupted")) << run.Stderr();
+  EXPECT_TRUE(absl::StrContains(run.Stdout(), "interrupted: ")) << run.Stdout();
+  EXPECT_TRUE(std::filesystem::exists(path)) << "the mesh learned so far was not written";
 }
 
 TEST(LocalCliHelpTest, HelpDocumentsEveryReconstructFlag) {
   const RunResult help = RunNeuralmesh({"reconstruct", "--help"});
   ASSERT_EQ(help.exit_code, 0) << help.Describe();
-  for (const char* flag :
-       {"--output", "--vertices", "--seed", "--lod", "--alpha_w", "--alpha_l", "--c_l", "--c_vs",
-        "--c_ec", "--alpha_sc", "--alpha_r", "--alpha_m", "--remove_triangles",
-        "--merge_boundaries", "--splits_per_step", "--sampling", "--time_budget", "--max_steps",
-        "--quantization_bits", "--encode_speed", "--progress", "--server", "--out-dir",
-        "--batch-size", "--ply"}) {
+  for (const char* flag : {"--output",
+                           "--vertices",
+                           "--seed",
+                           "--lod",
+                           "--alpha_w",
+                           "--alpha_l",
+                           "--c_l",
+                           "--c_vs",
+                           "--c_ec",
+                           "--alpha_sc",
+                           "--alpha_r",
+                           "--alpha_m",
+                           "--remove_triangles",
+                           "--merge_boundaries",
+                           "--splits_per_step",
+                           "--sampling",
+                           "--time_budget",
+                           "--max_steps",
+                           "--quantization_bits",
+                           "--encode_speed",
+                           "--progress",
+                           "--server",
+                           "--out-dir",
+                           "--batch-size",
+                           "--ply"}) {
     EXPECT_TRUE(absl::StrContains(help.out, std::string(flag) + "\n") ||
                 absl::StrContains(help.out, std::string(flag) + ","))
-        << flag << " is not documented:\n" << help.out;
+        << flag << " is not documented:\n"
+        << help.out;
   }
 }
 

@@ -35,10 +35,10 @@ class RemoteCliTest : public ::testing::Test {
     *start_error_ = error;
     dir_ = new std::string(MakeTempDir("cli_remote"));
     if (server_ != nullptr) {
-      reconstruct_ = new RunResult(RunNeuralmesh(
-          {"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir",
-           *dir_ + "/out", "--vertices", "400", "--points", "4000", "--lod", "100,200",
-           "--batch-size", "500", "--ply"}));
+      reconstruct_ = new RunResult(
+          RunNeuralmesh({"reconstruct", "builtin:sphere", "--server", server_->address(),
+                         "--out-dir", *dir_ + "/out", "--vertices", "400", "--points", "4000",
+                         "--lod", "100,200", "--batch-size", "500", "--ply"}));
     }
   }
   static void TearDownTestSuite() {
@@ -125,13 +125,12 @@ TEST(RemoteCliUnreachableTest, AnUnreachableServerFailsClearly) {
   const std::string address = "127.0.0.1:" + std::to_string(PickFreePort());
   const std::string dir = MakeTempDir("cli_unreachable");
   for (const std::vector<std::string>& args :
-       {std::vector<std::string>{"reconstruct", "builtin:sphere", "--server", address,
-                                 "--out-dir", dir, "--connect_timeout", "1s"},
+       {std::vector<std::string>{"reconstruct", "builtin:sphere", "--server", address, "--out-dir",
+                                 dir, "--connect_timeout", "1s"},
         std::vector<std::string>{"sessions", "--server", address, "--connect_timeout", "1s"}}) {
     const RunResult run = RunNeuralmesh(args);
     EXPECT_NE(run.exit_code, 0) << run.Describe();
-    EXPECT_TRUE(absl::StrContains(run.err, "cannot reach") &&
-                absl::StrContains(run.err, address))
+    EXPECT_TRUE(absl::StrContains(run.err, "cannot reach") && absl::StrContains(run.err, address))
         << run.err;
   }
   std::filesystem::remove_all(dir);

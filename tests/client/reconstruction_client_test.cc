@@ -80,8 +80,8 @@ TEST_F(ReconstructionClientTest, UploadWatchAndFinishDeliverTheFinalMesh) {
 
   std::vector<uint64_t> progress;
   const PointCloud cloud = SpherePoints(2000);
-  absl::StatusOr<v1::UploadPointsResponse> uploaded = client_->UploadPoints(
-      id, cloud, 300, [&](uint64_t sent, uint64_t total) {
+  absl::StatusOr<v1::UploadPointsResponse> uploaded =
+      client_->UploadPoints(id, cloud, 300, [&](uint64_t sent, uint64_t total) {
         EXPECT_EQ(total, 2000u);
         progress.push_back(sent);
       });

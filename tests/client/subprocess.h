@@ -49,8 +49,8 @@ struct RunResult {
 
   // For failure messages.
   std::string Describe() const {
-    return "exit code " + std::to_string(exit_code) + "\n--- stdout:\n" + out +
-           "\n--- stderr:\n" + err;
+    return "exit code " + std::to_string(exit_code) + "\n--- stdout:\n" + out + "\n--- stderr:\n" +
+           err;
   }
 };
 
@@ -136,6 +136,16 @@ class BackgroundProcess {
     if (pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) != 0) pid_ = -1;  // Exited and reaped.
     return pid_ > 0;
   }
+  // Sends `signal` and waits for the process to end; returns its exit code as RunResult does
+  // (-1 when it had already ended).
+  int SignalAndWait(int signal) {
+    if (pid_ <= 0) return -1;
+    kill(pid_, signal);
+    const int code = internal::WaitExitCode(pid_);
+    pid_ = -1;
+    return code;
+  }
+
   std::string Stdout() const { return ReadWholeFile(out_path_); }
   std::string Stderr() const { return ReadWholeFile(err_path_); }
 

@@ -47,8 +47,7 @@ class TestServer {
   std::string Stderr() const { return process_.Stderr(); }
 
  private:
-  explicit TestServer(const std::vector<std::string>& args)
-      : process_("neuralmesh-server", args) {}
+  explicit TestServer(const std::vector<std::string>& args) : process_("neuralmesh-server", args) {}
 
   BackgroundProcess process_;
   std::string address_;

@@ -484,7 +484,7 @@ TEST_F(ReconstructionServiceTest, CancelAndDeleteEndWatchers) {
 TEST_F(ReconstructionServiceTest, ShutdownEndsEveryOpenStream) {
   const std::string id = MustCreate(*stub_, CreateRequest(100000));
   v1::UploadPointsResponse response;
-  ASSERT_TRUE(testing::Upload(*stub_, id, TorusPoints(20000, 19), 2, &response).ok());
+  ASSERT_TRUE(testing::Upload(*stub_, id, TorusPoints(20000, 19), 5, &response).ok());
 
   grpc::Status watch_status, upload_status, bidi_status, wait_status;
   std::vector<v1::MeshUpdate> updates;

@@ -66,7 +66,8 @@ TEST(ServiceConcurrentTest, EightSessionsOnTwoWorkersStayIsolatedAndAllProgress)
   }
   for (std::thread& t : threads) t.join();
   for (int i = 0; i < kSessions; ++i) {
-    ASSERT_TRUE(statuses[i].ok()) << "session " << i << ": " << statuses[i].error_message();
+    ASSERT_TRUE(statuses[i].ok()) << "session " << i << ": " << statuses[i].error_message()
+                                  << "\n" << testing::GetSession(*stub, ids[i]).DebugString();
     EXPECT_EQ(finals[i].session_id(), ids[i]);
     EXPECT_EQ(finals[i].vertex_count(), 400u + 10 * i) << "each session keeps its own target";
     EXPECT_EQ(finals[i].learning().points_received(), counts[i]);

@@ -17,8 +17,8 @@ constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 absl::Status ParseVertex(const std::vector<absl::string_view>& tokens, int line,
                          ParsedGeometry* out) {
   if (tokens.size() < 4) {
-    return LineError(line, absl::StrCat("expected 'v x y z', found ", tokens.size() - 1,
-                                        " coordinates"));
+    return LineError(line,
+                     absl::StrCat("expected 'v x y z', found ", tokens.size() - 1, " coordinates"));
   }
   Vec3f p;
   for (int c = 0; c < 3; ++c) {
@@ -36,8 +36,7 @@ absl::Status ParseVertex(const std::vector<absl::string_view>& tokens, int line,
 
 // Resolves the vertex part of one face reference ("7", "7/2", "7/2/5", "7//5", "-1").
 // Positive indices may refer to vertices defined later; they are checked at the end.
-absl::StatusOr<int64_t> ParseReference(absl::string_view reference, int line,
-                                       size_t num_vertices) {
+absl::StatusOr<int64_t> ParseReference(absl::string_view reference, int line, size_t num_vertices) {
   absl::string_view parts[3];
   int num_parts = 0;
   for (size_t start = 0;;) {
@@ -52,8 +51,8 @@ absl::StatusOr<int64_t> ParseReference(absl::string_view reference, int line,
   }
   int64_t index = 0;
   if (!ParseInt64(parts[0], &index)) {
-    return LineError(line, absl::StrCat("expected a vertex index in face reference ",
-                                        Quoted(reference)));
+    return LineError(line,
+                     absl::StrCat("expected a vertex index in face reference ", Quoted(reference)));
   }
   // Texture and normal indices are ignored but must be integers when present.
   for (int k = 1; k < num_parts; ++k) {
@@ -66,9 +65,9 @@ absl::StatusOr<int64_t> ParseReference(absl::string_view reference, int line,
   if (index < 0) {
     const int64_t resolved = static_cast<int64_t>(num_vertices) + index;
     if (resolved < 0) {
-      return LineError(line, absl::StrCat("relative face index ", index, " points before the ",
-                                          "first vertex; only ", num_vertices,
-                                          " vertices precede it"));
+      return LineError(line,
+                       absl::StrCat("relative face index ", index, " points before the ",
+                                    "first vertex; only ", num_vertices, " vertices precede it"));
     }
     return resolved;
   }
@@ -96,8 +95,8 @@ absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling fac
       NM_RETURN_IF_ERROR(ParseVertex(tokens, n, &out));
     } else if (tokens[0] == "f" && faces == FaceHandling::kRead) {
       if (tokens.size() < 4) {
-        return LineError(n, absl::StrCat("a face needs at least 3 vertices, found ",
-                                         tokens.size() - 1));
+        return LineError(
+            n, absl::StrCat("a face needs at least 3 vertices, found ", tokens.size() - 1));
       }
       polygon.clear();
       for (size_t k = 1; k < tokens.size(); ++k) {

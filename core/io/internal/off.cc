@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "absl/strings/match.h"
-#include "absl/strings/strip.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
 #include "core/io/internal/text.h"
 #include "core/status_macros.h"
 
@@ -50,8 +50,8 @@ absl::Status ParseKeyword(absl::string_view keyword, int line, bool* has_normals
 
 absl::Status ParseCount(absl::string_view token, int line, const char* what, int64_t* count) {
   if (!ParseInt64(token, count) || *count < 0) {
-    return LineError(line, absl::StrCat("expected a non-negative ", what, " count, found ",
-                                        Quoted(token)));
+    return LineError(
+        line, absl::StrCat("expected a non-negative ", what, " count, found ", Quoted(token)));
   }
   return absl::OkStatus();
 }
@@ -83,9 +83,9 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
   NM_RETURN_IF_ERROR(ParseCount(tokens[0], counts_line, "vertex", &num_vertices));
   NM_RETURN_IF_ERROR(ParseCount(tokens[1], counts_line, "face", &num_faces));
   if (static_cast<uint64_t>(num_vertices) > cursor.remaining() / kMinVertexBytes + 1) {
-    return LineError(counts_line, absl::StrCat("the header declares ", num_vertices,
-                                               " vertices but only ", cursor.remaining(),
-                                               " bytes follow"));
+    return LineError(counts_line,
+                     absl::StrCat("the header declares ", num_vertices, " vertices but only ",
+                                  cursor.remaining(), " bytes follow"));
   }
 
   ParsedGeometry out;
@@ -101,8 +101,7 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
     const int n = cursor.line_number();
     if (tokens.size() < min_tokens) {
       return LineError(n, absl::StrCat("expected ", has_normals ? "'x y z nx ny nz'" : "'x y z'",
-                                       " for vertex ", i, ", found ", tokens.size(),
-                                       " values"));
+                                       " for vertex ", i, ", found ", tokens.size(), " values"));
     }
     float values[6];
     for (size_t k = 0; k < min_tokens; ++k) {
@@ -117,17 +116,16 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
   if (faces == FaceHandling::kSkip) return out;
 
   if (static_cast<uint64_t>(num_faces) > cursor.remaining() / kMinFaceBytes + 1) {
-    return LineError(counts_line, absl::StrCat("the header declares ", num_faces,
-                                               " faces but only ", cursor.remaining(),
-                                               " bytes follow the vertices"));
+    return LineError(counts_line,
+                     absl::StrCat("the header declares ", num_faces, " faces but only ",
+                                  cursor.remaining(), " bytes follow the vertices"));
   }
   out.faces.reserve(num_faces);
   std::vector<uint32_t> polygon;
   for (int64_t f = 0; f < num_faces; ++f) {
     if (!NextContentLine(cursor, &tokens)) {
-      return LineError(cursor.line_number(),
-                       absl::StrCat("the file ends after ", f, " of the ", num_faces,
-                                    " faces the header declares"));
+      return LineError(cursor.line_number(), absl::StrCat("the file ends after ", f, " of the ",
+                                                          num_faces, " faces the header declares"));
     }
     const int n = cursor.line_number();
     int64_t count = 0;
@@ -143,8 +141,8 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
     for (int64_t k = 1; k <= count; ++k) {
       int64_t index = 0;
       if (!ParseInt64(tokens[k], &index)) {
-        return LineError(n, absl::StrCat("expected a vertex index in face ", f, ", found ",
-                                         Quoted(tokens[k])));
+        return LineError(
+            n, absl::StrCat("expected a vertex index in face ", f, ", found ", Quoted(tokens[k])));
       }
       if (index < 0 || index >= num_vertices) {
         return LineError(n, absl::StrCat("face ", f, " uses vertex ", index,

@@ -5,164 +5,22 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "core/io/internal/binary.h"
+#include "core/io/internal/ply_header.h"
 #include "core/io/internal/text.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::io_internal {
 namespace {
 
-enum class PlyFormat { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
-enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
-
-struct PlyProperty {
-  std::string name;
-  PlyType type = PlyType::kFloat32;  // The item type of a list.
-  bool is_list = false;
-  PlyType count_type = PlyType::kUint8;
-};
-
-struct PlyElement {
-  std::string name;
-  uint64_t count = 0;
-  std::vector<PlyProperty> properties;
-  int line = 0;  // Where the header declares it.
-};
-
-struct PlyHeader {
-  PlyFormat format = PlyFormat::kAscii;
-  std::vector<PlyElement> elements;
-  size_t body_offset = 0;  // First byte after the end_header line.
-  int body_line = 0;       // Number of the first line after end_header.
-};
-
 // Face indices are stored as uint32_t; the largest index must fit, with one value to spare.
 constexpr uint64_t kMaxVertices = std::numeric_limits<uint32_t>::max();
 
-bool ParseType(absl::string_view name, PlyType* type) {
-  if (name == "char" || name == "int8") *type = PlyType::kInt8;
-  else if (name == "uchar" || name == "uint8") *type = PlyType::kUint8;
-  else if (name == "short" || name == "int16") *type = PlyType::kInt16;
-  else if (name == "ushort" || name == "uint16") *type = PlyType::kUint16;
-  else if (name == "int" || name == "int32") *type = PlyType::kInt32;
-  else if (name == "uint" || name == "uint32") *type = PlyType::kUint32;
-  else if (name == "float" || name == "float32") *type = PlyType::kFloat32;
-  else if (name == "double" || name == "float64") *type = PlyType::kFloat64;
-  else return false;
-  return true;
-}
-
-size_t TypeSize(PlyType type) {
-  switch (type) {
-    case PlyType::kInt8:
-    case PlyType::kUint8:
-      return 1;
-    case PlyType::kInt16:
-    case PlyType::kUint16:
-      return 2;
-    case PlyType::kInt32:
-    case PlyType::kUint32:
-    case PlyType::kFloat32:
-      return 4;
-    case PlyType::kFloat64:
-      return 8;
-  }
-  return 0;
-}
-
-bool IsIntegral(PlyType type) { return type != PlyType::kFloat32 && type != PlyType::kFloat64; }
-
-constexpr char kTypeNames[] = "char, uchar, short, ushort, int, uint, float, double";
-
-absl::Status ParseProperty(const std::vector<absl::string_view>& tokens, int line,
-                           PlyElement* element) {
-  PlyProperty property;
-  if (tokens.size() >= 2 && tokens[1] == "list") {
-    if (tokens.size() != 5) {
-      return LineError(line, "expected 'property list <count type> <item type> <name>'");
-    }
-    property.is_list = true;
-    if (!ParseType(tokens[2], &property.count_type) || !IsIntegral(property.count_type)) {
-      return LineError(line, absl::StrCat("expected an integer list count type, found ",
-                                          Quoted(tokens[2])));
-    }
-    if (!ParseType(tokens[3], &property.type)) {
-      return LineError(line, absl::StrCat("unknown property type ", Quoted(tokens[3]),
-                                          "; expected one of ", kTypeNames));
-    }
-    property.name = std::string(tokens[4]);
-  } else {
-    if (tokens.size() != 3) return LineError(line, "expected 'property <type> <name>'");
-    if (!ParseType(tokens[1], &property.type)) {
-      return LineError(line, absl::StrCat("unknown property type ", Quoted(tokens[1]),
-                                          "; expected one of ", kTypeNames));
-    }
-    property.name = std::string(tokens[2]);
-  }
-  element->properties.push_back(std::move(property));
-  return absl::OkStatus();
-}
-
-absl::StatusOr<PlyHeader> ParseHeader(absl::string_view data) {
-  LineCursor cursor(data);
-  absl::string_view line;
-  std::vector<absl::string_view> tokens;
-  if (cursor.Next(&line)) SplitWhitespace(line, &tokens);
-  if (tokens.size() != 1 || tokens[0] != "ply") {
-    return LineError(1, absl::StrCat("not a PLY file: expected 'ply', found ",
-                                     Quoted(line.substr(0, 16))));
-  }
-  PlyHeader header;
-  bool have_format = false;
-  while (cursor.Next(&line)) {
-    const int n = cursor.line_number();
-    SplitWhitespace(line, &tokens);
-    if (tokens.empty()) continue;
-    const absl::string_view key = tokens[0];
-    if (key == "comment" || key == "obj_info") continue;
-    if (key == "format") {
-      if (tokens.size() != 3) return LineError(n, "expected 'format <kind> 1.0'");
-      if (tokens[1] == "ascii") header.format = PlyFormat::kAscii;
-      else if (tokens[1] == "binary_little_endian") header.format = PlyFormat::kBinaryLittleEndian;
-      else if (tokens[1] == "binary_big_endian") header.format = PlyFormat::kBinaryBigEndian;
-      else {
-        return LineError(n, absl::StrCat("unknown PLY format ", Quoted(tokens[1]),
-                                         "; expected ascii, binary_little_endian or "
-                                         "binary_big_endian"));
-      }
-      if (tokens[2] != "1.0") {
-        return LineError(n, absl::StrCat("unsupported PLY version ", Quoted(tokens[2]),
-                                         "; expected 1.0"));
-      }
-      have_format = true;
-    } else if (key == "element") {
-      int64_t count = -1;
-      if (tokens.size() != 3 || !ParseInt64(tokens[2], &count) || count < 0) {
-        return LineError(n, "expected 'element <name> <non-negative count>'");
-      }
-      header.elements.push_back({std::string(tokens[1]), static_cast<uint64_t>(count), {}, n});
-    } else if (key == "property") {
-      if (header.elements.empty()) return LineError(n, "'property' before any 'element'");
-      NM_RETURN_IF_ERROR(ParseProperty(tokens, n, &header.elements.back()));
-    } else if (key == "end_header") {
-      if (!have_format) return LineError(n, "the header has no 'format' line");
-      header.body_offset = cursor.offset();
-      header.body_line = n + 1;
-      return header;
-    } else {
-      return LineError(n, absl::StrCat("unexpected header keyword ", Quoted(key),
-                                       "; expected format, element, property, comment or "
-                                       "end_header"));
-    }
-  }
-  return LineError(cursor.line_number(), "the header has no 'end_header' line");
-}
-
-// Reads values from a binary body. Every read is bounds-checked against the data.
 class BinaryBody {
  public:
   BinaryBody(absl::string_view data, size_t offset, bool big_endian)
@@ -172,14 +30,14 @@ class BinaryBody {
   absl::Status BeginElement(const PlyElement& element) {
     uint64_t min_size = 0;
     for (const PlyProperty& p : element.properties) {
-      min_size += TypeSize(p.is_list ? p.count_type : p.type);
+      min_size += PlyTypeSize(p.is_list ? p.count_type : p.type);
     }
     const uint64_t remaining = data_.size() - offset_;
     if (min_size > 0 && element.count > remaining / min_size) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "byte ", offset_, ": the header declares ", element.count, " '", element.name,
-          "' elements of at least ", min_size, " bytes each, but only ", remaining,
-          " bytes follow"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("byte ", offset_, ": the header declares ", element.count, " '",
+                       element.name, "' elements of at least ", min_size, " bytes each, but only ",
+                       remaining, " bytes follow"));
     }
     return absl::OkStatus();
   }
@@ -192,23 +50,39 @@ class BinaryBody {
 
   absl::Status Read(PlyType type, const PlyElement& element, uint64_t index,
                     const PlyProperty& property, double* value) {
-    const size_t size = TypeSize(type);
+    const size_t size = PlyTypeSize(type);
     if (data_.size() - offset_ < size) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "byte ", offset_, ": the data ends inside ", element.name, " ", index,
-          " (property '", property.name, "'); the file is truncated"));
+      return absl::InvalidArgumentError(absl::StrCat("byte ", offset_, ": the data ends inside ",
+                                                     element.name, " ", index, " (property '",
+                                                     property.name, "'); the file is truncated"));
     }
     const char* p = data_.data() + offset_;
     offset_ += size;
     switch (type) {
-      case PlyType::kInt8: *value = LoadScalar<int8_t>(p, big_endian_); break;
-      case PlyType::kUint8: *value = LoadScalar<uint8_t>(p, big_endian_); break;
-      case PlyType::kInt16: *value = LoadScalar<int16_t>(p, big_endian_); break;
-      case PlyType::kUint16: *value = LoadScalar<uint16_t>(p, big_endian_); break;
-      case PlyType::kInt32: *value = LoadScalar<int32_t>(p, big_endian_); break;
-      case PlyType::kUint32: *value = LoadScalar<uint32_t>(p, big_endian_); break;
-      case PlyType::kFloat32: *value = LoadScalar<float>(p, big_endian_); break;
-      case PlyType::kFloat64: *value = LoadScalar<double>(p, big_endian_); break;
+      case PlyType::kInt8:
+        *value = LoadScalar<int8_t>(p, big_endian_);
+        break;
+      case PlyType::kUint8:
+        *value = LoadScalar<uint8_t>(p, big_endian_);
+        break;
+      case PlyType::kInt16:
+        *value = LoadScalar<int16_t>(p, big_endian_);
+        break;
+      case PlyType::kUint16:
+        *value = LoadScalar<uint16_t>(p, big_endian_);
+        break;
+      case PlyType::kInt32:
+        *value = LoadScalar<int32_t>(p, big_endian_);
+        break;
+      case PlyType::kUint32:
+        *value = LoadScalar<uint32_t>(p, big_endian_);
+        break;
+      case PlyType::kFloat32:
+        *value = LoadScalar<float>(p, big_endian_);
+        break;
+      case PlyType::kFloat64:
+        *value = LoadScalar<double>(p, big_endian_);
+        break;
     }
     return absl::OkStatus();
   }
@@ -229,9 +103,9 @@ class AsciiBody {
   absl::Status BeginElement(const PlyElement& element) {
     // Each element with properties takes at least one character.
     if (!element.properties.empty() && element.count > cursor_.remaining()) {
-      return LineError(Line(), absl::StrCat("the header declares ", element.count, " '",
-                                            element.name, "' elements but only ",
-                                            cursor_.remaining(), " bytes follow"));
+      return LineError(Line(),
+                       absl::StrCat("the header declares ", element.count, " '", element.name,
+                                    "' elements but only ", cursor_.remaining(), " bytes follow"));
     }
     return absl::OkStatus();
   }
@@ -240,9 +114,9 @@ class AsciiBody {
     absl::string_view line;
     do {
       if (!cursor_.Next(&line)) {
-        return LineError(Line(), absl::StrCat("the file ends after ", index, " of the ",
-                                              element.count, " '", element.name,
-                                              "' elements the header declares"));
+        return LineError(
+            Line(), absl::StrCat("the file ends after ", index, " of the ", element.count, " '",
+                                 element.name, "' elements the header declares"));
       }
       SplitWhitespace(line, &tokens_);
     } while (tokens_.empty());
@@ -263,20 +137,23 @@ class AsciiBody {
   absl::Status Read(PlyType type, const PlyElement& element, uint64_t index,
                     const PlyProperty& property, double* value) {
     if (next_ >= tokens_.size()) {
-      return LineError(Line(), absl::StrCat(element.name, " ", index,
-                                            " has too few values: property '", property.name,
-                                            "' is missing"));
+      return LineError(Line(),
+                       absl::StrCat(element.name, " ", index, " has too few values: property '",
+                                    property.name, "' is missing"));
     }
     const absl::string_view token = tokens_[next_++];
     if (!ParseDouble(token, value)) {
-      return LineError(Line(), absl::StrCat("expected a number for property '", property.name,
-                                            "' of ", element.name, " ", index, ", found ",
-                                            Quoted(token)));
+      return LineError(Line(),
+                       absl::StrCat("expected a number for property '", property.name, "' of ",
+                                    element.name, " ", index, ", found ", Quoted(token)));
     }
-    if (IsIntegral(type) && std::floor(*value) != *value) {
-      return LineError(Line(), absl::StrCat("expected an integer for property '",
-                                            property.name, "' of ", element.name, " ", index,
-                                            ", found ", Quoted(token)));
+    if (IsIntegralPlyType(type)) {
+      const auto [lo, hi] = IntegralPlyRange(type);
+      if (!(*value >= lo && *value <= hi) || std::floor(*value) != *value) {
+        return LineError(Line(), absl::StrCat("expected an integer in [", lo, ", ", hi,
+                                              "] for property '", property.name, "' of ",
+                                              element.name, " ", index, ", found ", Quoted(token)));
+      }
     }
     return absl::OkStatus();
   }
@@ -297,8 +174,8 @@ absl::Status ReadListCount(Body& body, const PlyElement& element, uint64_t index
   double value = 0;
   NM_RETURN_IF_ERROR(body.Read(property.count_type, element, index, property, &value));
   if (value < 0) {
-    return absl::InvalidArgumentError(absl::StrCat(body.Where(), ": list '", property.name,
-                                                   "' of ", element.name, " ", index,
+    return absl::InvalidArgumentError(absl::StrCat(body.Where(), ": list '", property.name, "' of ",
+                                                   element.name, " ", index,
                                                    " has negative length ", value));
   }
   *count = static_cast<uint64_t>(value);
@@ -351,8 +228,8 @@ absl::StatusOr<std::vector<Role>> VertexRoles(const PlyElement& element, bool* h
   for (int c = 0; c < 3; ++c) {
     const int i = find(axes[c]);
     if (i < 0) {
-      return LineError(element.line, absl::StrCat("element 'vertex' has no scalar property '",
-                                                  axes[c], "'"));
+      return LineError(element.line,
+                       absl::StrCat("element 'vertex' has no scalar property '", axes[c], "'"));
     }
     roles[i] = static_cast<Role>(kX + c);
   }
@@ -378,9 +255,9 @@ absl::StatusOr<std::vector<Role>> VertexRoles(const PlyElement& element, bool* h
 template <typename Body>
 absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry* out) {
   if (element.count > kMaxVertices) {
-    return LineError(element.line, absl::StrCat("the header declares ", element.count,
-                                                " vertices; at most ", kMaxVertices,
-                                                " are supported"));
+    return LineError(element.line,
+                     absl::StrCat("the header declares ", element.count, " vertices; at most ",
+                                  kMaxVertices, " are supported"));
   }
   bool has_normals = false, has_weights = false;
   NM_ASSIGN_OR_RETURN(std::vector<Role> roles, VertexRoles(element, &has_normals, &has_weights));
@@ -400,24 +277,30 @@ absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry*
       }
     }
     NM_RETURN_IF_ERROR(body.EndRecord(element, i));
-    const Vec3f p(static_cast<float>(values[kX]), static_cast<float>(values[kY]),
-                  static_cast<float>(values[kZ]));
+    const Vec3f p(NarrowToFloat(values[kX]), NarrowToFloat(values[kY]), NarrowToFloat(values[kZ]));
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          body.Where(), ": vertex ", i, " has a non-finite coordinate (", values[kX], ", ",
-          values[kY], ", ", values[kZ], ")"));
+      return absl::InvalidArgumentError(absl::StrCat(body.Where(), ": vertex ", i,
+                                                     " has a non-finite coordinate (", values[kX],
+                                                     ", ", values[kY], ", ", values[kZ], ")"));
     }
     out->positions.push_back(p);
     if (has_normals) {
-      const Vec3f n(static_cast<float>(values[kNx]), static_cast<float>(values[kNy]),
-                    static_cast<float>(values[kNz]));
+      const Vec3f n(NarrowToFloat(values[kNx]), NarrowToFloat(values[kNy]),
+                    NarrowToFloat(values[kNz]));
       if (!std::isfinite(n[0]) || !std::isfinite(n[1]) || !std::isfinite(n[2])) {
         return absl::InvalidArgumentError(
             absl::StrCat(body.Where(), ": vertex ", i, " has a non-finite normal"));
       }
       out->normals.push_back(n);
     }
-    if (has_weights) out->weights.push_back(static_cast<float>(values[kWeight]));
+    if (has_weights) {
+      const float w = NarrowToFloat(values[kWeight]);
+      if (!std::isfinite(w)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(body.Where(), ": vertex ", i, " has a non-finite weight"));
+      }
+      out->weights.push_back(w);
+    }
   }
   return absl::OkStatus();
 }
@@ -451,8 +334,8 @@ absl::Status ReadFaces(Body& body, const PlyElement& element, size_t num_vertice
       uint64_t count = 0;
       NM_RETURN_IF_ERROR(ReadListCount(body, element, i, property, &count));
       if (count < 3) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            body.Where(), ": face ", i, " has ", count, " vertices; a face needs at least 3"));
+        return absl::InvalidArgumentError(absl::StrCat(body.Where(), ": face ", i, " has ", count,
+                                                       " vertices; a face needs at least 3"));
       }
       polygon.clear();
       for (uint64_t c = 0; c < count; ++c) {
@@ -478,8 +361,7 @@ absl::Status ReadFaces(Body& body, const PlyElement& element, size_t num_vertice
 }
 
 template <typename Body>
-absl::StatusOr<ParsedGeometry> ReadBody(const PlyHeader& header, Body& body,
-                                        FaceHandling faces) {
+absl::StatusOr<ParsedGeometry> ReadBody(const PlyHeader& header, Body& body, FaceHandling faces) {
   ParsedGeometry out;
   bool have_vertices = false;
   bool faces_before_vertices = false;
@@ -502,8 +384,8 @@ absl::StatusOr<ParsedGeometry> ReadBody(const PlyHeader& header, Body& body,
       for (uint32_t v : out.faces[f]) {
         if (v >= out.positions.size()) {
           return absl::InvalidArgumentError(absl::StrCat("triangle ", f, " uses vertex ", v,
-                                                         "; the file has ",
-                                                         out.positions.size(), " vertices"));
+                                                         "; the file has ", out.positions.size(),
+                                                         " vertices"));
         }
       }
     }
@@ -514,7 +396,7 @@ absl::StatusOr<ParsedGeometry> ReadBody(const PlyHeader& header, Body& body,
 }  // namespace
 
 absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces) {
-  NM_ASSIGN_OR_RETURN(const PlyHeader header, ParseHeader(data));
+  NM_ASSIGN_OR_RETURN(const PlyHeader header, ParsePlyHeader(data));
   if (header.format == PlyFormat::kAscii) {
     AsciiBody body(data, header.body_offset, header.body_line);
     return ReadBody(header, body, faces);

@@ -34,8 +34,7 @@ class VertexMerger {
       const float value = p[c] == 0.0f ? 0.0f : p[c];
       std::memcpy(&key[c], &value, sizeof(float));
     }
-    const auto [it, inserted] =
-        index_.emplace(key, static_cast<uint32_t>(out_->positions.size()));
+    const auto [it, inserted] = index_.emplace(key, static_cast<uint32_t>(out_->positions.size()));
     if (inserted) out_->positions.push_back(p);
     return it->second;
   }
@@ -61,8 +60,7 @@ bool IsFinite(const Vec3f& p) {
 bool IsText(absl::string_view data) {
   for (const char c : data) {
     const unsigned char u = static_cast<unsigned char>(c);
-    if (!(u >= 0x20 && u < 0x7f) && u != '\n' && u != '\r' && u != '\t' && u != '\f' &&
-        u != '\v') {
+    if (!(u >= 0x20 && u < 0x7f) && u != '\n' && u != '\r' && u != '\t' && u != '\f' && u != '\v') {
       return false;
     }
   }
@@ -81,8 +79,8 @@ absl::StatusOr<ParsedGeometry> ParseBinary(absl::string_view data, uint32_t coun
       const Vec3f v(LoadScalar<float>(p, false), LoadScalar<float>(p + 4, false),
                     LoadScalar<float>(p + 8, false));
       if (!IsFinite(v)) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "byte ", offset, ": triangle ", t, " has a non-finite coordinate"));
+        return absl::InvalidArgumentError(
+            absl::StrCat("byte ", offset, ": triangle ", t, " has a non-finite coordinate"));
       }
       face[k] = merger.Add(v);
     }
@@ -187,16 +185,14 @@ absl::StatusOr<ParsedGeometry> ParseStl(absl::string_view data) {
   if (expected == data.size()) return ParseBinary(data, count);
   const std::string size_mismatch =
       absl::StrCat("byte ", kHeaderBytes, ": the binary STL header declares ", count,
-                   " triangles, which take ", expected, " bytes, but the file has ",
-                   data.size());
+                   " triangles, which take ", expected, " bytes, but the file has ", data.size());
   if (!looks_ascii) return absl::InvalidArgumentError(size_mismatch);
   absl::StatusOr<ParsedGeometry> ascii = ParseAscii(data);
   if (ascii.ok() || IsText(data)) return ascii;
   // Some binary files also start with "solid"; for one of those, say both what the ASCII
   // reader found and why it was not read as binary.
-  return absl::InvalidArgumentError(absl::StrCat(ascii.status().message(),
-                                                 " (read as ASCII STL; as binary STL: ",
-                                                 size_mismatch, ")"));
+  return absl::InvalidArgumentError(absl::StrCat(
+      ascii.status().message(), " (read as ASCII STL; as binary STL: ", size_mismatch, ")"));
 }
 
 std::string FormatStl(const GeometryView& geometry) {

@@ -3,9 +3,9 @@
 #define NEURALMESH_CORE_IO_INTERNAL_STL_H_
 
 #include <string>
-#include "absl/strings/string_view.h"
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
 
 namespace neuralmesh::io_internal {

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -52,8 +53,15 @@ bool ParseDouble(absl::string_view token, double* value) {
 bool ParseFloat(absl::string_view token, float* value) {
   double wide = 0;
   if (!ParseDouble(token, &wide)) return false;
-  *value = static_cast<float>(wide);
+  *value = NarrowToFloat(wide);
   return true;
+}
+
+float NarrowToFloat(double value) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (value > kMax) return std::numeric_limits<float>::infinity();
+  if (value < -kMax) return -std::numeric_limits<float>::infinity();
+  return static_cast<float>(value);
 }
 
 bool ParseInt64(absl::string_view token, int64_t* value) {

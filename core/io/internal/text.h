@@ -5,10 +5,10 @@
 
 #include <cstdint>
 #include <string>
-#include "absl/strings/string_view.h"
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/strings/string_view.h"
 
 namespace neuralmesh::io_internal {
 
@@ -43,8 +43,12 @@ absl::string_view StripHashComment(absl::string_view line);
 // Parses the whole token as a decimal number (no trailing characters). Accepts "nan" and
 // "inf", which callers reject with a clearer message where coordinates must be finite.
 bool ParseDouble(absl::string_view token, double* value);
-// As ParseDouble, then rounds to float (values beyond the float range become infinite).
+// As ParseDouble, then NarrowToFloat.
 bool ParseFloat(absl::string_view token, float* value);
+
+// Rounds to float; values beyond the float range become infinite (a plain cast would be
+// undefined behavior).
+float NarrowToFloat(double value);
 // Parses the whole token as a base-10 integer.
 bool ParseInt64(absl::string_view token, int64_t* value);
 

@@ -28,8 +28,7 @@ absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data) {
     }
     first_content_line = false;
     if (columns == 0) {
-      if (tokens.size() != 3 && tokens.size() != 4 && tokens.size() != 6 &&
-          tokens.size() != 7) {
+      if (tokens.size() != 3 && tokens.size() != 4 && tokens.size() != 6 && tokens.size() != 7) {
         return LineError(n, absl::StrCat("expected 3, 4, 6 or 7 numbers (x y z [nx ny nz] "
                                          "[weight]), found ",
                                          tokens.size(), " values"));
@@ -43,12 +42,11 @@ absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data) {
     float values[7];
     for (size_t k = 0; k < columns; ++k) {
       if (!ParseFloat(tokens[k], &values[k])) {
-        return LineError(n, absl::StrCat("expected a number in column ", k + 1, ", found ",
-                                         Quoted(tokens[k])));
+        return LineError(
+            n, absl::StrCat("expected a number in column ", k + 1, ", found ", Quoted(tokens[k])));
       }
       if (!std::isfinite(values[k])) {
-        return LineError(n, absl::StrCat("column ", k + 1, " is not finite: ",
-                                         Quoted(tokens[k])));
+        return LineError(n, absl::StrCat("column ", k + 1, " is not finite: ", Quoted(tokens[k])));
       }
     }
     out.positions.emplace_back(values[0], values[1], values[2]);

@@ -16,13 +16,20 @@ std::string Str(const Vec3& v) {
 
 const char* Name(TriangleFeature f) {
   switch (f) {
-    case TriangleFeature::kVertexA: return "vertex A";
-    case TriangleFeature::kVertexB: return "vertex B";
-    case TriangleFeature::kVertexC: return "vertex C";
-    case TriangleFeature::kEdgeAB: return "edge AB";
-    case TriangleFeature::kEdgeBC: return "edge BC";
-    case TriangleFeature::kEdgeCA: return "edge CA";
-    case TriangleFeature::kFace: return "face";
+    case TriangleFeature::kVertexA:
+      return "vertex A";
+    case TriangleFeature::kVertexB:
+      return "vertex B";
+    case TriangleFeature::kVertexC:
+      return "vertex C";
+    case TriangleFeature::kEdgeAB:
+      return "edge AB";
+    case TriangleFeature::kEdgeBC:
+      return "edge BC";
+    case TriangleFeature::kEdgeCA:
+      return "edge CA";
+    case TriangleFeature::kFace:
+      return "face";
   }
   return "?";
 }
@@ -103,8 +110,8 @@ TEST(ClosestPointTriangleTest, RandomQueriesAreNeverBeatenByPointsOfTheTriangle)
     const int k = 60;
     for (int i = 0; i <= k; ++i) {
       for (int j = 0; i + j <= k; ++j) {
-        const Vec3 q = a + (b - a) * (static_cast<double>(i) / k) +
-                       (c - a) * (static_cast<double>(j) / k);
+        const Vec3 q =
+            a + (b - a) * (static_cast<double>(i) / k) + (c - a) * (static_cast<double>(j) / k);
         ASSERT_GE((p - q).norm(), d - 1e-12)
             << "trial " << trial << ": grid point " << Str(q) << " beats the result "
             << Str(result.point) << " in region " << Name(result.feature);
@@ -116,23 +123,23 @@ TEST(ClosestPointTriangleTest, RandomQueriesAreNeverBeatenByPointsOfTheTriangle)
 TEST(ClosestPointTriangleTest, DegenerateTrianglesBehaveAsSegmentsOrPoints) {
   {
     // Collinear corners: the triangle is the segment from (0,0,0) to (2,0,0).
-    const TriangleClosestPoint r = ClosestPointOnTriangle(
-        Vec3(1.5, 1, 0), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0));
+    const TriangleClosestPoint r =
+        ClosestPointOnTriangle(Vec3(1.5, 1, 0), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0));
     EXPECT_LT((r.point - Vec3(1.5, 0, 0)).norm(), 1e-15)
         << "collinear triangle: got " << Str(r.point);
     EXPECT_TRUE(std::isfinite(r.point[0])) << "collinear triangle gave a non-finite point";
   }
   {
     // Two coincident corners: the segment from a to c.
-    const TriangleClosestPoint r = ClosestPointOnTriangle(
-        Vec3(-1, 3, 0), Vec3(0, 0, 0), Vec3(0, 0, 0), Vec3(0, 2, 0));
+    const TriangleClosestPoint r =
+        ClosestPointOnTriangle(Vec3(-1, 3, 0), Vec3(0, 0, 0), Vec3(0, 0, 0), Vec3(0, 2, 0));
     EXPECT_LT((r.point - Vec3(0, 2, 0)).norm(), 1e-15)
         << "two coincident corners: got " << Str(r.point);
   }
   {
     // All corners coincide: a point.
-    const TriangleClosestPoint r = ClosestPointOnTriangle(
-        Vec3(1, 1, 1), Vec3(0.5, 0.5, 0.5), Vec3(0.5, 0.5, 0.5), Vec3(0.5, 0.5, 0.5));
+    const TriangleClosestPoint r = ClosestPointOnTriangle(Vec3(1, 1, 1), Vec3(0.5, 0.5, 0.5),
+                                                          Vec3(0.5, 0.5, 0.5), Vec3(0.5, 0.5, 0.5));
     EXPECT_LT((r.point - Vec3(0.5, 0.5, 0.5)).norm(), 1e-15)
         << "point triangle: got " << Str(r.point);
   }

@@ -24,8 +24,7 @@ GeometricErrorOptions FewSamples(size_t samples = 20000) {
 
 TEST(GeometricErrorTest, IdenticalMeshesHaveZeroErrorAndFullNormalConsistency) {
   const TriangleMesh sphere = Icosphere(3);
-  const absl::StatusOr<GeometricError> error =
-      ComputeGeometricError(sphere, sphere, FewSamples());
+  const absl::StatusOr<GeometricError> error = ComputeGeometricError(sphere, sphere, FewSamples());
   ASSERT_TRUE(error.ok()) << "comparing a mesh with itself failed: " << error.status();
   EXPECT_LT(error->chamfer_l1, 1e-9) << "a mesh is at distance 0 from itself";
   EXPECT_LT(error->hausdorff, 1e-9) << "a mesh is at Hausdorff distance 0 from itself";
@@ -69,13 +68,12 @@ TEST(GeometricErrorTest, AccuracyAndCompletenessHaveTheirDirections) {
   TriangleMesh half = reference;
   half.faces.clear();
   for (const auto& f : reference.faces) {
-    if (reference.positions[f[0]][2] + reference.positions[f[1]][2] +
-            reference.positions[f[2]][2] > 0) {
+    if (reference.positions[f[0]][2] + reference.positions[f[1]][2] + reference.positions[f[2]][2] >
+        0) {
       half.faces.push_back(f);
     }
   }
-  const absl::StatusOr<GeometricError> error =
-      ComputeGeometricError(half, reference, FewSamples());
+  const absl::StatusOr<GeometricError> error = ComputeGeometricError(half, reference, FewSamples());
   ASSERT_TRUE(error.ok()) << error.status();
   EXPECT_LT(error->accuracy, 1e-9) << "every reconstruction point lies on the reference";
   EXPECT_GT(error->completeness, 0.05) << "half the reference is far from the reconstruction";
@@ -133,9 +131,8 @@ TEST(GeometricErrorTest, RejectsInvalidInput) {
 
 TEST(GeometricErrorTest, DistancesToMeshAreExact) {
   const TriangleMesh patch = GridPatch(4, 4);  // [0,1]^2 at z = 0.
-  const std::vector<Vec3> points = {Vec3(0.5, 0.5, 0.25), Vec3(0.3, 0.7, -2.0),
-                                    Vec3(2.0, 0.5, 0.0), Vec3(-1.0, -1.0, 0.0),
-                                    Vec3(0.25, 0.25, 0.0)};
+  const std::vector<Vec3> points = {Vec3(0.5, 0.5, 0.25), Vec3(0.3, 0.7, -2.0), Vec3(2.0, 0.5, 0.0),
+                                    Vec3(-1.0, -1.0, 0.0), Vec3(0.25, 0.25, 0.0)};
   const double expected[] = {0.25, 2.0, 1.0, std::sqrt(2.0), 0.0};
   const absl::StatusOr<std::vector<double>> distances = DistancesToMesh(points, patch);
   ASSERT_TRUE(distances.ok()) << distances.status();
@@ -155,8 +152,7 @@ TriangleMesh Torus(int n, int m, double minor) {
     for (int i = 0; i < n; ++i) {
       const double u = 2.0 * M_PI * i / n, v = 2.0 * M_PI * j / m;
       mesh.positions.emplace_back((2.0 + minor * std::cos(v)) * std::cos(u),
-                                  (2.0 + minor * std::cos(v)) * std::sin(u),
-                                  minor * std::sin(v));
+                                  (2.0 + minor * std::cos(v)) * std::sin(u), minor * std::sin(v));
     }
   }
   auto id = [&](int i, int j) { return static_cast<uint32_t>((j % m) * n + (i % n)); };
@@ -185,10 +181,10 @@ TEST(GeometricErrorTest, DISABLED_MillionTriangleTiming) {
   const double total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_TRUE(error.ok()) << error.status();
-  std::printf("1M-triangle tree build: %.3f s; full error (two trees, 2 x 200k samples + "
-              "2 x 500k vertices): %.3f s; chamfer*diag %.6f, hausdorff*diag %.6f\n",
-              build, total, error->chamfer_l1 * error->diagonal,
-              error->hausdorff * error->diagonal);
+  std::printf(
+      "1M-triangle tree build: %.3f s; full error (two trees, 2 x 200k samples + "
+      "2 x 500k vertices): %.3f s; chamfer*diag %.6f, hausdorff*diag %.6f\n",
+      build, total, error->chamfer_l1 * error->diagonal, error->hausdorff * error->diagonal);
   EXPECT_NEAR(error->hausdorff * error->diagonal, 0.01, 0.001)
       << "the tori are a minor-radius gap of 0.01 apart";
 }

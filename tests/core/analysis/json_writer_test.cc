@@ -15,27 +15,30 @@ using ::neuralmesh::testing::JsonValue;
 
 TEST(JsonWriterTest, WritesCompactNestedDocument) {
   JsonWriter json;
-  json.BeginObject()
-      .Key("name").String("bunny")
-      .Key("count").Uint(12)
-      .Key("delta").Int(-3)
-      .Key("ok").Bool(true)
-      .Key("nothing").Null()
-      .Key("list").BeginArray().Int(1).Int(2).BeginObject().EndObject().BeginArray().EndArray()
-      .EndArray()
-      .EndObject();
+  json.BeginObject();
+  json.Key("name").String("bunny");
+  json.Key("count").Uint(12);
+  json.Key("delta").Int(-3);
+  json.Key("ok").Bool(true);
+  json.Key("nothing").Null();
+  json.Key("list").BeginArray().Int(1).Int(2);
+  json.BeginObject().EndObject();
+  json.BeginArray().EndArray();
+  json.EndArray();
+  json.EndObject();
   const absl::StatusOr<std::string> text = json.Finish();
   ASSERT_TRUE(text.ok()) << "a well-formed sequence of calls was rejected: " << text.status();
-  EXPECT_EQ(*text,
-            R"({"name":"bunny","count":12,"delta":-3,"ok":true,"nothing":null,)"
-            R"("list":[1,2,{},[]]})")
+  EXPECT_EQ(*text, R"({"name":"bunny","count":12,"delta":-3,"ok":true,"nothing":null,)"
+                   R"("list":[1,2,{},[]]})")
       << "compact output differs from the expected text";
 }
 
 TEST(JsonWriterTest, IndentedOutputParsesToSameValues) {
   JsonWriter json(2);
-  json.BeginObject().Key("a").BeginArray().Uint(1).Uint(2).EndArray().Key("b").String("x")
-      .EndObject();
+  json.BeginObject();
+  json.Key("a").BeginArray().Uint(1).Uint(2).EndArray();
+  json.Key("b").String("x");
+  json.EndObject();
   const absl::StatusOr<std::string> text = json.Finish();
   ASSERT_TRUE(text.ok()) << text.status();
   EXPECT_EQ(*text, "{\n  \"a\": [\n    1,\n    2\n  ],\n  \"b\": \"x\"\n}")
@@ -49,8 +52,7 @@ TEST(JsonWriterTest, IndentedOutputParsesToSameValues) {
 TEST(JsonWriterTest, EscapesQuotesBackslashesAndControlCharacters) {
   const std::string nasty = std::string("q\"b\\s/n\nt\tr\rb\bf\fz") + '\x01' + "\x7f" +
                             "\xc3\xa9";  // UTF-8 e-acute passes through.
-  EXPECT_EQ(JsonWriter::Quote(nasty),
-            "\"q\\\"b\\\\s/n\\nt\\tr\\rb\\bf\\fz\\u0001\x7f\xc3\xa9\"")
+  EXPECT_EQ(JsonWriter::Quote(nasty), "\"q\\\"b\\\\s/n\\nt\\tr\\rb\\bf\\fz\\u0001\x7f\xc3\xa9\"")
       << "Quote() escaped something wrongly";
   JsonWriter json;
   json.BeginObject().Key(nasty).String(nasty).EndObject();
@@ -64,8 +66,8 @@ TEST(JsonWriterTest, EscapesQuotesBackslashesAndControlCharacters) {
 }
 
 TEST(JsonWriterTest, DoublesRoundTripAndNonFiniteBecomesNull) {
-  const double values[] = {0.0, 1.0, -2.5, 0.1, 1.0 / 3.0, 1e-300, 6.02214076e23,
-                           std::numeric_limits<double>::max()};
+  const double values[] = {0.0,       1.0,    -2.5,          0.1,
+                           1.0 / 3.0, 1e-300, 6.02214076e23, std::numeric_limits<double>::max()};
   JsonWriter json;
   json.BeginArray();
   for (double v : values) json.Double(v);

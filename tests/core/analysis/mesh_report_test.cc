@@ -38,8 +38,7 @@ TriangleMesh TorusGrid(int n, int m, double major = 2.0, double minor = 0.5) {
     for (int i = 0; i < n; ++i) {
       const double u = 2.0 * M_PI * i / n, v = 2.0 * M_PI * j / m;
       mesh.positions.emplace_back((major + minor * std::cos(v)) * std::cos(u),
-                                  (major + minor * std::cos(v)) * std::sin(u),
-                                  minor * std::sin(v));
+                                  (major + minor * std::cos(v)) * std::sin(u), minor * std::sin(v));
     }
   }
   auto id = [&](int i, int j) { return static_cast<uint32_t>((j % m) * n + (i % n)); };
@@ -330,11 +329,11 @@ TEST(MeshReportTest, OpenCylinderHasTwoBoundaryLoops) {
 }
 
 TEST(MeshReportTest, CountsIsolatedDegenerateDuplicateAndInvalid) {
-  TriangleMesh mesh = GridPatch(2, 2);  // 9 vertices, 8 faces.
+  TriangleMesh mesh = GridPatch(2, 2);         // 9 vertices, 8 faces.
   mesh.positions.emplace_back(5.f, 5.f, 5.f);  // Isolated.
   mesh.faces.push_back({0, 0, 1});             // Degenerate.
   mesh.faces.push_back({mesh.faces[0][2], mesh.faces[0][1], mesh.faces[0][0]});  // Duplicate.
-  mesh.faces.push_back({0, 1, 999});           // Invalid.
+  mesh.faces.push_back({0, 1, 999});                                             // Invalid.
   const MeshReport r = ComputeMeshReport(mesh);
   EXPECT_EQ(r.vertices, 9u) << "vertices counts referenced vertices only";
   EXPECT_EQ(r.isolated_vertices, 1u) << "the extra position is isolated";
@@ -367,14 +366,14 @@ TEST(MeshReportTest, EmptyMeshReportsZeros) {
 
 TEST(MeshReportTest, TextContainsTableAndKeyFacts) {
   const std::string text = MeshReportToText(ComputeMeshReport(Icosphere(2)));
-  for (const char* needle : {"vertices", "genus", "boundary loops", "manifold", "oriented",
-                             "other", "share %", "92.6", "7.4"}) {
-    EXPECT_NE(text.find(needle), std::string::npos)
-        << "text report lacks \"" << needle << "\":\n" << text;
+  for (const char* needle : {"vertices", "genus", "boundary loops", "manifold", "oriented", "other",
+                             "share %", "92.6", "7.4"}) {
+    EXPECT_NE(text.find(needle), std::string::npos) << "text report lacks \"" << needle << "\":\n"
+                                                    << text;
   }
   const std::string open = MeshReportToText(ComputeMeshReport(OpenCylinder(10, 3)));
-  EXPECT_NE(open.find("(lengths 10, 10)"), std::string::npos)
-      << "loop lengths missing from:\n" << open;
+  EXPECT_NE(open.find("(lengths 10, 10)"), std::string::npos) << "loop lengths missing from:\n"
+                                                              << open;
 }
 
 TEST(MeshReportTest, JsonIsValidAndMatchesReport) {

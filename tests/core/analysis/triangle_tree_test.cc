@@ -19,10 +19,10 @@ Vec3 ToVec3(const Vec3f& v) { return Vec3(v[0], v[1], v[2]); }
 double BruteForceDistance(const TriangleMesh& mesh, const Vec3& p) {
   double best = std::numeric_limits<double>::infinity();
   for (const auto& f : mesh.faces) {
-    const Vec3 q = ClosestPointOnTriangle(p, ToVec3(mesh.positions[f[0]]),
-                                          ToVec3(mesh.positions[f[1]]),
-                                          ToVec3(mesh.positions[f[2]]))
-                       .point;
+    const Vec3 q =
+        ClosestPointOnTriangle(p, ToVec3(mesh.positions[f[0]]), ToVec3(mesh.positions[f[1]]),
+                               ToVec3(mesh.positions[f[2]]))
+            .point;
     best = std::min(best, (p - q).norm());
   }
   return best;
@@ -67,10 +67,10 @@ TEST(TriangleTreeTest, MatchesBruteForceOnRandomQueries) {
         << "query " << i << ": reported point is not at the reported distance";
     ASSERT_LT(result.face, mesh.faces.size()) << "query " << i << ": face index out of range";
     const auto& f = mesh.faces[result.face];
-    const Vec3 on_face = ClosestPointOnTriangle(p, ToVec3(mesh.positions[f[0]]),
-                                                ToVec3(mesh.positions[f[1]]),
-                                                ToVec3(mesh.positions[f[2]]))
-                             .point;
+    const Vec3 on_face =
+        ClosestPointOnTriangle(p, ToVec3(mesh.positions[f[0]]), ToVec3(mesh.positions[f[1]]),
+                               ToVec3(mesh.positions[f[2]]))
+            .point;
     EXPECT_LT((on_face - result.point).norm(), 1e-12)
         << "query " << i << ": the reported point does not lie on the reported face";
   }
@@ -154,8 +154,7 @@ TEST(TriangleTreeTest, NonFiniteQueryGivesInfiniteDistance) {
 }
 
 TEST(TriangleTreeTest, RejectsInvalidMeshes) {
-  EXPECT_EQ(TriangleTree::Build(TriangleMesh()).status().code(),
-            absl::StatusCode::kInvalidArgument)
+  EXPECT_EQ(TriangleTree::Build(TriangleMesh()).status().code(), absl::StatusCode::kInvalidArgument)
       << "an empty mesh must be rejected";
   TriangleMesh no_faces = Icosphere(0);
   no_faces.faces.clear();
@@ -163,8 +162,7 @@ TEST(TriangleTreeTest, RejectsInvalidMeshes) {
       << "a mesh without faces must be rejected";
   TriangleMesh out_of_range = Icosphere(0);
   out_of_range.faces[4][1] = 12;
-  EXPECT_EQ(TriangleTree::Build(out_of_range).status().code(),
-            absl::StatusCode::kInvalidArgument)
+  EXPECT_EQ(TriangleTree::Build(out_of_range).status().code(), absl::StatusCode::kInvalidArgument)
       << "an out-of-range index must be rejected";
   TriangleMesh not_finite = Icosphere(0);
   not_finite.positions[3][2] = std::numeric_limits<float>::infinity();

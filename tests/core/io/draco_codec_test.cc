@@ -57,9 +57,13 @@ TEST(DracoOptionsTest, ValidateNamesTheBadField) {
       {"decode_speed", [](DracoOptions& o) { o.decode_speed = 11; }},
       {"quantization_box.range", [](DracoOptions& o) { o.quantization_box = QuantizationBox{}; }},
       {"quantization_box.range",
-       [](DracoOptions& o) { o.quantization_box = QuantizationBox{Vec3f(0, 0, 0), NAN}; }},
+       [](DracoOptions& o) {
+         o.quantization_box = QuantizationBox{Vec3f(0, 0, 0), NAN};
+       }},
       {"quantization_box.origin",
-       [](DracoOptions& o) { o.quantization_box = QuantizationBox{Vec3f(INFINITY, 0, 0), 1}; }},
+       [](DracoOptions& o) {
+         o.quantization_box = QuantizationBox{Vec3f(INFINITY, 0, 0), 1};
+       }},
   };
   for (const Case& c : cases) {
     DracoOptions options;
@@ -104,10 +108,9 @@ TEST(DracoCodecTest, MeshRoundTripIsWithinQuantizationTolerance) {
       ASSERT_TRUE(bytes.ok()) << "encoding failed at " << bits << " bits: " << bytes.status();
       const absl::StatusOr<TriangleMesh> decoded = DecodeMesh(*bytes);
       ASSERT_TRUE(decoded.ok()) << "decoding failed: " << decoded.status();
-      ExpectSameMesh(mesh, *decoded,
-                     QuantizationTolerance(BoundingCubeRange(mesh.positions), bits),
-                     "Icosphere(3) at " + std::to_string(bits) + " bits, speed " +
-                         std::to_string(speed));
+      ExpectSameMesh(
+          mesh, *decoded, QuantizationTolerance(BoundingCubeRange(mesh.positions), bits),
+          "Icosphere(3) at " + std::to_string(bits) + " bits, speed " + std::to_string(speed));
     }
   }
 }
@@ -128,8 +131,8 @@ TEST(DracoCodecTest, IcosphereLevel5NeedsAtMost8BytesPerVertexAt11Bits) {
   const absl::StatusOr<std::string> bytes = EncodeMesh(mesh, options);
   ASSERT_TRUE(bytes.ok()) << bytes.status();
   const double per_vertex = static_cast<double>(bytes->size()) / mesh.positions.size();
-  std::cout << "Draco Icosphere(5): " << mesh.positions.size() << " vertices, "
-            << mesh.faces.size() << " faces, " << bytes->size() << " bytes = " << per_vertex
+  std::cout << "Draco Icosphere(5): " << mesh.positions.size() << " vertices, " << mesh.faces.size()
+            << " faces, " << bytes->size() << " bytes = " << per_vertex
             << " bytes/vertex at 11 bits, speed 5\n";
   ::testing::Test::RecordProperty("bytes_per_vertex", std::to_string(per_vertex));
   EXPECT_LE(per_vertex, 8.0) << "the product budget is 8 bytes per vertex";
@@ -145,8 +148,7 @@ TEST(DracoCodecTest, PointCloudRoundTripKeepsNormalsAndWeights) {
     ASSERT_TRUE(bytes.ok()) << bytes.status();
     const absl::StatusOr<PointCloud> decoded = DecodePointCloud(*bytes);
     ASSERT_TRUE(decoded.ok()) << decoded.status();
-    ExpectSameCloud(cloud, *decoded,
-                    QuantizationTolerance(BoundingCubeRange(cloud.positions), 11),
+    ExpectSameCloud(cloud, *decoded, QuantizationTolerance(BoundingCubeRange(cloud.positions), 11),
                     /*normal_tolerance=*/0.01f, /*weight_tolerance=*/1.5f / 65535 + 1e-5f,
                     "speed " + std::to_string(speed));
   }
@@ -205,11 +207,15 @@ TEST(DracoCodecTest, FixedQuantizationBoxPutsSuccessiveMeshesOnOneGrid) {
   const float tolerance = QuantizationTolerance(3.0f, 12);
   ExpectSameMesh(a, *decoded_a, tolerance, "mesh A in the fixed box");
   ExpectSameMesh(b, *decoded_b, tolerance, "mesh B in the fixed box");
-  const std::vector<int> match_a = io_test::MatchPoints(a.positions, decoded_a->positions, tolerance);
-  const std::vector<int> match_b = io_test::MatchPoints(b.positions, decoded_b->positions, tolerance);
+  const std::vector<int> match_a =
+      io_test::MatchPoints(a.positions, decoded_a->positions, tolerance);
+  const std::vector<int> match_b =
+      io_test::MatchPoints(b.positions, decoded_b->positions, tolerance);
   std::vector<int> where_a(a.positions.size(), -1), where_b(b.positions.size(), -1);
-  for (size_t i = 0; i < match_a.size(); ++i) if (match_a[i] >= 0) where_a[match_a[i]] = i;
-  for (size_t i = 0; i < match_b.size(); ++i) if (match_b[i] >= 0) where_b[match_b[i]] = i;
+  for (size_t i = 0; i < match_a.size(); ++i)
+    if (match_a[i] >= 0) where_a[match_a[i]] = i;
+  for (size_t i = 0; i < match_b.size(); ++i)
+    if (match_b[i] >= 0) where_b[match_b[i]] = i;
 
   const double step = 3.0 / ((1 << 12) - 1);
   int shared = 0;
@@ -236,8 +242,10 @@ TEST(DracoCodecTest, FixedQuantizationBoxPutsSuccessiveMeshesOnOneGrid) {
   const absl::StatusOr<TriangleMesh> own_b = DecodeMesh(*EncodeMesh(b, {}));
   ASSERT_TRUE(own_a.ok() && own_b.ok());
   std::vector<Vec3f> sorted_a, sorted_b;
-  for (const Vec3f& p : own_a->positions) if (p[2] < 0.2f) sorted_a.push_back(p);
-  for (const Vec3f& p : own_b->positions) if (p[2] < 0.2f) sorted_b.push_back(p);
+  for (const Vec3f& p : own_a->positions)
+    if (p[2] < 0.2f) sorted_a.push_back(p);
+  for (const Vec3f& p : own_b->positions)
+    if (p[2] < 0.2f) sorted_b.push_back(p);
   auto less = [](const Vec3f& x, const Vec3f& y) {
     return std::lexicographical_compare(x.data(), x.data() + 3, y.data(), y.data() + 3);
   };
@@ -335,6 +343,33 @@ TEST(DracoCodecTest, CorruptAndTruncatedDataIsRejectedWithoutCrashing) {
           << "trial " << trial << ": " << cloud_status;
     }
   }
+}
+
+TEST(DracoCodecTest, HugePointCountsInTinyBuffersAreRejectedBeforeAllocating) {
+  PointCloud cloud = io_test::RandomCloud(50, 21, true, true);
+  for (int speed : {5, 10}) {
+    DracoOptions options;
+    options.encode_speed = speed;
+    const absl::StatusOr<std::string> bytes = EncodePointCloud(cloud, options);
+    ASSERT_TRUE(bytes.ok()) << bytes.status();
+    // The point count is the int32 after the 11-byte header. Left unchecked, Draco would try
+    // to fill gigabytes for this buffer of a few hundred bytes.
+    for (const uint32_t count : {0x7f7f7f7fu, 0xffffffffu, 0x10000000u}) {
+      std::string corrupt = *bytes;
+      std::memcpy(&corrupt[11], &count, sizeof(count));
+      const absl::Status status = DecodePointCloud(corrupt).status();
+      ExpectInvalid(status, "points in only", "point count " + std::to_string(count));
+    }
+  }
+  // Draco stores many identical points in a few bytes; such legitimate streams still decode.
+  PointCloud identical;
+  identical.positions.assign(200000, Vec3f(1, 2, 3));
+  const absl::StatusOr<std::string> tiny = EncodePointCloud(identical, {});
+  ASSERT_TRUE(tiny.ok()) << tiny.status();
+  const absl::StatusOr<PointCloud> decoded = DecodePointCloud(*tiny);
+  ASSERT_TRUE(decoded.ok()) << "200000 identical points in " << tiny->size()
+                            << " bytes must decode: " << decoded.status();
+  EXPECT_EQ(decoded->size(), 200000u) << "points lost";
 }
 
 bool HaveTool(const char* path) { return access(path, X_OK) == 0; }

@@ -100,8 +100,8 @@ inline void ExpectSameMesh(const TriangleMesh& expected, const TriangleMesh& act
   for (size_t i = 0; i < match.size(); ++i) {
     if (match[i] < 0) {
       if (++unmatched <= 3) {
-        ADD_FAILURE() << "decoded vertex " << i << " (" << actual.positions[i]
-                      << ") is not within " << tolerance << " of any input vertex";
+        ADD_FAILURE() << "decoded vertex " << i << " (" << actual.positions[i] << ") is not within "
+                      << tolerance << " of any input vertex";
       }
     } else {
       hit[match[i]] = true;
@@ -129,8 +129,8 @@ inline void ExpectSameMesh(const TriangleMesh& expected, const TriangleMesh& act
 
 // Expects `actual` to be `expected` up to point order: positions within `tolerance`, normals
 // within `normal_tolerance`, weights within `weight_tolerance`.
-inline void ExpectSameCloud(const PointCloud& expected, const PointCloud& actual,
-                            float tolerance, float normal_tolerance, float weight_tolerance,
+inline void ExpectSameCloud(const PointCloud& expected, const PointCloud& actual, float tolerance,
+                            float normal_tolerance, float weight_tolerance,
                             const std::string& context) {
   SCOPED_TRACE(context);
   ASSERT_EQ(actual.size(), expected.size()) << "point count changed";
@@ -151,8 +151,8 @@ inline void ExpectSameCloud(const PointCloud& expected, const PointCloud& actual
     if (!expected.normals.empty()) {
       const Vec3f d = actual.normals[i] - expected.normals[match[i]];
       if (d.max_abs() > normal_tolerance) {
-        ADD_FAILURE() << "normal of point " << i << " is " << actual.normals[i]
-                      << ", expected " << expected.normals[match[i]];
+        ADD_FAILURE() << "normal of point " << i << " is " << actual.normals[i] << ", expected "
+                      << expected.normals[match[i]];
         ++failures;
       }
     }

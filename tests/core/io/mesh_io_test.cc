@@ -66,7 +66,7 @@ void ExpectExactly(const TriangleMesh& expected, const absl::StatusOr<TriangleMe
 // The unit square 0-1-2-3 and an apex 4, as used by the hand-written files below.
 const TriangleMesh kSquarePyramid =
     MakeMesh({Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(1, 1, 0), Vec3f(0, 1, 0), Vec3f(0.5f, 0.5f, 1)},
-         {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}});
+             {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}});
 
 class MeshRoundTripTest : public ::testing::TestWithParam<const char*> {};
 
@@ -142,10 +142,10 @@ TEST(MeshIoTest, EmptyFilesAreRejected) {
 }
 
 TEST(MeshIoTest, PlyVerticesWithoutFacesReadAsAMeshWithoutFaces) {
-  const absl::StatusOr<TriangleMesh> mesh = ReadContent(
-      "points_only.ply",
-      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
-      "property float z\nend_header\n1 2 3\n4 5 6\n");
+  const absl::StatusOr<TriangleMesh> mesh =
+      ReadContent("points_only.ply",
+                  "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                  "property float z\nend_header\n1 2 3\n4 5 6\n");
   ExpectExactly(MakeMesh({Vec3f(1, 2, 3), Vec3f(4, 5, 6)}, {}), mesh, "PLY without faces");
 }
 
@@ -245,8 +245,9 @@ TEST(PlyReadTest, BinaryLittleEndianWithIntegerCoordinates) {
   }
   Put<int32_t>(3, false, &ply);
   for (uint16_t v : {2, 1, 0}) Put(v, false, &ply);
-  ExpectExactly(MakeMesh({Vec3f(-2, -128, 0), Vec3f(300, 5, 7), Vec3f(0, 127, 100000)}, {{2, 1, 0}}),
-                ReadContent("ints.ply", ply), "integer-typed PLY coordinates");
+  ExpectExactly(
+      MakeMesh({Vec3f(-2, -128, 0), Vec3f(300, 5, 7), Vec3f(0, 127, 100000)}, {{2, 1, 0}}),
+      ReadContent("ints.ply", ply), "integer-typed PLY coordinates");
 }
 
 const char kAsciiHeader[] =
@@ -284,13 +285,15 @@ TEST(PlyReadTest, MalformedFilesAreRejectedWithAReason) {
        "no 'end_header'"},
       {"unknown keyword", "ply\nformat ascii 1.0\nelemnt vertex 1\nend_header\n",
        "line 3: unexpected header keyword"},
-      {"unknown type", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\n"
-                       "end_header\n0\n",
+      {"unknown type",
+       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\n"
+       "end_header\n0\n",
        "line 4: unknown property type 'float128'"},
       {"negative count", "ply\nformat ascii 1.0\nelement vertex -1\nend_header\n",
        "line 3: expected 'element <name> <non-negative count>'"},
-      {"missing x", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\n"
-                    "property float z\nend_header\n1 2\n",
+      {"missing x",
+       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\n"
+       "property float z\nend_header\n1 2\n",
        "no scalar property 'x'"},
       {"truncated binary", truncated, "truncated"},
       {"vertex count beyond the data", bogus_count, "declares 999999999999 'vertex' elements"},
@@ -319,12 +322,14 @@ TEST(PlyReadTest, MalformedFilesAreRejectedWithAReason) {
        "vertex 0 has a non-finite coordinate"},
       {"binary face index out of range", binary_bad_index, "uses vertex index 9"},
       {"binary NaN", binary_nan, "non-finite"},
-      {"no vertex element", "ply\nformat ascii 1.0\nelement face 0\n"
-                            "property list uchar int vertex_indices\nend_header\n",
+      {"no vertex element",
+       "ply\nformat ascii 1.0\nelement face 0\n"
+       "property list uchar int vertex_indices\nend_header\n",
        "no 'vertex' element"},
-      {"face without indices", "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\n"
-                               "property float y\nproperty float z\nelement face 1\n"
-                               "property int a\nend_header\n1\n",
+      {"face without indices",
+       "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\n"
+       "property float y\nproperty float z\nelement face 1\n"
+       "property int a\nend_header\n1\n",
        "no 'vertex_indices'"},
   };
   for (const Case& c : cases) ExpectRejected("malformed.ply", c.content, c.message, c.what);
@@ -353,17 +358,11 @@ TEST(ObjReadTest, AllFaceReferenceFormsNegativeIndicesAndPolygons) {
       "f -1 -5 -4\n"  // Relative: the apex, vertex 1, vertex 2.
       "f 1 2 3 4 5\n"
       "l 1 2\n";
-  ExpectExactly(MakeMesh({Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(1, 1, 0), Vec3f(0, 1, 0),
-                      Vec3f(0.5f, 0.5f, 1)},
-                     {{0, 1, 2},
-                      {0, 2, 3},
-                      {0, 1, 2},
-                      {0, 2, 3},
-                      {4, 0, 1},
-                      {0, 1, 2},
-                      {0, 2, 3},
-                      {0, 3, 4}}),
-                ReadContent("forms.obj", obj), "OBJ reference forms");
+  ExpectExactly(
+      MakeMesh(
+          {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(1, 1, 0), Vec3f(0, 1, 0), Vec3f(0.5f, 0.5f, 1)},
+          {{0, 1, 2}, {0, 2, 3}, {0, 1, 2}, {0, 2, 3}, {4, 0, 1}, {0, 1, 2}, {0, 2, 3}, {0, 3, 4}}),
+      ReadContent("forms.obj", obj), "OBJ reference forms");
 }
 
 TEST(ObjReadTest, MalformedFilesAreRejectedWithAReason) {
@@ -396,8 +395,7 @@ TEST(ObjReadTest, MalformedFilesAreRejectedWithAReason) {
 
 TEST(OffReadTest, VariantsCommentsAndPolygons) {
   const TriangleMesh expected = kSquarePyramid;
-  const std::string body =
-      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n4 0 1 2 3\n3 0 3 4\n";
+  const std::string body = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n4 0 1 2 3\n3 0 3 4\n";
   ExpectExactly(expected, ReadContent("plain.off", "OFF\n5 2 0\n" + body), "OFF");
   ExpectExactly(expected, ReadContent("inline_counts.off", "# comment\nOFF 5 2 8\n\n" + body),
                 "counts on the keyword line");
@@ -427,8 +425,7 @@ TEST(OffReadTest, MalformedFilesAreRejectedWithAReason) {
       {"letters in the counts", "OFF\nthree 1 0\n", "line 2: expected a non-negative vertex count"},
       {"missing counts", "OFF\n", "expected the counts"},
       {"count beyond the data", "OFF\n99999999 1 0\n0 0 0\n", "declares 99999999 vertices"},
-      {"too few vertices", "OFF\n4 1 0\n" + vertices,
-       "the file ends after 3 of the 4 vertices"},
+      {"too few vertices", "OFF\n4 1 0\n" + vertices, "the file ends after 3 of the 4 vertices"},
       {"too few faces", "OFF\n3 2 0\n" + vertices + "3 0 1 2\n",
        "the file ends after 1 of the 2 faces"},
       {"letters in a vertex", "OFF\n3 1 0\n0 0 0\n1 x 0\n1 1 0\n3 0 1 2\n",
@@ -453,8 +450,8 @@ TEST(OffReadTest, MalformedFilesAreRejectedWithAReason) {
 // Two triangles sharing the edge (1,0,0)-(0,1,0): 4 distinct positions.
 constexpr float kStlTriangles[2][3][3] = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
                                           {{1, 0, 0}, {1, 1, 0}, {0, 1, 0}}};
-const TriangleMesh kStlMesh =
-    MakeMesh({Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(1, 1, 0)}, {{0, 1, 2}, {1, 3, 2}});
+const TriangleMesh kStlMesh = MakeMesh(
+    {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(1, 1, 0)}, {{0, 1, 2}, {1, 3, 2}});
 
 std::string BinaryStl(const std::string& header_text, int count_adjust = 0) {
   std::string out = header_text;

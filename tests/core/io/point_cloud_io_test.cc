@@ -71,8 +71,7 @@ const std::vector<Vec3f> kThreeNormals = {Vec3f(0, 0, 1), Vec3f(0, 1, 0), Vec3f(
 // ---------------------------------------------------------------------------------------------
 // Round trips: every writable format, with and without normals and weights.
 
-class CloudRoundTripTest
-    : public ::testing::TestWithParam<std::tuple<const char*, bool, bool>> {};
+class CloudRoundTripTest : public ::testing::TestWithParam<std::tuple<const char*, bool, bool>> {};
 
 TEST_P(CloudRoundTripTest, WriteThenReadGivesTheSameCloud) {
   const auto [extension, normals, weights] = GetParam();
@@ -91,15 +90,15 @@ TEST_P(CloudRoundTripTest, WriteThenReadGivesTheSameCloud) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    AllWritableFormats, CloudRoundTripTest,
-    ::testing::Combine(::testing::Values(".ply", ".xyz", ".txt", ".pts", ".drc"),
-                       ::testing::Bool(), ::testing::Bool()),
-    [](const auto& info) {
-      return std::string(std::get<0>(info.param) + 1) +
-             (std::get<1>(info.param) ? "_normals" : "") +
-             (std::get<2>(info.param) ? "_weights" : "");
-    });
+INSTANTIATE_TEST_SUITE_P(AllWritableFormats, CloudRoundTripTest,
+                         ::testing::Combine(::testing::Values(".ply", ".xyz", ".txt", ".pts",
+                                                              ".drc"),
+                                            ::testing::Bool(), ::testing::Bool()),
+                         [](const auto& info) {
+                           return std::string(std::get<0>(info.param) + 1) +
+                                  (std::get<1>(info.param) ? "_normals" : "") +
+                                  (std::get<2>(info.param) ? "_weights" : "");
+                         });
 
 TEST(PointCloudIoTest, ExtensionHelpers) {
   for (const char* name : {"a.ply", "b.XYZ", "c.txt", "d.Pts", "e.obj", "f.off", "g.drc"}) {
@@ -271,20 +270,22 @@ TEST(ObjCloudTest, ReadsVertexLinesOnly) {
 }
 
 TEST(OffCloudTest, ReadsVerticesAndNoffNormals) {
-  ExpectCloud(kThree, ReadContent("points.off", "OFF\n3 1 0\n0 0 0\n1 2 3\n-1.5 0.25 8\n"
-                                                "3 0 1 99\n"),
-              "OFF vertices (faces skipped)");
-  ExpectCloud(MakeCloud(kThree.positions, kThreeNormals),
-              ReadContent("normals.off",
-                          "NOFF\n3 0 0\n0 0 0 0 0 1\n1 2 3 0 1 0\n-1.5 0.25 8 1 0 0\n"),
-              "NOFF normals");
   ExpectCloud(kThree,
-              ReadContent("colors.off", "COFF 3 0 0\n0 0 0 1 0 0 1\n1 2 3 0 1 0 1\n"
-                                        "-1.5 0.25 8 0 0 1 1\n"),
+              ReadContent("points.off",
+                          "OFF\n3 1 0\n0 0 0\n1 2 3\n-1.5 0.25 8\n"
+                          "3 0 1 99\n"),
+              "OFF vertices (faces skipped)");
+  ExpectCloud(
+      MakeCloud(kThree.positions, kThreeNormals),
+      ReadContent("normals.off", "NOFF\n3 0 0\n0 0 0 0 0 1\n1 2 3 0 1 0\n-1.5 0.25 8 1 0 0\n"),
+      "NOFF normals");
+  ExpectCloud(kThree,
+              ReadContent("colors.off",
+                          "COFF 3 0 0\n0 0 0 1 0 0 1\n1 2 3 0 1 0 1\n"
+                          "-1.5 0.25 8 0 0 1 1\n"),
               "COFF colors ignored");
   ExpectRejected("short.off", "OFF\n3 0 0\n0 0 0\n1 1 1\n",
-                 "the file ends after 2 of the 3 vertices",
-                 "too few vertices");
+                 "the file ends after 2 of the 3 vertices", "too few vertices");
 }
 
 TEST(DracoCloudTest, ReadsDracoMeshesAsPoints) {
@@ -293,8 +294,8 @@ TEST(DracoCloudTest, ReadsDracoMeshesAsPoints) {
   ASSERT_TRUE(WriteMesh(mesh, path).ok());
   const absl::StatusOr<PointCloud> cloud = ReadPointCloud(path);
   ASSERT_TRUE(cloud.ok()) << cloud.status();
-  ExpectSameCloud(MakeCloud(mesh.positions), *cloud, io_test::QuantizationTolerance(2.0f, 11), 0,
-                  0, "mesh vertices from .drc");
+  ExpectSameCloud(MakeCloud(mesh.positions), *cloud, io_test::QuantizationTolerance(2.0f, 11), 0, 0,
+                  "mesh vertices from .drc");
   ExpectRejected("corrupt.drc", "DRACO garbage", "Draco", "corrupt Draco file");
 }
 

@@ -231,9 +231,9 @@ TEST(BoundaryMergingTest, ThresholdFollowsTheGivenMeanArea) {
 // only the closest pair merges, and each of its rims only once.
 TEST(BoundaryMergingTest, ClosestPairFirstAndEachLoopOnce) {
   TriangleMesh shape;
-  AppendTube(shape, 12, 7, 1.0, 0.0, 3.0, 0.0);   // A
-  AppendTube(shape, 12, 7, 1.0, 3.1, 6.1, 0.0);   // B
-  AppendTube(shape, 12, 7, 1.1, 3.3, 9.3, 0.2);   // C, around B
+  AppendTube(shape, 12, 7, 1.0, 0.0, 3.0, 0.0);  // A
+  AppendTube(shape, 12, 7, 1.0, 3.1, 6.1, 0.0);  // B
+  AppendTube(shape, 12, 7, 1.1, 3.3, 9.3, 0.2);  // C, around B
   Mesh mesh = MustToMesh(shape);
   const Counts before = Count(mesh);
 
@@ -310,8 +310,8 @@ TEST(BoundaryMergingTest, RandomCasesStayValid) {
     auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * random.NextDouble(); };
     auto jitter = [&](Mesh& mesh, double amount) {
       for (auto vh : mesh.vertices()) {
-        mesh.set_point(vh, mesh.point(vh) + amount * Vec3(uniform(-1, 1), uniform(-1, 1),
-                                                          uniform(-1, 1)));
+        mesh.set_point(
+            vh, mesh.point(vh) + amount * Vec3(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)));
       }
     };
     const int kind = static_cast<int>(seed % 3);
@@ -361,8 +361,8 @@ TEST(BoundaryMergingTest, RandomCasesStayValid) {
       const absl::Status removed_status = ValidateMesh(mesh);
       ASSERT_TRUE(removed_status.ok()) << "seed " << seed << " after removal: " << removed_status;
       const Counts before = Count(mesh);
-      const BoundaryMergingResult result = MergeCloseBoundaries(
-          mesh, BoundaryMergingOptions{uniform(1, 100)}, removal.mean_area);
+      const BoundaryMergingResult result =
+          MergeCloseBoundaries(mesh, BoundaryMergingOptions{uniform(1, 100)}, removal.mean_area);
       const Counts after = Count(mesh);
       EXPECT_EQ(after.boundary_loops, before.boundary_loops - 2 * result.merges)
           << "seed " << seed << ": each merge must close two loops";

@@ -137,8 +137,8 @@ TEST(TriangleRemovalTest, RemovalThatWouldPinchAVertexIsSkipped) {
   const uint32_t base = static_cast<uint32_t>(shape.positions.size());
   auto ring = [](double degrees, double radius) {
     const double a = degrees * M_PI / 180;
-    return Vec3f(static_cast<float>(radius * std::cos(a)),
-                 static_cast<float>(radius * std::sin(a)), 0.f) +
+    return Vec3f(static_cast<float>(radius * std::cos(a)), static_cast<float>(radius * std::sin(a)),
+                 0.f) +
            Vec3f(0, 0, 5);
   };
   shape.positions.push_back(Vec3f(0, 0, 5));  // Centre.
@@ -269,9 +269,8 @@ TEST(TriangleRemovalTest, LegalityRuleIsExactUnderRandomRemovals) {
         const Mesh::FaceHandle fh = refused[random.NextIndex(refused.size())];
         Mesh copy = mesh;
         copy.delete_face(fh, true);
-        EXPECT_FALSE(ValidateMesh(copy).ok())
-            << "seed " << seed << ": the refused removal of face " << fh.idx()
-            << " would have left a valid mesh";
+        EXPECT_FALSE(ValidateMesh(copy).ok()) << "seed " << seed << ": the refused removal of face "
+                                              << fh.idx() << " would have left a valid mesh";
         ++refused_checked;
       }
       if (legal.empty()) break;

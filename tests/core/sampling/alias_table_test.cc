@@ -98,8 +98,8 @@ TEST(AliasTableTest, DeterministicForSeed) {
 TEST(AliasTableTest, RejectsInvalidWeights) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
-  const std::vector<std::vector<double>> invalid = {
-      {}, {1, -1}, {1, nan}, {inf, 1}, {0, 0, 0}, {1e308, 1e308}};
+  const std::vector<std::vector<double>> invalid = {{},       {1, -1},   {1, nan},
+                                                    {inf, 1}, {0, 0, 0}, {1e308, 1e308}};
   for (const auto& weights : invalid) {
     const absl::StatusOr<AliasTable> table = AliasTable::Create(weights);
     EXPECT_EQ(table.status().code(), absl::StatusCode::kInvalidArgument)

@@ -65,8 +65,8 @@ void Read(const GrowingPointCloud& cloud, const std::atomic<bool>& done, uint64_
     const double x = p[0];
     const long i = std::lround(x);
     if (x != static_cast<double>(i) || p[1] != 2 * x || p[2] != -x) {
-      report->Fail(absl::StrCat("sample (", p[0], ", ", p[1], ", ", p[2],
-                                ") is not a fully written point"));
+      report->Fail(
+          absl::StrCat("sample (", p[0], ", ", p[1], ", ", p[2], ") is not a fully written point"));
     } else if (i < 0 || static_cast<size_t>(i) >= size_after) {
       report->Fail(absl::StrCat("sample ", i, " is beyond the size ", size_after));
     } else if (!allowed(static_cast<int>(i))) {
@@ -104,8 +104,10 @@ TEST(GrowingPointCloudConcurrentTest, ReadersOnlySeeFullyWrittenPoints) {
   std::vector<ReaderReport> reports(kReaders);
   std::vector<std::thread> readers;
   for (int r = 0; r < kReaders; ++r) {
-    readers.emplace_back(
-        [&, r] { Read(cloud, done, 100 + r, [](int) { return true; }, &reports[r]); });
+    readers.emplace_back([&, r] {
+      Read(
+          cloud, done, 100 + r, [](int) { return true; }, &reports[r]);
+    });
   }
   absl::Status writer_status;
   for (size_t b = 0; b + 1 < starts.size() && writer_status.ok(); ++b) {
@@ -160,6 +162,67 @@ TEST(GrowingPointCloudConcurrentTest, WeightsArrivingMidwayStayConsistent) {
   for (int i = 0; i < kTotalPoints; ++i) {
     const float expected = !weighted_point[i] ? 1.0f : i % 7 == 0 ? 0.0f : 1.0f + i % 3;
     ASSERT_EQ(copy.weights[i], expected) << "weight of point " << i;
+  }
+  ExpectClean(reports);
+}
+
+// Two writers append concurrently: appends serialise, each batch lands contiguously, and
+// readers still only see fully written points.
+TEST(GrowingPointCloudConcurrentTest, ConcurrentAppendsKeepBatchesWhole) {
+  GrowingPointCloud cloud;
+  const std::vector<int> starts = BatchStarts();  // Ids of writer w are offset by w * total.
+  constexpr int kWriters = 2;
+  std::atomic<bool> done{false};
+  std::vector<ReaderReport> reports(kReaders);
+  std::vector<std::thread> readers;
+  for (int r = 0; r < kReaders; ++r) {
+    readers.emplace_back([&, r] {
+      Random rng(300 + r);
+      while (!done.load(std::memory_order_acquire)) {
+        if (cloud.empty()) continue;
+        const Vec3 p = cloud.Sample(rng);
+        ++reports[r].samples;
+        if (p[1] != 2 * p[0] || p[2] != -p[0] || p[0] != std::floor(p[0])) {
+          reports[r].Fail(absl::StrCat("sample (", p[0], ", ", p[1], ", ", p[2],
+                                       ") is not a fully written point"));
+        }
+        if (!cloud.Bounds().Contains(p)) reports[r].Fail("a sample lies outside Bounds()");
+      }
+    });
+  }
+  std::vector<absl::Status> writer_status(kWriters);
+  std::vector<std::thread> writers;
+  for (int w = 0; w < kWriters; ++w) {
+    writers.emplace_back([&, w] {
+      for (size_t b = 0; b + 1 < starts.size() && writer_status[w].ok(); ++b) {
+        std::vector<Vec3f> batch;
+        for (int i = starts[b]; i < starts[b + 1]; ++i)
+          batch.push_back(PointFor(w * kTotalPoints + i));
+        writer_status[w] = cloud.Append(batch);
+      }
+    });
+  }
+  for (std::thread& writer : writers) writer.join();
+  done.store(true, std::memory_order_release);
+  for (std::thread& reader : readers) reader.join();
+
+  for (int w = 0; w < kWriters; ++w) EXPECT_TRUE(writer_status[w].ok()) << writer_status[w];
+  const PointCloud copy = cloud.Copy();
+  ASSERT_EQ(copy.size(), static_cast<size_t>(kWriters * kTotalPoints)) << "every batch is in";
+  std::vector<bool> batch_start(kTotalPoints + 1, false);
+  for (int start : starts) batch_start[start] = true;
+  std::vector<int> next_id(kWriters, 0);  // Per writer, the id expected next (order kept).
+  for (size_t k = 0; k < copy.size(); ++k) {
+    const int id = static_cast<int>(copy.positions[k][0]);
+    const int w = id / kTotalPoints;
+    ASSERT_EQ(copy.positions[k], PointFor(id)) << "point " << k << " is torn";
+    ASSERT_TRUE(w >= 0 && w < kWriters) << "point " << k << " has an unknown id " << id;
+    ASSERT_EQ(id % kTotalPoints, next_id[w]) << "writer " << w << "'s points are out of order";
+    ++next_id[w];
+    if (k + 1 < copy.size() && static_cast<int>(copy.positions[k + 1][0]) != id + 1) {
+      ASSERT_TRUE(batch_start[id % kTotalPoints + 1])
+          << "another writer's points cut into a batch after id " << id;
+    }
   }
   ExpectClean(reports);
 }

@@ -126,8 +126,7 @@ TEST(GrowingPointCloudTest, RejectsInvalidBatchesAndAppendsNothing) {
 
   EXPECT_EQ(cloud.Append(with_nan).code(), absl::StatusCode::kInvalidArgument) << "NaN position";
   EXPECT_EQ(cloud.Append(with_inf).code(), absl::StatusCode::kInvalidArgument) << "inf position";
-  EXPECT_EQ(cloud.Append(two, std::vector<float>{1.0f}).code(),
-            absl::StatusCode::kInvalidArgument)
+  EXPECT_EQ(cloud.Append(two, std::vector<float>{1.0f}).code(), absl::StatusCode::kInvalidArgument)
       << "one weight for two points";
   EXPECT_EQ(cloud.Append(two, std::vector<float>{1.0f, nan}).code(),
             absl::StatusCode::kInvalidArgument)
@@ -141,8 +140,7 @@ TEST(GrowingPointCloudTest, RejectsInvalidBatchesAndAppendsNothing) {
   EXPECT_EQ(cloud.Append(two, {}, std::vector<Vec3f>{Vec3f(0, 0, 1), Vec3f(nan, 0, 0)}).code(),
             absl::StatusCode::kInvalidArgument)
       << "NaN normal";
-  EXPECT_EQ(cloud.Append({}, std::vector<float>{1.0f}).code(),
-            absl::StatusCode::kInvalidArgument)
+  EXPECT_EQ(cloud.Append({}, std::vector<float>{1.0f}).code(), absl::StatusCode::kInvalidArgument)
       << "a weight without a point";
   EXPECT_EQ(cloud.size(), 3u) << "rejected batches must append nothing";
   const PointCloud copy = cloud.Copy();

@@ -21,8 +21,8 @@ double MeshArea(const TriangleMesh& mesh) {
   double area = 0;
   for (const auto& f : mesh.faces) {
     const Vec3 a(mesh.positions[f[0]]);
-    area += 0.5 * OpenMesh::cross(Vec3(mesh.positions[f[1]]) - a, Vec3(mesh.positions[f[2]]) - a)
-                      .norm();
+    area += 0.5 *
+            OpenMesh::cross(Vec3(mesh.positions[f[1]]) - a, Vec3(mesh.positions[f[2]]) - a).norm();
   }
   return area;
 }
@@ -51,7 +51,8 @@ void ExpectDeterministic(const Sampler& sampler, const std::string& name) {
   Random a(31);
   Random b(31);
   for (int i = 0; i < 1000; ++i) {
-    ASSERT_EQ(sampler.Sample(a), sampler.Sample(b)) << name << ": same seed, different sample " << i;
+    ASSERT_EQ(sampler.Sample(a), sampler.Sample(b))
+        << name << ": same seed, different sample " << i;
   }
 }
 
@@ -92,8 +93,8 @@ TEST(ImplicitSurfacesTest, SphereSamplesAreAreaUniform) {
   for (int i = 0; i < n; ++i) {
     const Vec3 p = sphere->Sample(rng);
     ++heights[std::min(bins - 1, static_cast<int>((p[2] + radius) / (2 * radius) * bins))];
-    ++azimuths[std::min(bins - 1, static_cast<int>((std::atan2(p[1], p[0]) + M_PI) /
-                                                   (2 * M_PI) * bins))];
+    ++azimuths[std::min(bins - 1,
+                        static_cast<int>((std::atan2(p[1], p[0]) + M_PI) / (2 * M_PI) * bins))];
   }
   const std::vector<double> expected(bins, static_cast<double>(n) / bins);
   // 19 degrees of freedom: P(chi2 > 45) < 1e-3.
@@ -167,8 +168,8 @@ TEST(ImplicitSurfacesTest, TorusSamplesAreAreaUniform) {
     const double v = std::atan2(p[2], rho - major);  // Tube angle, 0 on the outer equator.
     outer += rho > major;
     ++tube[std::min(bins - 1, static_cast<int>((v + M_PI) / (2 * M_PI) * bins))];
-    ++azimuth[std::min(bins - 1, static_cast<int>((std::atan2(p[1], p[0]) + M_PI) /
-                                                  (2 * M_PI) * bins))];
+    ++azimuth[std::min(bins - 1,
+                       static_cast<int>((std::atan2(p[1], p[0]) + M_PI) / (2 * M_PI) * bins))];
   }
   // The outer half (cos v > 0) holds 2 pi r (pi R + 2 r) of the area 4 pi^2 R r.
   const double outer_share = 0.5 + minor / (M_PI * major);
@@ -216,7 +217,9 @@ TEST(ImplicitSurfacesTest, TorusReferenceMeshIsAClosedGenusOneGrid) {
 
 class GenusTwoTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { surface_ = Must(MakeGenusTwo(kCenter, kScale, kThickness)).release(); }
+  static void SetUpTestSuite() {
+    surface_ = Must(MakeGenusTwo(kCenter, kScale, kThickness)).release();
+  }
   static void TearDownTestSuite() {
     delete surface_;
     surface_ = nullptr;
@@ -279,8 +282,7 @@ TEST_F(GenusTwoTest, DistanceIsExactNearTheSurface) {
   EXPECT_LT(surface_->Value(kCenter), 0) << "the crossing of the figure eight is inside";
   EXPECT_GT(surface_->Value(kCenter + Vec3(std::sqrt(0.5) * kScale, 0, 0)), 0)
       << "the centre of a hole is outside";
-  EXPECT_NEAR(surface_->Distance(kCenter + Vec3(0, 0, 2 * kScale)), (2 - kThickness) * kScale,
-              1e-9)
+  EXPECT_NEAR(surface_->Distance(kCenter + Vec3(0, 0, 2 * kScale)), (2 - kThickness) * kScale, 1e-9)
       << "straight above the crossing, the nearest point is the top of the tube";
 }
 
@@ -319,8 +321,7 @@ TEST_F(GenusTwoTest, SamplingIsAreaUniform) {
 
 TEST(ImplicitSurfacesTest, GenusTwoReferenceMeshIsAClosedGenusTwoSurface) {
   for (double thickness : {0.05, 0.1, 0.2}) {
-    std::unique_ptr<ImplicitSurface> surface =
-        Must(MakeGenusTwo(Vec3(0, 0, 0), 1.5, thickness));
+    std::unique_ptr<ImplicitSurface> surface = Must(MakeGenusTwo(Vec3(0, 0, 0), 1.5, thickness));
     ASSERT_NE(surface, nullptr);
     for (int n : {1, 4, 8}) {
       const TriangleMesh mesh = surface->ReferenceMesh(n);
@@ -356,8 +357,7 @@ TEST(ImplicitSurfacesTest, FactoriesRejectInvalidParameters) {
       << "infinite radius";
   EXPECT_EQ(MakeTorus(origin, 1, 1).status().code(), absl::StatusCode::kInvalidArgument)
       << "r == R is a horn torus, not genus 1";
-  EXPECT_EQ(MakeTorus(origin, 1, 2).status().code(), absl::StatusCode::kInvalidArgument)
-      << "r > R";
+  EXPECT_EQ(MakeTorus(origin, 1, 2).status().code(), absl::StatusCode::kInvalidArgument) << "r > R";
   EXPECT_EQ(MakeTorus(origin, 1, 0).status().code(), absl::StatusCode::kInvalidArgument)
       << "zero minor radius";
   EXPECT_EQ(MakeTorus(origin, inf, 1).status().code(), absl::StatusCode::kInvalidArgument)

@@ -58,8 +58,7 @@ TEST(PointCloudSamplerTest, WeightThreeDrawnThreeTimesAsOften) {
 }
 
 TEST(PointCloudSamplerTest, MakePointCloudSamplerPicksWeightedWhenWeightsExist) {
-  absl::StatusOr<std::unique_ptr<Sampler>> weighted =
-      MakePointCloudSampler(Line(2, {0.0f, 1.0f}));
+  absl::StatusOr<std::unique_ptr<Sampler>> weighted = MakePointCloudSampler(Line(2, {0.0f, 1.0f}));
   ASSERT_TRUE(weighted.ok()) << weighted.status();
   std::map<int, int> counts = CountIndices(**weighted, 10000, 2);
   EXPECT_EQ(counts[0], 0) << "with weights, the point of weight zero must never be drawn";
@@ -72,8 +71,8 @@ TEST(PointCloudSamplerTest, MakePointCloudSamplerPicksWeightedWhenWeightsExist) 
 
 TEST(PointCloudSamplerTest, DeterministicForSeed) {
   for (bool weighted : {false, true}) {
-    absl::StatusOr<std::unique_ptr<Sampler>> sampler = MakePointCloudSampler(
-        weighted ? Line(100, std::vector<float>(100, 2.0f)) : Line(100));
+    absl::StatusOr<std::unique_ptr<Sampler>> sampler =
+        MakePointCloudSampler(weighted ? Line(100, std::vector<float>(100, 2.0f)) : Line(100));
     ASSERT_TRUE(sampler.ok()) << sampler.status();
     Random a(123);
     Random b(123);

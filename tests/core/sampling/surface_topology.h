@@ -17,7 +17,7 @@ struct SurfaceTopology {
   std::string problem;  // Empty when the mesh is a closed oriented 2-manifold.
   long euler = 0;       // V - E + F.
   int components = 0;
-  double volume = 0;    // Signed; > 0 when the faces are counter-clockwise seen from outside.
+  double volume = 0;  // Signed; > 0 when the faces are counter-clockwise seen from outside.
 };
 
 inline SurfaceTopology MeasureTopology(const TriangleMesh& triangles) {

@@ -1,0 +1,103 @@
+// Learner benchmark (issue 2): time to 1K, 5K, 20K and 100K vertices with the paper's
+// parameters on a 50,000-point and a 5,000,000-point sample of the same surface, the time split
+// by step kind, and Basic Steps per second. Prints a table; it is not a test.
+//
+//   build/bin/learner-bench [--points=50000,5000000] [--milestones=1000,5000,20000,100000]
+//                           [--seed=1]
+//
+// "us/step" is measured in a window just below each milestone (from 0.9 N to N vertices), so
+// it shows the cost of a Basic Step at that mesh size rather than an average over the run.
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_split.h"
+#include "core/learning/learner.h"
+#include "core/sampling/implicit_surfaces.h"
+#include "core/sampling/point_cloud_sampler.h"
+#include "core/sampling/sample_points.h"
+
+ABSL_FLAG(std::string, points, "50000,5000000", "Point counts of the sampled input surfaces.");
+ABSL_FLAG(std::string, milestones, "1000,5000,20000,100000", "Vertex counts to time.");
+ABSL_FLAG(uint64_t, seed, 1, "Seed of the learner and of the point sampling.");
+
+namespace neuralmesh {
+namespace {
+
+std::vector<size_t> ParseList(const std::string& text) {
+  std::vector<size_t> out;
+  for (absl::string_view part : absl::StrSplit(text, ',', absl::SkipEmpty())) {
+    size_t value = 0;
+    if (!absl::SimpleAtoi(part, &value) || value == 0) {
+      std::fprintf(stderr, "learner-bench: '%s' is not a positive integer\n",
+                   std::string(part).c_str());
+      std::exit(2);
+    }
+    out.push_back(value);
+  }
+  return out;
+}
+
+double Seconds(absl::Duration d) { return absl::ToDoubleSeconds(d); }
+
+int Run() {
+  const std::vector<size_t> point_counts = ParseList(absl::GetFlag(FLAGS_points));
+  const std::vector<size_t> milestones = ParseList(absl::GetFlag(FLAGS_milestones));
+  const uint64_t seed = absl::GetFlag(FLAGS_seed);
+  // The input: a torus (R = 1, r = 0.35) sampled uniformly.
+  auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.35).value();
+
+  std::printf("Neural Meshes learner, paper parameters (alpha_w = alpha_L = 0.06, C_L = 5, "
+              "C_vs = 100, C_ec = 10, alpha_sc = 0.95, alpha_r = 7, alpha_m = 5), one thread\n\n");
+  std::printf("%10s %8s %9s %11s %9s %8s %8s %8s %8s %8s %8s %10s\n", "points", "#v", "total s",
+              "steps", "us/step", "octree", "smooth", "split", "collapse", "removal", "merge",
+              "steps/s");
+  for (size_t n : point_counts) {
+    auto cloud = std::make_shared<const PointCloud>(SamplePoints(*torus, n, seed));
+    auto sampler = MakePointCloudSampler(cloud).value();
+    LearnerOptions options;
+    options.seed = seed;
+    auto learner = Learner::Create(options, sampler.get()).value();
+    learner->EnableTimings(true);
+    const auto start = std::chrono::steady_clock::now();
+    for (size_t target : milestones) {
+      StopCriteria to_window;
+      to_window.target_vertices = target * 9 / 10;
+      if (!learner->Run(to_window).ok()) return 1;
+      const uint64_t window_steps = learner->progress().basic_steps;
+      const auto window_start = std::chrono::steady_clock::now();
+      StopCriteria to_target;
+      to_target.target_vertices = target;
+      if (!learner->Run(to_target).ok()) return 1;
+      const auto now = std::chrono::steady_clock::now();
+      const double window_s = std::chrono::duration<double>(now - window_start).count();
+      const double total_s = std::chrono::duration<double>(now - start).count();
+      const LearnerProgress p = learner->progress();
+      const LearnerTimings t = learner->timings();
+      const double us_per_step = 1e6 * window_s / static_cast<double>(p.basic_steps - window_steps);
+      std::printf("%10zu %8zu %9.2f %11llu %9.3f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %10.0f\n", n,
+                  p.vertices, total_s, static_cast<unsigned long long>(p.basic_steps), us_per_step,
+                  Seconds(t.winner_search), Seconds(t.smoothing), Seconds(t.split),
+                  Seconds(t.collapse), Seconds(t.removal), Seconds(t.merging),
+                  static_cast<double>(p.basic_steps) / total_s);
+      std::fflush(stdout);
+    }
+  }
+  std::printf("\nColumns octree..merge: seconds spent per step kind (octree = sampling, winner "
+              "search and index updates; smooth = Eq. 1 and C_L smoothing; split = Step 2 with "
+              "the counters; collapse, removal, merge = Steps 3, 4, 5).\n");
+  return 0;
+}
+
+}  // namespace
+}  // namespace neuralmesh
+
+int main(int argc, char** argv) {
+  absl::ParseCommandLine(argc, argv);
+  return neuralmesh::Run();
+}

@@ -1,0 +1,62 @@
+// The learner samples a GrowingPointCloud while another thread appends points: the situation of
+// a server session that learns while a client streams points in. Also run under ThreadSanitizer
+// (ctest label "concurrency").
+#include <atomic>
+#include <cmath>
+#include <thread>
+#include <vector>
+
+#include "core/learning/learner.h"
+#include "core/mesh_validation.h"
+#include "core/sampling/growing_point_cloud.h"
+#include "core/sampling/implicit_surfaces.h"
+#include "core/sampling/sample_points.h"
+#include "gtest/gtest.h"
+
+namespace neuralmesh {
+namespace {
+
+TEST(LearnerGrowingCloudConcurrentTest, LearnsWhilePointsStreamIn) {
+  auto sphere = MakeSphere(Vec3(0, 0, 0), 1.0).value();
+  const PointCloud all = SamplePoints(*sphere, 40000, 9);
+  GrowingPointCloud cloud;
+  const size_t kBatch = 400;
+  ASSERT_TRUE(cloud.Append(absl::MakeConstSpan(all.positions).subspan(0, kBatch)).ok());
+
+  std::atomic<bool> writer_done{false};
+  std::thread writer([&] {
+    for (size_t start = kBatch; start < all.size(); start += kBatch) {
+      const absl::Status s =
+          cloud.Append(absl::MakeConstSpan(all.positions).subspan(start, kBatch));
+      EXPECT_TRUE(s.ok()) << s;
+      std::this_thread::yield();
+    }
+    writer_done = true;
+  });
+
+  auto learner = Learner::Create(LearnerOptions{}, &cloud).value();
+  size_t last_size = 0;
+  StopCriteria stop;
+  stop.target_vertices = 1500;
+  stop.poll_interval = 2000;
+  stop.observer = [&](const LearnerProgress&) {
+    const size_t size = cloud.size();
+    EXPECT_GE(size, last_size) << "the visible point count must never shrink";
+    last_size = size;
+    return true;
+  };
+  const auto reason = learner->Run(stop);
+  writer.join();
+  ASSERT_TRUE(reason.ok()) << reason.status();
+  EXPECT_TRUE(writer_done);
+  EXPECT_EQ(cloud.size(), all.size()) << "every appended point must be kept";
+  EXPECT_TRUE(ValidateMesh(learner->mesh()).ok()) << ValidateMesh(learner->mesh());
+  double worst = 0;
+  for (auto v : learner->mesh().vertices()) {
+    worst = std::max(worst, std::abs(learner->mesh().point(v).norm() - 1.0));
+  }
+  EXPECT_LT(worst, 0.02) << "the mesh learned from streamed points must lie on the sphere";
+}
+
+}  // namespace
+}  // namespace neuralmesh

@@ -1,0 +1,74 @@
+#include "core/learning/signal_counters.h"
+
+#include <cmath>
+#include <vector>
+
+#include "core/random.h"
+#include "gtest/gtest.h"
+
+namespace neuralmesh {
+namespace {
+
+// The paper's process done literally: each step add 1 to the winner, then multiply every
+// counter by alpha_sc. The lazy log-domain counters must pick the same vertex and agree on
+// the values (up to the constant factor alpha_sc that the literal order applies once more).
+TEST(SignalCountersTest, MatchesTheLiteralProcess) {
+  const double alpha = 0.95;
+  const int n = 50;
+  SignalCounters lazy(alpha);
+  std::vector<double> literal(n, 0.0);
+  for (int i = 0; i < n; ++i) lazy.Add(i, 0.0, 0);
+  Random rng(11);
+  uint64_t step = 0;
+  for (int round = 0; round < 200; ++round) {
+    for (int k = 0; k < 100; ++k) {
+      // Skewed winners so that counters differ.
+      const int w = static_cast<int>(rng.NextIndex(rng.NextDouble() < 0.5 ? 10 : n));
+      ++step;
+      lazy.RecordWin(w, step);
+      literal[w] += 1;
+      for (double& c : literal) c *= alpha;
+    }
+    int expected = 0;
+    for (int i = 1; i < n; ++i) {
+      if (literal[i] > literal[expected]) expected = i;
+    }
+    const int got = lazy.MostActive([](int) { return true; });
+    ASSERT_EQ(got, expected) << "round " << round;
+    for (int i = 0; i < n; ++i) {
+      ASSERT_NEAR(lazy.Value(i, step) * alpha, literal[i], 1e-9 * (1 + literal[i]))
+          << "counter " << i << " at round " << round;
+    }
+  }
+}
+
+TEST(SignalCountersTest, SkipsIneligibleAndForgetsRemoved) {
+  SignalCounters counters(0.95);
+  counters.Add(0, 5.0, 10);
+  counters.Add(1, 3.0, 10);
+  counters.Add(2, 1.0, 10);
+  EXPECT_EQ(counters.MostActive([](int id) { return id != 0; }), 1)
+      << "the best eligible counter must be chosen";
+  counters.Remove(1);
+  EXPECT_EQ(counters.MostActive([](int id) { return id != 0; }), 2);
+  counters.RecordWin(1, 11);  // A win of a removed id is ignored.
+  counters.Flush();
+  EXPECT_FALSE(counters.Contains(1));
+  EXPECT_EQ(counters.MostActive([](int) { return false; }), -1) << "nothing eligible";
+}
+
+TEST(SignalCountersTest, NoUnderflowAfterLongInactivity) {
+  // With plain doubles, 0.95^20000 underflows to zero (the paper's c_M, Eq. 9); the
+  // log-domain keys still order vertices by their last activity.
+  SignalCounters counters(0.95);
+  counters.Add(0, 1.0, 0);
+  counters.Add(1, 1.0, 5);
+  EXPECT_EQ(counters.MostActive([](int) { return true; }), 1);
+  counters.Add(2, 1.0, 3);
+  EXPECT_EQ(counters.Value(0, 20000), 0.0) << "the value itself underflows";
+  EXPECT_EQ(counters.MostActive([](int) { return true; }), 1)
+      << "but the ordering survives: 1 was active last";
+}
+
+}  // namespace
+}  // namespace neuralmesh

@@ -44,6 +44,13 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
   if (l.has_alpha_m()) o.alpha_m = l.alpha_m().value();
   if (l.has_splits_per_step()) o.splits_per_step = l.splits_per_step().value();
   if (l.has_seed()) o.seed = l.seed().value();
+  if (l.has_close_small_holes()) o.close_small_holes = l.close_small_holes().value();
+  if (l.has_max_closed_hole_vertices()) {
+    o.max_closed_hole_vertices = l.max_closed_hole_vertices().value();
+  }
+  if (l.has_merge_only_settled_boundaries()) {
+    o.merge_only_settled_boundaries = l.merge_only_settled_boundaries().value();
+  }
 
   config.target_vertices = proto.target_vertices();
   config.lod_milestones.assign(proto.lod_milestones().begin(), proto.lod_milestones().end());
@@ -99,6 +106,9 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
   l.mutable_alpha_m()->set_value(o.alpha_m);
   l.mutable_splits_per_step()->set_value(o.splits_per_step);
   l.mutable_seed()->set_value(o.seed);
+  l.mutable_close_small_holes()->set_value(o.close_small_holes);
+  l.mutable_max_closed_hole_vertices()->set_value(o.max_closed_hole_vertices);
+  l.mutable_merge_only_settled_boundaries()->set_value(o.merge_only_settled_boundaries);
 
   proto.set_target_vertices(config.target_vertices);
   for (size_t m : config.lod_milestones) proto.add_lod_milestones(m);

@@ -256,7 +256,13 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
 
  private:
   absl::Status HandleRequest() {
-    const uint64_t index = batches_ + rejected_;
+    uint64_t index = 0, points = 0, batches = 0;
+    {
+      absl::MutexLock lock(&mu_);
+      index = batches_ + rejected_;
+      points = points_;
+      batches = batches_;
+    }
     if (session_ == nullptr) {
       if (request_.session_id().empty()) {
         return absl::InvalidArgumentError("the first message must set session_id");
@@ -275,7 +281,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
         Ingest(*session_, request_.batch(), manager_->limits().max_batch_points, &total);
     if (!accepted.ok()) {
       ++rejected_;
-      return BatchError(accepted.status(), index, points_, batches_);
+      return BatchError(accepted.status(), index, points, batches);
     }
     absl::MutexLock lock(&mu_);
     points_ += *accepted;

@@ -17,6 +17,10 @@
 // the learner toward min(next milestone, allowed); at a milestone it snapshots; between
 // milestones it snapshots every refresh interval; when it reaches `allowed` it pauses (one more
 // refresh snapshot) until more points arrive.
+//
+// A learner whose vertex count makes no new maximum for kStallSplits * C_vs Basic Steps while
+// it should grow (Step 3 collapsing as many vertices as Step 2 splits, as happens on some thin
+// shapes at a few vertices) fails the session with a message instead of spinning forever.
 #ifndef NEURALMESH_SERVER_SESSION_H_
 #define NEURALMESH_SERVER_SESSION_H_
 
@@ -182,6 +186,9 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   absl::Duration learning_time_;
   absl::Time last_publish_time_ = absl::InfinitePast();
   uint64_t last_publish_steps_ = 0;
+  // Stall detection: the largest vertex count of the current learner and its step count then.
+  size_t max_vertices_ = 0;
+  uint64_t steps_at_max_ = 0;
 };
 
 }  // namespace neuralmesh::server

@@ -51,10 +51,14 @@ std::string JsonWriter::Quote(absl::string_view value) {
 }
 
 void JsonWriter::Fail(absl::string_view message) {
-  if (status_.ok()) {
-    status_ = absl::FailedPreconditionError(
-        absl::StrCat("JsonWriter: ", message, " after \"", text_, "\""));
-  }
+  if (!status_.ok()) return;
+  // The end of the document is enough context to find the faulty call.
+  constexpr size_t kContext = 60;
+  const absl::string_view written(text_);
+  const absl::string_view tail =
+      written.size() > kContext ? written.substr(written.size() - kContext) : written;
+  status_ = absl::FailedPreconditionError(absl::StrCat(
+      "JsonWriter: ", message, " after \"", written.size() > kContext ? "..." : "", tail, "\""));
 }
 
 void JsonWriter::NewLine(size_t depth) {

@@ -1,6 +1,7 @@
 #include "core/io/draco_codec.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -254,13 +255,21 @@ absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOpti
   }
   NM_RETURN_IF_ERROR(CheckPositions(mesh.positions, options));
   const size_t num_vertices = mesh.positions.size();
+  bool any_proper_face = false;
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
-    for (uint32_t v : mesh.faces[f]) {
+    const std::array<uint32_t, 3>& face = mesh.faces[f];
+    for (uint32_t v : face) {
       if (v >= num_vertices) {
         return absl::InvalidArgumentError(absl::StrCat(
             "face ", f, " uses vertex ", v, " but the mesh has only ", num_vertices, " vertices"));
       }
     }
+    any_proper_face |= face[0] != face[1] && face[1] != face[2] && face[2] != face[0];
+  }
+  if (!any_proper_face) {
+    return absl::InvalidArgumentError(
+        "every face repeats a vertex index; Edgebreaker drops such degenerate faces, so nothing "
+        "would remain");
   }
 
   draco::Mesh geometry;

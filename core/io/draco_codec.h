@@ -8,7 +8,8 @@
 // QuantizationBox::range).
 //
 // Draco may reorder vertices and faces. Edgebreaker keeps only vertices that some face uses,
-// and splits non-manifold vertices into copies at the same position.
+// drops degenerate faces (a repeated vertex index), and splits non-manifold vertices (and
+// vertices where orientation is inconsistent) into copies at the same position.
 #ifndef NEURALMESH_CORE_IO_DRACO_CODEC_H_
 #define NEURALMESH_CORE_IO_DRACO_CODEC_H_
 
@@ -32,14 +33,15 @@ struct QuantizationBox {
 
 struct DracoOptions {
   int position_quantization_bits = 11;  // 1..30.
-  int normal_quantization_bits = 10;    // 2..30; point-cloud normals (octahedral coding).
+  int normal_quantization_bits = 10;    // 2..30; point-cloud normals.
   int weight_quantization_bits = 16;    // 1..30; point weights, against their own min..max.
   int encode_speed = 5;                 // 0 (smallest output) .. 10 (fastest).
   int decode_speed = 5;                 // 0 .. 10.
   // When set, positions are quantized against this fixed cube instead of each geometry's own
   // bounding box, so successive meshes of one session share one grid (no jitter, no cracks):
   // the same input position always decodes to bit-identical floats. Every position must lie
-  // inside the cube (encoding returns INVALID_ARGUMENT otherwise; nothing is clamped).
+  // inside the cube, give or take a quarter grid step for float rounding; encoding returns
+  // INVALID_ARGUMENT otherwise (nothing is clamped).
   std::optional<QuantizationBox> quantization_box;
 
   // Returns INVALID_ARGUMENT naming the first field that is out of range.
@@ -47,9 +49,9 @@ struct DracoOptions {
 };
 
 // Encodes `mesh` (positions and faces) with Edgebreaker.
-// Returns INVALID_ARGUMENT when `options` is invalid, the mesh has no vertices or no faces, a
-// face index is out of range, a coordinate is not finite, or a position lies outside
-// `options.quantization_box`; INTERNAL if Draco fails for another reason.
+// Returns INVALID_ARGUMENT when `options` is invalid, the mesh has no vertices or no
+// non-degenerate faces, a face index is out of range, a coordinate is not finite, or a position
+// lies outside `options.quantization_box`; INTERNAL if Draco fails for another reason.
 absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOptions& options);
 
 // Encodes the positions of `cloud`, its normals when present and its weights (as a generic

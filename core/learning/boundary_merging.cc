@@ -245,21 +245,50 @@ absl::Status BoundaryMergingOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("alpha_m (Eq. 3) must be finite and non-negative, got ", alpha_m));
   }
+  if (close_small_holes) return hole_closing.Validate();
   return absl::OkStatus();
 }
 
 BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOptions& options,
                                            double mean_area) {
+  return MergeCloseBoundaries(mesh, options, mean_area, {});
+}
+
+BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOptions& options,
+                                           double mean_area,
+                                           absl::Span<const Mesh::VertexHandle> growing_vertices) {
   BoundaryMergingResult result;
+  if (options.close_small_holes) {
+    result.closed = CloseSmallHoles(mesh, options.hole_closing, mean_area);
+  }
   const std::vector<BoundaryLoop> loops = CollectBoundaryLoops(mesh);
   if (loops.size() < 2) return result;
   if (mean_area <= 0) mean_area = MeanTriangleArea(mesh);
   const double limit = options.alpha_m * std::sqrt(mean_area);
   if (!(limit > 0)) return result;
 
+  // Loops that Step 4 is still growing take no part.
+  std::vector<bool> growing(loops.size(), false);
+  if (!growing_vertices.empty()) {
+    std::unordered_map<int, size_t> loop_of;
+    for (size_t x = 0; x < loops.size(); ++x) {
+      for (auto vh : loops[x].vertices) loop_of.emplace(vh.idx(), x);
+    }
+    for (auto vh : growing_vertices) {
+      if (!vh.is_valid() || vh.idx() >= static_cast<int>(mesh.n_vertices()) ||
+          mesh.status(vh).deleted()) {
+        continue;
+      }
+      const auto it = loop_of.find(vh.idx());
+      if (it != loop_of.end()) growing[it->second] = true;
+    }
+  }
+
   std::vector<CandidatePair> candidates;
   for (size_t x = 0; x < loops.size(); ++x) {
+    if (growing[x]) continue;
     for (size_t y = x + 1; y < loops.size(); ++y) {
+      if (growing[y]) continue;
       if (HausdorffLowerBound(loops[x], loops[y]) >= limit) continue;
       const auto distance = HausdorffBelow(mesh, loops[x].vertices, loops[y].vertices, limit);
       if (distance) candidates.push_back({*distance, x, y});

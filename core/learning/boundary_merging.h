@@ -42,29 +42,43 @@
 // one. Loops never share a vertex and have at least 3 vertices, since every boundary vertex
 // of a valid mesh has exactly one boundary gap and there are no double edges.
 // Foldovers created by the strip are left to the learner's Laplacian smoothing (Section 2.3).
+//
+// Not in the paper, off by default (the learner turns it on, LearnerOptions::
+// close_small_holes): before looking for pairs, small loops whose filling triangles Step 4
+// would keep are closed again (CloseSmallHoles, hole_closing.h, which gives the reasons), so
+// that only real boundaries are merged and two tiny holes cut while the geometry was still
+// converging are never sewn into a spurious handle.
 #ifndef NEURALMESH_CORE_LEARNING_BOUNDARY_MERGING_H_
 #define NEURALMESH_CORE_LEARNING_BOUNDARY_MERGING_H_
 
 #include <cstddef>
 
 #include "absl/status/status.h"
+#include "absl/types/span.h"
+#include "core/learning/hole_closing.h"
 #include "core/mesh.h"
 
 namespace neuralmesh {
 
 struct BoundaryMergingOptions {
   double alpha_m = 5;  // alpha_m, Eq. 3: merge loops closer than alpha_m sqrt(E(Area)), >= 0.
+  // Close small holes (CloseSmallHoles with `hole_closing`) before merging. Not in the paper.
+  bool close_small_holes = false;
+  HoleClosingOptions hole_closing;
 
-  // Returns INVALID_ARGUMENT unless alpha_m is finite and non-negative.
+  // Returns INVALID_ARGUMENT unless alpha_m is finite and non-negative and, when
+  // close_small_holes is set, hole_closing is valid.
   absl::Status Validate() const;
 };
 
 struct BoundaryMergingResult {
   size_t merges = 0;       // Pairs of loops sewn together.
   size_t added_faces = 0;  // Faces of all strips; no vertex is ever added or removed.
+  HoleClosingResult closed;  // Small holes closed before merging (close_small_holes).
 };
 
-// Step 5 (Eq. 3): merges every pair of boundary loops of `mesh` whose vertex sets are closer
+// Step 5 (Eq. 3): when options.close_small_holes is set, first closes the small holes as
+// CloseSmallHoles does; then merges every pair of boundary loops of `mesh` whose vertex sets are closer
 // than options.alpha_m * sqrt(mean_area) in Hausdorff distance, closest pair first, each loop
 // at most once per call. `mean_area` is E(Area) (for example TriangleRemovalResult::mean_area);
 // pass <= 0 to compute it from the live faces. `options` must be valid (Validate()).
@@ -73,6 +87,20 @@ struct BoundaryMergingResult {
 // per pair that passes a bounding-box lower bound on H and per merge.
 BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOptions& options,
                                            double mean_area);
+
+// As above, but a loop through any of `growing_vertices` is not merged in this call (it may
+// still be closed as a small hole). Not in the paper: the learner passes the corners of the
+// faces that Step 4 has just removed (TriangleRemovalResult::touched_vertices). A boundary
+// that Step 4 is still enlarging lies, at least in part, over a region without data that is
+// being cut away (the membranes a shrinking mesh stretches across the hole of a torus, the
+// remains of a strip sewn too early); sewing it now would build the handle inside that
+// region and leave the rest of it to be cut again into further holes, each merged into a
+// spurious handle. A boundary that Step 4 no longer touches has reached the data (Section
+// 2.3: a real boundary slightly underestimates P), and is merged as the paper says.
+// Deleted handles in `growing_vertices` are ignored.
+BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOptions& options,
+                                           double mean_area,
+                                           absl::Span<const Mesh::VertexHandle> growing_vertices);
 
 }  // namespace neuralmesh
 

@@ -169,6 +169,7 @@ class Learner::Impl {
     timings_.collapse += Since(t0);
     ++progress_.connectivity_calls;
     double mean_area = 0;
+    std::vector<Mesh::VertexHandle> growing;  // Boundary vertices Step 4 has just cut to.
     if (options_.remove_triangles) {
       t0 = Clock::now();
       TriangleRemovalOptions removal;
@@ -177,13 +178,17 @@ class Learner::Impl {
       for (auto v : removed.removed_vertices) ForgetVertex(v);
       progress_.removed_triangles += removed.removed_faces;
       mean_area = removed.mean_area;
+      if (options_.merge_only_settled_boundaries) growing = removed.touched_vertices;
       timings_.removal += Since(t0);
     }
     if (options_.merge_boundaries) {
       t0 = Clock::now();
       BoundaryMergingOptions merging;
       merging.alpha_m = options_.alpha_m;
-      const BoundaryMergingResult merged = MergeCloseBoundaries(mesh_, merging, mean_area);
+      merging.close_small_holes = options_.close_small_holes;
+      merging.hole_closing.alpha_r = options_.alpha_r;
+      merging.hole_closing.max_loop_vertices = options_.max_closed_hole_vertices;
+      const BoundaryMergingResult merged = MergeCloseBoundaries(mesh_, merging, mean_area, growing);
       progress_.merged_boundaries += merged.merges;
       timings_.merging += Since(t0);
     }

@@ -27,6 +27,15 @@ struct LearnerOptions {
   bool merge_boundaries = true;  // Step 5 on or off.
   double alpha_m = 5;            // alpha_m, Eq. 3: merge boundaries closer than
                                  // alpha_m sqrt(E(Area)) (Hausdorff distance).
+  // Not in the paper (hole_closing.h): right before Step 5, a boundary loop of at most
+  // max_closed_hole_vertices vertices is filled again when Step 4 would keep every filling
+  // triangle (area <= alpha_r E(Area)), so holes cut while the geometry was still converging
+  // do not stay forever nor get sewn into extra handles (Section 1: no topological noise).
+  bool close_small_holes = true;
+  int max_closed_hole_vertices = 6;  // >= 3: larger loops are never closed.
+  // Not in the paper (boundary_merging.h): Step 5 leaves alone a loop that Step 4 has cut into
+  // in the same call; it is merged once it has stopped growing, i.e. reached the data.
+  bool merge_only_settled_boundaries = true;
 
   // Splits per call of Step 2. The paper uses 1; Section 3.3 suggests more for speed on very
   // large meshes at a negligible cost in quality.

@@ -139,6 +139,7 @@ TriangleRemovalResult RemoveLargeTriangles(Mesh& mesh, const TriangleRemovalOpti
     // boundary now grow it.
     for (auto vh : corners) {
       if (mesh.status(vh).deleted()) continue;
+      result.touched_vertices.push_back(vh);
       for (auto neighbour : mesh.vf_range(vh)) {
         auto it = large.find(neighbour.idx());
         if (it == large.end()) continue;

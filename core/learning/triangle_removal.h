@@ -67,6 +67,9 @@ struct TriangleRemovalResult {
   // Vertices deleted because their last face was removed. The learner must drop them from
   // its spatial index and its per-vertex statistics.
   std::vector<Mesh::VertexHandle> removed_vertices;
+  // The surviving corners of the removed faces: they lie on a boundary that grew in this call
+  // (Step 5 leaves such still-growing boundaries alone, see boundary_merging.h).
+  std::vector<Mesh::VertexHandle> touched_vertices;
   // E(Area): the mean area of the live faces at the start of the call (0 for an empty mesh).
   double mean_area = 0;
 };

@@ -94,8 +94,8 @@ class LocalGenusTwo {
   // y = 0, since g grows with y^2) and y^2 = (1 + 4 t) / 8 (where g = t, at
   // x^2 = (3 - 4 t) / 8).
   static Vec3 ExactHalfExtent(double t) {
-    return Vec3(std::sqrt((1.0 + std::sqrt(1.0 + 4.0 * t)) / 2.0),
-                std::sqrt((1.0 + 4.0 * t) / 8.0), t);
+    return Vec3(std::sqrt((1.0 + std::sqrt(1.0 + 4.0 * t)) / 2.0), std::sqrt((1.0 + 4.0 * t) / 8.0),
+                t);
   }
 
   static double Lemniscate(const Vec3& q) {

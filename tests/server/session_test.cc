@@ -250,6 +250,21 @@ TEST_F(SessionTest, AllMeshesShareOneQuantizationBoxUntilDataFallsOutside) {
       << "the cube grows to hold data outside it";
 }
 
+TEST_F(SessionTest, AStalledLearnerFailsTheSessionInsteadOfSpinning) {
+  SessionConfig config;
+  config.target_vertices = 100;
+  config.learner.c_ec = 0.01;  // Step 3 after every Basic Step: collapses win over splits.
+  config.learner.c_vs = 10;
+  auto session = NewSession(config);
+  ASSERT_TRUE(session->AddPoints(Torus(2000, 9)).ok());
+  ASSERT_TRUE(session->Finish().ok());
+  absl::Status status = recorder_.AwaitClose();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInternal) << status;
+  EXPECT_THAT(std::string(status.message()), HasSubstr("stalled"));
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_FAILED);
+  EXPECT_THAT(session->ToProto().error(), HasSubstr("stalled"));
+}
+
 TEST(IsSpatiallyBiasedTest, RandomOrderIsNotBiasedAScanIs) {
   const PointCloud random = Torus(20000, 7);
   EXPECT_FALSE(IsSpatiallyBiased(random.positions));

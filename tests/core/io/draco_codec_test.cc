@@ -86,6 +86,11 @@ TEST(DracoCodecTest, EncodeRejectsEmptyAndInvalidInput) {
   bad_index.faces[3][1] = 1000;
   ExpectInvalid(EncodeMesh(bad_index, {}).status(), "face 3", "face index out of range");
 
+  TriangleMesh all_degenerate;
+  all_degenerate.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0)};
+  all_degenerate.faces = {{0, 0, 1}, {1, 1, 1}};
+  ExpectInvalid(EncodeMesh(all_degenerate, {}).status(), "degenerate", "only degenerate faces");
+
   TriangleMesh nan_vertex = testing::Icosphere(1);
   nan_vertex.positions[7][2] = NAN;
   ExpectInvalid(EncodeMesh(nan_vertex, {}).status(), "vertex 7", "NaN coordinate");
@@ -124,6 +129,29 @@ TEST(DracoCodecTest, OpenMeshWithBoundaryRoundTrips) {
   ExpectSameMesh(grid, *decoded, QuantizationTolerance(1.0f, 11), "GridPatch(7, 5)");
 }
 
+TEST(DracoCodecTest, EdgebreakerDropsUnusedVerticesAndDegenerateFacesAndSplitsBowties) {
+  const TriangleMesh sphere = testing::Icosphere(1);
+  TriangleMesh messy = sphere;
+  messy.positions.emplace_back(5.0f, 5.0f, 5.0f);  // Used by no face.
+  messy.faces.push_back({0, 0, 1});                // Degenerate.
+  const absl::StatusOr<std::string> bytes = EncodeMesh(messy, {});
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  const absl::StatusOr<TriangleMesh> decoded = DecodeMesh(*bytes);
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  ExpectSameMesh(sphere, *decoded, QuantizationTolerance(BoundingCubeRange(messy.positions), 11),
+                 "the sphere without its unused vertex and degenerate face");
+
+  // Two triangles touching at vertex 0 only: Draco gives each fan its own copy of vertex 0.
+  TriangleMesh bowtie;
+  bowtie.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(-1, 0, 0),
+                      Vec3f(0, -1, 0)};
+  bowtie.faces = {{0, 1, 2}, {0, 3, 4}};
+  const absl::StatusOr<TriangleMesh> split = DecodeMesh(*EncodeMesh(bowtie, {}));
+  ASSERT_TRUE(split.ok()) << split.status();
+  EXPECT_EQ(split->positions.size(), 6u) << "the non-manifold vertex should be duplicated";
+  ExpectSameMesh(bowtie, *split, QuantizationTolerance(2.0f, 11), "bowtie geometry");
+}
+
 TEST(DracoCodecTest, IcosphereLevel5NeedsAtMost8BytesPerVertexAt11Bits) {
   const TriangleMesh mesh = testing::Icosphere(5);
   DracoOptions options;
@@ -151,6 +179,13 @@ TEST(DracoCodecTest, PointCloudRoundTripKeepsNormalsAndWeights) {
     ExpectSameCloud(cloud, *decoded, QuantizationTolerance(BoundingCubeRange(cloud.positions), 11),
                     /*normal_tolerance=*/0.01f, /*weight_tolerance=*/1.5f / 65535 + 1e-5f,
                     "speed " + std::to_string(speed));
+    if (speed == 10) {
+      const float tolerance = QuantizationTolerance(BoundingCubeRange(cloud.positions), 11);
+      for (size_t i = 0; i < cloud.size(); ++i) {
+        ASSERT_LE((decoded->positions[i] - cloud.positions[i]).max_abs(), tolerance)
+            << "the sequential coder (speed 10) should keep point " << i << " in place";
+      }
+    }
   }
 }
 

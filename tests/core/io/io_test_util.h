@@ -19,11 +19,17 @@
 
 namespace neuralmesh::io_test {
 
-// A path under the test's temporary directory.
+// A path under the temporary directory, prefixed with the running test's name so that tests
+// run in parallel (ctest -j) never share a file.
 inline std::string TempPath(const std::string& name) {
   std::string dir = ::testing::TempDir();
   if (dir.empty() || dir.back() != '/') dir += '/';
-  return dir + name;
+  std::string prefix = "neuralmesh_io_";
+  if (const auto* test = ::testing::UnitTest::GetInstance()->current_test_info()) {
+    prefix += std::string(test->test_suite_name()) + "." + test->name() + "_";
+  }
+  std::replace(prefix.begin(), prefix.end(), '/', '_');
+  return dir + prefix + name;
 }
 
 // Writes raw bytes (text or binary) to `path`, failing the test if that is impossible.

@@ -65,6 +65,12 @@ TriangleMesh BentTube(int rings, int around, double gap) {
   return out;
 }
 
+BoundaryMergingOptions AlphaM(double alpha_m) {
+  BoundaryMergingOptions options;
+  options.alpha_m = alpha_m;
+  return options;
+}
+
 struct Counts {
   size_t vertices = 0;
   size_t edges = 0;
@@ -138,9 +144,9 @@ bool FacesPointAwayFromTheAxis(const Mesh& mesh) {
 
 TEST(BoundaryMergingTest, OptionsValidate) {
   EXPECT_TRUE(BoundaryMergingOptions{}.Validate().ok()) << "the paper's alpha_m = 5 is valid";
-  EXPECT_TRUE(BoundaryMergingOptions{0}.Validate().ok()) << "alpha_m = 0 (never merge) is valid";
-  EXPECT_FALSE(BoundaryMergingOptions{-1}.Validate().ok()) << "negative alpha_m accepted";
-  EXPECT_FALSE(BoundaryMergingOptions{INFINITY}.Validate().ok()) << "infinite alpha_m accepted";
+  EXPECT_TRUE(AlphaM(0).Validate().ok()) << "alpha_m = 0 (never merge) is valid";
+  EXPECT_FALSE(AlphaM(-1).Validate().ok()) << "negative alpha_m accepted";
+  EXPECT_FALSE(AlphaM(INFINITY).Validate().ok()) << "infinite alpha_m accepted";
 }
 
 TEST(BoundaryMergingTest, FacingTubesBecomeOneTube) {
@@ -258,7 +264,7 @@ TEST(BoundaryMergingTest, TwoHolesOfOneSphereMakeAHandle) {
 
   // The holes are on opposite sides, about 2 apart: alpha_m = 20 reaches across.
   const BoundaryMergingResult result =
-      MergeCloseBoundaries(mesh, BoundaryMergingOptions{20}, removal.mean_area);
+      MergeCloseBoundaries(mesh, AlphaM(20), removal.mean_area);
   EXPECT_EQ(result.merges, 1u) << "the two holes must merge";
   EXPECT_EQ(result.added_faces, 10u) << "a strip between two pentagons has 10 faces";
   const Counts after = Count(mesh);
@@ -330,7 +336,7 @@ TEST(BoundaryMergingTest, RandomCasesStayValid) {
       // A threshold below the tube length: only the facing rims can be close enough.
       const double alpha_m = 0.9 * length / std::sqrt(MeanTriangleArea(mesh));
       const BoundaryMergingResult result =
-          MergeCloseBoundaries(mesh, BoundaryMergingOptions{alpha_m}, 0);
+          MergeCloseBoundaries(mesh, AlphaM(alpha_m), 0);
       EXPECT_EQ(result.merges, 1u) << "seed " << seed << ": facing rims did not merge";
       EXPECT_EQ(result.added_faces, static_cast<size_t>(n1 + n2))
           << "seed " << seed << ": a strip uses each rim edge once";
@@ -343,7 +349,7 @@ TEST(BoundaryMergingTest, RandomCasesStayValid) {
       mesh = MustToMesh(BentTube(rings, around, 2 * M_PI / rings * uniform(0.3, 1.5)));
       jitter(mesh, 0.03);
       const BoundaryMergingResult result =
-          MergeCloseBoundaries(mesh, BoundaryMergingOptions{100}, 0);
+          MergeCloseBoundaries(mesh, AlphaM(100), 0);
       EXPECT_EQ(result.merges, 1u) << "seed " << seed << ": the tube ends did not merge";
       const Counts after = Count(mesh);
       EXPECT_EQ(after.boundary_loops, 0u) << "seed " << seed << ": torus not closed";
@@ -362,7 +368,7 @@ TEST(BoundaryMergingTest, RandomCasesStayValid) {
       ASSERT_TRUE(removed_status.ok()) << "seed " << seed << " after removal: " << removed_status;
       const Counts before = Count(mesh);
       const BoundaryMergingResult result =
-          MergeCloseBoundaries(mesh, BoundaryMergingOptions{uniform(1, 100)}, removal.mean_area);
+          MergeCloseBoundaries(mesh, AlphaM(uniform(1, 100)), removal.mean_area);
       const Counts after = Count(mesh);
       EXPECT_EQ(after.boundary_loops, before.boundary_loops - 2 * result.merges)
           << "seed " << seed << ": each merge must close two loops";
@@ -375,6 +381,74 @@ TEST(BoundaryMergingTest, RandomCasesStayValid) {
     ASSERT_TRUE(status.ok()) << "seed " << seed << " (kind " << kind << "): " << status;
     EXPECT_EQ(OrientationProblem(mesh), "") << "seed " << seed << ": inconsistent orientation";
   }
+}
+
+}  // namespace
+}  // namespace neuralmesh
+
+namespace neuralmesh {
+namespace {
+
+TEST(BoundaryMergingTest, LoopsThatStepFourIsStillGrowingAreNotMerged) {
+  TriangleMesh shape;
+  AppendTube(shape, 12, 7, 1.0, 0.0, 3.0, 0.0);
+  AppendTube(shape, 12, 7, 1.0, 3.2, 6.2, 0.1);
+  Mesh mesh = MustToMesh(shape);
+  // Vertex 6 * 12 is on the top rim of the first tube, one of the two facing rims.
+  const std::vector<Mesh::VertexHandle> growing = {Mesh::VertexHandle(6 * 12)};
+  ASSERT_TRUE(mesh.is_boundary(growing[0]));
+  BoundaryMergingResult result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 0, growing);
+  EXPECT_EQ(result.merges, 0u) << "a rim that Step 4 has just cut into must wait";
+  EXPECT_EQ(Count(mesh).boundary_loops, 4u);
+
+  const std::vector<Mesh::VertexHandle> elsewhere = {Mesh::VertexHandle(0)};  // Bottom rim.
+  result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 0, elsewhere);
+  EXPECT_EQ(result.merges, 1u) << "growing far rims must not stop the facing rims merging";
+  EXPECT_EQ(Count(mesh).boundary_loops, 2u);
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+TEST(BoundaryMergingTest, SmallHolesAreClosedInsteadOfMergedWhenAsked) {
+  // Two one-triangle holes next to each other on a sphere: close enough to merge into a
+  // handle, but their triangles are of ordinary size, so they are noise, not boundaries.
+  Mesh mesh = MustToMesh(Icosphere(3));
+  const double mean_area = MeanTriangleArea(mesh);
+  // f1: the face nearest to f0 that shares no vertex nor edge with it, so that removing both
+  // is legal and a strip between the two holes can be planned.
+  const Mesh::FaceHandle f0(0);
+  Mesh::FaceHandle f1;
+  double nearest = INFINITY;
+  for (auto fh : mesh.faces()) {
+    bool shares = false;  // A common vertex, or an edge between the two triangles.
+    for (auto a : mesh.fv_range(fh)) {
+      for (auto b : mesh.fv_range(f0)) {
+        shares = shares || a == b || mesh.find_halfedge(a, b).is_valid();
+      }
+    }
+    const double d = (mesh.calc_face_centroid(fh) - mesh.calc_face_centroid(f0)).norm();
+    if (!shares && d < nearest) {
+      nearest = d;
+      f1 = fh;
+    }
+  }
+  ASSERT_TRUE(f1.is_valid());
+  RemoveTriangle(mesh, f0, nullptr);
+  RemoveTriangle(mesh, f1, nullptr);
+  ASSERT_EQ(Count(mesh).boundary_loops, 2u);
+
+  Mesh merged_copy = mesh;
+  EXPECT_EQ(MergeCloseBoundaries(merged_copy, BoundaryMergingOptions{}, mean_area).merges, 1u)
+      << "the paper's Step 5 alone sews the two holes into a handle";
+
+  BoundaryMergingOptions options;
+  options.close_small_holes = true;
+  const BoundaryMergingResult result = MergeCloseBoundaries(mesh, options, mean_area);
+  EXPECT_EQ(result.closed.closed_holes, 2u) << "both tiny holes must be closed";
+  EXPECT_EQ(result.merges, 0u) << "nothing is left to merge";
+  const Counts after = Count(mesh);
+  EXPECT_EQ(after.boundary_loops, 0u);
+  EXPECT_EQ(after.euler(), 2) << "the sphere must stay genus 0";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
 }
 
 }  // namespace

@@ -1,0 +1,134 @@
+#include "core/learning/hole_closing.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "core/learning/triangle_removal.h"
+#include "core/mesh_validation.h"
+#include "gtest/gtest.h"
+#include "tests/testing/shapes.h"
+
+namespace neuralmesh {
+namespace {
+
+using testing::GridPatch;
+using testing::Icosphere;
+using testing::MustToMesh;
+
+std::vector<size_t> BoundaryLoopSizes(const Mesh& mesh) {
+  std::vector<size_t> sizes;
+  std::vector<bool> seen(mesh.n_halfedges(), false);
+  for (auto start : mesh.halfedges()) {
+    if (seen[start.idx()] || !mesh.is_boundary(start)) continue;
+    size_t n = 0;
+    auto h = start;
+    do {
+      seen[h.idx()] = true;
+      ++n;
+      h = mesh.next_halfedge_handle(h);
+    } while (h != start);
+    sizes.push_back(n);
+  }
+  std::sort(sizes.begin(), sizes.end());
+  return sizes;
+}
+
+long EulerCharacteristic(const Mesh& mesh) {
+  long chi = 0;
+  for (auto vh : mesh.vertices()) (void)vh, ++chi;
+  for (auto eh : mesh.edges()) (void)eh, --chi;
+  for (auto fh : mesh.faces()) (void)fh, ++chi;
+  return chi;
+}
+
+TEST(HoleClosingTest, OptionsValidate) {
+  EXPECT_TRUE(HoleClosingOptions{}.Validate().ok()) << "the defaults must be valid";
+  EXPECT_FALSE((HoleClosingOptions{0, 6}).Validate().ok()) << "alpha_r = 0 accepted";
+  EXPECT_FALSE((HoleClosingOptions{7, 2}).Validate().ok()) << "loops of 2 vertices accepted";
+}
+
+TEST(HoleClosingTest, OneTriangleHoleOfOrdinarySizeIsClosed) {
+  Mesh mesh = MustToMesh(Icosphere(2));
+  const double mean_area = MeanTriangleArea(mesh);
+  RemoveTriangle(mesh, Mesh::FaceHandle(5), nullptr);
+  ASSERT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({3}));
+  const HoleClosingResult result = CloseSmallHoles(mesh, HoleClosingOptions{}, mean_area);
+  EXPECT_EQ(result.closed_holes, 1u);
+  EXPECT_EQ(result.added_faces, 1u) << "a 3-vertex hole takes one triangle";
+  EXPECT_TRUE(BoundaryLoopSizes(mesh).empty()) << "the sphere must be closed again";
+  EXPECT_EQ(EulerCharacteristic(mesh), 2) << "and stay genus 0";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+TEST(HoleClosingTest, HoleWhoseFillingStepFourWouldRemoveStaysOpen) {
+  Mesh mesh = MustToMesh(Icosphere(2));
+  const double mean_area = MeanTriangleArea(mesh);
+  RemoveTriangle(mesh, Mesh::FaceHandle(5), nullptr);
+  HoleClosingOptions options;
+  options.alpha_r = 0.5;  // The filling triangle (about E(Area)) is now "large".
+  const HoleClosingResult result = CloseSmallHoles(mesh, options, mean_area);
+  EXPECT_EQ(result.closed_holes, 0u) << "a filling that Step 4 would cut again was added";
+  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({3}));
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+TEST(HoleClosingTest, HoleLeftByAVertexFanIsClosedEarByEar) {
+  Mesh mesh = MustToMesh(Icosphere(2));
+  const double mean_area = MeanTriangleArea(mesh);
+  // Remove every face around vertex 20 (valence 6): a hexagonal hole, the vertex goes too.
+  const Mesh::VertexHandle centre(20);
+  std::vector<Mesh::FaceHandle> fan;
+  for (auto fh : mesh.vf_range(centre)) fan.push_back(fh);
+  ASSERT_EQ(fan.size(), 6u);
+  // Around the fan, each removal is legal when it starts next to the growing hole.
+  std::vector<Mesh::VertexHandle> removed;
+  while (!fan.empty()) {
+    auto it = std::find_if(fan.begin(), fan.end(),
+                           [&](Mesh::FaceHandle fh) { return IsTriangleRemovalOk(mesh, fh); });
+    ASSERT_NE(it, fan.end());
+    RemoveTriangle(mesh, *it, &removed);
+    fan.erase(it);
+  }
+  ASSERT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({6}));
+  const HoleClosingResult result = CloseSmallHoles(mesh, HoleClosingOptions{}, mean_area);
+  EXPECT_EQ(result.closed_holes, 1u);
+  EXPECT_EQ(result.added_faces, 4u) << "a hexagon takes four triangles";
+  EXPECT_TRUE(BoundaryLoopSizes(mesh).empty());
+  EXPECT_EQ(EulerCharacteristic(mesh), 2) << "the sphere must stay genus 0";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+
+  HoleClosingOptions five;
+  five.max_loop_vertices = 5;
+  Mesh again = MustToMesh(Icosphere(2));
+  fan.clear();
+  for (auto fh : again.vf_range(centre)) fan.push_back(fh);
+  while (!fan.empty()) {
+    auto it = std::find_if(fan.begin(), fan.end(),
+                           [&](Mesh::FaceHandle fh) { return IsTriangleRemovalOk(again, fh); });
+    RemoveTriangle(again, *it, nullptr);
+    fan.erase(it);
+  }
+  EXPECT_EQ(CloseSmallHoles(again, five, mean_area).closed_holes, 0u)
+      << "a loop above max_loop_vertices was closed";
+}
+
+TEST(HoleClosingTest, BorderOfAnOpenSurfaceIsNeverClosed) {
+  Mesh mesh = MustToMesh(GridPatch(4, 4));
+  const HoleClosingResult result = CloseSmallHoles(mesh, HoleClosingOptions{}, 0);
+  EXPECT_EQ(result.closed_holes, 0u) << "a 16-vertex border is not a small hole";
+  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({16}));
+}
+
+TEST(HoleClosingTest, LoopAroundASingleTriangleIsNotDoubled) {
+  // A lone triangle (a component of one face) has a 3-vertex border; closing it would put a
+  // second face on the same three vertices, leaving vertices of valence 2.
+  TriangleMesh triangle;
+  triangle.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
+  triangle.faces = {{0, 1, 2}};
+  Mesh mesh = MustToMesh(triangle);
+  EXPECT_EQ(CloseSmallHoles(mesh, HoleClosingOptions{}, 0).closed_holes, 0u);
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+}  // namespace
+}  // namespace neuralmesh

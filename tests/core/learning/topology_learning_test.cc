@@ -1,0 +1,323 @@
+// Acceptance tests of topology learning (Steps 4 and 5 of Neural Meshes, Section 2.3, with
+// the small-hole rules of hole_closing.h and boundary_merging.h): whole reconstructions of
+// shapes with known topology, each over seeds 1..10, compared with the true surface.
+//
+// Every seed runs to kTopologyVertices and its topology is checked there; seeds
+// 1..kGeometrySeeds then continue to kGeometryVertices, where the topology is checked again
+// and the Chamfer-L1 distance to the true surface must stay below 1% of the bounding-box
+// diagonal. The split keeps the file at a few minutes on two cores.
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/analysis/geometric_error.h"
+#include "core/analysis/mesh_report.h"
+#include "core/learning/learner.h"
+#include "core/mesh_validation.h"
+#include "core/random.h"
+#include "core/sampling/implicit_surfaces.h"
+#include "core/sampling/point_cloud_sampler.h"
+#include "gtest/gtest.h"
+
+namespace neuralmesh {
+namespace {
+
+constexpr uint64_t kFirstSeed = 1;
+constexpr uint64_t kLastSeed = 10;
+constexpr size_t kTopologyVertices = 3000;
+constexpr uint64_t kGeometrySeeds = 2;
+constexpr size_t kGeometryVertices = 5000;
+constexpr double kMaxChamfer = 0.01;  // Of the reference's bounding-box diagonal.
+constexpr size_t kCloudPoints = 100000;
+
+Vec3 ToVec3(const Vec3f& p) { return Vec3(p[0], p[1], p[2]); }
+
+double MeanEdgeLength(const TriangleMesh& mesh) {
+  double total = 0;
+  for (const auto& f : mesh.faces) {
+    for (int k = 0; k < 3; ++k) {
+      total += (ToVec3(mesh.positions[f[k]]) - ToVec3(mesh.positions[f[(k + 1) % 3]])).norm();
+    }
+  }
+  return mesh.faces.empty() ? 0 : total / (3.0 * mesh.faces.size());
+}
+
+// The vertices on a boundary edge (an edge of exactly one face).
+std::vector<Vec3> BoundaryVertices(const TriangleMesh& mesh) {
+  std::vector<std::pair<uint32_t, uint32_t>> edges;
+  for (const auto& f : mesh.faces) {
+    for (int k = 0; k < 3; ++k) {
+      edges.emplace_back(std::min(f[k], f[(k + 1) % 3]), std::max(f[k], f[(k + 1) % 3]));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  std::vector<bool> on_boundary(mesh.positions.size(), false);
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i == 1) on_boundary[edges[i].first] = on_boundary[edges[i].second] = true;
+    i = j;
+  }
+  std::vector<Vec3> out;
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    if (on_boundary[v]) out.push_back(ToVec3(mesh.positions[v]));
+  }
+  return out;
+}
+
+// A test shape: what the learner samples, the true surface to compare with, and what the
+// reconstruction's topology must be.
+struct Shape {
+  std::unique_ptr<ImplicitSurface> surface;  // Owns the sampler when it is an implicit one.
+  std::unique_ptr<Sampler> cloud_sampler;    // Owns the sampler when it is a point cloud.
+  const Sampler* target = nullptr;
+  TriangleMesh reference;
+  int genus = 0;
+  size_t boundary_loops = 0;
+  // For open shapes: the true border is the circle where this returns 0 (signed distance of a
+  // boundary vertex to the cut plane).
+  std::function<double(const Vec3&)> border_offset;
+};
+
+// The unit sphere's reference mesh keeping the faces whose centroid satisfies `keep`.
+TriangleMesh PartOfSphere(const ImplicitSurface& sphere, const std::function<bool(Vec3)>& keep) {
+  TriangleMesh full = sphere.ReferenceMesh(40);
+  TriangleMesh part;
+  part.positions = full.positions;
+  for (const auto& f : full.faces) {
+    const Vec3 c =
+        (ToVec3(full.positions[f[0]]) + ToVec3(full.positions[f[1]]) + ToVec3(full.positions[f[2]])) /
+        3.0;
+    if (keep(c)) part.faces.push_back(f);
+  }
+  return part;
+}
+
+std::unique_ptr<Sampler> CloudSampler(PointCloud cloud) {
+  auto sampler = MakePointCloudSampler(std::make_shared<const PointCloud>(std::move(cloud)));
+  EXPECT_TRUE(sampler.ok()) << sampler.status();
+  return std::move(sampler).value();
+}
+
+Shape Sphere() {
+  Shape shape;
+  shape.surface = MakeSphere(Vec3(0, 0, 0), 1.0).value();
+  shape.target = shape.surface.get();
+  shape.reference = shape.surface->ReferenceMesh(40);
+  return shape;
+}
+
+Shape Torus() {
+  Shape shape;
+  shape.surface = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4).value();
+  shape.target = shape.surface.get();
+  shape.reference = shape.surface->ReferenceMesh(40);
+  shape.genus = 1;
+  return shape;
+}
+
+Shape GenusTwo() {
+  Shape shape;
+  shape.surface = MakeGenusTwo(Vec3(0, 0, 0), 1.0, 0.15).value();
+  shape.target = shape.surface.get();
+  shape.reference = shape.surface->ReferenceMesh(20);
+  shape.genus = 2;
+  return shape;
+}
+
+// Points of the unit sphere with z >= 0 (hemisphere) or z <= 0.7 (a cap cut away), and the
+// matching part of the sphere as reference. The cloud depends on the seed.
+Shape PartialSphere(bool hemisphere, uint64_t seed) {
+  const double cut = hemisphere ? 0.0 : 0.7;
+  auto keep = [hemisphere, cut](const Vec3& p) { return hemisphere ? p[2] >= cut : p[2] <= cut; };
+  auto sphere = MakeSphere(Vec3(0, 0, 0), 1.0).value();
+  Random rng(seed * 7919 + 1);
+  PointCloud cloud;
+  while (cloud.size() < kCloudPoints) {
+    const Vec3 p = sphere->Sample(rng);
+    if (keep(p)) cloud.positions.emplace_back(p[0], p[1], p[2]);
+  }
+  Shape shape;
+  shape.cloud_sampler = CloudSampler(std::move(cloud));
+  shape.target = shape.cloud_sampler.get();
+  shape.reference = PartOfSphere(*sphere, keep);
+  shape.boundary_loops = 1;
+  shape.border_offset = [cut](const Vec3& p) { return p[2] - cut; };
+  return shape;
+}
+
+Vec3 RotateAbout(const Vec3& p, const Vec3& axis, double angle) {
+  const Vec3 k = axis.normalized();
+  return p * std::cos(angle) + OpenMesh::cross(k, p) * std::sin(angle) +
+         k * OpenMesh::dot(k, p) * (1 - std::cos(angle));
+}
+
+// Six overlapping "range images" of the torus: the points whose normal is within 70 degrees
+// of one of the six axis directions, each patch rotated by 0.5 degrees about a random axis
+// and shifted by 0.2% of the torus's size in a random direction, all in one cloud.
+Shape MisalignedTorusPatches(uint64_t seed) {
+  constexpr double kR = 1.0;
+  constexpr double kr = 0.4;
+  Shape shape;
+  shape.surface = MakeTorus(Vec3(0, 0, 0), kR, kr).value();
+  shape.reference = shape.surface->ReferenceMesh(40);
+  shape.genus = 1;
+  const Vec3 views[6] = {Vec3(1, 0, 0),  Vec3(-1, 0, 0), Vec3(0, 1, 0),
+                         Vec3(0, -1, 0), Vec3(0, 0, 1),  Vec3(0, 0, -1)};
+  const double cos_limit = std::cos(70 * M_PI / 180);
+  const double size = 2 * (kR + kr);
+  Random rng(seed * 104729 + 3);
+  auto random_direction = [&rng] {
+    Vec3 d;
+    do {
+      d = Vec3(rng.NextDouble() - 0.5, rng.NextDouble() - 0.5, rng.NextDouble() - 0.5);
+    } while (d.norm() < 0.1 || d.norm() > 0.5);
+    return d.normalized();
+  };
+  PointCloud cloud;
+  for (const Vec3& view : views) {
+    const Vec3 axis = random_direction();
+    const double angle = 0.5 * M_PI / 180;
+    const Vec3 shift = random_direction() * (0.002 * size);
+    for (size_t n = 0; n < kCloudPoints / 6;) {
+      const Vec3 p = shape.surface->Sample(rng);
+      const Vec3 on_circle = Vec3(p[0], p[1], 0).normalized() * kR;
+      if (OpenMesh::dot((p - on_circle).normalized(), view) < cos_limit) continue;
+      const Vec3 q = RotateAbout(p, axis, angle) + shift;
+      cloud.positions.emplace_back(q[0], q[1], q[2]);
+      ++n;
+    }
+  }
+  shape.cloud_sampler = CloudSampler(std::move(cloud));
+  shape.target = shape.cloud_sampler.get();
+  return shape;
+}
+
+// Checks the topology of `learner`'s mesh against `shape`; returns "" or what is wrong.
+std::string TopologyProblem(const Learner& learner, const Shape& shape) {
+  std::ostringstream problem;
+  const absl::Status valid = ValidateMesh(learner.mesh());
+  if (!valid.ok()) problem << "invalid mesh: " << valid << "; ";
+  const TriangleMesh mesh = learner.Snapshot();
+  const MeshReport report = ComputeMeshReport(mesh);
+  if (!report.manifold()) problem << "not a manifold; ";
+  if (report.components != 1) problem << report.components << " components; ";
+  if (report.genus != shape.genus) {
+    problem << "genus " << report.genus << " instead of " << shape.genus << "; ";
+  }
+  if (report.boundary_loops != shape.boundary_loops) {
+    problem << report.boundary_loops << " boundary loops instead of " << shape.boundary_loops
+            << " (lengths";
+    for (size_t length : report.boundary_loop_lengths) problem << " " << length;
+    problem << "); ";
+  }
+  if (shape.border_offset) {
+    // The border must lie along the true one: every boundary vertex within a few mean edge
+    // lengths of the cut (a real boundary slightly underestimates the data, Section 2.3).
+    const double tolerance = 3 * MeanEdgeLength(mesh);
+    double worst = 0;
+    for (const Vec3& p : BoundaryVertices(mesh)) {
+      worst = std::max(worst, std::abs(shape.border_offset(p)));
+    }
+    if (worst > tolerance) {
+      problem << "a boundary vertex lies " << worst << " from the true border (tolerance "
+              << tolerance << "); ";
+    }
+  }
+  return problem.str();
+}
+
+std::unique_ptr<Learner> StartLearner(const Shape& shape, uint64_t seed) {
+  LearnerOptions options;
+  options.seed = seed;
+  auto learner = Learner::Create(options, shape.target);
+  EXPECT_TRUE(learner.ok()) << learner.status();
+  return std::move(learner).value();
+}
+
+void LearnTo(Learner& learner, size_t vertices) {
+  StopCriteria stop;
+  stop.target_vertices = vertices;
+  const auto reason = learner.Run(stop);
+  ASSERT_TRUE(reason.ok()) << reason.status();
+  ASSERT_EQ(*reason, StopReason::kTargetReached);
+}
+
+// Runs every seed, checks topology (and geometry on the first seeds), and fails once with the
+// list of failing seeds, so that the pass rate is visible in the output.
+void CheckOverSeeds(const std::string& name, const std::function<Shape(uint64_t)>& make_shape,
+                    const std::function<void(const Learner&, const Shape&, std::string*)>&
+                        extra_check = nullptr) {
+  size_t passed = 0;
+  std::ostringstream failures;
+  for (uint64_t seed = kFirstSeed; seed <= kLastSeed; ++seed) {
+    const Shape shape = make_shape(seed);
+    auto learner = StartLearner(shape, seed);
+    LearnTo(*learner, kTopologyVertices);
+    std::string problem = TopologyProblem(*learner, shape);
+    if (extra_check) extra_check(*learner, shape, &problem);
+    if (problem.empty() && seed < kFirstSeed + kGeometrySeeds) {
+      LearnTo(*learner, kGeometryVertices);
+      problem = TopologyProblem(*learner, shape);
+      if (extra_check) extra_check(*learner, shape, &problem);
+      GeometricErrorOptions error_options;
+      error_options.samples = 50000;
+      error_options.threads = 1;
+      const auto error = ComputeGeometricError(learner->Snapshot(), shape.reference, error_options);
+      if (!error.ok()) {
+        problem += "geometric error failed: " + std::string(error.status().message());
+      } else if (error->chamfer_l1 >= kMaxChamfer) {
+        problem += "Chamfer-L1 " + std::to_string(error->chamfer_l1) + " of the diagonal at " +
+                   std::to_string(kGeometryVertices) + " vertices";
+      }
+    }
+    if (problem.empty()) {
+      ++passed;
+    } else {
+      failures << "\n  seed " << seed << " at " << learner->num_vertices()
+               << " vertices: " << problem;
+    }
+  }
+  std::cout << "[ " << name << " ] " << passed << "/" << (kLastSeed - kFirstSeed + 1)
+            << " seeds pass" << std::endl;
+  EXPECT_EQ(passed, kLastSeed - kFirstSeed + 1) << name << ": failing seeds:" << failures.str();
+}
+
+TEST(TopologyLearningTest, TorusBecomesAClosedGenusOneManifold) {
+  CheckOverSeeds("torus", [](uint64_t) { return Torus(); });
+}
+
+TEST(TopologyLearningTest, GenusTwoSurfaceBecomesAClosedGenusTwoManifold) {
+  CheckOverSeeds("genus 2", [](uint64_t) { return GenusTwo(); });
+}
+
+TEST(TopologyLearningTest, SphereStaysClosedWithoutAnyRemoval) {
+  CheckOverSeeds("sphere", [](uint64_t) { return Sphere(); },
+                 [](const Learner& learner, const Shape&, std::string* problem) {
+                   if (learner.progress().removed_triangles != 0) {
+                     *problem += std::to_string(learner.progress().removed_triangles) +
+                                 " triangles removed from a sphere; ";
+                   }
+                 });
+}
+
+TEST(TopologyLearningTest, HemisphereEndsWithOneBoundaryAlongItsBorder) {
+  CheckOverSeeds("hemisphere", [](uint64_t seed) { return PartialSphere(true, seed); });
+}
+
+TEST(TopologyLearningTest, SphereWithAMissingCapGetsOneBoundaryAtTheHole) {
+  CheckOverSeeds("missing cap", [](uint64_t seed) { return PartialSphere(false, seed); });
+}
+
+TEST(TopologyLearningTest, MisalignedPatchesGiveAClosedTorusWithoutTopologicalNoise) {
+  CheckOverSeeds("misaligned patches", MisalignedTorusPatches);
+}
+
+}  // namespace
+}  // namespace neuralmesh

@@ -34,6 +34,8 @@ ABSL_FLAG(int64_t, batch_points, 1 << 18, "Points per batch in the ingest measur
 ABSL_FLAG(int64_t, lod_target, 20000, "Target vertex count of the LOD measurement.");
 ABSL_FLAG(double, learn_seconds, 3.0, "Measurement window of the learning-rate measurement.");
 ABSL_FLAG(int, worker_threads, 2, "The server's learning threads.");
+ABSL_FLAG(int, lod_refresh_ms, 250, "Refresh interval of the LOD session (0: milestones only).");
+ABSL_FLAG(bool, only_lods, false, "Run the LOD and learning-rate measurements only.");
 
 namespace neuralmesh {
 namespace {
@@ -53,10 +55,11 @@ v1::PointBatch Batch(const PointCloud& cloud, size_t begin, size_t end) {
 }
 
 std::string Create(v1::ReconstructionService::Stub& stub, uint64_t target,
-                   v1::FinalPass final_pass = v1::FINAL_PASS_AUTO) {
+                   v1::FinalPass final_pass = v1::FINAL_PASS_AUTO, int refresh_ms = 250) {
   grpc::ClientContext context;
   v1::CreateSessionRequest request;
   request.mutable_config()->set_target_vertices(target);
+  request.mutable_config()->mutable_refresh_interval_ms()->set_value(refresh_ms);
   request.mutable_config()->set_final_pass(final_pass);
   v1::Session session;
   grpc::Status status = stub.CreateSession(&context, request, &session);
@@ -171,7 +174,8 @@ void MeasureFirstMesh(v1::ReconstructionService::Stub& stub) {
 std::pair<double, uint64_t> MeasureLods(v1::ReconstructionService::Stub& stub,
                                         const PointCloud& points) {
   const uint64_t target = static_cast<uint64_t>(absl::GetFlag(FLAGS_lod_target));
-  const std::string id = Create(stub, target, v1::FINAL_PASS_CONTINUE);
+  const std::string id = Create(stub, target, v1::FINAL_PASS_CONTINUE,
+                                absl::GetFlag(FLAGS_lod_refresh_ms));
   std::vector<v1::MeshUpdate> updates;
   std::thread watcher([&] {
     grpc::ClientContext context;
@@ -199,7 +203,8 @@ std::pair<double, uint64_t> MeasureLods(v1::ReconstructionService::Stub& stub,
   }
   watcher.join();
   const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
-  std::printf("LODs (11-bit positions, Draco speed 5):\n");
+  std::printf("LODs (11-bit positions, Draco speed 5, refresh every %d ms):\n",
+              absl::GetFlag(FLAGS_lod_refresh_ms));
   std::printf("  %-9s %9s %9s %10s %8s %10s\n", "kind", "vertices", "faces", "bytes", "B/vert",
               "encode ms");
   for (const v1::MeshUpdate& u : updates) {
@@ -213,21 +218,40 @@ std::pair<double, uint64_t> MeasureLods(v1::ReconstructionService::Stub& stub,
   }
   std::printf("  [target <= 8 bytes per vertex at 11 bits]\n");
   const uint64_t steps = updates.empty() ? 0 : updates.back().learning().basic_steps();
+  if (!updates.empty()) {
+    const v1::LearningState& learning = updates.back().learning();
+    std::printf("  the session's learning thread: %llu Basic Steps in %.2f s of learning "
+                "(%.0f steps/s); wall time from upload to final mesh %.2f s\n",
+                static_cast<unsigned long long>(learning.basic_steps()),
+                learning.learning_seconds(), learning.steps_per_second(), seconds);
+  }
   Delete(stub, id);
   return {seconds, steps};
 }
 
+// Learns from scratch to --lod_target vertices in this process, as the local CLI does;
+// returns the wall time in seconds.
+double LocalToTarget(const PointCloud& points) {
+  GrowingPointCloud cloud(points.size());
+  if (!cloud.Append(points.positions).ok()) std::exit(1);
+  auto learner = Learner::Create(LearnerOptions(), &cloud);
+  StopCriteria to_target;
+  to_target.target_vertices = static_cast<size_t>(absl::GetFlag(FLAGS_lod_target));
+  const absl::Time start = absl::Now();
+  if (!(*learner)->Run(to_target).ok()) std::exit(1);
+  return absl::ToDoubleSeconds(absl::Now() - start);
+}
+
 void MeasureLearning(v1::ReconstructionService::Stub& stub, const PointCloud& points,
-                     double lod_wall_seconds, uint64_t lod_steps) {
+                     double lod_wall_seconds, uint64_t lod_steps, double local_to_target) {
   const absl::Duration window = absl::Seconds(absl::GetFlag(FLAGS_learn_seconds));
   const absl::Duration warmup = absl::Milliseconds(500);
 
   // The same learner in this process, on the same points: what the local CLI runs.
   double local_rate = 0;
-  double local_to_target = 0;
   {
     GrowingPointCloud cloud(points.size());
-    cloud.Append(points.positions);
+    if (!cloud.Append(points.positions).ok()) std::exit(1);
     auto learner = Learner::Create(LearnerOptions(), &cloud);
     StopCriteria warm;
     warm.time_budget = warmup;
@@ -240,14 +264,9 @@ void MeasureLearning(v1::ReconstructionService::Stub& stub, const PointCloud& po
     local_rate = ((*learner)->progress().basic_steps - before) /
                  absl::ToDoubleSeconds(absl::Now() - start);
 
-    auto fresh = Learner::Create(LearnerOptions(), &cloud);
-    StopCriteria to_target;
-    to_target.target_vertices = static_cast<size_t>(absl::GetFlag(FLAGS_lod_target));
-    const absl::Time t = absl::Now();
-    (*fresh)->Run(to_target);
-    local_to_target = absl::ToDoubleSeconds(absl::Now() - t);
   }
-  std::printf("learning, local learner: %.0f Basic Steps/s; to %lld vertices in %.2f s\n",
+  std::printf("learning, local learner: %.0f Basic Steps/s; to %lld vertices in %.2f s "
+              "(mean of a run before and one after the server session)\n",
               local_rate, static_cast<long long>(absl::GetFlag(FLAGS_lod_target)),
               local_to_target);
   std::printf("learning, one server session to %lld vertices (upload, learning, snapshots, "
@@ -315,11 +334,17 @@ int main(int argc, char** argv) {
               (*server)->target().c_str(), options.worker_threads,
               std::thread::hardware_concurrency());
 
-  MeasureIngest(*stub);
-  MeasureFirstMesh(*stub);
+  if (!absl::GetFlag(FLAGS_only_lods)) {
+    MeasureIngest(*stub);
+    MeasureFirstMesh(*stub);
+  }
   const PointCloud points = Torus(400000, 3);
+  // Local runs right before and after the server's, so that load from other processes on
+  // the machine weighs on both sides alike.
+  const double local_before = LocalToTarget(points);
   const auto [lod_seconds, lod_steps] = MeasureLods(*stub, points);
-  MeasureLearning(*stub, points, lod_seconds, lod_steps);
+  const double local_after = LocalToTarget(points);
+  MeasureLearning(*stub, points, lod_seconds, lod_steps, (local_before + local_after) / 2);
   (*server)->Shutdown();
   return 0;
 }

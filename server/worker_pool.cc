@@ -60,22 +60,30 @@ void WorkerPool::WorkerLoop() {
     entry.wake_pending = false;
     std::shared_ptr<Schedulable> task = entry.task;  // Keeps it alive outside the lock.
 
-    mu_.Unlock();
-    const SliceResult result = task->RunSlice(absl::Now() + slice_);
-    mu_.Lock();
+    while (true) {
+      mu_.Unlock();
+      const SliceResult result = task->RunSlice(absl::Now() + slice_);
+      mu_.Lock();
 
-    // Shutdown may have cleared the table while the slice ran.
-    auto it = entries_.find(key);
-    if (it == entries_.end()) continue;
-    if (result.kind == SliceResult::kDone) {
-      entries_.erase(it);
-    } else if (result.kind == SliceResult::kMore || it->second.wake_pending) {
-      it->second.place = Place::kQueued;
-      it->second.wake_pending = false;
-      queue_.push_back(key);
-    } else {
+      // Shutdown may have cleared the table while the slice ran.
+      auto it = entries_.find(key);
+      if (it == entries_.end()) break;
+      if (result.kind == SliceResult::kDone) {
+        entries_.erase(it);
+        break;
+      }
+      if (result.kind == SliceResult::kMore || it->second.wake_pending) {
+        it->second.wake_pending = false;
+        FireTimersLocked(absl::Now());
+        // Nobody else waits: keep the task on this thread, where its data is in the caches.
+        if (queue_.empty() && !shutdown_) continue;
+        it->second.place = Place::kQueued;
+        queue_.push_back(key);
+        break;
+      }
       entries_.erase(it);
       if (result.wake_at != absl::InfiniteFuture()) timers_.emplace(result.wake_at, task);
+      break;
     }
     // Drop our reference outside the lock: the last reference may destroy a session.
     mu_.Unlock();

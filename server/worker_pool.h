@@ -4,7 +4,9 @@
 // front of one FIFO run queue, calls RunSlice with a deadline one slice away, and puts the task
 // back at the end of the queue if it has more to do. With W workers and S runnable sessions
 // every session therefore gets about W / S of the cores and waits at most about
-// (S / W) * slice between two of its slices: 8 sessions on 2 workers all make progress.
+// (S / W) * slice between two of its slices: 8 sessions on 2 workers all make progress. When
+// no other task waits, a task that wants more keeps its worker (no hop to another core with
+// cold caches).
 //
 // A task is in one of three places: nowhere (idle, not known to the pool), in the queue, or
 // running on a worker. Wake() makes an idle task runnable; waking a task that is running marks

@@ -72,19 +72,19 @@ struct BoundaryMergingOptions {
 };
 
 struct BoundaryMergingResult {
-  size_t merges = 0;       // Pairs of loops sewn together.
-  size_t added_faces = 0;  // Faces of all strips; no vertex is ever added or removed.
+  size_t merges = 0;         // Pairs of loops sewn together.
+  size_t added_faces = 0;    // Faces of all strips; no vertex is ever added or removed.
   HoleClosingResult closed;  // Small holes closed before merging (close_small_holes).
 };
 
 // Step 5 (Eq. 3): when options.close_small_holes is set, first closes the small holes as
-// CloseSmallHoles does; then merges every pair of boundary loops of `mesh` whose vertex sets are closer
-// than options.alpha_m * sqrt(mean_area) in Hausdorff distance, closest pair first, each loop
-// at most once per call. `mean_area` is E(Area) (for example TriangleRemovalResult::mean_area);
-// pass <= 0 to compute it from the live faces. `options` must be valid (Validate()).
-// Works on meshes with deleted elements, adds elements without garbage collection, and leaves
-// the mesh passing ValidateMesh after each merge. O(h) to find the loops, plus O(|A| |B|)
-// per pair that passes a bounding-box lower bound on H and per merge.
+// CloseSmallHoles does; then merges every pair of boundary loops of `mesh` whose vertex sets are
+// closer than options.alpha_m * sqrt(mean_area) in Hausdorff distance, closest pair first, each
+// loop at most once per call. `mean_area` is E(Area) (for example
+// TriangleRemovalResult::mean_area); pass <= 0 to compute it from the live faces. `options` must be
+// valid (Validate()). Works on meshes with deleted elements, adds elements without garbage
+// collection, and leaves the mesh passing ValidateMesh after each merge. O(h) to find the loops,
+// plus O(|A| |B|) per pair that passes a bounding-box lower bound on H and per merge.
 BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOptions& options,
                                            double mean_area);
 

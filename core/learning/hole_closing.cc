@@ -104,8 +104,7 @@ absl::Status HoleClosingOptions::Validate() const {
   return absl::OkStatus();
 }
 
-HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options,
-                                  double mean_area) {
+HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options, double mean_area) {
   HoleClosingResult result;
   const std::vector<VertexLoop> loops =
       CollectSmallLoops(mesh, static_cast<size_t>(options.max_loop_vertices));

@@ -66,8 +66,7 @@ struct HoleClosingResult {
 // to compute it from the live faces. `options` must be valid (Validate()). Works on meshes
 // with deleted elements, adds faces and edges without garbage collection, never adds or
 // removes a vertex. O(h) to find the loops plus O(k^3) per loop of k vertices.
-HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options,
-                                  double mean_area);
+HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options, double mean_area);
 
 }  // namespace neuralmesh
 

@@ -285,8 +285,14 @@ TEST_F(ReconstructionServiceTest, WatchersJoinLateLeaveEarlyAndReadSlowly) {
   EXPECT_EQ(response.batches_accepted(), 20u);
 
   // A late watcher gets the latest mesh at once.
+  // Learning and encoding run concurrently with the upload: wait (bounded) for a mesh.
   v1::Session before = testing::GetSession(*stub_, id);
-  ASSERT_GT(before.latest_sequence(), 0u) << "meshes should have been published by now";
+  for (const absl::Time deadline = absl::Now() + absl::Seconds(20);
+       before.latest_sequence() == 0 && absl::Now() < deadline;
+       before = testing::GetSession(*stub_, id)) {
+    absl::SleepFor(absl::Milliseconds(5));
+  }
+  ASSERT_GT(before.latest_sequence(), 0u) << "no mesh was published within 20 s of the upload";
   {
     grpc::ClientContext context;
     v1::WatchSessionRequest request;

@@ -216,8 +216,20 @@ TEST_F(SessionTest, CancelStopsLearningAndEndsWatchersWithCancelled) {
   EXPECT_EQ(recorder_.AwaitClose(absl::Seconds(5)).code(), absl::StatusCode::kCancelled);
   EXPECT_TRUE(session->Cancel("again").ok()) << "cancelling twice is a no-op";
   EXPECT_EQ(session->Finish().code(), absl::StatusCode::kFailedPrecondition);
-  const uint64_t steps = session->ToProto().learning().basic_steps();
-  absl::SleepFor(absl::Milliseconds(100));
+  // The slice that was running stops at the learner's next poll and leaves the pool.
+  const absl::Time deadline = absl::Now() + absl::Seconds(5);
+  while (pool_.active_tasks() > 0 && absl::Now() < deadline) absl::SleepFor(absl::Milliseconds(1));
+  EXPECT_EQ(pool_.active_tasks(), 0u) << "a cancelled session must leave the worker pool";
+  // The last slice's progress may be published just after it leaves the pool; once two
+  // readings 100 ms apart agree, the count must stay put.
+  uint64_t steps = session->ToProto().learning().basic_steps();
+  for (const absl::Time settle = absl::Now() + absl::Seconds(5); absl::Now() < settle;) {
+    absl::SleepFor(absl::Milliseconds(100));
+    const uint64_t now = session->ToProto().learning().basic_steps();
+    if (now == steps) break;
+    steps = now;
+  }
+  absl::SleepFor(absl::Milliseconds(300));
   EXPECT_EQ(session->ToProto().learning().basic_steps(), steps) << "learning goes on";
   EXPECT_EQ(session->ToProto().error(), "test");
 }

@@ -263,8 +263,7 @@ TEST(BoundaryMergingTest, TwoHolesOfOneSphereMakeAHandle) {
   ASSERT_EQ(Count(mesh).euler(), 0) << "a sphere with two holes";
 
   // The holes are on opposite sides, about 2 apart: alpha_m = 20 reaches across.
-  const BoundaryMergingResult result =
-      MergeCloseBoundaries(mesh, AlphaM(20), removal.mean_area);
+  const BoundaryMergingResult result = MergeCloseBoundaries(mesh, AlphaM(20), removal.mean_area);
   EXPECT_EQ(result.merges, 1u) << "the two holes must merge";
   EXPECT_EQ(result.added_faces, 10u) << "a strip between two pentagons has 10 faces";
   const Counts after = Count(mesh);
@@ -335,8 +334,7 @@ TEST(BoundaryMergingTest, RandomCasesStayValid) {
       jitter(mesh, 0.05);
       // A threshold below the tube length: only the facing rims can be close enough.
       const double alpha_m = 0.9 * length / std::sqrt(MeanTriangleArea(mesh));
-      const BoundaryMergingResult result =
-          MergeCloseBoundaries(mesh, AlphaM(alpha_m), 0);
+      const BoundaryMergingResult result = MergeCloseBoundaries(mesh, AlphaM(alpha_m), 0);
       EXPECT_EQ(result.merges, 1u) << "seed " << seed << ": facing rims did not merge";
       EXPECT_EQ(result.added_faces, static_cast<size_t>(n1 + n2))
           << "seed " << seed << ": a strip uses each rim edge once";
@@ -348,8 +346,7 @@ TEST(BoundaryMergingTest, RandomCasesStayValid) {
       const int around = 3 + static_cast<int>(random.NextIndex(10));
       mesh = MustToMesh(BentTube(rings, around, 2 * M_PI / rings * uniform(0.3, 1.5)));
       jitter(mesh, 0.03);
-      const BoundaryMergingResult result =
-          MergeCloseBoundaries(mesh, AlphaM(100), 0);
+      const BoundaryMergingResult result = MergeCloseBoundaries(mesh, AlphaM(100), 0);
       EXPECT_EQ(result.merges, 1u) << "seed " << seed << ": the tube ends did not merge";
       const Counts after = Count(mesh);
       EXPECT_EQ(after.boundary_loops, 0u) << "seed " << seed << ": torus not closed";

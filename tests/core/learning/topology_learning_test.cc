@@ -91,9 +91,9 @@ TriangleMesh PartOfSphere(const ImplicitSurface& sphere, const std::function<boo
   TriangleMesh part;
   part.positions = full.positions;
   for (const auto& f : full.faces) {
-    const Vec3 c =
-        (ToVec3(full.positions[f[0]]) + ToVec3(full.positions[f[1]]) + ToVec3(full.positions[f[2]])) /
-        3.0;
+    const Vec3 c = (ToVec3(full.positions[f[0]]) + ToVec3(full.positions[f[1]]) +
+                    ToVec3(full.positions[f[2]])) /
+                   3.0;
     if (keep(c)) part.faces.push_back(f);
   }
   return part;
@@ -251,9 +251,9 @@ void LearnTo(Learner& learner, size_t vertices) {
 
 // Runs every seed, checks topology (and geometry on the first seeds), and fails once with the
 // list of failing seeds, so that the pass rate is visible in the output.
-void CheckOverSeeds(const std::string& name, const std::function<Shape(uint64_t)>& make_shape,
-                    const std::function<void(const Learner&, const Shape&, std::string*)>&
-                        extra_check = nullptr) {
+void CheckOverSeeds(
+    const std::string& name, const std::function<Shape(uint64_t)>& make_shape,
+    const std::function<void(const Learner&, const Shape&, std::string*)>& extra_check = nullptr) {
   size_t passed = 0;
   std::ostringstream failures;
   for (uint64_t seed = kFirstSeed; seed <= kLastSeed; ++seed) {
@@ -298,13 +298,14 @@ TEST(TopologyLearningTest, GenusTwoSurfaceBecomesAClosedGenusTwoManifold) {
 }
 
 TEST(TopologyLearningTest, SphereStaysClosedWithoutAnyRemoval) {
-  CheckOverSeeds("sphere", [](uint64_t) { return Sphere(); },
-                 [](const Learner& learner, const Shape&, std::string* problem) {
-                   if (learner.progress().removed_triangles != 0) {
-                     *problem += std::to_string(learner.progress().removed_triangles) +
-                                 " triangles removed from a sphere; ";
-                   }
-                 });
+  CheckOverSeeds(
+      "sphere", [](uint64_t) { return Sphere(); },
+      [](const Learner& learner, const Shape&, std::string* problem) {
+        if (learner.progress().removed_triangles != 0) {
+          *problem += std::to_string(learner.progress().removed_triangles) +
+                      " triangles removed from a sphere; ";
+        }
+      });
 }
 
 TEST(TopologyLearningTest, HemisphereEndsWithOneBoundaryAlongItsBorder) {

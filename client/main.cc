@@ -62,6 +62,14 @@ ABSL_FLAG(bool, merge_boundaries, kLearnerDefaults.merge_boundaries,
           "Step 5 (Section 2.3): boundary merging on or off (--nomerge_boundaries).");
 ABSL_FLAG(int32_t, splits_per_step, kLearnerDefaults.splits_per_step,
           "Vertex splits per call of Step 2 (Section 3.3), >= 1.");
+ABSL_FLAG(bool, close_small_holes, kLearnerDefaults.close_small_holes,
+          "Step 5: refill small holes whose filling triangles pass Step 4's area test "
+          "(--noclose_small_holes).");
+ABSL_FLAG(int32_t, max_closed_hole_vertices, kLearnerDefaults.max_closed_hole_vertices,
+          "The largest boundary loop, in vertices, that close_small_holes refills, >= 3.");
+ABSL_FLAG(bool, merge_only_settled_boundaries, kLearnerDefaults.merge_only_settled_boundaries,
+          "Step 5 skips loops that Step 4 cut into in the same call "
+          "(--nomerge_only_settled_boundaries).");
 
 // Local learning.
 ABSL_FLAG(std::string, sampling, "uniform",
@@ -122,6 +130,9 @@ neuralmesh::LearnerOptions LearnerFromFlags() {
   o.merge_boundaries = absl::GetFlag(FLAGS_merge_boundaries);
   o.alpha_m = absl::GetFlag(FLAGS_alpha_m);
   o.splits_per_step = absl::GetFlag(FLAGS_splits_per_step);
+  o.close_small_holes = absl::GetFlag(FLAGS_close_small_holes);
+  o.max_closed_hole_vertices = absl::GetFlag(FLAGS_max_closed_hole_vertices);
+  o.merge_only_settled_boundaries = absl::GetFlag(FLAGS_merge_only_settled_boundaries);
   o.seed = absl::GetFlag(FLAGS_seed);
   return o;
 }
@@ -224,7 +235,8 @@ std::vector<Subcommand> Commands() {
   const std::vector<std::string> reconstruct = {
       "output", "vertices", "lod", "seed", "alpha_w", "alpha_l", "c_l", "c_vs", "c_ec",
       "alpha_sc", "alpha_r", "alpha_m", "remove_triangles", "merge_boundaries",
-      "splits_per_step", "sampling", "time_budget", "max_steps", "quantization_bits",
+      "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
+      "merge_only_settled_boundaries", "sampling", "time_budget", "max_steps", "quantization_bits",
       "encode_speed", "progress", "server", "out-dir", "batch-size", "points", "ply",
       "connect_timeout"};
   // clang-format on

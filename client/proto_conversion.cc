@@ -15,6 +15,10 @@ v1::LearnerOptions ToProto(const LearnerOptions& options) {
   proto.mutable_merge_boundaries()->set_value(options.merge_boundaries);
   proto.mutable_alpha_m()->set_value(options.alpha_m);
   proto.mutable_splits_per_step()->set_value(options.splits_per_step);
+  proto.mutable_close_small_holes()->set_value(options.close_small_holes);
+  proto.mutable_max_closed_hole_vertices()->set_value(options.max_closed_hole_vertices);
+  proto.mutable_merge_only_settled_boundaries()->set_value(
+      options.merge_only_settled_boundaries);
   proto.mutable_seed()->set_value(options.seed);
   return proto;
 }

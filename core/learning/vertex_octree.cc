@@ -93,6 +93,20 @@ void VertexOctree::Insert(int id, const Vec3& p) {
   ++size_;
 }
 
+int VertexOctree::ChildToward(int n, const Vec3& p) {
+  const int o = Octant(nodes_[n], p);
+  int child = nodes_[n].children[o];
+  if (child < 0) {
+    const double h = nodes_[n].half * 0.5;
+    const Vec3& center = nodes_[n].center;
+    const Vec3 c(center[0] + ((o & 1) ? h : -h), center[1] + ((o & 2) ? h : -h),
+                 center[2] + ((o & 4) ? h : -h));
+    child = NewNode(c, h, n);
+    nodes_[n].children[o] = child;
+  }
+  return child;
+}
+
 void VertexOctree::InsertIntoTree(int id) {
   const Vec3& p = position_[id];
   int n = root_;
@@ -101,16 +115,7 @@ void VertexOctree::InsertIntoTree(int id) {
     Node& node = nodes_[n];
     ++node.count;
     if (node.leaf) break;
-    const int o = Octant(node, p);
-    int child = node.children[o];
-    if (child < 0) {
-      const double h = node.half * 0.5;
-      const Vec3 c(node.center[0] + ((o & 1) ? h : -h), node.center[1] + ((o & 2) ? h : -h),
-                   node.center[2] + ((o & 4) ? h : -h));
-      child = NewNode(c, h, n);  // May reallocate nodes_: do not use `node` after this.
-      nodes_[n].children[o] = child;
-    }
-    n = child;
+    n = ChildToward(n, p);  // May reallocate nodes_: `node` is not used after this.
     ++depth;
   }
   Node& leaf = nodes_[n];
@@ -133,16 +138,7 @@ void VertexOctree::SplitLeaf(int n) {
       Node& node = nodes_[m];
       ++node.count;
       if (node.leaf) break;
-      const int o = Octant(node, p);
-      int child = node.children[o];
-      if (child < 0) {
-        const double h = node.half * 0.5;
-        const Vec3 c(node.center[0] + ((o & 1) ? h : -h), node.center[1] + ((o & 2) ? h : -h),
-                     node.center[2] + ((o & 4) ? h : -h));
-        child = NewNode(c, h, m);
-        nodes_[m].children[o] = child;
-      }
-      m = child;
+      m = ChildToward(m, p);
     }
     leaf_of_[id] = m;
     slot_[id] = static_cast<int>(nodes_[m].items.size());

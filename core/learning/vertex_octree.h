@@ -52,6 +52,8 @@ class VertexOctree {
   bool InCube(const Node& node, const Vec3& p) const;
   int Octant(const Node& node, const Vec3& p) const;
   void GrowRootToward(const Vec3& p);
+  // The child of internal node n that contains p, created (as an empty leaf) if absent.
+  int ChildToward(int n, const Vec3& p);
   void InsertIntoTree(int id);
   void SplitLeaf(int n);
   void CollapseSubtree(int n);

@@ -3,6 +3,7 @@
 #ifndef NEURALMESH_TESTS_CORE_IO_IO_TEST_UTIL_H_
 #define NEURALMESH_TESTS_CORE_IO_IO_TEST_UTIL_H_
 
+#include <cstring>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -18,6 +19,17 @@
 #include "gtest/gtest.h"
 
 namespace neuralmesh::io_test {
+
+// Appends `value` in the given byte order, for hand-built binary files.
+template <typename T>
+void Put(T value, bool big_endian, std::string* out) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  const bool host_big = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
+  if (big_endian != host_big) std::reverse(bytes, bytes + sizeof(T));
+  out->append(bytes, sizeof(T));
+}
+
 
 // A path under the temporary directory, prefixed with the running test's name so that tests
 // run in parallel (ctest -j) never share a file.
@@ -191,3 +203,4 @@ inline PointCloud RandomCloud(int n, uint64_t seed, bool normals, bool weights) 
 }  // namespace neuralmesh::io_test
 
 #endif  // NEURALMESH_TESTS_CORE_IO_IO_TEST_UTIL_H_
+

@@ -15,19 +15,11 @@ namespace neuralmesh {
 namespace {
 
 using io_test::ExpectSameMesh;
+using io_test::Put;
 using io_test::TempPath;
 using io_test::WriteBytes;
 using ::testing::HasSubstr;
 
-// Appends `value` in the given byte order, for hand-built binary files.
-template <typename T>
-void Put(T value, bool big_endian, std::string* out) {
-  char bytes[sizeof(T)];
-  std::memcpy(bytes, &value, sizeof(T));
-  const bool host_big = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
-  if (big_endian != host_big) std::reverse(bytes, bytes + sizeof(T));
-  out->append(bytes, sizeof(T));
-}
 
 // Writes `content` to a fresh file called `name` and reads it as a mesh.
 absl::StatusOr<TriangleMesh> ReadContent(const std::string& name, const std::string& content) {

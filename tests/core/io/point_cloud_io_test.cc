@@ -17,18 +17,11 @@ namespace neuralmesh {
 namespace {
 
 using io_test::ExpectSameCloud;
+using io_test::Put;
 using io_test::TempPath;
 using io_test::WriteBytes;
 using ::testing::HasSubstr;
 
-template <typename T>
-void Put(T value, bool big_endian, std::string* out) {
-  char bytes[sizeof(T)];
-  std::memcpy(bytes, &value, sizeof(T));
-  const bool host_big = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
-  if (big_endian != host_big) std::reverse(bytes, bytes + sizeof(T));
-  out->append(bytes, sizeof(T));
-}
 
 absl::StatusOr<PointCloud> ReadContent(const std::string& name, const std::string& content) {
   const std::string path = TempPath(name);

@@ -97,9 +97,10 @@ int Run() {
       std::fflush(stdout);
     }
   }
-  std::printf("\nColumns octree..merge: seconds spent per step kind (octree = sampling, winner "
-              "search and index updates; smooth = Eq. 1 and C_L smoothing; split = Step 2 with "
-              "the counters; collapse, removal, merge = Steps 3, 4, 5).\n");
+  std::printf("\nColumns octree..merge: seconds spent per step kind (octree = sampling and the "
+              "winner search; smooth = Eq. 1, the C_L smoothing passes and the octree updates of "
+              "the moved vertices; split = Step 2 with the counters; collapse, removal, merge = "
+              "Steps 3, 4, 5).\n");
   return 0;
 }
 

@@ -49,8 +49,8 @@ struct LearnerProgress {
 // Wall time spent per kind of step, filled only when timing is enabled (it costs two clock
 // reads per Basic Step).
 struct LearnerTimings {
-  absl::Duration winner_search;  // Sampling, octree query and update.
-  absl::Duration smoothing;      // Eq. 1 move and C_L smoothing iterations.
+  absl::Duration winner_search;  // Sampling and the octree query.
+  absl::Duration smoothing;      // Eq. 1, C_L smoothing passes, octree updates of moved vertices.
   absl::Duration split;          // Step 2 including the signal counters.
   absl::Duration collapse;       // Step 3.
   absl::Duration removal;        // Step 4.

@@ -1,5 +1,6 @@
 #include "tests/testing/shapes.h"
 
+#include <algorithm>
 #include <map>
 #include <utility>
 
@@ -58,6 +59,24 @@ TriangleMesh GridPatch(int nx, int ny) {
     }
   }
   return m;
+}
+
+std::vector<size_t> BoundaryLoopSizes(const Mesh& mesh) {
+  std::vector<size_t> sizes;
+  std::vector<bool> seen(mesh.n_halfedges(), false);
+  for (auto start : mesh.halfedges()) {
+    if (seen[start.idx()] || !mesh.is_boundary(start)) continue;
+    size_t n = 0;
+    auto h = start;
+    do {  // Bounded, so that a broken mesh fails the test instead of hanging it.
+      seen[h.idx()] = true;
+      ++n;
+      h = mesh.next_halfedge_handle(h);
+    } while (h != start && n <= mesh.n_halfedges());
+    sizes.push_back(n);
+  }
+  std::sort(sizes.begin(), sizes.end());
+  return sizes;
 }
 
 Mesh MustToMesh(const TriangleMesh& triangles) {

@@ -11,27 +11,10 @@
 namespace neuralmesh {
 namespace {
 
+using testing::BoundaryLoopSizes;
 using testing::GridPatch;
 using testing::Icosphere;
 using testing::MustToMesh;
-
-std::vector<size_t> BoundaryLoopSizes(const Mesh& mesh) {
-  std::vector<size_t> sizes;
-  std::vector<bool> seen(mesh.n_halfedges(), false);
-  for (auto start : mesh.halfedges()) {
-    if (seen[start.idx()] || !mesh.is_boundary(start)) continue;
-    size_t n = 0;
-    auto h = start;
-    do {
-      seen[h.idx()] = true;
-      ++n;
-      h = mesh.next_halfedge_handle(h);
-    } while (h != start);
-    sizes.push_back(n);
-  }
-  std::sort(sizes.begin(), sizes.end());
-  return sizes;
-}
 
 long EulerCharacteristic(const Mesh& mesh) {
   long chi = 0;

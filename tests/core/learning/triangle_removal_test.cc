@@ -12,6 +12,7 @@
 namespace neuralmesh {
 namespace {
 
+using testing::BoundaryLoopSizes;
 using testing::GridPatch;
 using testing::Icosphere;
 using testing::MustToMesh;
@@ -23,25 +24,6 @@ size_t LiveFaces(const Mesh& mesh) {
     ++n;
   }
   return n;
-}
-
-// Sizes of the boundary loops over live half-edges, sorted.
-std::vector<size_t> BoundaryLoopSizes(const Mesh& mesh) {
-  std::vector<size_t> sizes;
-  std::vector<bool> seen(mesh.n_halfedges(), false);
-  for (auto start : mesh.halfedges()) {
-    if (seen[start.idx()] || !mesh.is_boundary(start)) continue;
-    size_t n = 0;
-    auto h = start;
-    do {
-      seen[h.idx()] = true;
-      ++n;
-      h = mesh.next_halfedge_handle(h);
-    } while (h != start && n <= mesh.n_halfedges());
-    sizes.push_back(n);
-  }
-  std::sort(sizes.begin(), sizes.end());
-  return sizes;
 }
 
 double FaceArea(const Mesh& mesh, Mesh::FaceHandle fh) {

@@ -44,15 +44,17 @@ struct ReaderReport {
   }
 };
 
-// Samples until `done`, checking each sample against the pattern, the size and the box.
-// `allowed(i)` says whether point i may be drawn at all (weight zero may not).
+// Samples until `done` and at least kMinSamples times (on a loaded machine the writer may
+// finish before a reader is first scheduled), checking each sample against the pattern, the
+// size and the box. `allowed(i)` says whether point i may be drawn at all (weight zero may not).
+constexpr long kMinSamples = 2000;
 template <typename Allowed>
 void Read(const GrowingPointCloud& cloud, const std::atomic<bool>& done, uint64_t seed,
           Allowed allowed, ReaderReport* report) {
   Random rng(seed);
   size_t last_size = 0;
   long round = 0;
-  while (!done.load(std::memory_order_acquire)) {
+  while (!done.load(std::memory_order_acquire) || report->samples < kMinSamples) {
     const size_t size_before = cloud.size();
     if (size_before < last_size) {
       report->Fail(absl::StrCat("size went down from ", last_size, " to ", size_before));
@@ -178,7 +180,7 @@ TEST(GrowingPointCloudConcurrentTest, ConcurrentAppendsKeepBatchesWhole) {
   for (int r = 0; r < kReaders; ++r) {
     readers.emplace_back([&, r] {
       Random rng(300 + r);
-      while (!done.load(std::memory_order_acquire)) {
+      while (!done.load(std::memory_order_acquire) || reports[r].samples < kMinSamples) {
         if (cloud.empty()) continue;
         const Vec3 p = cloud.Sample(rng);
         ++reports[r].samples;

@@ -255,12 +255,12 @@ void MeasureLearning(v1::ReconstructionService::Stub& stub, const PointCloud& po
     auto learner = Learner::Create(LearnerOptions(), &cloud);
     StopCriteria warm;
     warm.time_budget = warmup;
-    (*learner)->Run(warm);
+    if (!(*learner)->Run(warm).ok()) std::exit(1);
     const uint64_t before = (*learner)->progress().basic_steps;
     StopCriteria measure;
     measure.time_budget = window;
     const absl::Time start = absl::Now();
-    (*learner)->Run(measure);
+    if (!(*learner)->Run(measure).ok()) std::exit(1);
     local_rate = ((*learner)->progress().basic_steps - before) /
                  absl::ToDoubleSeconds(absl::Now() - start);
 

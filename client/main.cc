@@ -63,13 +63,17 @@ ABSL_FLAG(bool, merge_boundaries, kLearnerDefaults.merge_boundaries,
 ABSL_FLAG(int32_t, splits_per_step, kLearnerDefaults.splits_per_step,
           "Vertex splits per call of Step 2 (Section 3.3), >= 1.");
 ABSL_FLAG(bool, close_small_holes, kLearnerDefaults.close_small_holes,
-          "Step 5: refill small holes whose filling triangles pass Step 4's area test "
-          "(--noclose_small_holes).");
+          "Step 5: refill holes and slits whose filling passes Step 4's area test and bridges "
+          "no more than Step 5 would (--noclose_small_holes).");
 ABSL_FLAG(int32_t, max_closed_hole_vertices, kLearnerDefaults.max_closed_hole_vertices,
           "The largest boundary loop, in vertices, that close_small_holes refills, >= 3.");
 ABSL_FLAG(bool, merge_only_settled_boundaries, kLearnerDefaults.merge_only_settled_boundaries,
           "Step 5 skips loops that Step 4 cut into in the same call "
           "(--nomerge_only_settled_boundaries).");
+ABSL_FLAG(bool, split_largest_cell_near_most_active,
+          kLearnerDefaults.split_largest_cell_near_most_active,
+          "Step 2 splits the largest cell (F_v, Eq. 5-6) of the most active vertex's 1-ring; "
+          "--nosplit_largest_cell_near_most_active splits the most active vertex itself.");
 
 // Local learning.
 ABSL_FLAG(std::string, sampling, "uniform",
@@ -133,6 +137,8 @@ neuralmesh::LearnerOptions LearnerFromFlags() {
   o.close_small_holes = absl::GetFlag(FLAGS_close_small_holes);
   o.max_closed_hole_vertices = absl::GetFlag(FLAGS_max_closed_hole_vertices);
   o.merge_only_settled_boundaries = absl::GetFlag(FLAGS_merge_only_settled_boundaries);
+  o.split_largest_cell_near_most_active =
+      absl::GetFlag(FLAGS_split_largest_cell_near_most_active);
   o.seed = absl::GetFlag(FLAGS_seed);
   return o;
 }
@@ -236,7 +242,7 @@ std::vector<Subcommand> Commands() {
       "output", "vertices", "lod", "seed", "alpha_w", "alpha_l", "c_l", "c_vs", "c_ec",
       "alpha_sc", "alpha_r", "alpha_m", "remove_triangles", "merge_boundaries",
       "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
-      "merge_only_settled_boundaries", "sampling", "time_budget", "max_steps", "quantization_bits",
+      "merge_only_settled_boundaries", "split_largest_cell_near_most_active", "sampling", "time_budget", "max_steps", "quantization_bits",
       "encode_speed", "progress", "server", "out-dir", "batch-size", "points", "ply",
       "connect_timeout"};
   // clang-format on

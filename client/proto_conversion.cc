@@ -19,6 +19,8 @@ v1::LearnerOptions ToProto(const LearnerOptions& options) {
   proto.mutable_max_closed_hole_vertices()->set_value(options.max_closed_hole_vertices);
   proto.mutable_merge_only_settled_boundaries()->set_value(
       options.merge_only_settled_boundaries);
+  proto.mutable_split_largest_cell_near_most_active()->set_value(
+      options.split_largest_cell_near_most_active);
   proto.mutable_seed()->set_value(options.seed);
   return proto;
 }

@@ -51,6 +51,9 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
   if (l.has_merge_only_settled_boundaries()) {
     o.merge_only_settled_boundaries = l.merge_only_settled_boundaries().value();
   }
+  if (l.has_split_largest_cell_near_most_active()) {
+    o.split_largest_cell_near_most_active = l.split_largest_cell_near_most_active().value();
+  }
 
   config.target_vertices = proto.target_vertices();
   config.lod_milestones.assign(proto.lod_milestones().begin(), proto.lod_milestones().end());
@@ -109,6 +112,8 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
   l.mutable_close_small_holes()->set_value(o.close_small_holes);
   l.mutable_max_closed_hole_vertices()->set_value(o.max_closed_hole_vertices);
   l.mutable_merge_only_settled_boundaries()->set_value(o.merge_only_settled_boundaries);
+  l.mutable_split_largest_cell_near_most_active()->set_value(
+      o.split_largest_cell_near_most_active);
 
   proto.set_target_vertices(config.target_vertices);
   for (size_t m : config.lod_milestones) proto.add_lod_milestones(m);

@@ -5,32 +5,35 @@
 //
 //   E <- E(Area) (given, or the mean area of the live faces)
 //   for every boundary loop L with at most max_loop_vertices vertices:
-//     repeat until L is filled or no ear qualifies:
-//       among the ears (a, b, c) of L (three consecutive vertices, b removable) whose area is
-//       <= alpha_r * E, whose new edge a-c does not exist yet, and that leave every vertex
-//       with a legal valence: add the one of largest minimum angle quality
-//     when L cannot be filled completely, the ears already added are removed again
+//     among the triangulations of L in which every triangle has area <= alpha_r * E (Step 4
+//     would keep it), every new edge is at most alpha_m * sqrt(E) long (the distance at which
+//     Step 5 merges two boundaries) and does not exist yet, and every vertex keeps a legal
+//     valence: add the one of least total new-edge length, if there is one
 //
 // Why: Step 4 removes a triangle when its area says that it covers a region without data
 // (Eq. 2). While the mesh is still learning the geometry (a misplaced vertex, the remains of a
 // strip sewn across a cavity by Step 5), it also cuts triangles in regions that do have data.
 // The hole then shrinks back as its vertices converge, but it can never vanish: Step 3 may not
 // collapse an edge of a loop of 3 vertices (OpenMesh's link condition), so the hole stays
-// forever, and Step 5 sews pairs of such tiny holes into extra handles. A hole is refilled here
-// only when Step 4 itself would no longer remove any of the filling triangles: the data has
-// come back, so the removal was premature. A real boundary (an open surface's border, a hole
-// over a cavity that Step 5 still has to merge) is never closed: its filling triangles span a
-// region without data and are far larger than alpha_r E (a loop of v vertices around a real
-// hole spans about v^2 / (4 pi) mean triangles), or it has more than max_loop_vertices vertices.
-// Closing a hole is undone by Step 4 if its triangles grow large again, so the rule cannot
-// fight the paper's steps; it only removes loops that would otherwise be stuck.
+// forever, and Step 5 sews pairs of such tiny holes into extra handles. Removals along a seam
+// that Step 5 has sewn can also open a long thin slit: one loop whose two sides lie a few
+// edges apart, which Step 5 cannot merge because it joins two different loops. A hole is
+// refilled here only when Step 4 itself would keep every filling triangle (the data has come
+// back, so the removal was premature) and no new edge is longer than Step 5 would bridge: the
+// slit is zipped as Step 5 would sew two loops that close. A real boundary (an open surface's
+// border, a hole over a cavity that Step 5 still has to merge) is never closed: any
+// triangulation of a round hole has an edge across it, about sqrt(3) times its radius, so only
+// holes narrower than about alpha_m sqrt(E) (a few edge lengths) qualify, and their filling
+// triangles must still pass Step 4. Closing a hole is undone by Step 4 if its triangles grow
+// large again, so the rule cannot fight the paper's steps; it only removes loops that would
+// otherwise be stuck.
 //
-// Legality: each ear uses two boundary half-edges of the loop and adds one edge (a, c) that
-// must not exist yet (no double edge, which also excludes closing a loop of 3 vertices that
-// bounds a single face on the other side); its middle vertex b becomes interior and must keep
-// valence >= 3; the last triangle of a loop uses three boundary half-edges, and each of its
-// vertices becomes interior with valence >= 3. A loop never shares a vertex with another loop
-// in a valid mesh, so filling one leaves every other loop intact and the mesh passes
+// Legality: no new edge may exist yet (no double edge, which also excludes closing a loop of 3
+// vertices that bounds a single face on the other side); a vertex that gets no new edge (an
+// ear tip, or each corner of a loop of 3) becomes interior and must have valence >= 3. The
+// faces are added children first, each sharing two sides with the current hole border, in
+// the loop's half-edge order, so orientation is kept. A loop never shares a vertex with another
+// loop in a valid mesh, so filling one leaves every other loop intact and the mesh passes
 // ValidateMesh after every closed hole.
 #ifndef NEURALMESH_CORE_LEARNING_HOLE_CLOSING_H_
 #define NEURALMESH_CORE_LEARNING_HOLE_CLOSING_H_
@@ -46,12 +49,14 @@ struct HoleClosingOptions {
   // alpha_r of Eq. 2: a filling triangle must have area <= alpha_r * E(Area), the test that
   // Step 4 applies to keep a triangle. > 0.
   double alpha_r = 7;
-  // Loops with more vertices are never closed, whatever their area. >= 3. Six vertices are
-  // the ring of one vertex: the largest hole that a single premature removal with its corner
-  // (or two neighbouring removals) opens.
-  int max_loop_vertices = 6;
+  // alpha_m of Eq. 3: a new edge may be at most alpha_m * sqrt(E(Area)) long, the distance
+  // below which Step 5 merges two boundaries. > 0.
+  double alpha_m = 5;
+  // Loops with more vertices are never closed. >= 3. It bounds the O(k^3) work per loop.
+  int max_loop_vertices = 256;
 
-  // Returns INVALID_ARGUMENT unless alpha_r is finite and positive and max_loop_vertices >= 3.
+  // Returns INVALID_ARGUMENT unless alpha_r and alpha_m are finite and positive and
+  // max_loop_vertices >= 3.
   absl::Status Validate() const;
 };
 
@@ -60,12 +65,12 @@ struct HoleClosingResult {
   size_t added_faces = 0;
 };
 
-// Fills every boundary loop of `mesh` with at most options.max_loop_vertices vertices whose
-// filling triangles all have area <= options.alpha_r * mean_area and are legal (see the file
-// comment). `mean_area` is E(Area) (for example TriangleRemovalResult::mean_area); pass <= 0
-// to compute it from the live faces. `options` must be valid (Validate()). Works on meshes
-// with deleted elements, adds faces and edges without garbage collection, never adds or
-// removes a vertex. O(h) to find the loops plus O(k^3) per loop of k vertices.
+// Fills every boundary loop of `mesh` with at most options.max_loop_vertices vertices that has
+// an admissible triangulation (see the file comment). `mean_area` is E(Area) (for example
+// TriangleRemovalResult::mean_area); pass <= 0 to compute it from the live faces. `options` must be
+// valid (Validate()). Works on meshes with deleted elements, adds faces and edges without garbage
+// collection, never adds or removes a vertex. O(h) to find the loops plus O(k^3) per loop of k
+// vertices.
 HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options, double mean_area);
 
 }  // namespace neuralmesh

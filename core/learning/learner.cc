@@ -13,6 +13,7 @@
 #include "core/learning/tangential_smoothing.h"
 #include "core/learning/triangle_removal.h"
 #include "core/learning/vertex_octree.h"
+#include "core/learning/vertex_ring_cache.h"
 #include "core/learning/vertex_split.h"
 #include "core/status_macros.h"
 
@@ -21,9 +22,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-absl::Duration Since(Clock::time_point start) {
-  return absl::FromChrono(Clock::now() - start);
-}
+absl::Duration Since(Clock::time_point start) { return absl::FromChrono(Clock::now() - start); }
 
 }  // namespace
 
@@ -63,8 +62,8 @@ class Learner::Impl {
     Vec3& pw = mesh_.point(w);
     pw = (1.0 - options_.alpha_w) * pw + options_.alpha_w * s;  // Eq. 1
     octree_.Move(winner, pw);
-    smoother_.Smooth(mesh_, w, options_.alpha_l, options_.c_l);
-    for (auto q : smoother_.moved()) octree_.Move(q.idx(), mesh_.point(q));
+    smoother_.Smooth(mesh_, rings_, w, options_.alpha_l, options_.c_l);
+    for (const int q : smoother_.moved()) octree_.Move(q, mesh_.point(Mesh::VertexHandle(q)));
     if (timed) timings_.smoothing += Since(t1);
 
     ++step_;
@@ -82,8 +81,7 @@ class Learner::Impl {
 
   absl::StatusOr<StopReason> Run(const StopCriteria& stop) {
     if (stop.target_vertices == 0 && stop.max_basic_steps == 0 &&
-        stop.time_budget == absl::InfiniteDuration() && stop.cancel == nullptr &&
-        !stop.observer) {
+        stop.time_budget == absl::InfiniteDuration() && stop.cancel == nullptr && !stop.observer) {
       return absl::InvalidArgumentError(
           "no stop criterion: set a target vertex count, a step or time budget, a cancel flag "
           "or an observer");
@@ -140,17 +138,26 @@ class Learner::Impl {
     return static_cast<uint64_t>(std::ceil(options_.c_ec * static_cast<double>(live_vertices_)));
   }
 
-  // Step 2: split the most active vertex; its counter is shared in proportion to F_v (Eq. 5-6).
+  // Step 2: split the most active vertex, or the largest cell next to it (see
+  // split_largest_cell_near_most_active); the split vertex's counter is shared in proportion
+  // to F_v (Eq. 5-6).
   void SplitMostActive() {
-    const int id = counters_.MostActive(
+    const int most_active = counters_.MostActive(
         [this](int v) { return CanSplitVertex(mesh_, Mesh::VertexHandle(v)); });
-    if (id < 0) return;
-    const Mesh::VertexHandle v(id);
+    if (most_active < 0) return;
+    const Mesh::VertexHandle v = options_.split_largest_cell_near_most_active
+                                     ? LargestCellNear(mesh_, Mesh::VertexHandle(most_active))
+                                     : Mesh::VertexHandle(most_active);
+    const int id = v.idx();
     const double counter = counters_.Value(id, step_);
     const Mesh::VertexHandle v0 = SplitVertex(mesh_, v);
     if (!v0.is_valid()) return;
     ++live_vertices_;
     ++progress_.splits;
+    // Every ring the split changed (v, v0, the two cut neighbours, the neighbours v0 took
+    // over) belongs to v0 or one of its neighbours.
+    rings_.Invalidate(v0.idx());
+    for (auto u : mesh_.vv_range(v0)) rings_.Invalidate(u.idx());
     const double f1 = VoronoiAreaEstimate(mesh_, v);
     const double f0 = VoronoiAreaEstimate(mesh_, v0);
     const double share0 = (f0 + f1) > 0 ? f0 / (f0 + f1) : 0.5;
@@ -187,6 +194,7 @@ class Learner::Impl {
       merging.alpha_m = options_.alpha_m;
       merging.close_small_holes = options_.close_small_holes;
       merging.hole_closing.alpha_r = options_.alpha_r;
+      merging.hole_closing.alpha_m = options_.alpha_m;
       merging.hole_closing.max_loop_vertices = options_.max_closed_hole_vertices;
       const BoundaryMergingResult merged = MergeCloseBoundaries(mesh_, merging, mean_area, growing);
       progress_.merged_boundaries += merged.merges;
@@ -196,6 +204,7 @@ class Learner::Impl {
     last_connectivity_step_ = step_;
     next_connectivity_step_ = step_ + std::max<uint64_t>(1, ConnectivityInterval());
     CollectGarbageIfWorthIt();
+    rings_.InvalidateAll();  // Collapses, removals, merges and compaction changed rings.
   }
 
   void CollapseInactive() {
@@ -249,6 +258,7 @@ class Learner::Impl {
   VertexOctree octree_;
   SignalCounters counters_;
   OneRingSmoother smoother_;
+  VertexRingCache rings_;
   OpenMesh::VPropHandleT<uint64_t> last_win_;
   uint64_t step_ = 0;
   uint64_t last_connectivity_step_ = 0;

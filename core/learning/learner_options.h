@@ -20,6 +20,15 @@ struct LearnerOptions {
   int c_vs = 100;          // C_vs, Section 2.2: Basic Steps between two vertex splits, >= 1.
   double c_ec = 10;        // C_ec, Section 2.2: Step 3 runs every C_ec * v Basic Steps, > 0.
   double alpha_sc = 0.95;  // alpha_sc, Section 2.2 / Eq. 4: signal counter decay, (0, 1).
+  // Where Step 2 splits (vertex_split.h, LargestCellNear). The paper splits the vertex with the
+  // highest signal counter and relies on high-valence vertices having larger restricted Voronoi
+  // cells (Section 3.1). With alpha_sc = 0.95 the counter remembers about 20 Basic Steps, so at
+  // thousands of vertices it is in effect the most recent winner, and that rule alone ends at
+  // about 29% valence-6 vertices instead of the paper's 46%. When true (not in the paper),
+  // the counter picks the place, and the split goes to the vertex of the most active vertex's
+  // closed 1-ring with the largest F_v (Eq. 5-6): about 50% valence 6 and the same density
+  // adaptation (Section 3.1). False gives the paper's literal rule.
+  bool split_largest_cell_near_most_active = true;
 
   // Topology changes (Section 2.3), run right after each Step 3.
   bool remove_triangles = true;  // Step 4 on or off.
@@ -28,11 +37,13 @@ struct LearnerOptions {
   double alpha_m = 5;            // alpha_m, Eq. 3: merge boundaries closer than
                                  // alpha_m sqrt(E(Area)) (Hausdorff distance).
   // Not in the paper (hole_closing.h): right before Step 5, a boundary loop of at most
-  // max_closed_hole_vertices vertices is filled again when Step 4 would keep every filling
-  // triangle (area <= alpha_r E(Area)), so holes cut while the geometry was still converging
-  // do not stay forever nor get sewn into extra handles (Section 1: no topological noise).
+  // max_closed_hole_vertices vertices is filled again when it can be triangulated with
+  // triangles Step 4 would keep (area <= alpha_r E(Area)) and edges no longer than Step 5
+  // bridges (alpha_m sqrt(E(Area))), so holes and slits cut while the geometry was still
+  // converging do not stay forever nor get sewn into extra handles (Section 1: no topological
+  // noise). Real borders and holes are wider than that and stay open.
   bool close_small_holes = true;
-  int max_closed_hole_vertices = 6;  // >= 3: larger loops are never closed.
+  int max_closed_hole_vertices = 256;  // >= 3: longer loops are never closed (O(k^3) work).
   // Not in the paper (boundary_merging.h): Step 5 leaves alone a loop that Step 4 has cut into
   // in the same call; it is merged once it has stopped growing, i.e. reached the data.
   bool merge_only_settled_boundaries = true;

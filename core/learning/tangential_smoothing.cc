@@ -14,34 +14,16 @@ void StoreUnit(double x, double y, double z, double* out) {
   out[2] = z * inv;
 }
 
-// Appends the neighbours of v in rotation order. A raw half-edge walk: OpenMesh's circulators
-// cost several times more, and this runs seven times per Basic Step.
-void AppendNeighbours(const Mesh& mesh, Mesh::VertexHandle v, std::vector<int>& out) {
-  const Mesh::HalfedgeHandle first = mesh.halfedge_handle(v);
-  Mesh::HalfedgeHandle h = first;
-  do {
-    out.push_back(mesh.to_vertex_handle(h).idx());
-    h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
-  } while (h != first);
-}
-
 }  // namespace
 
-void OneRingSmoother::Smooth(Mesh& mesh, Mesh::VertexHandle winner, double alpha_l,
-                             int iterations) {
+void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle winner,
+                             double alpha_l, int iterations) {
   ring_.clear();
   offsets_.clear();
   neighbours_.clear();
   direction_.clear();
   on_border_.clear();
-  {
-    const Mesh::HalfedgeHandle first = mesh.halfedge_handle(winner);
-    Mesh::HalfedgeHandle h = first;
-    do {
-      ring_.push_back(mesh.to_vertex_handle(h));
-      h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
-    } while (h != first);
-  }
+  rings.AppendRing(mesh, winner.idx(), ring_);
   if (alpha_l <= 0 || iterations <= 0) return;
 
   // The points live in one contiguous array (an OpenMesh property); nothing below adds a
@@ -50,17 +32,19 @@ void OneRingSmoother::Smooth(Mesh& mesh, Mesh::VertexHandle winner, double alpha
   auto at = [points](int v) { return points + 3 * static_cast<size_t>(v); };
 
   // Gather each ring vertex's neighbours once, and its normal (or border tangent).
-  for (auto q : ring_) {
-    offsets_.push_back(static_cast<int>(neighbours_.size()));
-    const bool border = mesh.is_boundary(q);
+  for (const int q : ring_) {
+    const int first = static_cast<int>(neighbours_.size());
+    offsets_.push_back(first);
+    const bool border = rings.AppendRing(mesh, q, neighbours_);
     on_border_.push_back(border);
     direction_.resize(direction_.size() + 3);
     double* dir = direction_.data() + direction_.size() - 3;
     if (border) {
-      // Outgoing boundary half-edge q -> b1, and the incoming one b0 -> q.
-      const auto out = mesh.halfedge_handle(q);
-      const int b1 = mesh.to_vertex_handle(out).idx();
-      const int b0 = mesh.from_vertex_handle(mesh.prev_halfedge_handle(out)).idx();
+      // Only the two neighbours along the border count: b1 (the end of the outgoing boundary
+      // half-edge) comes first in the ring, b0 (the start of the incoming one) last.
+      const int b1 = neighbours_[first];
+      const int b0 = neighbours_.back();
+      neighbours_.resize(first);
       neighbours_.push_back(b0);
       neighbours_.push_back(b1);
       const double* p0 = at(b0);
@@ -68,10 +52,8 @@ void OneRingSmoother::Smooth(Mesh& mesh, Mesh::VertexHandle winner, double alpha
       StoreUnit(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2], dir);
       continue;
     }
-    const int first = static_cast<int>(neighbours_.size());
-    AppendNeighbours(mesh, q, neighbours_);
     const int count = static_cast<int>(neighbours_.size()) - first;
-    const double* p = at(q.idx());
+    const double* p = at(q);
     double nx = 0, ny = 0, nz = 0;
     for (int i = 0; i < count; ++i) {
       const double* a = at(neighbours_[first + i]);
@@ -97,7 +79,7 @@ void OneRingSmoother::Smooth(Mesh& mesh, Mesh::VertexHandle winner, double alpha
         cy += u[1];
         cz += u[2];
       }
-      double* p = at(ring_[i].idx());
+      double* p = at(ring_[i]);
       const double inv = 1.0 / (end - begin);
       const double lx = cx * inv - p[0], ly = cy * inv - p[1], lz = cz * inv - p[2];
       const double* d = direction_.data() + 3 * i;

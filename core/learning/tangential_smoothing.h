@@ -16,19 +16,23 @@
 
 #include <vector>
 
+#include "core/learning/vertex_ring_cache.h"
 #include "core/mesh.h"
 
 namespace neuralmesh {
 
 class OneRingSmoother {
  public:
-  // Smooths the 1-ring of `winner`. The vertices it moved are in moved() afterwards.
-  void Smooth(Mesh& mesh, Mesh::VertexHandle winner, double alpha_l, int iterations);
-  const std::vector<Mesh::VertexHandle>& moved() const { return ring_; }
+  // Smooths the 1-ring of `winner`, reading rings through `rings` (which the caller keeps
+  // up to date with the connectivity). The vertices it moved (indices) are in moved()
+  // afterwards.
+  void Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle winner, double alpha_l,
+              int iterations);
+  const std::vector<int>& moved() const { return ring_; }
 
  private:
   // Scratch storage reused across calls: the Basic Step allocates nothing.
-  std::vector<Mesh::VertexHandle> ring_;
+  std::vector<int> ring_;
   std::vector<int> offsets_;     // Into neighbours_, per ring vertex (+1 end).
   std::vector<int> neighbours_;  // Vertex indices.
   std::vector<double> direction_;  // 3 per ring vertex: unit normal, or unit border tangent.

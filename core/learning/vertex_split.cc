@@ -43,6 +43,20 @@ double VoronoiAreaEstimate(const Mesh& mesh, Mesh::VertexHandle v) {
   return l * l;
 }
 
+Mesh::VertexHandle LargestCellNear(const Mesh& mesh, Mesh::VertexHandle center) {
+  Mesh::VertexHandle best = center;
+  double best_area = CanSplitVertex(mesh, center) ? VoronoiAreaEstimate(mesh, center) : -1;
+  for (auto u : mesh.vv_range(center)) {
+    if (!CanSplitVertex(mesh, u)) continue;
+    const double area = VoronoiAreaEstimate(mesh, u);
+    if (area > best_area) {
+      best_area = area;
+      best = u;
+    }
+  }
+  return best;
+}
+
 Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
   if (!CanSplitVertex(mesh, v)) return Mesh::VertexHandle();
   std::vector<Mesh::HalfedgeHandle> star;

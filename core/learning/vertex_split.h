@@ -25,6 +25,11 @@ Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v);
 // v's restricted Voronoi cell by which a split divides the signal counter.
 double VoronoiAreaEstimate(const Mesh& mesh, Mesh::VertexHandle v);
 
+// Of `center` and its neighbours, the vertex that CanSplitVertex allows with the largest
+// VoronoiAreaEstimate (ties: `center` first, then rotation order), or `center` when none is
+// splittable. O(valence^2).
+Mesh::VertexHandle LargestCellNear(const Mesh& mesh, Mesh::VertexHandle center);
+
 }  // namespace neuralmesh
 
 #endif  // NEURALMESH_CORE_LEARNING_VERTEX_SPLIT_H_

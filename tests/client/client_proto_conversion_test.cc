@@ -20,6 +20,10 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   options.alpha_m = 4;
   options.splits_per_step = 2;
   options.seed = 99;
+  options.close_small_holes = false;
+  options.max_closed_hole_vertices = 5;
+  options.merge_only_settled_boundaries = false;
+  options.split_largest_cell_near_most_active = false;
   const v1::LearnerOptions proto = ToProto(options);
   EXPECT_EQ(proto.alpha_w().value(), 0.1);
   EXPECT_EQ(proto.alpha_l().value(), 0.2);
@@ -35,6 +39,13 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   EXPECT_EQ(proto.alpha_m().value(), 4);
   EXPECT_EQ(proto.splits_per_step().value(), 2);
   EXPECT_EQ(proto.seed().value(), 99u);
+  ASSERT_TRUE(proto.has_close_small_holes());
+  EXPECT_FALSE(proto.close_small_holes().value());
+  EXPECT_EQ(proto.max_closed_hole_vertices().value(), 5);
+  ASSERT_TRUE(proto.has_merge_only_settled_boundaries());
+  EXPECT_FALSE(proto.merge_only_settled_boundaries().value());
+  ASSERT_TRUE(proto.has_split_largest_cell_near_most_active());
+  EXPECT_FALSE(proto.split_largest_cell_near_most_active().value());
 }
 
 TEST(ClientProtoConversionTest, DracoSpeedBecomesCompressionSpeed) {

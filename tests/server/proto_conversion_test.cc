@@ -106,12 +106,14 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
 
   proto.mutable_learner()->mutable_alpha_l()->set_value(0);  // A valid zero, not "unset".
   proto.mutable_learner()->mutable_remove_triangles()->set_value(false);
+  proto.mutable_learner()->mutable_split_largest_cell_near_most_active()->set_value(false);
   proto.mutable_refresh_interval_ms()->set_value(0);
   proto.mutable_draco()->mutable_position_quantization_bits()->set_value(14);
   config = SessionConfigFromProto(proto);
   ASSERT_TRUE(config.ok());
   EXPECT_EQ(config->learner.alpha_l, 0.0);
   EXPECT_FALSE(config->learner.remove_triangles);
+  EXPECT_FALSE(config->learner.split_largest_cell_near_most_active);
   EXPECT_EQ(config->refresh_interval, absl::ZeroDuration()) << "0 turns refreshes off";
   EXPECT_EQ(config->draco.position_quantization_bits, 14);
 
@@ -121,6 +123,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   absl::StatusOr<SessionConfig> again = SessionConfigFromProto(echo);
   ASSERT_TRUE(again.ok());
   EXPECT_EQ(again->learner.alpha_l, 0.0);
+  EXPECT_FALSE(again->learner.split_largest_cell_near_most_active);
   EXPECT_EQ(again->draco.position_quantization_bits, 14);
 }
 

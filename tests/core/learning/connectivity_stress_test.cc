@@ -23,8 +23,7 @@ StressCounts Stress(Mesh& mesh, uint64_t seed, int operations) {
   Random rng(seed);
   StressCounts counts;
   std::vector<Mesh::VertexHandle> live;
-  size_t live_count = 0;
-  for (auto v : mesh.vertices()) ++live_count;
+  size_t live_count = mesh.n_vertices();
   for (int op = 0; op < operations; ++op) {
     live.clear();
     for (auto v : mesh.vertices()) live.push_back(v);

@@ -1,6 +1,7 @@
 #include "core/learning/hole_closing.h"
 
 #include <algorithm>
+#include <functional>
 #include <vector>
 
 #include "core/learning/triangle_removal.h"
@@ -26,8 +27,9 @@ long EulerCharacteristic(const Mesh& mesh) {
 
 TEST(HoleClosingTest, OptionsValidate) {
   EXPECT_TRUE(HoleClosingOptions{}.Validate().ok()) << "the defaults must be valid";
-  EXPECT_FALSE((HoleClosingOptions{0, 6}).Validate().ok()) << "alpha_r = 0 accepted";
-  EXPECT_FALSE((HoleClosingOptions{7, 2}).Validate().ok()) << "loops of 2 vertices accepted";
+  EXPECT_FALSE((HoleClosingOptions{0, 5, 6}).Validate().ok()) << "alpha_r = 0 accepted";
+  EXPECT_FALSE((HoleClosingOptions{7, 0, 6}).Validate().ok()) << "alpha_m = 0 accepted";
+  EXPECT_FALSE((HoleClosingOptions{7, 5, 2}).Validate().ok()) << "loops of 2 vertices accepted";
 }
 
 TEST(HoleClosingTest, OneTriangleHoleOfOrdinarySizeIsClosed) {
@@ -93,6 +95,65 @@ TEST(HoleClosingTest, HoleLeftByAVertexFanIsClosedEarByEar) {
   }
   EXPECT_EQ(CloseSmallHoles(again, five, mean_area).closed_holes, 0u)
       << "a loop above max_loop_vertices was closed";
+}
+
+// Removes the faces of `mesh` whose centroid satisfies `cut`, growing one hole from the face
+// nearest to `start` so that every removal is legal.
+void CutFaces(Mesh& mesh, const Vec3& start, const std::function<bool(const Vec3&)>& cut) {
+  std::vector<Mesh::FaceHandle> faces;
+  for (auto fh : mesh.faces()) {
+    if (cut(mesh.calc_face_centroid(fh))) faces.push_back(fh);
+  }
+  std::sort(faces.begin(), faces.end(), [&](Mesh::FaceHandle a, Mesh::FaceHandle b) {
+    return (mesh.calc_face_centroid(a) - start).sqrnorm() <
+           (mesh.calc_face_centroid(b) - start).sqrnorm();
+  });
+  while (!faces.empty()) {
+    auto it = std::find_if(faces.begin(), faces.end(),
+                           [&](Mesh::FaceHandle fh) { return IsTriangleRemovalOk(mesh, fh); });
+    ASSERT_NE(it, faces.end()) << "no legal removal left";
+    RemoveTriangle(mesh, *it, nullptr);
+    faces.erase(it);
+  }
+}
+
+TEST(HoleClosingTest, LongThinSlitIsZipped) {
+  // A row of faces cut across most of a 20 x 20 grid: one loop of 36 vertices, one edge wide.
+  // Step 5 cannot merge it (it joins two loops); closing zips it with ordinary triangles.
+  Mesh mesh = MustToMesh(GridPatch(20, 20));
+  const double mean_area = MeanTriangleArea(mesh);
+  CutFaces(mesh, Vec3(0, 0.5, 0),
+           [](const Vec3& c) { return c[1] > 0.5 && c[1] < 0.55 && c[0] > 0.1 && c[0] < 0.9; });
+  ASSERT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({34, 80}));
+  const HoleClosingResult result = CloseSmallHoles(mesh, HoleClosingOptions{}, mean_area);
+  EXPECT_EQ(result.closed_holes, 1u);
+  EXPECT_EQ(result.added_faces, 32u) << "a loop of k vertices takes k - 2 triangles";
+  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({80})) << "only the border is left";
+  EXPECT_EQ(EulerCharacteristic(mesh), 1) << "a disc again";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+  for (auto fh : mesh.faces()) {
+    EXPECT_LE(mesh.calc_face_area(fh), 7 * mean_area) << "a filling triangle Step 4 would cut";
+  }
+}
+
+TEST(HoleClosingTest, HoleWiderThanStepFiveBridgesStaysOpen) {
+  // A round hole of radius 0.25 in a 20 x 20 grid (edge 0.05): sqrt(E(Area)) is about 0.035,
+  // so alpha_m = 5 bridges 0.18, less than any triangulation of the hole needs.
+  Mesh mesh = MustToMesh(GridPatch(20, 20));
+  const double mean_area = MeanTriangleArea(mesh);
+  auto disc = [](const Vec3& c) { return (c - Vec3(0.5, 0.5, 0)).norm() < 0.25; };
+  CutFaces(mesh, Vec3(0.5, 0.5, 0), disc);
+  const std::vector<size_t> loops = BoundaryLoopSizes(mesh);
+  ASSERT_EQ(loops.size(), 2u);
+  HoleClosingOptions options;
+  options.alpha_r = 1e9;  // Only the edge-length rule can keep it open.
+  EXPECT_EQ(CloseSmallHoles(mesh, options, mean_area).closed_holes, 0u);
+  EXPECT_EQ(BoundaryLoopSizes(mesh), loops);
+
+  options.alpha_m = 20;  // Bridging 0.7: now the hole may be filled.
+  EXPECT_EQ(CloseSmallHoles(mesh, options, mean_area).closed_holes, 1u);
+  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({80}));
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
 }
 
 TEST(HoleClosingTest, BorderOfAnOpenSurfaceIsNeverClosed) {

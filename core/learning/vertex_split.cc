@@ -82,9 +82,14 @@ Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
     // inside the arc, (n-2)/2 of them so that the star is halved: valences become
     // inner+3 and n-inner+1. The cut neighbours vl = u[e+k1], vr = u[e-k2] gain an edge each;
     // of the admissible arcs, take the one that leaves the four affected valences most
-    // regular ("distributing the valences as regularly as possible").
+    // regular ("distributing the valences as regularly as possible"). A cut neighbour on the
+    // border does not count: a border vertex of valence 4 may not be split (Section 2.2), so
+    // gaining an edge is the only way a border refines along with the surface (valence 5
+    // splits into 4 + 4); penalising it kept borders at their first, coarse resolution, too
+    // sparse for Step 5 to see two facing borders as close.
     auto deviation = [&](Mesh::VertexHandle w, int valence) {
-      const double d = valence - (mesh.is_boundary(w) ? 4 : 6);
+      if (mesh.is_boundary(w)) return 0.0;
+      const double d = valence - 6;
       return d * d;
     };
     int k1 = 1, k2 = 1;

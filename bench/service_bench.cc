@@ -8,6 +8,7 @@
 // at 11-bit quantization; one session under the server >= 90% of the local learning rate.
 //
 //   build/bin/service-bench [--ingest_points=20000000] [--lod_target=20000] [--learn_seconds=3]
+//                           [--lod_milestones=10,20,50] [--only_lods]
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
+#include "absl/strings/numbers.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "core/learning/learner.h"
@@ -35,6 +37,9 @@ ABSL_FLAG(int64_t, lod_target, 20000, "Target vertex count of the LOD measuremen
 ABSL_FLAG(double, learn_seconds, 3.0, "Measurement window of the learning-rate measurement.");
 ABSL_FLAG(int, worker_threads, 2, "The server's learning threads.");
 ABSL_FLAG(int, lod_refresh_ms, 250, "Refresh interval of the LOD session (0: milestones only).");
+ABSL_FLAG(std::vector<std::string>, lod_milestones, {},
+          "Milestones of the LOD session, e.g. 10,20,50 (the target is appended); empty: the "
+          "server's default series.");
 ABSL_FLAG(bool, only_lods, false, "Run the LOD and learning-rate measurements only.");
 
 namespace neuralmesh {
@@ -55,10 +60,12 @@ v1::PointBatch Batch(const PointCloud& cloud, size_t begin, size_t end) {
 }
 
 std::string Create(v1::ReconstructionService::Stub& stub, uint64_t target,
-                   v1::FinalPass final_pass = v1::FINAL_PASS_AUTO, int refresh_ms = 250) {
+                   v1::FinalPass final_pass = v1::FINAL_PASS_AUTO, int refresh_ms = 250,
+                   const std::vector<uint64_t>& milestones = {}) {
   grpc::ClientContext context;
   v1::CreateSessionRequest request;
   request.mutable_config()->set_target_vertices(target);
+  for (uint64_t m : milestones) request.mutable_config()->add_lod_milestones(m);
   request.mutable_config()->mutable_refresh_interval_ms()->set_value(refresh_ms);
   request.mutable_config()->set_final_pass(final_pass);
   v1::Session session;
@@ -174,8 +181,17 @@ void MeasureFirstMesh(v1::ReconstructionService::Stub& stub) {
 std::pair<double, uint64_t> MeasureLods(v1::ReconstructionService::Stub& stub,
                                         const PointCloud& points) {
   const uint64_t target = static_cast<uint64_t>(absl::GetFlag(FLAGS_lod_target));
+  std::vector<uint64_t> milestones;
+  for (const std::string& m : absl::GetFlag(FLAGS_lod_milestones)) {
+    uint64_t value = 0;
+    if (!absl::SimpleAtoi(m, &value)) {
+      std::fprintf(stderr, "--lod_milestones: \"%s\" is not a vertex count\n", m.c_str());
+      std::exit(1);
+    }
+    milestones.push_back(value);
+  }
   const std::string id = Create(stub, target, v1::FINAL_PASS_CONTINUE,
-                                absl::GetFlag(FLAGS_lod_refresh_ms));
+                                absl::GetFlag(FLAGS_lod_refresh_ms), milestones);
   std::vector<v1::MeshUpdate> updates;
   std::thread watcher([&] {
     grpc::ClientContext context;
@@ -207,16 +223,20 @@ std::pair<double, uint64_t> MeasureLods(v1::ReconstructionService::Stub& stub,
               absl::GetFlag(FLAGS_lod_refresh_ms));
   std::printf("  %-9s %9s %9s %10s %8s %10s\n", "kind", "vertices", "faces", "bytes", "B/vert",
               "encode ms");
+  double worst = 0;
   for (const v1::MeshUpdate& u : updates) {
     if (u.kind() == v1::UPDATE_KIND_REFRESH) continue;
+    const double per_vertex = static_cast<double>(u.draco_mesh().size()) / u.vertex_count();
+    worst = std::max(worst, per_vertex);
     std::printf("  %-9s %9llu %9llu %10zu %8.2f %10.2f\n",
                 u.kind() == v1::UPDATE_KIND_FINAL ? "final" : "milestone",
                 static_cast<unsigned long long>(u.vertex_count()),
                 static_cast<unsigned long long>(u.face_count()), u.draco_mesh().size(),
-                static_cast<double>(u.draco_mesh().size()) / u.vertex_count(),
-                u.encode_time_us() / 1000.0);
+                per_vertex, u.encode_time_us() / 1000.0);
   }
-  std::printf("  [target <= 8 bytes per vertex at 11 bits]\n");
+  std::printf("  at most %.2f bytes per vertex over the LODs   [target <= 8 bytes per vertex at "
+              "11 bits]\n",
+              worst);
   const uint64_t steps = updates.empty() ? 0 : updates.back().learning().basic_steps();
   if (!updates.empty()) {
     const v1::LearningState& learning = updates.back().learning();

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <thread>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -125,6 +126,80 @@ absl::Status ReconstructionClient::Watch(const std::string& session_id, uint64_t
   const grpc::Status status = reader->Finish();
   if (stopped) return absl::OkStatus();
   return FromGrpcStatus(status, "WatchSession");
+}
+
+absl::StatusOr<ReconstructResult> ReconstructionClient::Reconstruct(
+    const v1::SessionConfig& config, const std::string& name, const PointCloud& cloud,
+    size_t batch_size, const UpdateCallback& on_update, const UploadProgress& progress) {
+  if (cloud.empty()) return absl::InvalidArgumentError("Reconstruct: no points to upload");
+  if (batch_size == 0) return absl::InvalidArgumentError("Reconstruct: batch size must be > 0");
+  grpc::ClientContext context;
+  std::unique_ptr<grpc::ClientReaderWriter<v1::ReconstructRequest, v1::ReconstructResponse>>
+      stream = stub_->Reconstruct(&context);
+
+  // gRPC's synchronous streams allow one writing and one reading thread at a time. The points
+  // go out from this thread while the calling thread reads, so the callbacks can take their
+  // time: the server never waits for a reader (latest wins). A failed write means the call is
+  // over (the server ended it, or the reader below cancelled it); Finish says why.
+  std::thread sender([&] {
+    v1::ReconstructRequest request;
+    v1::CreateSessionRequest* create = request.mutable_start()->mutable_create();
+    *create->mutable_config() = config;
+    create->set_name(name);
+    if (!stream->Write(request)) return;
+    for (size_t begin = 0; begin < cloud.size(); begin += batch_size) {
+      const size_t end = std::min(cloud.size(), begin + batch_size);
+      *request.mutable_points() = PackPointBatch(cloud, begin, end);
+      if (!stream->Write(request)) return;
+    }
+    // Half-closing finishes the session: the server learns to the target and sends the final
+    // mesh before it ends the call.
+    stream->WritesDone();
+  });
+
+  ReconstructResult result;
+  bool final_received = false;
+  bool stopped = false;
+  v1::ReconstructResponse response;
+  while (!stopped && stream->Read(&response)) {
+    switch (response.kind_case()) {
+      case v1::ReconstructResponse::kSession:
+        result.session = std::move(*response.mutable_session());
+        break;
+      case v1::ReconstructResponse::kAck:
+        result.last_ack = response.ack();
+        if (progress) progress(result.last_ack.points_accepted(), cloud.size());
+        break;
+      case v1::ReconstructResponse::kUpdate: {
+        const bool final = response.update().kind() == v1::UPDATE_KIND_FINAL;
+        // After the final mesh only the call's OK can follow, so there is nothing to stop.
+        stopped = !on_update(response.update()) && !final;
+        if (final) {
+          final_received = true;
+          result.final_mesh = std::move(*response.mutable_update());
+        }
+        break;
+      }
+      case v1::ReconstructResponse::KIND_NOT_SET:
+        break;
+    }
+  }
+  if (stopped) context.TryCancel();
+  sender.join();
+  const grpc::Status status = stream->Finish();
+
+  const std::string& id = result.session.session_id();
+  const std::string what = id.empty() ? "Reconstruct" : absl::StrCat("Reconstruct of session ", id);
+  if (stopped) {
+    return absl::CancelledError(absl::StrCat(
+        what, ": stopped by the update callback; the session goes on until it is cancelled"));
+  }
+  if (!status.ok()) return FromGrpcStatus(status, what);
+  if (!final_received) {
+    // The server sends the final mesh before OK; anything else is a broken server.
+    return absl::InternalError(absl::StrCat(what, ": the call ended without the final mesh"));
+  }
+  return result;
 }
 
 absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& session_id) {

@@ -9,6 +9,11 @@
 //   client->Finish(s.session_id());
 //   watcher.join();
 //
+// or, in one call that creates the session, streams the points and returns the final mesh:
+//
+//   NM_ASSIGN_OR_RETURN(ReconstructResult r,
+//                       client->Reconstruct(config, "scan", cloud, 10000, on_update));
+//
 // Thread-safety: all methods may be called concurrently (gRPC stubs are thread-safe); a
 // typical client watches on one thread while it uploads on another.
 #ifndef NEURALMESH_CLIENT_RECONSTRUCTION_CLIENT_H_
@@ -32,10 +37,17 @@ namespace neuralmesh::client {
 
 namespace v1 = ::neuralmesh::v1;
 
+// What a Reconstruct call delivered.
+struct ReconstructResult {
+  v1::Session session;        // The session the call created (the call's first response).
+  v1::PointsAck last_ack;     // The server's last acknowledgement of the points received.
+  v1::MeshUpdate final_mesh;  // The final mesh (kind UPDATE_KIND_FINAL).
+};
+
 struct ClientOptions {
   // How long Connect waits for the server to accept a connection.
   absl::Duration connect_timeout = absl::Seconds(5);
-  // Deadline of each simple rpc (not of UploadPoints, Watch or a waiting GetMesh).
+  // Deadline of each simple rpc (not of UploadPoints, Watch, Reconstruct or a waiting GetMesh).
   absl::Duration call_timeout = absl::Seconds(30);
 };
 
@@ -78,6 +90,29 @@ class ReconstructionClient {
   // UNAVAILABLE (server gone).
   absl::Status Watch(const std::string& session_id, uint64_t after_sequence,
                      const UpdateCallback& on_update);
+
+  // The Reconstruct rpc, everything in one bidirectional call: creates a session from
+  // `config` (labelled `name`), streams `cloud` into it in batches of at most `batch_size`
+  // points, half-closes (which finishes the session) and calls `on_update` with every mesh
+  // update the server sends, coarse to fine, the final mesh last. `progress`, when set, gets
+  // the points the server has acknowledged; acknowledgements are latest wins, so not every
+  // batch is reported, but the last one is. Both callbacks run on the calling thread while
+  // the points go out from a thread of the call's own; a slow callback holds back neither the
+  // upload nor the learning (the server skips to the newest update meanwhile).
+  //
+  // Returns the session, the last acknowledgement and the final mesh when the call ended with
+  // OK. Otherwise, before any call: INVALID_ARGUMENT for an empty cloud or a zero batch size;
+  // from the server, its status, prefixed with "Reconstruct" and the session id once known:
+  // INVALID_ARGUMENT for an invalid config or a bad batch (the session keeps the batches
+  // accepted before and stays open: cancel or delete it), RESOURCE_EXHAUSTED when the server
+  // or the session is full, CANCELLED when the session was cancelled, NOT_FOUND when it was
+  // deleted, INTERNAL when its learning failed, UNAVAILABLE when the server went away.
+  // CANCELLED also when `on_update` returned false before the final mesh: the call is
+  // cancelled, but not the session, which the message names.
+  absl::StatusOr<ReconstructResult> Reconstruct(const v1::SessionConfig& config,
+                                                const std::string& name, const PointCloud& cloud,
+                                                size_t batch_size, const UpdateCallback& on_update,
+                                                const UploadProgress& progress = {});
 
   absl::StatusOr<v1::Session> GetSession(const std::string& session_id);
   absl::StatusOr<std::vector<v1::Session>> ListSessions();

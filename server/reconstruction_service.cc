@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/synchronization/mutex.h"
 #include "server/grpc_status.h"
+#include "server/latest_wins_writer.h"
 #include "server/proto_conversion.h"
 #include "server/update_channel.h"
 
@@ -56,27 +57,26 @@ absl::StatusOr<size_t> Ingest(Session& session, const v1::PointBatch& batch,
 // WatchSession: server-to-client stream, latest wins.
 //
 // Flow control. gRPC allows one outstanding write per stream, and a watcher may read slower
-// than the session publishes. The reactor therefore holds at most two updates: the one being
-// written (`in_flight_`, kept alive until OnWriteDone) and the newest one not yet written
-// (`pending_`). The update channel calls OnUpdate on the publishing thread (the encoder); if no
-// write is in flight the update is written at once, otherwise it replaces `pending_`, so the
+// than the session publishes. The update channel calls OnUpdate on the publishing thread (the
+// encoder); `writer_` (latest_wins_writer.h) writes the update at once if no write is in
+// flight, and otherwise keeps it as the one to write next, replacing an older one, so the
 // updates in between are skipped and the publisher never waits. OnWriteDone starts the write
-// of `pending_` if there is one. Updates carry increasing sequence numbers; nothing older than
-// the last one written is ever sent (a reconnecting watcher passes after_sequence).
+// of the waiting update if there is one. Updates carry increasing sequence numbers; nothing
+// older than the last one written is ever sent (a reconnecting watcher passes after_sequence).
 //
 // The end of the stream: the channel's OnClose (OK after the final mesh, CANCELLED, NOT_FOUND
-// when deleted, INTERNAL when learning failed), Abort from the registry at shutdown
-// (UNAVAILABLE, dropping `pending_`), or the client going away (OnCancel, or a failed write).
-// The status is remembered in `end_` and Finish is called once no write is in flight, so the
-// final mesh is always written before OK. OnDone unsubscribes (after which the channel never
-// calls again), unregisters and deletes the reactor.
+// when deleted, INTERNAL when learning failed; the waiting update still goes out first), Abort
+// from the registry at shutdown (UNAVAILABLE, dropping the waiting update), or the client going
+// away (OnCancel, or a failed write). The writer finishes the call once no write is in flight,
+// so the final mesh is always written before OK. OnDone unsubscribes (after which the channel
+// never calls again), unregisters and deletes the reactor.
 class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
                            public UpdateSubscriber,
                            public LiveReactor {
  public:
   WatchReactor(SessionManager* manager, ReactorRegistry* reactors,
                const v1::WatchSessionRequest& request)
-      : reactors_(reactors) {
+      : reactors_(reactors), writer_(request.after_sequence()) {
     registered_ = reactors_->Add(this);
     if (!registered_) {
       EndNow(Unavailable());
@@ -89,52 +89,37 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
     }
     session_ = *std::move(session);
     session_->AddStream();
-    {
-      absl::MutexLock lock(&mu_);
-      last_sent_ = request.after_sequence();
-    }
     // May call OnUpdate/OnClose right away (the latest mesh, a closed session).
     handle_ = session_->updates().Subscribe(this, request.after_sequence());
   }
 
   void OnUpdate(const MeshUpdatePtr& update) override {
     absl::MutexLock lock(&mu_);
-    pending_ = update;
+    writer_.Offer(update);
     MaybeWriteLocked();
   }
 
   void OnClose(const absl::Status& status) override {
     absl::MutexLock lock(&mu_);
-    if (!end_.has_value()) end_ = status;
+    writer_.End(status);
     MaybeWriteLocked();
   }
 
   void Abort(const absl::Status& status) override {
     absl::MutexLock lock(&mu_);
-    pending_.reset();
-    end_ = status;
+    writer_.Abort(status);
     MaybeWriteLocked();
   }
 
   void OnWriteDone(bool ok) override {
     absl::MutexLock lock(&mu_);
-    writing_ = false;
-    in_flight_.reset();
-    if (!ok) {
-      // The client is gone; nothing more can be written.
-      pending_.reset();
-      if (!end_.has_value()) end_ = absl::CancelledError("the watcher went away");
-    }
+    writer_.WriteDone();
+    // A failed write means the client is gone; nothing more can be written.
+    if (!ok) writer_.EndNow(absl::CancelledError("the watcher went away"));
     MaybeWriteLocked();
   }
 
-  void OnCancel() override {
-    absl::MutexLock lock(&mu_);
-    cancelled_ = true;
-    pending_.reset();
-    if (!end_.has_value()) end_ = absl::CancelledError("the watcher cancelled the call");
-    MaybeWriteLocked();
-  }
+  void OnCancel() override { EndNow(absl::CancelledError("the watcher cancelled the call")); }
 
   void OnDone() override {
     if (session_ != nullptr) {
@@ -148,26 +133,15 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
  private:
   void EndNow(const absl::Status& status) {
     absl::MutexLock lock(&mu_);
-    end_ = status;
+    writer_.EndNow(status);
     MaybeWriteLocked();
   }
 
   void MaybeWriteLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
-    if (writing_ || finished_) return;
-    if (pending_ != nullptr && !cancelled_) {
-      if (pending_->sequence() > last_sent_) {
-        in_flight_ = std::move(pending_);
-        pending_.reset();
-        last_sent_ = in_flight_->sequence();
-        writing_ = true;
-        StartWrite(in_flight_.get());
-        return;
-      }
-      pending_.reset();
-    }
-    if (end_.has_value()) {
-      finished_ = true;
-      Finish(ToGrpcStatus(*end_));
+    if (writer_.CanWrite() && writer_.has_update()) {
+      StartWrite(&writer_.StartUpdate());
+    } else if (std::optional<absl::Status> end = writer_.TakeFinish()) {
+      Finish(ToGrpcStatus(*end));
     }
   }
 
@@ -177,13 +151,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
   uint64_t handle_ = 0;
 
   absl::Mutex mu_;
-  MeshUpdatePtr in_flight_ ABSL_GUARDED_BY(mu_);
-  MeshUpdatePtr pending_ ABSL_GUARDED_BY(mu_);
-  uint64_t last_sent_ ABSL_GUARDED_BY(mu_) = 0;
-  std::optional<absl::Status> end_ ABSL_GUARDED_BY(mu_);
-  bool writing_ ABSL_GUARDED_BY(mu_) = false;
-  bool finished_ ABSL_GUARDED_BY(mu_) = false;
-  bool cancelled_ ABSL_GUARDED_BY(mu_) = false;
+  LatestWinsWriter writer_ ABSL_GUARDED_BY(mu_);
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -325,18 +293,20 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
 //
 // Flow control, writes. Three kinds of response compete for the one outstanding write: the
 // session (once, first), acknowledgements and mesh updates. Acknowledgements carry running
-// totals and updates are snapshots, so for both only the newest matters: the reactor keeps
-// one pending acknowledgement and one pending update, each replaced by a newer one while a
-// write is in flight (latest wins, as in WatchSession), and alternates between the two kinds
-// when both wait so neither starves. The response being written lives in `out_` until
-// OnWriteDone. Memory per call is therefore bounded by two responses however slowly the
-// client reads, and neither ingestion nor learning ever waits for the writer.
+// totals and updates are snapshots, so for both only the newest matters: `writer_`
+// (latest_wins_writer.h) keeps one waiting update, the reactor one waiting acknowledgement,
+// each replaced by a newer one while a write is in flight (latest wins, as in WatchSession),
+// and the reactor alternates between the two kinds when both wait so neither starves. The
+// response being written lives in `out_` until OnWriteDone. Memory per call is therefore
+// bounded by a few responses however slowly the client reads, and neither ingestion nor
+// learning ever waits for the writer.
 //
 // The end: when the client half-closes, the session is finished (no more points) and the call
 // waits for the channel to close after the final mesh, then finishes with OK. A bad batch, a
 // failed start, the session being cancelled or deleted, Abort at shutdown or the client going
-// away set `end_`; Finish follows as soon as no write is in flight. An outstanding read is
-// completed by gRPC with OnReadDone(false) after Finish; no read starts after it.
+// away end the call with an error, and then nothing more is written (EndNow); Finish follows as
+// soon as no write is in flight. An outstanding read is completed by gRPC with
+// OnReadDone(false) after Finish; no read starts after it.
 class ReconstructReactor final
     : public grpc::ServerBidiReactor<v1::ReconstructRequest, v1::ReconstructResponse>,
       public UpdateSubscriber,
@@ -355,7 +325,7 @@ class ReconstructReactor final
   void OnReadDone(bool ok) override {
     {
       absl::MutexLock lock(&mu_);
-      if (finished_ || end_.has_value()) return;
+      if (writer_.has_end()) return;
     }
     if (!ok) {
       HalfClosed();
@@ -367,13 +337,12 @@ class ReconstructReactor final
       return;
     }
     absl::MutexLock lock(&mu_);
-    if (!finished_ && !end_.has_value()) StartRead(&request_);
+    if (!writer_.has_end()) StartRead(&request_);
   }
 
   void OnUpdate(const MeshUpdatePtr& update) override {
     absl::MutexLock lock(&mu_);
-    if (update->sequence() <= last_update_) return;
-    pending_update_ = update;
+    writer_.Offer(update);
     MaybeWriteLocked();
   }
 
@@ -381,34 +350,19 @@ class ReconstructReactor final
 
   void Abort(const absl::Status& status) override {
     absl::MutexLock lock(&mu_);
-    pending_update_.reset();
-    pending_ack_.reset();
-    pending_session_.reset();
-    end_ = status;
+    writer_.Abort(status);
     MaybeWriteLocked();
   }
 
   void OnWriteDone(bool ok) override {
     absl::MutexLock lock(&mu_);
-    writing_ = false;
+    writer_.WriteDone();
     out_.Clear();
-    if (!ok) {
-      pending_update_.reset();
-      pending_ack_.reset();
-      pending_session_.reset();
-      if (!end_.has_value()) end_ = absl::CancelledError("the client went away");
-    }
+    if (!ok) writer_.EndNow(absl::CancelledError("the client went away"));
     MaybeWriteLocked();
   }
 
-  void OnCancel() override {
-    absl::MutexLock lock(&mu_);
-    pending_update_.reset();
-    pending_ack_.reset();
-    pending_session_.reset();
-    if (!end_.has_value()) end_ = absl::CancelledError("the client cancelled the call");
-    MaybeWriteLocked();
-  }
+  void OnCancel() override { End(absl::CancelledError("the client cancelled the call")); }
 
   void OnDone() override {
     if (session_ != nullptr) {
@@ -510,40 +464,38 @@ class ReconstructReactor final
     }
   }
 
+  // Ends the call: after what waits is written for OK (the final mesh), at once otherwise.
   void End(const absl::Status& status) {
     absl::MutexLock lock(&mu_);
-    if (!end_.has_value()) end_ = status;
+    if (status.ok()) {
+      writer_.End(status);
+    } else {
+      writer_.EndNow(status);
+    }
     MaybeWriteLocked();
   }
 
   void MaybeWriteLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
-    if (writing_ || finished_) return;
-    const bool failed = end_.has_value() && !end_->ok();
-    if (!failed) {
+    if (writer_.CanWrite()) {
       if (pending_session_.has_value()) {
         *out_.mutable_session() = *std::move(pending_session_);
         pending_session_.reset();
-      } else if (pending_ack_.has_value() &&
-                 (pending_update_ == nullptr || last_was_update_)) {
+        writer_.StartOther();
+      } else if (pending_ack_.has_value() && (!writer_.has_update() || last_was_update_)) {
         *out_.mutable_ack() = *std::move(pending_ack_);
         pending_ack_.reset();
         last_was_update_ = false;
-      } else if (pending_update_ != nullptr) {
-        *out_.mutable_update() = *pending_update_;
-        last_update_ = pending_update_->sequence();
-        pending_update_.reset();
+        writer_.StartOther();
+      } else if (writer_.has_update()) {
+        *out_.mutable_update() = writer_.StartUpdate();
         last_was_update_ = true;
       }
       if (out_.kind_case() != v1::ReconstructResponse::KIND_NOT_SET) {
-        writing_ = true;
         StartWrite(&out_);
         return;
       }
     }
-    if (end_.has_value()) {
-      finished_ = true;
-      Finish(ToGrpcStatus(*end_));
-    }
+    if (std::optional<absl::Status> end = writer_.TakeFinish()) Finish(ToGrpcStatus(*end));
   }
 
   SessionManager* const manager_;
@@ -560,15 +512,11 @@ class ReconstructReactor final
   uint64_t rejected_ = 0;
 
   absl::Mutex mu_;
+  LatestWinsWriter writer_ ABSL_GUARDED_BY(mu_);
   v1::ReconstructResponse out_ ABSL_GUARDED_BY(mu_);
   std::optional<v1::Session> pending_session_ ABSL_GUARDED_BY(mu_);
   std::optional<v1::PointsAck> pending_ack_ ABSL_GUARDED_BY(mu_);
-  MeshUpdatePtr pending_update_ ABSL_GUARDED_BY(mu_);
-  uint64_t last_update_ ABSL_GUARDED_BY(mu_) = 0;
   bool last_was_update_ ABSL_GUARDED_BY(mu_) = false;
-  std::optional<absl::Status> end_ ABSL_GUARDED_BY(mu_);
-  bool writing_ ABSL_GUARDED_BY(mu_) = false;
-  bool finished_ ABSL_GUARDED_BY(mu_) = false;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -12,7 +12,10 @@ std::vector<size_t> DefaultLodMilestones(size_t target) {
   static constexpr size_t kSeries[] = {1, 2, 5};
   for (size_t decade = 10; decade < target; decade *= 10) {
     for (size_t step : kSeries) {
-      if (decade * step < target) milestones.push_back(decade * step);
+      const size_t milestone = decade * step;
+      if (milestone >= kFirstDefaultMilestone && milestone < target) {
+        milestones.push_back(milestone);
+      }
     }
     if (decade > target / 10) break;  // decade * 10 would exceed the target (or overflow).
   }

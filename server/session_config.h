@@ -27,12 +27,20 @@ inline constexpr size_t kMaxLodMilestones = 256;
 inline constexpr absl::Duration kDefaultRefreshInterval = absl::Milliseconds(250);
 inline constexpr absl::Duration kMinRefreshInterval = absl::Milliseconds(10);
 inline constexpr double kDefaultPointsPerVertex = 2.0;
+// The smallest milestone of the default series. The stream's budget is 8 bytes per vertex at
+// 11-bit quantization, and Draco spends about 70 bytes on any mesh (header, connectivity and
+// attribute headers, the quantization box, entropy-coder tables) before its vertices. Even
+// with the shortest of the encodings core/io/draco_codec.h tries, learned meshes of 10
+// vertices took at least 108 bytes (10.8 per vertex) and of 20 vertices up to 163 (8.15, in
+// the tighter box that SessionConfig.bounds gives), while from 40 vertices on they stayed
+// below 6.2 per vertex (80 tori and spheres). So the series starts at 50.
+inline constexpr size_t kFirstDefaultMilestone = 50;
 
 struct SessionConfig {
   LearnerOptions learner;       // The paper's parameters.
   size_t target_vertices = 0;   // The final vertex count, >= 4.
   // Publication milestones, strictly increasing, ending with target_vertices once resolved.
-  // Empty before ResolveSessionConfig: the 1-2-5 series.
+  // Empty before ResolveSessionConfig: the 1-2-5 series from 50 (DefaultLodMilestones).
   std::vector<size_t> lod_milestones;
   // Wall time between two republications while learning; zero disables them.
   absl::Duration refresh_interval = kDefaultRefreshInterval;
@@ -45,7 +53,8 @@ struct SessionConfig {
   FinalPass final_pass = FinalPass::kAuto;
 };
 
-// 10, 20, 50, 100, 200, 500, ... below `target`, then `target` itself.
+// The 1-2-5 series from kFirstDefaultMilestone, 50, 100, 200, 500, 1000, ... below `target`,
+// then `target` itself (the only milestone of a target up to 50).
 std::vector<size_t> DefaultLodMilestones(size_t target);
 
 // Validates `config` and fills in the milestones (the default series when empty, the target

@@ -1,8 +1,10 @@
 // Tests of client/reconstruction_client.h against a real neuralmesh-server on 127.0.0.1
-// (started as a subprocess, port 0).
+// (started as a subprocess, port 0), and of the Reconstruct call on an in-process server.
 #include "client/reconstruction_client.h"
 
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <string>
 #include <thread>
@@ -14,6 +16,7 @@
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
 #include "tests/client/test_server.h"
+#include "tests/server/server_test_support.h"
 
 namespace neuralmesh::client {
 namespace {
@@ -153,6 +156,147 @@ TEST_F(ReconstructionClientTest, StatusesKeepTheServersCodeAndNameTheCall) {
 TEST_F(ReconstructionClientTest, UploadRejectsAnEmptyCloudAndAZeroBatchSize) {
   EXPECT_TRUE(absl::IsInvalidArgument(client_->UploadPoints("any", PointCloud(), 10).status()));
   EXPECT_TRUE(absl::IsInvalidArgument(client_->UploadPoints("any", SpherePoints(10), 0).status()));
+}
+
+// The Reconstruct call on an in-process server (no sockets): the client's logic alone.
+class ReconstructCallTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    server_ = server::testing::StartServer(/*listen=*/false);
+    ASSERT_NE(server_, nullptr);
+    client_ = std::make_unique<ReconstructionClient>(server_->InProcessChannel(), ClientOptions());
+  }
+  void TearDown() override {
+    if (server_ != nullptr) server_->Shutdown(absl::Seconds(2));
+  }
+
+  std::unique_ptr<server::ReconstructionServer> server_;
+  std::unique_ptr<ReconstructionClient> client_;
+};
+
+TEST_F(ReconstructCallTest, StreamsASphereAndReceivesCoarseToFineMeshes) {
+  const PointCloud cloud = SpherePoints(20000);
+  v1::SessionConfig config;
+  config.set_target_vertices(1000);  // Default milestones: 10, 20, 50, ..., 500, 1000.
+  std::vector<v1::MeshUpdate> updates;
+  std::vector<uint64_t> acknowledged;
+  const std::thread::id caller = std::this_thread::get_id();
+  absl::StatusOr<ReconstructResult> result = client_->Reconstruct(
+      config, "sphere", cloud, /*batch_size=*/200,
+      [&](const v1::MeshUpdate& update) {
+        EXPECT_EQ(std::this_thread::get_id(), caller) << "callbacks run on the calling thread";
+        updates.push_back(update);
+        return true;
+      },
+      [&](uint64_t accepted, uint64_t total) {
+        EXPECT_EQ(total, 20000u);
+        acknowledged.push_back(accepted);
+      });
+  ASSERT_TRUE(result.ok()) << result.status();
+
+  EXPECT_FALSE(result->session.session_id().empty());
+  EXPECT_EQ(result->session.config().target_vertices(), 1000u);
+  EXPECT_EQ(result->last_ack.total_points(), 20000u);
+  EXPECT_EQ(result->last_ack.batches_accepted(), 100u) << "20000 points in batches of 200";
+  ASSERT_FALSE(acknowledged.empty());
+  for (size_t i = 1; i < acknowledged.size(); ++i) {
+    EXPECT_GT(acknowledged[i], acknowledged[i - 1]) << "acknowledgement " << i;
+  }
+  EXPECT_EQ(acknowledged.back(), 20000u) << "the last acknowledgement always arrives";
+
+  // Coarse to fine: milestone meshes with increasing vertex counts, then the final mesh.
+  ASSERT_FALSE(updates.empty());
+  std::vector<uint64_t> counts;
+  for (size_t i = 0; i < updates.size(); ++i) {
+    if (i > 0) {
+      EXPECT_GT(updates[i].sequence(), updates[i - 1].sequence()) << "update " << i;
+    }
+    if (updates[i].kind() != v1::UPDATE_KIND_REFRESH) counts.push_back(updates[i].vertex_count());
+  }
+  ASSERT_GE(counts.size(), 4u) << "too few milestone meshes arrived";
+  for (size_t i = 1; i < counts.size(); ++i) {
+    EXPECT_GT(counts[i], counts[i - 1]) << "milestone vertex counts must increase";
+  }
+  const v1::MeshUpdate& last = updates.back();
+  ASSERT_EQ(last.kind(), v1::UPDATE_KIND_FINAL) << "the final mesh comes last";
+  EXPECT_EQ(last.vertex_count(), 1000u);
+  EXPECT_EQ(result->final_mesh.sequence(), last.sequence());
+  EXPECT_EQ(result->final_mesh.session_id(), result->session.session_id());
+
+  absl::StatusOr<TriangleMesh> mesh = DecodeMesh(result->final_mesh.draco_mesh());
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->faces.size(), result->final_mesh.face_count());
+  auto sphere = MakeSphere(Vec3(0, 0, 0), 1.0);
+  ASSERT_TRUE(sphere.ok());
+  EXPECT_LT(server::testing::MaxVertexDistance(*mesh, **sphere), 0.05)
+      << "the final mesh lies off the unit sphere";
+
+  absl::StatusOr<v1::Session> session = client_->GetSession(result->session.session_id());
+  ASSERT_TRUE(session.ok()) << session.status();
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_FINISHED) << "half-closing finished the session";
+}
+
+TEST_F(ReconstructCallTest, ABadBatchEndsTheCallAndTheSessionKeepsTheGoodOnes) {
+  PointCloud cloud = SpherePoints(2000);
+  cloud.positions[1700][1] = std::numeric_limits<float>::quiet_NaN();  // In the fourth batch.
+  v1::SessionConfig config;
+  config.set_target_vertices(200);
+  absl::StatusOr<ReconstructResult> result = client_->Reconstruct(
+      config, "bad", cloud, /*batch_size=*/500, [](const v1::MeshUpdate&) { return true; });
+  ASSERT_FALSE(result.ok());
+  EXPECT_TRUE(absl::IsInvalidArgument(result.status())) << result.status();
+  EXPECT_NE(result.status().message().find("Reconstruct of session "), absl::string_view::npos)
+      << "the status names the session the caller must clean up: " << result.status();
+
+  absl::StatusOr<std::vector<v1::Session>> sessions = client_->ListSessions();
+  ASSERT_TRUE(sessions.ok()) << sessions.status();
+  ASSERT_EQ(sessions->size(), 1u);
+  const v1::Session& session = sessions->front();
+  EXPECT_NE(result.status().message().find(session.session_id()), absl::string_view::npos)
+      << result.status();
+  EXPECT_EQ(session.learning().points_received(), 1500u) << "the three good batches stay";
+  EXPECT_TRUE(session.state() == v1::SESSION_STATE_COLLECTING ||
+              session.state() == v1::SESSION_STATE_LEARNING)
+      << "a rejected batch neither finishes nor cancels the session: "
+      << v1::SessionState_Name(session.state());
+}
+
+TEST_F(ReconstructCallTest, AnInvalidConfigIsRejectedBeforeAnyUpdate) {
+  v1::SessionConfig config;  // No target_vertices.
+  int updates = 0;
+  absl::StatusOr<ReconstructResult> result =
+      client_->Reconstruct(config, "invalid", SpherePoints(100), 50, [&](const v1::MeshUpdate&) {
+        ++updates;
+        return true;
+      });
+  EXPECT_TRUE(absl::IsInvalidArgument(result.status())) << result.status();
+  EXPECT_EQ(updates, 0);
+}
+
+TEST_F(ReconstructCallTest, ReturningFalseFromTheCallbackCancelsTheCall) {
+  v1::SessionConfig config;
+  config.set_target_vertices(5000);
+  int updates = 0;
+  absl::StatusOr<ReconstructResult> result = client_->Reconstruct(
+      config, "stopped", SpherePoints(20000), 1000, [&](const v1::MeshUpdate&) {
+        ++updates;
+        return false;
+      });
+  EXPECT_TRUE(absl::IsCancelled(result.status())) << result.status();
+  EXPECT_EQ(updates, 1) << "no update is delivered after the callback said stop";
+}
+
+TEST_F(ReconstructCallTest, RejectsAnEmptyCloudAndAZeroBatchSize) {
+  v1::SessionConfig config;
+  config.set_target_vertices(100);
+  const auto ignore = [](const v1::MeshUpdate&) { return true; };
+  EXPECT_TRUE(absl::IsInvalidArgument(
+      client_->Reconstruct(config, "empty", PointCloud(), 10, ignore).status()));
+  EXPECT_TRUE(absl::IsInvalidArgument(
+      client_->Reconstruct(config, "zero", SpherePoints(10), 0, ignore).status()));
+  absl::StatusOr<std::vector<v1::Session>> sessions = client_->ListSessions();
+  ASSERT_TRUE(sessions.ok()) << sessions.status();
+  EXPECT_TRUE(sessions->empty()) << "no call was made";
 }
 
 TEST(ReconstructionClientConnectTest, NoServerGivesUnavailable) {

@@ -62,7 +62,7 @@ TEST_F(ReconstructionServiceTest, CreateGetListAndDelete) {
   EXPECT_EQ(session.name(), "test");
   EXPECT_DOUBLE_EQ(session.config().learner().alpha_w().value(), 0.06)
       << "unset options echo the paper's defaults";
-  EXPECT_EQ(session.config().lod_milestones_size(), 6) << "10 20 50 100 200 500";
+  EXPECT_EQ(session.config().lod_milestones_size(), 4) << "50 100 200 500";
   EXPECT_EQ(session.config().draco().position_quantization_bits().value(), 11);
 
   grpc::ClientContext list_context;

@@ -9,13 +9,18 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
-TEST(DefaultLodMilestonesTest, OneTwoFiveSeriesUpToTheTarget) {
-  EXPECT_THAT(DefaultLodMilestones(2000), ElementsAre(10, 20, 50, 100, 200, 500, 1000, 2000))
-      << "the default schedule is the 1-2-5 series below the target, then the target";
-  EXPECT_THAT(DefaultLodMilestones(1500), ElementsAre(10, 20, 50, 100, 200, 500, 1000, 1500));
+TEST(DefaultLodMilestonesTest, OneTwoFiveSeriesFrom50UpToTheTarget) {
+  EXPECT_THAT(DefaultLodMilestones(2000), ElementsAre(50, 100, 200, 500, 1000, 2000))
+      << "the default schedule is the 1-2-5 series from 50 below the target, then the target";
+  EXPECT_THAT(DefaultLodMilestones(1500), ElementsAre(50, 100, 200, 500, 1000, 1500));
   EXPECT_THAT(DefaultLodMilestones(4), ElementsAre(4)) << "a tiny target is its only milestone";
-  EXPECT_THAT(DefaultLodMilestones(10), ElementsAre(10));
-  EXPECT_THAT(DefaultLodMilestones(11), ElementsAre(10, 11));
+  EXPECT_THAT(DefaultLodMilestones(20), ElementsAre(20))
+      << "no milestone below 50: meshes that small exceed 8 bytes per vertex";
+  EXPECT_THAT(DefaultLodMilestones(50), ElementsAre(50));
+  EXPECT_THAT(DefaultLodMilestones(51), ElementsAre(50, 51));
+  EXPECT_THAT(DefaultLodMilestones(20000000),
+              ElementsAre(50, 100, 200, 500, 1000, 2000, 5000, 10000, 20000, 50000, 100000, 200000,
+                          500000, 1000000, 2000000, 5000000, 10000000, 20000000));
 }
 
 SessionConfig Valid() {
@@ -27,7 +32,7 @@ SessionConfig Valid() {
 TEST(ResolveSessionConfigTest, FillsDefaultMilestonesAndAppendsTheTarget) {
   SessionConfig config = Valid();
   ASSERT_TRUE(ResolveSessionConfig(1 << 20, config).ok());
-  EXPECT_THAT(config.lod_milestones, ElementsAre(10, 20, 50, 100, 200, 500, 1000));
+  EXPECT_THAT(config.lod_milestones, ElementsAre(50, 100, 200, 500, 1000));
 
   config = Valid();
   config.lod_milestones = {50, 300};

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/io/mesh_io.h"
@@ -164,6 +165,77 @@ TEST(DracoCodecTest, IcosphereLevel5NeedsAtMost8BytesPerVertexAt11Bits) {
             << " bytes/vertex at 11 bits, speed 5\n";
   ::testing::Test::RecordProperty("bytes_per_vertex", std::to_string(per_vertex));
   EXPECT_LE(per_vertex, 8.0) << "the product budget is 8 bytes per vertex";
+}
+
+// Small meshes like a session's first levels of detail (6 to 42 vertices, closed and open),
+// each with the quantization box a session would give it: its bounding cube enlarged 2x.
+std::vector<TriangleMesh> SmallMeshes() {
+  std::vector<TriangleMesh> meshes;
+  for (int seed = 1; seed <= 4; ++seed) {
+    TriangleMesh bumpy = testing::Icosphere(0);
+    for (size_t v = 0; v < bumpy.positions.size(); ++v) {
+      bumpy.positions[v] *= 1.0f + 0.15f * std::sin(static_cast<float>(seed * 7 + v * 3));
+    }
+    meshes.push_back(bumpy);
+  }
+  for (const auto& [nx, ny] : {std::pair{1, 2}, {2, 2}, {3, 3}, {3, 4}, {4, 5}, {5, 6}}) {
+    meshes.push_back(testing::GridPatch(nx, ny));
+  }
+  TriangleMesh octahedron;
+  octahedron.positions = {Vec3f(1, 0, 0),  Vec3f(-1, 0, 0), Vec3f(0, 1, 0),
+                          Vec3f(0, -1, 0), Vec3f(0, 0, 1),  Vec3f(0, 0, -1)};
+  octahedron.faces = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                      {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  meshes.push_back(octahedron);
+  return meshes;
+}
+
+DracoOptions SessionOptions(const TriangleMesh& mesh) {
+  const float range = BoundingCubeRange(mesh.positions);
+  Vec3f low = mesh.positions.front(), high = low;
+  for (const Vec3f& p : mesh.positions) {
+    low.minimize(p);
+    high.maximize(p);
+  }
+  const Vec3f centre = (low + high) / 2;
+  DracoOptions options;
+  options.quantization_box = QuantizationBox{centre - Vec3f(range, range, range), 2 * range};
+  return options;
+}
+
+TEST(DracoCodecTest, SmallMeshesKeepTheShortestOfSeveralEncodings) {
+  int shorter = 0;
+  const std::vector<TriangleMesh> meshes = SmallMeshes();
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const std::string context = "small mesh " + std::to_string(i) + " (" +
+                                std::to_string(meshes[i].positions.size()) + " vertices)";
+    DracoOptions exact = SessionOptions(meshes[i]);
+    exact.shrink_small_meshes = false;
+    const absl::StatusOr<std::string> given = EncodeMesh(meshes[i], exact);
+    const absl::StatusOr<std::string> shortest = EncodeMesh(meshes[i], SessionOptions(meshes[i]));
+    ASSERT_TRUE(given.ok() && shortest.ok())
+        << context << ": " << given.status() << " / " << shortest.status();
+    EXPECT_LE(shortest->size(), given->size())
+        << context << ": the shortest stream is longer than the one with the given settings";
+    shorter += shortest->size() < given->size() ? 1 : 0;
+    const absl::StatusOr<TriangleMesh> from_given = DecodeMesh(*given);
+    const absl::StatusOr<TriangleMesh> from_shortest = DecodeMesh(*shortest);
+    ASSERT_TRUE(from_given.ok() && from_shortest.ok()) << context << ": decoding failed";
+    ExpectSameMesh(*from_given, *from_shortest, 0.0f,
+                   context + ": every encoding decodes to the same grid points and faces");
+  }
+  EXPECT_GT(shorter, 0) << "no small mesh got a shorter stream than with the given settings, "
+                           "so the other encodings were not tried (or never help)";
+}
+
+TEST(DracoCodecTest, MeshesOf64VerticesOrMoreUseTheGivenSettingsOnly) {
+  const TriangleMesh mesh = testing::Icosphere(2);  // 162 vertices.
+  DracoOptions exact = SessionOptions(mesh);
+  exact.shrink_small_meshes = false;
+  const absl::StatusOr<std::string> given = EncodeMesh(mesh, exact);
+  const absl::StatusOr<std::string> chosen = EncodeMesh(mesh, SessionOptions(mesh));
+  ASSERT_TRUE(given.ok() && chosen.ok()) << given.status() << " / " << chosen.status();
+  EXPECT_EQ(*chosen, *given) << "a larger mesh must be encoded once, as configured";
 }
 
 TEST(DracoCodecTest, PointCloudRoundTripKeepsNormalsAndWeights) {
@@ -429,6 +501,31 @@ TEST(DracoInteropTest, ReferenceDecoderReadsOurMesh) {
   ASSERT_TRUE(ours.ok()) << ours.status();
   ExpectSameMesh(*ours, *reference, 0.0f, "reference decoder vs. our decoder, exactly");
   ExpectSameMesh(mesh, *reference, QuantizationTolerance(2.0f, 11), "reference vs. input");
+}
+
+TEST(DracoInteropTest, ReferenceDecoderReadsTheShortestEncodingsOfSmallMeshes) {
+  if (!HaveTool(kDracoDecoder)) GTEST_SKIP() << kDracoDecoder << " is not installed";
+  int other_than_given = 0;
+  const std::vector<TriangleMesh> meshes = SmallMeshes();
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const std::string context = "small mesh " + std::to_string(i);
+    DracoOptions exact = SessionOptions(meshes[i]);
+    exact.shrink_small_meshes = false;
+    const absl::StatusOr<std::string> bytes = EncodeMesh(meshes[i], SessionOptions(meshes[i]));
+    ASSERT_TRUE(bytes.ok()) << context << ": " << bytes.status();
+    other_than_given += *bytes != *EncodeMesh(meshes[i], exact) ? 1 : 0;
+    const std::string in = TempPath("small.drc"), out = TempPath("small_by_reference.ply");
+    io_test::WriteBytes(in, *bytes);
+    ASSERT_EQ(RunTool(std::string(kDracoDecoder) + " -i " + in + " -o " + out), 0)
+        << context << ": draco_decoder failed: " << io_test::ReadBytes(TempPath("draco_tool.log"));
+    const absl::StatusOr<TriangleMesh> reference = ReadMesh(out);
+    ASSERT_TRUE(reference.ok()) << context << ": " << reference.status();
+    const absl::StatusOr<TriangleMesh> ours = DecodeMesh(*bytes);
+    ASSERT_TRUE(ours.ok()) << context << ": " << ours.status();
+    ExpectSameMesh(*ours, *reference, 0.0f, context + ": reference decoder vs. ours, exactly");
+  }
+  EXPECT_GT(other_than_given, 0) << "no stream used other settings than the given ones, so "
+                                    "this test did not exercise them";
 }
 
 TEST(DracoInteropTest, ReferenceDecoderReadsOurPointCloud) {

@@ -57,12 +57,12 @@ TEST(ConnectivityStressTest, HundredThousandOperationsKeepAValidManifold) {
   StressCounts total;
   for (uint64_t seed = 1; seed <= 2; ++seed) {
     Mesh closed = testing::MustToMesh(testing::Icosphere(1));
-    const StressCounts c = Stress(closed, seed, 30000);
+    const StressCounts c = Stress(closed, seed, 40000);
     total.splits += c.splits;
     total.collapses += c.collapses;
     if (HasFailure()) return;
     Mesh bordered = testing::MustToMesh(testing::GridPatch(6, 6));
-    const StressCounts b = Stress(bordered, seed + 100, 30000);
+    const StressCounts b = Stress(bordered, seed + 100, 40000);
     total.splits += b.splits;
     total.collapses += b.collapses;
     if (HasFailure()) return;

@@ -2,14 +2,61 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace neuralmesh {
 namespace {
 
+// Splitting stops here: only (nearly) coincident points get this deep, and they go into
+// chained buckets instead.
 constexpr int kMaxDepth = 40;
 
-double Sq(double x) { return x * x; }
+bool InCube(const double center[3], double half, const double p[3]) {
+  return std::abs(p[0] - center[0]) <= half && std::abs(p[1] - center[1]) <= half &&
+         std::abs(p[2] - center[2]) <= half;
+}
+
+int Octant(const double center[3], const double p[3]) {
+  return (p[0] >= center[0] ? 1 : 0) | (p[1] >= center[1] ? 2 : 0) | (p[2] >= center[2] ? 4 : 0);
+}
+
+// The centre of child `octant` of the cube (center, half). Every cube below the root is
+// computed by this one expression from its parent's stored centre, so that routing a point
+// down the tree and bounding a subtree during a search agree to the last bit.
+// (Multiplying by +-1 is exact and, unlike a conditional, compiles without a branch.)
+void ChildCenter(const double center[3], double half, int octant, double out[3]) {
+  static constexpr double kSign[2] = {-1.0, 1.0};
+  const double h = half * 0.5;
+  for (int i = 0; i < 3; ++i) out[i] = center[i] + h * kSign[(octant >> i) & 1];
+}
+
+// max(x, 0) without a branch (exact: x + |x| is 2x or 0).
+double PositivePart(double x) { return (x + std::abs(x)) * 0.5; }
+
+// The bits of a non-negative double, which order like the values: comparing them compiles to
+// conditional moves where comparing doubles would compile to an unpredictable branch.
+uint64_t OrderedBits(double x) {
+  uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  return bits;
+}
+
+struct SearchEntry {
+  int node;
+  double d2;  // Squared distance from the query to the node's cube.
+};
+constexpr int kInlineSearchEntries = 256;
+
+// Moves the search stack (`capacity` entries at *stack) to the heap with twice the room;
+// returns the new capacity. Only trees deeper than about 30 levels need it.
+int GrowSearchStack(int capacity, SearchEntry** stack, std::vector<SearchEntry>* heap) {
+  std::vector<SearchEntry> bigger(2 * static_cast<size_t>(capacity));
+  std::copy(*stack, *stack + capacity, bigger.begin());
+  heap->swap(bigger);
+  *stack = heap->data();
+  return static_cast<int>(heap->size());
+}
 
 }  // namespace
 
@@ -23,247 +70,388 @@ VertexOctree::VertexOctree(const BoundingBox& initial_box, int bucket_size)
     half = std::max({extent[0], extent[1], extent[2]}) * 0.5 * 1.01;
     if (!(half > 0) || !std::isfinite(half)) half = 1;
   }
-  root_ = NewNode(center, half, -1);
+  for (int i = 0; i < 3; ++i) root_center_[i] = center[i];
+  root_half_ = half;
+  // Block 0 holds only the root, in slot 0.
+  blocks_.resize(1);
+  Block& b = blocks_[0];
+  for (int i = 0; i < 3; ++i) b.center[i] = root_center_[i];
+  b.half = root_half_;
+  b.parent = -1;
+  b.next_free = -1;
+  for (Node& n : b.nodes) n = Node{kEmpty, 0};
 }
 
-int VertexOctree::NewNode(const Vec3& center, double half, int parent) {
-  int n;
-  if (!free_nodes_.empty()) {
-    n = free_nodes_.back();
-    free_nodes_.pop_back();
-    nodes_[n] = Node();
-  } else {
-    n = static_cast<int>(nodes_.size());
-    nodes_.emplace_back();
+inline void VertexOctree::NodeCube(int n, double center[3], double* half) const {
+  if (n == 0) {
+    for (int i = 0; i < 3; ++i) center[i] = root_center_[i];
+    *half = root_half_;
+    return;
   }
-  Node& node = nodes_[n];
-  node.center = center;
-  node.half = half;
-  node.parent = parent;
-  return n;
+  const Block& b = blocks_[n >> 3];
+  ChildCenter(b.center, b.half, n & 7, center);
+  *half = b.half * 0.5;
 }
 
-void VertexOctree::FreeNode(int n) {
-  nodes_[n].items.clear();
-  nodes_[n].items.shrink_to_fit();
-  free_nodes_.push_back(n);
+int VertexOctree::NewBlock(int parent, const double center[3], double half) {
+  int b;
+  if (free_blocks_ >= 0) {
+    b = free_blocks_;
+    free_blocks_ = blocks_[b].next_free;
+  } else {
+    b = static_cast<int>(blocks_.size());
+    blocks_.emplace_back();
+  }
+  Block& block = blocks_[b];
+  for (int i = 0; i < 3; ++i) block.center[i] = center[i];
+  block.half = half;
+  block.parent = parent;
+  block.next_free = -1;
+  for (Node& n : block.nodes) n = Node{kEmpty, 0};
+  return b;
 }
 
-bool VertexOctree::InCube(const Node& node, const Vec3& p) const {
-  return std::abs(p[0] - node.center[0]) <= node.half &&
-         std::abs(p[1] - node.center[1]) <= node.half &&
-         std::abs(p[2] - node.center[2]) <= node.half;
+void VertexOctree::FreeBlock(int b) {
+  blocks_[b].next_free = free_blocks_;
+  free_blocks_ = b;
 }
 
-int VertexOctree::Octant(const Node& node, const Vec3& p) const {
-  return (p[0] >= node.center[0] ? 1 : 0) | (p[1] >= node.center[1] ? 2 : 0) |
-         (p[2] >= node.center[2] ? 4 : 0);
+int VertexOctree::NewBucket() {
+  int b;
+  if (!free_buckets_.empty()) {
+    b = free_buckets_.back();
+    free_buckets_.pop_back();
+  } else {
+    b = static_cast<int>(bucket_next_.size());
+    bucket_next_.push_back(-1);
+    items_.resize(items_.size() + static_cast<size_t>(bucket_size_));
+  }
+  bucket_next_[b] = -1;
+  return b;
+}
+
+void VertexOctree::FreeBucket(int b) { free_buckets_.push_back(b); }
+
+void VertexOctree::AppendToLeaf(int n, int id, const double p[3]) {
+  if (node(n).child == kEmpty) node(n).child = LeafChild(NewBucket());
+  int b = LeafBucket(node(n).child);
+  int k = node(n).count;
+  while (k >= bucket_size_) {
+    if (bucket_next_[b] < 0) {
+      const int chained = NewBucket();
+      bucket_next_[b] = chained;
+    }
+    b = bucket_next_[b];
+    k -= bucket_size_;
+  }
+  Item& item = BucketItems(b)[k];
+  for (int i = 0; i < 3; ++i) item.p[i] = p[i];
+  item.id = id;
+  where_[id] = Location{b * bucket_size_ + k, n};
+  ++node(n).count;
 }
 
 void VertexOctree::GrowRootToward(const Vec3& p) {
   // The new root doubles the old one; the old root becomes the child on the far side of p.
-  const Node old = nodes_[root_];
-  Vec3 center;
+  double center[3];
   int octant = 0;
   for (int i = 0; i < 3; ++i) {
-    const bool up = p[i] >= old.center[i];
-    center[i] = old.center[i] + (up ? old.half : -old.half);
+    const bool up = p[i] >= root_center_[i];
+    center[i] = root_center_[i] + (up ? root_half_ : -root_half_);
     if (!up) octant |= (1 << i);
   }
-  const int old_root = root_;
-  root_ = NewNode(center, old.half * 2, -1);
-  Node& root = nodes_[root_];
-  root.leaf = false;
-  root.count = nodes_[old_root].count;
-  root.children[octant] = old_root;
-  nodes_[old_root].parent = root_;
+  const double half = root_half_ * 2;
+  const Node old = node(0);
+  const int block = NewBlock(0, center, half);
+  const int m = block * 8 + octant;
+  node(m) = old;
+  if (old.child >= 0) {
+    blocks_[old.child].parent = m;
+  } else if (old.child != kEmpty) {
+    int remaining = old.count;
+    for (int b = LeafBucket(old.child); remaining > 0; b = bucket_next_[b]) {
+      const int k = std::min(remaining, bucket_size_);
+      for (int j = 0; j < k; ++j) where_[BucketItems(b)[j].id].leaf = m;
+      remaining -= k;
+    }
+  }
+  node(0) = Node{block, old.count};
+  // The old root's cube as a search derives it from the new root may be off by a rounding
+  // error from the one its points were sorted by; searches widen every cube by that much.
+  double derived[3];
+  ChildCenter(center, half, octant, derived);
+  for (int i = 0; i < 3; ++i) {
+    slack_ = std::max(slack_, 2 * std::abs(derived[i] - root_center_[i]));
+    root_center_[i] = center[i];
+  }
+  root_half_ = half;
 }
 
 void VertexOctree::Insert(int id, const Vec3& p) {
-  if (id >= static_cast<int>(leaf_of_.size())) {
-    const size_t n = static_cast<size_t>(id) + 1;
-    leaf_of_.resize(n, -1);
-    slot_.resize(n, -1);
-    position_.resize(n);
+  if (id >= static_cast<int>(where_.size())) {
+    where_.resize(static_cast<size_t>(id) + 1, Location{-1, -1});
   }
-  if (leaf_of_[id] >= 0) Remove(id);
-  position_[id] = p;
-  for (int guard = 0; !InCube(nodes_[root_], p) && guard < 2048; ++guard) GrowRootToward(p);
-  InsertIntoTree(id);
+  if (Contains(id)) Remove(id);
+  const double pos[3] = {p[0], p[1], p[2]};
+  for (int guard = 0; !InCube(root_center_, root_half_, pos) && guard < 2048; ++guard) {
+    GrowRootToward(p);
+  }
+  InsertIntoTree(id, pos);
   ++size_;
 }
 
-int VertexOctree::ChildToward(int n, const Vec3& p) {
-  const int o = Octant(nodes_[n], p);
-  int child = nodes_[n].children[o];
-  if (child < 0) {
-    const double h = nodes_[n].half * 0.5;
-    const Vec3& center = nodes_[n].center;
-    const Vec3 c(center[0] + ((o & 1) ? h : -h), center[1] + ((o & 2) ? h : -h),
-                 center[2] + ((o & 4) ? h : -h));
-    child = NewNode(c, h, n);
-    nodes_[n].children[o] = child;
-  }
-  return child;
-}
-
-void VertexOctree::InsertIntoTree(int id) {
-  const Vec3& p = position_[id];
-  int n = root_;
+void VertexOctree::InsertIntoTree(int id, const double p[3]) {
+  int n = 0;
   int depth = 0;
   while (true) {
-    Node& node = nodes_[n];
-    ++node.count;
-    if (node.leaf) break;
-    n = ChildToward(n, p);  // May reallocate nodes_: `node` is not used after this.
-    ++depth;
+    Node& nd = node(n);
+    if (nd.child >= 0) {
+      ++nd.count;
+      n = nd.child * 8 + Octant(blocks_[nd.child].center, p);
+      ++depth;
+    } else if (nd.child != kEmpty && nd.count >= bucket_size_ && depth < kMaxDepth) {
+      SplitLeaf(n);  // n is internal now; the next iteration descends into it.
+    } else {
+      AppendToLeaf(n, id, p);
+      return;
+    }
   }
-  Node& leaf = nodes_[n];
-  leaf_of_[id] = n;
-  slot_[id] = static_cast<int>(leaf.items.size());
-  leaf.items.push_back(id);
-  if (static_cast<int>(leaf.items.size()) > bucket_size_ && depth < kMaxDepth) SplitLeaf(n);
 }
 
 void VertexOctree::SplitLeaf(int n) {
-  std::vector<int> items;
-  items.swap(nodes_[n].items);
-  nodes_[n].leaf = false;
-  nodes_[n].count -= static_cast<int>(items.size());
-  // Re-insert below n: walk down from n only.
-  for (int id : items) {
-    const Vec3& p = position_[id];
-    int m = n;
-    while (true) {
-      Node& node = nodes_[m];
-      ++node.count;
-      if (node.leaf) break;
-      m = ChildToward(m, p);
-    }
-    leaf_of_[id] = m;
-    slot_[id] = static_cast<int>(nodes_[m].items.size());
-    nodes_[m].items.push_back(id);
+  scratch_.clear();
+  GatherItems(n, scratch_);
+  for (int b = LeafBucket(node(n).child); b >= 0; b = bucket_next_[b]) FreeBucket(b);
+  double center[3], half;
+  NodeCube(n, center, &half);
+  const int block = NewBlock(n, center, half);
+  node(n) = Node{block, static_cast<int32_t>(scratch_.size())};
+  for (const Item& item : scratch_) {
+    AppendToLeaf(block * 8 + Octant(center, item.p), item.id, item.p);
   }
-  // A child that received everything (all points in one octant) splits again on next insert.
+  // A child that received every point is full; the insertion that follows splits it again.
 }
 
 void VertexOctree::Remove(int id) {
   if (!Contains(id)) return;
-  const int n = leaf_of_[id];
-  Node& leaf = nodes_[n];
-  const int s = slot_[id];
-  const int last = leaf.items.back();
-  leaf.items[s] = last;
-  slot_[last] = s;
-  leaf.items.pop_back();
-  leaf_of_[id] = -1;
-  slot_[id] = -1;
+  const int hole = where_[id].item;
+  const int n = where_[id].leaf;
+  Node& leaf = node(n);
+  // Fill the hole with the leaf's last item.
+  const int head = LeafBucket(leaf.child);
+  int last = head;
+  int before_last = -1;
+  int k = leaf.count - 1;
+  while (k >= bucket_size_) {
+    before_last = last;
+    last = bucket_next_[last];
+    k -= bucket_size_;
+  }
+  const Item moved = BucketItems(last)[k];
+  items_[hole] = moved;
+  where_[moved.id].item = hole;
+  where_[id] = Location{-1, -1};
+  if (k == 0 && before_last >= 0) {
+    bucket_next_[before_last] = -1;
+    FreeBucket(last);
+  }
+  if (--leaf.count == 0) {
+    FreeBucket(head);
+    leaf.child = kEmpty;
+  }
   --size_;
   // Update counts upward and merge the highest ancestor whose subtree became small.
   int merge_at = -1;
-  for (int m = n; m >= 0; m = nodes_[m].parent) {
-    --nodes_[m].count;
-    if (!nodes_[m].leaf && nodes_[m].count <= bucket_size_ / 2) merge_at = m;
+  for (int m = Parent(n); m >= 0; m = Parent(m)) {
+    if (--node(m).count <= bucket_size_ / 2) merge_at = m;
   }
   if (merge_at >= 0) CollapseSubtree(merge_at);
 }
 
-void VertexOctree::GatherItems(int n, std::vector<int>& out) {
-  Node& node = nodes_[n];
-  if (node.leaf) {
-    out.insert(out.end(), node.items.begin(), node.items.end());
+void VertexOctree::GatherItems(int n, std::vector<Item>& out) const {
+  const Node& nd = node(n);
+  if (nd.child >= 0) {
+    for (int o = 0; o < 8; ++o) GatherItems(nd.child * 8 + o, out);
     return;
   }
-  for (int c : node.children) {
-    if (c >= 0) GatherItems(c, out);
+  if (nd.child == kEmpty) return;
+  int remaining = nd.count;
+  for (int b = LeafBucket(nd.child); b >= 0 && remaining > 0; b = bucket_next_[b]) {
+    const int m = std::min(remaining, bucket_size_);
+    out.insert(out.end(), BucketItems(b), BucketItems(b) + m);
+    remaining -= m;
   }
+}
+
+void VertexOctree::FreeSubtree(int n) {
+  const Node nd = node(n);
+  if (nd.child >= 0) {
+    for (int o = 0; o < 8; ++o) FreeSubtree(nd.child * 8 + o);
+    FreeBlock(nd.child);
+  } else if (nd.child != kEmpty) {
+    for (int b = LeafBucket(nd.child); b >= 0; b = bucket_next_[b]) FreeBucket(b);
+  }
+  node(n) = Node{kEmpty, 0};
 }
 
 void VertexOctree::CollapseSubtree(int n) {
-  std::vector<int> items;
-  GatherItems(n, items);
-  // Free every descendant.
-  std::vector<int> stack;
-  for (int c : nodes_[n].children) {
-    if (c >= 0) stack.push_back(c);
-  }
-  while (!stack.empty()) {
-    const int m = stack.back();
-    stack.pop_back();
-    for (int c : nodes_[m].children) {
-      if (c >= 0) stack.push_back(c);
-    }
-    FreeNode(m);
-  }
-  Node& node = nodes_[n];
-  std::fill(std::begin(node.children), std::end(node.children), -1);
-  node.leaf = true;
-  node.items = std::move(items);
-  for (size_t i = 0; i < node.items.size(); ++i) {
-    leaf_of_[node.items[i]] = n;
-    slot_[node.items[i]] = static_cast<int>(i);
-  }
+  scratch_.clear();
+  GatherItems(n, scratch_);
+  FreeSubtree(n);
+  for (const Item& item : scratch_) AppendToLeaf(n, item.id, item.p);
 }
 
 void VertexOctree::Move(int id, const Vec3& p) {
-  const int n = leaf_of_[id];
-  if (n >= 0 && InCube(nodes_[n], p)) {
-    position_[id] = p;
-    return;
+  if (Contains(id)) {
+    const Location at = where_[id];
+    double center[3], half;
+    NodeCube(at.leaf, center, &half);
+    const double pos[3] = {p[0], p[1], p[2]};
+    if (InCube(center, half, pos)) {
+      Item& item = items_[at.item];
+      for (int i = 0; i < 3; ++i) item.p[i] = pos[i];
+      return;
+    }
   }
   Remove(id);
   Insert(id, p);
 }
 
+void VertexOctree::ScanLeaf(const Node& leaf, const double q[3], int* best, double* best_d2) const {
+  int remaining = leaf.count;
+  int b = LeafBucket(leaf.child);
+  const Item* found = nullptr;
+  // Squared distances are >= 0 (NaN only if coordinates overflow; then nothing is found).
+  uint64_t found_bits = OrderedBits(*best_d2);
+  while (true) {
+    const Item* items = BucketItems(b);
+    const int m = std::min(remaining, bucket_size_);
+    for (int j = 0; j < m; ++j) {
+      const double dx = items[j].p[0] - q[0];
+      const double dy = items[j].p[1] - q[1];
+      const double dz = items[j].p[2] - q[2];
+      const uint64_t bits = OrderedBits(dx * dx + dy * dy + dz * dz);
+      const bool closer = bits < found_bits;
+      found = closer ? &items[j] : found;
+      found_bits = closer ? bits : found_bits;
+    }
+    remaining -= m;
+    if (remaining == 0) break;
+    b = bucket_next_[b];
+  }
+  if (found != nullptr) {
+    *best = found->id;
+    std::memcpy(best_d2, &found_bits, sizeof found_bits);
+  }
+}
+
 int VertexOctree::Nearest(const Vec3& q) const {
   if (size_ == 0) return -1;
+  const double qp[3] = {q[0], q[1], q[2]};
   int best = -1;
   double best_d2 = std::numeric_limits<double>::infinity();
-  Search(root_, q, best, best_d2);
+
+  // Depth-first search with an explicit stack; an expansion pushes at most 8 entries, so the
+  // stack stays small and lives on the call stack unless the tree is very deep.
+  SearchEntry inline_stack[kInlineSearchEntries];
+  std::vector<SearchEntry> heap_stack;
+  SearchEntry* stack = inline_stack;
+  int capacity = kInlineSearchEntries;
+
+  // First straight down to the leaf on q's side: it most likely holds the answer. The path is
+  // kept (in the stack's storage) to find where the search must start.
+  int depth = 0;
+  stack[0].node = 0;
+  while (node(stack[depth].node).child >= 0) {
+    const int block = node(stack[depth].node).child;
+    const int c = block * 8 + Octant(blocks_[block].center, qp);
+    if (node(c).count == 0) break;
+    if (depth + 2 > capacity) capacity = GrowSearchStack(capacity, &stack, &heap_stack);
+    stack[++depth].node = c;
+  }
+  int scanned = -1;
+  int start = 0;
+  if (node(stack[depth].node).child < 0 && node(stack[depth].node).count > 0) {
+    scanned = stack[depth].node;
+    ScanLeaf(node(scanned), qp, &best, &best_d2);
+    // Anything nearer lies in the ball of radius sqrt(best_d2) around q; the search starts at
+    // the lowest cube on the path that contains that ball (the test allows for its rounding).
+    const double r = std::sqrt(best_d2) * (1 + 1e-12) + slack_;
+    for (int d = depth; d >= 0; --d) {
+      double center[3], half;
+      NodeCube(stack[d].node, center, &half);
+      bool inside = true;
+      for (int i = 0; i < 3; ++i) {
+        const double rounding = 1e-15 * (std::abs(qp[i]) + std::abs(center[i]) + half);
+        inside &= std::abs(qp[i] - center[i]) + r + rounding <= half;
+      }
+      if (inside) {
+        start = stack[d].node;
+        break;
+      }
+    }
+    if (start == scanned) return best;
+  }
+
+  int top = 0;
+  stack[top++] = SearchEntry{start, 0.0};
+  while (top > 0) {
+    const SearchEntry e = stack[--top];
+    if (e.d2 >= best_d2) continue;
+    const Node& nd = node(e.node);
+    if (nd.child < 0) {
+      ScanLeaf(nd, qp, &best, &best_d2);  // Non-empty: empty nodes are never pushed.
+      continue;
+    }
+    if (top + 8 > capacity) capacity = GrowSearchStack(capacity, &stack, &heap_stack);
+    const Block& block = blocks_[nd.child];
+    const double h = block.half * 0.5;
+    const int own = Octant(block.center, qp);
+    // Per axis, the squared distance from q to the lower and the upper half of the cube, and
+    // the halves within reach, q's own last.
+    double axis_d2[3][2];
+    int halves[3][2];
+    int num_halves[3];
+    for (int i = 0; i < 3; ++i) {
+      const double lo = PositivePart(std::abs(qp[i] - (block.center[i] - h)) - h - slack_);
+      const double hi = PositivePart(std::abs(qp[i] - (block.center[i] + h)) - h - slack_);
+      axis_d2[i][0] = lo * lo;
+      axis_d2[i][1] = hi * hi;
+      const int mine = (own >> i) & 1;
+      int k = 0;
+      halves[i][k] = mine ^ 1;
+      k += axis_d2[i][mine ^ 1] < best_d2;
+      halves[i][k] = mine;
+      k += axis_d2[i][mine] < best_d2;
+      num_halves[i] = k;
+    }
+    // Pushed so that q's own octant is popped first.
+    for (int a = 0; a < num_halves[2]; ++a) {
+      const int z = halves[2][a];
+      for (int b = 0; b < num_halves[1]; ++b) {
+        const int y = halves[1][b];
+        const double dyz = axis_d2[1][y] + axis_d2[2][z];
+        for (int c = 0; c < num_halves[0]; ++c) {
+          const int x = halves[0][c];
+          const int o = x | (y << 1) | (z << 2);
+          const double d2 = axis_d2[0][x] + dyz;
+          const int child = nd.child * 8 + o;
+          stack[top] = SearchEntry{child, d2};
+          top += (block.nodes[o].count != 0) & (d2 < best_d2) & (child != scanned);
+        }
+      }
+    }
+  }
   return best;
 }
 
-void VertexOctree::Search(int n, const Vec3& q, int& best, double& best_d2) const {
-  const Node& node = nodes_[n];
-  if (node.leaf) {
-    for (int id : node.items) {
-      const Vec3& p = position_[id];
-      const double d2 = Sq(p[0] - q[0]) + Sq(p[1] - q[1]) + Sq(p[2] - q[2]);
-      if (d2 < best_d2) {
-        best_d2 = d2;
-        best = id;
-      }
-    }
-    return;
-  }
-  // The octant holding q first: it most likely holds the answer and tightens the bound.
-  const int first = Octant(node, q);
-  if (node.children[first] >= 0 && nodes_[node.children[first]].count > 0) {
-    Search(node.children[first], q, best, best_d2);
-  }
-  for (int o = 0; o < 8; ++o) {
-    const int c = node.children[o];
-    if (o == first || c < 0) continue;
-    const Node& child = nodes_[c];
-    if (child.count == 0) continue;
-    double d2 = 0;
-    for (int i = 0; i < 3; ++i) {
-      const double d = std::abs(q[i] - child.center[i]) - child.half;
-      if (d > 0) d2 += d * d;
-    }
-    if (d2 < best_d2) Search(c, q, best, best_d2);
-  }
-}
-
-int VertexOctree::Depth() const { return DepthOf(root_); }
+int VertexOctree::Depth() const { return DepthOf(0); }
 
 int VertexOctree::DepthOf(int n) const {
-  const Node& node = nodes_[n];
-  if (node.leaf) return 0;
+  const Node& nd = node(n);
+  if (nd.child < 0) return 0;
   int d = 0;
-  for (int c : node.children) {
-    if (c >= 0) d = std::max(d, 1 + DepthOf(c));
-  }
+  for (int o = 0; o < 8; ++o) d = std::max(d, 1 + DepthOf(nd.child * 8 + o));
   return d;
 }
 

@@ -6,9 +6,19 @@
 // to half a bucket merges back into a leaf, and the root doubles toward any point inserted
 // outside it, so no bounding box has to be known in advance (points stream in).
 // Query: O(log v) expected; a move that stays inside its leaf is O(1), others O(log v).
+//
+// Layout and search (for speed: every Basic Step of the learner makes one query and about 7
+// moves): the children of a node are allocated together as one block of 8 compact nodes that
+// also holds their parent's cube, so a query reads one block per level; a leaf keeps copies of
+// its points' coordinates next to their ids in a fixed-size bucket, so scanning it reads a few
+// consecutive cache lines and no other array. A query first scans the leaf on q's side, then
+// searches depth-first (explicit stack, nearest octant first, pruned by cube distance) from the
+// lowest cube on that path that contains the ball the first leaf bounds. Leaves at the maximum
+// depth (many coincident points) chain further buckets.
 #ifndef NEURALMESH_CORE_LEARNING_VERTEX_OCTREE_H_
 #define NEURALMESH_CORE_LEARNING_VERTEX_OCTREE_H_
 
+#include <cstdint>
 #include <vector>
 
 #include "core/bounding_box.h"
@@ -18,15 +28,17 @@ namespace neuralmesh {
 
 class VertexOctree {
  public:
-  // `initial_box` sizes the root; it grows as needed.
-  explicit VertexOctree(const BoundingBox& initial_box, int bucket_size = 12);
+  // `initial_box` sizes the root; it grows as needed. `bucket_size` (at least 2) is the
+  // capacity of a leaf (32 measured best or near-best from 1K to 100K points on a surface,
+  // bench/octree_bench.cc).
+  explicit VertexOctree(const BoundingBox& initial_box, int bucket_size = 32);
 
   // Ids are small non-negative integers (vertex indices); `p` must be finite.
   void Insert(int id, const Vec3& p);
   void Remove(int id);
   void Move(int id, const Vec3& p);
   bool Contains(int id) const {
-    return id >= 0 && id < static_cast<int>(leaf_of_.size()) && leaf_of_[id] >= 0;
+    return id >= 0 && id < static_cast<int>(where_.size()) && where_[id].item >= 0;
   }
 
   // The id of the point nearest to `q` (ties: any), or -1 when empty. Exact.
@@ -37,38 +49,79 @@ class VertexOctree {
   int Depth() const;
 
  private:
+  // A node is named by an int: block * 8 + octant; node 0 (in block 0, whose other slots are
+  // unused) is the root. `child` >= 0: internal, its children are block `child`;
+  // kEmpty: a leaf without points; otherwise a leaf whose first bucket is LeafBucket(child).
   struct Node {
-    Vec3 center;
-    double half = 0;
-    int parent = -1;
-    int count = 0;  // Points in the subtree.
-    int children[8] = {-1, -1, -1, -1, -1, -1, -1, -1};
-    bool leaf = true;
-    std::vector<int> items;  // Leaf only.
+    int32_t child;
+    int32_t count;  // Points in the subtree.
   };
+  // The 8 children of one node plus that node's cube, from which the children's cubes follow
+  // (ChildCenter). 128 bytes, aligned so that it spans one adjacent pair of cache lines.
+  struct alignas(128) Block {
+    double center[3];
+    double half;
+    int32_t parent;  // The node whose children these are.
+    int32_t next_free;
+    Node nodes[8];
+  };
+  // A leaf's points are kept in buckets of `bucket_size_` items; a leaf has one bucket except
+  // at the maximum depth, where further ones are chained. 32 bytes, so that an item never
+  // straddles two cache lines.
+  struct alignas(32) Item {
+    double p[3];
+    int32_t id;
+    int32_t unused;  // Padding.
+  };
+  // Where a point is kept. Move tests the new position against the leaf's cube, which follows
+  // from the leaf's block (usually in cache: the learner moves vertices near the one it has
+  // just searched for).
+  struct Location {
+    int32_t item;  // Index in items_, or -1 when absent.
+    int32_t leaf;
+  };
+  static constexpr int32_t kEmpty = -1;
+  static int32_t LeafChild(int bucket) { return -2 - bucket; }
+  static int LeafBucket(int32_t child) { return -2 - child; }
 
-  int NewNode(const Vec3& center, double half, int parent);
-  void FreeNode(int n);
-  bool InCube(const Node& node, const Vec3& p) const;
-  int Octant(const Node& node, const Vec3& p) const;
+  Node& node(int n) { return blocks_[n >> 3].nodes[n & 7]; }
+  const Node& node(int n) const { return blocks_[n >> 3].nodes[n & 7]; }
+  int Parent(int n) const { return n == 0 ? -1 : blocks_[n >> 3].parent; }
+  // The cube of node n (the root's is stored, the others follow from their block).
+  void NodeCube(int n, double center[3], double* half) const;
+  Item* BucketItems(int b) { return &items_[static_cast<size_t>(b) * bucket_size_]; }
+  const Item* BucketItems(int b) const { return &items_[static_cast<size_t>(b) * bucket_size_]; }
+
+  int NewBlock(int parent, const double center[3], double half);
+  void FreeBlock(int b);
+  int NewBucket();
+  void FreeBucket(int b);
+  // Appends (id, p) to leaf n (which may be empty), chaining a bucket if needed.
+  void AppendToLeaf(int n, int id, const double p[3]);
   void GrowRootToward(const Vec3& p);
-  // The child of internal node n that contains p, created (as an empty leaf) if absent.
-  int ChildToward(int n, const Vec3& p);
-  void InsertIntoTree(int id);
+  void InsertIntoTree(int id, const double p[3]);
   void SplitLeaf(int n);
   void CollapseSubtree(int n);
-  void GatherItems(int n, std::vector<int>& out);
-  void Search(int n, const Vec3& q, int& best, double& best_d2) const;
+  void GatherItems(int n, std::vector<Item>& out) const;
+  void FreeSubtree(int n);
+  // Updates (best, best_d2) with the points of a non-empty leaf.
+  void ScanLeaf(const Node& leaf, const double q[3], int* best, double* best_d2) const;
   int DepthOf(int n) const;
 
-  std::vector<Node> nodes_;
-  std::vector<int> free_nodes_;
-  std::vector<Vec3> position_;
-  std::vector<int> leaf_of_;  // -1 when absent.
-  std::vector<int> slot_;     // Index in the leaf's items.
-  int root_ = -1;
+  std::vector<Block> blocks_;
+  int free_blocks_ = -1;
+  std::vector<Item> items_;       // bucket_size_ items per bucket; fewer than 2^31 in all.
+  std::vector<int> bucket_next_;  // The next bucket of the same leaf, or -1.
+  std::vector<int> free_buckets_;
+  std::vector<Location> where_;  // By id.
+  double root_center_[3];
+  double root_half_;
+  // Tolerance added to the cube of an old root: after the root grows, the old root's cube as
+  // derived from the new root may differ from the stored one by a rounding error.
+  double slack_ = 0;
   int bucket_size_;
   size_t size_ = 0;
+  std::vector<Item> scratch_;  // For SplitLeaf and CollapseSubtree.
 };
 
 }  // namespace neuralmesh

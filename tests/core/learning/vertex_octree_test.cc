@@ -1,6 +1,10 @@
 #include "core/learning/vertex_octree.h"
 
+#include <algorithm>
+#include <cmath>
+#include <functional>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "core/random.h"
@@ -22,6 +26,65 @@ int BruteForceNearest(const std::vector<Vec3>& points, const std::vector<bool>& 
     }
   }
   return best;
+}
+
+// Compares tree.Nearest(q) with brute force; returns a failure message or "".
+std::string CheckNearest(const VertexOctree& tree, const std::vector<Vec3>& points,
+                         const std::vector<bool>& present, const Vec3& q) {
+  double best_d2;
+  const int expected = BruteForceNearest(points, present, q, &best_d2);
+  const int got = tree.Nearest(q);
+  if (expected < 0) return got == -1 ? "" : "the tree answers for an empty set";
+  if (got < 0 || got >= static_cast<int>(points.size()) || !present[got]) {
+    return "the tree answers " + std::to_string(got) + ", which is not a live id";
+  }
+  const double got_d2 = (points[got] - q).sqrnorm();
+  // Exact up to the rounding of the distance itself (a few ulps, as ASSERT_DOUBLE_EQ).
+  if (!(got_d2 <= best_d2 * (1 + 4 * std::numeric_limits<double>::epsilon()))) {
+    return "the tree's answer " + std::to_string(got) + " is not the nearest (" +
+           std::to_string(expected) + ")";
+  }
+  return "";
+}
+
+// Random inserts, moves and removals of `num_ids` ids, with new points from `new_point` and
+// moves by `offset`; after every operation a query from `query` must match brute force.
+void RunRandomOperations(VertexOctree& tree, int num_ids, int num_ops, uint64_t seed,
+                         const std::function<Vec3(Random&)>& new_point,
+                         const std::function<Vec3(Random&)>& offset,
+                         const std::function<Vec3(Random&)>& query) {
+  Random rng(seed);
+  std::vector<Vec3> points(num_ids);
+  std::vector<bool> present(num_ids, false);
+  for (int op = 0; op < num_ops; ++op) {
+    const int id = static_cast<int>(rng.NextIndex(num_ids));
+    const double r = rng.NextDouble();
+    if (!present[id]) {
+      points[id] = new_point(rng);
+      tree.Insert(id, points[id]);
+      present[id] = true;
+    } else if (r < 0.6) {
+      points[id] += offset(rng);
+      tree.Move(id, points[id]);
+    } else {
+      tree.Remove(id);
+      present[id] = false;
+    }
+    const std::string error = CheckNearest(tree, points, present, query(rng));
+    ASSERT_EQ(error, "") << "op " << op;
+    ASSERT_EQ(tree.Contains(id), present[id]) << "op " << op << ": Contains(" << id << ") is wrong";
+  }
+  size_t count = 0;
+  for (bool p : present) count += p;
+  EXPECT_EQ(tree.size(), count) << "size() disagrees with the number of live ids";
+  // Finally every point must find itself (or a coincident one).
+  for (int id = 0; id < num_ids; ++id) {
+    if (!present[id]) continue;
+    const int got = tree.Nearest(points[id]);
+    ASSERT_GE(got, 0) << "point " << id << " is lost";
+    EXPECT_EQ((points[got] - points[id]).sqrnorm(), 0.0)
+        << "point " << id << " does not find itself";
+  }
 }
 
 TEST(VertexOctreeTest, EmptyTreeHasNoNearest) {
@@ -89,6 +152,203 @@ TEST(VertexOctreeTest, DepthStaysLogarithmic) {
     tree.Insert(i, Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble()));
   }
   EXPECT_LE(tree.Depth(), 12) << "uniform points should give a shallow tree";
+}
+
+// The learner's kind of data: points on a surface (a sphere) that move by small steps, at
+// several leaf sizes, including the smallest.
+TEST(VertexOctreeTest, MatchesBruteForceOnASurfaceForEveryBucketSize) {
+  for (int bucket_size : {2, 3, 8, 32, 64}) {
+    SCOPED_TRACE("bucket_size " + std::to_string(bucket_size));
+    BoundingBox box;
+    box.Extend(Vec3(-1, -1, -1));
+    box.Extend(Vec3(1, 1, 1));
+    VertexOctree tree(box, bucket_size);
+    auto on_sphere = [](Random& rng) {
+      const double z = 2 * rng.NextDouble() - 1;
+      const double phi = 2 * M_PI * rng.NextDouble();
+      const double s = std::sqrt(1 - z * z);
+      return Vec3(s * std::cos(phi), s * std::sin(phi), z);
+    };
+    RunRandomOperations(
+        tree, /*num_ids=*/600, /*num_ops=*/20000, /*seed=*/11, on_sphere,
+        [](Random& rng) {
+          return Vec3(rng.NextDouble() - 0.5, rng.NextDouble() - 0.5, rng.NextDouble() - 0.5) *
+                 0.02;
+        },
+        on_sphere);
+  }
+}
+
+// Many points at identical coordinates: no amount of splitting separates them, so the leaf
+// at the maximum depth has to hold more than a bucket.
+TEST(VertexOctreeTest, HandlesManyCoincidentPoints) {
+  BoundingBox box;
+  box.Extend(Vec3(0, 0, 0));
+  box.Extend(Vec3(1, 1, 1));
+  VertexOctree tree(box, /*bucket_size=*/2);
+  const Vec3 spot(0.3, 0.6, 0.2);
+  const int kCoincident = 100;
+  for (int id = 0; id < kCoincident; ++id) tree.Insert(id, spot);
+  tree.Insert(kCoincident, Vec3(0.9, 0.9, 0.9));
+  tree.Insert(kCoincident + 1, Vec3(0.3, 0.6, 0.2 + 1e-9));
+  EXPECT_EQ(tree.size(), static_cast<size_t>(kCoincident + 2));
+  EXPECT_GE(tree.Depth(), 30) << "coincident points should drive a leaf to the maximum depth";
+  // Remove them in a scrambled order; the rest must still be found exactly.
+  Random rng(5);
+  std::vector<int> order;
+  for (int id = 0; id < kCoincident; ++id) order.push_back(id);
+  for (int i = kCoincident - 1; i > 0; --i) std::swap(order[i], order[rng.NextIndex(i + 1)]);
+  std::vector<bool> present(kCoincident, true);
+  for (int k = 0; k < kCoincident; ++k) {
+    const int got = tree.Nearest(spot);
+    ASSERT_TRUE(got >= 0 && got < kCoincident && present[got])
+        << "after " << k << " removals the tree answers " << got
+        << " instead of a remaining coincident point";
+    // Move one of them away and back: it leaves the deep leaf and returns to it.
+    const int moving = order[kCoincident - 1];
+    tree.Move(moving, Vec3(0.8, 0.1, 0.1));
+    ASSERT_EQ(tree.Nearest(Vec3(0.8, 0.1, 0.1)), moving) << "a point moved out is lost";
+    tree.Move(moving, spot);
+    tree.Remove(order[k]);
+    present[order[k]] = false;
+    ASSERT_FALSE(tree.Contains(order[k]));
+    ASSERT_EQ(tree.size(), static_cast<size_t>(kCoincident + 1 - k));
+  }
+  EXPECT_EQ(tree.Nearest(spot), kCoincident + 1) << "the nearly coincident point should win";
+  EXPECT_LE(tree.Depth(), 2) << "the deep subtree should have merged back";
+}
+
+// Clusters of points closer than 1e-9 (trees near the maximum depth, coincident points mixed
+// with distinct ones) under random operations.
+TEST(VertexOctreeTest, MatchesBruteForceOnTinyClusters) {
+  BoundingBox box;
+  box.Extend(Vec3(-1, -1, -1));
+  box.Extend(Vec3(1, 1, 1));
+  VertexOctree tree(box, /*bucket_size=*/3);
+  const std::vector<Vec3> centers = {Vec3(0.1, 0.2, 0.3), Vec3(-0.5, 0.25, 0.125),
+                                     Vec3(0.1, 0.2, 0.3 + 1e-6)};
+  auto near_a_center = [&](Random& rng) {
+    const Vec3& c = centers[rng.NextIndex(centers.size())];
+    const double scale = std::pow(10.0, -9.0 - 6.0 * rng.NextDouble());
+    if (rng.NextDouble() < 0.3) return c;  // Exactly coincident.
+    return c + Vec3(rng.NextDouble() - 0.5, rng.NextDouble() - 0.5, rng.NextDouble() - 0.5) * scale;
+  };
+  RunRandomOperations(
+      tree, /*num_ids=*/200, /*num_ops=*/10000, /*seed=*/17, near_a_center,
+      [](Random& rng) {
+        const double scale = std::pow(10.0, -8.0 - 6.0 * rng.NextDouble());
+        return Vec3(rng.NextDouble() - 0.5, rng.NextDouble() - 0.5, rng.NextDouble() - 0.5) * scale;
+      },
+      near_a_center);
+}
+
+// The root doubles toward points far outside it, many times over, in every direction; points
+// near the initial box must still be found exactly, and removing the far points must work.
+TEST(VertexOctreeTest, RootGrowsTowardFarPoints) {
+  BoundingBox box;
+  box.Extend(Vec3(0.1, 0.1, 0.1));
+  box.Extend(Vec3(0.3, 0.7, 0.2));
+  VertexOctree tree(box, /*bucket_size=*/4);
+  std::vector<Vec3> points;
+  Random rng(23);
+  for (int i = 0; i < 300; ++i) {
+    points.push_back(Vec3(0.1 + 0.2 * rng.NextDouble(), 0.1 + 0.6 * rng.NextDouble(),
+                          0.1 + 0.1 * rng.NextDouble()));
+  }
+  const std::vector<Vec3> far = {Vec3(1e3, 0, 0),         Vec3(0, -1e9, 0),
+                                 Vec3(0, 0, 1e15),        Vec3(-3e15, 2e15, 7),
+                                 Vec3(1e-3, 1e-3, -1e12), Vec3(1e15, 1e15, 1e15)};
+  const int first_far = static_cast<int>(points.size());
+  points.insert(points.end(), far.begin(), far.end());
+  std::vector<bool> present(points.size(), false);
+  // Interleave: some near points, then each far point, then more near points.
+  for (int id = 0; id < first_far / 2; ++id) {
+    tree.Insert(id, points[id]);
+    present[id] = true;
+  }
+  for (int id = first_far; id < static_cast<int>(points.size()); ++id) {
+    tree.Insert(id, points[id]);
+    present[id] = true;
+  }
+  for (int id = first_far / 2; id < first_far; ++id) {
+    tree.Insert(id, points[id]);
+    present[id] = true;
+  }
+  auto check_queries = [&](const char* stage) {
+    for (int k = 0; k < 500; ++k) {
+      Vec3 q(0.4 * rng.NextDouble(), 0.8 * rng.NextDouble(), 0.3 * rng.NextDouble());
+      if (k % 10 == 0) q = far[k / 10 % far.size()] * (0.5 + rng.NextDouble());
+      const std::string error = CheckNearest(tree, points, present, q);
+      ASSERT_EQ(error, "") << stage << ", query " << k;
+    }
+  };
+  check_queries("after inserting");
+  // Small moves of the near points and a far point moved next to them.
+  for (int id = 0; id < first_far; id += 3) {
+    points[id] += Vec3(1e-3, -1e-3, 5e-4);
+    tree.Move(id, points[id]);
+  }
+  points[first_far] = Vec3(0.2, 0.2, 0.15);
+  tree.Move(first_far, points[first_far]);
+  check_queries("after moving");
+  for (int id = first_far + 1; id < static_cast<int>(points.size()); ++id) {
+    tree.Remove(id);
+    present[id] = false;
+  }
+  check_queries("after removing the far points");
+  EXPECT_EQ(tree.size(), static_cast<size_t>(first_far + 1));
+}
+
+// A point near the largest doubles makes the root grow about a thousand times, so the points
+// near the initial box sit a thousand levels deep: deeper than the search's inline stack.
+TEST(VertexOctreeTest, SearchesVeryDeepTrees) {
+  BoundingBox box;
+  box.Extend(Vec3(0, 0, 0));
+  box.Extend(Vec3(1, 1, 1));
+  VertexOctree tree(box, /*bucket_size=*/2);
+  std::vector<Vec3> points;
+  Random rng(31);
+  for (int i = 0; i < 60; ++i) {
+    points.push_back(Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble()));
+  }
+  points.push_back(Vec3(1e300, -1e300, 1e300));
+  points.push_back(Vec3(-1e299, 0.5, 0.5));
+  std::vector<bool> present(points.size(), true);
+  for (size_t id = 0; id < points.size(); ++id) tree.Insert(static_cast<int>(id), points[id]);
+  EXPECT_GT(tree.Depth(), 900) << "the root should have grown about a thousand times";
+  for (int k = 0; k < 200; ++k) {
+    Vec3 q(rng.NextDouble(), rng.NextDouble(), rng.NextDouble());
+    if (k % 20 == 0) q = Vec3(-3e298, 1e10, 0);
+    if (k % 20 == 1) q = Vec3(1e299, 1e299, 1e299);
+    ASSERT_EQ(CheckNearest(tree, points, present, q), "") << "query " << k;
+  }
+  for (int id = 0; id < 60; id += 2) {
+    points[id] += Vec3(0.01, 0.02, -0.01);
+    tree.Move(id, points[id]);
+  }
+  for (int k = 0; k < 200; ++k) {
+    const Vec3 q(rng.NextDouble(), rng.NextDouble(), rng.NextDouble());
+    ASSERT_EQ(CheckNearest(tree, points, present, q), "") << "after moves, query " << k;
+  }
+}
+
+// A tree built without a box (empty) starts from a unit cube and grows.
+TEST(VertexOctreeTest, EmptyInitialBoxGrows) {
+  VertexOctree tree{BoundingBox()};
+  std::vector<Vec3> points;
+  std::vector<bool> present;
+  Random rng(29);
+  for (int id = 0; id < 2000; ++id) {
+    points.push_back(Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble()) * 100.0 -
+                     Vec3(30, 30, 30));
+    present.push_back(true);
+    tree.Insert(id, points[id]);
+  }
+  for (int k = 0; k < 500; ++k) {
+    const Vec3 q =
+        Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble()) * 120.0 - Vec3(40, 40, 40);
+    ASSERT_EQ(CheckNearest(tree, points, present, q), "") << "query " << k;
+  }
 }
 
 }  // namespace

@@ -16,8 +16,7 @@
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
-#include "absl/strings/numbers.h"
-#include "absl/strings/str_split.h"
+#include "bench/count_list.h"
 #include "core/learning/learner.h"
 #include "core/sampling/implicit_surfaces.h"
 #include "core/sampling/point_cloud_sampler.h"
@@ -30,31 +29,20 @@ ABSL_FLAG(uint64_t, seed, 1, "Seed of the learner and of the point sampling.");
 namespace neuralmesh {
 namespace {
 
-std::vector<size_t> ParseList(const std::string& text) {
-  std::vector<size_t> out;
-  for (absl::string_view part : absl::StrSplit(text, ',', absl::SkipEmpty())) {
-    size_t value = 0;
-    if (!absl::SimpleAtoi(part, &value) || value == 0) {
-      std::fprintf(stderr, "learner-bench: '%s' is not a positive integer\n",
-                   std::string(part).c_str());
-      std::exit(2);
-    }
-    out.push_back(value);
-  }
-  return out;
-}
-
 double Seconds(absl::Duration d) { return absl::ToDoubleSeconds(d); }
 
 int Run() {
-  const std::vector<size_t> point_counts = ParseList(absl::GetFlag(FLAGS_points));
-  const std::vector<size_t> milestones = ParseList(absl::GetFlag(FLAGS_milestones));
+  const std::vector<size_t> point_counts =
+      bench::ParseCountList(absl::GetFlag(FLAGS_points), "learner-bench");
+  const std::vector<size_t> milestones =
+      bench::ParseCountList(absl::GetFlag(FLAGS_milestones), "learner-bench");
   const uint64_t seed = absl::GetFlag(FLAGS_seed);
   // The input: a torus (R = 1, r = 0.35) sampled uniformly.
   auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.35).value();
 
-  std::printf("Neural Meshes learner, paper parameters (alpha_w = alpha_L = 0.06, C_L = 5, "
-              "C_vs = 100, C_ec = 10, alpha_sc = 0.95, alpha_r = 7, alpha_m = 5), one thread\n\n");
+  std::printf(
+      "Neural Meshes learner, paper parameters (alpha_w = alpha_L = 0.06, C_L = 5, "
+      "C_vs = 100, C_ec = 10, alpha_sc = 0.95, alpha_r = 7, alpha_m = 5), one thread\n\n");
   std::printf("%10s %8s %9s %11s %9s %8s %8s %8s %8s %8s %8s %10s\n", "points", "#v", "total s",
               "steps", "us/step", "octree", "smooth", "split", "collapse", "removal", "merge",
               "steps/s");
@@ -97,10 +85,11 @@ int Run() {
       std::fflush(stdout);
     }
   }
-  std::printf("\nColumns octree..merge: seconds spent per step kind (octree = sampling and the "
-              "winner search; smooth = Eq. 1, the C_L smoothing passes and the octree updates of "
-              "the moved vertices; split = Step 2 with the counters; collapse, removal, merge = "
-              "Steps 3, 4, 5).\n");
+  std::printf(
+      "\nColumns octree..merge: seconds spent per step kind (octree = sampling and the "
+      "winner search; smooth = Eq. 1, the C_L smoothing passes and the octree updates of "
+      "the moved vertices; split = Step 2 with the counters; collapse, removal, merge = "
+      "Steps 3, 4, 5).\n");
   return 0;
 }
 

@@ -20,8 +20,7 @@
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
-#include "absl/strings/numbers.h"
-#include "absl/strings/str_split.h"
+#include "bench/count_list.h"
 #include "core/bounding_box.h"
 #include "core/learning/vertex_octree.h"
 #include "core/random.h"
@@ -37,20 +36,6 @@ namespace neuralmesh {
 namespace {
 
 constexpr int kMovesPerStep = 7;
-
-std::vector<size_t> ParseList(const std::string& text) {
-  std::vector<size_t> out;
-  for (absl::string_view part : absl::StrSplit(text, ',', absl::SkipEmpty())) {
-    size_t value = 0;
-    if (!absl::SimpleAtoi(part, &value) || value == 0) {
-      std::fprintf(stderr, "octree-bench: '%s' is not a positive integer\n",
-                   std::string(part).c_str());
-      std::exit(2);
-    }
-    out.push_back(value);
-  }
-  return out;
-}
 
 // CPU time of this thread: the machine is shared, and wall time would count the time other
 // processes hold the core.
@@ -140,7 +125,8 @@ RunResult RunOnce(const Workload& w, int bucket_size, bool verify) {
 }
 
 int Run() {
-  const std::vector<size_t> sizes = ParseList(absl::GetFlag(FLAGS_sizes));
+  const std::vector<size_t> sizes =
+      bench::ParseCountList(absl::GetFlag(FLAGS_sizes), "octree-bench");
   const int iterations = std::max(1, absl::GetFlag(FLAGS_iterations));
   const int repeats = std::max(1, absl::GetFlag(FLAGS_repeats));
   const int bucket_size = absl::GetFlag(FLAGS_bucket_size);

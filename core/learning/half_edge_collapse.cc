@@ -49,6 +49,7 @@ bool IsCollapseLegal(Mesh& mesh, Mesh::HalfedgeHandle h, size_t live_vertices) {
   const int b = static_cast<int>(mesh.valence(u));
   const int shared = boundary_edge ? 1 : 2;
   if (a + b - 2 - shared < MinValence(mesh, u)) return false;
+  if (a + b - 2 - shared > 2 * IdealValence(mesh, u)) return false;  // No hubs (header).
   for (auto side : {h, mesh.opposite_halfedge_handle(h)}) {
     if (mesh.is_boundary(side)) continue;
     const auto w = mesh.to_vertex_handle(mesh.next_halfedge_handle(side));

@@ -9,6 +9,13 @@
 // A boundary vertex collapses only along a boundary edge, keeping the border in place.
 // Every candidate is checked first (OpenMesh's link condition plus minimum valences), so the
 // mesh stays a manifold.
+// Not in the paper: nor may a collapse leave u with more than twice its ideal valence (12
+// inside, 8 on a boundary). Eq. 10-11 only rank the candidates of one vertex; when all of
+// them are bad the least bad one was taken, and on the membranes that Step 4 cuts away (no
+// data, so every vertex is inactive) the border vertices passed their stars on from collapse
+// to collapse, into hubs of valence 20-45 whose sliver fans Step 4 could not remove and which
+// kept reopening holes in the data once the handle had formed. Such a vertex now waits, and
+// Step 4 removes its large faces instead.
 #ifndef NEURALMESH_CORE_LEARNING_HALF_EDGE_COLLAPSE_H_
 #define NEURALMESH_CORE_LEARNING_HALF_EDGE_COLLAPSE_H_
 
@@ -25,7 +32,8 @@ Mesh::HalfedgeHandle BestCollapse(Mesh& mesh, Mesh::VertexHandle v, size_t live_
 double CollapseIrregularity(const Mesh& mesh, Mesh::HalfedgeHandle h);
 
 // Whether collapsing `h` keeps the mesh a manifold with valences >= 3 inside and >= 2 on
-// boundaries, and leaves at least 4 vertices.
+// boundaries, leaves the target vertex at most twice its ideal valence, and leaves at least 4
+// vertices.
 bool IsCollapseLegal(Mesh& mesh, Mesh::HalfedgeHandle h, size_t live_vertices);
 
 }  // namespace neuralmesh

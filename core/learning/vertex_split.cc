@@ -83,13 +83,14 @@ Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
     // inner+3 and n-inner+1. The cut neighbours vl = u[e+k1], vr = u[e-k2] gain an edge each;
     // of the admissible arcs, take the one that leaves the four affected valences most
     // regular ("distributing the valences as regularly as possible"). A cut neighbour on the
-    // border does not count: a border vertex of valence 4 may not be split (Section 2.2), so
-    // gaining an edge is the only way a border refines along with the surface (valence 5
-    // splits into 4 + 4); penalising it kept borders at their first, coarse resolution, too
-    // sparse for Step 5 to see two facing borders as close.
+    // border costs nothing up to valence 5: a border vertex of valence 4 may not be split
+    // (Section 2.2), so gaining an edge is the only way a border refines along with the
+    // surface (valence 5 splits into 4 + 4); penalising it kept borders at their first, coarse
+    // resolution, too sparse for Step 5 to see two facing borders as close. Above 5 it counts
+    // again (from 5, not 4): free edges let border vertices that are never split themselves
+    // grow into hubs of valence 20 and more.
     auto deviation = [&](Mesh::VertexHandle w, int valence) {
-      if (mesh.is_boundary(w)) return 0.0;
-      const double d = valence - 6;
+      const double d = mesh.is_boundary(w) ? std::max(0, valence - 5) : valence - 6;
       return d * d;
     };
     int k1 = 1, k2 = 1;

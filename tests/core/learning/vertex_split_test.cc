@@ -1,5 +1,6 @@
 #include "core/learning/vertex_split.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/mesh_validation.h"
@@ -59,6 +60,31 @@ TEST(VertexSplitTest, BorderSplitKeepsOneBorderThroughBothVertices) {
   EXPECT_EQ(mesh.valence(v), 4u) << "valence 5 on the border splits into 4 and 4";
   EXPECT_EQ(mesh.valence(v0), 4u);
   EXPECT_EQ(mesh.n_faces(), 5u) << "one new face; the new edge lies on the border";
+}
+
+TEST(VertexSplitTest, InteriorSplitsDoNotPileEdgesOntoTheBorder) {
+  // Split the inner vertices next to the border over and over, as the learner does where a
+  // border meets the data. A cut neighbour on the border may gain edges up to valence 5 for
+  // free (so that it can split itself), but not beyond: border vertices that are never split
+  // must not grow into hubs.
+  Mesh mesh = testing::MustToMesh(testing::GridPatch(6, 6));
+  for (int round = 0; round < 300; ++round) {
+    Mesh::VertexHandle next;
+    for (auto v : mesh.vertices()) {
+      if (mesh.is_boundary(v)) continue;
+      bool next_to_border = false;
+      for (auto u : mesh.vv_range(v)) next_to_border = next_to_border || mesh.is_boundary(u);
+      if (next_to_border && (!next.is_valid() || mesh.valence(v) > mesh.valence(next))) next = v;
+    }
+    ASSERT_TRUE(next.is_valid());
+    ASSERT_TRUE(SplitVertex(mesh, next).is_valid());
+  }
+  ASSERT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+  size_t max_border_valence = 0;
+  for (auto v : mesh.vertices()) {
+    if (mesh.is_boundary(v)) max_border_valence = std::max<size_t>(max_border_valence, mesh.valence(v));
+  }
+  EXPECT_LE(max_border_valence, 8u) << "with border neighbours free at any valence it reaches 12";
 }
 
 TEST(VertexSplitTest, VoronoiAreaEstimateIsSquaredMeanEdgeLength) {

@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package that building, testing and running neuralmesh needs.
 # Idempotent: when everything is already installed it only checks and returns.
+#
+# Usage: scripts/install-deps.sh [EXTRA_PACKAGE...]
+# Extra packages (e.g. podman for scripts/container-test.sh) are checked and installed with
+# the others, so that `apt-get update` runs at most once.
 set -euo pipefail
 
 packages=(
@@ -13,6 +17,7 @@ packages=(
   libbenchmark-dev
   # Tests and tools: the reference Draco binaries, an independent Python gRPC client.
   draco python3 python3-grpcio python3-grpc-tools python3-protobuf
+  "$@"
 )
 
 missing=()

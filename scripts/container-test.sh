@@ -1,0 +1,281 @@
+#!/usr/bin/env bash
+# Builds the container image from docker/Dockerfile with podman and tests it end to end, on a
+# Debian 12 machine without a Docker engine, where podman works with a few adjustments:
+#   1. installs podman, runc and debootstrap (and the project's build dependencies) when missing;
+#   2. creates the base image docker.io/library/debian:bookworm-slim from Debian's own packages
+#      (debootstrap + podman import) when it is not there, since no registry can be reached;
+#   3. builds the image (podman build --isolation=chroot; cached layers make re-runs cheap);
+#   4. runs it with its port published on 127.0.0.1 only, at a free host port, and waits for the
+#      standard gRPC health service (grpc.health.v1) to report SERVING;
+#   5. reconstructs builtin:torus through the container with the host's client
+#      (build/bin/neuralmesh, built when missing) and decodes the final .drc with Debian's
+#      draco_decoder and `neuralmesh stats`;
+#   6. stops the container with SIGTERM (podman stop) and checks that the server shut down
+#      gracefully (exit status 0, shutdown messages in its log).
+# The container is always removed at the end. The Dockerfile itself stays standard: every
+# podman adjustment (containers.conf, chroot isolation, the imported base image) lives here.
+#
+# Usage: scripts/container-test.sh      (as root; from anywhere, paths are relative to the repo)
+# Environment: IMAGE (default localhost/neuralmesh:latest), BUILD_DIR (host build, default
+#              build), JOBS (host build jobs, default: all cores), VERTICES (default 2000),
+#              OUT_DIR (logs and meshes, default out/container-test).
+# Prints a PASS/FAIL summary; exits non-zero, naming the failed step, on any failure.
+set -euo pipefail
+
+cd "$(dirname "$0")/.."
+IMAGE=${IMAGE:-localhost/neuralmesh:latest}
+BUILD_DIR=${BUILD_DIR:-build}
+JOBS=${JOBS:-$(nproc)}
+VERTICES=${VERTICES:-2000}
+OUT_DIR=${OUT_DIR:-out/container-test}
+BASE_IMAGE=docker.io/library/debian:bookworm-slim
+CONTAINER_PORT=50051  # the port the image's ENTRYPOINT listens on
+# Debian's interpreter, where python3-grpcio lives; an earlier python3 on PATH may lack it.
+PYTHON=/usr/bin/python3
+CLI="${BUILD_DIR}/bin/neuralmesh"
+
+STARTED_AT=$(date +%s)
+STEP="start"
+CONTAINER=""
+ROOTFS=""
+WORK_DIR=""
+IMAGE_BUILD_SECONDS="-"
+IMAGE_SIZE="-"
+
+say() { printf '==> %s\n' "$*" >&2; }
+step() {  # step NAME: what is being done now, named by the FAIL summary if it goes wrong
+  STEP=$1
+  say "$1"
+}
+fail() {
+  printf 'container-test: %s failed: %s\n' "${STEP}" "$*" >&2
+  exit 1
+}
+
+cleanup() {
+  local status=$?
+  trap - EXIT INT TERM
+  if [[ -n "${CONTAINER}" ]]; then
+    if [[ ${status} -ne 0 ]]; then
+      say "Last lines of the container's log:"
+      podman logs "${CONTAINER}" 2>&1 | tail -n 20 >&2 || true
+    fi
+    podman rm -f "${CONTAINER}" >/dev/null 2>&1 || true
+  fi
+  [[ -n "${ROOTFS}" ]] && rm -rf "${ROOTFS}"
+  [[ -n "${WORK_DIR}" ]] && rm -rf "${WORK_DIR}"
+  local total=$(($(date +%s) - STARTED_AT))
+  echo
+  if [[ ${status} -eq 0 ]]; then
+    echo "container-test: PASS (image build ${IMAGE_BUILD_SECONDS} s, whole script ${total} s," \
+      "image ${IMAGE} ${IMAGE_SIZE})"
+  else
+    echo "container-test: FAIL at step: ${STEP} (exit ${status}, after ${total} s;" \
+      "logs in ${OUT_DIR}/)"
+  fi
+  exit "${status}"
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+[[ "$(id -u)" -eq 0 ]] || fail "run as root (podman runs rootful here, debootstrap needs root)"
+rm -rf "${OUT_DIR}"
+mkdir -p "${OUT_DIR}"
+WORK_DIR=$(mktemp -d -t neuralmesh-container.XXXXXX)
+
+# --- 1. Packages ---------------------------------------------------------------------------
+step "Checking packages (podman, runc, debootstrap and the build dependencies)"
+scripts/install-deps.sh podman runc debootstrap >&2 || fail "installing packages"
+
+# The sandboxes of these machines refuse podman's default resource limits, their cgroup
+# layout is hybrid, and podman is to use runc (installed above): a containers.conf of our own.
+cat >"${WORK_DIR}/containers.conf" <<'EOF'
+[containers]
+default_ulimits = []
+
+[engine]
+cgroup_manager = "cgroupfs"
+runtime = "runc"
+EOF
+export CONTAINERS_CONF="${WORK_DIR}/containers.conf"
+
+# --- 2. Base image -------------------------------------------------------------------------
+if podman image exists "${BASE_IMAGE}"; then
+  say "Base image ${BASE_IMAGE} present"
+else
+  step "Creating the base image ${BASE_IMAGE} with debootstrap (no registry here)"
+  ROOTFS=$(mktemp -d /var/tmp/neuralmesh-rootfs.XXXXXX)
+  debootstrap --variant=minbase bookworm "${ROOTFS}" http://deb.debian.org/debian \
+    >"${OUT_DIR}/debootstrap.log" 2>&1 || fail "debootstrap (see ${OUT_DIR}/debootstrap.log)"
+  # Make it behave like the official slim image, so that a standard Dockerfile gives the same
+  # result here: its apt sources (with updates and security), its apt settings that keep no
+  # package cache in a layer, and the slim variant's dpkg excludes (no docs, man pages,
+  # translations).
+  rm -f "${ROOTFS}/etc/apt/sources.list"
+  cat >"${ROOTFS}/etc/apt/sources.list.d/debian.sources" <<'EOF'
+Types: deb
+URIs: http://deb.debian.org/debian
+Suites: bookworm bookworm-updates
+Components: main
+Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
+
+Types: deb
+URIs: http://deb.debian.org/debian-security
+Suites: bookworm-security
+Components: main
+Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
+EOF
+  apt_conf="${ROOTFS}/etc/apt/apt.conf.d"
+  cat >"${apt_conf}/docker-clean" <<'EOF'
+DPkg::Post-Invoke { "rm -f /var/cache/apt/archives/*.deb /var/cache/apt/archives/partial/*.deb /var/cache/apt/*.bin || true"; };
+APT::Update::Post-Invoke { "rm -f /var/cache/apt/archives/*.deb /var/cache/apt/archives/partial/*.deb /var/cache/apt/*.bin || true"; };
+Dir::Cache::pkgcache "";
+Dir::Cache::srcpkgcache "";
+EOF
+  echo 'Acquire::Languages "none";' >"${apt_conf}/docker-no-languages"
+  echo 'Acquire::GzipIndexes "true";' >"${apt_conf}/docker-gzip-indexes"
+  echo 'Apt::AutoRemove::SuggestsImportant "false";' >"${apt_conf}/docker-autoremove-suggests"
+  echo 'force-unsafe-io' >"${ROOTFS}/etc/dpkg/dpkg.cfg.d/docker-apt-speedup"
+  cat >"${ROOTFS}/etc/dpkg/dpkg.cfg.d/docker" <<'EOF'
+path-exclude /usr/share/doc/*
+path-include /usr/share/doc/*/copyright
+path-exclude /usr/share/groff/*
+path-exclude /usr/share/info/*
+path-exclude /usr/share/linda/*
+path-exclude /usr/share/lintian/overrides/*
+path-exclude /usr/share/locale/*
+path-exclude /usr/share/man/*
+EOF
+  find "${ROOTFS}/usr/share/doc" -mindepth 1 -not -type d -not -name copyright -delete
+  find "${ROOTFS}/usr/share/doc" -mindepth 1 -type d -empty -delete
+  rm -rf "${ROOTFS}"/usr/share/{groff,info,linda,lintian/overrides,locale,man}/*
+  rm -rf "${ROOTFS}"/var/cache/apt/archives/*.deb "${ROOTFS}"/var/cache/apt/*.bin \
+    "${ROOTFS}"/var/lib/apt/lists/*
+  tar -C "${ROOTFS}" -c . | podman import --quiet --change 'CMD ["bash"]' - "${BASE_IMAGE}" \
+    >/dev/null || fail "podman import of the debootstrap root file system"
+  rm -rf "${ROOTFS}"
+  ROOTFS=""
+fi
+
+# --- 3. Image ------------------------------------------------------------------------------
+step "Building ${IMAGE} from docker/Dockerfile (log: ${OUT_DIR}/image-build.log)"
+build_start=$(date +%s)
+if ! podman build --isolation=chroot -f docker/Dockerfile -t "${IMAGE}" . \
+  >"${OUT_DIR}/image-build.log" 2>&1; then
+  tail -n 30 "${OUT_DIR}/image-build.log" >&2
+  fail "podman build (see ${OUT_DIR}/image-build.log)"
+fi
+IMAGE_BUILD_SECONDS=$(($(date +%s) - build_start))
+IMAGE_SIZE=$(podman images --format '{{.Size}}' "${IMAGE}" | head -n 1)
+say "Image built in ${IMAGE_BUILD_SECONDS} s, ${IMAGE_SIZE}"
+image_user=$(podman image inspect --format '{{.Config.User}}' "${IMAGE}")
+[[ -n "${image_user}" && "${image_user%%:*}" != root && "${image_user%%:*}" != 0 ]] \
+  || fail "the image runs as '${image_user:-root}', not as an unprivileged user"
+
+# --- 4. Host client ------------------------------------------------------------------------
+step "Building the host client ${CLI}"
+if [[ -f "${BUILD_DIR}/CMakeCache.txt" ]]; then
+  cmake -S . -B "${BUILD_DIR}" >/dev/null || fail "cmake configure"
+elif command -v ninja >/dev/null 2>&1; then
+  cmake -S . -B "${BUILD_DIR}" -G Ninja >/dev/null || fail "cmake configure"
+else
+  cmake -S . -B "${BUILD_DIR}" >/dev/null || fail "cmake configure"
+fi
+cmake --build "${BUILD_DIR}" --target neuralmesh -j "${JOBS}" >"${OUT_DIR}/client-build.log" 2>&1 \
+  || fail "building the client (see ${OUT_DIR}/client-build.log)"
+
+# --- 5. Run --------------------------------------------------------------------------------
+step "Starting the container on 127.0.0.1"
+free_port() {
+  "${PYTHON}" -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'
+}
+CONTAINER="neuralmesh-test-$$"
+PORT=""
+# The port is free when picked; should another process take it before podman binds it, pick
+# another.
+for _ in 1 2 3; do
+  PORT=$(free_port)
+  if podman run -d --name "${CONTAINER}" -p "127.0.0.1:${PORT}:${CONTAINER_PORT}" "${IMAGE}" \
+    >/dev/null 2>"${WORK_DIR}/run.err"; then
+    break
+  fi
+  podman rm -f "${CONTAINER}" >/dev/null 2>&1 || true
+  PORT=""
+done
+[[ -n "${PORT}" ]] || fail "podman run: $(cat "${WORK_DIR}/run.err")"
+ADDRESS="127.0.0.1:${PORT}"
+
+step "Waiting for grpc.health.v1 to report SERVING on ${ADDRESS}"
+# grpc.health.v1.Health/Check with raw bytes, so no stubs are needed: a request naming a
+# service is field 1 (string); the answer SERVING is field 1 (enum) = 1, i.e. bytes 08 01.
+cat >"${WORK_DIR}/health.py" <<'EOF'
+import sys
+
+import grpc
+
+target, service = sys.argv[1], sys.argv[2].encode()
+request = b"\x0a" + bytes([len(service)]) + service if service else b""
+with grpc.insecure_channel(target) as channel:
+    check = channel.unary_unary("/grpc.health.v1.Health/Check",
+                                request_serializer=lambda b: b, response_deserializer=lambda b: b)
+    try:
+        answer = check(request, timeout=2, wait_for_ready=True)
+    except grpc.RpcError as error:
+        print("health check: %s" % error.code(), file=sys.stderr)
+        sys.exit(1)
+    if answer != b"\x08\x01":
+        print("health check: not SERVING (answer %r)" % answer, file=sys.stderr)
+        sys.exit(1)
+EOF
+healthy=0
+for _ in $(seq 1 60); do
+  running=$(podman inspect --format '{{.State.Running}}' "${CONTAINER}" 2>/dev/null || echo false)
+  [[ "${running}" == true ]] || fail "the container exited at start"
+  if "${PYTHON}" "${WORK_DIR}/health.py" "${ADDRESS}" "" 2>"${WORK_DIR}/health.err" \
+    && "${PYTHON}" "${WORK_DIR}/health.py" "${ADDRESS}" neuralmesh.v1.ReconstructionService \
+      2>"${WORK_DIR}/health.err"; then
+    healthy=1
+    break
+  fi
+  sleep 1
+done
+[[ ${healthy} -eq 1 ]] || fail "not SERVING within 60 s: $(cat "${WORK_DIR}/health.err")"
+say "SERVING on ${ADDRESS}: the server and neuralmesh.v1.ReconstructionService"
+
+# --- 6. Reconstruction ---------------------------------------------------------------------
+step "Reconstructing builtin:torus to ${VERTICES} vertices through the container"
+MESH_DIR="${OUT_DIR}/meshes"
+status=0
+timeout 600 "${CLI}" reconstruct builtin:torus --server "${ADDRESS}" --out-dir "${MESH_DIR}" \
+  --vertices "${VERTICES}" >"${OUT_DIR}/reconstruct.out" 2>"${OUT_DIR}/reconstruct.err" \
+  || status=$?
+cat "${OUT_DIR}/reconstruct.out" >&2
+[[ ${status} -eq 0 ]] || fail "the client exited with ${status}: $(tail -n 5 "${OUT_DIR}/reconstruct.err")"
+FINAL="${MESH_DIR}/torus.drc"
+[[ -s "${FINAL}" ]] || fail "the client wrote no final mesh ${FINAL}"
+
+step "Decoding ${FINAL}"
+draco_decoder -i "${FINAL}" -o "${WORK_DIR}/final.obj" >"${OUT_DIR}/draco_decoder.log" 2>&1 \
+  || fail "draco_decoder: $(tail -n 3 "${OUT_DIR}/draco_decoder.log")"
+decoded_vertices=$(grep -c '^v ' "${WORK_DIR}/final.obj" || true)
+decoded_faces=$(grep -c '^f ' "${WORK_DIR}/final.obj" || true)
+[[ ${decoded_vertices} -gt 0 && ${decoded_faces} -gt 0 ]] \
+  || fail "draco_decoder gave ${decoded_vertices} vertices and ${decoded_faces} faces"
+"${CLI}" stats "${FINAL}" >"${OUT_DIR}/stats.out" 2>&1 \
+  || fail "neuralmesh stats: $(tail -n 3 "${OUT_DIR}/stats.out")"
+say "Final mesh: ${decoded_vertices} vertices, ${decoded_faces} faces (draco_decoder)"
+
+# --- 7. Graceful stop ----------------------------------------------------------------------
+step "Stopping the container with SIGTERM"
+podman stop --time 30 "${CONTAINER}" >/dev/null || fail "podman stop"
+exit_code=$(podman inspect --format '{{.State.ExitCode}}' "${CONTAINER}")
+podman logs "${CONTAINER}" >"${OUT_DIR}/server.log" 2>&1
+[[ "${exit_code}" == 0 ]] || fail "the server exited with status ${exit_code}, not 0"
+grep -q 'SIGTERM received, shutting down' "${OUT_DIR}/server.log" \
+  || fail "no 'SIGTERM received' in the server's log"
+grep -q 'neuralmesh-server: stopped' "${OUT_DIR}/server.log" \
+  || fail "no 'neuralmesh-server: stopped' in the server's log"
+say "The server shut down gracefully (exit status 0)"
+podman rm "${CONTAINER}" >/dev/null
+CONTAINER=""
+STEP="done"

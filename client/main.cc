@@ -74,6 +74,9 @@ ABSL_FLAG(bool, split_largest_cell_near_most_active,
           kLearnerDefaults.split_largest_cell_near_most_active,
           "Step 2 splits the largest cell (F_v, Eq. 5-6) of the most active vertex's 1-ring; "
           "--nosplit_largest_cell_near_most_active splits the most active vertex itself.");
+ABSL_FLAG(int32_t, sewn_strip_grace_calls, kLearnerDefaults.sewn_strip_grace_calls,
+          "Calls of Step 4 that spare the faces around a strip Step 5 has just sewn, in "
+          "[0, 1000]; 0 is the paper's rule.");
 
 // Local learning.
 ABSL_FLAG(std::string, sampling, "uniform",
@@ -139,6 +142,7 @@ neuralmesh::LearnerOptions LearnerFromFlags() {
   o.merge_only_settled_boundaries = absl::GetFlag(FLAGS_merge_only_settled_boundaries);
   o.split_largest_cell_near_most_active =
       absl::GetFlag(FLAGS_split_largest_cell_near_most_active);
+  o.sewn_strip_grace_calls = absl::GetFlag(FLAGS_sewn_strip_grace_calls);
   o.seed = absl::GetFlag(FLAGS_seed);
   return o;
 }
@@ -242,7 +246,8 @@ std::vector<Subcommand> Commands() {
       "output", "vertices", "lod", "seed", "alpha_w", "alpha_l", "c_l", "c_vs", "c_ec",
       "alpha_sc", "alpha_r", "alpha_m", "remove_triangles", "merge_boundaries",
       "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
-      "merge_only_settled_boundaries", "split_largest_cell_near_most_active", "sampling", "time_budget", "max_steps", "quantization_bits",
+      "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
+      "sewn_strip_grace_calls", "sampling", "time_budget", "max_steps", "quantization_bits",
       "encode_speed", "progress", "server", "out-dir", "batch-size", "points", "ply",
       "connect_timeout"};
   // clang-format on

@@ -21,6 +21,7 @@ v1::LearnerOptions ToProto(const LearnerOptions& options) {
       options.merge_only_settled_boundaries);
   proto.mutable_split_largest_cell_near_most_active()->set_value(
       options.split_largest_cell_near_most_active);
+  proto.mutable_sewn_strip_grace_calls()->set_value(options.sewn_strip_grace_calls);
   proto.mutable_seed()->set_value(options.seed);
   return proto;
 }

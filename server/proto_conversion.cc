@@ -54,6 +54,9 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
   if (l.has_split_largest_cell_near_most_active()) {
     o.split_largest_cell_near_most_active = l.split_largest_cell_near_most_active().value();
   }
+  if (l.has_sewn_strip_grace_calls()) {
+    o.sewn_strip_grace_calls = l.sewn_strip_grace_calls().value();
+  }
 
   config.target_vertices = proto.target_vertices();
   config.lod_milestones.assign(proto.lod_milestones().begin(), proto.lod_milestones().end());
@@ -114,6 +117,7 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
   l.mutable_merge_only_settled_boundaries()->set_value(o.merge_only_settled_boundaries);
   l.mutable_split_largest_cell_near_most_active()->set_value(
       o.split_largest_cell_near_most_active);
+  l.mutable_sewn_strip_grace_calls()->set_value(o.sewn_strip_grace_calls);
 
   proto.set_target_vertices(config.target_vertices);
   for (size_t m : config.lod_milestones) proto.add_lod_milestones(m);

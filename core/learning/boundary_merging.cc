@@ -309,6 +309,8 @@ BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOpti
     const auto strip = PlanStrip(mesh, a, b);
     if (!strip || !AddStrip(mesh, *strip, a, b)) continue;
     merged[pair.first] = merged[pair.second] = true;
+    result.sewn_vertices.insert(result.sewn_vertices.end(), a.begin(), a.end());
+    result.sewn_vertices.insert(result.sewn_vertices.end(), b.begin(), b.end());
     ++result.merges;
     result.added_faces += strip->size();
   }

@@ -52,6 +52,7 @@
 #define NEURALMESH_CORE_LEARNING_BOUNDARY_MERGING_H_
 
 #include <cstddef>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/types/span.h"
@@ -75,6 +76,8 @@ struct BoundaryMergingResult {
   size_t merges = 0;         // Pairs of loops sewn together.
   size_t added_faces = 0;    // Faces of all strips; no vertex is ever added or removed.
   HoleClosingResult closed;  // Small holes closed before merging (close_small_holes).
+  // The vertices of the loops that were sewn together: the corners of every strip face.
+  std::vector<Mesh::VertexHandle> sewn_vertices;
 };
 
 // Step 5 (Eq. 3): when options.close_small_holes is set, first closes the small holes as

@@ -36,10 +36,12 @@ class Learner::Impl {
         octree_(target->Bounds()),
         counters_(options.alpha_sc) {
     mesh_.add_property(last_win_);
+    mesh_.add_property(spared_until_);
     for (auto v : mesh_.vertices()) {
       octree_.Insert(v.idx(), mesh_.point(v));
       counters_.Add(v.idx(), 1.0, 0);
       mesh_.property(last_win_, v) = 0;
+      mesh_.property(spared_until_, v) = 0;
     }
     live_vertices_ = mesh_.n_vertices();
     next_connectivity_step_ = ConnectivityInterval();
@@ -134,8 +136,10 @@ class Learner::Impl {
   LearnerTimings timings() const { return timings_; }
 
  private:
+  // C_ec * v Basic Steps, with v at least C_vs (learner_options.h).
   uint64_t ConnectivityInterval() const {
-    return static_cast<uint64_t>(std::ceil(options_.c_ec * static_cast<double>(live_vertices_)));
+    const double v = std::max(static_cast<double>(live_vertices_), static_cast<double>(options_.c_vs));
+    return static_cast<uint64_t>(std::ceil(options_.c_ec * v));
   }
 
   // Step 2: split the most active vertex, or the largest cell next to it (see
@@ -165,6 +169,7 @@ class Learner::Impl {
     counters_.Add(v0.idx(), counter * share0, step_);
     // The new vertex counts as active: it must get a chance to win before Step 3 judges it.
     mesh_.property(last_win_, v0) = step_;
+    mesh_.property(spared_until_, v0) = mesh_.property(spared_until_, v);  // Same strip.
     octree_.Insert(v0.idx(), mesh_.point(v0));
   }
 
@@ -181,7 +186,15 @@ class Learner::Impl {
       t0 = Clock::now();
       TriangleRemovalOptions removal;
       removal.alpha_r = options_.alpha_r;
-      const TriangleRemovalResult removed = RemoveLargeTriangles(mesh_, removal);
+      // Spared: the faces around a strip sewn in the last sewn_strip_grace_calls calls.
+      const uint64_t call = progress_.connectivity_calls;
+      const TriangleRemovalResult removed =
+          RemoveLargeTriangles(mesh_, removal, [this, call](Mesh::FaceHandle f) {
+            for (auto corner : mesh_.fv_range(f)) {
+              if (mesh_.property(spared_until_, corner) >= call) return true;
+            }
+            return false;
+          });
       for (auto v : removed.removed_vertices) ForgetVertex(v);
       progress_.removed_triangles += removed.removed_faces;
       mean_area = removed.mean_area;
@@ -198,6 +211,10 @@ class Learner::Impl {
       merging.hole_closing.max_loop_vertices = options_.max_closed_hole_vertices;
       const BoundaryMergingResult merged = MergeCloseBoundaries(mesh_, merging, mean_area, growing);
       progress_.merged_boundaries += merged.merges;
+      for (auto vh : merged.sewn_vertices) {
+        mesh_.property(spared_until_, vh) =
+            progress_.connectivity_calls + static_cast<uint64_t>(options_.sewn_strip_grace_calls);
+      }
       timings_.merging += Since(t0);
     }
     RecountDeletedFaces();
@@ -260,6 +277,8 @@ class Learner::Impl {
   OneRingSmoother smoother_;
   VertexRingCache rings_;
   OpenMesh::VPropHandleT<uint64_t> last_win_;
+  // The last call of Step 4 that spares this vertex's faces (sewn_strip_grace_calls).
+  OpenMesh::VPropHandleT<uint64_t> spared_until_;
   uint64_t step_ = 0;
   uint64_t last_connectivity_step_ = 0;
   uint64_t next_connectivity_step_ = 0;

@@ -23,6 +23,9 @@ absl::Status LearnerOptions::Validate() const {
   if (!(alpha_sc > 0 && alpha_sc < 1)) return OutOfRange("alpha_sc", alpha_sc, "(0, 1)");
   if (!(alpha_r > 0 && std::isfinite(alpha_r))) return OutOfRange("alpha_r", alpha_r, "(0, inf)");
   if (!(alpha_m > 0 && std::isfinite(alpha_m))) return OutOfRange("alpha_m", alpha_m, "(0, inf)");
+  if (sewn_strip_grace_calls < 0 || sewn_strip_grace_calls > 1000) {
+    return OutOfRange("sewn_strip_grace_calls", sewn_strip_grace_calls, "[0, 1000]");
+  }
   if (max_closed_hole_vertices < 3 || max_closed_hole_vertices > 1000) {
     return OutOfRange("max_closed_hole_vertices", max_closed_hole_vertices, "[3, 1000]");
   }

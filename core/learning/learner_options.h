@@ -18,7 +18,13 @@ struct LearnerOptions {
 
   // Connectivity changes (Section 2.2).
   int c_vs = 100;          // C_vs, Section 2.2: Basic Steps between two vertex splits, >= 1.
-  double c_ec = 10;        // C_ec, Section 2.2: Step 3 runs every C_ec * v Basic Steps, > 0.
+  // C_ec, Section 2.2: Step 3 runs every C_ec * v Basic Steps, > 0. Not in the paper: v counts
+  // as at least C_vs, so at least C_ec splits happen between two calls. Below C_vs vertices a
+  // call every C_ec * v steps left about one split per call, and the collapse of every vertex
+  // over a part without data (the disc that closes a hemisphere) undid it: learning a
+  // hemisphere lingered near 15 vertices for minutes, where its great disc is too small a
+  // share of the mesh for Step 4 to ever see its triangles as large.
+  double c_ec = 10;
   double alpha_sc = 0.95;  // alpha_sc, Section 2.2 / Eq. 4: signal counter decay, (0, 1).
   // Where Step 2 splits (vertex_split.h, LargestCellNear). The paper splits the vertex with the
   // highest signal counter and relies on high-valence vertices having larger restricted Voronoi
@@ -47,6 +53,12 @@ struct LearnerOptions {
   // Not in the paper (boundary_merging.h): Step 5 leaves alone a loop that Step 4 has cut into
   // in the same call; it is merged once it has stopped growing, i.e. reached the data.
   bool merge_only_settled_boundaries = true;
+  // Not in the paper: for this many calls of Step 4 after Step 5 sewed a strip, the faces
+  // around the strip's vertices (and the vertices split from them) are not removed. A fresh
+  // strip is a thin tube that the Basic Step still has to widen onto the data; its faces
+  // stretch while it does, and removing them cut it apart again into holes that grew and
+  // were sewn into extra handles. 0 gives the paper's rule.
+  int sewn_strip_grace_calls = 4;
 
   // Splits per call of Step 2. The paper uses 1; Section 3.3 suggests more for speed on very
   // large meshes at a negligible cost in quality.

@@ -92,6 +92,12 @@ void RemoveTriangle(Mesh& mesh, Mesh::FaceHandle fh,
 }
 
 TriangleRemovalResult RemoveLargeTriangles(Mesh& mesh, const TriangleRemovalOptions& options) {
+  return RemoveLargeTriangles(mesh, options, nullptr);
+}
+
+TriangleRemovalResult RemoveLargeTriangles(
+    Mesh& mesh, const TriangleRemovalOptions& options,
+    const std::function<bool(Mesh::FaceHandle)>& spared) {
   TriangleRemovalResult result;
   result.mean_area = MeanTriangleArea(mesh);
   const double threshold = options.alpha_r * result.mean_area;
@@ -111,7 +117,7 @@ TriangleRemovalResult RemoveLargeTriangles(Mesh& mesh, const TriangleRemovalOpti
   };
   for (auto fh : mesh.faces()) {
     const double area = TriangleArea(mesh, fh);
-    if (area > threshold) enqueue(fh.idx(), area);
+    if (area > threshold && !(spared && spared(fh))) enqueue(fh.idx(), area);
   }
 
   while (!frontier.empty() || !seeds.empty()) {

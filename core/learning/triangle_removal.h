@@ -48,6 +48,7 @@
 #define NEURALMESH_CORE_LEARNING_TRIANGLE_REMOVAL_H_
 
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -95,6 +96,12 @@ void RemoveTriangle(Mesh& mesh, Mesh::FaceHandle fh,
 // illegal is retried after a neighbouring removal has changed its surroundings. `options`
 // must be valid (Validate()). O(f + k log k) for k large faces.
 TriangleRemovalResult RemoveLargeTriangles(Mesh& mesh, const TriangleRemovalOptions& options);
+
+// As above, but a face for which `spared` returns true is never removed (it still counts in
+// E(Area)).
+TriangleRemovalResult RemoveLargeTriangles(
+    Mesh& mesh, const TriangleRemovalOptions& options,
+    const std::function<bool(Mesh::FaceHandle)>& spared);
 
 }  // namespace neuralmesh
 

@@ -24,6 +24,7 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   options.max_closed_hole_vertices = 5;
   options.merge_only_settled_boundaries = false;
   options.split_largest_cell_near_most_active = false;
+  options.sewn_strip_grace_calls = 0;
   const v1::LearnerOptions proto = ToProto(options);
   EXPECT_EQ(proto.alpha_w().value(), 0.1);
   EXPECT_EQ(proto.alpha_l().value(), 0.2);
@@ -46,6 +47,8 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   EXPECT_FALSE(proto.merge_only_settled_boundaries().value());
   ASSERT_TRUE(proto.has_split_largest_cell_near_most_active());
   EXPECT_FALSE(proto.split_largest_cell_near_most_active().value());
+  ASSERT_TRUE(proto.has_sewn_strip_grace_calls()) << "0 must be sent, not left unset";
+  EXPECT_EQ(proto.sewn_strip_grace_calls().value(), 0);
 }
 
 TEST(ClientProtoConversionTest, DracoSpeedBecomesCompressionSpeed) {

@@ -179,6 +179,18 @@ TEST(BoundaryMergingTest, LoopsWithDifferentVertexCountsMerge) {
   const BoundaryMergingResult result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 0);
   EXPECT_EQ(result.merges, 1u) << "the facing 12- and 17-gon rims must merge";
   EXPECT_EQ(result.added_faces, 29u) << "the strip uses each of the 12 + 17 rim edges once";
+  EXPECT_EQ(result.sewn_vertices.size(), 29u) << "both rims' vertices are reported as sewn";
+  for (auto vh : result.sewn_vertices) {
+    int strip_faces = 0;
+    for (auto f : mesh.vf_range(vh)) {
+      int rim_corners = 0;
+      for (auto c : mesh.fv_range(f)) {
+        rim_corners += std::count(result.sewn_vertices.begin(), result.sewn_vertices.end(), c) > 0;
+      }
+      strip_faces += rim_corners == 3;
+    }
+    EXPECT_GE(strip_faces, 1) << "a sewn vertex is a corner of the strip";
+  }
   const Counts after = Count(mesh);
   EXPECT_EQ(after.boundary_loops, 2u) << "two outer rims must remain";
   EXPECT_EQ(after.components, 1u) << "the tubes must be joined";

@@ -6,6 +6,7 @@
 
 #include "core/analysis/mesh_report.h"
 #include "core/mesh_validation.h"
+#include "core/random.h"
 #include "core/sampling/implicit_surfaces.h"
 #include "core/sampling/point_cloud_sampler.h"
 #include "gtest/gtest.h"
@@ -192,6 +193,43 @@ TEST(LearnerTest, LearnsFromAPointCloudAsWellAsFromAnImplicitSurface) {
     worst = std::max(worst, std::abs((learner->mesh().point(v) - Vec3(10, 0, 0)).norm() - 2.0));
   }
   EXPECT_LT(worst, 0.04) << "vertices must lie within 2% of the sampled sphere's radius";
+}
+
+TEST(LearnerTest, SmallMeshesGetAtLeastCecSplitsBetweenConnectivityCalls) {
+  // Step 3 runs every C_ec max(v, C_vs) Basic Steps: at least C_ec * C_vs = 1,000 apart.
+  auto sphere = UnitSphere();
+  LearnerOptions options;
+  auto learner = Learner::Create(options, sphere.get()).value();
+  StopCriteria stop;
+  stop.max_basic_steps = 8000;
+  ASSERT_TRUE(learner->Run(stop).ok());
+  ASSERT_LT(learner->num_vertices(), static_cast<size_t>(options.c_vs)) << "still a small mesh";
+  EXPECT_LE(learner->progress().connectivity_calls, 8u);
+  EXPECT_GE(learner->progress().connectivity_calls, 6u);
+}
+
+TEST(LearnerTest, HemisphereGrowsPastItsFirstVertices) {
+  // A hemisphere's tetrahedron first closes it with a disc. With Step 3 every C_ec v steps
+  // the disc's inactive vertices were collapsed as fast as splits made them, and the mesh
+  // lingered near 15 vertices for hundreds of thousands of steps.
+  auto sphere = UnitSphere();
+  PointCloud cloud;
+  Random rng(3);
+  while (cloud.size() < 20000) {
+    const Vec3 p = sphere->Sample(rng);
+    if (p[2] >= 0) cloud.positions.emplace_back(p[0], p[1], p[2]);
+  }
+  auto sampler =
+      MakePointCloudSampler(std::make_shared<const PointCloud>(std::move(cloud))).value();
+  auto learner = Learner::Create(LearnerOptions{}, sampler.get()).value();
+  StopCriteria stop;
+  stop.target_vertices = 500;
+  stop.max_basic_steps = 100000;  // Enough for about 1,000 vertices.
+  const auto reason = learner->Run(stop);
+  ASSERT_TRUE(reason.ok()) << reason.status();
+  EXPECT_EQ(*reason, StopReason::kTargetReached) << "stuck at " << learner->num_vertices();
+  const MeshReport report = ComputeMeshReport(learner->Snapshot());
+  EXPECT_EQ(report.boundary_loops, 1u) << "Step 4 has cut the disc away";
 }
 
 }  // namespace

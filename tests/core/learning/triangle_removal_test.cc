@@ -234,6 +234,21 @@ TEST(TriangleRemovalTest, RemovingEverythingStopsAtTheMinimum) {
       << "every vertex is either live or reported removed";
 }
 
+TEST(TriangleRemovalTest, SparedFacesStay) {
+  // As above every face is a candidate, but the faces around vertex 0 are spared: they all
+  // stay, and the rest still goes down to what legality allows.
+  Mesh mesh = MustToMesh(Icosphere(1));
+  const Mesh::VertexHandle spared_vertex(0);
+  const std::vector<Mesh::FaceHandle> spared = FacesAround(mesh, spared_vertex);
+  const TriangleRemovalResult result =
+      RemoveLargeTriangles(mesh, TriangleRemovalOptions{1e-9}, [&](Mesh::FaceHandle f) {
+        return std::find(spared.begin(), spared.end(), f) != spared.end();
+      });
+  for (auto f : spared) EXPECT_FALSE(mesh.status(f).deleted()) << "spared face " << f.idx();
+  EXPECT_GT(result.removed_faces, 60u) << "the faces that are not spared still go";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
 // The legality rule is exact: a removal it allows keeps the mesh valid, and a removal it
 // refuses breaks it. Random legal faces are removed until none is left, with ValidateMesh
 // after every single removal; at each step a random refused face is deleted from a copy.

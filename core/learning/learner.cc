@@ -53,6 +53,7 @@ class Learner::Impl {
 
     // Basic Step (Section 2.1).
     const Vec3 s = target_->Sample(rng_);
+    target_->PrefetchSample(rng_);  // The next step's sample: a cache miss on large inputs.
     const int winner = octree_.Nearest(s);
     const Mesh::VertexHandle w(winner);
     Clock::time_point t1;

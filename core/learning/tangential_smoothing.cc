@@ -23,7 +23,7 @@ void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHan
   ring_.assign(winner_ring.neighbours, winner_ring.neighbours + winner_ring.size);
   if (alpha_l <= 0 || iterations <= 0) return;
   const int m = static_cast<int>(ring_.size());
-  local_.resize(ring_.size());
+  if (local_.size() < ring_.size()) local_.resize(ring_.size());
 
   // The points live in one contiguous array (an OpenMesh property); nothing below adds a
   // vertex, so the pointer stays valid.

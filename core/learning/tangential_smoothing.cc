@@ -31,17 +31,11 @@ void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHan
   auto at = [points](int v) { return points + 3 * static_cast<size_t>(v); };
   // slot_of_vertex_[v]: the slot of v in ring_, or -1 when v does not move.
   if (slot_of_vertex_.size() < mesh.n_vertices()) slot_of_vertex_.resize(mesh.n_vertices(), -1);
-  // On a large mesh the rings and positions read below are cache misses; issued together
-  // they overlap. First the ring vertices' cached rings and positions, then (once those rings
-  // are in) the second ring's positions.
   for (int i = 0; i < m; ++i) {
     slot_of_vertex_[ring_[i]] = i;
+    // On a large mesh these are cache misses; issued together they overlap.
     rings.Prefetch(ring_[i]);
     __builtin_prefetch(at(ring_[i]));
-  }
-  for (int i = 0; i < m; ++i) {
-    const VertexRingCache::RingView view = rings.Ring(mesh, ring_[i]);
-    for (int k = 0; k < view.size; ++k) __builtin_prefetch(at(view.neighbours[k]));
   }
 
   // Gathered once per call: each ring vertex's position, its normal (or border tangent), and

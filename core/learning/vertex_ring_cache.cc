@@ -4,12 +4,11 @@
 
 namespace neuralmesh {
 
-VertexRingCache::RingView VertexRingCache::Ring(const Mesh& mesh, int v) {
+VertexRingCache::RingView VertexRingCache::Walk(const Mesh& mesh, int v) {
   if (static_cast<size_t>(v) >= lines_.size()) {
     lines_.resize(std::max<size_t>(static_cast<size_t>(v) + 1, lines_.size() * 3 / 2));
   }
   Line& line = lines_[v];
-  if (line.epoch == current_epoch_) return {line.neighbours, line.valence, line.boundary != 0};
   // A raw half-edge walk: OpenMesh's circulators cost several times more.
   const Mesh::VertexHandle vh(v);
   const bool boundary = mesh.is_boundary(vh);

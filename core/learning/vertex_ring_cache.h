@@ -34,7 +34,13 @@ class VertexRingCache {
     int size;
     bool boundary;
   };
-  RingView Ring(const Mesh& mesh, int v);
+  RingView Ring(const Mesh& mesh, int v) {
+    if (static_cast<size_t>(v) < lines_.size()) {
+      const Line& line = lines_[v];
+      if (line.epoch == current_epoch_) return {line.neighbours, line.valence, line.boundary != 0};
+    }
+    return Walk(mesh, v);
+  }
   // A hint: starts loading the cached ring of `v`, for a caller about to read several rings.
   void Prefetch(int v) const {
     if (static_cast<size_t>(v) < lines_.size()) __builtin_prefetch(&lines_[v]);
@@ -49,6 +55,9 @@ class VertexRingCache {
   void InvalidateAll();
 
  private:
+  // Reads the ring of `v` from the half-edges and caches it if it fits.
+  RingView Walk(const Mesh& mesh, int v);
+
   // Rings of up to kSlots neighbours are cached; a vertex of higher valence (rare: the
   // learner keeps valences near 6) is walked every time.
   static constexpr int kSlots = 14;

@@ -9,6 +9,7 @@
 #include "core/learning/boundary_merging.h"
 #include "core/learning/half_edge_collapse.h"
 #include "core/learning/initial_mesh.h"
+#include "core/learning/morton_vertex_order.h"
 #include "core/learning/signal_counters.h"
 #include "core/learning/tangential_smoothing.h"
 #include "core/learning/triangle_removal.h"
@@ -54,6 +55,7 @@ class Learner::Impl {
 
     // Basic Step (Section 2.1).
     const Vec3 s = target_->Sample(rng_);
+    target_->PrefetchSample(rng_);  // The next step's sample: a cache miss on large inputs.
     const int winner = octree_.Nearest(s);
     const Mesh::VertexHandle w(winner);
     Clock::time_point t1;
@@ -220,7 +222,7 @@ class Learner::Impl {
     RecountDeletedFaces();
     last_connectivity_step_ = step_;
     next_connectivity_step_ = step_ + std::max<uint64_t>(1, ConnectivityInterval());
-    CollectGarbageIfWorthIt();
+    CompactInMortonOrder();
     rings_.InvalidateAll();  // Collapses, removals, merges and compaction changed rings.
   }
 
@@ -250,14 +252,15 @@ class Learner::Impl {
     deleted_faces_ = deleted;
   }
 
-  // Deleted elements are only marked; compact when they outnumber the live ones. Handles
-  // change, so the octree and the counters are rebuilt: O(v), like the step that got here.
-  void CollectGarbageIfWorthIt() {
-    if (mesh_.n_vertices() < 2 * live_vertices_ + 64) return;
+  // Deleted elements are only marked until here. Compacting and renumbering the vertices in
+  // Morton order (morton_vertex_order.h) keeps the data a Basic Step touches close together;
+  // handles change, so the octree and the counters are rebuilt: O(v log v) every C_ec v steps.
+  void CompactInMortonOrder() {
     OpenMesh::VPropHandleT<double> counter;
     mesh_.add_property(counter);
     for (auto v : mesh_.vertices()) mesh_.property(counter, v) = counters_.Value(v.idx(), step_);
     mesh_.garbage_collection();
+    SortVerticesInMortonOrder(mesh_);
     counters_.Clear();
     octree_ = VertexOctree(target_->Bounds());
     for (auto v : mesh_.vertices()) {

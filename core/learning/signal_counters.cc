@@ -13,23 +13,20 @@ double SignalCounters::KeyOf(double value, uint64_t step) const {
 }
 
 double SignalCounters::Value(int id, uint64_t step) const {
-  const double k = key_[id];
+  if (!Contains(id)) return 0;
+  const double k = heap_[heap_pos_[id]].key;
   if (k == -std::numeric_limits<double>::infinity()) return 0;
   return std::exp(k + static_cast<double>(step) * log_alpha_);
 }
 
 void SignalCounters::Add(int id, double value, uint64_t step) {
-  if (id >= static_cast<int>(heap_pos_.size())) {
-    heap_pos_.resize(static_cast<size_t>(id) + 1, -1);
-    key_.resize(static_cast<size_t>(id) + 1, 0);
-  }
+  if (id >= static_cast<int>(heap_pos_.size())) heap_pos_.resize(static_cast<size_t>(id) + 1, -1);
   if (heap_pos_[id] >= 0) {
     Set(id, value, step);
     return;
   }
-  key_[id] = KeyOf(value, step);
   heap_pos_[id] = static_cast<int>(heap_.size());
-  heap_.push_back(id);
+  heap_.push_back({KeyOf(value, step), id});
   SiftUp(heap_.size() - 1);
 }
 
@@ -52,9 +49,9 @@ void SignalCounters::Remove(int id) {
 void SignalCounters::Set(int id, double value, uint64_t step) { Update(id, KeyOf(value, step)); }
 
 void SignalCounters::Update(int id, double key) {
-  const double old = key_[id];
-  key_[id] = key;
   const size_t i = static_cast<size_t>(heap_pos_[id]);
+  const double old = heap_[i].key;
+  heap_[i].key = key;
   if (key > old) {
     SiftUp(i);
   } else {
@@ -76,7 +73,7 @@ void SignalCounters::Flush() {
 int SignalCounters::MostActive(const std::function<bool(int)>& eligible) {
   Flush();
   if (heap_.empty()) return -1;
-  if (eligible(heap_[0])) return heap_[0];
+  if (eligible(heap_[0].id)) return heap_[0].id;
   // Best-first walk of the heap: the largest eligible key is found without popping anything.
   std::vector<size_t> frontier = {0};
   int best = -1;
@@ -85,16 +82,16 @@ int SignalCounters::MostActive(const std::function<bool(int)>& eligible) {
     // Take the frontier entry with the largest key.
     size_t pick = 0;
     for (size_t j = 1; j < frontier.size(); ++j) {
-      if (key_[heap_[frontier[j]]] > key_[heap_[frontier[pick]]]) pick = j;
+      if (heap_[frontier[j]].key > heap_[frontier[pick]].key) pick = j;
     }
     const size_t i = frontier[pick];
     frontier[pick] = frontier.back();
     frontier.pop_back();
-    const int id = heap_[i];
-    if (best >= 0 && key_[id] <= best_key) break;
-    if (eligible(id)) {
-      best = id;
-      best_key = key_[id];
+    const Entry& entry = heap_[i];
+    if (best >= 0 && entry.key <= best_key) break;
+    if (eligible(entry.id)) {
+      best = entry.id;
+      best_key = entry.key;
       break;
     }
     for (size_t c = 2 * i + 1; c <= 2 * i + 2 && c < heap_.size(); ++c) frontier.push_back(c);
@@ -103,7 +100,6 @@ int SignalCounters::MostActive(const std::function<bool(int)>& eligible) {
 }
 
 void SignalCounters::Clear() {
-  key_.clear();
   heap_pos_.clear();
   heap_.clear();
   pending_.clear();
@@ -111,14 +107,14 @@ void SignalCounters::Clear() {
 
 void SignalCounters::Swap(size_t a, size_t b) {
   std::swap(heap_[a], heap_[b]);
-  heap_pos_[heap_[a]] = static_cast<int>(a);
-  heap_pos_[heap_[b]] = static_cast<int>(b);
+  heap_pos_[heap_[a].id] = static_cast<int>(a);
+  heap_pos_[heap_[b].id] = static_cast<int>(b);
 }
 
 void SignalCounters::SiftUp(size_t i) {
   while (i > 0) {
     const size_t parent = (i - 1) / 2;
-    if (key_[heap_[parent]] >= key_[heap_[i]]) break;
+    if (heap_[parent].key >= heap_[i].key) break;
     Swap(i, parent);
     i = parent;
   }
@@ -129,8 +125,8 @@ void SignalCounters::SiftDown(size_t i) {
   while (true) {
     size_t largest = i;
     const size_t l = 2 * i + 1, r = 2 * i + 2;
-    if (l < n && key_[heap_[l]] > key_[heap_[largest]]) largest = l;
-    if (r < n && key_[heap_[r]] > key_[heap_[largest]]) largest = r;
+    if (l < n && heap_[l].key > heap_[largest].key) largest = l;
+    if (r < n && heap_[r].key > heap_[largest].key) largest = r;
     if (largest == i) break;
     Swap(i, largest);
     i = largest;

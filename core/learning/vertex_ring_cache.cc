@@ -4,33 +4,34 @@
 
 namespace neuralmesh {
 
-bool VertexRingCache::AppendRing(const Mesh& mesh, int v, std::vector<int>& out) {
+VertexRingCache::RingView VertexRingCache::Walk(const Mesh& mesh, int v) {
   if (static_cast<size_t>(v) >= lines_.size()) {
     lines_.resize(std::max<size_t>(static_cast<size_t>(v) + 1, lines_.size() * 3 / 2));
   }
   Line& line = lines_[v];
-  if (line.epoch == current_epoch_) {
-    out.insert(out.end(), line.neighbours, line.neighbours + line.valence);
-    return line.boundary != 0;
-  }
   // A raw half-edge walk: OpenMesh's circulators cost several times more.
   const Mesh::VertexHandle vh(v);
   const bool boundary = mesh.is_boundary(vh);
-  const size_t first = out.size();
+  long_ring_.clear();
   const Mesh::HalfedgeHandle start = mesh.halfedge_handle(vh);
   Mesh::HalfedgeHandle h = start;
   do {
-    out.push_back(mesh.to_vertex_handle(h).idx());
+    long_ring_.push_back(mesh.to_vertex_handle(h).idx());
     h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
   } while (h != start);
-  const size_t valence = out.size() - first;
-  if (valence <= static_cast<size_t>(kSlots)) {
-    std::copy(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(), line.neighbours);
-    line.valence = static_cast<uint16_t>(valence);
-    line.boundary = boundary ? 1 : 0;
-    line.epoch = current_epoch_;
-  }
-  return boundary;
+  const int valence = static_cast<int>(long_ring_.size());
+  if (valence > kSlots) return {long_ring_.data(), valence, boundary};
+  std::copy(long_ring_.begin(), long_ring_.end(), line.neighbours);
+  line.valence = static_cast<uint16_t>(valence);
+  line.boundary = boundary ? 1 : 0;
+  line.epoch = current_epoch_;
+  return {line.neighbours, valence, boundary};
+}
+
+bool VertexRingCache::AppendRing(const Mesh& mesh, int v, std::vector<int>& out) {
+  const RingView ring = Ring(mesh, v);
+  out.insert(out.end(), ring.neighbours, ring.neighbours + ring.size);
+  return ring.boundary;
 }
 
 void VertexRingCache::InvalidateAll() {

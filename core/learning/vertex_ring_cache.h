@@ -26,6 +26,26 @@ class VertexRingCache {
   // boundary. Amortised O(valence) with one cache line read when the ring is cached.
   bool AppendRing(const Mesh& mesh, int v, std::vector<int>& out);
 
+  // The same ring without a copy: `neighbours` points into the cache (or, for a ring too long
+  // to cache, into scratch storage) and stays valid until the next call of Ring or
+  // AppendRing, or the next invalidation.
+  struct RingView {
+    const int32_t* neighbours;
+    int size;
+    bool boundary;
+  };
+  RingView Ring(const Mesh& mesh, int v) {
+    if (static_cast<size_t>(v) < lines_.size()) {
+      const Line& line = lines_[v];
+      if (line.epoch == current_epoch_) return {line.neighbours, line.valence, line.boundary != 0};
+    }
+    return Walk(mesh, v);
+  }
+  // A hint: starts loading the cached ring of `v`, for a caller about to read several rings.
+  void Prefetch(int v) const {
+    if (static_cast<size_t>(v) < lines_.size()) __builtin_prefetch(&lines_[v]);
+  }
+
   // Marks the ring of `v` stale. Call it for every vertex whose set or order of neighbours
   // changed, or whose boundary status did.
   void Invalidate(int v) {
@@ -35,6 +55,9 @@ class VertexRingCache {
   void InvalidateAll();
 
  private:
+  // Reads the ring of `v` from the half-edges and caches it if it fits.
+  RingView Walk(const Mesh& mesh, int v);
+
   // Rings of up to kSlots neighbours are cached; a vertex of higher valence (rare: the
   // learner keeps valences near 6) is walked every time.
   static constexpr int kSlots = 14;
@@ -47,6 +70,7 @@ class VertexRingCache {
   static_assert(sizeof(Line) == 64, "one cache line per vertex");
 
   std::vector<Line> lines_;  // Indexed by vertex index.
+  std::vector<int32_t> long_ring_;  // The last ring too long for a line.
   uint32_t current_epoch_ = 1;
 };
 

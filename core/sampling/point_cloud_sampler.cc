@@ -36,6 +36,11 @@ Vec3 UniformPointCloudSampler::Sample(Random& rng) const {
   return Vec3(cloud_->positions[rng.NextIndex(cloud_->positions.size())]);
 }
 
+void UniformPointCloudSampler::PrefetchSample(const Random& rng) const {
+  Random peek = rng;
+  __builtin_prefetch(&cloud_->positions[peek.NextIndex(cloud_->positions.size())]);
+}
+
 absl::StatusOr<std::unique_ptr<Sampler>> WeightedPointCloudSampler::Create(
     std::shared_ptr<const PointCloud> cloud) {
   NM_RETURN_IF_ERROR(CheckUsable(cloud));

@@ -28,6 +28,8 @@ class UniformPointCloudSampler final : public Sampler {
   static absl::StatusOr<std::unique_ptr<Sampler>> Create(std::shared_ptr<const PointCloud> cloud);
 
   Vec3 Sample(Random& rng) const override;  // O(1): one NextIndex.
+  // Peeks at the next index with a copy of `rng`.
+  void PrefetchSample(const Random& rng) const override;
   bool empty() const override { return false; }
   BoundingBox Bounds() const override { return bounds_; }
   const PointCloud& cloud() const { return *cloud_; }

@@ -19,6 +19,11 @@ class Sampler {
   // (see GrowingPointCloud).
   virtual Vec3 Sample(Random& rng) const = 0;
 
+  // A hint, for samplers that read a large array: starts loading what Sample would read if
+  // called now with `rng`, which it leaves unchanged. The learner calls it one Basic Step
+  // ahead, so that the draw does not wait for main memory. By default nothing.
+  virtual void PrefetchSample(const Random& rng) const { (void)rng; }
+
   // Whether there is nothing to sample yet.
   virtual bool empty() const = 0;
 

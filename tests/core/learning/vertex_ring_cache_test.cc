@@ -33,6 +33,13 @@ void ExpectEveryRingMatches(const Mesh& mesh, VertexRingCache& cache, int op) {
     const bool boundary = cache.AppendRing(mesh, v.idx(), cached);
     ASSERT_EQ(cached, WalkRing(mesh, v)) << "vertex " << v.idx() << " after operation " << op;
     ASSERT_EQ(boundary, mesh.is_boundary(v)) << "vertex " << v.idx() << " after operation " << op;
+    // The view without a copy says the same.
+    cache.Prefetch(v.idx());
+    const VertexRingCache::RingView view = cache.Ring(mesh, v.idx());
+    ASSERT_EQ(std::vector<int>(view.neighbours, view.neighbours + view.size), cached)
+        << "Ring() of vertex " << v.idx() << " after operation " << op;
+    ASSERT_EQ(view.boundary, boundary) << "Ring() of vertex " << v.idx() << " after operation "
+                                       << op;
   }
 }
 

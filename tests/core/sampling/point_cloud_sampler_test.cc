@@ -83,6 +83,21 @@ TEST(PointCloudSamplerTest, DeterministicForSeed) {
   }
 }
 
+TEST(PointCloudSamplerTest, PrefetchingLeavesTheSequenceAlone) {
+  for (bool weighted : {false, true}) {
+    absl::StatusOr<std::unique_ptr<Sampler>> sampler =
+        MakePointCloudSampler(weighted ? Line(100, std::vector<float>(100, 2.0f)) : Line(100));
+    ASSERT_TRUE(sampler.ok()) << sampler.status();
+    Random plain(7);
+    Random prefetching(7);
+    for (int i = 0; i < 1000; ++i) {
+      (*sampler)->PrefetchSample(prefetching);
+      ASSERT_EQ((*sampler)->Sample(plain), (*sampler)->Sample(prefetching))
+          << "prefetching changed sample " << i << " (weighted: " << weighted << ")";
+    }
+  }
+}
+
 TEST(PointCloudSamplerTest, BoundsCoverAllPoints) {
   absl::StatusOr<std::unique_ptr<Sampler>> sampler = MakePointCloudSampler(Line(10));
   ASSERT_TRUE(sampler.ok()) << sampler.status();

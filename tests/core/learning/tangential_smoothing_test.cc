@@ -1,0 +1,140 @@
+#include "core/learning/tangential_smoothing.h"
+
+#include <cmath>
+#include <vector>
+
+#include "core/learning/vertex_ring_cache.h"
+#include "core/random.h"
+#include "gtest/gtest.h"
+#include "tests/testing/shapes.h"
+
+namespace neuralmesh {
+namespace {
+
+using testing::GridPatch;
+using testing::Icosphere;
+using testing::MustToMesh;
+
+// The smoothing as the header states it, written plainly on OpenMesh's circulators and in
+// place: each ring vertex in rotation order, C_L times, sees the ones updated before it.
+void ReferenceSmooth(Mesh& mesh, Mesh::VertexHandle winner, double alpha_l, int iterations) {
+  std::vector<Mesh::VertexHandle> ring;
+  const auto start = mesh.halfedge_handle(winner);
+  auto h = start;
+  do {
+    ring.push_back(mesh.to_vertex_handle(h));
+    h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
+  } while (h != start);
+  std::vector<std::vector<Mesh::VertexHandle>> neighbours(ring.size());
+  std::vector<Vec3> direction(ring.size());
+  for (size_t i = 0; i < ring.size(); ++i) {
+    const Mesh::VertexHandle q = ring[i];
+    std::vector<Mesh::VertexHandle> all;
+    const auto first = mesh.halfedge_handle(q);
+    auto g = first;
+    do {
+      all.push_back(mesh.to_vertex_handle(g));
+      g = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(g));
+    } while (g != first);
+    if (mesh.is_boundary(q)) {
+      neighbours[i] = {all.back(), all.front()};
+      direction[i] = (mesh.point(all.front()) - mesh.point(all.back())).normalized();
+      continue;
+    }
+    neighbours[i] = all;
+    Vec3 n(0, 0, 0);
+    for (size_t k = 0; k < all.size(); ++k) {
+      n += OpenMesh::cross(mesh.point(all[k]) - mesh.point(q),
+                           mesh.point(all[(k + 1) % all.size()]) - mesh.point(q));
+    }
+    direction[i] = n.normalized();
+  }
+  for (int it = 0; it < iterations; ++it) {
+    for (size_t i = 0; i < ring.size(); ++i) {
+      Vec3 centroid(0, 0, 0);
+      for (auto u : neighbours[i]) centroid += mesh.point(u);
+      centroid /= static_cast<double>(neighbours[i].size());
+      const Vec3 l = centroid - mesh.point(ring[i]);
+      const Vec3& d = direction[i];
+      const Vec3 t = mesh.is_boundary(ring[i]) ? OpenMesh::dot(l, d) * d
+                                               : l - OpenMesh::dot(l, d) * d;
+      mesh.point(ring[i]) += alpha_l * t;
+    }
+  }
+}
+
+// Moves every vertex by up to `amount` in each coordinate, so that normals and centroids are
+// not trivially aligned.
+void Jitter(Mesh& mesh, double amount, uint64_t seed) {
+  Random rng(seed);
+  for (auto v : mesh.vertices()) {
+    for (int c = 0; c < 3; ++c) {
+      mesh.point(v)[c] += amount * (2.0 * static_cast<double>(rng.NextIndex(1 << 20)) /
+                                        static_cast<double>(1 << 20) -
+                                    1.0);
+    }
+  }
+}
+
+// Smooths around many winners with OneRingSmoother and with the reference, and compares every
+// point after each call.
+void ExpectSameAsReference(Mesh mesh, double alpha_l, int iterations, const char* shape) {
+  Mesh reference = mesh;
+  OneRingSmoother smoother;
+  VertexRingCache rings;
+  Random rng(11);
+  for (int call = 0; call < 300; ++call) {
+    const Mesh::VertexHandle w(static_cast<int>(rng.NextIndex(mesh.n_vertices())));
+    smoother.Smooth(mesh, rings, w, alpha_l, iterations);
+    ReferenceSmooth(reference, w, alpha_l, iterations);
+    std::vector<int> expected_moved;
+    for (auto u : reference.vv_range(w)) expected_moved.push_back(u.idx());
+    EXPECT_EQ(smoother.moved().size(), expected_moved.size())
+        << shape << ": moved() is not the winner's ring at call " << call;
+    for (auto v : mesh.vertices()) {
+      ASSERT_LT((mesh.point(v) - reference.point(v)).norm(), 1e-12)
+          << shape << ": vertex " << v.idx() << " differs from the reference after call " << call
+          << " (winner " << w.idx() << ")";
+    }
+  }
+}
+
+TEST(OneRingSmootherTest, MatchesThePlainInPlaceSmoothingOnAClosedSurface) {
+  Mesh mesh = MustToMesh(Icosphere(2));
+  Jitter(mesh, 0.05, 1);
+  ExpectSameAsReference(mesh, 0.06, 5, "icosphere");
+  ExpectSameAsReference(mesh, 0.5, 3, "icosphere, large alpha_L");
+}
+
+TEST(OneRingSmootherTest, MatchesThePlainInPlaceSmoothingAlongBorders) {
+  Mesh mesh = MustToMesh(GridPatch(7, 6));
+  Jitter(mesh, 0.1, 2);
+  ExpectSameAsReference(mesh, 0.06, 5, "grid patch");
+}
+
+TEST(OneRingSmootherTest, LeavesTheWinnerAndEverythingOutsideItsRingAlone) {
+  Mesh mesh = MustToMesh(Icosphere(2));
+  Jitter(mesh, 0.05, 3);
+  const Mesh before = mesh;
+  const Mesh::VertexHandle w(17);
+  OneRingSmoother smoother;
+  VertexRingCache rings;
+  smoother.Smooth(mesh, rings, w, 0.06, 5);
+  std::vector<bool> in_ring(mesh.n_vertices(), false);
+  for (auto u : mesh.vv_range(w)) in_ring[u.idx()] = true;
+  int moved = 0;
+  for (auto v : mesh.vertices()) {
+    if (in_ring[v.idx()]) {
+      moved += mesh.point(v) != before.point(v) ? 1 : 0;
+      continue;
+    }
+    EXPECT_EQ(mesh.point(v), before.point(v)) << "vertex " << v.idx() << " is not in the ring";
+  }
+  EXPECT_GT(moved, 0) << "nothing in the ring moved";
+  smoother.Smooth(mesh, rings, w, 0.0, 5);
+  smoother.Smooth(mesh, rings, w, 0.06, 0);
+  EXPECT_EQ(smoother.moved().size(), mesh.valence(w)) << "moved() is the ring even when idle";
+}
+
+}  // namespace
+}  // namespace neuralmesh

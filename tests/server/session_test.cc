@@ -296,10 +296,11 @@ TEST_F(SessionTest, ScanOrderEndsAsGoodAsRandomOrder) {
     return std::atan2(a[1], a[0]) < std::atan2(b[1], b[0]);
   });
 
-  auto run = [&](const PointCloud& cloud) -> TriangleMesh {
+  auto run = [&](const PointCloud& cloud, uint64_t seed) -> TriangleMesh {
     Recorder recorder;
     SessionConfig config;
     config.target_vertices = 1000;
+    config.learner.seed = seed;
     EXPECT_TRUE(ResolveSessionConfig(1 << 20, config).ok());
     auto session =
         std::make_shared<Session>("s", "", config, size_t{1} << 20, &pool_, &encoder_);
@@ -315,20 +316,39 @@ TEST_F(SessionTest, ScanOrderEndsAsGoodAsRandomOrder) {
     EXPECT_TRUE(mesh.ok());
     return mesh.ok() ? *mesh : TriangleMesh();
   };
-  const TriangleMesh from_random = run(random);
-  const TriangleMesh from_scan = run(scan);
+  // One reconstruction of 1,000 vertices is at the mercy of its seed (a handle that forms a
+  // few calls late costs twice the error), so each order is judged by its median over three
+  // seeds.
   const TriangleMesh reference = (*torus)->ReferenceMesh(16);
   GeometricErrorOptions options;
   options.samples = 20000;
   options.threads = 1;
-  absl::StatusOr<GeometricError> random_error =
-      ComputeGeometricError(from_random, reference, options);
-  absl::StatusOr<GeometricError> scan_error = ComputeGeometricError(from_scan, reference, options);
-  ASSERT_TRUE(random_error.ok() && scan_error.ok());
-  EXPECT_LT(scan_error->chamfer_l1, 1.25 * random_error->chamfer_l1 + 1e-3)
-      << "scan order: " << scan_error->chamfer_l1 << ", random order: "
-      << random_error->chamfer_l1;
-  EXPECT_LT(scan_error->hausdorff, 2 * random_error->hausdorff + 0.01);
+  auto median_error = [&](const PointCloud& cloud) -> GeometricError {
+    std::vector<GeometricError> errors;
+    for (uint64_t seed = 1; seed <= 3; ++seed) {
+      absl::StatusOr<GeometricError> error =
+          ComputeGeometricError(run(cloud, seed), reference, options);
+      EXPECT_TRUE(error.ok()) << error.status();
+      if (error.ok()) errors.push_back(*error);
+    }
+    if (errors.size() != 3) return GeometricError{};
+    auto by = [&](auto field) {
+      std::vector<double> values;
+      for (const GeometricError& e : errors) values.push_back(e.*field);
+      std::sort(values.begin(), values.end());
+      return values[1];
+    };
+    GeometricError median = errors[0];
+    median.chamfer_l1 = by(&GeometricError::chamfer_l1);
+    median.hausdorff = by(&GeometricError::hausdorff);
+    return median;
+  };
+  const GeometricError random_error = median_error(random);
+  const GeometricError scan_error = median_error(scan);
+  ASSERT_GT(random_error.chamfer_l1, 0) << "the random-order runs must produce meshes";
+  EXPECT_LT(scan_error.chamfer_l1, 1.25 * random_error.chamfer_l1 + 1e-3)
+      << "scan order: " << scan_error.chamfer_l1 << ", random order: " << random_error.chamfer_l1;
+  EXPECT_LT(scan_error.hausdorff, 2 * random_error.hausdorff + 0.01);
 }
 
 }  // namespace

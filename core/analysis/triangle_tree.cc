@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/analysis/closest_point_triangle.h"
+#include "core/morton_code.h"
 
 namespace neuralmesh {
 namespace {
@@ -59,28 +60,6 @@ inline double TriangleBoxDistance2(const Vec3f& a, const Vec3f& b, const Vec3f& 
   return BoxDistance2(lo, hi, p);
 }
 
-// Spreads the low 21 bits of x so that two zero bits follow each one.
-uint64_t SpreadBits(uint64_t x) {
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffULL;
-  x = (x | x << 16) & 0x1f0000ff0000ffULL;
-  x = (x | x << 8) & 0x100f00f00f00f00fULL;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
-  x = (x | x << 2) & 0x1249249249249249ULL;
-  return x;
-}
-
-// Position of p along a Z-order curve over `box` (points outside are clamped).
-uint64_t MortonCode(const Vec3& p, const BoundingBox& box) {
-  uint64_t code = 0;
-  for (int i = 0; i < 3; ++i) {
-    const double extent = box.max[i] - box.min[i];
-    double t = extent > 0.0 ? (p[i] - box.min[i]) / extent : 0.0;
-    t = std::isfinite(t) ? std::clamp(t, 0.0, 1.0) : 0.0;
-    code |= SpreadBits(static_cast<uint64_t>(t * 2097151.0)) << i;
-  }
-  return code;
-}
 
 }  // namespace
 
@@ -230,7 +209,7 @@ std::vector<TriangleTree::ClosestPointResult> TriangleTree::ClosestPoints(
   // batches of random samples are several times slower. The order does not change results.
   std::vector<std::pair<uint64_t, size_t>> order(points.size());
   for (size_t i = 0; i < points.size(); ++i) {
-    order[i] = {MortonCode(points[i], bounds_), i};
+    order[i] = {MortonCode(points[i], bounds_.min, bounds_.max), i};
   }
   std::sort(order.begin(), order.end());
 

@@ -24,12 +24,9 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "core/morton_code.h"
 
 namespace neuralmesh {
-
-// The Morton code of `p` in the cube grid of 2^21 cells per axis over [min, max] (per axis;
-// coordinates outside are clamped).
-uint64_t MortonCode(const Vec3& p, const Vec3& min, const Vec3& max);
 
 // Renumbers the vertices of `mesh` in Morton order (see above). Returns the new index of each
 // old vertex index, for callers that keep per-vertex data outside the mesh's properties.

@@ -140,7 +140,8 @@ class Learner::Impl {
  private:
   // C_ec * v Basic Steps, with v at least C_vs (learner_options.h).
   uint64_t ConnectivityInterval() const {
-    const double v = std::max(static_cast<double>(live_vertices_), static_cast<double>(options_.c_vs));
+    const double v =
+        std::max(static_cast<double>(live_vertices_), static_cast<double>(options_.c_vs));
     return static_cast<uint64_t>(std::ceil(options_.c_ec * v));
   }
 

@@ -15,27 +15,28 @@ using testing::GridPatch;
 using testing::Icosphere;
 using testing::MustToMesh;
 
+// The neighbours of v in rotation order, starting at the end of v's stored half-edge (for a
+// border vertex, its outgoing border half-edge).
+std::vector<Mesh::VertexHandle> RotationOrder(const Mesh& mesh, Mesh::VertexHandle v) {
+  std::vector<Mesh::VertexHandle> out;
+  const auto start = mesh.halfedge_handle(v);
+  auto h = start;
+  do {
+    out.push_back(mesh.to_vertex_handle(h));
+    h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
+  } while (h != start);
+  return out;
+}
+
 // The smoothing as the header states it, written plainly on OpenMesh's circulators and in
 // place: each ring vertex in rotation order, C_L times, sees the ones updated before it.
 void ReferenceSmooth(Mesh& mesh, Mesh::VertexHandle winner, double alpha_l, int iterations) {
-  std::vector<Mesh::VertexHandle> ring;
-  const auto start = mesh.halfedge_handle(winner);
-  auto h = start;
-  do {
-    ring.push_back(mesh.to_vertex_handle(h));
-    h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
-  } while (h != start);
+  const std::vector<Mesh::VertexHandle> ring = RotationOrder(mesh, winner);
   std::vector<std::vector<Mesh::VertexHandle>> neighbours(ring.size());
   std::vector<Vec3> direction(ring.size());
   for (size_t i = 0; i < ring.size(); ++i) {
     const Mesh::VertexHandle q = ring[i];
-    std::vector<Mesh::VertexHandle> all;
-    const auto first = mesh.halfedge_handle(q);
-    auto g = first;
-    do {
-      all.push_back(mesh.to_vertex_handle(g));
-      g = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(g));
-    } while (g != first);
+    const std::vector<Mesh::VertexHandle> all = RotationOrder(mesh, q);
     if (mesh.is_boundary(q)) {
       neighbours[i] = {all.back(), all.front()};
       direction[i] = (mesh.point(all.front()) - mesh.point(all.back())).normalized();

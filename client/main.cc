@@ -77,6 +77,9 @@ ABSL_FLAG(bool, split_largest_cell_near_most_active,
 ABSL_FLAG(int32_t, sewn_strip_grace_calls, kLearnerDefaults.sewn_strip_grace_calls,
           "Calls of Step 4 that spare the faces around a strip Step 5 has just sewn, in "
           "[0, 1000]; 0 is the paper's rule.");
+ABSL_FLAG(int32_t, min_merged_loop_vertices, kLearnerDefaults.min_merged_loop_vertices,
+          "Step 5 merges only boundary loops of at least this many vertices, in [3, 1000]; 3 "
+          "is the paper's rule.");
 
 // Local learning.
 ABSL_FLAG(std::string, sampling, "uniform",
@@ -143,6 +146,7 @@ neuralmesh::LearnerOptions LearnerFromFlags() {
   o.split_largest_cell_near_most_active =
       absl::GetFlag(FLAGS_split_largest_cell_near_most_active);
   o.sewn_strip_grace_calls = absl::GetFlag(FLAGS_sewn_strip_grace_calls);
+  o.min_merged_loop_vertices = absl::GetFlag(FLAGS_min_merged_loop_vertices);
   o.seed = absl::GetFlag(FLAGS_seed);
   return o;
 }
@@ -247,9 +251,9 @@ std::vector<Subcommand> Commands() {
       "alpha_sc", "alpha_r", "alpha_m", "remove_triangles", "merge_boundaries",
       "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
-      "sewn_strip_grace_calls", "sampling", "time_budget", "max_steps", "quantization_bits",
-      "encode_speed", "progress", "server", "out-dir", "batch-size", "points", "ply",
-      "connect_timeout"};
+      "sewn_strip_grace_calls", "min_merged_loop_vertices", "sampling", "time_budget",
+      "max_steps", "quantization_bits", "encode_speed", "progress", "server", "out-dir",
+      "batch-size", "points", "ply", "connect_timeout"};
   // clang-format on
   return {
       {"reconstruct",

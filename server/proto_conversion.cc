@@ -57,6 +57,9 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
   if (l.has_sewn_strip_grace_calls()) {
     o.sewn_strip_grace_calls = l.sewn_strip_grace_calls().value();
   }
+  if (l.has_min_merged_loop_vertices()) {
+    o.min_merged_loop_vertices = l.min_merged_loop_vertices().value();
+  }
 
   config.target_vertices = proto.target_vertices();
   config.lod_milestones.assign(proto.lod_milestones().begin(), proto.lod_milestones().end());
@@ -118,6 +121,7 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
   l.mutable_split_largest_cell_near_most_active()->set_value(
       o.split_largest_cell_near_most_active);
   l.mutable_sewn_strip_grace_calls()->set_value(o.sewn_strip_grace_calls);
+  l.mutable_min_merged_loop_vertices()->set_value(o.min_merged_loop_vertices);
 
   proto.set_target_vertices(config.target_vertices);
   for (size_t m : config.lod_milestones) proto.add_lod_milestones(m);

@@ -99,6 +99,14 @@ double TriangleQuality(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
   return 2 * std::sqrt(3.0) * OpenMesh::cross(p1 - p0, p2 - p0).norm() / squared_lengths;
 }
 
+// The cost of a strip triangle: 1 / quality, so 1 for an equilateral triangle, and a sliver
+// costs more than any number of good triangles can save.
+double TriangleCost(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  return 1.0 / std::max(TriangleQuality(p0, p1, p2), 1e-9);
+}
+
+constexpr double kNoStrip = std::numeric_limits<double>::infinity();
+
 // Plans the strip between loop `a` (boundary half-edges a[i] -> a[i+1]) and loop `b`
 // (b[j] -> b[j+1]). Returns the faces in the order they must be added, or nullopt when no
 // legal strip of this kind exists. O(|a| |b| + sum of the valences of a).
@@ -111,8 +119,8 @@ double TriangleQuality(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
 // only where the walk wraps: (n, k) against (0, k) and (i, m) against (i, 0). We rule that
 // out by deciding the first move: if it advances on A, no (0, k > 0) is visited, so only
 // (i < n, m) and (n, 0) are forbidden (B is consumed last); symmetrically if it advances on B.
-// For each choice a table of the states from which (n, m) can still be reached lets the
-// greedy choice of the better triangle never run into a dead end.
+// For each choice, a table of the least cost from every state to (n, m) (infinite where it
+// cannot be reached) gives the best walk of that kind; the cheaper of the two is taken.
 std::optional<std::vector<Triangle>> PlanStrip(const Mesh& mesh, const VertexLoop& a,
                                                const VertexLoop& b) {
   const int n = static_cast<int>(a.size());
@@ -152,53 +160,60 @@ std::optional<std::vector<Triangle>> PlanStrip(const Mesh& mesh, const VertexLoo
   auto vertex_c = [&](int k) { return b[walk_c(k)]; };
 
   const size_t width = static_cast<size_t>(m) + 1;
-  auto reachable_table = [&](bool a_first) {
+  auto point = [&](Mesh::VertexHandle vh) -> const Vec3& { return mesh.point(vh); };
+  auto cost_a = [&](int i, int k) {  // The triangle that advances on A from (i, k).
+    return TriangleCost(point(vertex_a(i)), point(vertex_a(i + 1)), point(vertex_c(k)));
+  };
+  auto cost_b = [&](int i, int k) {  // The triangle that advances on B from (i, k).
+    return TriangleCost(point(vertex_c(k + 1)), point(vertex_c(k)), point(vertex_a(i)));
+  };
+  // For one choice of the first move: the least total cost of a walk from each state to
+  // (n, m), infinite where (n, m) cannot be reached.
+  auto cost_table = [&](bool a_first) {
     auto allowed = [&](int i, int k) {
       if ((i == 0 && k == 0) || (i == n && k == m)) return true;
       if (linked[static_cast<size_t>(walk_a(i)) * m + walk_c(k)]) return false;
       if (a_first) return !(i == 0 || (k == m && i < n) || (i == n && k == 0));
       return !(k == 0 || (i == n && k < m) || (k == m && i == 0));
     };
-    std::vector<char> reach((static_cast<size_t>(n) + 1) * width, 0);
+    std::vector<double> to_end((static_cast<size_t>(n) + 1) * width, kNoStrip);
     for (int i = n; i >= 0; --i) {
       for (int k = m; k >= 0; --k) {
-        reach[i * width + k] =
-            allowed(i, k) && ((i == n && k == m) || (i < n && reach[(i + 1) * width + k]) ||
-                              (k < m && reach[i * width + k + 1]));
+        if (!allowed(i, k)) continue;
+        double& best = to_end[i * width + k];
+        if (i == n && k == m) {
+          best = 0;
+          continue;
+        }
+        if (i < n && to_end[(i + 1) * width + k] < kNoStrip) {
+          best = std::min(best, cost_a(i, k) + to_end[(i + 1) * width + k]);
+        }
+        if (k < m && to_end[i * width + k + 1] < kNoStrip) {
+          best = std::min(best, cost_b(i, k) + to_end[i * width + k + 1]);
+        }
       }
     }
-    return reach;
-  };
-  auto point = [&](Mesh::VertexHandle vh) -> const Vec3& { return mesh.point(vh); };
-  auto quality_a = [&](int i, int k) {  // Advance on A from (i, k).
-    return TriangleQuality(point(vertex_a(i)), point(vertex_a(i + 1)), point(vertex_c(k)));
-  };
-  auto quality_b = [&](int i, int k) {  // Advance on B from (i, k).
-    return TriangleQuality(point(vertex_c(k + 1)), point(vertex_c(k)), point(vertex_a(i)));
+    return to_end;
   };
 
-  const std::vector<char> reach_a_first = reachable_table(true);
-  const std::vector<char> reach_b_first = reachable_table(false);
-  const bool can_a_first = reach_a_first[width];  // State (1, 0).
-  const bool can_b_first = reach_b_first[1];      // State (0, 1).
-  if (!can_a_first && !can_b_first) return std::nullopt;
-  const std::vector<char>& reach =
-      can_a_first && (!can_b_first || quality_a(0, 0) >= quality_b(0, 0)) ? reach_a_first
-                                                                          : reach_b_first;
+  const std::vector<double> a_first = cost_table(true);
+  const std::vector<double> b_first = cost_table(false);
+  if (a_first[0] >= kNoStrip && b_first[0] >= kNoStrip) return std::nullopt;
+  const std::vector<double>& to_end = a_first[0] <= b_first[0] ? a_first : b_first;
 
+  // Follow the cheapest walk.
   std::vector<Triangle> strip;
   strip.reserve(n + m);
   int i = 0;
   int k = 0;
   while (i < n || k < m) {
-    // -1 marks a move into a dead end; a triangle's quality is >= 0.
-    const double move_a = i < n && reach[(i + 1) * width + k] ? quality_a(i, k) : -1;
-    const double move_b = k < m && reach[i * width + k + 1] ? quality_b(i, k) : -1;
-    // Ties advance the loop that is behind in relative progress.
-    const bool advance_a = move_a != move_b
-                               ? move_a > move_b
-                               : static_cast<int64_t>(i + 1) * m <= static_cast<int64_t>(k + 1) * n;
-    if (advance_a) {
+    const double via_a =
+        i < n && to_end[(i + 1) * width + k] < kNoStrip ? cost_a(i, k) + to_end[(i + 1) * width + k]
+                                                        : kNoStrip;
+    const double via_b =
+        k < m && to_end[i * width + k + 1] < kNoStrip ? cost_b(i, k) + to_end[i * width + k + 1]
+                                                      : kNoStrip;
+    if (via_a <= via_b) {
       strip.push_back({vertex_a(i), vertex_a(i + 1), vertex_c(k)});
       ++i;
     } else {
@@ -245,6 +260,10 @@ absl::Status BoundaryMergingOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("alpha_m (Eq. 3) must be finite and non-negative, got ", alpha_m));
   }
+  if (min_loop_vertices < 3) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_loop_vertices must be at least 3, got ", min_loop_vertices));
+  }
   if (close_small_holes) return hole_closing.Validate();
   return absl::OkStatus();
 }
@@ -284,11 +303,16 @@ BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOpti
     }
   }
 
+  // Neither loops that Step 4 is still growing nor loops below min_loop_vertices take part.
+  std::vector<bool> excluded = growing;
+  for (size_t x = 0; x < loops.size(); ++x) {
+    if (loops[x].vertices.size() < options.min_loop_vertices) excluded[x] = true;
+  }
   std::vector<CandidatePair> candidates;
   for (size_t x = 0; x < loops.size(); ++x) {
-    if (growing[x]) continue;
+    if (excluded[x]) continue;
     for (size_t y = x + 1; y < loops.size(); ++y) {
-      if (growing[y]) continue;
+      if (excluded[y]) continue;
       if (HausdorffLowerBound(loops[x], loops[y]) >= limit) continue;
       const auto distance = HausdorffBelow(mesh, loops[x].vertices, loops[y].vertices, limit);
       if (distance) candidates.push_back({*distance, x, y});

@@ -11,12 +11,12 @@
 //     keep (A, B) if H(A, B) < alpha_m * sqrt(E)                           (Eq. 3)
 //   for the kept pairs, closest first, skipping loops already merged in this call:
 //     plan a strip: start at the closest vertex pair (a_0, c_0) not already joined by an
-//       edge, and walk A along its boundary half-edges and B against them; at each step add
-//       the better of the two triangles
+//       edge, and walk A along its boundary half-edges and B against them; each step adds
+//       one of the two triangles
 //         (a_i, a_i+1, c_k)    advance on A, using A's boundary half-edge a_i -> a_i+1
 //         (c_k+1, c_k, a_i)    advance on B, using B's boundary half-edge c_k+1 -> c_k
-//       among those from which the walk can still finish, until both loops are consumed and
-//       the strip closes on (a_0, c_0)
+//       until both loops are consumed and the strip closes on (a_0, c_0); of all such walks,
+//       take the one whose triangles are closest to equilateral: least sum of 1 / quality
 //     if a plan exists, add its |A| + |B| faces (undo them all if OpenMesh refuses one)
 //
 // Orientation: a new face sharing a boundary edge must traverse it in the direction of the
@@ -29,15 +29,21 @@
 //
 // Quality of a triangle (the paper: "how close it is to be equilateral"):
 // q = 4 sqrt(3) area / (l0^2 + l1^2 + l2^2), 1 for an equilateral triangle and 0 for a
-// degenerate one; cheap, scale-free and without trigonometry. Ties advance the loop that is
-// behind in relative progress.
+// degenerate one; cheap, scale-free and without trigonometry.
+// The best walk, not the best next triangle: the paper adds "the best triangle" at each step.
+// That greedy choice fails where one loop has a short edge right after a long one (common on
+// the holes Step 4 cuts): every triangle over the short edge is a sliver, so the walk runs
+// all the way round the other loop first and closes the strip with two fans of slivers. On a
+// torus this gave vertices of valence 19 and 21, and the strip then tore into holes that were
+// sewn into an extra handle. A dynamic program over the same walks (O(|A| |B|)) finds the one
+// of least total cost; with 1 / q as the cost, one sliver costs more than many good
+// triangles save.
 //
 // Legality: the walk never creates an edge that already exists (two loops of one thin
 // component are often joined by edges) nor the same cross edge twice (possible only where it
 // wraps around; the loop not advanced by the first triangle is consumed last, which excludes
-// it). A table of the states from which the walk can still finish steers the greedy choice,
-// so a strip is found whenever one of this kind exists, and a pair is skipped, untouched,
-// only when none does. Every step is then legal for OpenMesh: it uses one free boundary
+// it). The dynamic program only walks through allowed states, so a strip is found whenever
+// one of this kind exists, and a pair is skipped, untouched, only when none does. Every step is then legal for OpenMesh: it uses one free boundary
 // half-edge of a loop, and cross edges that are either new or the free side of an earlier
 // one. Loops never share a vertex and have at least 3 vertices, since every boundary vertex
 // of a valid mesh has exactly one boundary gap and there are no double edges.
@@ -63,12 +69,14 @@ namespace neuralmesh {
 
 struct BoundaryMergingOptions {
   double alpha_m = 5;  // alpha_m, Eq. 3: merge loops closer than alpha_m sqrt(E(Area)), >= 0.
+  // Loops with fewer vertices take no part. 3 (every loop) is the paper's rule. >= 3.
+  size_t min_loop_vertices = 3;
   // Close small holes (CloseSmallHoles with `hole_closing`) before merging. Not in the paper.
   bool close_small_holes = false;
   HoleClosingOptions hole_closing;
 
-  // Returns INVALID_ARGUMENT unless alpha_m is finite and non-negative and, when
-  // close_small_holes is set, hole_closing is valid.
+  // Returns INVALID_ARGUMENT unless alpha_m is finite and non-negative, min_loop_vertices is
+  // at least 3 and, when close_small_holes is set, hole_closing is valid.
   absl::Status Validate() const;
 };
 

@@ -208,6 +208,7 @@ class Learner::Impl {
       t0 = Clock::now();
       BoundaryMergingOptions merging;
       merging.alpha_m = options_.alpha_m;
+      merging.min_loop_vertices = static_cast<size_t>(options_.min_merged_loop_vertices);
       merging.close_small_holes = options_.close_small_holes;
       merging.hole_closing.alpha_r = options_.alpha_r;
       merging.hole_closing.alpha_m = options_.alpha_m;

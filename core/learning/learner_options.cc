@@ -26,6 +26,9 @@ absl::Status LearnerOptions::Validate() const {
   if (sewn_strip_grace_calls < 0 || sewn_strip_grace_calls > 1000) {
     return OutOfRange("sewn_strip_grace_calls", sewn_strip_grace_calls, "[0, 1000]");
   }
+  if (min_merged_loop_vertices < 3 || min_merged_loop_vertices > 1000) {
+    return OutOfRange("min_merged_loop_vertices", min_merged_loop_vertices, "[3, 1000]");
+  }
   if (max_closed_hole_vertices < 3 || max_closed_hole_vertices > 1000) {
     return OutOfRange("max_closed_hole_vertices", max_closed_hole_vertices, "[3, 1000]");
   }

@@ -25,6 +25,7 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   options.merge_only_settled_boundaries = false;
   options.split_largest_cell_near_most_active = false;
   options.sewn_strip_grace_calls = 0;
+  options.min_merged_loop_vertices = 5;
   const v1::LearnerOptions proto = ToProto(options);
   EXPECT_EQ(proto.alpha_w().value(), 0.1);
   EXPECT_EQ(proto.alpha_l().value(), 0.2);
@@ -49,6 +50,7 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   EXPECT_FALSE(proto.split_largest_cell_near_most_active().value());
   ASSERT_TRUE(proto.has_sewn_strip_grace_calls()) << "0 must be sent, not left unset";
   EXPECT_EQ(proto.sewn_strip_grace_calls().value(), 0);
+  EXPECT_EQ(proto.min_merged_loop_vertices().value(), 5);
 }
 
 TEST(ClientProtoConversionTest, DracoSpeedBecomesCompressionSpeed) {

@@ -173,6 +173,9 @@ TEST(LearnerTest, InvalidOptionsAndEmptyTargetsAreRejected) {
   o = {};
   o.alpha_r = 0;
   expect_invalid(o, "alpha_r");
+  o = {};
+  o.min_merged_loop_vertices = 2;
+  expect_invalid(o, "min_merged_loop_vertices");
   EXPECT_EQ(Learner::Create(LearnerOptions{}, nullptr).status().code(),
             absl::StatusCode::kInvalidArgument);
 }

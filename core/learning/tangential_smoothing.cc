@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 namespace neuralmesh {
 namespace {
 
@@ -15,7 +19,93 @@ void StoreUnit(double x, double y, double z, double* out) {
   out[2] = z * inv;
 }
 
+// The C_L passes in ring order. Only the product with q_{i-1}, carried in registers from the
+// update before, waits for that update: this chain through the ring is what bounds the speed
+// of the loop, so it is kept one product and two sums deep.
+//
+// Both versions below evaluate the same expressions in the same order (the AVX2 one four lanes
+// at a time, the fourth lane unused), and the file is compiled without contraction into fused
+// multiply-adds (core/CMakeLists.txt), so they give bitwise the same positions: a seed gives
+// the same mesh whichever one the CPU runs.
+void SmoothPassesScalar(const OneRingSmoother::RingVertex* ring, OneRingSmoother::Position* q,
+                        const int* moving, int m, int iterations) {
+  for (int it = 0; it < iterations; ++it) {
+    double px = q[m - 1].v[0], py = q[m - 1].v[1], pz = q[m - 1].v[2];
+    for (int i = 0; i < m; ++i) {
+      const OneRingSmoother::RingVertex& r = ring[i];
+      double* qi = q[i].v;
+      double sx = 0, sy = 0, sz = 0;
+      for (int k = r.first_moving; k < r.end_moving; ++k) {
+        const double* u = q[moving[k]].v;
+        sx += u[0];
+        sy += u[1];
+        sz += u[2];
+      }
+      double next[3];
+      for (int c = 0; c < 3; ++c) {
+        const double t =
+            ((r.own[0][c] * qi[0] + r.own[1][c] * qi[1]) + r.own[2][c] * qi[2]) +
+            (((r.neighbour[0][c] * sx + r.neighbour[1][c] * sy) + r.neighbour[2][c] * sz) +
+             r.offset[c]);
+        next[c] = (r.previous[0][c] * px + r.previous[1][c] * py) + (r.previous[2][c] * pz + t);
+      }
+      px = qi[0] = next[0];
+      py = qi[1] = next[1];
+      pz = qi[2] = next[2];
+    }
+  }
+}
+
+#if defined(__x86_64__)
+__attribute__((target("avx2"))) void SmoothPassesAvx2(const OneRingSmoother::RingVertex* ring,
+                                                      OneRingSmoother::Position* q,
+                                                      const int* moving, int m, int iterations) {
+  for (int it = 0; it < iterations; ++it) {
+    __m256d previous = _mm256_load_pd(q[m - 1].v);
+    for (int i = 0; i < m; ++i) {
+      const OneRingSmoother::RingVertex& r = ring[i];
+      double* qi = q[i].v;
+      __m256d sx = _mm256_setzero_pd(), sy = sx, sz = sx;
+      for (int k = r.first_moving; k < r.end_moving; ++k) {
+        const double* u = q[moving[k]].v;
+        sx = _mm256_add_pd(sx, _mm256_broadcast_sd(u));
+        sy = _mm256_add_pd(sy, _mm256_broadcast_sd(u + 1));
+        sz = _mm256_add_pd(sz, _mm256_broadcast_sd(u + 2));
+      }
+      const __m256d own = _mm256_add_pd(
+          _mm256_add_pd(_mm256_mul_pd(_mm256_load_pd(r.own[0]), _mm256_broadcast_sd(qi)),
+                        _mm256_mul_pd(_mm256_load_pd(r.own[1]), _mm256_broadcast_sd(qi + 1))),
+          _mm256_mul_pd(_mm256_load_pd(r.own[2]), _mm256_broadcast_sd(qi + 2)));
+      const __m256d others = _mm256_add_pd(
+          _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_load_pd(r.neighbour[0]), sx),
+                                      _mm256_mul_pd(_mm256_load_pd(r.neighbour[1]), sy)),
+                        _mm256_mul_pd(_mm256_load_pd(r.neighbour[2]), sz)),
+          _mm256_load_pd(r.offset));
+      const __m256d t = _mm256_add_pd(own, others);
+      const __m256d px = _mm256_permute4x64_pd(previous, 0x00);
+      const __m256d py = _mm256_permute4x64_pd(previous, 0x55);
+      const __m256d pz = _mm256_permute4x64_pd(previous, 0xaa);
+      previous = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_load_pd(r.previous[0]), px),
+                                             _mm256_mul_pd(_mm256_load_pd(r.previous[1]), py)),
+                               _mm256_add_pd(_mm256_mul_pd(_mm256_load_pd(r.previous[2]), pz), t));
+      _mm256_store_pd(qi, previous);
+    }
+  }
+}
+
+bool CpuHasAvx2() { return __builtin_cpu_supports("avx2"); }
+#else
+void SmoothPassesAvx2(const OneRingSmoother::RingVertex* ring, OneRingSmoother::Position* q,
+                      const int* moving, int m, int iterations) {
+  SmoothPassesScalar(ring, q, moving, m, iterations);
+}
+
+bool CpuHasAvx2() { return false; }
+#endif
+
 }  // namespace
+
+OneRingSmoother::OneRingSmoother(bool allow_simd) : simd_(allow_simd && CpuHasAvx2()) {}
 
 void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle winner,
                              double alpha_l, int iterations) {
@@ -23,7 +113,10 @@ void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHan
   ring_.assign(winner_ring.neighbours, winner_ring.neighbours + winner_ring.size);
   if (alpha_l <= 0 || iterations <= 0) return;
   const int m = static_cast<int>(ring_.size());
-  if (local_.size() < ring_.size()) local_.resize(ring_.size());
+  if (local_.size() < ring_.size()) {
+    local_.resize(ring_.size());
+    q_.resize(ring_.size());
+  }
 
   // The points live in one contiguous array (an OpenMesh property); nothing below adds a
   // vertex, so the pointer stays valid.
@@ -40,35 +133,61 @@ void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHan
 
   // Gathered once per call: each ring vertex's position, its normal (or border tangent), and
   // its neighbours split into those that stay put during the smoothing (the winner and the
-  // second ring: summed here once) and those that move (other ring vertices).
-  moving_.clear();
+  // second ring: summed into c_i) and those that move (other ring vertices). One pass over
+  // the neighbours does both, without branches on the kind of neighbour: which neighbour is
+  // the winner or a ring vertex changes from one ring vertex to the next, and mispredicted
+  // branches cost more here than the arithmetic.
+  int num_moving = 0;
   for (int i = 0; i < m; ++i) {
     RingVertex& r = local_[i];
     const double* p = at(ring_[i]);
-    for (int c = 0; c < 3; ++c) r.p[c] = p[c];
+    double* q = q_[i].v;
+    q[0] = p[0];
+    q[1] = p[1];
+    q[2] = p[2];
+    q[3] = 0;
     const VertexRingCache::RingView view = rings.Ring(mesh, ring_[i]);
-    const int32_t* neighbours = view.neighbours;
-    int count = view.size;
-    int32_t border_pair[2];
+    if (moving_.size() < static_cast<size_t>(num_moving + view.size)) {
+      moving_.resize(2 * static_cast<size_t>(num_moving + view.size));
+    }
+    const int previous = m > 1 ? (i == 0 ? m - 1 : i - 1) : -2;  // -2: matches no slot.
+    r.first_moving = num_moving;
+    bool has_previous = false;
+    double fx = 0, fy = 0, fz = 0;  // The sum of the neighbours that stay put.
+    auto classify = [&](int u, const double* b) {
+      const int slot = slot_of_vertex_[u];
+      const bool is_previous = slot == previous;
+      const double stays = slot < 0 ? 1.0 : 0.0;
+      has_previous |= is_previous;
+      fx += stays * b[0];
+      fy += stays * b[1];
+      fz += stays * b[2];
+      moving_[num_moving] = slot;
+      num_moving += (slot >= 0) & !is_previous;
+    };
     double d[3];
-    r.border = view.boundary;
-    if (r.border) {
+    int count;
+    const bool border = view.boundary;
+    if (border) {
       // Only the two neighbours along the border count: b1 (the end of the outgoing boundary
       // half-edge) comes first in the ring, b0 (the start of the incoming one) last.
-      border_pair[0] = neighbours[count - 1];
-      border_pair[1] = neighbours[0];
-      const double* p0 = at(border_pair[0]);
-      const double* p1 = at(border_pair[1]);
+      const int b0 = view.neighbours[view.size - 1];
+      const int b1 = view.neighbours[0];
+      const double* p0 = at(b0);
+      const double* p1 = at(b1);
+      classify(b0, p0);
+      classify(b1, p1);
       StoreUnit(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2], d);
-      neighbours = border_pair;
       count = 2;
     } else {
       // Area-weighted normal: the sum of (a_k - q) x (a_k+1 - q) around the ring.
-      const double* last = at(neighbours[count - 1]);
+      count = view.size;
+      const double* last = at(view.neighbours[count - 1]);
       double ax = last[0] - p[0], ay = last[1] - p[1], az = last[2] - p[2];
       double nx = 0, ny = 0, nz = 0;
       for (int k = 0; k < count; ++k) {
-        const double* b = at(neighbours[k]);
+        const int u = view.neighbours[k];
+        const double* b = at(u);
         const double bx = b[0] - p[0], by = b[1] - p[1], bz = b[2] - p[2];
         nx += ay * bz - az * by;
         ny += az * bx - ax * bz;
@@ -76,93 +195,42 @@ void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHan
         ax = bx;
         ay = by;
         az = bz;
+        classify(u, b);
       }
       StoreUnit(nx, ny, nz, d);
     }
-    for (int c = 0; c < 3; ++c) r.direction[c] = d[c];
-    r.inverse_count = 1.0 / static_cast<double>(count);
+    r.end_moving = num_moving;
 
-    // The tangential projection P (I - d d^T off the normal, d d^T along a border) and
-    //   M = alpha_L / count * P,
-    // the part of the update that is linear in the previous ring vertex (see below).
-    const double scale = alpha_l * r.inverse_count;
-    for (int a = 0; a < 3; ++a) {
-      for (int b = 0; b < 3; ++b) {
-        const double along = d[a] * d[b];
-        r.previous_weight[a][b] = scale * (r.border ? along : (a == b ? 1.0 : 0.0) - along);
+    // P = I - d d^T off the normal, d d^T along a border; A = I - alpha_L P and
+    // G = alpha_L / count P, and G again for q_{i-1} when it is a neighbour.
+    const double scale = alpha_l / static_cast<double>(count);
+    const double identity = border ? 0.0 : 1.0;
+    const double sign = border ? 1.0 : -1.0;
+    const double previous_on = has_previous ? 1.0 : 0.0;
+    for (int col = 0; col < 3; ++col) {
+      for (int row = 0; row < 3; ++row) {
+        const double proj = (row == col ? identity : 0.0) + sign * (d[row] * d[col]);
+        r.own[col][row] = (row == col ? 1.0 : 0.0) - alpha_l * proj;
+        r.neighbour[col][row] = scale * proj;
+        r.previous[col][row] = previous_on * r.neighbour[col][row];
       }
+      r.own[col][3] = r.neighbour[col][3] = r.previous[col][3] = 0;
     }
-
-    const int previous = i == 0 ? m - 1 : i - 1;
-    r.has_previous = false;
-    r.fixed_sum[0] = r.fixed_sum[1] = r.fixed_sum[2] = 0;
-    r.first_moving = static_cast<int>(moving_.size());
-    for (int k = 0; k < count; ++k) {
-      const int u = neighbours[k];
-      const int slot = slot_of_vertex_[u];
-      if (slot == previous && m > 1) {
-        r.has_previous = true;
-      } else if (slot >= 0) {
-        moving_.push_back(slot);
-      } else {
-        const double* q = at(u);
-        for (int c = 0; c < 3; ++c) r.fixed_sum[c] += q[c];
-      }
+    for (int row = 0; row < 3; ++row) {
+      r.offset[row] =
+          (r.neighbour[0][row] * fx + r.neighbour[1][row] * fy) + r.neighbour[2][row] * fz;
     }
-    r.end_moving = static_cast<int>(moving_.size());
+    r.offset[3] = 0;
   }
 
-  // C_L passes of Gauss-Seidel tangential smoothing in ring order (each update sees the ones
-  // before it), on local copies of the positions:
-  //   q_i += alpha_L P_i (centroid_i - q_i).
-  // Vertex i - 1, just updated, is usually a neighbour of q_i; the update is split into
-  //   K_i = q_i + alpha_L P_i ((sum of the other neighbours) / count - q_i)
-  //   q_i = K_i + M_i q_{i-1},
-  // so that only the short matrix product waits for q_{i-1}, not the whole projection: this
-  // chain through the ring is what bounds the speed of the loop.
-  for (int it = 0; it < iterations; ++it) {
-    for (int i = 0; i < m; ++i) {
-      RingVertex& r = local_[i];
-      double sx = r.fixed_sum[0], sy = r.fixed_sum[1], sz = r.fixed_sum[2];
-      for (int k = r.first_moving; k < r.end_moving; ++k) {
-        const double* u = local_[moving_[k]].p;
-        sx += u[0];
-        sy += u[1];
-        sz += u[2];
-      }
-      const double lx = sx * r.inverse_count - r.p[0];
-      const double ly = sy * r.inverse_count - r.p[1];
-      const double lz = sz * r.inverse_count - r.p[2];
-      const double* d = r.direction;
-      const double dot = lx * d[0] + ly * d[1] + lz * d[2];
-      double tx, ty, tz;
-      if (r.border) {  // Along the border tangent.
-        tx = dot * d[0];
-        ty = dot * d[1];
-        tz = dot * d[2];
-      } else {  // Off the normal.
-        tx = lx - dot * d[0];
-        ty = ly - dot * d[1];
-        tz = lz - dot * d[2];
-      }
-      double kx = r.p[0] + alpha_l * tx;
-      double ky = r.p[1] + alpha_l * ty;
-      double kz = r.p[2] + alpha_l * tz;
-      if (r.has_previous) {
-        const double* u = local_[i == 0 ? m - 1 : i - 1].p;
-        const double(*w)[3] = r.previous_weight;
-        kx += w[0][0] * u[0] + w[0][1] * u[1] + w[0][2] * u[2];
-        ky += w[1][0] * u[0] + w[1][1] * u[1] + w[1][2] * u[2];
-        kz += w[2][0] * u[0] + w[2][1] * u[1] + w[2][2] * u[2];
-      }
-      r.p[0] = kx;
-      r.p[1] = ky;
-      r.p[2] = kz;
-    }
+  if (simd_) {
+    SmoothPassesAvx2(local_.data(), q_.data(), moving_.data(), m, iterations);
+  } else {
+    SmoothPassesScalar(local_.data(), q_.data(), moving_.data(), m, iterations);
   }
   for (int i = 0; i < m; ++i) {
     double* p = at(ring_[i]);
-    for (int c = 0; c < 3; ++c) p[c] = local_[i].p[c];
+    for (int c = 0; c < 3; ++c) p[c] = q_[i].v[c];
     slot_of_vertex_[ring_[i]] = -1;
   }
 }

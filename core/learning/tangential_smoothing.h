@@ -9,12 +9,15 @@
 //     q += alpha_L (L - (L . n_q) n_q)          n_q: area-weighted normal at q
 //   a boundary neighbour moves along its border instead: L is projected on the direction
 //   between its two boundary neighbours, so borders neither shrink nor fray.
-// Normals are computed once per call (the moves are small). Only the ring vertices move, so the
-// neighbours of a ring vertex that are not in the ring (the winner, the second ring) are summed
-// once per call, and the C_L passes read and write local copies of the ring's positions (in
-// the same order as in place: Gauss-Seidel, each update sees the ones before it). The
-// arithmetic is written on raw coordinates: OpenMesh's vector temporaries cost several times
-// more in this, the hottest loop.
+// Normals are computed once per call (the moves are small). With the normals fixed, each
+// update is affine in the positions:
+//   q_i <- A_i q_i + G_i (sum of the moving neighbours of q_i) + c_i
+//   A_i = I - alpha_L P_i,  G_i = alpha_L / count_i P_i,  c_i = G_i (sum of the others),
+// P_i the tangential projection (I - n n^T, or t t^T along a border), count_i the number of
+// neighbours the centroid averages. Only the ring vertices move, so the neighbours that are
+// not in the ring (the winner, the second ring) fold into c_i once per call, and the C_L
+// passes run on local copies of the ring's positions, in the same order as in place
+// (Gauss-Seidel: each update sees the ones before it).
 #ifndef NEURALMESH_CORE_LEARNING_TANGENTIAL_SMOOTHING_H_
 #define NEURALMESH_CORE_LEARNING_TANGENTIAL_SMOOTHING_H_
 
@@ -27,30 +30,40 @@ namespace neuralmesh {
 
 class OneRingSmoother {
  public:
+  // With `allow_simd`, the C_L passes run on AVX2 when the CPU has it, with bitwise the same
+  // results as without (false is for tests that compare the two).
+  explicit OneRingSmoother(bool allow_simd = true);
+
   // Smooths the 1-ring of `winner`, reading rings through `rings` (which the caller keeps
   // up to date with the connectivity). The vertices it moved (indices) are in moved()
   // afterwards.
   void Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle winner, double alpha_l,
               int iterations);
   const std::vector<int>& moved() const { return ring_; }
+  // Whether the passes run on AVX2.
+  bool simd() const { return simd_; }
+
+  // The affine update of one vertex of the winner's 1-ring; 3x3 matrices stored by columns,
+  // each padded to four lanes. (Public only for the scalar and SIMD passes in the .cc.)
+  struct alignas(32) RingVertex {
+    double own[3][4];        // A_i.
+    double neighbour[3][4];  // G_i, applied to the moving neighbours other than q_{i-1}.
+    double previous[3][4];   // G_i if q_{i-1} (just updated) is a neighbour, else zero.
+    double offset[4];        // c_i.
+    int first_moving;        // The other moving neighbours: moving_[first_moving, end_moving).
+    int end_moving;
+  };
+  struct alignas(32) Position {
+    double v[4];  // x, y, z, 0.
+  };
 
  private:
-  // A vertex of the winner's 1-ring while it is smoothed.
-  struct RingVertex {
-    double p[3];          // Its position, written back to the mesh at the end.
-    double direction[3];  // Unit normal, or unit border tangent.
-    double fixed_sum[3];  // The sum of its neighbours that do not move.
-    double previous_weight[3][3];  // M: how its update depends on the previous ring vertex.
-    double inverse_count;  // 1 / the number of neighbours its centroid averages.
-    int first_moving;      // Its other neighbours that move: moving_[first_moving, end_moving).
-    int end_moving;
-    bool has_previous;  // Whether the previous ring vertex is one of its neighbours.
-    bool border;
-  };
+  bool simd_;
   // Scratch storage reused across calls: the Basic Step allocates nothing.
   std::vector<int> ring_;
-  std::vector<RingVertex> local_;  // Parallel to ring_.
-  std::vector<int> moving_;        // Slots in ring_.
+  std::vector<RingVertex> local_;    // Parallel to ring_.
+  std::vector<Position> q_;          // Parallel to ring_: the positions being smoothed.
+  std::vector<int> moving_;          // Slots in ring_.
   std::vector<int> slot_of_vertex_;  // By vertex index: the slot in ring_, or -1 (between calls:
                                      // all -1).
 };

@@ -57,8 +57,8 @@ void ReferenceSmooth(Mesh& mesh, Mesh::VertexHandle winner, double alpha_l, int 
       centroid /= static_cast<double>(neighbours[i].size());
       const Vec3 l = centroid - mesh.point(ring[i]);
       const Vec3& d = direction[i];
-      const Vec3 t = mesh.is_boundary(ring[i]) ? OpenMesh::dot(l, d) * d
-                                               : l - OpenMesh::dot(l, d) * d;
+      const Vec3 t =
+          mesh.is_boundary(ring[i]) ? OpenMesh::dot(l, d) * d : l - OpenMesh::dot(l, d) * d;
       mesh.point(ring[i]) += alpha_l * t;
     }
   }
@@ -70,18 +70,19 @@ void Jitter(Mesh& mesh, double amount, uint64_t seed) {
   Random rng(seed);
   for (auto v : mesh.vertices()) {
     for (int c = 0; c < 3; ++c) {
-      mesh.point(v)[c] += amount * (2.0 * static_cast<double>(rng.NextIndex(1 << 20)) /
-                                        static_cast<double>(1 << 20) -
-                                    1.0);
+      mesh.point(v)[c] +=
+          amount *
+          (2.0 * static_cast<double>(rng.NextIndex(1 << 20)) / static_cast<double>(1 << 20) - 1.0);
     }
   }
 }
 
 // Smooths around many winners with OneRingSmoother and with the reference, and compares every
 // point after each call.
-void ExpectSameAsReference(Mesh mesh, double alpha_l, int iterations, const char* shape) {
+void ExpectSameAsReference(Mesh mesh, double alpha_l, int iterations, const char* shape,
+                           bool allow_simd = true) {
   Mesh reference = mesh;
-  OneRingSmoother smoother;
+  OneRingSmoother smoother(allow_simd);
   VertexRingCache rings;
   Random rng(11);
   for (int call = 0; call < 300; ++call) {
@@ -111,6 +112,50 @@ TEST(OneRingSmootherTest, MatchesThePlainInPlaceSmoothingAlongBorders) {
   Mesh mesh = MustToMesh(GridPatch(7, 6));
   Jitter(mesh, 0.1, 2);
   ExpectSameAsReference(mesh, 0.06, 5, "grid patch");
+}
+
+TEST(OneRingSmootherTest, ScalarPathMatchesThePlainInPlaceSmoothing) {
+  Mesh sphere = MustToMesh(Icosphere(2));
+  Jitter(sphere, 0.05, 1);
+  ExpectSameAsReference(sphere, 0.06, 5, "icosphere, scalar", /*allow_simd=*/false);
+  Mesh patch = MustToMesh(GridPatch(7, 6));
+  Jitter(patch, 0.1, 2);
+  ExpectSameAsReference(patch, 0.06, 5, "grid patch, scalar", /*allow_simd=*/false);
+}
+
+// A seed must give the same mesh whichever path the CPU takes: the SIMD and the scalar passes
+// agree to the last bit, over a long run in which their results feed back into later calls.
+TEST(OneRingSmootherTest, SimdAndScalarPathsGiveBitwiseTheSamePositions) {
+  OneRingSmoother simd(/*allow_simd=*/true);
+  OneRingSmoother scalar(/*allow_simd=*/false);
+  ASSERT_FALSE(scalar.simd()) << "allow_simd = false must select the scalar path";
+  if (!simd.simd()) GTEST_SKIP() << "this CPU has no AVX2: only the scalar path runs";
+  struct Case {
+    Mesh mesh;
+    const char* shape;
+  };
+  Case cases[] = {{MustToMesh(Icosphere(3)), "icosphere"}, {MustToMesh(GridPatch(9, 8)), "grid"}};
+  Jitter(cases[0].mesh, 0.05, 4);
+  Jitter(cases[1].mesh, 0.1, 5);
+  for (Case& c : cases) {
+    Mesh a = c.mesh;
+    Mesh b = c.mesh;
+    VertexRingCache rings_a;
+    VertexRingCache rings_b;
+    Random rng(12);
+    for (int call = 0; call < 2000; ++call) {
+      const Mesh::VertexHandle w(static_cast<int>(rng.NextIndex(a.n_vertices())));
+      simd.Smooth(a, rings_a, w, 0.06, 5);
+      scalar.Smooth(b, rings_b, w, 0.06, 5);
+    }
+    for (auto v : a.vertices()) {
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_EQ(a.point(v)[k], b.point(v)[k])
+            << c.shape << ": vertex " << v.idx() << " coordinate " << k
+            << " differs between the SIMD and the scalar path";
+      }
+    }
+  }
 }
 
 TEST(OneRingSmootherTest, LeavesTheWinnerAndEverythingOutsideItsRingAlone) {

@@ -34,7 +34,7 @@ absl::StatusOr<std::unique_ptr<ImplicitSurface>> MakeBuiltinSurface(absl::string
   const Vec3 origin(0, 0, 0);
   if (builtin->name == "sphere") return MakeSphere(origin, 1.0);
   if (builtin->name == "torus") return MakeTorus(origin, 1.0, 0.4);
-  return MakeGenusTwo(origin, 1.0, 0.1);
+  return MakeGenusTwo(origin, 1.0, 0.15);
 }
 
 absl::StatusOr<TriangleMesh> BuiltinReferenceMesh(absl::string_view input) {

@@ -1,7 +1,8 @@
 // End-to-end tests of the local subcommands of build/bin/neuralmesh (client/main.cc), run as
-// a subprocess: reconstruct, stats and eval on the built-in sphere.
+// a subprocess: reconstruct, stats and eval on the built-in shapes.
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
@@ -79,6 +80,24 @@ TEST_F(LocalCliTest, StatsReportsAClosedGenusZeroMeshOfTheRequestedSize) {
   EXPECT_EQ(JsonValue(stats.out, "closed"), "true") << stats.out;
   EXPECT_EQ(JsonValue(stats.out, "genus"), "0") << stats.out;
   EXPECT_EQ(JsonValue(stats.out, "boundary_loops"), "0") << stats.out;
+}
+
+// Issue 3's check through the command line: reconstructions of the torus and the genus-2
+// surface at 5,000 vertices, whose stats must report their genus and no boundary. Seed 1 (the
+// default); the acceptance scenarios in topology_learning_test cover seeds 1-10.
+TEST_F(LocalCliTest, StatsReportsTheGenusOfTorusAndGenusTwoReconstructions) {
+  for (const auto& [shape, genus] : {std::pair<std::string, std::string>{"torus", "1"},
+                                     std::pair<std::string, std::string>{"genus2", "2"}}) {
+    const std::string path = *dir_ + "/" + shape + ".ply";
+    const RunResult run =
+        RunNeuralmesh({"reconstruct", "builtin:" + shape, "-o", path, "--vertices", "5000"});
+    ASSERT_EQ(run.exit_code, 0) << run.Describe();
+    const RunResult stats = RunNeuralmesh({"stats", path, "--json"});
+    ASSERT_EQ(stats.exit_code, 0) << stats.Describe();
+    EXPECT_EQ(JsonValue(stats.out, "genus"), genus) << shape << ":\n" << stats.out;
+    EXPECT_EQ(JsonValue(stats.out, "boundary_loops"), "0") << shape << ":\n" << stats.out;
+    EXPECT_EQ(JsonValue(stats.out, "components"), "1") << shape << ":\n" << stats.out;
+  }
 }
 
 TEST_F(LocalCliTest, StatsPrintsTextByDefault) {

@@ -5,7 +5,7 @@
 // it joins them.
 //
 //   E <- E(Area) (given, or the mean area of the live faces)
-//   L <- the boundary loops of the mesh
+//   L <- the boundary loops of the mesh with at least min_loop_vertices vertices (3: all)
 //   for every pair (A, B) of loops:                                       (box prefilter first)
 //     H(A, B) <- symmetric Hausdorff distance of their VERTEX SETS         (Section 2.3)
 //     keep (A, B) if H(A, B) < alpha_m * sqrt(E)                           (Eq. 3)
@@ -43,9 +43,9 @@
 // component are often joined by edges) nor the same cross edge twice (possible only where it
 // wraps around; the loop not advanced by the first triangle is consumed last, which excludes
 // it). The dynamic program only walks through allowed states, so a strip is found whenever
-// one of this kind exists, and a pair is skipped, untouched, only when none does. Every step is then legal for OpenMesh: it uses one free boundary
-// half-edge of a loop, and cross edges that are either new or the free side of an earlier
-// one. Loops never share a vertex and have at least 3 vertices, since every boundary vertex
+// one of this kind exists, and a pair is skipped, untouched, only when none does. Every step
+// is then legal for OpenMesh: it uses one free boundary half-edge of a loop, and cross edges
+// that are either new or the free side of an earlier one. Loops never share a vertex and have at least 3 vertices, since every boundary vertex
 // of a valid mesh has exactly one boundary gap and there are no double edges.
 // Foldovers created by the strip are left to the learner's Laplacian smoothing (Section 2.3).
 //

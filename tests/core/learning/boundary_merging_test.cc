@@ -223,7 +223,8 @@ double WorstQualityAmong(const Mesh& mesh, const std::vector<Mesh::VertexHandle>
       p.push_back(mesh.point(c));
     }
     if (p.size() != 3) continue;
-    const double squares = (p[1] - p[0]).sqrnorm() + (p[2] - p[1]).sqrnorm() + (p[0] - p[2]).sqrnorm();
+    const double squares =
+        (p[1] - p[0]).sqrnorm() + (p[2] - p[1]).sqrnorm() + (p[0] - p[2]).sqrnorm();
     worst = std::min(worst, 2 * std::sqrt(3.0) * OpenMesh::cross(p[1] - p[0], p[2] - p[0]).norm() /
                                 squares);
   }

@@ -20,6 +20,14 @@ std::shared_ptr<const PointCloud> Line(int n, std::vector<float> weights = {}) {
   return std::make_shared<const PointCloud>(std::move(cloud));
 }
 
+// A sampler over Line(100), with equal weights when `weighted` (the weighted sampler's path).
+std::unique_ptr<Sampler> LineSampler(bool weighted) {
+  absl::StatusOr<std::unique_ptr<Sampler>> sampler =
+      MakePointCloudSampler(weighted ? Line(100, std::vector<float>(100, 2.0f)) : Line(100));
+  EXPECT_TRUE(sampler.ok()) << sampler.status();
+  return sampler.ok() ? std::move(sampler).value() : nullptr;
+}
+
 std::map<int, int> CountIndices(const Sampler& sampler, int draws, uint64_t seed) {
   Random rng(seed);
   std::map<int, int> counts;
@@ -71,13 +79,12 @@ TEST(PointCloudSamplerTest, MakePointCloudSamplerPicksWeightedWhenWeightsExist) 
 
 TEST(PointCloudSamplerTest, DeterministicForSeed) {
   for (bool weighted : {false, true}) {
-    absl::StatusOr<std::unique_ptr<Sampler>> sampler =
-        MakePointCloudSampler(weighted ? Line(100, std::vector<float>(100, 2.0f)) : Line(100));
-    ASSERT_TRUE(sampler.ok()) << sampler.status();
+    const std::unique_ptr<Sampler> sampler = LineSampler(weighted);
+    ASSERT_NE(sampler, nullptr);
     Random a(123);
     Random b(123);
     for (int i = 0; i < 1000; ++i) {
-      ASSERT_EQ((*sampler)->Sample(a), (*sampler)->Sample(b))
+      ASSERT_EQ(sampler->Sample(a), sampler->Sample(b))
           << "same seed, different sample " << i << " (weighted: " << weighted << ")";
     }
   }
@@ -85,14 +92,13 @@ TEST(PointCloudSamplerTest, DeterministicForSeed) {
 
 TEST(PointCloudSamplerTest, PrefetchingLeavesTheSequenceAlone) {
   for (bool weighted : {false, true}) {
-    absl::StatusOr<std::unique_ptr<Sampler>> sampler =
-        MakePointCloudSampler(weighted ? Line(100, std::vector<float>(100, 2.0f)) : Line(100));
-    ASSERT_TRUE(sampler.ok()) << sampler.status();
+    const std::unique_ptr<Sampler> sampler = LineSampler(weighted);
+    ASSERT_NE(sampler, nullptr);
     Random plain(7);
     Random prefetching(7);
     for (int i = 0; i < 1000; ++i) {
-      (*sampler)->PrefetchSample(prefetching);
-      ASSERT_EQ((*sampler)->Sample(plain), (*sampler)->Sample(prefetching))
+      sampler->PrefetchSample(prefetching);
+      ASSERT_EQ(sampler->Sample(plain), sampler->Sample(prefetching))
           << "prefetching changed sample " << i << " (weighted: " << weighted << ")";
     }
   }

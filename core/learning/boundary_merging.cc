@@ -168,38 +168,47 @@ std::optional<std::vector<Triangle>> PlanStrip(const Mesh& mesh, const VertexLoo
     return TriangleCost(point(vertex_c(k + 1)), point(vertex_c(k)), point(vertex_a(i)));
   };
   // For one choice of the first move: the least total cost of a walk from each state to
-  // (n, m), infinite where (n, m) cannot be reached.
-  auto cost_table = [&](bool a_first) {
+  // (n, m), infinite where (n, m) cannot be reached, and whether that walk advances on B next.
+  struct Walks {
+    std::vector<double> to_end;
+    std::vector<char> advance_b;
+  };
+  auto best_walks = [&](bool a_first) {
     auto allowed = [&](int i, int k) {
       if ((i == 0 && k == 0) || (i == n && k == m)) return true;
       if (linked[static_cast<size_t>(walk_a(i)) * m + walk_c(k)]) return false;
       if (a_first) return !(i == 0 || (k == m && i < n) || (i == n && k == 0));
       return !(k == 0 || (i == n && k < m) || (k == m && i == 0));
     };
-    std::vector<double> to_end((static_cast<size_t>(n) + 1) * width, kNoStrip);
+    const size_t states = (static_cast<size_t>(n) + 1) * width;
+    Walks walks{std::vector<double>(states, kNoStrip), std::vector<char>(states, 0)};
     for (int i = n; i >= 0; --i) {
       for (int k = m; k >= 0; --k) {
         if (!allowed(i, k)) continue;
-        double& best = to_end[i * width + k];
+        double& best = walks.to_end[i * width + k];
         if (i == n && k == m) {
           best = 0;
           continue;
         }
-        if (i < n && to_end[(i + 1) * width + k] < kNoStrip) {
-          best = std::min(best, cost_a(i, k) + to_end[(i + 1) * width + k]);
+        if (i < n && walks.to_end[(i + 1) * width + k] < kNoStrip) {
+          best = cost_a(i, k) + walks.to_end[(i + 1) * width + k];
         }
-        if (k < m && to_end[i * width + k + 1] < kNoStrip) {
-          best = std::min(best, cost_b(i, k) + to_end[i * width + k + 1]);
+        if (k < m && walks.to_end[i * width + k + 1] < kNoStrip) {
+          const double via_b = cost_b(i, k) + walks.to_end[i * width + k + 1];
+          if (via_b < best) {
+            best = via_b;
+            walks.advance_b[i * width + k] = 1;
+          }
         }
       }
     }
-    return to_end;
+    return walks;
   };
 
-  const std::vector<double> a_first = cost_table(true);
-  const std::vector<double> b_first = cost_table(false);
-  if (a_first[0] >= kNoStrip && b_first[0] >= kNoStrip) return std::nullopt;
-  const std::vector<double>& to_end = a_first[0] <= b_first[0] ? a_first : b_first;
+  const Walks a_first = best_walks(true);
+  const Walks b_first = best_walks(false);
+  if (a_first.to_end[0] >= kNoStrip && b_first.to_end[0] >= kNoStrip) return std::nullopt;
+  const Walks& walks = a_first.to_end[0] <= b_first.to_end[0] ? a_first : b_first;
 
   // Follow the cheapest walk.
   std::vector<Triangle> strip;
@@ -207,18 +216,12 @@ std::optional<std::vector<Triangle>> PlanStrip(const Mesh& mesh, const VertexLoo
   int i = 0;
   int k = 0;
   while (i < n || k < m) {
-    const double via_a =
-        i < n && to_end[(i + 1) * width + k] < kNoStrip ? cost_a(i, k) + to_end[(i + 1) * width + k]
-                                                        : kNoStrip;
-    const double via_b =
-        k < m && to_end[i * width + k + 1] < kNoStrip ? cost_b(i, k) + to_end[i * width + k + 1]
-                                                      : kNoStrip;
-    if (via_a <= via_b) {
-      strip.push_back({vertex_a(i), vertex_a(i + 1), vertex_c(k)});
-      ++i;
-    } else {
+    if (walks.advance_b[i * width + k]) {
       strip.push_back({vertex_c(k + 1), vertex_c(k), vertex_a(i)});
       ++k;
+    } else {
+      strip.push_back({vertex_a(i), vertex_a(i + 1), vertex_c(k)});
+      ++i;
     }
   }
   return strip;

@@ -63,8 +63,8 @@ ABSL_FLAG(bool, merge_boundaries, kLearnerDefaults.merge_boundaries,
 ABSL_FLAG(int32_t, splits_per_step, kLearnerDefaults.splits_per_step,
           "Vertex splits per call of Step 2 (Section 3.3), >= 1.");
 ABSL_FLAG(bool, close_small_holes, kLearnerDefaults.close_small_holes,
-          "Step 5: refill holes and slits whose filling passes Step 4's area test and bridges "
-          "no more than Step 5 would (--noclose_small_holes).");
+          "Step 5: refill holes, and zip slits in longer borders, where the filling passes "
+          "Step 4's area test and bridges no more than Step 5 would (--noclose_small_holes).");
 ABSL_FLAG(int32_t, max_closed_hole_vertices, kLearnerDefaults.max_closed_hole_vertices,
           "The largest boundary loop, in vertices, that close_small_holes refills, >= 3.");
 ABSL_FLAG(bool, merge_only_settled_boundaries, kLearnerDefaults.merge_only_settled_boundaries,
@@ -80,6 +80,10 @@ ABSL_FLAG(int32_t, sewn_strip_grace_calls, kLearnerDefaults.sewn_strip_grace_cal
 ABSL_FLAG(int32_t, min_merged_loop_vertices, kLearnerDefaults.min_merged_loop_vertices,
           "Step 5 merges only boundary loops of at least this many vertices, in [3, 1000]; 3 "
           "is the paper's rule.");
+ABSL_FLAG(bool, cut_inactive_faces, kLearnerDefaults.cut_inactive_faces,
+          "After Step 4: cut out faces over no data that Steps 3 and 4 cannot remove, a "
+          "bridge between two holes and the faces of a border vertex Step 3 could not "
+          "collapse (--nocut_inactive_faces).");
 
 // Local learning.
 ABSL_FLAG(std::string, sampling, "uniform",
@@ -147,6 +151,7 @@ neuralmesh::LearnerOptions LearnerFromFlags() {
       absl::GetFlag(FLAGS_split_largest_cell_near_most_active);
   o.sewn_strip_grace_calls = absl::GetFlag(FLAGS_sewn_strip_grace_calls);
   o.min_merged_loop_vertices = absl::GetFlag(FLAGS_min_merged_loop_vertices);
+  o.cut_inactive_faces = absl::GetFlag(FLAGS_cut_inactive_faces);
   o.seed = absl::GetFlag(FLAGS_seed);
   return o;
 }
@@ -251,7 +256,8 @@ std::vector<Subcommand> Commands() {
       "alpha_sc", "alpha_r", "alpha_m", "remove_triangles", "merge_boundaries",
       "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
-      "sewn_strip_grace_calls", "min_merged_loop_vertices", "sampling", "time_budget",
+      "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "sampling",
+      "time_budget",
       "max_steps", "quantization_bits", "encode_speed", "progress", "server", "out-dir",
       "batch-size", "points", "ply", "connect_timeout"};
   // clang-format on

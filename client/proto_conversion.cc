@@ -23,6 +23,7 @@ v1::LearnerOptions ToProto(const LearnerOptions& options) {
       options.split_largest_cell_near_most_active);
   proto.mutable_sewn_strip_grace_calls()->set_value(options.sewn_strip_grace_calls);
   proto.mutable_min_merged_loop_vertices()->set_value(options.min_merged_loop_vertices);
+  proto.mutable_cut_inactive_faces()->set_value(options.cut_inactive_faces);
   proto.mutable_seed()->set_value(options.seed);
   return proto;
 }

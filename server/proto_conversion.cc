@@ -60,6 +60,7 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
   if (l.has_min_merged_loop_vertices()) {
     o.min_merged_loop_vertices = l.min_merged_loop_vertices().value();
   }
+  if (l.has_cut_inactive_faces()) o.cut_inactive_faces = l.cut_inactive_faces().value();
 
   config.target_vertices = proto.target_vertices();
   config.lod_milestones.assign(proto.lod_milestones().begin(), proto.lod_milestones().end());
@@ -122,6 +123,7 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
       o.split_largest_cell_near_most_active);
   l.mutable_sewn_strip_grace_calls()->set_value(o.sewn_strip_grace_calls);
   l.mutable_min_merged_loop_vertices()->set_value(o.min_merged_loop_vertices);
+  l.mutable_cut_inactive_faces()->set_value(o.cut_inactive_faces);
 
   proto.set_target_vertices(config.target_vertices);
   for (size_t m : config.lod_milestones) proto.add_lod_milestones(m);

@@ -1,8 +1,10 @@
 #include "core/learning/hole_closing.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -13,9 +15,15 @@ namespace {
 
 using VertexLoop = std::vector<Mesh::VertexHandle>;
 
+// Slits (ZipBorderSlits): the chains considered, and the work bounds per call.
+constexpr size_t kMaxSlitChainEdges = 48;
+constexpr double kMinSlitPathToChord = 3;
+constexpr size_t kMaxSlitCandidatesPerLoop = 8;
+constexpr size_t kMaxSlitZipsPerCall = 64;
+
 // The boundary loops with at most `max_vertices` vertices, each as the from-vertices of its
 // boundary half-edges in half-edge order (loop[i] -> loop[i + 1] is a boundary half-edge).
-std::vector<VertexLoop> CollectSmallLoops(const Mesh& mesh, size_t max_vertices) {
+std::vector<VertexLoop> CollectLoops(const Mesh& mesh, size_t max_vertices) {
   std::vector<VertexLoop> loops;
   std::vector<bool> visited(mesh.n_halfedges(), false);
   for (auto start : mesh.halfedges()) {
@@ -41,8 +49,13 @@ double Area(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
 // satisfies the constraints.
 class LoopTriangulation {
  public:
-  LoopTriangulation(const Mesh& mesh, const VertexLoop& loop, double max_area, double max_edge)
+  // `closed`: the side loop[n-1] -> loop[0] is a boundary half-edge (a whole loop is filled).
+  // Otherwise `loop` is a chain of boundary half-edges and that side is a new edge, which
+  // becomes a boundary edge (a slit is zipped).
+  LoopTriangulation(const Mesh& mesh, const VertexLoop& loop, double max_area, double max_edge,
+                    bool closed = true)
       : mesh_(mesh),
+        closed_(closed),
         loop_(loop),
         n_(loop.size()),
         max_area_(max_area),
@@ -58,7 +71,7 @@ class LoopTriangulation {
     for (size_t span = 2; span < n_; ++span) {
       for (size_t i = 0; i + span < n_; ++i) {
         const size_t j = i + span;
-        const bool outer = (i == 0 && j == n_ - 1);  // The side loop[n-1] -> loop[0].
+        const bool outer = closed_ && i == 0 && j == n_ - 1;  // loop[n-1] -> loop[0].
         double chord = 0;
         if (!outer && !ChordAllowed(i, j, &chord)) continue;
         for (size_t m = i + 1; m < j; ++m) {
@@ -106,7 +119,7 @@ class LoopTriangulation {
     if (Area(mesh_.point(loop_[i]), mesh_.point(loop_[m]), mesh_.point(loop_[j])) > max_area_) {
       return false;
     }
-    if (n_ == 3) {
+    if (n_ == 3 && closed_) {
       for (const auto& v : loop_) {
         if (mesh_.valence(v) < 3) return false;
       }
@@ -115,12 +128,14 @@ class LoopTriangulation {
     if (m == i + 1 && j == m + 1 && mesh_.valence(loop_[m]) < 3) return false;
     // The ears that wrap around the outer side: loop[0] between loop[n-1] and loop[1], and
     // loop[n-1] between loop[n-2] and loop[0].
+    if (!closed_) return true;
     if (i == 0 && m == 1 && j == n_ - 1 && mesh_.valence(loop_[0]) < 3) return false;
     if (i == 0 && m == n_ - 2 && j == n_ - 1 && mesh_.valence(loop_[n_ - 1]) < 3) return false;
     return true;
   }
 
   const Mesh& mesh_;
+  const bool closed_;
   const VertexLoop& loop_;
   const size_t n_;
   const double max_area_;
@@ -129,14 +144,34 @@ class LoopTriangulation {
   std::vector<int> apex_;
 };
 
+// Whether a filling triangle lies folded back over the face across one of its chain edges
+// (their normals point apart): the chain then went round a tongue of the mesh, not a slit.
+bool FoldsOver(const Mesh& mesh, const VertexLoop& chain,
+               const std::vector<std::array<size_t, 3>>& triangles) {
+  for (const auto& t : triangles) {
+    const Vec3 n = OpenMesh::cross(mesh.point(chain[t[1]]) - mesh.point(chain[t[0]]),
+                                   mesh.point(chain[t[2]]) - mesh.point(chain[t[0]]));
+    for (int k = 0; k < 3; ++k) {
+      const size_t a = t[k], b = t[(k + 1) % 3];
+      if (b != a + 1) continue;  // Not a chain edge.
+      const auto h = mesh.find_halfedge(chain[a], chain[b]);  // The boundary half-edge.
+      const auto across = mesh.opposite_face_handle(h);
+      if (across.is_valid() && OpenMesh::dot(n, mesh.calc_face_normal(across)) <= 0) return true;
+    }
+  }
+  return false;
+}
+
 // Fills `loop` with its admissible triangulation of least total new-edge length; returns the
 // number of faces added, 0 when there is none (the mesh is then unchanged).
-size_t FillLoop(Mesh& mesh, const VertexLoop& loop, double max_area, double max_edge) {
+size_t FillLoop(Mesh& mesh, const VertexLoop& loop, double max_area, double max_edge,
+                bool closed = true) {
   if (loop.size() < 3) return 0;
-  LoopTriangulation triangulation(mesh, loop, max_area, max_edge);
+  LoopTriangulation triangulation(mesh, loop, max_area, max_edge, closed);
   if (triangulation.Solve() >= LoopTriangulation::kInfeasible) return 0;
   std::vector<std::array<size_t, 3>> triangles;
   triangulation.Triangles(0, loop.size() - 1, triangles);
+  if (!closed && FoldsOver(mesh, loop, triangles)) return 0;
   std::vector<Mesh::FaceHandle> added;
   for (const auto& t : triangles) {
     // Loop order is the order of the boundary half-edges, so (i, m, j) continues the
@@ -152,6 +187,51 @@ size_t FillLoop(Mesh& mesh, const VertexLoop& loop, double max_area, double max_
     added.push_back(fh);
   }
   return added.size();
+}
+
+// The chains of `loop` that may close a slit, most slit-like first: for each start, the chain
+// of at least 3 and at most kMaxSlitChainEdges edges (and at most half the loop) whose ends
+// are at most max_edge apart and whose chord is the smallest share of its path, if that share
+// is at most 1 / kMinSlitPathToChord. Along a smooth border the path is barely longer than the
+// chord; across the mouth of a slit it is many times longer, and the mouth is where the share
+// is smallest.
+std::vector<VertexLoop> SlitCandidates(const Mesh& mesh, const VertexLoop& loop,
+                                       double max_edge) {
+  const size_t n = loop.size();
+  const size_t max_k = std::min(kMaxSlitChainEdges, n / 2);
+  std::vector<double> edge(n);
+  for (size_t i = 0; i < n; ++i) {
+    edge[i] = (mesh.point(loop[(i + 1) % n]) - mesh.point(loop[i])).norm();
+  }
+  struct Candidate {
+    double share;  // chord / path.
+    size_t start;
+    size_t edges;
+  };
+  std::vector<Candidate> candidates;
+  for (size_t i = 0; i < n; ++i) {
+    double path = 0;
+    Candidate best = {1.0 / kMinSlitPathToChord, i, 0};
+    for (size_t k = 1; k <= max_k; ++k) {
+      path += edge[(i + k - 1) % n];
+      const double chord = (mesh.point(loop[(i + k) % n]) - mesh.point(loop[i])).norm();
+      if (k >= 3 && chord <= max_edge && path > 0 && chord / path <= best.share) {
+        best = {chord / path, i, k};
+      }
+    }
+    if (best.edges > 0) candidates.push_back(best);
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.share != b.share ? a.share < b.share : a.start < b.start;
+  });
+  if (candidates.size() > kMaxSlitCandidatesPerLoop) candidates.resize(kMaxSlitCandidatesPerLoop);
+  std::vector<VertexLoop> chains;
+  for (const Candidate& c : candidates) {
+    VertexLoop chain;
+    for (size_t step = 0; step <= c.edges; ++step) chain.push_back(loop[(c.start + step) % n]);
+    chains.push_back(std::move(chain));
+  }
+  return chains;
 }
 
 }  // namespace
@@ -175,7 +255,7 @@ absl::Status HoleClosingOptions::Validate() const {
 HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options, double mean_area) {
   HoleClosingResult result;
   const std::vector<VertexLoop> loops =
-      CollectSmallLoops(mesh, static_cast<size_t>(options.max_loop_vertices));
+      CollectLoops(mesh, static_cast<size_t>(options.max_loop_vertices));
   if (loops.empty()) return result;
   if (mean_area <= 0) mean_area = MeanTriangleArea(mesh);
   const double max_area = options.alpha_r * mean_area;
@@ -186,6 +266,32 @@ HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options,
     if (added == 0) continue;
     ++result.closed_holes;
     result.added_faces += added;
+  }
+  return result;
+}
+
+HoleClosingResult ZipBorderSlits(Mesh& mesh, const HoleClosingOptions& options,
+                                 double mean_area) {
+  HoleClosingResult result;
+  if (mean_area <= 0) mean_area = MeanTriangleArea(mesh);
+  const double max_area = options.alpha_r * mean_area;
+  const double max_edge = options.alpha_m * std::sqrt(mean_area);
+  if (!(max_area > 0)) return result;
+  // Each zip changes the loops, so they are collected again after it.
+  for (size_t zips = 0; zips < kMaxSlitZipsPerCall; ++zips) {
+    bool zipped = false;
+    for (const VertexLoop& loop : CollectLoops(mesh, std::numeric_limits<size_t>::max())) {
+      for (const VertexLoop& chain : SlitCandidates(mesh, loop, max_edge)) {
+        const size_t added = FillLoop(mesh, chain, max_area, max_edge, /*closed=*/false);
+        if (added == 0) continue;
+        ++result.closed_holes;
+        result.added_faces += added;
+        zipped = true;
+        break;
+      }
+      if (zipped) break;
+    }
+    if (!zipped) break;
   }
   return result;
 }

@@ -28,6 +28,16 @@
 // large again, so the rule cannot fight the paper's steps; it only removes loops that would
 // otherwise be stuck.
 //
+// Slits in longer loops (ZipBorderSlits): Step 4 can also cut a slit into a border, two sides
+// about an edge apart running several edges into the data (hemisphere scenario of
+// topology_learning_test: notches 3 to 5 edge lengths deep that stayed to the end). It is part
+// of the border's loop, so CloseSmallHoles never sees it, and Step 5 merges different loops
+// only. A stretch of a loop whose ends lie within alpha_m sqrt(E) of each other while the loop
+// runs at least 3 times as far between them is filled as a hole whose last side is the new edge
+// between its ends; a smooth border never qualifies (its path is barely longer than its chords).
+// The fill is refused when a filling triangle folds back over the face across a chain edge
+// (their normals point apart): the chain then went round a tongue of the mesh, not a slit.
+//
 // Legality: no new edge may exist yet (no double edge, which also excludes closing a loop of 3
 // vertices that bounds a single face on the other side); a vertex that gets no new edge (an
 // ear tip, or each corner of a loop of 3) becomes interior and must have valence >= 3. The
@@ -72,6 +82,17 @@ struct HoleClosingResult {
 // collection, never adds or removes a vertex. O(h) to find the loops plus O(k^3) per loop of k
 // vertices.
 HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options, double mean_area);
+
+// Zips slits in boundary loops of any length (see the file comment): repeatedly, the most
+// slit-like chain of a loop (the smallest ratio of the distance between its ends to its length,
+// at most 1/3, ends at most alpha_m sqrt(E(Area)) apart, 3 to 48 edges and at most half the
+// loop) is filled by the same admissible triangulation as a small hole, with the chord between
+// its ends as the new boundary edge, unless a filling triangle would fold back over the face
+// across a chain edge. HoleClosingResult counts zipped slits as closed holes. `mean_area` and
+// `options` as for CloseSmallHoles. O(h) per zip to find the loops plus O(n * 48) per loop of n
+// vertices and O(48^3) per tried chain; at most 64 zips per call.
+HoleClosingResult ZipBorderSlits(Mesh& mesh, const HoleClosingOptions& options,
+                                 double mean_area);
 
 }  // namespace neuralmesh
 

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/learning/boundary_merging.h"
+#include "core/learning/inactive_face_removal.h"
 #include "core/learning/half_edge_collapse.h"
 #include "core/learning/initial_mesh.h"
 #include "core/learning/morton_vertex_order.h"
@@ -208,6 +209,26 @@ class Learner::Impl {
       progress_.removed_triangles += removed.removed_faces;
       mean_area = removed.mean_area;
       if (options_.merge_only_settled_boundaries) growing = removed.touched_vertices;
+      // Inactive: not a winner since the last call of Step 3 (inactive_face_removal.h).
+      const uint64_t since = last_connectivity_step_;
+      auto inactive = [this, since](Mesh::VertexHandle v) {
+        return mesh_.property(last_win_, v) <= since;
+      };
+      std::vector<Mesh::VertexHandle>* grown =
+          options_.merge_only_settled_boundaries ? &growing : nullptr;
+      if (options_.cut_inactive_faces) {
+        const BridgeCuttingResult cut = CutInactiveBridges(mesh_, inactive);
+        progress_.cut_bridges += cut.cut_bridges;
+        if (grown) {
+          grown->insert(grown->end(), cut.touched_vertices.begin(), cut.touched_vertices.end());
+        }
+        std::vector<Mesh::VertexHandle> gone;
+        for (auto v : stuck_border_vertices_) {
+          if (mesh_.status(v).deleted() || !inactive(v)) continue;
+          if (CutOutBorderVertex(mesh_, v, &gone, grown)) ++progress_.cut_out_border_vertices;
+        }
+        for (auto v : gone) ForgetVertex(v);
+      }
       timings_.removal += Since(t0);
     }
     if (options_.merge_boundaries) {
@@ -216,6 +237,7 @@ class Learner::Impl {
       merging.alpha_m = options_.alpha_m;
       merging.min_loop_vertices = static_cast<size_t>(options_.min_merged_loop_vertices);
       merging.close_small_holes = options_.close_small_holes;
+      merging.zip_border_slits = options_.close_small_holes;
       merging.hole_closing.alpha_r = options_.alpha_r;
       merging.hole_closing.alpha_m = options_.alpha_m;
       merging.hole_closing.max_loop_vertices = options_.max_closed_hole_vertices;
@@ -235,13 +257,17 @@ class Learner::Impl {
   }
 
   void CollapseInactive() {
+    stuck_border_vertices_.clear();
     const size_t n = mesh_.n_vertices();
     for (size_t i = 0; i < n; ++i) {
       const Mesh::VertexHandle v(static_cast<int>(i));
       if (mesh_.status(v).deleted()) continue;
       if (mesh_.property(last_win_, v) > last_connectivity_step_) continue;
       const Mesh::HalfedgeHandle h = BestCollapse(mesh_, v, live_vertices_);
-      if (!h.is_valid()) continue;
+      if (!h.is_valid()) {
+        if (mesh_.is_boundary(v)) stuck_border_vertices_.push_back(v);
+        continue;
+      }
       mesh_.collapse(h);
       ForgetVertex(v);
       ++progress_.collapses;
@@ -290,6 +316,8 @@ class Learner::Impl {
   OpenMesh::VPropHandleT<uint64_t> last_win_;
   // The last call of Step 4 that spares this vertex's faces (sewn_strip_grace_calls).
   OpenMesh::VPropHandleT<uint64_t> spared_until_;
+  // Inactive boundary vertices that Step 3 could not collapse in this call.
+  std::vector<Mesh::VertexHandle> stuck_border_vertices_;
   uint64_t step_ = 0;
   uint64_t last_connectivity_step_ = 0;
   uint64_t next_connectivity_step_ = 0;

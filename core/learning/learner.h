@@ -43,6 +43,10 @@ struct LearnerProgress {
   uint64_t collapses = 0;
   uint64_t removed_triangles = 0;
   uint64_t merged_boundaries = 0;
+  // Right after Step 4 (inactive_face_removal.h): bridges cut between two holes, and border
+  // vertices that Step 3 could not collapse cut out with their faces.
+  uint64_t cut_bridges = 0;
+  uint64_t cut_out_border_vertices = 0;
   uint64_t connectivity_calls = 0;  // Calls of Step 3 (each followed by Steps 4 and 5).
 };
 

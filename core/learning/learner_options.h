@@ -47,12 +47,22 @@ struct LearnerOptions {
   // triangles Step 4 would keep (area <= alpha_r E(Area)) and edges no longer than Step 5
   // bridges (alpha_m sqrt(E(Area))), so holes and slits cut while the geometry was still
   // converging do not stay forever nor get sewn into extra handles (Section 1: no topological
-  // noise). Real borders and holes are wider than that and stay open.
+  // noise). Real borders and holes are wider than that and stay open. Slits in a longer loop
+  // are zipped the same way (ZipBorderSlits): a stretch of border whose ends lie within
+  // alpha_m sqrt(E(Area)) while the border between them is at least 3 times as long.
   bool close_small_holes = true;
   int max_closed_hole_vertices = 256;  // >= 3: longer loops are never closed (O(k^3) work).
   // Not in the paper (boundary_merging.h): Step 5 leaves alone a loop that Step 4 has cut into
   // in the same call; it is merged once it has stopped growing, i.e. reached the data.
   bool merge_only_settled_boundaries = true;
+  // Not in the paper (inactive_face_removal.h): right after Step 4, faces over no data that
+  // Steps 3 and 4 can never remove are cut out, judged as Step 3 judges vertices (no win since
+  // its last call): a bridge of two triangles between two holes (holes opened side by side in
+  // a membrane otherwise never join, since removing either triangle alone pinches a vertex),
+  // and the faces of a border vertex that Step 3 could not collapse (a border vertex moves only
+  // when it wins, so one on a flap folded under the surface never moves nor collapses, and the
+  // border keeps a notch in the data).
+  bool cut_inactive_faces = true;
   // Not in the paper: for this many calls of Step 4 after Step 5 sewed a strip, the faces
   // around the strip's vertices (and the vertices split from them) are not removed. A fresh
   // strip is a thin tube that the Basic Step still has to widen onto the data; its faces

@@ -26,6 +26,7 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   options.split_largest_cell_near_most_active = false;
   options.sewn_strip_grace_calls = 0;
   options.min_merged_loop_vertices = 5;
+  options.cut_inactive_faces = false;
   const v1::LearnerOptions proto = ToProto(options);
   EXPECT_EQ(proto.alpha_w().value(), 0.1);
   EXPECT_EQ(proto.alpha_l().value(), 0.2);
@@ -51,6 +52,8 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   ASSERT_TRUE(proto.has_sewn_strip_grace_calls()) << "0 must be sent, not left unset";
   EXPECT_EQ(proto.sewn_strip_grace_calls().value(), 0);
   EXPECT_EQ(proto.min_merged_loop_vertices().value(), 5);
+  ASSERT_TRUE(proto.has_cut_inactive_faces());
+  EXPECT_FALSE(proto.cut_inactive_faces().value());
 }
 
 TEST(ClientProtoConversionTest, DracoSpeedBecomesCompressionSpeed) {

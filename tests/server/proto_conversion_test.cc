@@ -109,6 +109,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   proto.mutable_learner()->mutable_split_largest_cell_near_most_active()->set_value(false);
   proto.mutable_learner()->mutable_sewn_strip_grace_calls()->set_value(0);
   proto.mutable_learner()->mutable_min_merged_loop_vertices()->set_value(3);
+  proto.mutable_learner()->mutable_cut_inactive_faces()->set_value(false);
   proto.mutable_refresh_interval_ms()->set_value(0);
   proto.mutable_draco()->mutable_position_quantization_bits()->set_value(14);
   config = SessionConfigFromProto(proto);
@@ -118,6 +119,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_FALSE(config->learner.split_largest_cell_near_most_active);
   EXPECT_EQ(config->learner.sewn_strip_grace_calls, 0) << "0 is the paper's rule, not unset";
   EXPECT_EQ(config->learner.min_merged_loop_vertices, 3);
+  EXPECT_FALSE(config->learner.cut_inactive_faces);
   EXPECT_EQ(config->refresh_interval, absl::ZeroDuration()) << "0 turns refreshes off";
   EXPECT_EQ(config->draco.position_quantization_bits, 14);
 
@@ -130,6 +132,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_FALSE(again->learner.split_largest_cell_near_most_active);
   EXPECT_EQ(again->learner.sewn_strip_grace_calls, 0);
   EXPECT_EQ(again->learner.min_merged_loop_vertices, 3);
+  EXPECT_FALSE(again->learner.cut_inactive_faces);
   EXPECT_EQ(again->draco.position_quantization_bits, 14);
 }
 

@@ -174,5 +174,55 @@ TEST(HoleClosingTest, LoopAroundASingleTriangleIsNotDoubled) {
   EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
 }
 
+TEST(HoleClosingTest, SlitInABorderIsZipped) {
+  // A slit one edge wide and ten deep, cut into the bottom border of a 20 x 20 grid (edge
+  // 0.05): part of the one border loop, so CloseSmallHoles cannot fill it, but its mouth is
+  // one edge across while the border runs 21 edges round it.
+  Mesh mesh = MustToMesh(GridPatch(20, 20));
+  const double mean_area = MeanTriangleArea(mesh);
+  CutFaces(mesh, Vec3(0.525, 0, 0),
+           [](const Vec3& c) { return c[0] > 0.5 && c[0] < 0.55 && c[1] < 0.5; });
+  ASSERT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({100}));
+  EXPECT_EQ(CloseSmallHoles(mesh, HoleClosingOptions{}, mean_area).closed_holes, 0u);
+
+  const HoleClosingResult result = ZipBorderSlits(mesh, HoleClosingOptions{}, mean_area);
+
+  EXPECT_EQ(result.closed_holes, 1u);
+  EXPECT_EQ(result.added_faces, 20u) << "the slit's 22 vertices take 20 triangles";
+  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({80})) << "the square's border again";
+  EXPECT_EQ(EulerCharacteristic(mesh), 1) << "still a disc";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+  for (auto fh : mesh.faces()) {
+    EXPECT_GT(mesh.calc_face_normal(fh)[2], 0) << "every face keeps the grid's orientation";
+  }
+}
+
+TEST(HoleClosingTest, StraightBordersAndTonguesAreNotZipped) {
+  Mesh square = MustToMesh(GridPatch(4, 4));
+  EXPECT_EQ(ZipBorderSlits(square, HoleClosingOptions{}, 0).closed_holes, 0u)
+      << "a border whose path is never 3 times its chord has no slit";
+  EXPECT_EQ(BoundaryLoopSizes(square), std::vector<size_t>({16}));
+
+  // A tongue one edge wide standing out of the upper half of the grid: the border runs round
+  // it as round a slit, but the chain's empty side is outside it, and filling the chain
+  // would fold triangles back over the tongue.
+  const TriangleMesh grid = GridPatch(20, 20);
+  TriangleMesh with_tongue;
+  with_tongue.positions = grid.positions;
+  for (const auto& f : grid.faces) {
+    Vec3 c(0, 0, 0);
+    for (uint32_t v : f) c += Vec3(grid.positions[v][0], grid.positions[v][1], 0) / 3.0;
+    if (c[1] < 0.5 || (c[0] > 0.5 && c[0] < 0.55)) with_tongue.faces.push_back(f);
+  }
+  Mesh mesh = MustToMesh(with_tongue);
+  const double mean_area = MeanTriangleArea(mesh);
+  const std::vector<size_t> loops = BoundaryLoopSizes(mesh);
+  ASSERT_EQ(loops.size(), 1u);
+  const size_t faces = mesh.n_faces();
+  EXPECT_EQ(ZipBorderSlits(mesh, HoleClosingOptions{}, mean_area).closed_holes, 0u);
+  EXPECT_EQ(BoundaryLoopSizes(mesh), loops);
+  EXPECT_EQ(mesh.n_faces(), faces) << "a rejected zip leaves no face behind";
+}
+
 }  // namespace
 }  // namespace neuralmesh

@@ -54,7 +54,7 @@
 // would keep are closed again (CloseSmallHoles, hole_closing.h, which gives the reasons), so
 // that only real boundaries are merged and two tiny holes cut while the geometry was still
 // converging are never sewn into a spurious handle. Slits in a border are zipped the same way
-// (ZipBorderSlits, LearnerOptions::zip_border_slits).
+// (ZipBorderSlits; the learner turns it on with close_small_holes).
 #ifndef NEURALMESH_CORE_LEARNING_BOUNDARY_MERGING_H_
 #define NEURALMESH_CORE_LEARNING_BOUNDARY_MERGING_H_
 

@@ -126,9 +126,9 @@ class LoopTriangulation {
       return true;
     }
     if (m == i + 1 && j == m + 1 && mesh_.valence(loop_[m]) < 3) return false;
+    if (!closed_) return true;  // A chain's ends stay on the border.
     // The ears that wrap around the outer side: loop[0] between loop[n-1] and loop[1], and
     // loop[n-1] between loop[n-2] and loop[0].
-    if (!closed_) return true;
     if (i == 0 && m == 1 && j == n_ - 1 && mesh_.valence(loop_[0]) < 3) return false;
     if (i == 0 && m == n_ - 2 && j == n_ - 1 && mesh_.valence(loop_[n_ - 1]) < 3) return false;
     return true;

@@ -7,8 +7,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/learning/boundary_merging.h"
-#include "core/learning/inactive_face_removal.h"
 #include "core/learning/half_edge_collapse.h"
+#include "core/learning/inactive_face_removal.h"
 #include "core/learning/initial_mesh.h"
 #include "core/learning/morton_vertex_order.h"
 #include "core/learning/signal_counters.h"

@@ -117,6 +117,13 @@ void CutFaces(Mesh& mesh, const Vec3& start, const std::function<bool(const Vec3
   }
 }
 
+// A 20 x 20 grid is one valid disc again: its 80-edge border is the only loop left.
+void ExpectWholeGrid(const Mesh& mesh) {
+  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({80})) << "only the border is left";
+  EXPECT_EQ(EulerCharacteristic(mesh), 1) << "a disc again";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
 TEST(HoleClosingTest, LongThinSlitIsZipped) {
   // A row of faces cut across most of a 20 x 20 grid: one loop of 36 vertices, one edge wide.
   // Step 5 cannot merge it (it joins two loops); closing zips it with ordinary triangles.
@@ -128,9 +135,7 @@ TEST(HoleClosingTest, LongThinSlitIsZipped) {
   const HoleClosingResult result = CloseSmallHoles(mesh, HoleClosingOptions{}, mean_area);
   EXPECT_EQ(result.closed_holes, 1u);
   EXPECT_EQ(result.added_faces, 32u) << "a loop of k vertices takes k - 2 triangles";
-  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({80})) << "only the border is left";
-  EXPECT_EQ(EulerCharacteristic(mesh), 1) << "a disc again";
-  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+  ExpectWholeGrid(mesh);
   for (auto fh : mesh.faces()) {
     EXPECT_LE(mesh.calc_face_area(fh), 7 * mean_area) << "a filling triangle Step 4 would cut";
   }
@@ -189,9 +194,7 @@ TEST(HoleClosingTest, SlitInABorderIsZipped) {
 
   EXPECT_EQ(result.closed_holes, 1u);
   EXPECT_EQ(result.added_faces, 20u) << "the slit's 22 vertices take 20 triangles";
-  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({80})) << "the square's border again";
-  EXPECT_EQ(EulerCharacteristic(mesh), 1) << "still a disc";
-  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+  ExpectWholeGrid(mesh);
   for (auto fh : mesh.faces()) {
     EXPECT_GT(mesh.calc_face_normal(fh)[2], 0) << "every face keeps the grid's orientation";
   }

@@ -35,6 +35,7 @@ class BoundaryLoops {
   }
 
   void Join(int a, int b) { parent_[Find(a)] = Find(b); }
+  size_t count() const { return parent_.size(); }  // Loops found, joins not subtracted.
 
  private:
   int Find(int loop) {
@@ -112,6 +113,7 @@ BridgeCuttingResult CutInactiveBridges(
     Mesh& mesh, const std::function<bool(Mesh::VertexHandle)>& inactive) {
   BridgeCuttingResult result;
   BoundaryLoops loops(mesh);
+  if (loops.count() < 2) return result;  // A closed mesh or a single border: nothing to join.
   const size_t num_edges = mesh.n_edges();  // Cuts only delete edges.
   for (size_t i = 0; i < num_edges; ++i) {
     const Mesh::EdgeHandle e(static_cast<int>(i));

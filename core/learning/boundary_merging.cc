@@ -12,39 +12,32 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/learning/boundary_loops.h"
 #include "core/learning/triangle_removal.h"
 
 namespace neuralmesh {
 namespace {
 
-using VertexLoop = std::vector<Mesh::VertexHandle>;
 using Triangle = std::array<Mesh::VertexHandle, 3>;
 
+// A boundary loop with its bounding box.
 struct BoundaryLoop {
-  // The from-vertex of each boundary half-edge, in half-edge order: vertices[i] ->
-  // vertices[i + 1] is a boundary half-edge.
-  VertexLoop vertices;
+  VertexLoop vertices;  // In half-edge order (boundary_loops.h).
   Vec3 box_min;
   Vec3 box_max;
 };
 
-std::vector<BoundaryLoop> CollectBoundaryLoops(const Mesh& mesh) {
+std::vector<BoundaryLoop> LoopsWithBoxes(const Mesh& mesh) {
   std::vector<BoundaryLoop> loops;
-  std::vector<bool> visited(mesh.n_halfedges(), false);
-  for (auto start : mesh.halfedges()) {
-    if (visited[start.idx()] || !mesh.is_boundary(start)) continue;
+  for (VertexLoop& vertices : CollectBoundaryLoops(mesh)) {
     BoundaryLoop loop;
     loop.box_min = Vec3(std::numeric_limits<double>::infinity());
     loop.box_max = Vec3(-std::numeric_limits<double>::infinity());
-    auto h = start;
-    do {
-      visited[h.idx()] = true;
-      const auto vh = mesh.from_vertex_handle(h);
-      loop.vertices.push_back(vh);
+    for (auto vh : vertices) {
       loop.box_min.minimize(mesh.point(vh));
       loop.box_max.maximize(mesh.point(vh));
-      h = mesh.next_halfedge_handle(h);
-    } while (h != start);
+    }
+    loop.vertices = std::move(vertices);
     loops.push_back(std::move(loop));
   }
   return loops;
@@ -286,7 +279,7 @@ BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOpti
   if (options.zip_border_slits) {
     result.zipped = ZipBorderSlits(mesh, options.hole_closing, mean_area);
   }
-  const std::vector<BoundaryLoop> loops = CollectBoundaryLoops(mesh);
+  const std::vector<BoundaryLoop> loops = LoopsWithBoxes(mesh);
   if (loops.size() < 2) return result;
   if (mean_area <= 0) mean_area = MeanTriangleArea(mesh);
   const double limit = options.alpha_m * std::sqrt(mean_area);

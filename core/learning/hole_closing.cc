@@ -8,12 +8,11 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/learning/boundary_loops.h"
 #include "core/learning/triangle_removal.h"
 
 namespace neuralmesh {
 namespace {
-
-using VertexLoop = std::vector<Mesh::VertexHandle>;
 
 // Slits (ZipBorderSlits): the chains considered, and the work bounds per call.
 constexpr size_t kMaxSlitChainEdges = 48;
@@ -21,22 +20,14 @@ constexpr double kMinSlitPathToChord = 3;
 constexpr size_t kMaxSlitCandidatesPerLoop = 8;
 constexpr size_t kMaxSlitZipsPerCall = 64;
 
-// The boundary loops with at most `max_vertices` vertices, each as the from-vertices of its
-// boundary half-edges in half-edge order (loop[i] -> loop[i + 1] is a boundary half-edge).
+// The boundary loops with at most `max_vertices` vertices (boundary_loops.h).
 std::vector<VertexLoop> CollectLoops(const Mesh& mesh, size_t max_vertices) {
-  std::vector<VertexLoop> loops;
-  std::vector<bool> visited(mesh.n_halfedges(), false);
-  for (auto start : mesh.halfedges()) {
-    if (visited[start.idx()] || !mesh.is_boundary(start)) continue;
-    VertexLoop loop;
-    auto h = start;
-    do {
-      visited[h.idx()] = true;
-      loop.push_back(mesh.from_vertex_handle(h));
-      h = mesh.next_halfedge_handle(h);
-    } while (h != start);
-    if (loop.size() <= max_vertices) loops.push_back(std::move(loop));
-  }
+  std::vector<VertexLoop> loops = CollectBoundaryLoops(mesh);
+  loops.erase(std::remove_if(loops.begin(), loops.end(),
+                             [max_vertices](const VertexLoop& loop) {
+                               return loop.size() > max_vertices;
+                             }),
+              loops.end());
   return loops;
 }
 
@@ -280,7 +271,7 @@ HoleClosingResult ZipBorderSlits(Mesh& mesh, const HoleClosingOptions& options,
   // Each zip changes the loops, so they are collected again after it.
   for (size_t zips = 0; zips < kMaxSlitZipsPerCall; ++zips) {
     bool zipped = false;
-    for (const VertexLoop& loop : CollectLoops(mesh, std::numeric_limits<size_t>::max())) {
+    for (const VertexLoop& loop : CollectBoundaryLoops(mesh)) {
       for (const VertexLoop& chain : SlitCandidates(mesh, loop, max_edge)) {
         const size_t added = FillLoop(mesh, chain, max_area, max_edge, /*closed=*/false);
         if (added == 0) continue;

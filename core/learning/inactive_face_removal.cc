@@ -4,6 +4,7 @@
 #include <array>
 #include <vector>
 
+#include "core/learning/boundary_loops.h"
 #include "core/learning/triangle_removal.h"
 
 namespace neuralmesh {
@@ -14,17 +15,10 @@ namespace {
 class BoundaryLoops {
  public:
   explicit BoundaryLoops(const Mesh& mesh) : loop_of_vertex_(mesh.n_vertices(), -1) {
-    std::vector<bool> seen(mesh.n_halfedges(), false);
-    for (auto start : mesh.halfedges()) {
-      if (seen[start.idx()] || !mesh.is_boundary(start)) continue;
+    for (const VertexLoop& vertices : CollectBoundaryLoops(mesh)) {
       const int loop = static_cast<int>(parent_.size());
       parent_.push_back(loop);
-      auto h = start;
-      do {
-        seen[h.idx()] = true;
-        loop_of_vertex_[mesh.from_vertex_handle(h).idx()] = loop;
-        h = mesh.next_halfedge_handle(h);
-      } while (h != start);
+      for (auto v : vertices) loop_of_vertex_[v.idx()] = loop;
     }
   }
 

@@ -8,8 +8,12 @@
 // Milestones above half the input's point count are skipped (see the loop).
 // "us/step" is measured in a window just below each milestone (from 0.9 N to N vertices), so
 // it shows the cost of a Basic Step at that mesh size rather than an average over the run.
+// After each input, a fingerprint of the final mesh (positions and faces): a change meant only
+// to make the learner faster must leave it unchanged.
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,6 +34,24 @@ namespace neuralmesh {
 namespace {
 
 double Seconds(absl::Duration d) { return absl::ToDoubleSeconds(d); }
+
+// FNV-1a over the bits of every live vertex's position and the vertex indices of every live
+// face, in handle order.
+uint64_t Fingerprint(const Mesh& mesh) {
+  uint64_t hash = 14695981039346656037ull;
+  auto mix = [&hash](const void* data, size_t size) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < size; ++i) hash = (hash ^ bytes[i]) * 1099511628211ull;
+  };
+  for (auto v : mesh.vertices()) mix(mesh.point(v).data(), 3 * sizeof(double));
+  for (auto f : mesh.faces()) {
+    for (auto v : mesh.fv_range(f)) {
+      const int index = v.idx();
+      mix(&index, sizeof index);
+    }
+  }
+  return hash;
+}
 
 int Run() {
   const std::vector<size_t> point_counts =
@@ -84,6 +106,8 @@ int Run() {
                   static_cast<double>(p.basic_steps) / total_s);
       std::fflush(stdout);
     }
+    std::printf("%10zu points: mesh fingerprint %016llx\n", n,
+                static_cast<unsigned long long>(Fingerprint(learner->mesh())));
   }
   std::printf(
       "\nColumns octree..merge: seconds spent per step kind (octree = sampling and the "

@@ -1,5 +1,6 @@
 #include "core/learning/signal_counters.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -34,15 +35,14 @@ void SignalCounters::Remove(int id) {
   if (!Contains(id)) return;
   const size_t i = static_cast<size_t>(heap_pos_[id]);
   const size_t last = heap_.size() - 1;
+  heap_pos_[id] = -1;
   if (i != last) {
-    Swap(i, last);
+    Place(i, heap_[last]);
     heap_.pop_back();
-    heap_pos_[id] = -1;
     SiftDown(i);
     SiftUp(i);
   } else {
     heap_.pop_back();
-    heap_pos_[id] = -1;
   }
 }
 
@@ -60,10 +60,20 @@ void SignalCounters::Update(int id, double key) {
 }
 
 void SignalCounters::Flush() {
+  // Below e^-38 (< 2^-54) a counter adds nothing to the 1 of a win: before + 1.0 rounds to
+  // exactly 1.0. Such wins, most of them on a large mesh (a vertex wins about once every v
+  // Basic Steps, and e^-38 = alpha_sc^740 for the paper's 0.95), skip the exp and the log and
+  // still give bitwise the same key.
+  constexpr double kNegligibleExponent = -38;
   for (const auto& [id, step] : pending_) {
     if (!Contains(id)) continue;
     // c(step) after the win = c(step) before it + 1 (Eq. 4's 1 + sum alpha^-x, one term at a
     // time); the common factor alpha^t stays implicit in the key.
+    const double time_term = static_cast<double>(step) * log_alpha_;
+    if (heap_[heap_pos_[id]].key + time_term < kNegligibleExponent) {
+      Update(id, 0.0 - time_term);  // KeyOf(1.0, step): log(1) is exactly 0.
+      continue;
+    }
     const double before = Value(id, step);
     Update(id, KeyOf(before + 1.0, step));
   }
@@ -94,7 +104,9 @@ int SignalCounters::MostActive(const std::function<bool(int)>& eligible) {
       best_key = entry.key;
       break;
     }
-    for (size_t c = 2 * i + 1; c <= 2 * i + 2 && c < heap_.size(); ++c) frontier.push_back(c);
+    for (size_t c = FirstChild(i); c < FirstChild(i) + kArity && c < heap_.size(); ++c) {
+      frontier.push_back(c);
+    }
   }
   return best;
 }
@@ -105,32 +117,40 @@ void SignalCounters::Clear() {
   pending_.clear();
 }
 
-void SignalCounters::Swap(size_t a, size_t b) {
-  std::swap(heap_[a], heap_[b]);
-  heap_pos_[heap_[a].id] = static_cast<int>(a);
-  heap_pos_[heap_[b].id] = static_cast<int>(b);
+void SignalCounters::Place(size_t i, const Entry& entry) {
+  heap_[i] = entry;
+  heap_pos_[entry.id] = static_cast<int>(i);
 }
 
+// Both sifts move the entry through a hole: each level writes one entry and one position
+// instead of swapping two.
 void SignalCounters::SiftUp(size_t i) {
+  const Entry moving = heap_[i];
   while (i > 0) {
-    const size_t parent = (i - 1) / 2;
-    if (heap_[parent].key >= heap_[i].key) break;
-    Swap(i, parent);
+    const size_t parent = (i - 1) / kArity;
+    if (heap_[parent].key >= moving.key) break;
+    Place(i, heap_[parent]);
     i = parent;
   }
+  Place(i, moving);
 }
 
 void SignalCounters::SiftDown(size_t i) {
   const size_t n = heap_.size();
+  const Entry moving = heap_[i];
   while (true) {
-    size_t largest = i;
-    const size_t l = 2 * i + 1, r = 2 * i + 2;
-    if (l < n && heap_[l].key > heap_[largest].key) largest = l;
-    if (r < n && heap_[r].key > heap_[largest].key) largest = r;
-    if (largest == i) break;
-    Swap(i, largest);
+    const size_t first = FirstChild(i);
+    if (first >= n) break;
+    size_t largest = first;
+    const size_t end = std::min(first + kArity, n);
+    for (size_t c = first + 1; c < end; ++c) {
+      if (heap_[c].key > heap_[largest].key) largest = c;
+    }
+    if (heap_[largest].key <= moving.key) break;
+    Place(i, heap_[largest]);
     i = largest;
   }
+  Place(i, moving);
 }
 
 }  // namespace neuralmesh

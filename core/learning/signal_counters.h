@@ -51,7 +51,6 @@ class SignalCounters {
   double KeyOf(double value, uint64_t step) const;
   void SiftUp(size_t i);
   void SiftDown(size_t i);
-  void Swap(size_t a, size_t b);
   void Update(int id, double key);
 
   // The keys live in the heap entries, so that sifting reads only the heap (a win's sift
@@ -60,6 +59,13 @@ class SignalCounters {
     double key;
     int id;
   };
+  // A win's key is nearly always the largest (keys grow with the time of the last win), so
+  // its sift runs to the top: a 4-ary heap halves the levels, and the misses, of a binary one.
+  static constexpr size_t kArity = 4;
+  static size_t FirstChild(size_t i) { return kArity * i + 1; }
+  // Writes `entry` at heap index i and records where its id now is.
+  void Place(size_t i, const Entry& entry);
+
   double log_alpha_;
   std::vector<int> heap_pos_;  // By id; -1 when not tracked.
   std::vector<Entry> heap_;    // Max-heap by key.

@@ -70,5 +70,72 @@ TEST(SignalCountersTest, NoUnderflowAfterLongInactivity) {
       << "but the ordering survives: 1 was active last";
 }
 
+// Many ids, with removals, splits (Set) and wins in random order: the heap must always give the
+// id with the largest counter among the eligible ones, as a plain scan over all values does.
+TEST(SignalCountersTest, MostActiveMatchesAScanUnderAddRemoveAndSet) {
+  const double alpha = 0.95;
+  const int n = 3000;
+  SignalCounters counters(alpha);
+  std::vector<bool> tracked(n, false);
+  Random rng(5);
+  uint64_t step = 0;
+  for (int i = 0; i < n; i += 2) {
+    counters.Add(i, rng.NextDouble(), step);
+    tracked[i] = true;
+  }
+  auto eligible = [](int id) { return id % 7 != 0; };
+  for (int round = 0; round < 300; ++round) {
+    for (int k = 0; k < 100; ++k) {
+      ++step;
+      const int id = static_cast<int>(rng.NextIndex(n));
+      if (tracked[id]) counters.RecordWin(id, step);
+    }
+    for (int k = 0; k < 5; ++k) {
+      const int id = static_cast<int>(rng.NextIndex(n));
+      if (tracked[id] && rng.NextDouble() < 0.5) {
+        counters.Remove(id);
+        tracked[id] = false;
+      } else if (tracked[id]) {
+        counters.Flush();
+        counters.Set(id, counters.Value(id, step) * rng.NextDouble(), step);
+      } else {
+        counters.Add(id, rng.NextDouble() * 3, step);
+        tracked[id] = true;
+      }
+    }
+    const int got = counters.MostActive(eligible);
+    int expected = -1;
+    double best = -1;
+    for (int i = 0; i < n; ++i) {
+      if (!tracked[i] || !eligible(i)) continue;
+      const double value = counters.Value(i, step);
+      if (value > best) {
+        best = value;
+        expected = i;
+      }
+    }
+    ASSERT_EQ(got, expected) << "round " << round;
+  }
+}
+
+// A win long after the previous one takes a shortcut (the old counter is below what a double
+// can add to 1); its counter must be bitwise the one a fresh counter of 1 gets, and a win
+// shortly after the previous one must still add the decayed counter.
+TEST(SignalCountersTest, WinsAfterLongAndShortGapsGiveExactCounters) {
+  const double alpha = 0.95;
+  SignalCounters counters(alpha);
+  SignalCounters fresh(alpha);
+  counters.Add(0, 1.0, 0);
+  counters.RecordWin(0, 5000);  // 0.95^5000: far below 2^-53.
+  counters.Flush();
+  fresh.Add(0, 1.0, 5000);
+  EXPECT_EQ(counters.Value(0, 5000), fresh.Value(0, 5000));
+  EXPECT_EQ(counters.Value(0, 6000), fresh.Value(0, 6000));
+
+  counters.RecordWin(0, 5100);  // 0.95^100 = 0.0059: must count.
+  counters.Flush();
+  EXPECT_NEAR(counters.Value(0, 5100), 1.0 + std::pow(alpha, 100), 1e-12);
+}
+
 }  // namespace
 }  // namespace neuralmesh

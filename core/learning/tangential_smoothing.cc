@@ -56,6 +56,183 @@ void SmoothPassesScalar(const OneRingSmoother::RingVertex* ring, OneRingSmoother
   }
 }
 
+// Sorts the neighbours of one ring vertex q_i into those that move during the smoothing
+// (other vertices of the winner's ring: their slots are appended to `moving`, except q_{i-1},
+// which is only flagged) and those that stay put (the winner, the second ring).
+struct NeighbourSorter {
+  const int* slot_of_vertex;  // By vertex: the slot in the winner's ring, or -1.
+  int* moving;
+  int num_moving;
+  int previous;  // The slot of q_{i-1}.
+  bool has_previous;
+
+  // Records neighbour u; returns 1 if it stays put, else 0.
+  double operator()(int u) {
+    const int slot = slot_of_vertex[u];
+    const bool is_previous = slot == previous;
+    has_previous |= is_previous;
+    moving[num_moving] = slot;
+    num_moving += (slot >= 0) & !is_previous;
+    return static_cast<double>(slot < 0);
+  }
+};
+
+// The sums over the ring of an interior vertex p (neighbours b_k in rotation order): the
+// area-weighted normal n = sum of (b_k-1 - p) x (b_k - p), and f = the sum of the neighbours
+// that `sorter` finds stay put. The scalar and the AVX2 versions evaluate the same expressions
+// in the same order (the AVX2 one with x, y, z in three lanes), so they give bitwise the same
+// sums. (Both work on a local copy of the sorter, which the compiler keeps in registers.)
+void InteriorSumsScalar(const double* points, const double* p, const int32_t* neighbours,
+                        int count, NeighbourSorter& shared_sorter, double n[3], double f[3]) {
+  NeighbourSorter sorter = shared_sorter;
+  const double* last = points + 3 * static_cast<size_t>(neighbours[count - 1]);
+  double ax = last[0] - p[0], ay = last[1] - p[1], az = last[2] - p[2];
+  double nx = 0, ny = 0, nz = 0, fx = 0, fy = 0, fz = 0;
+  for (int k = 0; k < count; ++k) {
+    const int u = neighbours[k];
+    const double* b = points + 3 * static_cast<size_t>(u);
+    const double bx = b[0] - p[0], by = b[1] - p[1], bz = b[2] - p[2];
+    nx += ay * bz - az * by;
+    ny += az * bx - ax * bz;
+    nz += ax * by - ay * bx;
+    ax = bx;
+    ay = by;
+    az = bz;
+    const double stays = sorter(u);
+    fx += stays * b[0];
+    fy += stays * b[1];
+    fz += stays * b[2];
+  }
+  shared_sorter = sorter;
+  n[0] = nx;
+  n[1] = ny;
+  n[2] = nz;
+  f[0] = fx;
+  f[1] = fy;
+  f[2] = fz;
+}
+
+#if defined(__x86_64__)
+__attribute__((target("avx2"))) void InteriorSumsAvx2(const double* points, const double* p,
+                                                      const int32_t* neighbours, int count,
+                                                      NeighbourSorter& shared_sorter,
+                                                      double n[3], double f[3]) {
+  NeighbourSorter sorter = shared_sorter;
+  // Positions are three doubles: loaded into lanes 0-2, lane 3 zero and never read from memory.
+  const __m256i xyz = _mm256_set_epi64x(0, -1, -1, -1);
+  constexpr int kYzx = _MM_SHUFFLE(3, 0, 2, 1);  // (x, y, z, w) -> (y, z, x, w).
+  const __m256d pv = _mm256_maskload_pd(p, xyz);
+  __m256d a = _mm256_sub_pd(
+      _mm256_maskload_pd(points + 3 * static_cast<size_t>(neighbours[count - 1]), xyz), pv);
+  __m256d a_yzx = _mm256_permute4x64_pd(a, kYzx);
+  // Lanes of `cross`: (nz, nx, ny) terms: ax by - ay bx, ay bz - az by, az bx - ax bz.
+  __m256d cross = _mm256_setzero_pd();
+  __m256d stay = _mm256_setzero_pd();
+  for (int k = 0; k < count; ++k) {
+    const int u = neighbours[k];
+    const __m256d b_raw = _mm256_maskload_pd(points + 3 * static_cast<size_t>(u), xyz);
+    const __m256d b = _mm256_sub_pd(b_raw, pv);
+    const __m256d b_yzx = _mm256_permute4x64_pd(b, kYzx);
+    cross = _mm256_add_pd(cross, _mm256_sub_pd(_mm256_mul_pd(a, b_yzx), _mm256_mul_pd(a_yzx, b)));
+    a = b;
+    a_yzx = b_yzx;
+    stay = _mm256_add_pd(stay, _mm256_mul_pd(_mm256_set1_pd(sorter(u)), b_raw));
+  }
+  shared_sorter = sorter;
+  alignas(32) double lanes[4];
+  _mm256_store_pd(lanes, _mm256_permute4x64_pd(cross, kYzx));
+  n[0] = lanes[0];
+  n[1] = lanes[1];
+  n[2] = lanes[2];
+  _mm256_store_pd(lanes, stay);
+  f[0] = lanes[0];
+  f[1] = lanes[1];
+  f[2] = lanes[2];
+}
+#else
+void InteriorSumsAvx2(const double* points, const double* p, const int32_t* neighbours, int count,
+                      NeighbourSorter& sorter, double n[3], double f[3]) {
+  InteriorSumsScalar(points, p, neighbours, count, sorter, n, f);
+}
+#endif
+
+// The affine update of one ring vertex (tangential_smoothing.h): P = I - d d^T off the
+// normal d, or d d^T along a border direction d; A = I - alpha_L P, G = scale P (scale =
+// alpha_L / count), G again for q_{i-1} if `previous_on` is 1 (zero if 0), and c = G f.
+// The AVX2 version computes, lane by lane, the same expressions in the same order.
+void BuildUpdateScalar(const double d[3], bool border, double alpha_l, double scale,
+                       double previous_on, const double f[3], OneRingSmoother::RingVertex& r) {
+  const double identity = border ? 0.0 : 1.0;
+  const double sign = border ? 1.0 : -1.0;
+  // P is symmetric (d[row] * d[col] == d[col] * d[row] exactly): six distinct entries. The
+  // loops are unrolled so that no element tests its row and column at run time. (0.0 + x is
+  // kept: it turns -0 into +0, as the formula does.)
+  const double p00 = identity + sign * (d[0] * d[0]);
+  const double p11 = identity + sign * (d[1] * d[1]);
+  const double p22 = identity + sign * (d[2] * d[2]);
+  const double p01 = 0.0 + sign * (d[1] * d[0]);
+  const double p02 = 0.0 + sign * (d[2] * d[0]);
+  const double p12 = 0.0 + sign * (d[2] * d[1]);
+  const double proj[3][4] = {{p00, p01, p02, 0}, {p01, p11, p12, 0}, {p02, p12, p22, 0}};
+#pragma GCC unroll 3
+  for (int col = 0; col < 3; ++col) {
+#pragma GCC unroll 4
+    for (int row = 0; row < 4; ++row) {
+      const double diagonal = row == col ? 1.0 : 0.0;
+      r.own[col][row] = row < 3 ? diagonal - alpha_l * proj[col][row] : 0.0;
+      r.neighbour[col][row] = scale * proj[col][row];
+      r.previous[col][row] = previous_on * r.neighbour[col][row];
+    }
+  }
+  for (int row = 0; row < 3; ++row) {
+    r.offset[row] = (r.neighbour[0][row] * f[0] + r.neighbour[1][row] * f[1]) +
+                    r.neighbour[2][row] * f[2];
+  }
+  r.offset[3] = 0;
+}
+
+#if defined(__x86_64__)
+__attribute__((target("avx2"))) void BuildUpdateAvx2(const double d[3], bool border,
+                                                     double alpha_l, double scale,
+                                                     double previous_on, const double f[3],
+                                                     OneRingSmoother::RingVertex& r) {
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d one = _mm256_set1_pd(1.0);
+  const __m256d identity = _mm256_set1_pd(border ? 0.0 : 1.0);
+  const __m256d sign = _mm256_set1_pd(border ? 1.0 : -1.0);
+  const __m256d dv = _mm256_set_pd(0.0, d[2], d[1], d[0]);
+  const __m256d alpha = _mm256_set1_pd(alpha_l);
+  const __m256d g = _mm256_set1_pd(scale);
+  const __m256d previous = _mm256_set1_pd(previous_on);
+  __m256d columns[3];
+#pragma GCC unroll 3
+  for (int col = 0; col < 3; ++col) {
+    const int lane = 1 << col;  // The diagonal's lane, as a blend mask.
+    // Lane `row`: (identity on the diagonal, else 0.0) + sign * (d[row] * d[col]).
+    const __m256d proj =
+        _mm256_add_pd(_mm256_blend_pd(zero, identity, lane),
+                      _mm256_mul_pd(sign, _mm256_mul_pd(dv, _mm256_set1_pd(d[col]))));
+    const __m256d neighbour = _mm256_mul_pd(g, proj);
+    // Lane 3 of proj is +0, so every matrix gets +0 there, as the scalar version writes.
+    _mm256_store_pd(r.own[col],
+                    _mm256_sub_pd(_mm256_blend_pd(zero, one, lane), _mm256_mul_pd(alpha, proj)));
+    _mm256_store_pd(r.neighbour[col], neighbour);
+    _mm256_store_pd(r.previous[col], _mm256_mul_pd(previous, neighbour));
+    columns[col] = neighbour;
+  }
+  const __m256d offset = _mm256_add_pd(
+      _mm256_add_pd(_mm256_mul_pd(columns[0], _mm256_set1_pd(f[0])),
+                    _mm256_mul_pd(columns[1], _mm256_set1_pd(f[1]))),
+      _mm256_mul_pd(columns[2], _mm256_set1_pd(f[2])));
+  _mm256_store_pd(r.offset, _mm256_blend_pd(offset, zero, 8));  // Lane 3: +0.
+}
+#else
+void BuildUpdateAvx2(const double d[3], bool border, double alpha_l, double scale,
+                     double previous_on, const double f[3], OneRingSmoother::RingVertex& r) {
+  BuildUpdateScalar(d, border, alpha_l, scale, previous_on, f, r);
+}
+#endif
+
 #if defined(__x86_64__)
 __attribute__((target("avx2"))) void SmoothPassesAvx2(const OneRingSmoother::RingVertex* ring,
                                                       OneRingSmoother::Position* q,
@@ -107,6 +284,13 @@ bool CpuHasAvx2() { return false; }
 
 OneRingSmoother::OneRingSmoother(bool allow_simd) : simd_(allow_simd && CpuHasAvx2()) {}
 
+// Compiled twice, for AVX2 and for the baseline, picked once at load time: the gather is
+// scalar arithmetic, and its AVX2 build (three-operand instructions, the passes inlined) takes
+// about a tenth fewer instructions. No fused multiply-adds in either (core/CMakeLists.txt), so
+// both give bitwise the same positions.
+#if defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle winner,
                              double alpha_l, int iterations) {
   const VertexRingCache::RingView winner_ring = rings.Ring(mesh, winner.idx());
@@ -150,21 +334,10 @@ void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHan
     if (moving_.size() < static_cast<size_t>(num_moving + view.size)) {
       moving_.resize(2 * static_cast<size_t>(num_moving + view.size));
     }
-    const int previous = m > 1 ? (i == 0 ? m - 1 : i - 1) : -2;  // -2: matches no slot.
     r.first_moving = num_moving;
-    bool has_previous = false;
+    NeighbourSorter sorter{slot_of_vertex_.data(), moving_.data(), num_moving,
+                           m > 1 ? (i == 0 ? m - 1 : i - 1) : -2, false};  // -2: no slot.
     double fx = 0, fy = 0, fz = 0;  // The sum of the neighbours that stay put.
-    auto classify = [&](int u, const double* b) {
-      const int slot = slot_of_vertex_[u];
-      const bool is_previous = slot == previous;
-      const double stays = slot < 0 ? 1.0 : 0.0;
-      has_previous |= is_previous;
-      fx += stays * b[0];
-      fy += stays * b[1];
-      fz += stays * b[2];
-      moving_[num_moving] = slot;
-      num_moving += (slot >= 0) & !is_previous;
-    };
     double d[3];
     int count;
     const bool border = view.boundary;
@@ -175,64 +348,38 @@ void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHan
       const int b1 = view.neighbours[0];
       const double* p0 = at(b0);
       const double* p1 = at(b1);
-      classify(b0, p0);
-      classify(b1, p1);
+      for (const double* b : {p0, p1}) {
+        const double stays = sorter(b == p0 ? b0 : b1);
+        fx += stays * b[0];
+        fy += stays * b[1];
+        fz += stays * b[2];
+      }
       StoreUnit(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2], d);
       count = 2;
     } else {
-      // Area-weighted normal: the sum of (a_k - q) x (a_k+1 - q) around the ring.
       count = view.size;
-      const double* last = at(view.neighbours[count - 1]);
-      double ax = last[0] - p[0], ay = last[1] - p[1], az = last[2] - p[2];
-      double nx = 0, ny = 0, nz = 0;
-      for (int k = 0; k < count; ++k) {
-        const int u = view.neighbours[k];
-        const double* b = at(u);
-        const double bx = b[0] - p[0], by = b[1] - p[1], bz = b[2] - p[2];
-        nx += ay * bz - az * by;
-        ny += az * bx - ax * bz;
-        nz += ax * by - ay * bx;
-        ax = bx;
-        ay = by;
-        az = bz;
-        classify(u, b);
+      double n[3], f[3];
+      if (simd_) {
+        InteriorSumsAvx2(points, p, view.neighbours, count, sorter, n, f);
+      } else {
+        InteriorSumsScalar(points, p, view.neighbours, count, sorter, n, f);
       }
-      StoreUnit(nx, ny, nz, d);
+      fx = f[0];
+      fy = f[1];
+      fz = f[2];
+      StoreUnit(n[0], n[1], n[2], d);
     }
+    num_moving = sorter.num_moving;
     r.end_moving = num_moving;
 
-    // P = I - d d^T off the normal, d d^T along a border; A = I - alpha_L P and
-    // G = alpha_L / count P, and G again for q_{i-1} when it is a neighbour.
     const double scale = alpha_l / static_cast<double>(count);
-    const double identity = border ? 0.0 : 1.0;
-    const double sign = border ? 1.0 : -1.0;
-    const double previous_on = has_previous ? 1.0 : 0.0;
-    // P is symmetric (d[row] * d[col] == d[col] * d[row] exactly): six distinct entries. The
-    // loops are unrolled so that no element tests its row and column at run time: built
-    // element by element, the matrices took more instructions than the rest of the gather.
-    // (0.0 + x is kept: it turns -0 into +0, as the formula does.)
-    const double p00 = identity + sign * (d[0] * d[0]);
-    const double p11 = identity + sign * (d[1] * d[1]);
-    const double p22 = identity + sign * (d[2] * d[2]);
-    const double p01 = 0.0 + sign * (d[1] * d[0]);
-    const double p02 = 0.0 + sign * (d[2] * d[0]);
-    const double p12 = 0.0 + sign * (d[2] * d[1]);
-    const double proj[3][4] = {{p00, p01, p02, 0}, {p01, p11, p12, 0}, {p02, p12, p22, 0}};
-#pragma GCC unroll 3
-    for (int col = 0; col < 3; ++col) {
-#pragma GCC unroll 4
-      for (int row = 0; row < 4; ++row) {
-        const double diagonal = row == col ? 1.0 : 0.0;
-        r.own[col][row] = row < 3 ? diagonal - alpha_l * proj[col][row] : 0.0;
-        r.neighbour[col][row] = scale * proj[col][row];
-        r.previous[col][row] = previous_on * r.neighbour[col][row];
-      }
+    const double previous_on = sorter.has_previous ? 1.0 : 0.0;
+    const double f[3] = {fx, fy, fz};
+    if (simd_) {
+      BuildUpdateAvx2(d, border, alpha_l, scale, previous_on, f, r);
+    } else {
+      BuildUpdateScalar(d, border, alpha_l, scale, previous_on, f, r);
     }
-    for (int row = 0; row < 3; ++row) {
-      r.offset[row] =
-          (r.neighbour[0][row] * fx + r.neighbour[1][row] * fy) + r.neighbour[2][row] * fz;
-    }
-    r.offset[3] = 0;
   }
 
   if (simd_) {

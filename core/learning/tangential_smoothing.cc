@@ -66,14 +66,14 @@ struct NeighbourSorter {
   int previous;  // The slot of q_{i-1}.
   bool has_previous;
 
-  // Records neighbour u; returns 1 if it stays put, else 0.
-  double operator()(int u) {
+  // Records neighbour u; returns whether it stays put.
+  bool operator()(int u) {
     const int slot = slot_of_vertex[u];
     const bool is_previous = slot == previous;
     has_previous |= is_previous;
     moving[num_moving] = slot;
     num_moving += (slot >= 0) & !is_previous;
-    return static_cast<double>(slot < 0);
+    return slot < 0;
   }
 };
 
@@ -98,7 +98,7 @@ void InteriorSumsScalar(const double* points, const double* p, const int32_t* ne
     ax = bx;
     ay = by;
     az = bz;
-    const double stays = sorter(u);
+    const double stays = sorter(u) ? 1.0 : 0.0;
     fx += stays * b[0];
     fy += stays * b[1];
     fz += stays * b[2];
@@ -136,7 +136,10 @@ __attribute__((target("avx2"))) void InteriorSumsAvx2(const double* points, cons
     cross = _mm256_add_pd(cross, _mm256_sub_pd(_mm256_mul_pd(a, b_yzx), _mm256_mul_pd(a_yzx, b)));
     a = b;
     a_yzx = b_yzx;
-    stay = _mm256_add_pd(stay, _mm256_mul_pd(_mm256_set1_pd(sorter(u)), b_raw));
+    // b_raw or +0 by a mask, not 1 or 0 times b_raw, which compiles to a branch that
+    // mispredicts: the same sums, as adding -0 or +0 to a sum that starts at +0 is the same.
+    const __m256d keep = _mm256_castsi256_pd(_mm256_set1_epi64x(-int64_t{sorter(u)}));
+    stay = _mm256_add_pd(stay, _mm256_and_pd(keep, b_raw));
   }
   shared_sorter = sorter;
   alignas(32) double lanes[4];
@@ -349,7 +352,7 @@ void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHan
       const double* p0 = at(b0);
       const double* p1 = at(b1);
       for (const double* b : {p0, p1}) {
-        const double stays = sorter(b == p0 ? b0 : b1);
+        const double stays = sorter(b == p0 ? b0 : b1) ? 1.0 : 0.0;
         fx += stays * b[0];
         fy += stays * b[1];
         fz += stays * b[2];

@@ -30,8 +30,9 @@ namespace neuralmesh {
 
 class OneRingSmoother {
  public:
-  // With `allow_simd`, the C_L passes run on AVX2 when the CPU has it, with bitwise the same
-  // results as without (false is for tests that compare the two).
+  // With `allow_simd`, the gather (normals, sums, update matrices) and the C_L passes run on
+  // AVX2 when the CPU has it, with bitwise the same results as without (false is for tests
+  // that compare the two).
   explicit OneRingSmoother(bool allow_simd = true);
 
   // Smooths the 1-ring of `winner`, reading rings through `rings` (which the caller keeps

@@ -7,6 +7,8 @@
 #include <immintrin.h>
 #endif
 
+#include "core/avx2_clone.h"
+
 namespace neuralmesh {
 namespace {
 
@@ -287,14 +289,11 @@ bool CpuHasAvx2() { return false; }
 
 OneRingSmoother::OneRingSmoother(bool allow_simd) : simd_(allow_simd && CpuHasAvx2()) {}
 
-// Compiled twice, for AVX2 and for the baseline, picked once at load time: what is left of
-// the gather's scalar arithmetic takes fewer instructions in its AVX2 build (three-operand
-// forms, the passes inlined; 5% fewer per Basic Step). No fused multiply-adds in either
-// (core/CMakeLists.txt), so both give bitwise the same positions.
-#if defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle winner,
+// Compiled for AVX2 and for the baseline (avx2_clone.h): what is left of the gather's scalar
+// arithmetic takes fewer instructions in its AVX2 build (three-operand forms, the passes
+// inlined; 5% fewer per Basic Step). No fused multiply-adds in either (core/CMakeLists.txt),
+// so both give bitwise the same positions.
+NEURALMESH_AVX2_CLONE void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle winner,
                              double alpha_l, int iterations) {
   const VertexRingCache::RingView winner_ring = rings.Ring(mesh, winner.idx());
   ring_.assign(winner_ring.neighbours, winner_ring.neighbours + winner_ring.size);

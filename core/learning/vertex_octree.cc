@@ -5,6 +5,8 @@
 #include <cstring>
 #include <limits>
 
+#include "core/avx2_clone.h"
+
 namespace neuralmesh {
 namespace {
 
@@ -303,13 +305,7 @@ void VertexOctree::CollapseSubtree(int n) {
 }
 
 // Move and Nearest, the octree's part of every Basic Step, are compiled for AVX2 as well as
-// for the baseline (picked once at load time): the same arithmetic in fewer instructions.
-#if defined(__x86_64__)
-#define NEURALMESH_AVX2_CLONE __attribute__((target_clones("avx2", "default")))
-#else
-#define NEURALMESH_AVX2_CLONE
-#endif
-
+// for the baseline (avx2_clone.h): the same arithmetic in fewer instructions.
 NEURALMESH_AVX2_CLONE void VertexOctree::Move(int id, const Vec3& p) {
   if (Contains(id)) {
     const Location at = where_[id];

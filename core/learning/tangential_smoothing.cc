@@ -293,8 +293,9 @@ OneRingSmoother::OneRingSmoother(bool allow_simd) : simd_(allow_simd && CpuHasAv
 // arithmetic takes fewer instructions in its AVX2 build (three-operand forms, the passes
 // inlined; 5% fewer per Basic Step). No fused multiply-adds in either (core/CMakeLists.txt),
 // so both give bitwise the same positions.
-NEURALMESH_AVX2_CLONE void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle winner,
-                             double alpha_l, int iterations) {
+NEURALMESH_AVX2_CLONE void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& rings,
+                                                   Mesh::VertexHandle winner, double alpha_l,
+                                                   int iterations) {
   const VertexRingCache::RingView winner_ring = rings.Ring(mesh, winner.idx());
   ring_.assign(winner_ring.neighbours, winner_ring.neighbours + winner_ring.size);
   if (alpha_l <= 0 || iterations <= 0) return;
@@ -339,7 +340,7 @@ NEURALMESH_AVX2_CLONE void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& 
     r.first_moving = num_moving;
     NeighbourSorter sorter{slot_of_vertex_.data(), moving_.data(), num_moving,
                            m > 1 ? (i == 0 ? m - 1 : i - 1) : -2, false};  // -2: no slot.
-    double fx = 0, fy = 0, fz = 0;  // The sum of the neighbours that stay put.
+    double f[3] = {0, 0, 0};  // The sum of the neighbours that stay put.
     double d[3];
     int count;
     const bool border = view.boundary;
@@ -351,9 +352,7 @@ NEURALMESH_AVX2_CLONE void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& 
       for (const int u : {b0, b1}) {
         const double* b = at(u);
         const double stays = sorter(u) ? 1.0 : 0.0;
-        fx += stays * b[0];
-        fy += stays * b[1];
-        fz += stays * b[2];
+        for (int c = 0; c < 3; ++c) f[c] += stays * b[c];
       }
       const double* p0 = at(b0);
       const double* p1 = at(b1);
@@ -361,15 +360,12 @@ NEURALMESH_AVX2_CLONE void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& 
       count = 2;
     } else {
       count = view.size;
-      double n[3], f[3];
+      double n[3];
       if (simd_) {
         InteriorSumsAvx2(points, p, view.neighbours, count, sorter, n, f);
       } else {
         InteriorSumsScalar(points, p, view.neighbours, count, sorter, n, f);
       }
-      fx = f[0];
-      fy = f[1];
-      fz = f[2];
       StoreUnit(n[0], n[1], n[2], d);
     }
     num_moving = sorter.num_moving;
@@ -377,7 +373,6 @@ NEURALMESH_AVX2_CLONE void OneRingSmoother::Smooth(Mesh& mesh, VertexRingCache& 
 
     const double scale = alpha_l / static_cast<double>(count);
     const double previous_on = sorter.has_previous ? 1.0 : 0.0;
-    const double f[3] = {fx, fy, fz};
     if (simd_) {
       BuildUpdateAvx2(d, border, alpha_l, scale, previous_on, f, r);
     } else {

@@ -10,8 +10,8 @@
 // it shows the cost of a Basic Step at that mesh size rather than an average over the run.
 // "window" is the number of Basic Steps in that window. After each input, the ratio of the
 // last measured milestone's us/step to the first one's (issue 2 asks for at most 1.5 from 1K
-// to 100K vertices) and a fingerprint of the final mesh (positions
-// and faces): a change meant only to make the learner faster must leave it unchanged.
+// to 100K vertices) and a fingerprint of the final mesh (positions and faces): a change meant
+// only to make the learner faster must leave it unchanged.
 // Under callgrind, only the windows are measured, so that instructions and cache misses per
 // Basic Step at one mesh size can be read off (one milestone per run; the windows of several
 // would add up):
@@ -74,11 +74,11 @@ uint64_t Fingerprint(const Mesh& mesh) {
 }
 
 void PrintMemoryLatency(const char* when) {
-  std::printf("Memory latency %s (one dependent load, random order): 32 KB %.1f ns, 1 MB %.1f ns, "
-              "16 MB %.1f ns\n",
-              when, bench::DependentLoadNanoseconds(32 << 10),
-              bench::DependentLoadNanoseconds(1 << 20),
-              bench::DependentLoadNanoseconds(16 << 20, 2'000'000));
+  std::printf(
+      "Memory latency %s (one dependent load, random order): 32 KB %.1f ns, 1 MB %.1f ns, "
+      "16 MB %.1f ns\n",
+      when, bench::DependentLoadNanoseconds(32 << 10), bench::DependentLoadNanoseconds(1 << 20),
+      bench::DependentLoadNanoseconds(16 << 20, 2'000'000));
   std::fflush(stdout);
 }
 
@@ -96,9 +96,9 @@ int Run() {
       "C_vs = 100, C_ec = 10, alpha_sc = 0.95, alpha_r = 7, alpha_m = 5), one thread\n");
   PrintMemoryLatency("before");
   std::printf("\n");
-  std::printf("%10s %8s %9s %11s %9s %9s %8s %8s %8s %8s %8s %8s %10s\n", "points", "#v",
-              "total s", "steps", "window", "us/step", "octree", "smooth", "split", "collapse", "removal", "merge",
-              "steps/s");
+  std::printf("%10s %8s %9s %11s %9s %9s %8s %8s %8s %8s %8s %8s %10s\n", "points", "#v", "total s",
+              "steps", "window", "us/step", "octree", "smooth", "split", "collapse", "removal",
+              "merge", "steps/s");
   for (size_t n : point_counts) {
     auto cloud = std::make_shared<const PointCloud>(SamplePoints(*torus, n, seed));
     auto sampler = MakePointCloudSampler(cloud).value();
@@ -142,12 +142,12 @@ int Run() {
       }
       last_target = target;
       last_us_per_step = us_per_step;
-      std::printf("%10zu %8zu %9.2f %11llu %9llu %9.3f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %10.0f\n",
-                  n, p.vertices, total_s, static_cast<unsigned long long>(p.basic_steps),
-                  static_cast<unsigned long long>(p.basic_steps - window_steps), us_per_step,
-                  Seconds(t.winner_search), Seconds(t.smoothing), Seconds(t.split),
-                  Seconds(t.collapse), Seconds(t.removal), Seconds(t.merging),
-                  static_cast<double>(p.basic_steps) / total_s);
+      std::printf(
+          "%10zu %8zu %9.2f %11llu %9llu %9.3f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %10.0f\n", n,
+          p.vertices, total_s, static_cast<unsigned long long>(p.basic_steps),
+          static_cast<unsigned long long>(p.basic_steps - window_steps), us_per_step,
+          Seconds(t.winner_search), Seconds(t.smoothing), Seconds(t.split), Seconds(t.collapse),
+          Seconds(t.removal), Seconds(t.merging), static_cast<double>(p.basic_steps) / total_s);
       std::fflush(stdout);
     }
     if (last_target != first_target) {

@@ -76,8 +76,10 @@ class Learner::Impl {
     // does not search it): their locations in it load meanwhile (2-3% less time at 100K
     // vertices, the same meshes).
     octree_.PrefetchLocation(winner);
-    const VertexRingCache::RingView ring = rings_.Ring(mesh_, winner);
-    for (int i = 0; i < ring.size; ++i) octree_.PrefetchLocation(ring.neighbours[i]);
+    {  // The view is valid only until the smoother reads rings.
+      const VertexRingCache::RingView ring = rings_.Ring(mesh_, winner);
+      for (int i = 0; i < ring.size; ++i) octree_.PrefetchLocation(ring.neighbours[i]);
+    }
     smoother_.Smooth(mesh_, rings_, w, options_.alpha_l, options_.c_l);
     octree_.Move(winner, pw);
     for (const int q : smoother_.moved()) octree_.Move(q, mesh_.point(Mesh::VertexHandle(q)));

@@ -94,7 +94,7 @@ ABSL_FLAG(absl::Duration, time_budget, absl::InfiniteDuration(),
 ABSL_FLAG(uint64_t, max_steps, 0,
           "Stop learning after this many Basic Steps and write the mesh so far; 0: no limit.");
 ABSL_FLAG(int32_t, quantization_bits, kDracoDefaults.position_quantization_bits,
-          "Draco position quantization bits (1..30) for .drc meshes.");
+          "Draco position quantization bits (1..24) for .drc meshes.");
 ABSL_FLAG(int32_t, encode_speed, kDracoDefaults.encode_speed,
           "Draco encoder speed, 0 (smallest) .. 10 (fastest), for .drc meshes.");
 ABSL_FLAG(bool, progress, false, "Draw progress bars on stderr even when it is not a terminal.");

@@ -74,7 +74,8 @@ QuantizationBox QuantizationCube(const BoundingBox& bounds, double enlarge) {
   QuantizationBox box;
   box.range = static_cast<float>(edge);
   for (int c = 0; c < 3; ++c) box.origin[c] = static_cast<float>(center[c] - edge / 2);
-  return box;
+  // The box every update announces is the one Draco quantizes against.
+  return DracoExactBox(box);
 }
 
 QuantizationBox GrowQuantizationCube(QuantizationBox box, const BoundingBox& bounds) {
@@ -82,7 +83,7 @@ QuantizationBox GrowQuantizationCube(QuantizationBox box, const BoundingBox& bou
     for (int c = 0; c < 3; ++c) box.origin[c] -= box.range / 2;
     box.range *= 2;
   }
-  return box;
+  return DracoExactBox(box);
 }
 
 Session::Session(std::string id, std::string name, SessionConfig config, size_t max_points,

@@ -60,10 +60,11 @@ namespace neuralmesh::server {
 bool IsSpatiallyBiased(absl::Span<const Vec3f> arrival_sample);
 
 // The cube all meshes of a session are quantized against, from the first data: the bounding
-// cube of `bounds` scaled by `enlarge` about its centre (a degenerate box gets edge 1).
+// cube of `bounds` scaled by `enlarge` about its centre (a degenerate box gets edge 1), widened
+// to the nearest cube Draco keeps exactly (DracoExactBox).
 QuantizationBox QuantizationCube(const BoundingBox& bounds, double enlarge);
 
-// `box` grown 2x about its centre until it contains `bounds`.
+// `box` grown 2x about its centre until it contains `bounds`, then widened as above.
 QuantizationBox GrowQuantizationCube(QuantizationBox box, const BoundingBox& bounds);
 
 class Session : public Schedulable, public std::enable_shared_from_this<Session> {

@@ -29,6 +29,11 @@ absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& 
         absl::StrCat("target_vertices is ", config.target_vertices,
                      "; it must be at least 4 (the initial tetrahedron)"));
   }
+  if (config.target_vertices > kMaxTargetVertices) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("target_vertices is ", config.target_vertices, "; at most ",
+                     kMaxTargetVertices, " are supported (the mesh numbers half-edges in 32 bits)"));
+  }
   if (!std::isfinite(config.points_per_vertex) || config.points_per_vertex <= 0) {
     return absl::InvalidArgumentError(absl::StrCat("points_per_vertex is ",
                                                    config.points_per_vertex,

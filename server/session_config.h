@@ -23,6 +23,8 @@ enum class FinalPass {
 };
 
 inline constexpr size_t kMinTargetVertices = 4;  // The initial tetrahedron.
+// The mesh numbers its elements with 32-bit ints, six half-edges per vertex.
+inline constexpr size_t kMaxTargetVertices = size_t{1} << 28;
 inline constexpr size_t kMaxLodMilestones = 256;
 inline constexpr absl::Duration kDefaultRefreshInterval = absl::Milliseconds(250);
 inline constexpr absl::Duration kMinRefreshInterval = absl::Milliseconds(10);
@@ -58,8 +60,8 @@ struct SessionConfig {
 std::vector<size_t> DefaultLodMilestones(size_t target);
 
 // Validates `config` and fills in the milestones (the default series when empty, the target
-// appended when missing). INVALID_ARGUMENT naming the first offending field: a target below 4
-// or unreachable within `max_points_per_session` points, milestones not strictly increasing,
+// appended when missing). INVALID_ARGUMENT naming the first offending field: a target below 4,
+// above kMaxTargetVertices or unreachable within `max_points_per_session` points, milestones not strictly increasing,
 // below 4, above the target or more than 256 of them, a refresh interval between 0 and 10 ms,
 // points_per_vertex not finite and positive, bounds not finite or inverted, and whatever
 // LearnerOptions::Validate and DracoOptions::Validate reject.

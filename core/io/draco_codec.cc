@@ -4,11 +4,14 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <new>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/status_macros.h"
@@ -19,6 +22,8 @@
 #include "draco/compression/expert_encode.h"
 #include "draco/core/decoder_buffer.h"
 #include "draco/core/encoder_buffer.h"
+#include "draco/core/options.h"
+#include "draco/core/varint_decoding.h"
 #include "draco/mesh/mesh.h"
 #include "draco/metadata/geometry_metadata.h"
 #include "draco/metadata/metadata_decoder.h"
@@ -41,31 +46,155 @@ bool IsFinite(const Vec3f& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }
 
-// Checks that every position is finite and, with a fixed box, that it quantizes to a grid
-// index inside [0, 2^bits - 1]. A quarter step of slack lets callers use a box computed in
-// float arithmetic whose far corner rounded just below the farthest point.
+// The grid Draco quantizes a `components`-component attribute against: per component from
+// origin[c], cells of range / (2^bits - 1). Without a fixed box Draco takes the values' minima
+// and the largest side of their bounding box (1 when they all coincide).
+struct DracoGrid {
+  float origin[3] = {0, 0, 0};
+  float range = 1;
+};
+
+DracoGrid GridOfValues(const float* values, size_t count, int components) {
+  DracoGrid grid;
+  grid.range = 0;
+  for (int c = 0; c < components; ++c) {
+    float lo = values[c], hi = values[c];
+    for (size_t i = 1; i < count; ++i) {
+      lo = std::min(lo, values[i * components + c]);
+      hi = std::max(hi, values[i * components + c]);
+    }
+    grid.origin[c] = lo;
+    grid.range = std::max(grid.range, hi - lo);
+  }
+  if (grid.range == 0) grid.range = 1;
+  return grid;
+}
+
+// The box Draco's encoder reads back from the one it is given: it passes the box's origin and
+// edge to its quantizer as text, with std::to_string's six decimals (draco::Options), so a
+// box of origin 1e-7 and edge 3e-9 reaches it as origin 0 and edge 0.
+QuantizationBox AsDracoReadsIt(const QuantizationBox& box) {
+  draco::Options text;
+  text.SetVector("origin", box.origin.data(), 3);
+  text.SetFloat("range", box.range);
+  QuantizationBox read;
+  text.GetVector("origin", 3, read.origin.data());
+  read.range = text.GetFloat("range");
+  return read;
+}
+
+// The value nearest to x, at or above it when `up`, else at or below, that Draco reads back
+// exactly (AsDracoReadsIt). Below 2^23 * 1e-6 floats are finer than six decimals, so the
+// candidates are whole millionths; above, floats are coarser and most read back unchanged.
+float ValueDracoKeeps(double x, bool up) {
+  const double direction = up ? 1 : -1;
+  const float toward = up ? std::numeric_limits<float>::infinity()
+                          : -std::numeric_limits<float>::infinity();
+  double millionths = up ? std::ceil(x * 1e6) : std::floor(x * 1e6);
+  float candidate = static_cast<float>(millionths * 1e-6);
+  while (true) {
+    draco::Options text;
+    text.SetFloat("value", candidate);
+    const bool on_side = up ? candidate >= x : candidate <= x;
+    if (on_side && text.GetFloat("value") == candidate) return candidate;
+    millionths += direction;
+    const float next_millionth = static_cast<float>(millionths * 1e-6);
+    const float next_float = std::nextafter(candidate, toward);
+    candidate = up ? std::max(next_millionth, next_float) : std::min(next_millionth, next_float);
+  }
+}
+
+// Draco multiplies by the float (2^bits - 1) / range and later decodes q * range / (2^bits - 1)
+// + origin, without checks. When the first overflows (a range below about 2^bits / 3.4e38: 6e-36
+// at 11 bits) its encoder crashes or quantizes everything to garbage, and when the second does
+// (a grid reaching to the largest float) the data decodes to infinities. Returns what is
+// wrong with `grid`, or "" when Draco can quantize against it.
+std::string GridProblem(const DracoGrid& grid, int components, int bits) {
+  const float max_index = static_cast<float>(std::ldexp(1.0, bits) - 1.0);
+  if (!std::isfinite(grid.range)) return "more than a float can hold";
+  if (!(grid.range > 0) || !std::isfinite(max_index / grid.range)) {
+    return absl::StrCat(grid.range, ", too little for ", bits, "-bit quantization (at least ",
+                        max_index / std::numeric_limits<float>::max(), ")");
+  }
+  // q * range / (2^bits - 1) and the far corner, with room for rounding in float.
+  const double far_margin = 1 + 1e-5;
+  const double largest = std::numeric_limits<float>::max();
+  for (int c = 0; c < components; ++c) {
+    if (double{grid.range} * far_margin > largest ||
+        double{grid.origin[c]} + double{grid.range} * far_margin > largest) {
+      return absl::StrCat(grid.range, " from ", grid.origin[c],
+                          ", reaching past the largest float");
+    }
+  }
+  return "";
+}
+
+// Checks that every position is finite, that Draco can quantize them (GridProblem) and, with a
+// fixed box, that each quantizes to a grid index inside [0, 2^bits - 1] of the box as Draco
+// reads it. A quarter step of slack lets callers use a box computed in float arithmetic whose
+// far corner rounded just below the farthest point.
 absl::Status CheckPositions(const std::vector<Vec3f>& positions, const DracoOptions& options) {
   for (size_t i = 0; i < positions.size(); ++i) {
     if (!IsFinite(positions[i])) {
       return absl::InvalidArgumentError(absl::StrCat("vertex ", i, " has a non-finite coordinate"));
     }
   }
-  if (!options.quantization_box.has_value()) return absl::OkStatus();
-  const QuantizationBox& box = *options.quantization_box;
-  const double max_index = std::ldexp(1.0, options.position_quantization_bits) - 1.0;
+  const int bits = options.position_quantization_bits;
+  if (!options.quantization_box.has_value()) {
+    const std::string problem =
+        GridProblem(GridOfValues(positions.front().data(), positions.size(), 3), 3, bits);
+    if (problem.empty()) return absl::OkStatus();
+    return absl::InvalidArgumentError(absl::StrCat(
+        "cannot quantize the positions with Draco: their bounding box spans ", problem));
+  }
+  const QuantizationBox& given = *options.quantization_box;
+  const QuantizationBox box = AsDracoReadsIt(given);
+  const auto describe = [&given, &box] {
+    std::string text = absl::StrCat("the quantization box with origin (", given.origin[0], ", ",
+                                    given.origin[1], ", ", given.origin[2], ") and range ",
+                                    given.range);
+    if (box.origin != given.origin || box.range != given.range) {
+      absl::StrAppend(&text, ", which Draco reads (with six decimals) as origin (", box.origin[0],
+                      ", ", box.origin[1], ", ", box.origin[2], ") and range ", box.range,
+                      " (DracoExactBox gives a box it keeps exactly)");
+    }
+    return text;
+  };
+  DracoGrid grid;
+  for (int c = 0; c < 3; ++c) grid.origin[c] = box.origin[c];
+  grid.range = box.range;
+  const std::string problem = GridProblem(grid, 3, bits);
+  if (!problem.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot quantize against ", describe(), ": its range is ", problem));
+  }
+  const double max_index = std::ldexp(1.0, bits) - 1.0;
   const double cells_per_unit = max_index / box.range;
   for (size_t i = 0; i < positions.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
       const double t = (double{positions[i][c]} - double{box.origin[c]}) * cells_per_unit;
       if (t < -0.25 || t > max_index + 0.25) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "vertex ", i, " (", positions[i][0], ", ", positions[i][1], ", ", positions[i][2],
-            ") lies outside the quantization box with origin (", box.origin[0], ", ", box.origin[1],
-            ", ", box.origin[2], ") and range ", box.range));
+        return absl::InvalidArgumentError(absl::StrCat("vertex ", i, " (", positions[i][0], ", ",
+                                                       positions[i][1], ", ", positions[i][2],
+                                                       ") lies outside ", describe()));
       }
     }
   }
   return absl::OkStatus();
+}
+
+// Draco codes a normal as a direction (octahedral), normalising it in float: one of length
+// 1e38 or more overflowed to infinity there and decoded to NaN (found by
+// fuzz/draco_encoder_fuzzer.cc). So the directions are taken here, in double; zero normals
+// stay zero.
+std::vector<Vec3f> UnitNormals(const std::vector<Vec3f>& normals) {
+  std::vector<Vec3f> unit(normals.size());
+  for (size_t i = 0; i < normals.size(); ++i) {
+    const Vec3 n(normals[i][0], normals[i][1], normals[i][2]);
+    const double length = n.norm();
+    unit[i] = length > 0 ? Vec3f(n / length) : normals[i];
+  }
+  return unit;
 }
 
 // Adds a per-point float attribute with identity mapping and copies `count` values into it.
@@ -106,23 +235,24 @@ absl::StatusOr<std::string> RunEncoder(draco::ExpertEncoder& encoder, const char
 // attribute headers, the 17-byte quantization box, the entropy coders' tables and the 8 bytes
 // of bounds of the prediction transform. Below this many vertices that overhead dominates, and
 // which settings give the shortest stream varies from mesh to mesh. Measured on 80 learned
-// meshes (tori and spheres, 11 bits, session-style boxes): without prediction at 10 vertices
-// (its bounds are not repaid), speed 0 or 10 (another predictor and entropy-coder precision)
-// at 15-30, and the given settings at every mesh from 40 vertices on. A mesh this small
-// encodes in about 0.1 ms, so every variant is tried and the shortest stream kept. Draco's
+// meshes (tori and spheres, 11 bits, session-style boxes): speed 0 or 10 (another predictor
+// and entropy-coder precision) at 10-30 vertices, and the given settings at every mesh from 40
+// vertices on. A mesh this small encodes in about 0.1 ms, so every variant is tried and the
+// shortest stream kept. Turning position prediction off saved up to 10 more bytes at 10
+// vertices, but Draco 1.5.5's encoder crashes without prediction on some meshes with a fixed
+// quantization box of small range (a fuzzer found 4 vertices in a box of edge 3e-29; a box of
+// 3e-7 still crashes it), so that variant is not tried. Draco's
 // sequential connectivity coder is not among them: it was never shorter (28% longer at 10
 // vertices, twice as long at 50, 2.7 times at 200), and it would keep what Edgebreaker drops
 // (see draco_codec.h).
 constexpr size_t kSmallMeshVertices = 64;
 
-// One way of encoding a mesh: Draco's speed settings and whether positions are predicted.
+// Draco's speed settings for one encoding of a mesh.
 struct MeshEncoding {
   int encode_speed;
   int decode_speed;
-  bool predict_positions;
   bool operator==(const MeshEncoding& o) const {
-    return encode_speed == o.encode_speed && decode_speed == o.decode_speed &&
-           predict_positions == o.predict_positions;
+    return encode_speed == o.encode_speed && decode_speed == o.decode_speed;
   }
 };
 
@@ -133,53 +263,90 @@ absl::StatusOr<std::string> EncodeMeshAs(const draco::Mesh& geometry, int positi
   encoder.SetSpeedOptions(encoding.encode_speed, encoding.decode_speed);
   encoder.SetEncodingMethod(draco::MESH_EDGEBREAKER_ENCODING);
   SetPositionQuantization(encoder, position_id, options);
-  if (!encoding.predict_positions) {
-    const draco::Status status =
-        encoder.SetAttributePredictionScheme(position_id, draco::PREDICTION_NONE);
-    if (!status.ok()) {
-      return absl::InternalError(
-          absl::StrCat("Draco refused to turn prediction off: ", status.error_msg_string()));
-    }
-  }
   return RunEncoder(encoder, "mesh");
 }
 
-// Draco sizes a point cloud's arrays from the point count in the stream without comparing it
-// with the data that follows, so a few corrupt bytes can demand gigabytes (one 120-byte buffer
-// made Draco 1.5.5 fill 8 GB before giving up). The count cannot be bounded tightly either:
-// kd-tree and entropy coding store a million identical points in under 200 bytes. So any count
-// up to kAlwaysAllowedPoints passes, and larger ones need a byte per kMaxPointsPerByte points.
-// Mesh streams need no such check: Draco validates their counts.
-constexpr uint64_t kAlwaysAllowedPoints = uint64_t{1} << 20;
-constexpr uint64_t kMaxPointsPerByte = 256;
+// Draco sizes its arrays from the counts at the start of a stream without comparing them with
+// the data that follows, so a few corrupt bytes can demand gigabytes (one 120-byte point cloud
+// made Draco 1.5.5 fill 8 GB before giving up; a 140-byte Edgebreaker mesh asked for 3.5 GB).
+// The counts cannot be bounded tightly either: kd-tree and entropy coding store a million
+// identical points in under 200 bytes. So any count up to kAlwaysAllowedElements passes, and
+// larger ones need a byte per kMaxElementsPerByte points, vertices or faces.
+constexpr uint64_t kAlwaysAllowedElements = uint64_t{1} << 20;
+constexpr uint64_t kMaxElementsPerByte = 256;
 
-absl::Status CheckDeclaredPointCount(std::string_view bytes) {
+// Reads one count as the given stream version stores it: fixed 32 bits before `varint_since`,
+// a varint from then on.
+bool DecodeCount(draco::DecoderBuffer& buffer, uint16_t version, uint16_t varint_since,
+                 uint64_t* count) {
+  uint32_t value = 0;
+  const bool ok = version < varint_since ? buffer.Decode(&value)
+                                         : draco::DecodeVarint(&value, &buffer);
+  *count = value;
+  return ok;
+}
+
+// The point count of a point cloud stream, or the vertex and face counts of a mesh stream,
+// where Draco reads them (its decoders' DecodeConnectivity); empty when the stream ends or is
+// malformed before them, which Draco then reports itself.
+std::vector<std::pair<const char*, uint64_t>> DeclaredCounts(std::string_view bytes) {
   draco::DecoderBuffer buffer;
   buffer.Init(bytes.data(), bytes.size());
   char magic[5];
   uint8_t major = 0, minor = 0, type = 0, method = 0;
   uint16_t flags = 0;
-  // Whatever fails to parse here fails in Draco too, with its own message.
   if (!buffer.Decode(magic, sizeof(magic)) || !buffer.Decode(&major) || !buffer.Decode(&minor) ||
-      !buffer.Decode(&type) || !buffer.Decode(&method) || !buffer.Decode(&flags) ||
-      type != draco::POINT_CLOUD) {
-    return absl::OkStatus();
+      !buffer.Decode(&type) || !buffer.Decode(&method) || !buffer.Decode(&flags)) {
+    return {};
   }
   const uint16_t version = DRACO_BITSTREAM_VERSION(major, minor);
   buffer.set_bitstream_version(version);
   if (version >= DRACO_BITSTREAM_VERSION(1, 3) && (flags & METADATA_FLAG_MASK) != 0) {
     draco::GeometryMetadata metadata;
     draco::MetadataDecoder metadata_decoder;
-    if (!metadata_decoder.DecodeGeometryMetadata(&buffer, &metadata)) return absl::OkStatus();
+    if (!metadata_decoder.DecodeGeometryMetadata(&buffer, &metadata)) return {};
   }
-  int32_t stored_count = 0;
-  if (!buffer.Decode(&stored_count)) return absl::OkStatus();
-  // The sequential decoder reads the count as unsigned.
-  const uint64_t count = static_cast<uint32_t>(stored_count);
-  const uint64_t limit = std::max<uint64_t>(kAlwaysAllowedPoints, kMaxPointsPerByte * bytes.size());
-  if (count > limit) {
-    return absl::InvalidArgumentError(absl::StrCat("corrupt Draco data: it declares ", count,
-                                                   " points in only ", bytes.size(), " bytes"));
+  if (type == draco::POINT_CLOUD) {
+    int32_t stored = 0;
+    if (!buffer.Decode(&stored)) return {};
+    return {{"points", static_cast<uint32_t>(stored)}};  // Read as unsigned by the decoders.
+  }
+  if (type != draco::TRIANGULAR_MESH) return {};
+  uint64_t vertices = 0, faces = 0;
+  if (method == draco::MESH_SEQUENTIAL_ENCODING) {
+    const uint16_t varint_since = DRACO_BITSTREAM_VERSION(2, 2);
+    if (!DecodeCount(buffer, version, varint_since, &faces) ||
+        !DecodeCount(buffer, version, varint_since, &vertices)) {
+      return {};
+    }
+  } else if (method == draco::MESH_EDGEBREAKER_ENCODING) {
+    const uint16_t varint_since = DRACO_BITSTREAM_VERSION(2, 0);
+    uint8_t traversal = 0;
+    uint64_t new_vertices = 0;
+    if (!buffer.Decode(&traversal)) return {};
+    if (version < DRACO_BITSTREAM_VERSION(2, 2) &&
+        !DecodeCount(buffer, version, varint_since, &new_vertices)) {
+      return {};
+    }
+    if (!DecodeCount(buffer, version, varint_since, &vertices) ||
+        !DecodeCount(buffer, version, varint_since, &faces)) {
+      return {};
+    }
+  } else {
+    return {};
+  }
+  return {{"vertices", vertices}, {"faces", faces}};
+}
+
+absl::Status CheckDeclaredCounts(std::string_view bytes) {
+  const uint64_t limit =
+      std::max<uint64_t>(kAlwaysAllowedElements, kMaxElementsPerByte * bytes.size());
+  for (const auto& [what, count] : DeclaredCounts(bytes)) {
+    if (count > limit) {
+      return absl::InvalidArgumentError(absl::StrCat("corrupt Draco data: it declares ", count,
+                                                     " ", what, " in only ", bytes.size(),
+                                                     " bytes"));
+    }
   }
   return absl::OkStatus();
 }
@@ -200,7 +367,7 @@ absl::StatusOr<std::unique_ptr<Geometry>> DecodeDraco(std::string_view bytes) {
   if (kWantMesh && type.value() != draco::TRIANGULAR_MESH) {
     return absl::InvalidArgumentError("the Draco data holds a point cloud, not a triangle mesh");
   }
-  NM_RETURN_IF_ERROR(CheckDeclaredPointCount(bytes));
+  NM_RETURN_IF_ERROR(CheckDeclaredCounts(bytes));
   buffer.Init(bytes.data(), bytes.size());
   draco::Decoder decoder;
   try {
@@ -228,6 +395,16 @@ absl::StatusOr<std::unique_ptr<Geometry>> DecodeDraco(std::string_view bytes) {
   }
 }
 
+// Draco's streams may declare an attribute of any data type, booleans included, and reading a
+// stored byte other than 0 or 1 as a bool is undefined (a fuzzer found a position attribute of
+// booleans holding 42). Positions, normals and weights must be numbers.
+absl::Status CheckNumeric(const draco::PointAttribute& attribute, const char* what) {
+  const draco::DataType type = attribute.data_type();
+  if (type >= draco::DT_INT8 && type <= draco::DT_FLOAT64) return absl::OkStatus();
+  return absl::InvalidArgumentError(absl::StrCat("the Draco ", what, " attribute has data type ",
+                                                 static_cast<int>(type), ", not a number type"));
+}
+
 absl::StatusOr<const draco::PointAttribute*> PositionAttribute(const draco::PointCloud& geometry) {
   const draco::PointAttribute* positions =
       geometry.GetNamedAttribute(draco::GeometryAttribute::POSITION);
@@ -239,6 +416,7 @@ absl::StatusOr<const draco::PointAttribute*> PositionAttribute(const draco::Poin
                                                    int{positions->num_components()},
                                                    " components; expected 3"));
   }
+  NM_RETURN_IF_ERROR(CheckNumeric(*positions, "position"));
   return positions;
 }
 
@@ -258,10 +436,24 @@ absl::StatusOr<Vec3f> ReadVec3(const draco::PointAttribute& attribute,
 
 }  // namespace
 
+QuantizationBox DracoExactBox(const QuantizationBox& box) {
+  QuantizationBox exact;
+  double range = 0;
+  for (int c = 0; c < 3; ++c) {
+    exact.origin[c] = ValueDracoKeeps(box.origin[c], /*up=*/false);
+    range = std::max(range, double{box.origin[c]} + double{box.range} - exact.origin[c]);
+  }
+  exact.range = ValueDracoKeeps(range, /*up=*/true);
+  return exact;
+}
+
 absl::Status DracoOptions::Validate() const {
-  NM_RETURN_IF_ERROR(CheckRange("position_quantization_bits", position_quantization_bits, 1, 30));
-  NM_RETURN_IF_ERROR(CheckRange("normal_quantization_bits", normal_quantization_bits, 2, 30));
-  NM_RETURN_IF_ERROR(CheckRange("weight_quantization_bits", weight_quantization_bits, 1, 30));
+  NM_RETURN_IF_ERROR(CheckRange("position_quantization_bits", position_quantization_bits, 1,
+                                kMaxQuantizationBits));
+  NM_RETURN_IF_ERROR(
+      CheckRange("normal_quantization_bits", normal_quantization_bits, 2, kMaxQuantizationBits));
+  NM_RETURN_IF_ERROR(
+      CheckRange("weight_quantization_bits", weight_quantization_bits, 1, kMaxQuantizationBits));
   NM_RETURN_IF_ERROR(CheckRange("encode_speed", encode_speed, 0, 10));
   NM_RETURN_IF_ERROR(CheckRange("decode_speed", decode_speed, 0, 10));
   if (quantization_box.has_value()) {
@@ -325,15 +517,13 @@ absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOpti
     geometry.SetFace(draco::FaceIndex(static_cast<uint32_t>(f)), face);
   }
 
-  const MeshEncoding given{options.encode_speed, options.decode_speed, true};
+  const MeshEncoding given{options.encode_speed, options.decode_speed};
   NM_ASSIGN_OR_RETURN(std::string best, EncodeMeshAs(geometry, position_id, options, given));
   if (!options.shrink_small_meshes || num_vertices >= kSmallMeshVertices) return best;
   // Draco takes the larger of the two speeds as the one that limits its choices, so both are
   // set. Every variant quantizes against the same grid, so they all decode to the same mesh
   // (up to the order of vertices and faces).
-  for (const MeshEncoding& variant :
-       {MeshEncoding{options.encode_speed, options.decode_speed, false}, MeshEncoding{0, 0, true},
-        MeshEncoding{10, 10, true}}) {
+  for (const MeshEncoding& variant : {MeshEncoding{0, 0}, MeshEncoding{10, 10}}) {
     if (variant == given) continue;
     NM_ASSIGN_OR_RETURN(std::string bytes, EncodeMeshAs(geometry, position_id, options, variant));
     if (bytes.size() < best.size()) best = std::move(bytes);
@@ -346,6 +536,15 @@ absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const Drac
   if (cloud.empty()) return absl::InvalidArgumentError("cannot encode an empty point cloud");
   NM_RETURN_IF_ERROR(ValidatePointCloud(cloud));
   NM_RETURN_IF_ERROR(CheckPositions(cloud.positions, options));
+  if (!cloud.weights.empty()) {
+    const std::string problem =
+        GridProblem(GridOfValues(cloud.weights.data(), cloud.weights.size(), 1), 1,
+                    options.weight_quantization_bits);
+    if (!problem.empty()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("cannot quantize the weights with Draco: they span ", problem));
+    }
+  }
 
   const size_t n = cloud.size();
   draco::PointCloud geometry;
@@ -354,8 +553,9 @@ absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const Drac
                                             cloud.positions.front().data(), n);
   int normal_id = -1;
   if (!cloud.normals.empty()) {
+    const std::vector<Vec3f> directions = UnitNormals(cloud.normals);
     normal_id = AddFloatAttribute(geometry, draco::GeometryAttribute::NORMAL, 3,
-                                  cloud.normals.front().data(), n);
+                                  directions.front().data(), n);
   }
   int weight_id = -1;
   if (!cloud.weights.empty()) {
@@ -425,6 +625,8 @@ absl::StatusOr<PointCloud> DecodePointCloud(std::string_view bytes) {
       break;
     }
   }
+  if (normals != nullptr) NM_RETURN_IF_ERROR(CheckNumeric(*normals, "normal"));
+  if (weights != nullptr) NM_RETURN_IF_ERROR(CheckNumeric(*weights, "weight"));
 
   PointCloud cloud;
   cloud.positions.reserve(n);

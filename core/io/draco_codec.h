@@ -32,22 +32,31 @@ struct QuantizationBox {
   float range = 0;                 // Edge length; must be finite and positive.
 };
 
+// The most quantization bits any attribute may ask for. Draco accepts up to 30, but its
+// entropy coder sizes a table by the largest symbol, so an encoding costs time and memory in
+// proportion to 2^bits whatever the geometry's size (measured with Draco 1.5.5 on a 25-vertex
+// mesh without prediction: 17 MB and 1-6 ms at 20 bits, 149 MB and 0.1 s at 24, 2 GB and 2 s
+// at 28); at 30 bits its mesh encoder crashes. More than 24 bits, a float's significand, add
+// no precision to float positions.
+inline constexpr int kMaxQuantizationBits = 24;
+
 struct DracoOptions {
-  int position_quantization_bits = 11;  // 1..30.
-  int normal_quantization_bits = 10;    // 2..30; point-cloud normals.
-  int weight_quantization_bits = 16;    // 1..30; point weights, against their own min..max.
+  int position_quantization_bits = 11;  // 1..kMaxQuantizationBits.
+  int normal_quantization_bits = 10;    // 2..kMaxQuantizationBits; point-cloud normals.
+  int weight_quantization_bits = 16;    // 1..kMaxQuantizationBits; point weights, against
+                                        // their own min..max.
   int encode_speed = 5;                 // 0 (smallest output) .. 10 (fastest).
   int decode_speed = 5;                 // 0 .. 10.
-  // Meshes under 64 vertices are also encoded without position prediction and at speeds 0 and
-  // 10, and the shortest stream is kept. Draco's fixed cost (about 70 bytes) dominates such
-  // meshes, and which settings save most varies from mesh to mesh (up to 10 bytes at 10
-  // vertices, 4 at 20); each try takes about 0.1 ms. Every variant decodes to the same mesh,
+  // Meshes under 64 vertices are also encoded at speeds 0 and 10, and the shortest stream is
+  // kept. Draco's fixed cost (about 70 bytes) dominates such meshes, and which settings save
+  // most varies from mesh to mesh (a few bytes at 10-30 vertices); each try takes about 0.1 ms. Every variant decodes to the same mesh,
   // with any Draco 1.5 decoder. False: exactly the speeds above.
   bool shrink_small_meshes = true;
   // When set, positions are quantized against this fixed cube instead of each geometry's own
   // bounding box, so successive meshes of one session share one grid (no jitter, no cracks):
-  // the same input position always decodes to bit-identical floats. Every position must lie
-  // inside the cube, give or take a quarter grid step for float rounding; encoding returns
+  // the same input position always decodes to bit-identical floats. Draco uses the cube as it
+  // reads it, rounded to six decimals (see DracoExactBox). Every position must lie inside that
+  // cube, give or take a quarter grid step for float rounding; encoding returns
   // INVALID_ARGUMENT otherwise (nothing is clamped).
   std::optional<QuantizationBox> quantization_box;
 
@@ -55,29 +64,39 @@ struct DracoOptions {
   absl::Status Validate() const;
 };
 
+// The smallest box containing `box` that Draco keeps exactly. Draco's encoder receives a fixed
+// box as text with six decimals (std::to_string), so a box of origin 1e-7 and edge 3e-9 reaches
+// it as origin 0 and edge 0, and any other box moves by up to 5e-7. The returned box's origin
+// and edge are millionths (floats above 8 or so: themselves); for data spanning less than about
+// 1e-3 the grid gets coarser than asked. Callers that announce their grid use it.
+QuantizationBox DracoExactBox(const QuantizationBox& box);
+
 // Encodes `mesh` (positions and faces) with Edgebreaker; see shrink_small_meshes for meshes
 // under 64 vertices.
 // Returns INVALID_ARGUMENT when `options` is invalid, the mesh has no vertices or no
-// non-degenerate faces, a face index is out of range, a coordinate is not finite, or a position
-// lies outside `options.quantization_box`; INTERNAL if Draco fails for another reason.
+// non-degenerate faces, a face index is out of range, a coordinate is not finite, a position
+// lies outside `options.quantization_box` (as Draco reads it), or the grid cannot be quantized
+// in float (an edge too small for its step, or spanning nearly the whole float range); INTERNAL
+// if Draco fails for another reason.
 absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOptions& options);
 
 // Encodes the positions of `cloud`, its normals when present and its weights (as a generic
 // one-component attribute) when present.
-// Returns INVALID_ARGUMENT when `options` is invalid, the cloud is empty, fails
-// ValidatePointCloud, or has a position outside `options.quantization_box`; INTERNAL if Draco
-// fails for another reason.
+// Returns INVALID_ARGUMENT as EncodeMesh does, also when the cloud is empty or fails
+// ValidatePointCloud, or its weights' spread cannot be quantized; INTERNAL if Draco fails for
+// another reason.
 absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const DracoOptions& options);
 
 // Decodes a Draco mesh: one position per distinct position value and the triangles.
 // Returns INVALID_ARGUMENT when `bytes` is not a valid Draco mesh (corrupt, truncated, a point
-// cloud, no position attribute, non-finite positions).
+// cloud, no numeric position attribute, non-finite positions, or counts of vertices or faces
+// far beyond what its size can hold: more than 2^20 and 256 per byte).
 absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes);
 
 // Decodes a Draco point cloud, or the points of a Draco mesh; restores normals (the NORMAL
 // attribute) and weights (the first one-component GENERIC attribute) when present.
-// Returns INVALID_ARGUMENT when `bytes` is not valid Draco data, has no positions, or decodes
-// to a cloud that fails ValidatePointCloud.
+// Returns INVALID_ARGUMENT when `bytes` is not valid Draco data (as for DecodeMesh), has no
+// numeric positions, or decodes to a cloud that fails ValidatePointCloud.
 absl::StatusOr<PointCloud> DecodePointCloud(std::string_view bytes);
 
 }  // namespace neuralmesh

@@ -201,9 +201,10 @@ __attribute__((target("avx2"))) void BuildUpdateAvx2(const double d[3], bool bor
                                                      double alpha_l, double scale,
                                                      double previous_on, const double f[3],
                                                      OneRingSmoother::RingVertex& r) {
+  // Row `col` is the unit vector of lane `col` (a blend with a run-time mask would not compile
+  // with clang, which wants the mask to be a constant).
+  alignas(32) static constexpr double kUnit[3][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}};
   const __m256d zero = _mm256_setzero_pd();
-  const __m256d one = _mm256_set1_pd(1.0);
-  const __m256d identity = _mm256_set1_pd(border ? 0.0 : 1.0);
   const __m256d sign = _mm256_set1_pd(border ? 1.0 : -1.0);
   const __m256d dv = _mm256_set_pd(0.0, d[2], d[1], d[0]);
   const __m256d alpha = _mm256_set1_pd(alpha_l);
@@ -212,15 +213,15 @@ __attribute__((target("avx2"))) void BuildUpdateAvx2(const double d[3], bool bor
   __m256d columns[3];
 #pragma GCC unroll 3
   for (int col = 0; col < 3; ++col) {
-    const int lane = 1 << col;  // The diagonal's lane, as a blend mask.
+    const __m256d unit = _mm256_load_pd(kUnit[col]);  // 1.0 on the diagonal's lane.
     // Lane `row`: (identity on the diagonal, else 0.0) + sign * (d[row] * d[col]).
     const __m256d proj =
-        _mm256_add_pd(_mm256_blend_pd(zero, identity, lane),
+        _mm256_add_pd(border ? zero : unit,
                       _mm256_mul_pd(sign, _mm256_mul_pd(dv, _mm256_set1_pd(d[col]))));
     const __m256d neighbour = _mm256_mul_pd(g, proj);
     // Lane 3 of proj is +0, so every matrix gets +0 there, as the scalar version writes.
     _mm256_store_pd(r.own[col],
-                    _mm256_sub_pd(_mm256_blend_pd(zero, one, lane), _mm256_mul_pd(alpha, proj)));
+                    _mm256_sub_pd(unit, _mm256_mul_pd(alpha, proj)));
     _mm256_store_pd(r.neighbour[col], neighbour);
     _mm256_store_pd(r.previous[col], _mm256_mul_pd(previous, neighbour));
     columns[col] = neighbour;

@@ -49,6 +49,14 @@ TEST(ResolveSessionConfigTest, RejectsInvalidOptionsNamingTheField) {
   };
   const Case cases[] = {
       {"target below 4", [](SessionConfig& c) { c.target_vertices = 3; }, "target_vertices"},
+      // Found by fuzz/session_config_fuzzer.cc: with a tiny points_per_vertex the point limit
+      // allowed it, and the default milestones overflowed past 2^64 into a disorder.
+      {"target near 2^64",
+       [](SessionConfig& c) {
+         c.target_vertices = 18446744073680191486u;
+         c.points_per_vertex = 1e-264;
+       },
+       "target_vertices"},
       {"alpha_w zero", [](SessionConfig& c) { c.learner.alpha_w = 0; }, "alpha_w"},
       {"alpha_w above 1", [](SessionConfig& c) { c.learner.alpha_w = 1.5; }, "alpha_w"},
       {"milestones not increasing", [](SessionConfig& c) { c.lod_milestones = {100, 50}; },

@@ -262,6 +262,40 @@ TEST_F(SessionTest, AllMeshesShareOneQuantizationBoxUntilDataFallsOutside) {
       << "the cube grows to hold data outside it";
 }
 
+// Draco receives a fixed box as text with six decimals: a torus 3e-7 across used to reach it
+// in a box of edge 0, and every mesh failed to encode. The session's box is one Draco keeps
+// exactly, so such data streams meshes whose vertices decode inside that box.
+TEST_F(SessionTest, DataOfTinyExtentStillStreamsMeshes) {
+  SessionConfig config;
+  config.target_vertices = 200;
+  auto session = NewSession(config);
+  PointCloud points = Torus(4000, 7);
+  for (Vec3f& p : points.positions) p *= 1e-7f;
+  ASSERT_TRUE(session->AddPoints(points).ok());
+  ASSERT_TRUE(session->Finish().ok());
+  ASSERT_TRUE(recorder_.AwaitClose().ok());
+  const std::vector<MeshUpdatePtr> updates = recorder_.updates();
+  ASSERT_FALSE(updates.empty());
+  const v1::MeshUpdate& last = *updates.back();
+  EXPECT_EQ(last.kind(), v1::UPDATE_KIND_FINAL);
+  const QuantizationBox box{Vec3f(last.quantization_box().origin_x(),
+                                  last.quantization_box().origin_y(),
+                                  last.quantization_box().origin_z()),
+                            last.quantization_box().range()};
+  const QuantizationBox exact = DracoExactBox(box);
+  EXPECT_EQ(exact.origin, box.origin) << "the announced box is not one Draco keeps exactly";
+  EXPECT_EQ(exact.range, box.range) << "the announced box is not one Draco keeps exactly";
+  const absl::StatusOr<TriangleMesh> mesh = DecodeMesh(last.draco_mesh());
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_GE(mesh->positions.size(), 50u);
+  for (const Vec3f& p : mesh->positions) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_GE(p[c], box.origin[c] - 1e-12f);
+      EXPECT_LE(p[c], box.origin[c] + box.range + 1e-12f);
+    }
+  }
+}
+
 TEST_F(SessionTest, AStalledLearnerFailsTheSessionInsteadOfSpinning) {
   SessionConfig config;
   config.target_vertices = 100;

@@ -6,7 +6,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <limits>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -50,9 +52,10 @@ TEST(DracoOptionsTest, ValidateNamesTheBadField) {
   };
   const Case cases[] = {
       {"position_quantization_bits", [](DracoOptions& o) { o.position_quantization_bits = 0; }},
-      {"position_quantization_bits", [](DracoOptions& o) { o.position_quantization_bits = 31; }},
+      {"position_quantization_bits", [](DracoOptions& o) { o.position_quantization_bits = 25; }},
       {"normal_quantization_bits", [](DracoOptions& o) { o.normal_quantization_bits = 1; }},
-      {"weight_quantization_bits", [](DracoOptions& o) { o.weight_quantization_bits = 31; }},
+      {"weight_quantization_bits", [](DracoOptions& o) { o.weight_quantization_bits = 25; }},
+      {"normal_quantization_bits", [](DracoOptions& o) { o.normal_quantization_bits = 25; }},
       {"encode_speed", [](DracoOptions& o) { o.encode_speed = -1; }},
       {"encode_speed", [](DracoOptions& o) { o.encode_speed = 11; }},
       {"decode_speed", [](DracoOptions& o) { o.decode_speed = 11; }},
@@ -228,6 +231,83 @@ TEST(DracoCodecTest, SmallMeshesKeepTheShortestOfSeveralEncodings) {
                            "so the other encodings were not tried (or never help)";
 }
 
+// Draco receives a fixed box as text with six decimals, so a box of edge 3e-9 reached it as
+// edge 0: it then crashed (fuzz/draco_encoder_fuzzer.cc found a 4-vertex mesh) or decoded every
+// point to 0. Such a box must be rejected with a message that says so, and DracoExactBox must
+// give a box that contains it and encodes at every scale.
+TEST(DracoCodecTest, FixedBoxesAreTakenAsDracoReadsThem) {
+  for (const double extent : {3e-9, 1e-6, 1e-3, 0.7, 1e3, 3e7}) {
+    const std::string context = "extent " + std::to_string(extent);
+    TriangleMesh mesh = testing::GridPatch(6, 6);  // [0, 1]^2 at z = 0.
+    for (size_t i = 0; i < mesh.positions.size(); ++i) {
+      Vec3f& p = mesh.positions[i];
+      p = Vec3f(static_cast<float>(extent * (p[0] + 0.1234567)),
+                static_cast<float>(extent * (p[1] - 2.345678)),
+                static_cast<float>(extent * 0.3 * std::sin(static_cast<double>(i))));
+    }
+    const QuantizationBox box{
+        Vec3f(static_cast<float>(extent * 0.07), static_cast<float>(extent * -2.4),
+              static_cast<float>(extent * -0.35)),
+        static_cast<float>(extent * 1.1)};
+    const QuantizationBox exact = DracoExactBox(box);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_LE(exact.origin[c], box.origin[c]) << context;
+      EXPECT_GE(double{exact.origin[c]} + exact.range, double{box.origin[c]} + box.range)
+          << context;
+    }
+    if (extent >= 1e-3) {
+      EXPECT_LE(exact.range, box.range * 1.01) << context << ": the exact box grew too much";
+    }
+    DracoOptions options;
+    options.position_quantization_bits = 14;
+    options.quantization_box = exact;
+    const absl::StatusOr<std::string> bytes = EncodeMesh(mesh, options);
+    ASSERT_TRUE(bytes.ok()) << context << ": " << bytes.status();
+    const absl::StatusOr<TriangleMesh> decoded = DecodeMesh(*bytes);
+    ASSERT_TRUE(decoded.ok()) << context << ": " << decoded.status();
+    // QuantizationTolerance's absolute slack is too coarse at these scales: half a step, and
+    // float rounding relative to the box.
+    const double tolerance =
+        exact.range / ((1 << 14) - 1) * 0.5 * 1.001 +
+        4 * std::numeric_limits<float>::epsilon() *
+            (std::abs(exact.origin[0]) + std::abs(exact.origin[1]) + exact.range);
+    ASSERT_EQ(decoded->positions.size(), mesh.positions.size()) << context;
+    EXPECT_EQ(decoded->faces.size(), mesh.faces.size()) << context;
+    for (const Vec3f& p : decoded->positions) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Vec3f& q : mesh.positions) {
+        double d = 0;
+        for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(double{p[c]} - double{q[c]}));
+        nearest = std::min(nearest, d);
+      }
+      EXPECT_LE(nearest, tolerance) << context << ": decoded vertex far from every input";
+    }
+    if (extent < 1e-6) {
+      options.quantization_box = box;
+      ExpectInvalid(EncodeMesh(mesh, options).status(), "six decimals", context);
+    }
+  }
+
+  // The fuzzer's mesh, in the server's box: 1.1 times its extent of 3e-29.
+  TriangleMesh tiny;
+  tiny.positions = {Vec3f(1.3132476e-38f, 0.0f, 2.8398993e-29f),
+                    Vec3f(2.8411367e-29f, 2.8411367e-29f, 2.8411367e-29f),
+                    Vec3f(2.8411367e-29f, 4.2336235e-37f, 2.8411367e-29f),
+                    Vec3f(6.0669049e-39f, 6.1350416e-39f, 6.1328892e-39f)};
+  tiny.faces = {{2, 0, 3}, {1, 2, 3}};
+  DracoOptions options;
+  options.position_quantization_bits = 14;
+  options.quantization_box =
+      QuantizationBox{Vec3f(-1.42057e-30f, -1.42057e-30f, -1.42057e-30f), 3.12525e-29f};
+  ExpectInvalid(EncodeMesh(tiny, options).status(), "six decimals", "the fuzzer's mesh");
+  options.quantization_box = DracoExactBox(*options.quantization_box);
+  const absl::StatusOr<std::string> bytes = EncodeMesh(tiny, options);
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  const absl::StatusOr<TriangleMesh> decoded = DecodeMesh(*bytes);
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_EQ(decoded->faces.size(), 2u) << "the fuzzer's mesh in its exact box";
+}
+
 TEST(DracoCodecTest, MeshesOf64VerticesOrMoreUseTheGivenSettingsOnly) {
   const TriangleMesh mesh = testing::Icosphere(2);  // 162 vertices.
   DracoOptions exact = SessionOptions(mesh);
@@ -392,6 +472,159 @@ TEST(DracoCodecTest, PositionsOutsideTheFixedBoxAreRejected) {
   options.quantization_box = QuantizationBox{Vec3f(0, 0, 0), 1};
   EXPECT_TRUE(EncodeMesh(testing::GridPatch(3, 3), options).ok())
       << "GridPatch spans exactly [0, 1]^2 and must fit the unit box";
+}
+
+// Draco multiplies by (2^bits - 1) / range in float; below about 2^bits / 3.4e38 that
+// overflows and its encoder crashed (found by fuzz/draco_fuzzer.cc re-encoding a decoded mesh
+// of extent 1e-42). Such ranges must be rejected, and the smallest ones that work must work.
+TEST(DracoCodecTest, RangesTooSmallToQuantizeAreRejectedNotCrashed) {
+  for (const auto& [bits, too_small, enough] :
+       {std::tuple{11, 1e-36f, 1e-35f}, {20, 1e-33f, 1e-31f}, {24, 1e-32f, 1e-30f}}) {
+    const std::string context = std::to_string(bits) + " bits";
+    DracoOptions options;
+    options.position_quantization_bits = bits;
+    TriangleMesh mesh = testing::Icosphere(1);
+    for (Vec3f& p : mesh.positions) p *= too_small;
+    ExpectInvalid(EncodeMesh(mesh, options).status(), "too little for", context);
+    PointCloud cloud;
+    cloud.positions = mesh.positions;
+    ExpectInvalid(EncodePointCloud(cloud, options).status(), "too little for", context);
+    options.quantization_box =
+        QuantizationBox{Vec3f(-too_small, -too_small, -too_small), 2 * too_small};
+    ExpectInvalid(EncodeMesh(mesh, options).status(), "its range is", context);
+
+    options.quantization_box.reset();
+    for (Vec3f& p : mesh.positions) p *= enough / too_small;
+    const absl::StatusOr<std::string> bytes = EncodeMesh(mesh, options);
+    ASSERT_TRUE(bytes.ok()) << context << ": " << bytes.status();
+    const absl::StatusOr<TriangleMesh> decoded = DecodeMesh(*bytes);
+    ASSERT_TRUE(decoded.ok()) << context << ": " << decoded.status();
+    // At this scale the grid's steps are denormal floats, too coarse for ExpectSameMesh's
+    // distance arithmetic; what must hold is that no two vertices collapse into one (as they
+    // all did when Draco's scale overflowed).
+    EXPECT_EQ(decoded->positions.size(), mesh.positions.size()) << context << ": vertices merged";
+    EXPECT_EQ(decoded->faces.size(), mesh.faces.size()) << context << ": faces lost";
+  }
+  PointCloud weighted = io_test::RandomCloud(20, 3, false, true);
+  for (size_t i = 0; i < weighted.size(); ++i) weighted.weights[i] = 1e-40f * (1 + i % 2);
+  ExpectInvalid(EncodePointCloud(weighted, DracoOptions{}).status(), "weights", "weights 1e-40");
+}
+
+// Draco decodes q * range / (2^bits - 1) + origin in float: a mesh spanning nearly the whole
+// float range (found by fuzz/draco_fuzzer.cc re-encoding a decoded mesh) encoded, then decoded
+// to infinities. It must be rejected instead.
+TEST(DracoCodecTest, RangesReachingPastTheLargestFloatAreRejected) {
+  TriangleMesh mesh;
+  mesh.positions = {Vec3f(9.4e-38f, 9.4e-38f, 2.3e-38f), Vec3f(0, -1.7e38f, -1.7e38f),
+                    Vec3f(-3.4028e38f, 3.2e-42f, 1.77e28f), Vec3f(1.7e25f, 4.3e27f, 7.2e28f)};
+  mesh.faces = {{0, 1, 2}, {0, 2, 3}};
+  ExpectInvalid(EncodeMesh(mesh, {}).status(), "past the largest float", "mesh");
+  PointCloud cloud;
+  cloud.positions = mesh.positions;
+  ExpectInvalid(EncodePointCloud(cloud, {}).status(), "past the largest float", "cloud");
+  for (Vec3f& p : mesh.positions) p *= 0.5f;  // Half the span is fine.
+  const absl::StatusOr<std::string> bytes = EncodeMesh(mesh, {});
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  const absl::StatusOr<TriangleMesh> decoded = DecodeMesh(*bytes);
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+}
+
+// The largest bit count allowed (kMaxQuantizationBits) must work at the speeds that pick
+// different predictors and coders, on small meshes (which also try the encodings without
+// prediction) and on a large one. (Each encoding at 24 bits takes about 0.1 s.)
+TEST(DracoCodecTest, MeshesEncodeAtTheMaximumBits) {
+  const std::vector<TriangleMesh> small = SmallMeshes();
+  const std::vector<TriangleMesh> meshes = {small.front(), small[small.size() / 2], small.back(),
+                                            testing::Icosphere(3)};
+  for (const int speed : {0, 1, 5, 10}) {
+    DracoOptions options;
+    options.position_quantization_bits = kMaxQuantizationBits;
+    options.encode_speed = speed;
+    options.decode_speed = speed;
+    for (const TriangleMesh& mesh : meshes) {
+      const std::string context =
+          std::to_string(mesh.positions.size()) + " vertices, speed " + std::to_string(speed);
+      const absl::StatusOr<std::string> bytes = EncodeMesh(mesh, options);
+      ASSERT_TRUE(bytes.ok()) << context << ": " << bytes.status();
+      const absl::StatusOr<TriangleMesh> decoded = DecodeMesh(*bytes);
+      ASSERT_TRUE(decoded.ok()) << context << ": " << decoded.status();
+      ExpectSameMesh(mesh, *decoded,
+                     QuantizationTolerance(BoundingCubeRange(mesh.positions), kMaxQuantizationBits),
+                     context);
+    }
+  }
+}
+
+// Found by fuzz/draco_fuzzer.cc: a 71-byte mesh whose position attribute is declared as
+// booleans, one of them stored as 42. Reading that as a bool was undefined; such data is not
+// a mesh anyone can mean, and must be rejected with a message naming the problem.
+TEST(DracoCodecTest, PositionsOfBooleansAreRejected) {
+  const std::string bytes(
+      "\x44\x52\x41\x43\x4f\x02\x02\x01\x01\x00\x00\x00\x04\x04\x00\x03\x00\x00\x01\x2f\x01\x01"
+      "\x10\x01\xff\x00\x00\x01\x00\x0b\x03\x00\x00\x00\x00\x00\x00\x00\x2a\x00\x3f\x00\xff\xff"
+      "\xff\xff\xff\xff\x08\x01\x01\x63\x74\x6f\x6e\x5f\x73\x63\x68\x65\x6d\x65\xff\xff\x6e\x2c"
+      "\x50\x6f\x64\x69\x00",
+      71);
+  ExpectInvalid(DecodeMesh(bytes).status(), "position attribute has data type", "mesh");
+  ExpectInvalid(DecodePointCloud(bytes).status(), "position attribute has data type", "cloud");
+}
+
+// Draco reserves memory by the counts at the start of a mesh stream before reading anything
+// else: a 140-byte stream found by fuzz/point_batch_fuzzer.cc declared 889 million faces and
+// made it ask for 3.5 GB. Counts far beyond what the bytes can hold must be rejected first.
+TEST(DracoCodecTest, MeshStreamsDeclaringFarTooManyFacesAreRejected) {
+  const absl::StatusOr<std::string> valid = EncodeMesh(testing::Icosphere(1), {});
+  ASSERT_TRUE(valid.ok()) << valid.status();
+  // Draco 2.2 Edgebreaker: an 11-byte header, the traversal type, then varints for the
+  // vertex and face counts.
+  size_t at = 12;
+  auto skip_varint = [&] {
+    while (static_cast<uint8_t>((*valid)[at]) & 0x80) ++at;
+    ++at;
+  };
+  skip_varint();
+  const size_t faces_at = at;
+  skip_varint();
+  auto with_faces = [&](uint32_t faces) {
+    std::string varint;
+    do {
+      varint.push_back(static_cast<char>((faces & 0x7f) | (faces > 0x7f ? 0x80 : 0)));
+      faces >>= 7;
+    } while (faces > 0);
+    return valid->substr(0, faces_at) + varint + valid->substr(at);
+  };
+  const absl::StatusOr<TriangleMesh> as_is = DecodeMesh(with_faces(80));
+  ASSERT_TRUE(as_is.ok()) << "the face count was not where the test expects it: "
+                          << as_is.status();
+  EXPECT_EQ(as_is->faces.size(), 80u);
+  ExpectInvalid(DecodeMesh(with_faces(889'000'000)).status(), "declares 889000000 faces",
+                "889 million faces");
+  ExpectInvalid(DecodePointCloud(with_faces(889'000'000)).status(), "declares 889000000 faces",
+                "889 million faces, read as points");
+}
+
+// Draco normalises normals in float, and one of length 3e38 (found by the encoder fuzzer)
+// overflowed there and decoded to NaN. Normals of any length encode as their directions.
+TEST(DracoCodecTest, NormalsOfAnyLengthEncodeAsDirections) {
+  PointCloud cloud;
+  cloud.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, 0, 1)};
+  cloud.normals = {Vec3f(3.4e38f, 3.4e38f, 3.4e38f), Vec3f(1e-30f, 0, 0),
+                   Vec3f(0, -2.5f, 0), Vec3f(1.3e36f, 3.4e38f, 1e-39f)};
+  const absl::StatusOr<std::string> bytes = EncodePointCloud(cloud, {});
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  const absl::StatusOr<PointCloud> decoded = DecodePointCloud(*bytes);
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  ASSERT_EQ(decoded->normals.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    // Draco may reorder points; match each by its position.
+    size_t k = 0;
+    while (k < 4 && (decoded->positions[k] - cloud.positions[i]).norm() > 1e-3f) ++k;
+    ASSERT_LT(k, 4u) << "point " << i << " is missing";
+    const Vec3 expected = Vec3(cloud.normals[i][0], cloud.normals[i][1], cloud.normals[i][2]);
+    const Vec3 got(decoded->normals[k][0], decoded->normals[k][1], decoded->normals[k][2]);
+    EXPECT_NEAR(got.norm(), 1.0, 1e-3) << "normal " << i;
+    EXPECT_GT(got.normalized() | expected.normalized(), 0.999) << "normal " << i;
+  }
 }
 
 TEST(DracoCodecTest, CorruptAndTruncatedDataIsRejectedWithoutCrashing) {

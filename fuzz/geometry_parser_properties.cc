@@ -1,0 +1,110 @@
+#include "fuzz/geometry_parser_properties.h"
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "core/analysis/mesh_report.h"
+#include "core/triangle_mesh.h"
+#include "fuzz/fuzz_check.h"
+
+namespace neuralmesh::fuzz {
+namespace {
+
+using io_internal::FaceHandling;
+using io_internal::GeometryView;
+using io_internal::ParsedGeometry;
+
+bool Finite(const Vec3f& v) {
+  return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+template <typename T>
+bool BitwiseEqual(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(),
+                                                           a.size() * sizeof(T)) == 0);
+}
+
+void CheckStatus(const absl::Status& status) {
+  FUZZ_CHECK(status.code() == absl::StatusCode::kInvalidArgument,
+             "a parser failed with a code other than INVALID_ARGUMENT: %s",
+             status.ToString().c_str());
+  FUZZ_CHECK(!status.message().empty(), "a parser failed without saying why");
+}
+
+void CheckGeometry(const ParsedGeometry& geometry) {
+  const size_t n = geometry.positions.size();
+  for (size_t i = 0; i < n; ++i) {
+    FUZZ_CHECK(Finite(geometry.positions[i]), "position %zu is not finite", i);
+  }
+  FUZZ_CHECK(geometry.normals.empty() || geometry.normals.size() == n,
+             "%zu normals for %zu positions", geometry.normals.size(), n);
+  FUZZ_CHECK(geometry.weights.empty() || geometry.weights.size() == n,
+             "%zu weights for %zu positions", geometry.weights.size(), n);
+  for (size_t f = 0; f < geometry.faces.size(); ++f) {
+    for (uint32_t index : geometry.faces[f]) {
+      FUZZ_CHECK(index < n, "face %zu refers to vertex %u of %zu", f, index, n);
+    }
+  }
+}
+
+bool SamePoints(const ParsedGeometry& a, const ParsedGeometry& b) {
+  return BitwiseEqual(a.positions, b.positions) && BitwiseEqual(a.normals, b.normals) &&
+         BitwiseEqual(a.weights, b.weights);
+}
+
+}  // namespace
+
+void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size_t size) {
+  const absl::string_view text(reinterpret_cast<const char*>(data), size);
+  const absl::StatusOr<ParsedGeometry> mesh = format.parse(text, FaceHandling::kRead);
+  if (!mesh.ok()) CheckStatus(mesh.status());
+
+  if (format.skips_faces) {
+    const absl::StatusOr<ParsedGeometry> points = format.parse(text, FaceHandling::kSkip);
+    if (!points.ok()) {
+      CheckStatus(points.status());
+      FUZZ_CHECK(!mesh.ok(), "parses with its faces but not without them: %s",
+                 points.status().ToString().c_str());
+    } else {
+      CheckGeometry(*points);
+      FUZZ_CHECK(points->faces.empty(), "%zu faces read while skipping faces",
+                 points->faces.size());
+      if (mesh.ok()) {
+        FUZZ_CHECK(SamePoints(*mesh, *points), "points differ with and without faces");
+      }
+    }
+  }
+  if (!mesh.ok()) return;
+  CheckGeometry(*mesh);
+
+  if (format.format) {
+    const GeometryView view{mesh->positions, mesh->normals, mesh->weights, mesh->faces};
+    const std::string written = format.format(view);
+    const absl::StatusOr<ParsedGeometry> reread = format.parse(written, FaceHandling::kRead);
+    FUZZ_CHECK(reread.ok(), "the writer's output does not parse: %s",
+               reread.status().ToString().c_str());
+    const bool same = format.writes_normals_and_weights
+                          ? SamePoints(*mesh, *reread)
+                          : BitwiseEqual(mesh->positions, reread->positions);
+    FUZZ_CHECK(same, "points change when written and read back");
+    FUZZ_CHECK(BitwiseEqual(mesh->faces, reread->faces),
+               "faces change when written and read back (%zu, then %zu)", mesh->faces.size(),
+               reread->faces.size());
+  }
+
+  TriangleMesh triangles;
+  triangles.positions = mesh->positions;
+  triangles.faces = mesh->faces;
+  const MeshReport report = ComputeMeshReport(triangles);
+  FUZZ_CHECK(report.vertices + report.isolated_vertices == triangles.positions.size(),
+             "the report counts %zu + %zu isolated vertices of %zu", report.vertices,
+             report.isolated_vertices, triangles.positions.size());
+  FUZZ_CHECK(report.faces + report.degenerate_faces == triangles.faces.size() &&
+                 report.invalid_faces == 0,
+             "the report counts %zu + %zu degenerate + %zu invalid faces of %zu", report.faces,
+             report.degenerate_faces, report.invalid_faces, triangles.faces.size());
+  (void)MeshReportToJson(report);
+}
+
+}  // namespace neuralmesh::fuzz

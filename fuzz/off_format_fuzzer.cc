@@ -1,0 +1,16 @@
+// The OFF parser and writer (core/io/internal/off.h) against the properties of
+// fuzz/geometry_parser_properties.h.
+#include <cstddef>
+#include <cstdint>
+
+#include "core/io/internal/off.h"
+#include "fuzz/geometry_parser_properties.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  // The writer keeps positions and faces only.
+  neuralmesh::fuzz::CheckGeometryParser(
+      {neuralmesh::io_internal::ParseOff, neuralmesh::io_internal::FormatOff, /*skips_faces=*/true,
+       /*writes_normals_and_weights=*/false},
+      data, size);
+  return 0;
+}

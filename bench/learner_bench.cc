@@ -3,7 +3,7 @@
 // by step kind, and Basic Steps per second. Prints a table; it is not a test.
 //
 //   build/bin/learner-bench [--points=50000,5000000] [--milestones=1000,5000,20000,100000]
-//                           [--seed=1]
+//                           [--seed=1] [--ab_lookahead_from=N]
 //
 // Milestones above half the input's point count are skipped (see the loop).
 // "us/step" is measured in a window just below each milestone (from 0.9 N to N vertices), so
@@ -22,11 +22,17 @@
 // Before and after the table, the machine's latency of a dependent load from 32 KB, 1 MB and
 // 16 MB (memory_latency.h): the step time ratio rests on it, and a change between the two
 // lines means the machine's speed drifted during the run.
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <chrono>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #if __has_include(<valgrind/callgrind.h>)
@@ -39,6 +45,8 @@
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 #include "bench/count_list.h"
 #include "bench/memory_latency.h"
 #include "core/learning/learner.h"
@@ -49,6 +57,15 @@
 ABSL_FLAG(std::string, points, "50000,5000000", "Point counts of the sampled input surfaces.");
 ABSL_FLAG(std::string, milestones, "1000,5000,20000,100000", "Vertex counts to time.");
 ABSL_FLAG(uint64_t, seed, 1, "Seed of the learner and of the point sampling.");
+ABSL_FLAG(int64_t, lookahead_from, -1,
+          "Look ahead from this many vertices on (Learner::SetLookaheadFromVertices); "
+          "-1: the learner's default.");
+ABSL_FLAG(int64_t, ab_lookahead_from, -1,
+          "Instead of the table: compare a learner without the lookahead with one that looks "
+          "ahead from this many vertices on, in turns of 20,000 Basic Steps in one process.");
+ABSL_FLAG(std::string, turns, "",
+          "IN_FIFO,OUT_FIFO: instead of the table, take turns of 20,000 Basic Steps with "
+          "another process (scripts/ab-bench.sh) and print us/step per band of vertex counts.");
 
 namespace neuralmesh {
 namespace {
@@ -82,6 +99,145 @@ void PrintMemoryLatency(const char* when) {
   std::fflush(stdout);
 }
 
+// Wall time and Basic Steps per band of vertex counts (between two milestones), taken in turns
+// of 20,000 Basic Steps so that two learners, or two processes, can alternate and the
+// machine's drift, which is large here, hits both alike.
+class BandTimer {
+ public:
+  explicit BandTimer(std::vector<size_t> bands)
+      : bands_(std::move(bands)), seconds_(bands_.size()), steps_(bands_.size()) {}
+  bool done(const Learner& learner) const { return band_of(learner) >= bands_.size(); }
+  // One turn of `learner`; false when it fails.
+  bool Turn(Learner& learner) {
+    const size_t band = band_of(learner);
+    StopCriteria turn;
+    turn.max_basic_steps = kTurnSteps;
+    turn.target_vertices = bands_.back();
+    const uint64_t before = learner.progress().basic_steps;
+    const auto start = std::chrono::steady_clock::now();
+    if (!learner.Run(turn).ok()) return false;
+    seconds_[band] +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    steps_[band] += learner.progress().basic_steps - before;
+    return true;
+  }
+  const std::vector<size_t>& bands() const { return bands_; }
+  double us_per_step(size_t band) const { return 1e6 * seconds_[band] / steps_[band]; }
+  uint64_t steps(size_t band) const { return steps_[band]; }
+
+ private:
+  static constexpr uint64_t kTurnSteps = 20000;
+  size_t band_of(const Learner& learner) const {
+    size_t band = 0;
+    while (band < bands_.size() && learner.num_vertices() >= bands_[band]) ++band;
+    return band;
+  }
+  std::vector<size_t> bands_;
+  std::vector<double> seconds_;
+  std::vector<uint64_t> steps_;
+};
+
+// The milestones a learner on n points can reach (see the table's loop).
+std::vector<size_t> ReachableMilestones(const std::vector<size_t>& milestones, size_t n) {
+  std::vector<size_t> reachable;
+  for (size_t m : milestones) {
+    if (m <= n / 2) reachable.push_back(m);
+  }
+  return reachable;
+}
+
+std::string BandName(const std::vector<size_t>& bands, size_t i) {
+  return absl::StrCat(i == 0 ? 0 : bands[i - 1], "-", bands[i]);
+}
+
+// Learners A (no lookahead) and B (lookahead from `from` vertices) on the same input and seed,
+// in turns. Their meshes are the same, so is their work. Prints B's time over A's per band and
+// checks the final fingerprints agree.
+int CompareLookahead(const Sampler& sampler, size_t n, const std::vector<size_t>& milestones,
+                     uint64_t seed, size_t from) {
+  LearnerOptions options;
+  options.seed = seed;
+  auto a = Learner::Create(options, &sampler).value();
+  auto b = Learner::Create(options, &sampler).value();
+  a->SetLookaheadFromVertices(std::numeric_limits<size_t>::max());
+  b->SetLookaheadFromVertices(from);
+  const std::vector<size_t> bands = ReachableMilestones(milestones, n);
+  BandTimer timer_a(bands), timer_b(bands);
+  while (!timer_a.done(*a)) {
+    if (!timer_a.Turn(*a) || !timer_b.Turn(*b)) return 1;
+    if (a->num_vertices() != b->num_vertices()) {
+      std::printf("the two learners diverged: %zu and %zu vertices\n", a->num_vertices(),
+                  b->num_vertices());
+      return 1;
+    }
+  }
+  for (size_t i = 0; i < bands.size(); ++i) {
+    std::printf("%10zu %17s %11llu %9.3f %9.3f %7.3f\n", n, BandName(bands, i).c_str(),
+                static_cast<unsigned long long>(timer_a.steps(i)), timer_a.us_per_step(i),
+                timer_b.us_per_step(i), timer_b.us_per_step(i) / timer_a.us_per_step(i));
+  }
+  const uint64_t fa = Fingerprint(a->mesh()), fb = Fingerprint(b->mesh());
+  std::printf("%10zu points: fingerprints %016llx and %016llx%s\n", n,
+              static_cast<unsigned long long>(fa), static_cast<unsigned long long>(fb),
+              fa == fb ? "" : ": DIFFERENT MESHES");
+  std::fflush(stdout);
+  return fa == fb ? 0 : 1;
+}
+
+// Takes turns with another process through two FIFOs (scripts/ab-bench.sh): waits for a byte
+// on `in` before each turn and writes one to `out` after it. When the other process has ended
+// (end of file, or nobody reading), turns go on alone.
+class FifoTurns {
+ public:
+  FifoTurns(const std::string& in, const std::string& out) {
+    std::signal(SIGPIPE, SIG_IGN);
+    out_ = open(out.c_str(), O_RDWR);  // Does not wait for a reader.
+    in_ = open(in.c_str(), O_RDONLY);  // Waits for the other process's out.
+  }
+  ~FifoTurns() {
+    if (in_ >= 0) close(in_);
+    if (out_ >= 0) close(out_);
+  }
+  bool ok() const { return in_ >= 0 && out_ >= 0; }
+  void Wait() {
+    char token;
+    if (!alone_ && read(in_, &token, 1) != 1) alone_ = true;
+  }
+  void Pass() {
+    const char token = 't';
+    if (!alone_ && write(out_, &token, 1) != 1) alone_ = true;
+  }
+
+ private:
+  int in_ = -1, out_ = -1;
+  bool alone_ = false;
+};
+
+// One learner per input in turns with another process; prints us/step per band and the final
+// fingerprint, which scripts/ab-bench.sh lines up with the other process's.
+int RunInTurns(FifoTurns& turns, const Sampler& sampler, size_t n,
+               const std::vector<size_t>& milestones, uint64_t seed, int64_t lookahead_from) {
+  LearnerOptions options;
+  options.seed = seed;
+  auto learner = Learner::Create(options, &sampler).value();
+  if (lookahead_from >= 0) learner->SetLookaheadFromVertices(static_cast<size_t>(lookahead_from));
+  BandTimer timer(ReachableMilestones(milestones, n));
+  while (!timer.done(*learner)) {
+    turns.Wait();
+    const bool ok = timer.Turn(*learner);
+    turns.Pass();
+    if (!ok) return 1;
+  }
+  for (size_t i = 0; i < timer.bands().size(); ++i) {
+    std::printf("band %zu %s %llu %.4f\n", n, BandName(timer.bands(), i).c_str(),
+                static_cast<unsigned long long>(timer.steps(i)), timer.us_per_step(i));
+  }
+  std::printf("fingerprint %zu %016llx\n", n,
+              static_cast<unsigned long long>(Fingerprint(learner->mesh())));
+  std::fflush(stdout);
+  return 0;
+}
+
 int Run() {
   const std::vector<size_t> point_counts =
       bench::ParseCountList(absl::GetFlag(FLAGS_points), "learner-bench");
@@ -91,11 +247,42 @@ int Run() {
   // The input: a torus (R = 1, r = 0.35) sampled uniformly.
   auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.35).value();
 
+  const int64_t lookahead_from = absl::GetFlag(FLAGS_lookahead_from);
+  if (const std::string fifos = absl::GetFlag(FLAGS_turns); !fifos.empty()) {
+    const std::vector<std::string> ends = absl::StrSplit(fifos, ',');
+    if (ends.size() != 2) {
+      std::fprintf(stderr, "learner-bench: --turns takes IN_FIFO,OUT_FIFO\n");
+      return 2;
+    }
+    FifoTurns turns(ends[0], ends[1]);
+    if (!turns.ok()) {
+      std::fprintf(stderr, "learner-bench: cannot open the FIFOs %s\n", fifos.c_str());
+      return 2;
+    }
+    for (size_t n : point_counts) {
+      auto cloud = std::make_shared<const PointCloud>(SamplePoints(*torus, n, seed));
+      auto sampler = MakePointCloudSampler(cloud).value();
+      if (RunInTurns(turns, *sampler, n, milestones, seed, lookahead_from) != 0) return 1;
+    }
+    return 0;
+  }
+
   std::printf(
       "Neural Meshes learner, paper parameters (alpha_w = alpha_L = 0.06, C_L = 5, "
       "C_vs = 100, C_ec = 10, alpha_sc = 0.95, alpha_r = 7, alpha_m = 5), one thread\n");
   PrintMemoryLatency("before");
   std::printf("\n");
+  if (const int64_t from = absl::GetFlag(FLAGS_ab_lookahead_from); from >= 0) {
+    std::printf("%10s %17s %11s %9s %9s %7s\n", "points", "vertices", "steps", "A us/step",
+                "B us/step", "B/A");
+    for (size_t n : point_counts) {
+      auto cloud = std::make_shared<const PointCloud>(SamplePoints(*torus, n, seed));
+      auto sampler = MakePointCloudSampler(cloud).value();
+      if (CompareLookahead(*sampler, n, milestones, seed, static_cast<size_t>(from)) != 0) return 1;
+    }
+    PrintMemoryLatency("after");
+    return 0;
+  }
   std::printf("%10s %8s %9s %11s %9s %9s %8s %8s %8s %8s %8s %8s %10s\n", "points", "#v", "total s",
               "steps", "window", "us/step", "octree", "smooth", "split", "collapse", "removal",
               "merge", "steps/s");
@@ -106,6 +293,7 @@ int Run() {
     options.seed = seed;
     auto learner = Learner::Create(options, sampler.get()).value();
     learner->EnableTimings(true);
+    if (lookahead_from >= 0) learner->SetLookaheadFromVertices(static_cast<size_t>(lookahead_from));
     const auto start = std::chrono::steady_clock::now();
     double first_us_per_step = 0, last_us_per_step = 0;
     size_t first_target = 0, last_target = 0;

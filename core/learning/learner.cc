@@ -2,10 +2,12 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/learning/basic_step_lookahead.h"
 #include "core/learning/boundary_merging.h"
 #include "core/learning/half_edge_collapse.h"
 #include "core/learning/inactive_face_removal.h"
@@ -60,10 +62,20 @@ class Learner::Impl {
     Clock::time_point t0;
     if (timed) t0 = Clock::now();
 
-    // Basic Step (Section 2.1).
-    const Vec3 s = target_->Sample(rng_);
-    target_->PrefetchSample(rng_);  // The next step's sample: a cache miss on large inputs.
-    const int winner = octree_.Nearest(s);
+    // Basic Step (Section 2.1). On a large mesh its sample was drawn and its winner found a few
+    // steps ago, and kept when nothing has moved near it since (basic_step_lookahead.h).
+    if (!lookahead_ && live_vertices_ >= lookahead_from_vertices_) lookahead_.emplace(step_);
+    Vec3 s;
+    int winner;
+    if (lookahead_) {
+      lookahead_->StartStep(step_, *target_, rng_, octree_, rings_, mesh_);
+      s = lookahead_->sample();
+      winner = lookahead_->Winner(octree_, mesh_);
+    } else {
+      s = target_->Sample(rng_);
+      target_->PrefetchSample(rng_);  // The next step's sample: a cache miss on large inputs.
+      winner = octree_.Nearest(s);
+    }
     const Mesh::VertexHandle w(winner);
     Clock::time_point t1;
     if (timed) {
@@ -82,7 +94,13 @@ class Learner::Impl {
     }
     smoother_.Smooth(mesh_, rings_, w, options_.alpha_l, options_.c_l);
     octree_.Move(winner, pw);
-    for (const int q : smoother_.moved()) octree_.Move(q, mesh_.point(Mesh::VertexHandle(q)));
+    if (lookahead_) lookahead_->RecordMove(pw);
+    for (const int q : smoother_.moved()) {
+      const Vec3& p = mesh_.point(Mesh::VertexHandle(q));
+      octree_.Move(q, p);
+      if (lookahead_) lookahead_->RecordMove(p);
+    }
+    if (lookahead_) lookahead_->ContinueStep(octree_, rings_, mesh_);
     if (timed) timings_.smoothing += kTimingSamplePeriod * Since(t1);
 
     ++step_;
@@ -150,6 +168,7 @@ class Learner::Impl {
   const LearnerOptions& options() const { return options_; }
   size_t num_vertices() const { return live_vertices_; }
   void EnableTimings(bool on) { timings_on_ = on; }
+  void SetLookaheadFromVertices(size_t vertices) { lookahead_from_vertices_ = vertices; }
   LearnerTimings timings() const { return timings_; }
 
  private:
@@ -189,6 +208,7 @@ class Learner::Impl {
     mesh_.property(last_win_, v0) = step_;
     mesh_.property(spared_until_, v0) = mesh_.property(spared_until_, v);  // Same strip.
     octree_.Insert(v0.idx(), mesh_.point(v0));
+    if (lookahead_) lookahead_->RecordMove(mesh_.point(v0));
   }
 
   // Step 3, then Steps 4 and 5, every C_ec v Basic Steps (Sections 2.2, 2.3).
@@ -262,6 +282,7 @@ class Learner::Impl {
     next_connectivity_step_ = step_ + std::max<uint64_t>(1, ConnectivityInterval());
     CompactInMortonOrder();
     rings_.InvalidateAll();  // Collapses, removals, merges and compaction changed rings.
+    if (lookahead_) lookahead_->ForgetWinners();  // And vertex indices.
   }
 
   void CollapseInactive() {
@@ -321,6 +342,9 @@ class Learner::Impl {
   SignalCounters counters_;
   OneRingSmoother smoother_;
   VertexRingCache rings_;
+  // Made at the first Basic Step with at least lookahead_from_vertices_ vertices; kept since.
+  std::optional<BasicStepLookahead> lookahead_;
+  size_t lookahead_from_vertices_ = kLookaheadFromVertices;
   OpenMesh::VPropHandleT<uint64_t> last_win_;
   // The last call of Step 4 that spares this vertex's faces (sewn_strip_grace_calls).
   OpenMesh::VPropHandleT<uint64_t> spared_until_;
@@ -356,6 +380,9 @@ const LearnerOptions& Learner::options() const { return impl_->options(); }
 LearnerProgress Learner::progress() const { return impl_->Progress(); }
 size_t Learner::num_vertices() const { return impl_->num_vertices(); }
 void Learner::EnableTimings(bool on) { impl_->EnableTimings(on); }
+void Learner::SetLookaheadFromVertices(size_t vertices) {
+  impl_->SetLookaheadFromVertices(vertices);
+}
 LearnerTimings Learner::timings() const { return impl_->timings(); }
 TriangleMesh Learner::Snapshot() const { return ToTriangleMesh(impl_->mesh()); }
 

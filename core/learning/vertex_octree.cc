@@ -322,6 +322,19 @@ NEURALMESH_AVX2_CLONE void VertexOctree::Move(int id, const Vec3& p) {
   Insert(id, p);
 }
 
+void VertexOctree::PrefetchNearest(const Vec3& q) const {
+  const double qp[3] = {q[0], q[1], q[2]};
+  int n = 0;
+  while (node(n).child >= 0) {
+    const int block = node(n).child;
+    n = block * 8 + Octant(blocks_[block].center, qp);
+  }
+  if (node(n).count == 0) return;
+  const char* items = reinterpret_cast<const char*>(BucketItems(LeafBucket(node(n).child)));
+  const size_t bytes = sizeof(Item) * static_cast<size_t>(std::min(node(n).count, bucket_size_));
+  for (size_t offset = 0; offset < bytes; offset += 64) __builtin_prefetch(items + offset);
+}
+
 // Inlined into both builds of Nearest.
 __attribute__((always_inline)) inline void VertexOctree::ScanLeaf(const Node& leaf,
                                                                   const double q[3], int* best,
@@ -353,7 +366,7 @@ __attribute__((always_inline)) inline void VertexOctree::ScanLeaf(const Node& le
   }
 }
 
-NEURALMESH_AVX2_CLONE int VertexOctree::Nearest(const Vec3& q) const {
+NEURALMESH_AVX2_CLONE int VertexOctree::Nearest(const Vec3& q, double* distance2) const {
   if (size_ == 0) return -1;
   const double qp[3] = {q[0], q[1], q[2]};
   int best = -1;
@@ -398,7 +411,10 @@ NEURALMESH_AVX2_CLONE int VertexOctree::Nearest(const Vec3& q) const {
         break;
       }
     }
-    if (start == scanned) return best;
+    if (start == scanned) {
+      if (distance2 != nullptr) *distance2 = best_d2;
+      return best;
+    }
   }
 
   int top = 0;
@@ -450,6 +466,7 @@ NEURALMESH_AVX2_CLONE int VertexOctree::Nearest(const Vec3& q) const {
       }
     }
   }
+  if (distance2 != nullptr) *distance2 = best_d2;
   return best;
 }
 

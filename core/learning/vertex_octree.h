@@ -47,8 +47,21 @@ class VertexOctree {
     if (static_cast<size_t>(id) < where_.size()) __builtin_prefetch(&where_[id]);
   }
 
-  // The id of the point nearest to `q` (ties: any), or -1 when empty. Exact.
-  int Nearest(const Vec3& q) const;
+  // A hint, once PrefetchLocation(id) has loaded: starts loading the point's own entry in its
+  // leaf, the other line Move reads.
+  void PrefetchItem(int id) const {
+    if (static_cast<size_t>(id) < where_.size() && where_[id].item >= 0) {
+      __builtin_prefetch(&items_[static_cast<size_t>(where_[id].item)]);
+    }
+  }
+  // A hint for a Nearest(q) to come: descends to the leaf on q's side (the upper levels of the
+  // tree are usually in cache) and starts loading the points it holds, which Nearest scans
+  // first.
+  void PrefetchNearest(const Vec3& q) const;
+
+  // The id of the point nearest to `q` (ties: any), or -1 when empty. Exact. With `distance2`,
+  // also stores its squared distance to `q` there (dx^2 + dy^2 + dz^2 in that order).
+  int Nearest(const Vec3& q, double* distance2 = nullptr) const;
 
   size_t size() const { return size_; }
   // Depth of the deepest leaf; for tests and diagnostics.

@@ -35,11 +35,17 @@ class VertexRingCache {
     bool boundary;
   };
   RingView Ring(const Mesh& mesh, int v) {
+    const RingView cached = CachedRing(v);
+    return cached.neighbours != nullptr ? cached : Walk(mesh, v);
+  }
+  // The cached ring of `v` without walking the half-edges when it is not cached: then
+  // `neighbours` is null and `size` 0. Valid as Ring's views are.
+  RingView CachedRing(int v) const {
     if (static_cast<size_t>(v) < lines_.size()) {
       const Line& line = lines_[v];
       if (line.epoch == current_epoch_) return {line.neighbours, line.valence, line.boundary != 0};
     }
-    return Walk(mesh, v);
+    return {nullptr, 0, false};
   }
   // A hint: starts loading the cached ring of `v`, for a caller about to read several rings.
   void Prefetch(int v) const {
@@ -69,7 +75,7 @@ class VertexRingCache {
   };
   static_assert(sizeof(Line) == 64, "one cache line per vertex");
 
-  std::vector<Line> lines_;  // Indexed by vertex index.
+  std::vector<Line> lines_;         // Indexed by vertex index.
   std::vector<int32_t> long_ring_;  // The last ring too long for a line.
   uint32_t current_epoch_ = 1;
 };

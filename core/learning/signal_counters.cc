@@ -65,6 +65,14 @@ void SignalCounters::Flush() {
   // Basic Steps, and e^-38 = alpha_sc^740 for the paper's 0.95), skip the exp and the log and
   // still give bitwise the same key.
   constexpr double kNegligibleExponent = -38;
+  // On a large mesh each win's entry is a cache miss, and so is its position in the heap
+  // before it: both start loading for all the wins first, one level at a time.
+  for (const auto& [id, step] : pending_) {
+    if (static_cast<size_t>(id) < heap_pos_.size()) __builtin_prefetch(&heap_pos_[id]);
+  }
+  for (const auto& [id, step] : pending_) {
+    if (Contains(id)) __builtin_prefetch(&heap_[heap_pos_[id]]);
+  }
   for (const auto& [id, step] : pending_) {
     if (!Contains(id)) continue;
     // c(step) after the win = c(step) before it + 1 (Eq. 4's 1 + sum alpha^-x, one term at a

@@ -33,9 +33,9 @@ inline constexpr double kDefaultPointsPerVertex = 2.0;
 // 11-bit quantization, and Draco spends about 70 bytes on any mesh (header, connectivity and
 // attribute headers, the quantization box, entropy-coder tables) before its vertices. Even
 // with the shortest of the encodings core/io/draco_codec.h tries, learned meshes of 10
-// vertices took at least 108 bytes (10.8 per vertex) and of 20 vertices up to 163 (8.15, in
-// the tighter box that SessionConfig.bounds gives), while from 40 vertices on they stayed
-// below 6.2 per vertex (80 tori and spheres). So the series starts at 50.
+// vertices took at least 110 bytes (11.0 per vertex) and of 20 vertices up to 164 (8.2, in
+// the tighter box that SessionConfig.bounds gives), while at 50 vertices they stayed below 5.7
+// per vertex (20 tori and 20 spheres each). So the series starts at 50.
 inline constexpr size_t kFirstDefaultMilestone = 50;
 
 struct SessionConfig {

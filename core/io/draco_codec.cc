@@ -86,22 +86,34 @@ QuantizationBox AsDracoReadsIt(const QuantizationBox& box) {
 // The value nearest to x, at or above it when `up`, else at or below, that Draco reads back
 // exactly (AsDracoReadsIt). Below 2^23 * 1e-6 floats are finer than six decimals, so the
 // candidates are whole millionths; above, floats are coarser and most read back unchanged.
+// (Should none of the first candidates qualify, the last is returned: it lies on the asked
+// side, and the encoders check boxes as Draco reads them anyway.)
 float ValueDracoKeeps(double x, bool up) {
+  // Draco reads an origin back as a vector and an edge as a float, through different parsers:
+  // a candidate must come back from both.
+  auto kept_on_side = [x, up](float candidate) {
+    draco::Options text;
+    text.SetFloat("float", candidate);
+    text.SetVector("vector", &candidate, 1);
+    float from_vector = 0;
+    text.GetVector("vector", 1, &from_vector);
+    return (up ? candidate >= x : candidate <= x) && text.GetFloat("float") == candidate &&
+           from_vector == candidate;
+  };
+  if (!std::isfinite(x) || kept_on_side(static_cast<float>(x))) return static_cast<float>(x);
   const double direction = up ? 1 : -1;
   const float toward = up ? std::numeric_limits<float>::infinity()
                           : -std::numeric_limits<float>::infinity();
   double millionths = up ? std::ceil(x * 1e6) : std::floor(x * 1e6);
   float candidate = static_cast<float>(millionths * 1e-6);
-  while (true) {
-    draco::Options text;
-    text.SetFloat("value", candidate);
-    const bool on_side = up ? candidate >= x : candidate <= x;
-    if (on_side && text.GetFloat("value") == candidate) return candidate;
+  for (int tries = 0; tries < 64; ++tries) {
+    if (kept_on_side(candidate)) return candidate;
     millionths += direction;
     const float next_millionth = static_cast<float>(millionths * 1e-6);
     const float next_float = std::nextafter(candidate, toward);
     candidate = up ? std::max(next_millionth, next_float) : std::min(next_millionth, next_float);
   }
+  return candidate;
 }
 
 // Draco multiplies by the float (2^bits - 1) / range and later decodes q * range / (2^bits - 1)

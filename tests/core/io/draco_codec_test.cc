@@ -231,6 +231,30 @@ TEST(DracoCodecTest, SmallMeshesKeepTheShortestOfSeveralEncodings) {
                            "so the other encodings were not tried (or never help)";
 }
 
+// DracoExactBox at every scale: the box contains the one asked for and is one Draco keeps
+// exactly, so asking again changes nothing.
+TEST(DracoCodecTest, ExactBoxesContainTheBoxAndAreKeptAsTheyAre) {
+  Random random(17);
+  for (int i = 0; i < 2000; ++i) {
+    const double scale = std::pow(10.0, -9 + 17 * random.NextDouble());
+    QuantizationBox box;
+    for (int c = 0; c < 3; ++c) {
+      box.origin[c] = static_cast<float>(scale * (4 * random.NextDouble() - 2));
+    }
+    box.range = static_cast<float>(scale * (0.01 + random.NextDouble()));
+    const QuantizationBox exact = DracoExactBox(box);
+    const std::string context = "box " + std::to_string(i) + " at scale " + std::to_string(scale);
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_LE(exact.origin[c], box.origin[c]) << context;
+      ASSERT_GE(double{exact.origin[c]} + exact.range, double{box.origin[c]} + box.range)
+          << context;
+    }
+    const QuantizationBox again = DracoExactBox(exact);
+    ASSERT_EQ(again.origin, exact.origin) << context;
+    ASSERT_EQ(again.range, exact.range) << context;
+  }
+}
+
 // Draco receives a fixed box as text with six decimals, so a box of edge 3e-9 reached it as
 // edge 0: it then crashed (fuzz/draco_encoder_fuzzer.cc found a 4-vertex mesh) or decoded every
 // point to 0. Such a box must be rejected with a message that says so, and DracoExactBox must

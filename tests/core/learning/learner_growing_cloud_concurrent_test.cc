@@ -3,6 +3,7 @@
 // (ctest label "concurrency").
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <thread>
 #include <vector>
 
@@ -16,7 +17,9 @@
 namespace neuralmesh {
 namespace {
 
-TEST(LearnerGrowingCloudConcurrentTest, LearnsWhilePointsStreamIn) {
+// Learns a sphere while another thread streams its points in; `lookahead_from` as in
+// Learner::SetLookaheadFromVertices (samples drawn ahead read the cloud earlier).
+void LearnWhilePointsStreamIn(size_t lookahead_from) {
   auto sphere = MakeSphere(Vec3(0, 0, 0), 1.0).value();
   const PointCloud all = SamplePoints(*sphere, 40000, 9);
   GrowingPointCloud cloud;
@@ -35,6 +38,7 @@ TEST(LearnerGrowingCloudConcurrentTest, LearnsWhilePointsStreamIn) {
   });
 
   auto learner = Learner::Create(LearnerOptions{}, &cloud).value();
+  learner->SetLookaheadFromVertices(lookahead_from);
   size_t last_size = 0;
   StopCriteria stop;
   stop.target_vertices = 1500;
@@ -56,6 +60,14 @@ TEST(LearnerGrowingCloudConcurrentTest, LearnsWhilePointsStreamIn) {
     worst = std::max(worst, std::abs(learner->mesh().point(v).norm() - 1.0));
   }
   EXPECT_LT(worst, 0.02) << "the mesh learned from streamed points must lie on the sphere";
+}
+
+TEST(LearnerGrowingCloudConcurrentTest, LearnsWhilePointsStreamIn) {
+  LearnWhilePointsStreamIn(std::numeric_limits<size_t>::max());
+}
+
+TEST(LearnerGrowingCloudConcurrentTest, LearnsWhilePointsStreamInLookingAhead) {
+  LearnWhilePointsStreamIn(0);
 }
 
 }  // namespace

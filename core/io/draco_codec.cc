@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <new>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -102,8 +103,8 @@ float ValueDracoKeeps(double x, bool up) {
   };
   if (!std::isfinite(x) || kept_on_side(static_cast<float>(x))) return static_cast<float>(x);
   const double direction = up ? 1 : -1;
-  const float toward = up ? std::numeric_limits<float>::infinity()
-                          : -std::numeric_limits<float>::infinity();
+  const float toward =
+      up ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
   double millionths = up ? std::ceil(x * 1e6) : std::floor(x * 1e6);
   float candidate = static_cast<float>(millionths * 1e-6);
   for (int tries = 0; tries < 64; ++tries) {
@@ -162,9 +163,9 @@ absl::Status CheckPositions(const std::vector<Vec3f>& positions, const DracoOpti
   const QuantizationBox& given = *options.quantization_box;
   const QuantizationBox box = AsDracoReadsIt(given);
   const auto describe = [&given, &box] {
-    std::string text = absl::StrCat("the quantization box with origin (", given.origin[0], ", ",
-                                    given.origin[1], ", ", given.origin[2], ") and range ",
-                                    given.range);
+    std::string text =
+        absl::StrCat("the quantization box with origin (", given.origin[0], ", ", given.origin[1],
+                     ", ", given.origin[2], ") and range ", given.range);
     if (box.origin != given.origin || box.range != given.range) {
       absl::StrAppend(&text, ", which Draco reads (with six decimals) as origin (", box.origin[0],
                       ", ", box.origin[1], ", ", box.origin[2], ") and range ", box.range,
@@ -292,56 +293,69 @@ constexpr uint64_t kMaxElementsPerByte = 256;
 bool DecodeCount(draco::DecoderBuffer& buffer, uint16_t version, uint16_t varint_since,
                  uint64_t* count) {
   uint32_t value = 0;
-  const bool ok = version < varint_since ? buffer.Decode(&value)
-                                         : draco::DecodeVarint(&value, &buffer);
+  const bool ok =
+      version < varint_since ? buffer.Decode(&value) : draco::DecodeVarint(&value, &buffer);
   *count = value;
   return ok;
 }
 
-// The point count of a point cloud stream, or the vertex and face counts of a mesh stream,
-// where Draco reads them (its decoders' DecodeConnectivity); empty when the stream ends or is
-// malformed before them, which Draco then reports itself.
-std::vector<std::pair<const char*, uint64_t>> DeclaredCounts(std::string_view bytes) {
-  draco::DecoderBuffer buffer;
+// The fields that open every Draco stream. ReadStreamStart leaves `buffer` after them and after
+// the metadata, when there is some, or returns nullopt when the stream ends or is malformed
+// before (Draco then reports it itself).
+struct StreamStart {
+  uint16_t version;
+  uint8_t type;
+  uint8_t method;
+};
+
+std::optional<StreamStart> ReadStreamStart(std::string_view bytes, draco::DecoderBuffer& buffer) {
   buffer.Init(bytes.data(), bytes.size());
   char magic[5];
-  uint8_t major = 0, minor = 0, type = 0, method = 0;
+  uint8_t major = 0, minor = 0;
+  StreamStart start{};
   uint16_t flags = 0;
   if (!buffer.Decode(magic, sizeof(magic)) || !buffer.Decode(&major) || !buffer.Decode(&minor) ||
-      !buffer.Decode(&type) || !buffer.Decode(&method) || !buffer.Decode(&flags)) {
-    return {};
+      !buffer.Decode(&start.type) || !buffer.Decode(&start.method) || !buffer.Decode(&flags)) {
+    return std::nullopt;
   }
-  const uint16_t version = DRACO_BITSTREAM_VERSION(major, minor);
-  buffer.set_bitstream_version(version);
-  if (version >= DRACO_BITSTREAM_VERSION(1, 3) && (flags & METADATA_FLAG_MASK) != 0) {
+  start.version = DRACO_BITSTREAM_VERSION(major, minor);
+  buffer.set_bitstream_version(start.version);
+  if (start.version >= DRACO_BITSTREAM_VERSION(1, 3) && (flags & METADATA_FLAG_MASK) != 0) {
     draco::GeometryMetadata metadata;
     draco::MetadataDecoder metadata_decoder;
-    if (!metadata_decoder.DecodeGeometryMetadata(&buffer, &metadata)) return {};
+    if (!metadata_decoder.DecodeGeometryMetadata(&buffer, &metadata)) return std::nullopt;
   }
-  if (type == draco::POINT_CLOUD) {
+  return start;
+}
+
+// The point count of a point cloud stream, or the vertex and face counts of a mesh stream,
+// where Draco reads them (its decoders' DecodeConnectivity); `buffer` as ReadStreamStart left it.
+std::vector<std::pair<const char*, uint64_t>> DeclaredCounts(const StreamStart& start,
+                                                             draco::DecoderBuffer& buffer) {
+  if (start.type == draco::POINT_CLOUD) {
     int32_t stored = 0;
     if (!buffer.Decode(&stored)) return {};
     return {{"points", static_cast<uint32_t>(stored)}};  // Read as unsigned by the decoders.
   }
-  if (type != draco::TRIANGULAR_MESH) return {};
+  if (start.type != draco::TRIANGULAR_MESH) return {};
   uint64_t vertices = 0, faces = 0;
-  if (method == draco::MESH_SEQUENTIAL_ENCODING) {
+  if (start.method == draco::MESH_SEQUENTIAL_ENCODING) {
     const uint16_t varint_since = DRACO_BITSTREAM_VERSION(2, 2);
-    if (!DecodeCount(buffer, version, varint_since, &faces) ||
-        !DecodeCount(buffer, version, varint_since, &vertices)) {
+    if (!DecodeCount(buffer, start.version, varint_since, &faces) ||
+        !DecodeCount(buffer, start.version, varint_since, &vertices)) {
       return {};
     }
-  } else if (method == draco::MESH_EDGEBREAKER_ENCODING) {
+  } else if (start.method == draco::MESH_EDGEBREAKER_ENCODING) {
     const uint16_t varint_since = DRACO_BITSTREAM_VERSION(2, 0);
     uint8_t traversal = 0;
     uint64_t new_vertices = 0;
     if (!buffer.Decode(&traversal)) return {};
-    if (version < DRACO_BITSTREAM_VERSION(2, 2) &&
-        !DecodeCount(buffer, version, varint_since, &new_vertices)) {
+    if (start.version < DRACO_BITSTREAM_VERSION(2, 2) &&
+        !DecodeCount(buffer, start.version, varint_since, &new_vertices)) {
       return {};
     }
-    if (!DecodeCount(buffer, version, varint_since, &vertices) ||
-        !DecodeCount(buffer, version, varint_since, &faces)) {
+    if (!DecodeCount(buffer, start.version, varint_since, &vertices) ||
+        !DecodeCount(buffer, start.version, varint_since, &faces)) {
       return {};
     }
   } else {
@@ -350,14 +364,30 @@ std::vector<std::pair<const char*, uint64_t>> DeclaredCounts(std::string_view by
   return {{"vertices", vertices}, {"faces", faces}};
 }
 
-absl::Status CheckDeclaredCounts(std::string_view bytes) {
+// Rejects what Draco would decode without bounds: streams older than the bitstream versions
+// current encoders write (2.2 for meshes, 2.3 for point clouds; Draco 1.5 decodes the older
+// ones through legacy paths with counts of their own that it never checks: a 102-byte kd-tree
+// point cloud of version 2.1 made it fill 21 GB), and counts far beyond what the stream's size
+// can hold.
+absl::Status CheckStreamStart(std::string_view bytes) {
+  draco::DecoderBuffer buffer;
+  const std::optional<StreamStart> start = ReadStreamStart(bytes, buffer);
+  if (!start.has_value()) return absl::OkStatus();
+  const uint16_t oldest = start->type == draco::POINT_CLOUD
+                              ? draco::kDracoPointCloudBitstreamVersion
+                              : draco::kDracoMeshBitstreamVersion;
+  if (start->version < oldest) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "Draco bitstream version ", start->version >> 8, ".", start->version & 0xff,
+        " is not supported (at least ", oldest >> 8, ".", oldest & 0xff,
+        ", what current Draco encoders write): encode the data again with a current Draco"));
+  }
   const uint64_t limit =
       std::max<uint64_t>(kAlwaysAllowedElements, kMaxElementsPerByte * bytes.size());
-  for (const auto& [what, count] : DeclaredCounts(bytes)) {
+  for (const auto& [what, count] : DeclaredCounts(*start, buffer)) {
     if (count > limit) {
-      return absl::InvalidArgumentError(absl::StrCat("corrupt Draco data: it declares ", count,
-                                                     " ", what, " in only ", bytes.size(),
-                                                     " bytes"));
+      return absl::InvalidArgumentError(absl::StrCat("corrupt Draco data: it declares ", count, " ",
+                                                     what, " in only ", bytes.size(), " bytes"));
     }
   }
   return absl::OkStatus();
@@ -379,7 +409,7 @@ absl::StatusOr<std::unique_ptr<Geometry>> DecodeDraco(std::string_view bytes) {
   if (kWantMesh && type.value() != draco::TRIANGULAR_MESH) {
     return absl::InvalidArgumentError("the Draco data holds a point cloud, not a triangle mesh");
   }
-  NM_RETURN_IF_ERROR(CheckDeclaredCounts(bytes));
+  NM_RETURN_IF_ERROR(CheckStreamStart(bytes));
   buffer.Init(bytes.data(), bytes.size());
   draco::Decoder decoder;
   try {

@@ -89,8 +89,9 @@ absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const Drac
 
 // Decodes a Draco mesh: one position per distinct position value and the triangles.
 // Returns INVALID_ARGUMENT when `bytes` is not a valid Draco mesh (corrupt, truncated, a point
-// cloud, no numeric position attribute, non-finite positions, or counts of vertices or faces
-// far beyond what its size can hold: more than 2^20 and 256 per byte).
+// cloud, no numeric position attribute, non-finite positions, counts of vertices or faces far
+// beyond what its size can hold: more than 2^20 and 256 per byte, or a bitstream version older
+// than what current Draco encoders write: 2.2 for meshes, 2.3 for point clouds).
 absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes);
 
 // Decodes a Draco point cloud, or the points of a Draco mesh; restores normals (the NORMAL

@@ -618,8 +618,7 @@ TEST(DracoCodecTest, MeshStreamsDeclaringFarTooManyFacesAreRejected) {
     return valid->substr(0, faces_at) + varint + valid->substr(at);
   };
   const absl::StatusOr<TriangleMesh> as_is = DecodeMesh(with_faces(80));
-  ASSERT_TRUE(as_is.ok()) << "the face count was not where the test expects it: "
-                          << as_is.status();
+  ASSERT_TRUE(as_is.ok()) << "the face count was not where the test expects it: " << as_is.status();
   EXPECT_EQ(as_is->faces.size(), 80u);
   ExpectInvalid(DecodeMesh(with_faces(889'000'000)).status(), "declares 889000000 faces",
                 "889 million faces");
@@ -632,8 +631,8 @@ TEST(DracoCodecTest, MeshStreamsDeclaringFarTooManyFacesAreRejected) {
 TEST(DracoCodecTest, NormalsOfAnyLengthEncodeAsDirections) {
   PointCloud cloud;
   cloud.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, 0, 1)};
-  cloud.normals = {Vec3f(3.4e38f, 3.4e38f, 3.4e38f), Vec3f(1e-30f, 0, 0),
-                   Vec3f(0, -2.5f, 0), Vec3f(1.3e36f, 3.4e38f, 1e-39f)};
+  cloud.normals = {Vec3f(3.4e38f, 3.4e38f, 3.4e38f), Vec3f(1e-30f, 0, 0), Vec3f(0, -2.5f, 0),
+                   Vec3f(1.3e36f, 3.4e38f, 1e-39f)};
   const absl::StatusOr<std::string> bytes = EncodePointCloud(cloud, {});
   ASSERT_TRUE(bytes.ok()) << bytes.status();
   const absl::StatusOr<PointCloud> decoded = DecodePointCloud(*bytes);
@@ -649,6 +648,28 @@ TEST(DracoCodecTest, NormalsOfAnyLengthEncodeAsDirections) {
     EXPECT_NEAR(got.norm(), 1.0, 1e-3) << "normal " << i;
     EXPECT_GT(got.normalized() | expected.normalized(), 0.999) << "normal " << i;
   }
+}
+
+// Draco 1.5 still decodes streams of older bitstream versions through legacy paths that read
+// counts of their own and never check them: a 102-byte kd-tree point cloud of version 2.1,
+// found by fuzz/draco_fuzzer.cc, made it fill 21 GB. Only the versions current encoders write
+// are accepted.
+TEST(DracoCodecTest, OldBitstreamVersionsAreRejected) {
+  const absl::StatusOr<std::string> cloud =
+      EncodePointCloud(io_test::RandomCloud(50, 4, false, false), {});
+  const absl::StatusOr<std::string> mesh = EncodeMesh(testing::Icosphere(1), {});
+  ASSERT_TRUE(cloud.ok() && mesh.ok());
+  // Bytes 5 and 6 hold the major and minor version.
+  EXPECT_EQ((*cloud)[5], 2);
+  EXPECT_EQ((*cloud)[6], 3) << "Draco 1.5 writes point clouds as version 2.3";
+  EXPECT_EQ((*mesh)[6], 2) << "and meshes as version 2.2";
+  std::string old_cloud = *cloud;
+  old_cloud[6] = 1;
+  ExpectInvalid(DecodePointCloud(old_cloud).status(), "bitstream version 2.1", "cloud of 2.1");
+  std::string old_mesh = *mesh;
+  old_mesh[6] = 1;
+  ExpectInvalid(DecodeMesh(old_mesh).status(), "bitstream version 2.1", "mesh of 2.1");
+  ExpectInvalid(DecodePointCloud(old_mesh).status(), "bitstream version 2.1", "mesh of 2.1");
 }
 
 TEST(DracoCodecTest, CorruptAndTruncatedDataIsRejectedWithoutCrashing) {

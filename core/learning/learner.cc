@@ -282,6 +282,12 @@ class Learner::Impl {
     next_connectivity_step_ = step_ + std::max<uint64_t>(1, ConnectivityInterval());
     CompactInMortonOrder();
     rings_.InvalidateAll();  // Collapses, removals, merges and compaction changed rings.
+    // Refilled at once, in vertex order: with the edges in vertex order too, the walks read the
+    // half-edges nearly in sequence, where the Basic Steps' walks one at a time would miss
+    // several lines each (5% less time per step from 20K to 100K vertices, with the sort).
+    for (auto v : mesh_.vertices()) {
+      if (!mesh_.is_isolated(v)) rings_.Ring(mesh_, v.idx());
+    }
     if (lookahead_) lookahead_->ForgetWinners();  // And vertex indices.
   }
 
@@ -316,14 +322,16 @@ class Learner::Impl {
   }
 
   // Deleted elements are only marked until here. Compacting and renumbering the vertices in
-  // Morton order (morton_vertex_order.h) keeps the data a Basic Step touches close together;
-  // handles change, so the octree and the counters are rebuilt: O(v log v) every C_ec v steps.
+  // Morton order, then the edges by their vertices (morton_vertex_order.h), keeps the data a
+  // Basic Step touches close together; handles change, so the octree and the counters are
+  // rebuilt: O(v log v) every C_ec v steps.
   void CompactInMortonOrder() {
     OpenMesh::VPropHandleT<double> counter;
     mesh_.add_property(counter);
     for (auto v : mesh_.vertices()) mesh_.property(counter, v) = counters_.Value(v.idx(), step_);
     mesh_.garbage_collection();
     SortVerticesInMortonOrder(mesh_);
+    SortEdgesByVertexIndex(mesh_);
     counters_.Clear();
     octree_ = VertexOctree(target_->Bounds());
     for (auto v : mesh_.vertices()) {

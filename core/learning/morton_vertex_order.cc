@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <utility>
+#include <vector>
 
 #include "core/morton_code.h"
 
@@ -56,6 +57,60 @@ std::vector<int> SortVerticesInMortonOrder(Mesh& mesh) {
     slot_of[wanted] = static_cast<int>(k);
   }
   return new_index;
+}
+
+void SortEdgesByVertexIndex(Mesh& mesh) {
+  const size_t n = mesh.n_edges();
+  if (n == 0) return;
+  std::vector<std::pair<std::pair<int, int>, int>> keyed(n);
+  for (size_t e = 0; e < n; ++e) {
+    const Mesh::HalfedgeHandle h(static_cast<int>(2 * e));
+    const int a = mesh.to_vertex_handle(h).idx();
+    const int b = mesh.to_vertex_handle(mesh.opposite_halfedge_handle(h)).idx();
+    keyed[e] = {{std::min(a, b), std::max(a, b)}, static_cast<int>(e)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<int> new_edge(n);
+  for (size_t k = 0; k < n; ++k) new_edge[keyed[k].second] = static_cast<int>(k);
+  auto moved = [&new_edge](Mesh::HalfedgeHandle h) {
+    return h.is_valid() ? Mesh::HalfedgeHandle(2 * new_edge[h.idx() >> 1] + (h.idx() & 1)) : h;
+  };
+
+  // The handles first, while the half-edges are still where the old indices say. OpenMesh sets
+  // a half-edge's next only together with that next's prev, so the links are kept aside and
+  // set once the half-edges have moved.
+  for (auto v : mesh.all_vertices()) mesh.set_halfedge_handle(v, moved(mesh.halfedge_handle(v)));
+  for (auto f : mesh.all_faces()) mesh.set_halfedge_handle(f, moved(mesh.halfedge_handle(f)));
+  std::vector<Mesh::HalfedgeHandle> next_of(2 * n);  // By new half-edge index.
+  for (auto h : mesh.all_halfedges()) next_of[moved(h).idx()] = moved(mesh.next_halfedge_handle(h));
+
+  // Then the edges with their half-edges' connectivity and every property, by swaps: slot k
+  // receives old edge keyed[k].second (as in SortVerticesInMortonOrder).
+  std::vector<int> slot_of(n), held_by(n);
+  for (size_t i = 0; i < n; ++i) slot_of[i] = held_by[i] = static_cast<int>(i);
+  for (size_t k = 0; k < n; ++k) {
+    const int wanted = keyed[k].second;
+    const size_t from = static_cast<size_t>(slot_of[wanted]);
+    if (from == k) continue;
+    std::swap(mesh.edge(Mesh::EdgeHandle(static_cast<int>(k))),
+              mesh.edge(Mesh::EdgeHandle(static_cast<int>(from))));
+    for (auto p = mesh.eprops_begin(); p != mesh.eprops_end(); ++p) {
+      if (*p != nullptr) (*p)->swap(k, from);
+    }
+    for (auto p = mesh.hprops_begin(); p != mesh.hprops_end(); ++p) {
+      if (*p == nullptr) continue;
+      (*p)->swap(2 * k, 2 * from);
+      (*p)->swap(2 * k + 1, 2 * from + 1);
+    }
+    const int displaced = held_by[k];
+    held_by[from] = displaced;
+    slot_of[displaced] = static_cast<int>(from);
+    held_by[k] = wanted;
+    slot_of[wanted] = static_cast<int>(k);
+  }
+  for (auto h : mesh.all_halfedges()) {
+    if (next_of[h.idx()].is_valid()) mesh.set_next_halfedge_handle(h, next_of[h.idx()]);
+  }
 }
 
 }  // namespace neuralmesh

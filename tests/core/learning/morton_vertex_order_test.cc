@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cstdlib>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "core/mesh_validation.h"
 #include "core/random.h"
 #include "gtest/gtest.h"
 #include "tests/testing/shapes.h"
@@ -135,6 +137,74 @@ TEST(MortonVertexOrderTest, KeepsBoundariesAndHandlesAnEmptyMesh) {
   }
   Mesh empty;
   EXPECT_TRUE(SortVerticesInMortonOrder(empty).empty()) << "an empty mesh has no vertices";
+}
+
+// Edge tags that name an edge by its end points' positions, and half-edge tags by its start.
+std::vector<double> EdgeKey(const Mesh& mesh, Mesh::HalfedgeHandle h) {
+  const Vec3& a = mesh.point(mesh.from_vertex_handle(h));
+  const Vec3& b = mesh.point(mesh.to_vertex_handle(h));
+  return {a[0], a[1], a[2], b[0], b[1], b[2]};
+}
+
+TEST(SortEdgesByVertexIndexTest, KeepsTheMeshAndMovesPropertiesWithTheirEdges) {
+  for (const bool with_border : {false, true}) {
+    const std::string context = with_border ? "grid patch" : "icosphere";
+    Mesh mesh = Shuffled(MustToMesh(with_border ? GridPatch(12, 9) : Icosphere(3)), 11);
+    SortVerticesInMortonOrder(mesh);
+    OpenMesh::EPropHandleT<std::vector<double>> edge_tag;
+    OpenMesh::HPropHandleT<std::vector<double>> halfedge_tag;
+    mesh.add_property(edge_tag);
+    mesh.add_property(halfedge_tag);
+    for (auto h : mesh.halfedges()) mesh.property(halfedge_tag, h) = EdgeKey(mesh, h);
+    for (auto e : mesh.edges())
+      mesh.property(edge_tag, e) = EdgeKey(mesh, mesh.halfedge_handle(e, 0));
+    const auto faces_before = FacesByPosition(mesh);
+    const auto loops_before = testing::BoundaryLoopSizes(mesh);
+    std::vector<std::vector<int>> rings_before;
+    for (auto v : mesh.vertices()) {
+      std::vector<int> ring;
+      for (auto u : mesh.vv_range(v)) ring.push_back(u.idx());
+      rings_before.push_back(ring);
+    }
+
+    SortEdgesByVertexIndex(mesh);
+
+    ASSERT_TRUE(ValidateMesh(mesh).ok()) << context << ": " << ValidateMesh(mesh);
+    EXPECT_EQ(FacesByPosition(mesh), faces_before) << context << ": the faces changed";
+    EXPECT_EQ(testing::BoundaryLoopSizes(mesh), loops_before) << context << ": the border changed";
+    for (auto v : mesh.vertices()) {
+      std::vector<int> ring;
+      for (auto u : mesh.vv_range(v)) ring.push_back(u.idx());
+      std::vector<int> expected = rings_before[v.idx()];
+      // The same neighbours in the same rotation; the walk may start elsewhere.
+      ASSERT_EQ(ring.size(), expected.size()) << context << ": vertex " << v.idx();
+      auto start = std::find(expected.begin(), expected.end(), ring.front());
+      ASSERT_NE(start, expected.end()) << context << ": vertex " << v.idx();
+      std::rotate(expected.begin(), start, expected.end());
+      EXPECT_EQ(ring, expected) << context << ": the ring of vertex " << v.idx() << " changed";
+      if (mesh.is_boundary(v)) {
+        EXPECT_TRUE(mesh.is_boundary(mesh.halfedge_handle(v)))
+            << context << ": border vertex " << v.idx() << " lost its boundary half-edge";
+      }
+    }
+    for (auto h : mesh.halfedges()) {
+      ASSERT_EQ(mesh.property(halfedge_tag, h), EdgeKey(mesh, h))
+          << context << ": a half-edge property did not follow half-edge " << h.idx();
+    }
+    std::pair<int, int> last(-1, -1);
+    for (auto e : mesh.edges()) {
+      const auto h = mesh.halfedge_handle(e, 0);
+      ASSERT_EQ(mesh.property(edge_tag, e), EdgeKey(mesh, h))
+          << context << ": an edge property did not follow edge " << e.idx();
+      const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
+      const std::pair<int, int> key(std::min(a, b), std::max(a, b));
+      ASSERT_LT(last, key) << context << ": edge " << e.idx() << " is out of order";
+      last = key;
+    }
+  }
+  Mesh empty;
+  SortEdgesByVertexIndex(empty);
+  EXPECT_EQ(empty.n_edges(), 0u);
 }
 
 }  // namespace

@@ -3,7 +3,9 @@
 // by step kind, and Basic Steps per second. Prints a table; it is not a test.
 //
 //   build/bin/learner-bench [--points=50000,5000000] [--milestones=1000,5000,20000,100000]
-//                           [--seed=1] [--ab_lookahead_from=N]
+//                           [--seed=1] [--lookahead_from=N]
+//   build/bin/learner-bench --ab_lookahead_from=N ...   (the lookahead against none, in turns)
+//   scripts/ab-bench.sh 'BUILD A' 'BUILD B' ...          (two builds in turns: --turns)
 //
 // Milestones above half the input's point count are skipped (see the loop).
 // "us/step" is measured in a window just below each milestone (from 0.9 N to N vertices), so

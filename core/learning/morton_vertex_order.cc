@@ -7,6 +7,30 @@
 #include "core/morton_code.h"
 
 namespace neuralmesh {
+namespace {
+
+// Rearranges slots 0..n-1 so that slot k holds what slot order[k] held (order: a permutation),
+// through swap_slots(a, b) calls that exchange two slots' contents: at most n - 1 of them.
+template <typename SwapSlots>
+void PermuteBySwaps(const std::vector<int>& order, SwapSlots swap_slots) {
+  const size_t n = order.size();
+  // slot_of[i]: where the original content of slot i is now; held_by: the reverse.
+  std::vector<int> slot_of(n), held_by(n);
+  for (size_t i = 0; i < n; ++i) slot_of[i] = held_by[i] = static_cast<int>(i);
+  for (size_t k = 0; k < n; ++k) {
+    const int wanted = order[k];
+    const size_t from = static_cast<size_t>(slot_of[wanted]);
+    if (from == k) continue;
+    swap_slots(k, from);
+    const int displaced = held_by[k];
+    held_by[from] = displaced;
+    slot_of[displaced] = static_cast<int>(from);
+    held_by[k] = wanted;
+    slot_of[wanted] = static_cast<int>(k);
+  }
+}
+
+}  // namespace
 
 std::vector<int> SortVerticesInMortonOrder(Mesh& mesh) {
   const size_t n = mesh.n_vertices();
@@ -39,23 +63,14 @@ std::vector<int> SortVerticesInMortonOrder(Mesh& mesh) {
     if (to.is_valid()) mesh.set_vertex_handle(h, Mesh::VertexHandle(new_index[to.idx()]));
   }
 
-  // Then every vertex property, by swaps: slot k receives old vertex keyed[k].second.
-  // slot_of[old] is where old vertex `old` currently sits, held_by[slot] the reverse.
-  std::vector<int> slot_of(n), held_by(n);
-  for (size_t i = 0; i < n; ++i) slot_of[i] = held_by[i] = static_cast<int>(i);
-  for (size_t k = 0; k < n; ++k) {
-    const int wanted = keyed[k].second;
-    const size_t from = static_cast<size_t>(slot_of[wanted]);
-    if (from == k) continue;
+  // Then every vertex property: slot k receives old vertex keyed[k].second.
+  std::vector<int> order(n);
+  for (size_t k = 0; k < n; ++k) order[k] = keyed[k].second;
+  PermuteBySwaps(order, [&mesh](size_t a, size_t b) {
     for (auto p = mesh.vprops_begin(); p != mesh.vprops_end(); ++p) {
-      if (*p != nullptr) (*p)->swap(k, from);
+      if (*p != nullptr) (*p)->swap(a, b);
     }
-    const int displaced = held_by[k];
-    held_by[from] = displaced;
-    slot_of[displaced] = static_cast<int>(from);
-    held_by[k] = wanted;
-    slot_of[wanted] = static_cast<int>(k);
-  }
+  });
   return new_index;
 }
 
@@ -84,30 +99,22 @@ void SortEdgesByVertexIndex(Mesh& mesh) {
   std::vector<Mesh::HalfedgeHandle> next_of(2 * n);  // By new half-edge index.
   for (auto h : mesh.all_halfedges()) next_of[moved(h).idx()] = moved(mesh.next_halfedge_handle(h));
 
-  // Then the edges with their half-edges' connectivity and every property, by swaps: slot k
-  // receives old edge keyed[k].second (as in SortVerticesInMortonOrder).
-  std::vector<int> slot_of(n), held_by(n);
-  for (size_t i = 0; i < n; ++i) slot_of[i] = held_by[i] = static_cast<int>(i);
-  for (size_t k = 0; k < n; ++k) {
-    const int wanted = keyed[k].second;
-    const size_t from = static_cast<size_t>(slot_of[wanted]);
-    if (from == k) continue;
-    std::swap(mesh.edge(Mesh::EdgeHandle(static_cast<int>(k))),
-              mesh.edge(Mesh::EdgeHandle(static_cast<int>(from))));
+  // Then the edges with their half-edges' connectivity and every property: slot k receives old
+  // edge keyed[k].second.
+  std::vector<int> order(n);
+  for (size_t k = 0; k < n; ++k) order[k] = keyed[k].second;
+  PermuteBySwaps(order, [&mesh](size_t a, size_t b) {
+    std::swap(mesh.edge(Mesh::EdgeHandle(static_cast<int>(a))),
+              mesh.edge(Mesh::EdgeHandle(static_cast<int>(b))));
     for (auto p = mesh.eprops_begin(); p != mesh.eprops_end(); ++p) {
-      if (*p != nullptr) (*p)->swap(k, from);
+      if (*p != nullptr) (*p)->swap(a, b);
     }
     for (auto p = mesh.hprops_begin(); p != mesh.hprops_end(); ++p) {
       if (*p == nullptr) continue;
-      (*p)->swap(2 * k, 2 * from);
-      (*p)->swap(2 * k + 1, 2 * from + 1);
+      (*p)->swap(2 * a, 2 * b);
+      (*p)->swap(2 * a + 1, 2 * b + 1);
     }
-    const int displaced = held_by[k];
-    held_by[from] = displaced;
-    slot_of[displaced] = static_cast<int>(from);
-    held_by[k] = wanted;
-    slot_of[wanted] = static_cast<int>(k);
-  }
+  });
   for (auto h : mesh.all_halfedges()) {
     if (next_of[h.idx()].is_valid()) mesh.set_next_halfedge_handle(h, next_of[h.idx()]);
   }

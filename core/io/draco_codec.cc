@@ -93,13 +93,10 @@ float ValueDracoKeeps(double x, bool up) {
   // Draco reads an origin back as a vector and an edge as a float, through different parsers:
   // a candidate must come back from both.
   auto kept_on_side = [x, up](float candidate) {
-    draco::Options text;
-    text.SetFloat("float", candidate);
-    text.SetVector("vector", &candidate, 1);
-    float from_vector = 0;
-    text.GetVector("vector", 1, &from_vector);
-    return (up ? candidate >= x : candidate <= x) && text.GetFloat("float") == candidate &&
-           from_vector == candidate;
+    const QuantizationBox read =
+        AsDracoReadsIt(QuantizationBox{Vec3f(candidate, candidate, candidate), candidate});
+    return (up ? candidate >= x : candidate <= x) && read.origin[0] == candidate &&
+           read.range == candidate;
   };
   if (!std::isfinite(x) || kept_on_side(static_cast<float>(x))) return static_cast<float>(x);
   const double direction = up ? 1 : -1;

@@ -17,6 +17,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/huge_page_allocator.h"
+
 namespace neuralmesh {
 
 class SignalCounters {
@@ -67,8 +69,8 @@ class SignalCounters {
   void Place(size_t i, const Entry& entry);
 
   double log_alpha_;
-  std::vector<int> heap_pos_;  // By id; -1 when not tracked.
-  std::vector<Entry> heap_;    // Max-heap by key.
+  HugePageVector<int> heap_pos_;  // By id; -1 when not tracked.
+  HugePageVector<Entry> heap_;    // Max-heap by key.
   std::vector<std::pair<int, uint64_t>> pending_;
 };
 

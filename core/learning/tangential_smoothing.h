@@ -23,6 +23,7 @@
 
 #include <vector>
 
+#include "core/huge_page_allocator.h"
 #include "core/learning/vertex_ring_cache.h"
 #include "core/mesh.h"
 
@@ -65,7 +66,7 @@ class OneRingSmoother {
   std::vector<RingVertex> local_;    // Parallel to ring_.
   std::vector<Position> q_;          // Parallel to ring_: the positions being smoothed.
   std::vector<int> moving_;          // Slots in ring_.
-  std::vector<int> slot_of_vertex_;  // By vertex index: the slot in ring_, or -1 (between calls:
+  HugePageVector<int> slot_of_vertex_;  // By vertex index: the slot in ring_, or -1 (between calls:
                                      // all -1).
 };
 

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/bounding_box.h"
+#include "core/huge_page_allocator.h"
 #include "core/mesh.h"
 
 namespace neuralmesh {
@@ -127,12 +128,12 @@ class VertexOctree {
   void ScanLeaf(const Node& leaf, const double q[3], int* best, double* best_d2) const;
   int DepthOf(int n) const;
 
-  std::vector<Block> blocks_;
+  HugePageVector<Block> blocks_;
   int free_blocks_ = -1;
-  std::vector<Item> items_;       // bucket_size_ items per bucket; fewer than 2^31 in all.
+  HugePageVector<Item> items_;       // bucket_size_ items per bucket; fewer than 2^31 in all.
   std::vector<int> bucket_next_;  // The next bucket of the same leaf, or -1.
   std::vector<int> free_buckets_;
-  std::vector<Location> where_;  // By id.
+  HugePageVector<Location> where_;  // By id.
   double root_center_[3];
   double root_half_;
   // Tolerance added to the cube of an old root: after the root grows, the old root's cube as

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/huge_page_allocator.h"
 #include "core/mesh.h"
 
 namespace neuralmesh {
@@ -75,7 +76,7 @@ class VertexRingCache {
   };
   static_assert(sizeof(Line) == 64, "one cache line per vertex");
 
-  std::vector<Line> lines_;         // Indexed by vertex index.
+  HugePageVector<Line> lines_;         // Indexed by vertex index.
   std::vector<int32_t> long_ring_;  // The last ring too long for a line.
   uint32_t current_epoch_ = 1;
 };

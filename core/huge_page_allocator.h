@@ -1,0 +1,83 @@
+// A standard allocator for the learner's large arrays indexed by vertex (octree, ring cache,
+// signal counters): an allocation of kHugePageMinBytes or more gets a mapping of its own,
+// aligned to 2 MB and marked for transparent huge pages (madvise MADV_HUGEPAGE); smaller ones
+// come from operator new.
+//
+// Why: a Basic Step touches a random place of the mesh, so at 100K vertices each of its loads
+// from these arrays (about 17 MB together) is also a TLB miss, and on a virtual machine a page
+// walk costs about as much as the load itself. 2 MB pages make the arrays fit in the TLB. Only
+// these mappings are marked, not the process's heap: in the server, other sessions and every
+// thread's stack keep 4 KB pages. Where the kernel has transparent huge pages switched off
+// (or set to "never"), the madvise fails quietly and the arrays use 4 KB pages as before.
+#ifndef NEURALMESH_CORE_HUGE_PAGE_ALLOCATOR_H_
+#define NEURALMESH_CORE_HUGE_PAGE_ALLOCATOR_H_
+
+#include <cstddef>
+#include <memory>
+#include <new>
+#include <type_traits>
+#include <vector>
+
+namespace neuralmesh {
+
+// Below this, an allocation comes from operator new (rounding it up to a huge page would
+// waste more than half of it).
+inline constexpr size_t kHugePageMinBytes = size_t{1} << 20;
+
+// Maps `bytes` (at least kHugePageMinBytes) aligned to 2 MB, rounded up to whole 2 MB pages,
+// and asks for huge pages. Throws std::bad_alloc when the mapping fails.
+void* AllocateHugePages(size_t bytes);
+// Unmaps what AllocateHugePages(bytes) returned, with the same `bytes`.
+void FreeHugePages(void* p, size_t bytes);
+
+template <typename T>
+class HugePageAllocator {
+ public:
+  using value_type = T;
+
+  HugePageAllocator() = default;
+  template <typename U>
+  HugePageAllocator(const HugePageAllocator<U>&) {}  // NOLINT: allocators convert implicitly.
+
+  T* allocate(size_t n) {
+    const size_t bytes = n * sizeof(T);
+    if (bytes >= kHugePageMinBytes) return static_cast<T*>(AllocateHugePages(bytes));
+    return static_cast<T*>(::operator new(bytes, std::align_val_t{alignof(T)}));
+  }
+  void deallocate(T* p, size_t n) {
+    const size_t bytes = n * sizeof(T);
+    if (bytes >= kHugePageMinBytes) {
+      FreeHugePages(p, bytes);
+    } else {
+      ::operator delete(p, std::align_val_t{alignof(T)});
+    }
+  }
+
+  friend bool operator==(const HugePageAllocator&, const HugePageAllocator&) { return true; }
+  friend bool operator!=(const HugePageAllocator&, const HugePageAllocator&) { return false; }
+};
+
+template <typename T>
+using HugePageVector = std::vector<T, HugePageAllocator<T>>;
+
+// A fixed-size array of trivially constructible T (left uninitialised) from HugePageAllocator.
+template <typename T>
+class HugePageArrayDeleter {
+ public:
+  explicit HugePageArrayDeleter(size_t n = 0) : n_(n) {}
+  void operator()(T* p) const { HugePageAllocator<T>().deallocate(p, n_); }
+
+ private:
+  size_t n_;
+};
+template <typename T>
+using HugePageArray = std::unique_ptr<T[], HugePageArrayDeleter<T>>;
+template <typename T>
+HugePageArray<T> MakeHugePageArray(size_t n) {
+  static_assert(std::is_trivially_destructible_v<T>, "elements are never destroyed");
+  return HugePageArray<T>(HugePageAllocator<T>().allocate(n), HugePageArrayDeleter<T>(n));
+}
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_HUGE_PAGE_ALLOCATOR_H_

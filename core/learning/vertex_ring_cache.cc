@@ -20,12 +20,19 @@ VertexRingCache::RingView VertexRingCache::Walk(const Mesh& mesh, int v) {
     h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
   } while (h != start);
   const int valence = static_cast<int>(long_ring_.size());
-  if (valence > kSlots) return {long_ring_.data(), valence, boundary};
-  std::copy(long_ring_.begin(), long_ring_.end(), line.neighbours);
-  line.valence = static_cast<uint16_t>(valence);
+  if (valence > kLongestCachedRing) return {long_ring_.data(), valence, boundary};
+  line.valence = static_cast<uint8_t>(valence);
   line.boundary = boundary ? 1 : 0;
   line.epoch = current_epoch_;
-  return {line.neighbours, valence, boundary};
+  if (valence <= kSlots) {
+    std::copy(long_ring_.begin(), long_ring_.end(), line.neighbours);
+    return {line.neighbours, valence, boundary};
+  }
+  // A ring stored again after an Invalidate leaves its old copy in overflow_ until the next
+  // InvalidateAll: few rings are long, and connectivity changes only at splits in between.
+  line.neighbours[0] = static_cast<int32_t>(overflow_.size());
+  overflow_.insert(overflow_.end(), long_ring_.begin(), long_ring_.end());
+  return {&overflow_[line.neighbours[0]], valence, boundary};
 }
 
 bool VertexRingCache::AppendRing(const Mesh& mesh, int v, std::vector<int>& out) {
@@ -35,6 +42,7 @@ bool VertexRingCache::AppendRing(const Mesh& mesh, int v, std::vector<int>& out)
 }
 
 void VertexRingCache::InvalidateAll() {
+  overflow_.clear();
   if (++current_epoch_ == 0) {  // Wrapped: no line may look current by accident.
     for (Line& line : lines_) line.epoch = 0;
     current_epoch_ = 1;

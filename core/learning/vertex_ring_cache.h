@@ -1,5 +1,5 @@
 // The neighbours of each vertex in rotation order, copied out of the half-edge structure into
-// one cache line per vertex.
+// half a cache line per vertex.
 //
 // The Basic Step's smoothing (tangential_smoothing.h) reads the rings of the winner and of its
 // neighbours: seven rings per step. Walking them through OpenMesh's half-edges is a chain of
@@ -44,7 +44,11 @@ class VertexRingCache {
   RingView CachedRing(int v) const {
     if (static_cast<size_t>(v) < lines_.size()) {
       const Line& line = lines_[v];
-      if (line.epoch == current_epoch_) return {line.neighbours, line.valence, line.boundary != 0};
+      if (line.epoch == current_epoch_) {
+        const int32_t* neighbours =
+            line.valence <= kSlots ? line.neighbours : &overflow_[line.neighbours[0]];
+        return {neighbours, line.valence, line.boundary != 0};
+      }
     }
     return {nullptr, 0, false};
   }
@@ -65,20 +69,24 @@ class VertexRingCache {
   // Reads the ring of `v` from the half-edges and caches it if it fits.
   RingView Walk(const Mesh& mesh, int v);
 
-  // Rings of up to kSlots neighbours are cached; a vertex of higher valence (rare: the
-  // learner keeps valences near 6) is walked every time.
-  static constexpr int kSlots = 14;
-  struct alignas(64) Line {
-    uint32_t epoch = 0;  // Valid when equal to current_epoch_; 0 is never current.
-    uint16_t valence = 0;
-    uint16_t boundary = 0;
-    int32_t neighbours[kSlots];
+  // A line holds rings of up to kSlots neighbours: 99% of the vertices of a learned mesh
+  // (valences 4 to 7). A longer ring (up to 255) is kept in overflow_, the line holding its
+  // offset there; overflow_ is emptied with InvalidateAll. Two lines share a cache line, so
+  // the cache of a 100K-vertex mesh takes 3.2 MB, half of what one line per vertex would.
+  static constexpr int kSlots = 7;
+  static constexpr int kLongestCachedRing = 255;
+  struct alignas(32) Line {
+    uint16_t epoch = 0;  // Valid when equal to current_epoch_; 0 is never current.
+    uint8_t valence = 0;
+    uint8_t boundary = 0;
+    int32_t neighbours[kSlots];  // Or, for a longer ring, neighbours[0]: its offset in overflow_.
   };
-  static_assert(sizeof(Line) == 64, "one cache line per vertex");
+  static_assert(sizeof(Line) == 32, "two lines per cache line");
 
-  HugePageVector<Line> lines_;         // Indexed by vertex index.
-  std::vector<int32_t> long_ring_;  // The last ring too long for a line.
-  uint32_t current_epoch_ = 1;
+  HugePageVector<Line> lines_;       // Indexed by vertex index.
+  std::vector<int32_t> overflow_;    // The cached rings longer than kSlots.
+  std::vector<int32_t> long_ring_;   // The last ring too long to cache.
+  uint16_t current_epoch_ = 1;
 };
 
 }  // namespace neuralmesh

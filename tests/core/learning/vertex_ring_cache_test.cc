@@ -38,8 +38,8 @@ void ExpectEveryRingMatches(const Mesh& mesh, VertexRingCache& cache, int op) {
     const VertexRingCache::RingView view = cache.Ring(mesh, v.idx());
     ASSERT_EQ(std::vector<int>(view.neighbours, view.neighbours + view.size), cached)
         << "Ring() of vertex " << v.idx() << " after operation " << op;
-    ASSERT_EQ(view.boundary, boundary) << "Ring() of vertex " << v.idx() << " after operation "
-                                       << op;
+    ASSERT_EQ(view.boundary, boundary)
+        << "Ring() of vertex " << v.idx() << " after operation " << op;
   }
 }
 
@@ -102,16 +102,24 @@ TEST(VertexRingCacheTest, ForgettingToInvalidateIsVisible) {
   EXPECT_EQ(fresh, WalkRing(mesh, v));
 }
 
-TEST(VertexRingCacheTest, BoundaryAndHighValenceRings) {
-  // A grid's border vertices and a fan of 20 triangles (valence above a cache line's slots).
+// A closed fan: vertex 0 surrounded by `n` triangles (valence n; the rim vertices are on the
+// boundary).
+Mesh Fan(int n) {
   TriangleMesh fan;
   fan.positions.emplace_back(0, 0, 0);
-  for (int i = 0; i < 20; ++i) {
-    const double a = 2 * M_PI * i / 20;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
     fan.positions.emplace_back(std::cos(a), std::sin(a), 0);
   }
-  for (uint32_t i = 0; i < 20; ++i) fan.faces.push_back({0, 1 + i, 1 + (i + 1) % 20});
-  Mesh mesh = MustToMesh(fan);
+  for (uint32_t i = 0; i < static_cast<uint32_t>(n); ++i) {
+    fan.faces.push_back({0, 1 + i, 1 + (i + 1) % n});
+  }
+  return MustToMesh(fan);
+}
+
+TEST(VertexRingCacheTest, BoundaryAndHighValenceRings) {
+  // A grid's border vertices and a fan of 20 triangles (valence above a line's slots).
+  Mesh mesh = Fan(20);
   VertexRingCache cache;
   ExpectEveryRingMatches(mesh, cache, 0);
   ExpectEveryRingMatches(mesh, cache, 1);  // Served from the cache where it fits.
@@ -120,6 +128,53 @@ TEST(VertexRingCacheTest, BoundaryAndHighValenceRings) {
   VertexRingCache grid_cache;
   ExpectEveryRingMatches(grid, grid_cache, 0);
   ExpectEveryRingMatches(grid, grid_cache, 1);
+}
+
+TEST(VertexRingCacheTest, LongRingsAreCachedOutsideTheirLineUpTo255) {
+  for (const int valence : {8, 20, 255}) {
+    Mesh mesh = Fan(valence);
+    VertexRingCache cache;
+    EXPECT_EQ(cache.CachedRing(0).neighbours, nullptr) << "nothing is cached before the first use";
+    cache.Ring(mesh, 0);
+    cache.Ring(mesh, 1);
+    const VertexRingCache::RingView ring = cache.CachedRing(0);
+    ASSERT_NE(ring.neighbours, nullptr) << "a ring of " << valence << " is cached";
+    EXPECT_EQ(std::vector<int>(ring.neighbours, ring.neighbours + ring.size),
+              WalkRing(mesh, Mesh::VertexHandle(0)));
+    EXPECT_FALSE(ring.boundary);
+    cache.Invalidate(0);
+    EXPECT_EQ(cache.CachedRing(0).neighbours, nullptr) << "invalidated";
+    cache.Ring(mesh, 0);  // Stored a second time.
+    const VertexRingCache::RingView again = cache.CachedRing(0);
+    ASSERT_NE(again.neighbours, nullptr);
+    EXPECT_EQ(std::vector<int>(again.neighbours, again.neighbours + again.size),
+              WalkRing(mesh, Mesh::VertexHandle(0)));
+    const VertexRingCache::RingView rim = cache.CachedRing(1);
+    ASSERT_NE(rim.neighbours, nullptr) << "the short ring beside it stays cached";
+    EXPECT_EQ(std::vector<int>(rim.neighbours, rim.neighbours + rim.size),
+              WalkRing(mesh, Mesh::VertexHandle(1)));
+    cache.InvalidateAll();
+    EXPECT_EQ(cache.CachedRing(0).neighbours, nullptr) << "InvalidateAll drops long rings too";
+    ExpectEveryRingMatches(mesh, cache, valence);
+  }
+  Mesh wide = Fan(256);
+  VertexRingCache cache;
+  ExpectEveryRingMatches(wide, cache, 0);
+  EXPECT_EQ(cache.CachedRing(0).neighbours, nullptr) << "a ring of 256 is walked every time";
+}
+
+TEST(VertexRingCacheTest, EpochsWrapWithoutReviving) {
+  Mesh mesh = Fan(6);
+  VertexRingCache cache;
+  cache.Ring(mesh, 0);
+  // Lines keep 16-bit epochs: after 2^16 InvalidateAll calls the epoch a line was stored in
+  // comes round again, and must not make it current.
+  for (int i = 0; i < (1 << 16); ++i) {
+    cache.InvalidateAll();
+    ASSERT_EQ(cache.CachedRing(0).neighbours, nullptr) << "after " << i + 1 << " InvalidateAll";
+  }
+  cache.Ring(mesh, 0);
+  EXPECT_NE(cache.CachedRing(0).neighbours, nullptr) << "cached again";
 }
 
 }  // namespace

@@ -19,9 +19,9 @@ namespace {
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "packing assumes little-endian");
 static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be three packed floats");
 
-template <typename Vector>
-std::string PackRange(const Vector& values, size_t begin, size_t end) {
-  std::string bytes((end - begin) * sizeof(typename Vector::value_type), '\0');
+template <typename T>
+std::string PackRange(const std::vector<T>& values, size_t begin, size_t end) {
+  std::string bytes((end - begin) * sizeof(T), '\0');
   std::memcpy(bytes.data(), values.data() + begin, bytes.size());
   return bytes;
 }

@@ -33,6 +33,18 @@ void* AllocateHugePages(size_t bytes) {
   return p;
 }
 
+void AdviseHugePages(const void* begin, size_t bytes) {
+  const uintptr_t first = (reinterpret_cast<uintptr_t>(begin) + kHugePage - 1) & ~(kHugePage - 1);
+  const uintptr_t last = (reinterpret_cast<uintptr_t>(begin) + bytes) & ~(kHugePage - 1);
+  if (last <= first) return;
+#ifdef MADV_HUGEPAGE
+  void* p = reinterpret_cast<void*>(first);
+  if (madvise(p, last - first, MADV_HUGEPAGE) != 0) return;
+  constexpr int kMadvCollapse = 25;  // MADV_COLLAPSE; Debian 12's headers predate it.
+  madvise(p, last - first, kMadvCollapse);
+#endif
+}
+
 void FreeHugePages(void* p, size_t bytes) { munmap(p, RoundUpToHugePages(bytes)); }
 
 }  // namespace neuralmesh

@@ -1,5 +1,5 @@
-// A standard allocator for the learner's large arrays indexed by vertex (octree, ring cache,
-// signal counters): an allocation of kHugePageMinBytes or more gets a mapping of its own,
+// Huge pages for the learner's large arrays. HugePageAllocator, a standard allocator for the
+// arrays indexed by vertex (octree, ring cache, signal counters): an allocation of kHugePageMinBytes or more gets a mapping of its own,
 // aligned to 2 MB and marked for transparent huge pages (madvise MADV_HUGEPAGE); smaller ones
 // come from operator new.
 //
@@ -13,9 +13,7 @@
 #define NEURALMESH_CORE_HUGE_PAGE_ALLOCATOR_H_
 
 #include <cstddef>
-#include <memory>
 #include <new>
-#include <type_traits>
 #include <vector>
 
 namespace neuralmesh {
@@ -60,23 +58,12 @@ class HugePageAllocator {
 template <typename T>
 using HugePageVector = std::vector<T, HugePageAllocator<T>>;
 
-// A fixed-size array of trivially constructible T (left uninitialised) from HugePageAllocator.
-template <typename T>
-class HugePageArrayDeleter {
- public:
-  explicit HugePageArrayDeleter(size_t n = 0) : n_(n) {}
-  void operator()(T* p) const { HugePageAllocator<T>().deallocate(p, n_); }
-
- private:
-  size_t n_;
-};
-template <typename T>
-using HugePageArray = std::unique_ptr<T[], HugePageArrayDeleter<T>>;
-template <typename T>
-HugePageArray<T> MakeHugePageArray(size_t n) {
-  static_assert(std::is_trivially_destructible_v<T>, "elements are never destroyed");
-  return HugePageArray<T>(HugePageAllocator<T>().allocate(n), HugePageArrayDeleter<T>(n));
-}
+// For a large array allocated elsewhere (a point cloud's positions): asks for huge pages
+// under the whole 2 MB pages inside [begin, begin + bytes), and has the kernel move the array
+// onto them now (MADV_COLLAPSE, Linux 6.1 and later; before, they come as the kernel gets to
+// it). Contents stay as they are; without transparent huge pages nothing happens. It costs
+// about what touching the range for the first time does.
+void AdviseHugePages(const void* begin, size_t bytes);
 
 }  // namespace neuralmesh
 

@@ -5,13 +5,12 @@
 #include <vector>
 
 #include "absl/status/status.h"
-#include "core/huge_page_allocator.h"
 #include "core/mesh.h"
 
 namespace neuralmesh {
 
 struct PointCloud {
-  HugePageVector<Vec3f> positions;  // Large clouds on huge pages (huge_page_allocator.h).
+  std::vector<Vec3f> positions;
   std::vector<float> weights;   // Empty, or one non-negative weight per point (Section 4.1).
   std::vector<Vec3f> normals;   // Empty, or one normal per point.
 

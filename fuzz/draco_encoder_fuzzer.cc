@@ -16,7 +16,6 @@
 #include <limits>
 #include <vector>
 
-#include "absl/types/span.h"
 #include "core/io/draco_codec.h"
 #include "core/point_cloud.h"
 #include "core/triangle_mesh.h"
@@ -58,7 +57,7 @@ void CheckFailure(const absl::Status& status) {
 
 // Half a grid step of the quantization, with slack for Draco's float arithmetic (its
 // dequantization adds q * step to the origin in float).
-float Tolerance(absl::Span<const Vec3f> positions, const DracoOptions& options) {
+float Tolerance(const std::vector<Vec3f>& positions, const DracoOptions& options) {
   float range = 0, magnitude = 0;
   if (options.quantization_box.has_value()) {
     range = options.quantization_box->range;
@@ -78,7 +77,7 @@ float Tolerance(absl::Span<const Vec3f> positions, const DracoOptions& options) 
   return static_cast<float>(0.5 * step * (1 + 1e-5) + slack) + std::numeric_limits<float>::min();
 }
 
-bool Near(const Vec3f& p, absl::Span<const Vec3f> candidates, float tolerance) {
+bool Near(const Vec3f& p, const std::vector<Vec3f>& candidates, float tolerance) {
   for (const Vec3f& q : candidates) {
     if (std::abs(p[0] - q[0]) <= tolerance && std::abs(p[1] - q[1]) <= tolerance &&
         std::abs(p[2] - q[2]) <= tolerance) {
@@ -176,7 +175,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     options.quantization_box = box;
   }
   TriangleMesh mesh;
-  mesh.positions.assign(cloud.positions.begin(), cloud.positions.end());
+  mesh.positions = cloud.positions;
   while (in.remaining() >= 6) {
     std::array<uint32_t, 3> face;
     for (uint32_t& v : face) v = in.Read<uint16_t>() % num_points;

@@ -12,10 +12,10 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
 namespace neuralmesh::server {
 namespace {
 
-template <typename Vector>
+template <typename T>
 absl::Status UnpackFloats(const std::string& bytes, const char* field, size_t expected,
-                          Vector& out) {
-  constexpr size_t kElementBytes = sizeof(typename Vector::value_type);
+                          std::vector<T>& out) {
+  constexpr size_t kElementBytes = sizeof(T);
   if (bytes.size() != expected * kElementBytes) {
     return absl::InvalidArgumentError(absl::StrCat(
         "PackedPoints.", field, " has ", bytes.size(), " bytes; ", expected, " points need ",

@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "absl/types/span.h"
 #include "core/status_macros.h"
 #include "draco/attributes/geometry_attribute.h"
 #include "draco/attributes/point_attribute.h"
@@ -144,7 +143,7 @@ std::string GridProblem(const DracoGrid& grid, int components, int bits) {
 // fixed box, that each quantizes to a grid index inside [0, 2^bits - 1] of the box as Draco
 // reads it. A quarter step of slack lets callers use a box computed in float arithmetic whose
 // far corner rounded just below the farthest point.
-absl::Status CheckPositions(absl::Span<const Vec3f> positions, const DracoOptions& options) {
+absl::Status CheckPositions(const std::vector<Vec3f>& positions, const DracoOptions& options) {
   for (size_t i = 0; i < positions.size(); ++i) {
     if (!IsFinite(positions[i])) {
       return absl::InvalidArgumentError(absl::StrCat("vertex ", i, " has a non-finite coordinate"));

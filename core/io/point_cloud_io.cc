@@ -57,9 +57,7 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
   }
   if (!parsed.ok()) return parsed.status();
   PointCloud cloud;
-  // A copy: the parsers' arrays are ordinary vectors, the cloud's may be on huge pages.
-  cloud.positions.assign(parsed->positions.begin(), parsed->positions.end());
-  parsed->positions = {};
+  cloud.positions = std::move(parsed->positions);
   cloud.normals = std::move(parsed->normals);
   cloud.weights = std::move(parsed->weights);
   return cloud;

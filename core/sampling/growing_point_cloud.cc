@@ -25,13 +25,13 @@ GrowingPointCloud::GrowingPointCloud(size_t max_points)
 }
 
 template <typename T>
-void GrowingPointCloud::Store(std::vector<HugePageArray<T>>& chunks, size_t begin,
+void GrowingPointCloud::Store(std::vector<std::unique_ptr<T[]>>& chunks, size_t begin,
                               absl::Span<const T> values) {
   size_t done = 0;
   while (done < values.size()) {
     const size_t i = begin + done;
-    HugePageArray<T>& chunk = chunks[i >> kChunkBits];
-    if (chunk == nullptr) chunk = MakeHugePageArray<T>(kChunkSize);
+    std::unique_ptr<T[]>& chunk = chunks[i >> kChunkBits];
+    if (chunk == nullptr) chunk.reset(new T[kChunkSize]);
     const size_t offset = i & (kChunkSize - 1);
     const size_t count = std::min(kChunkSize - offset, values.size() - done);
     std::copy_n(values.data() + done, count, chunk.get() + offset);
@@ -40,11 +40,11 @@ void GrowingPointCloud::Store(std::vector<HugePageArray<T>>& chunks, size_t begi
 }
 
 template <typename T>
-void GrowingPointCloud::Fill(std::vector<HugePageArray<T>>& chunks, size_t begin, size_t end,
+void GrowingPointCloud::Fill(std::vector<std::unique_ptr<T[]>>& chunks, size_t begin, size_t end,
                              const T& value) {
   for (size_t i = begin; i < end;) {
-    HugePageArray<T>& chunk = chunks[i >> kChunkBits];
-    if (chunk == nullptr) chunk = MakeHugePageArray<T>(kChunkSize);
+    std::unique_ptr<T[]>& chunk = chunks[i >> kChunkBits];
+    if (chunk == nullptr) chunk.reset(new T[kChunkSize]);
     const size_t offset = i & (kChunkSize - 1);
     const size_t count = std::min(kChunkSize - offset, end - i);
     std::fill_n(chunk.get() + offset, count, value);

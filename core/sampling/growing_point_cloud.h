@@ -2,7 +2,7 @@
 // while the learner samples on another (Section 2.1: the target space P is only ever touched
 // through one sample at a time, so it may keep growing during learning).
 //
-// Storage is a directory of fixed-size chunks (131072 points each) sized for max_points up
+// Storage is a directory of fixed-size chunks (65536 points each) sized for max_points up
 // front; chunks are allocated on demand and never move, so readers index them without a lock.
 // Appends serialise on a mutex, write the batch into the chunks and then publish the new size
 // with a release store; readers load the size with acquire and only touch points below it.
@@ -27,7 +27,6 @@
 #include "absl/types/span.h"
 #include "core/bounding_box.h"
 #include "core/mesh.h"
-#include "core/huge_page_allocator.h"
 #include "core/point_cloud.h"
 #include "core/random.h"
 #include "core/sampling/sampler.h"
@@ -37,8 +36,8 @@ namespace neuralmesh {
 class GrowingPointCloud : public Sampler {
  public:
   // `max_points`: capacity, fixed for the object's life; values above 2^34 are lowered to
-  // 2^34 (see max_points()). The chunk directory costs 24 bytes per 131072 points of capacity
-  // (384 KiB at the default); point memory is only allocated as points arrive.
+  // 2^34 (see max_points()). The chunk directory costs 24 bytes per 65536 points of capacity
+  // (768 KiB at the default); point memory is only allocated as points arrive.
   explicit GrowingPointCloud(size_t max_points = size_t{1} << 31);
 
   GrowingPointCloud(const GrowingPointCloud&) = delete;
@@ -76,9 +75,7 @@ class GrowingPointCloud : public Sampler {
   PointCloud Copy() const;
 
  private:
-  // 1.5 MB of positions a chunk: on huge pages (huge_page_allocator.h), so that a sample's
-  // draw is not also a TLB miss.
-  static constexpr int kChunkBits = 17;
+  static constexpr int kChunkBits = 16;
   static constexpr size_t kChunkSize = size_t{1} << kChunkBits;
 
   const Vec3f& PositionAt(size_t i) const {
@@ -91,10 +88,10 @@ class GrowingPointCloud : public Sampler {
 
   // Writer-side helpers, called with append_mu_ held.
   template <typename T>
-  static void Store(std::vector<HugePageArray<T>>& chunks, size_t begin,
+  static void Store(std::vector<std::unique_ptr<T[]>>& chunks, size_t begin,
                     absl::Span<const T> values);
   template <typename T>
-  static void Fill(std::vector<HugePageArray<T>>& chunks, size_t begin, size_t end,
+  static void Fill(std::vector<std::unique_ptr<T[]>>& chunks, size_t begin, size_t end,
                    const T& value);
 
   const size_t max_points_;
@@ -103,9 +100,9 @@ class GrowingPointCloud : public Sampler {
   // appending thread, under append_mu_) before the first release store of size_ or of the
   // matching has_* flag that makes any of its points visible, and never changes afterwards, so
   // readers read entries without a lock.
-  std::vector<HugePageArray<Vec3f>> position_chunks_;
-  std::vector<HugePageArray<float>> weight_chunks_;
-  std::vector<HugePageArray<Vec3f>> normal_chunks_;
+  std::vector<std::unique_ptr<Vec3f[]>> position_chunks_;
+  std::vector<std::unique_ptr<float[]>> weight_chunks_;
+  std::vector<std::unique_ptr<Vec3f[]>> normal_chunks_;
 
   std::atomic<size_t> size_{0};
   // Set (release) once every visible point has a weight (normal) stored; before size_ grows

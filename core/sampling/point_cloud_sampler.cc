@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "core/huge_page_allocator.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh {
@@ -11,6 +12,13 @@ absl::Status CheckUsable(const std::shared_ptr<const PointCloud>& cloud) {
   if (cloud == nullptr) return absl::InvalidArgumentError("the point cloud is null");
   if (cloud->empty()) return absl::InvalidArgumentError("the point cloud has no points");
   return ValidatePointCloud(*cloud);
+}
+
+// Every Basic Step reads one point at random: on a large cloud, with 4 KB pages, a TLB miss as
+// well as a cache miss (6% of a Basic Step at every mesh size on 5M points; huge pages take
+// 16% off the time per step below 1K vertices and 3% above 5K, scripts/ab-bench.sh).
+void UseHugePages(const PointCloud& cloud) {
+  AdviseHugePages(cloud.positions.data(), cloud.positions.size() * sizeof(Vec3f));
 }
 
 BoundingBox BoundsOf(const PointCloud& cloud) {
@@ -25,6 +33,7 @@ absl::StatusOr<std::unique_ptr<Sampler>> UniformPointCloudSampler::Create(
     std::shared_ptr<const PointCloud> cloud) {
   NM_RETURN_IF_ERROR(CheckUsable(cloud));
   const BoundingBox bounds = BoundsOf(*cloud);
+  UseHugePages(*cloud);
   return std::unique_ptr<Sampler>(new UniformPointCloudSampler(std::move(cloud), bounds));
 }
 
@@ -49,6 +58,7 @@ absl::StatusOr<std::unique_ptr<Sampler>> WeightedPointCloudSampler::Create(
   }
   NM_ASSIGN_OR_RETURN(AliasTable table, AliasTable::Create(cloud->weights));
   const BoundingBox bounds = BoundsOf(*cloud);
+  UseHugePages(*cloud);
   return std::unique_ptr<Sampler>(
       new WeightedPointCloudSampler(std::move(cloud), std::move(table), bounds));
 }

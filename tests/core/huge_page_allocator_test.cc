@@ -4,6 +4,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/mesh.h"
 #include "gtest/gtest.h"
@@ -70,15 +71,22 @@ TEST(HugePageAllocatorTest, GrowingAcrossTheThresholdKeepsTheContents) {
   EXPECT_EQ(values[9], 63);
 }
 
-TEST(HugePageAllocatorTest, ArraysOfFixedSize) {
-  const size_t n = 2 * kHugePageMinBytes / sizeof(float);
-  HugePageArray<float> large = MakeHugePageArray<float>(n);
-  EXPECT_EQ(reinterpret_cast<uintptr_t>(large.get()) % kHugePage, 0u);
-  for (size_t i = 0; i < n; ++i) large[i] = static_cast<float>(i);
-  EXPECT_EQ(large[n - 1], static_cast<float>(n - 1));
-  HugePageArray<float> small = MakeHugePageArray<float>(16);
-  small[15] = 3.0f;
-  EXPECT_EQ(small[15], 3.0f);
+TEST(HugePageAllocatorTest, AdvisingAnArrayAllocatedElsewhereKeepsItsContents) {
+  std::vector<float> values(3 * kHugePage / sizeof(float));
+  for (size_t i = 0; i < values.size(); ++i) values[i] = static_cast<float>(i % 100003);
+  AdviseHugePages(values.data(), values.size() * sizeof(float));
+  for (size_t i = 0; i < values.size(); i += 4099) {
+    ASSERT_EQ(values[i], static_cast<float>(i % 100003)) << "element " << i;
+  }
+  const uintptr_t interior =
+      (reinterpret_cast<uintptr_t>(values.data()) + kHugePage - 1) & ~(kHugePage - 1);
+  if (KernelHasTransparentHugePages()) {
+    const std::string flags = VmFlagsOfMappingAt(reinterpret_cast<const void*>(interior));
+    EXPECT_NE(flags.find(" hg"), std::string::npos)
+        << "the whole 2 MB pages inside the array are marked MADV_HUGEPAGE: " << flags;
+  }
+  AdviseHugePages(values.data(), 1000);  // No whole huge page inside: nothing to do.
+  EXPECT_EQ(values[999 / sizeof(float)], static_cast<float>(999 / sizeof(float)));
 }
 
 }  // namespace

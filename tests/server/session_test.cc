@@ -314,7 +314,7 @@ TEST_F(SessionTest, AStalledLearnerFailsTheSessionInsteadOfSpinning) {
 TEST(IsSpatiallyBiasedTest, RandomOrderIsNotBiasedAScanIs) {
   const PointCloud random = Torus(20000, 7);
   EXPECT_FALSE(IsSpatiallyBiased(random.positions));
-  std::vector<Vec3f> scan(random.positions.begin(), random.positions.end());
+  std::vector<Vec3f> scan = random.positions;
   std::sort(scan.begin(), scan.end(),
             [](const Vec3f& a, const Vec3f& b) { return std::atan2(a[1], a[0]) < std::atan2(b[1], b[0]); });
   EXPECT_TRUE(IsSpatiallyBiased(scan)) << "points sorted by angle arrive region after region";

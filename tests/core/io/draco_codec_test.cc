@@ -381,7 +381,7 @@ TEST(DracoCodecTest, DecodePointCloudAcceptsAMesh) {
   const absl::StatusOr<PointCloud> cloud = DecodePointCloud(*bytes);
   ASSERT_TRUE(cloud.ok()) << "a Draco mesh must decode as a point cloud: " << cloud.status();
   PointCloud expected;
-  expected.positions.assign(mesh.positions.begin(), mesh.positions.end());
+  expected.positions = mesh.positions;
   ExpectSameCloud(expected, *cloud, QuantizationTolerance(2.0f, 11), 0, 0, "mesh vertices");
 }
 
@@ -511,7 +511,7 @@ TEST(DracoCodecTest, RangesTooSmallToQuantizeAreRejectedNotCrashed) {
     for (Vec3f& p : mesh.positions) p *= too_small;
     ExpectInvalid(EncodeMesh(mesh, options).status(), "too little for", context);
     PointCloud cloud;
-    cloud.positions.assign(mesh.positions.begin(), mesh.positions.end());
+    cloud.positions = mesh.positions;
     ExpectInvalid(EncodePointCloud(cloud, options).status(), "too little for", context);
     options.quantization_box =
         QuantizationBox{Vec3f(-too_small, -too_small, -too_small), 2 * too_small};
@@ -544,7 +544,7 @@ TEST(DracoCodecTest, RangesReachingPastTheLargestFloatAreRejected) {
   mesh.faces = {{0, 1, 2}, {0, 2, 3}};
   ExpectInvalid(EncodeMesh(mesh, {}).status(), "past the largest float", "mesh");
   PointCloud cloud;
-  cloud.positions.assign(mesh.positions.begin(), mesh.positions.end());
+  cloud.positions = mesh.positions;
   ExpectInvalid(EncodePointCloud(cloud, {}).status(), "past the largest float", "cloud");
   for (Vec3f& p : mesh.positions) p *= 0.5f;  // Half the span is fine.
   const absl::StatusOr<std::string> bytes = EncodeMesh(mesh, {});

@@ -13,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "absl/types/span.h"
 #include "core/point_cloud.h"
 #include "core/random.h"
 #include "core/triangle_mesh.h"
@@ -65,7 +64,7 @@ inline float QuantizationTolerance(float range, int bits) {
 }
 
 // The largest side of the bounding box of `points`: the cube Draco quantizes against.
-inline float BoundingCubeRange(absl::Span<const Vec3f> points) {
+inline float BoundingCubeRange(const std::vector<Vec3f>& points) {
   Vec3f lo = points.front(), hi = points.front();
   for (const Vec3f& p : points) {
     lo.minimize(p);
@@ -76,8 +75,8 @@ inline float BoundingCubeRange(absl::Span<const Vec3f> points) {
 
 // For each point of `actual`, the index of the point of `expected` within `tolerance` (max
 // norm), or -1 when there is none. Expected points must be farther apart than 2 * tolerance.
-inline std::vector<int> MatchPoints(absl::Span<const Vec3f> expected,
-                                    absl::Span<const Vec3f> actual, float tolerance) {
+inline std::vector<int> MatchPoints(const std::vector<Vec3f>& expected,
+                                    const std::vector<Vec3f>& actual, float tolerance) {
   std::vector<int> by_x(expected.size());
   for (size_t i = 0; i < expected.size(); ++i) by_x[i] = static_cast<int>(i);
   std::sort(by_x.begin(), by_x.end(),

@@ -7,7 +7,6 @@
 #include <tuple>
 #include <vector>
 
-#include "absl/types/span.h"
 #include "core/io/mesh_io.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -50,10 +49,10 @@ void ExpectCloud(const PointCloud& expected, const absl::StatusOr<PointCloud>& a
   EXPECT_EQ(actual->weights, expected.weights) << what << ": weights differ";
 }
 
-PointCloud MakeCloud(absl::Span<const Vec3f> positions, std::vector<Vec3f> normals = {},
+PointCloud MakeCloud(std::vector<Vec3f> positions, std::vector<Vec3f> normals = {},
                      std::vector<float> weights = {}) {
   PointCloud cloud;
-  cloud.positions.assign(positions.begin(), positions.end());
+  cloud.positions = std::move(positions);
   cloud.normals = std::move(normals);
   cloud.weights = std::move(weights);
   return cloud;

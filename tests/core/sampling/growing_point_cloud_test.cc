@@ -93,8 +93,7 @@ TEST(GrowingPointCloudTest, NormalsFilledWithZeroWhereMissing) {
 TEST(GrowingPointCloudTest, AppendsAPointCloud) {
   GrowingPointCloud cloud;
   PointCloud batch;
-  const std::vector<Vec3f> line = LinePoints(0, 3);
-  batch.positions.assign(line.begin(), line.end());
+  batch.positions = LinePoints(0, 3);
   batch.weights = {1.0f, 2.0f, 3.0f};
   batch.normals = {Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, 0, 1)};
   ASSERT_TRUE(cloud.Append(batch).ok()) << "a valid PointCloud batch";

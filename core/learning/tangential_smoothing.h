@@ -63,11 +63,11 @@ class OneRingSmoother {
   bool simd_;
   // Scratch storage reused across calls: the Basic Step allocates nothing.
   std::vector<int> ring_;
-  std::vector<RingVertex> local_;    // Parallel to ring_.
-  std::vector<Position> q_;          // Parallel to ring_: the positions being smoothed.
-  std::vector<int> moving_;          // Slots in ring_.
+  std::vector<RingVertex> local_;       // Parallel to ring_.
+  std::vector<Position> q_;             // Parallel to ring_: the positions being smoothed.
+  std::vector<int> moving_;             // Slots in ring_.
   HugePageVector<int> slot_of_vertex_;  // By vertex index: the slot in ring_, or -1 (between calls:
-                                     // all -1).
+                                        // all -1).
 };
 
 }  // namespace neuralmesh

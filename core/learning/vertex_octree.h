@@ -130,7 +130,7 @@ class VertexOctree {
 
   HugePageVector<Block> blocks_;
   int free_blocks_ = -1;
-  HugePageVector<Item> items_;       // bucket_size_ items per bucket; fewer than 2^31 in all.
+  HugePageVector<Item> items_;    // bucket_size_ items per bucket; fewer than 2^31 in all.
   std::vector<int> bucket_next_;  // The next bucket of the same leaf, or -1.
   std::vector<int> free_buckets_;
   HugePageVector<Location> where_;  // By id.

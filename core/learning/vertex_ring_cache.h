@@ -83,9 +83,9 @@ class VertexRingCache {
   };
   static_assert(sizeof(Line) == 32, "two lines per cache line");
 
-  HugePageVector<Line> lines_;       // Indexed by vertex index.
-  std::vector<int32_t> overflow_;    // The cached rings longer than kSlots.
-  std::vector<int32_t> long_ring_;   // The last ring too long to cache.
+  HugePageVector<Line> lines_;      // Indexed by vertex index.
+  std::vector<int32_t> overflow_;   // The cached rings longer than kSlots.
+  std::vector<int32_t> long_ring_;  // The last ring too long to cache.
   uint16_t current_epoch_ = 1;
 };
 

@@ -15,8 +15,7 @@ absl::Status CheckUsable(const std::shared_ptr<const PointCloud>& cloud) {
 }
 
 // Every Basic Step reads one point at random: on a large cloud, with 4 KB pages, a TLB miss as
-// well as a cache miss (6% of a Basic Step at every mesh size on 5M points; huge pages take
-// 16% off the time per step below 1K vertices and 3% above 5K, scripts/ab-bench.sh).
+// well as a cache miss (huge_page_allocator.h).
 void UseHugePages(const PointCloud& cloud) {
   AdviseHugePages(cloud.positions.data(), cloud.positions.size() * sizeof(Vec3f));
 }

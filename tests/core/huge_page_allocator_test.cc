@@ -55,8 +55,7 @@ TEST(HugePageAllocatorTest, SmallArraysComeFromTheHeapUnmarked) {
   EXPECT_EQ(reinterpret_cast<uintptr_t>(small.data()) % alignof(double), 0u);
   if (KernelHasTransparentHugePages()) {
     EXPECT_EQ(VmFlagsOfMappingAt(small.data()).find(" hg"), std::string::npos)
-        << "a small array must not mark the heap it lives in: "
-        << VmFlagsOfMappingAt(small.data());
+        << "a small array must not mark the heap it lives in: " << VmFlagsOfMappingAt(small.data());
   }
 }
 

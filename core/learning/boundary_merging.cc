@@ -260,7 +260,9 @@ absl::Status BoundaryMergingOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("min_loop_vertices must be at least 3, got ", min_loop_vertices));
   }
-  if (close_small_holes || zip_border_slits) return hole_closing.Validate();
+  if (close_small_holes || zip_border_slits || close_bridged_holes) {
+    return hole_closing.Validate();
+  }
   return absl::OkStatus();
 }
 
@@ -275,6 +277,9 @@ BoundaryMergingResult MergeCloseBoundaries(Mesh& mesh, const BoundaryMergingOpti
   BoundaryMergingResult result;
   if (options.close_small_holes) {
     result.closed = CloseSmallHoles(mesh, options.hole_closing, mean_area);
+  }
+  if (options.close_bridged_holes) {
+    result.bridged = CloseBridgedHoles(mesh, options.hole_closing, mean_area);
   }
   if (options.zip_border_slits) {
     result.zipped = ZipBorderSlits(mesh, options.hole_closing, mean_area);

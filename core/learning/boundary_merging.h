@@ -54,7 +54,9 @@
 // would keep are closed again (CloseSmallHoles, hole_closing.h, which gives the reasons), so
 // that only real boundaries are merged and two tiny holes cut while the geometry was still
 // converging are never sewn into a spurious handle. Slits in a border are zipped the same way
-// (ZipBorderSlits; the learner turns it on with close_small_holes).
+// (ZipBorderSlits), and two holes split by a bridge of two triangles are closed as one
+// (CloseBridgedHoles: sewn together, they would make a handle whose tunnel is the bridge); the
+// learner turns both on with close_small_holes.
 #ifndef NEURALMESH_CORE_LEARNING_BOUNDARY_MERGING_H_
 #define NEURALMESH_CORE_LEARNING_BOUNDARY_MERGING_H_
 
@@ -76,25 +78,31 @@ struct BoundaryMergingOptions {
   bool close_small_holes = false;
   // Zip slits in borders (ZipBorderSlits with `hole_closing`) before merging. Not in the paper.
   bool zip_border_slits = false;
+  // Close pairs of holes split by a bridge (CloseBridgedHoles with `hole_closing`) before
+  // merging, right after the small holes. Not in the paper.
+  bool close_bridged_holes = false;
   HoleClosingOptions hole_closing;
 
   // Returns INVALID_ARGUMENT unless alpha_m is finite and non-negative, min_loop_vertices is
-  // at least 3 and, when close_small_holes or zip_border_slits is set, hole_closing is valid.
+  // at least 3 and, when close_small_holes, zip_border_slits or close_bridged_holes is set,
+  // hole_closing is valid.
   absl::Status Validate() const;
 };
 
 struct BoundaryMergingResult {
-  size_t merges = 0;         // Pairs of loops sewn together.
-  size_t added_faces = 0;    // Faces of all strips; no vertex is ever added or removed.
-  HoleClosingResult closed;  // Small holes closed before merging (close_small_holes).
-  HoleClosingResult zipped;  // Slits zipped before merging (zip_border_slits).
+  size_t merges = 0;          // Pairs of loops sewn together.
+  size_t added_faces = 0;     // Faces of all strips; no vertex is ever added or removed.
+  HoleClosingResult closed;   // Small holes closed before merging (close_small_holes).
+  HoleClosingResult zipped;   // Slits zipped before merging (zip_border_slits).
+  HoleClosingResult bridged;  // Pairs of holes split by a bridge closed (close_bridged_holes).
   // The vertices of the loops that were sewn together: the corners of every strip face.
   std::vector<Mesh::VertexHandle> sewn_vertices;
 };
 
 // Step 5 (Eq. 3): when options.close_small_holes is set, first closes the small holes as
-// CloseSmallHoles does, and when options.zip_border_slits is set, zips slits as ZipBorderSlits
-// does; then merges every pair of boundary loops of `mesh` whose vertex sets are
+// CloseSmallHoles does, when options.close_bridged_holes is set, the pairs of holes split by a
+// bridge as CloseBridgedHoles does, and when options.zip_border_slits is set, zips slits as
+// ZipBorderSlits does; then merges every pair of boundary loops of `mesh` whose vertex sets are
 // closer than options.alpha_m * sqrt(mean_area) in Hausdorff distance, closest pair first, each
 // loop at most once per call. `mean_area` is E(Area) (for example
 // TriangleRemovalResult::mean_area); pass <= 0 to compute it from the live faces. `options` must be

@@ -4,11 +4,13 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <set>
 #include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/learning/boundary_loops.h"
+#include "core/learning/inactive_face_removal.h"
 #include "core/learning/triangle_removal.h"
 
 namespace neuralmesh {
@@ -225,6 +227,56 @@ std::vector<VertexLoop> SlitCandidates(const Mesh& mesh, const VertexLoop& loop,
   return chains;
 }
 
+// The boundary loop through the boundary vertex `v`, in half-edge order (as
+// CollectBoundaryLoops lists it). OpenMesh keeps a boundary half-edge as v's outgoing one.
+VertexLoop LoopThrough(const Mesh& mesh, Mesh::VertexHandle v) {
+  VertexLoop loop;
+  const Mesh::HalfedgeHandle start = mesh.halfedge_handle(v);
+  if (!mesh.is_boundary(start)) return loop;
+  Mesh::HalfedgeHandle h = start;
+  do {
+    loop.push_back(mesh.from_vertex_handle(h));
+    h = mesh.next_halfedge_handle(h);
+  } while (h != start);
+  return loop;
+}
+
+// Cuts the bridge of the two faces on either side of the interior half-edge `h`, whose ends
+// lie on two different loops of `joined_vertices` vertices together, and fills the one loop
+// that the cut leaves (FillLoop) if it has at most `max_vertices`. When that loop has no
+// admissible triangulation, puts the two faces back and returns 0; otherwise returns the
+// number of faces added. The cut must be legal (IsFaceSetRemovalOk).
+size_t CutBridgeAndFill(Mesh& mesh, Mesh::HalfedgeHandle h, size_t joined_vertices,
+                        size_t max_vertices, double max_area, double max_edge) {
+  const std::array<Mesh::FaceHandle, 2> bridge = {mesh.face_handle(h),
+                                                  mesh.opposite_face_handle(h)};
+  std::array<std::array<Mesh::VertexHandle, 3>, 2> corners;
+  for (int k = 0; k < 2; ++k) {
+    int i = 0;
+    for (auto v : mesh.fv_range(bridge[k])) corners[k][i++] = v;
+  }
+  const Mesh::VertexHandle from = mesh.from_vertex_handle(h);
+  const Mesh::VertexHandle to = mesh.to_vertex_handle(h);
+  // As in CutInactiveBridges: the first removal leaves a pinch that the second one resolves.
+  RemoveTriangle(mesh, bridge[0], nullptr);
+  RemoveTriangle(mesh, bridge[1], nullptr);
+  const VertexLoop joined = LoopThrough(mesh, from);
+  const bool one_loop = joined.size() >= joined_vertices &&
+                        std::find(joined.begin(), joined.end(), to) != joined.end();
+  const size_t added =
+      one_loop && joined.size() <= max_vertices ? FillLoop(mesh, joined, max_area, max_edge) : 0;
+  if (added > 0) return added;
+  // Undo in reverse order: each add_face restores the state before the matching removal (the
+  // first one the pinch in between). Should OpenMesh refuse one, the mesh keeps the legal cut
+  // of both faces rather than a pinch.
+  const Mesh::FaceHandle second = mesh.add_face(corners[1][0], corners[1][1], corners[1][2]);
+  if (second.is_valid() &&
+      !mesh.add_face(corners[0][0], corners[0][1], corners[0][2]).is_valid()) {
+    RemoveTriangle(mesh, second, nullptr);
+  }
+  return 0;
+}
+
 }  // namespace
 
 absl::Status HoleClosingOptions::Validate() const {
@@ -255,6 +307,59 @@ HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options,
   for (const VertexLoop& loop : loops) {
     const size_t added = FillLoop(mesh, loop, max_area, max_edge);
     if (added == 0) continue;
+    ++result.closed_holes;
+    result.added_faces += added;
+  }
+  return result;
+}
+
+HoleClosingResult CloseBridgedHoles(Mesh& mesh, const HoleClosingOptions& options,
+                                    double mean_area) {
+  HoleClosingResult result;
+  const std::vector<VertexLoop> loops = CollectBoundaryLoops(mesh);
+  if (loops.size() < 2) return result;
+  if (mean_area <= 0) mean_area = MeanTriangleArea(mesh);
+  const double max_area = options.alpha_r * mean_area;
+  const double max_edge = options.alpha_m * std::sqrt(mean_area);
+  if (!(max_area > 0)) return result;
+  std::vector<int> loop_of(mesh.n_vertices(), -1);
+  for (size_t i = 0; i < loops.size(); ++i) {
+    for (auto v : loops[i]) loop_of[v.idx()] = static_cast<int>(i);
+  }
+  // The edges between two loops, as vertex pairs: a tried cut that is undone replaces the
+  // edges of its two faces, so half-edge handles would not survive it.
+  std::vector<std::pair<Mesh::VertexHandle, Mesh::VertexHandle>> bridges;
+  for (const VertexLoop& loop : loops) {
+    for (auto v : loop) {
+      for (auto u : mesh.vv_range(v)) {
+        if (loop_of[u.idx()] > loop_of[v.idx()]) bridges.emplace_back(v, u);
+      }
+    }
+  }
+  // A fill only changes the faces and edges of its own two loops, so the others stay as
+  // collected; a loop takes part in one fill per call. A pair of loops is tried once, through
+  // the first of its bridges whose cut is legal: the loop left by the cut is nearly the same
+  // whichever bridge goes, and a band of faces one triangle wide between two holes, every
+  // edge across it a bridge, would otherwise cost a triangulation per edge.
+  std::vector<bool> closed(loops.size(), false);
+  std::set<std::pair<int, int>> tried;
+  for (const auto& [v, u] : bridges) {
+    const int a = loop_of[v.idx()];
+    const int b = loop_of[u.idx()];
+    if (closed[a] || closed[b] || tried.count({a, b}) > 0) continue;
+    const size_t joined = loops[a].size() + loops[b].size();
+    if (joined > static_cast<size_t>(options.max_loop_vertices)) continue;
+    const Mesh::HalfedgeHandle h = mesh.find_halfedge(v, u);
+    if (!h.is_valid() || mesh.is_boundary(mesh.edge_handle(h))) continue;
+    const std::array<Mesh::FaceHandle, 2> bridge = {mesh.face_handle(h),
+                                                    mesh.opposite_face_handle(h)};
+    if (!IsFaceSetRemovalOk(mesh, bridge, Mesh::VertexHandle())) continue;
+    tried.insert({a, b});
+    const size_t added =
+        CutBridgeAndFill(mesh, h, joined, static_cast<size_t>(options.max_loop_vertices),
+                         max_area, max_edge);
+    if (added == 0) continue;
+    closed[a] = closed[b] = true;
     ++result.closed_holes;
     result.added_faces += added;
   }

@@ -38,6 +38,23 @@
 // The fill is refused when a filling triangle folds back over the face across a chain edge
 // (their normals point apart): the chain then went round a tongue of the mesh, not a slit.
 //
+// Holes split by a bridge (CloseBridgedHoles): two loops joined by an interior edge, a bridge of
+// two triangles whose free sides lie one on each loop, are one hole that a bridge one edge wide
+// cuts in two. They arise where Step 4 opens a second hole right beside one that is still open
+// while the mesh there is converging (a fold of the surface), and the bridge's corners lie over
+// data and win, so CutInactiveBridges keeps it. Step 5 then sews the two loops together, and since
+// the bridge already joins them, the strip and the bridge make a handle whose tunnel is the bridge:
+// a handle one edge across, the topological noise the paper rules out (Section 1). Nor can
+// CloseSmallHoles close either loop alone when the hole runs round a tube: each loop then winds
+// round the tube, and a filling would span the tube with edges as long as its diameter (genus-2
+// scenario of topology_learning_test, seed 18: two loops of 16 to 19 vertices side by side round a
+// tube of 0.18 x 0.30, joined by a bridge, were sewn into a third handle at 4,944 vertices). Cut
+// the bridge, and the two loops become the one loop of the hole, a band one or two edges wide round
+// the tube, which has a filling of ordinary triangles. The rule cuts the bridge only when that loop
+// then has an admissible triangulation as above (it is filled at once, and the bridge's two faces
+// are put back otherwise), so it adds no face Step 4 would remove and no edge Step 5 would not
+// bridge; it replaces two faces and a hole by a filling of the hole.
+//
 // Legality: no new edge may exist yet (no double edge, which also excludes closing a loop of 3
 // vertices that bounds a single face on the other side); a vertex that gets no new edge (an
 // ear tip, or each corner of a loop of 3) becomes interior and must have valence >= 3. The
@@ -82,6 +99,19 @@ struct HoleClosingResult {
 // collection, never adds or removes a vertex. O(h) to find the loops plus O(k^3) per loop of k
 // vertices.
 HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options, double mean_area);
+
+// Closes pairs of holes split by a bridge (see the file comment): for every interior edge whose
+// ends lie on two different boundary loops with at most options.max_loop_vertices vertices
+// together, when removing its two faces together is legal (IsFaceSetRemovalOk) and the one
+// loop this leaves has an admissible triangulation (as in CloseSmallHoles), removes the two
+// faces and adds that triangulation; otherwise the mesh is left as it was, up to
+// deleted-marked elements. Each pair of loops is tried once per call, through the first of its
+// bridges whose cut is legal, and each loop takes part in at most one fill. HoleClosingResult
+// counts each pair as one closed hole. `mean_area` and `options` as for CloseSmallHoles.
+// O(h + sum of the valences of the loops' vertices) plus O(k^3) per tried pair of k vertices
+// together.
+HoleClosingResult CloseBridgedHoles(Mesh& mesh, const HoleClosingOptions& options,
+                                    double mean_area);
 
 // Zips slits in boundary loops of any length (see the file comment): repeatedly, the most
 // slit-like chain of a loop (the smallest ratio of the distance between its ends to its length,

@@ -266,6 +266,7 @@ class Learner::Impl {
       merging.min_loop_vertices = static_cast<size_t>(options_.min_merged_loop_vertices);
       merging.close_small_holes = options_.close_small_holes;
       merging.zip_border_slits = options_.close_small_holes;
+      merging.close_bridged_holes = options_.close_small_holes;
       merging.hole_closing.alpha_r = options_.alpha_r;
       merging.hole_closing.alpha_m = options_.alpha_m;
       merging.hole_closing.max_loop_vertices = options_.max_closed_hole_vertices;

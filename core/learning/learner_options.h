@@ -49,7 +49,10 @@ struct LearnerOptions {
   // converging do not stay forever nor get sewn into extra handles (Section 1: no topological
   // noise). Real borders and holes are wider than that and stay open. Slits in a longer loop
   // are zipped the same way (ZipBorderSlits): a stretch of border whose ends lie within
-  // alpha_m sqrt(E(Area)) while the border between them is at least 3 times as long.
+  // alpha_m sqrt(E(Area)) while the border between them is at least 3 times as long. And two
+  // loops joined by a bridge of two triangles are closed as one hole when the loop left by
+  // cutting the bridge has such a filling (CloseBridgedHoles): sewn together by Step 5, they
+  // would make a handle whose tunnel is the bridge.
   bool close_small_holes = true;
   int max_closed_hole_vertices = 256;  // >= 3: longer loops are never closed (O(k^3) work).
   // Not in the paper (boundary_merging.h): Step 5 leaves alone a loop that Step 4 has cut into

@@ -1,6 +1,7 @@
 #include "tests/testing/shapes.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <utility>
 
@@ -58,6 +59,48 @@ TriangleMesh GridPatch(int nx, int ny) {
       m.faces.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
     }
   }
+  return m;
+}
+
+TriangleMesh TorusGrid(int along, int around, double major, double minor) {
+  TriangleMesh m;
+  for (int i = 0; i < along; ++i) {
+    const double u = 2 * M_PI * i / along;
+    for (int j = 0; j < around; ++j) {
+      const double v = 2 * M_PI * j / around;
+      const double r = major + minor * std::cos(v);
+      m.positions.emplace_back(static_cast<float>(r * std::cos(u)),
+                               static_cast<float>(r * std::sin(u)),
+                               static_cast<float>(minor * std::sin(v)));
+    }
+  }
+  auto id = [&](int i, int j) {
+    return static_cast<uint32_t>((i % along) * around + (j % around));
+  };
+  for (int i = 0; i < along; ++i) {
+    for (int j = 0; j < around; ++j) {
+      m.faces.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.faces.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  }
+  return m;
+}
+
+TriangleMesh TorusWithBridgedHoles(int along, int around, double major, double minor) {
+  const TriangleMesh torus = TorusGrid(along, around, major, minor);
+  TriangleMesh m;
+  m.positions = torus.positions;
+  // TorusGrid adds the two faces of the quad (ring 0, angle j) as faces 2j and 2j + 1.
+  for (size_t f = 0; f < torus.faces.size(); ++f) {
+    if (f < 2 * static_cast<size_t>(around) && f >= 4) continue;  // The cut, but quads 0, 1.
+    m.faces.push_back(torus.faces[f]);
+  }
+  auto ring0 = [](int j) { return static_cast<uint32_t>(j); };
+  auto ring1 = [around](int j) { return static_cast<uint32_t>(around + j % around); };
+  // Ring 0's side of the cut carries half-edges j -> j + 1 and ring 1's j + 1 -> j, so the band
+  // runs along them reversed.
+  m.faces.push_back({ring0(3), ring0(2), ring1(around - 1)});
+  m.faces.push_back({ring0(3), ring1(around - 1), ring1(0)});
   return m;
 }
 

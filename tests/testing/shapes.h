@@ -18,6 +18,20 @@ TriangleMesh Icosphere(int levels, double radius = 1.0);
 // an open disc with one boundary loop.
 TriangleMesh GridPatch(int nx, int ny);
 
+// A torus round the z axis, tube radius `minor` round a circle of radius `major`, as a grid of
+// `along` rings of `around` vertices (vertex i * around + j: ring i, angle j round the tube),
+// faces counter-clockwise seen from outside: closed, genus 1.
+TriangleMesh TorusGrid(int along, int around, double major, double minor);
+
+// TorusGrid(along, around, major, minor) with one hole round the tube, split in two by a bridge
+// (hole_closing.h, CloseBridgedHoles): the faces between rings 0 and 1 are cut out but for the
+// two quads at angles 0 and 1, which keep the two sides of the cut joined; a band of two
+// triangles then joins ring 0 between angles 2 and 3 to ring 1 between angles around - 1 and 0,
+// over those two quads. That band splits the hole into two loops of around - 1 vertices, each
+// winding once round the tube, and its two triangles share the one edge between the loops:
+// (ring 0, angle 3) - (ring 1, angle around - 1). around >= 6.
+TriangleMesh TorusWithBridgedHoles(int along, int around, double major, double minor);
+
 // Sizes of the boundary loops of `mesh` over its live half-edges, sorted ascending.
 std::vector<size_t> BoundaryLoopSizes(const Mesh& mesh);
 

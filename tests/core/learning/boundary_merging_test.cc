@@ -18,6 +18,7 @@ namespace {
 
 using testing::Icosphere;
 using testing::MustToMesh;
+using testing::TorusWithBridgedHoles;
 
 // Appends an open tube around the z axis: `rings` rings from z0 to z1 with radius `radius`,
 // each with a vertex at every angle of `degrees` (increasing), faces counter-clockwise seen
@@ -576,6 +577,35 @@ TEST(BoundaryMergingTest, SmallHolesAreClosedInsteadOfMergedWhenAsked) {
   const Counts after = Count(mesh);
   EXPECT_EQ(after.boundary_loops, 0u);
   EXPECT_EQ(after.euler(), 2) << "the sphere must stay genus 0";
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
+TEST(BoundaryMergingTest, HolesSplitByABridgeAreClosedInsteadOfSewnIntoAHandle) {
+  // One hole round the tube of a torus, split in two by a bridge of two faces (shapes.h): two
+  // loops of 15 side by side, each winding round the tube, already joined by the bridge's edge.
+  // Sewn together, the strip and the bridge make a handle one edge across (genus-2 scenario of
+  // topology_learning_test, seed 18).
+  Mesh mesh = MustToMesh(TorusWithBridgedHoles(48, 16, 3.0, 1.0));
+  const double mean_area = MeanTriangleArea(mesh);
+  ASSERT_EQ(Count(mesh).boundary_loops, 2u);
+  ASSERT_EQ(Count(mesh).euler(), -2);
+
+  BoundaryMergingOptions options;
+  options.close_small_holes = true;
+  options.zip_border_slits = true;
+  Mesh sewn = mesh;
+  EXPECT_EQ(MergeCloseBoundaries(sewn, options, mean_area).merges, 1u)
+      << "neither loop is a small hole: Step 5 sews them";
+  EXPECT_EQ(Count(sewn).euler(), -2) << "into a closed genus 2";
+  EXPECT_EQ(Count(sewn).boundary_loops, 0u);
+
+  options.close_bridged_holes = true;
+  const BoundaryMergingResult result = MergeCloseBoundaries(mesh, options, mean_area);
+  EXPECT_EQ(result.bridged.closed_holes, 1u) << "the pair must be closed as one hole";
+  EXPECT_EQ(result.merges, 0u) << "nothing is left to merge";
+  const Counts after = Count(mesh);
+  EXPECT_EQ(after.boundary_loops, 0u);
+  EXPECT_EQ(after.euler(), 0) << "the torus must stay genus 1";
   EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
 }
 

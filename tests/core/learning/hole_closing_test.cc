@@ -16,6 +16,7 @@ using testing::BoundaryLoopSizes;
 using testing::GridPatch;
 using testing::Icosphere;
 using testing::MustToMesh;
+using testing::TorusWithBridgedHoles;
 
 long EulerCharacteristic(const Mesh& mesh) {
   long chi = 0;
@@ -225,6 +226,76 @@ TEST(HoleClosingTest, StraightBordersAndTonguesAreNotZipped) {
   EXPECT_EQ(ZipBorderSlits(mesh, HoleClosingOptions{}, mean_area).closed_holes, 0u);
   EXPECT_EQ(BoundaryLoopSizes(mesh), loops);
   EXPECT_EQ(mesh.n_faces(), faces) << "a rejected zip leaves no face behind";
+}
+
+// 48 rings of 16 round a tube of radius 1 (edges about 0.39, sqrt(E(Area)) about 0.28, so
+// alpha_m = 5 bridges 1.4): two loops of 15 round the tube, split by a bridge of two faces.
+Mesh BridgedHoles() { return MustToMesh(TorusWithBridgedHoles(48, 16, 3.0, 1.0)); }
+
+size_t LiveFaces(const Mesh& mesh) {
+  size_t n = 0;
+  for (auto fh : mesh.faces()) (void)fh, ++n;
+  return n;
+}
+
+TEST(HoleClosingTest, TwoHolesSplitByABridgeAreClosedAsOne) {
+  Mesh mesh = BridgedHoles();
+  const double mean_area = MeanTriangleArea(mesh);
+  ASSERT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({15, 15}));
+  ASSERT_EQ(EulerCharacteristic(mesh), -2) << "a torus with two holes";
+  EXPECT_EQ(CloseSmallHoles(mesh, HoleClosingOptions{}, mean_area).closed_holes, 0u)
+      << "each loop winds round the tube: a filling would span its diameter, 2";
+
+  const HoleClosingResult result = CloseBridgedHoles(mesh, HoleClosingOptions{}, mean_area);
+
+  EXPECT_EQ(result.closed_holes, 1u);
+  EXPECT_EQ(result.added_faces, 28u) << "the two faces go, and the loop of 30 takes 28";
+  EXPECT_TRUE(BoundaryLoopSizes(mesh).empty()) << "the torus must be closed again";
+  EXPECT_EQ(EulerCharacteristic(mesh), 0) << "and stay genus 1: no handle through the bridge";
+  EXPECT_EQ(LiveFaces(mesh), 2u * 48 * 16);
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+  for (auto fh : mesh.faces()) {
+    EXPECT_LE(mesh.calc_face_area(fh), 7 * mean_area) << "a filling triangle Step 4 would cut";
+  }
+}
+
+TEST(HoleClosingTest, BridgedHolesWiderThanStepFiveBridgesAreLeftAsTheyWere) {
+  Mesh mesh = BridgedHoles();
+  const double mean_area = MeanTriangleArea(mesh);
+  const size_t faces = LiveFaces(mesh);
+  HoleClosingOptions options;
+  options.alpha_m = 1;  // Bridging 0.28: the cut's edges across the tube's outside are 0.52.
+
+  EXPECT_EQ(CloseBridgedHoles(mesh, options, mean_area).closed_holes, 0u);
+
+  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({15, 15}))
+      << "the bridge's faces must be put back";
+  EXPECT_EQ(LiveFaces(mesh), faces);
+  EXPECT_EQ(EulerCharacteristic(mesh), -2);
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+  // Put back as they were: the same two triangles, in the same orientation.
+  const Mesh::VertexHandle ring0_angle3(3), ring1_last(16 + 15);
+  const Mesh::HalfedgeHandle h = mesh.find_halfedge(ring0_angle3, ring1_last);
+  ASSERT_TRUE(h.is_valid());
+  EXPECT_FALSE(mesh.is_boundary(mesh.edge_handle(h)));
+  EXPECT_EQ(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)).idx(), 16) << "(3, 31, 16)";
+  EXPECT_EQ(
+      mesh.to_vertex_handle(mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h))).idx(), 2)
+      << "(31, 3, 2)";
+}
+
+TEST(HoleClosingTest, LoopsNotJoinedByAnEdgeAreNotClosedAsAPair) {
+  // Two round holes apart in a grid: no edge joins them, so neither is touched.
+  Mesh mesh = MustToMesh(GridPatch(20, 20));
+  const double mean_area = MeanTriangleArea(mesh);
+  CutFaces(mesh, Vec3(0.3, 0.5, 0),
+           [](const Vec3& c) { return (c - Vec3(0.3, 0.5, 0)).norm() < 0.1; });
+  CutFaces(mesh, Vec3(0.7, 0.5, 0),
+           [](const Vec3& c) { return (c - Vec3(0.7, 0.5, 0)).norm() < 0.1; });
+  const std::vector<size_t> loops = BoundaryLoopSizes(mesh);
+  ASSERT_EQ(loops.size(), 3u);
+  EXPECT_EQ(CloseBridgedHoles(mesh, HoleClosingOptions{}, mean_area).closed_holes, 0u);
+  EXPECT_EQ(BoundaryLoopSizes(mesh), loops);
 }
 
 }  // namespace

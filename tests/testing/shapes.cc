@@ -8,18 +8,26 @@
 #include "gtest/gtest.h"
 
 namespace neuralmesh::testing {
+namespace {
+
+// The two triangles (a, b, c) and (a, c, d) of the quad with corners a, b, c, d in order.
+void AddQuad(TriangleMesh& m, uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
+  m.faces.push_back({a, b, c});
+  m.faces.push_back({a, c, d});
+}
+
+}  // namespace
 
 TriangleMesh Icosphere(int levels, double radius) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   TriangleMesh m;
-  const double raw[12][3] = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0},
-                             {0, -1, t}, {0, 1, t},  {0, -1, -t}, {0, 1, -t},
-                             {t, 0, -1}, {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  const double raw[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                             {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                             {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
   for (const auto& p : raw) m.positions.push_back(Vec3f(p[0], p[1], p[2]).normalized());
-  m.faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-             {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-             {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-             {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  m.faces = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+             {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+             {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (int level = 0; level < levels; ++level) {
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoint;
     auto mid = [&](uint32_t a, uint32_t b) {
@@ -54,10 +62,7 @@ TriangleMesh GridPatch(int nx, int ny) {
   }
   auto id = [&](int i, int j) { return static_cast<uint32_t>(j * (nx + 1) + i); };
   for (int j = 0; j < ny; ++j) {
-    for (int i = 0; i < nx; ++i) {
-      m.faces.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.faces.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
+    for (int i = 0; i < nx; ++i) AddQuad(m, id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
   }
   return m;
 }
@@ -79,8 +84,7 @@ TriangleMesh TorusGrid(int along, int around, double major, double minor) {
   };
   for (int i = 0; i < along; ++i) {
     for (int j = 0; j < around; ++j) {
-      m.faces.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.faces.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+      AddQuad(m, id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
     }
   }
   return m;

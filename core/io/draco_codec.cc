@@ -285,13 +285,11 @@ absl::StatusOr<std::string> EncodeMeshAs(const draco::Mesh& geometry, int positi
 constexpr uint64_t kAlwaysAllowedElements = uint64_t{1} << 20;
 constexpr uint64_t kMaxElementsPerByte = 256;
 
-// Reads one count as the given stream version stores it: fixed 32 bits before `varint_since`,
-// a varint from then on.
-bool DecodeCount(draco::DecoderBuffer& buffer, uint16_t version, uint16_t varint_since,
-                 uint64_t* count) {
+// Reads one count as mesh streams of the versions CheckStreamStart accepts (2.2 and later)
+// store it: a varint.
+bool DecodeCount(draco::DecoderBuffer& buffer, uint64_t* count) {
   uint32_t value = 0;
-  const bool ok =
-      version < varint_since ? buffer.Decode(&value) : draco::DecodeVarint(&value, &buffer);
+  const bool ok = draco::DecodeVarint(&value, &buffer);
   *count = value;
   return ok;
 }
@@ -326,7 +324,8 @@ std::optional<StreamStart> ReadStreamStart(std::string_view bytes, draco::Decode
 }
 
 // The point count of a point cloud stream, or the vertex and face counts of a mesh stream,
-// where Draco reads them (its decoders' DecodeConnectivity); `buffer` as ReadStreamStart left it.
+// where Draco reads them (its decoders' DecodeConnectivity); `buffer` as ReadStreamStart left
+// it, for a stream of a version CheckStreamStart accepts.
 std::vector<std::pair<const char*, uint64_t>> DeclaredCounts(const StreamStart& start,
                                                              draco::DecoderBuffer& buffer) {
   if (start.type == draco::POINT_CLOUD) {
@@ -337,24 +336,11 @@ std::vector<std::pair<const char*, uint64_t>> DeclaredCounts(const StreamStart& 
   if (start.type != draco::TRIANGULAR_MESH) return {};
   uint64_t vertices = 0, faces = 0;
   if (start.method == draco::MESH_SEQUENTIAL_ENCODING) {
-    const uint16_t varint_since = DRACO_BITSTREAM_VERSION(2, 2);
-    if (!DecodeCount(buffer, start.version, varint_since, &faces) ||
-        !DecodeCount(buffer, start.version, varint_since, &vertices)) {
-      return {};
-    }
+    if (!DecodeCount(buffer, &faces) || !DecodeCount(buffer, &vertices)) return {};
   } else if (start.method == draco::MESH_EDGEBREAKER_ENCODING) {
-    const uint16_t varint_since = DRACO_BITSTREAM_VERSION(2, 0);
     uint8_t traversal = 0;
-    uint64_t new_vertices = 0;
     if (!buffer.Decode(&traversal)) return {};
-    if (start.version < DRACO_BITSTREAM_VERSION(2, 2) &&
-        !DecodeCount(buffer, start.version, varint_since, &new_vertices)) {
-      return {};
-    }
-    if (!DecodeCount(buffer, start.version, varint_since, &vertices) ||
-        !DecodeCount(buffer, start.version, varint_since, &faces)) {
-      return {};
-    }
+    if (!DecodeCount(buffer, &vertices) || !DecodeCount(buffer, &faces)) return {};
   } else {
     return {};
   }

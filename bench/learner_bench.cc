@@ -145,6 +145,17 @@ class BandTimer {
   std::vector<uint64_t> steps_;
 };
 
+// A learner with the paper's parameters and `seed`, looking ahead from `lookahead_from`
+// vertices on (-1: the learner's default).
+std::unique_ptr<Learner> MakeLearner(const Sampler& sampler, uint64_t seed,
+                                     int64_t lookahead_from) {
+  LearnerOptions options;
+  options.seed = seed;
+  auto learner = Learner::Create(options, &sampler).value();
+  if (lookahead_from >= 0) learner->SetLookaheadFromVertices(static_cast<size_t>(lookahead_from));
+  return learner;
+}
+
 // The milestones a learner on n points can reach (see the table's loop).
 std::vector<size_t> ReachableMilestones(const std::vector<size_t>& milestones, size_t n) {
   std::vector<size_t> reachable;
@@ -163,12 +174,8 @@ std::string BandName(const std::vector<size_t>& bands, size_t i) {
 // checks the final fingerprints agree.
 int CompareLookahead(const Sampler& sampler, size_t n, const std::vector<size_t>& milestones,
                      uint64_t seed, size_t from) {
-  LearnerOptions options;
-  options.seed = seed;
-  auto a = Learner::Create(options, &sampler).value();
-  auto b = Learner::Create(options, &sampler).value();
-  a->SetLookaheadFromVertices(std::numeric_limits<size_t>::max());
-  b->SetLookaheadFromVertices(from);
+  auto a = MakeLearner(sampler, seed, std::numeric_limits<int64_t>::max());
+  auto b = MakeLearner(sampler, seed, static_cast<int64_t>(from));
   const std::vector<size_t> bands = ReachableMilestones(milestones, n);
   BandTimer timer_a(bands), timer_b(bands);
   while (!timer_a.done(*a)) {
@@ -225,10 +232,7 @@ class FifoTurns {
 // fingerprint, which scripts/ab-bench.sh lines up with the other process's.
 int RunInTurns(FifoTurns& turns, const Sampler& sampler, size_t n,
                const std::vector<size_t>& milestones, uint64_t seed, int64_t lookahead_from) {
-  LearnerOptions options;
-  options.seed = seed;
-  auto learner = Learner::Create(options, &sampler).value();
-  if (lookahead_from >= 0) learner->SetLookaheadFromVertices(static_cast<size_t>(lookahead_from));
+  auto learner = MakeLearner(sampler, seed, lookahead_from);
   BandTimer timer(ReachableMilestones(milestones, n));
   while (!timer.done(*learner)) {
     turns.Wait();
@@ -326,11 +330,8 @@ int Run() {
   for (size_t n : point_counts) {
     auto cloud = std::make_shared<const PointCloud>(SamplePoints(*torus, n, seed));
     auto sampler = MakePointCloudSampler(cloud).value();
-    LearnerOptions options;
-    options.seed = seed;
-    auto learner = Learner::Create(options, sampler.get()).value();
+    auto learner = MakeLearner(*sampler, seed, lookahead_from);
     learner->EnableTimings(true);
-    if (lookahead_from >= 0) learner->SetLookaheadFromVertices(static_cast<size_t>(lookahead_from));
     const auto start = std::chrono::steady_clock::now();
     double first_us_per_step = 0, last_us_per_step = 0;
     size_t first_target = 0, last_target = 0;
@@ -371,10 +372,7 @@ int Run() {
         std::vector<double> windows = {first_us_per_step};
         for (int i = 0; i < repeats; ++i) {
           // Not marked for callgrind: a run under it measures the windows of the table only.
-          auto fresh = Learner::Create(options, sampler.get()).value();
-          if (lookahead_from >= 0) {
-            fresh->SetLookaheadFromVertices(static_cast<size_t>(lookahead_from));
-          }
+          auto fresh = MakeLearner(*sampler, seed, lookahead_from);
           const double window = TimeWindowBelow(*fresh, first_target, false);
           if (window < 0) return 1;
           windows.push_back(window);

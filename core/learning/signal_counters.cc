@@ -6,7 +6,10 @@
 
 namespace neuralmesh {
 
-SignalCounters::SignalCounters(double alpha_sc) : log_alpha_(std::log(alpha_sc)) {}
+SignalCounters::SignalCounters(double alpha_sc)
+    : log_alpha_(std::log(alpha_sc)),
+      initial_log_bound_(-std::log1p(-alpha_sc)),
+      log_bound_(initial_log_bound_) {}
 
 double SignalCounters::KeyOf(double value, uint64_t step) const {
   if (!(value > 0)) return -std::numeric_limits<double>::infinity();
@@ -15,48 +18,57 @@ double SignalCounters::KeyOf(double value, uint64_t step) const {
 
 double SignalCounters::Value(int id, uint64_t step) const {
   if (!Contains(id)) return 0;
-  const double k = heap_[heap_pos_[id]].key;
+  const double k = key_[id];
   if (k == -std::numeric_limits<double>::infinity()) return 0;
   return std::exp(k + static_cast<double>(step) * log_alpha_);
 }
 
 void SignalCounters::Add(int id, double value, uint64_t step) {
-  if (id >= static_cast<int>(heap_pos_.size())) heap_pos_.resize(static_cast<size_t>(id) + 1, -1);
-  if (heap_pos_[id] >= 0) {
-    Set(id, value, step);
-    return;
-  }
-  heap_pos_[id] = static_cast<int>(heap_.size());
-  heap_.push_back({KeyOf(value, step), id});
-  SiftUp(heap_.size() - 1);
+  if (id >= static_cast<int>(key_.size())) key_.resize(static_cast<size_t>(id) + 1, kUntracked);
+  if (!Contains(id)) ++tracked_;
+  log_bound_ = std::max(log_bound_, std::log(value));
+  SetKey(id, KeyOf(value, step), step);
 }
 
 void SignalCounters::Remove(int id) {
   if (!Contains(id)) return;
-  const size_t i = static_cast<size_t>(heap_pos_[id]);
-  const size_t last = heap_.size() - 1;
-  heap_pos_[id] = -1;
-  if (i != last) {
-    Place(i, heap_[last]);
-    heap_.pop_back();
-    SiftDown(i);
-    SiftUp(i);
-  } else {
-    heap_.pop_back();
-  }
+  key_[id] = kUntracked;  // Its touches stay in the log, where searches skip them.
+  --tracked_;
 }
 
-void SignalCounters::Set(int id, double value, uint64_t step) { Update(id, KeyOf(value, step)); }
+void SignalCounters::Set(int id, double value, uint64_t step) {
+  if (!Contains(id)) return;
+  log_bound_ = std::max(log_bound_, std::log(value));
+  SetKey(id, KeyOf(value, step), step);
+}
 
-void SignalCounters::Update(int id, double key) {
-  const size_t i = static_cast<size_t>(heap_pos_[id]);
-  const double old = heap_[i].key;
-  heap_[i].key = key;
-  if (key > old) {
-    SiftUp(i);
-  } else {
-    SiftDown(i);
+void SignalCounters::SetKey(int id, double key, uint64_t step) {
+  key_[id] = key;
+  // The largest key a counter of at most B can have at this step, computed as KeyOf computes
+  // keys, plus a margin for their rounding.
+  double bound = log_bound_ - static_cast<double>(step) * log_alpha_;
+  bound += 1e-9 * (1 + std::abs(bound));
+  if (!log_.empty()) bound = std::max(bound, static_cast<double>(log_.back().bound));
+  float rounded = static_cast<float>(bound);
+  if (static_cast<double>(rounded) < bound) {
+    rounded = std::nextafter(rounded, std::numeric_limits<float>::infinity());
   }
+  log_.push_back(LoggedTouch{id, rounded});
+  if (log_.size() > 2 * tracked_ + kLogSlack) CompactLog();
+}
+
+void SignalCounters::CompactLog() {
+  seen_.assign((key_.size() + 63) / 64, 0);
+  // Newest first: the first touch met of an id is its last one.
+  size_t kept = log_.size();
+  for (size_t i = log_.size(); i-- > 0;) {
+    const LoggedTouch touch = log_[i];
+    const size_t id = static_cast<size_t>(touch.id);
+    if (key_[id] == kUntracked || (seen_[id / 64] >> (id % 64) & 1) != 0) continue;
+    seen_[id / 64] |= uint64_t{1} << (id % 64);
+    log_[--kept] = touch;  // kept > i: nothing unread is overwritten.
+  }
+  log_.erase(log_.begin(), log_.begin() + static_cast<std::ptrdiff_t>(kept));
 }
 
 void SignalCounters::Flush() {
@@ -65,100 +77,52 @@ void SignalCounters::Flush() {
   // Basic Steps, and e^-38 = alpha_sc^740 for the paper's 0.95), skip the exp and the log and
   // still give bitwise the same key.
   constexpr double kNegligibleExponent = -38;
-  // On a large mesh each win's entry is a cache miss, and so is its position in the heap
-  // before it: both start loading for all the wins first, one level at a time.
+  // On a large mesh each win's key is a cache miss: they all start loading first.
   for (const auto& [id, step] : pending_) {
-    if (static_cast<size_t>(id) < heap_pos_.size()) __builtin_prefetch(&heap_pos_[id]);
-  }
-  for (const auto& [id, step] : pending_) {
-    if (Contains(id)) __builtin_prefetch(&heap_[heap_pos_[id]]);
+    if (static_cast<size_t>(id) < key_.size()) __builtin_prefetch(&key_[id]);
   }
   for (const auto& [id, step] : pending_) {
     if (!Contains(id)) continue;
     // c(step) after the win = c(step) before it + 1 (Eq. 4's 1 + sum alpha^-x, one term at a
     // time); the common factor alpha^t stays implicit in the key.
     const double time_term = static_cast<double>(step) * log_alpha_;
-    if (heap_[heap_pos_[id]].key + time_term < kNegligibleExponent) {
-      Update(id, 0.0 - time_term);  // KeyOf(1.0, step): log(1) is exactly 0.
+    if (key_[id] + time_term < kNegligibleExponent) {
+      SetKey(id, 0.0 - time_term, step);  // KeyOf(1.0, step): log(1) is exactly 0.
       continue;
     }
-    const double before = Value(id, step);
-    Update(id, KeyOf(before + 1.0, step));
+    SetKey(id, KeyOf(Value(id, step) + 1.0, step), step);
   }
   pending_.clear();
 }
 
 int SignalCounters::MostActive(const std::function<bool(int)>& eligible) {
   Flush();
-  if (heap_.empty()) return -1;
-  if (eligible(heap_[0].id)) return heap_[0].id;
-  // Best-first walk of the heap: the largest eligible key is found without popping anything.
-  std::vector<size_t> frontier = {0};
   int best = -1;
   double best_key = -std::numeric_limits<double>::infinity();
-  while (!frontier.empty()) {
-    // Take the frontier entry with the largest key.
-    size_t pick = 0;
-    for (size_t j = 1; j < frontier.size(); ++j) {
-      if (heap_[frontier[j]].key > heap_[frontier[pick]].key) pick = j;
-    }
-    const size_t i = frontier[pick];
-    frontier[pick] = frontier.back();
-    frontier.pop_back();
-    const Entry& entry = heap_[i];
-    if (best >= 0 && entry.key <= best_key) break;
-    if (eligible(entry.id)) {
-      best = entry.id;
-      best_key = entry.key;
-      break;
-    }
-    for (size_t c = FirstChild(i); c < FirstChild(i) + kArity && c < heap_.size(); ++c) {
-      frontier.push_back(c);
+  for (size_t i = log_.size(); i-- > 0;) {
+    const LoggedTouch touch = log_[i];
+    if (touch.bound < best_key) break;  // Nobody touched at or before this one beats best.
+    const double key = key_[touch.id];
+    if (key != kUntracked && key > best_key && eligible(touch.id)) {
+      best = touch.id;
+      best_key = key;
     }
   }
-  return best;
+  if (best >= 0) return best;
+  // No eligible counter above 0 (ln 0 = -inf): any eligible one, the last touched first.
+  for (size_t i = log_.size(); i-- > 0;) {
+    const int id = log_[i].id;
+    if (key_[id] != kUntracked && eligible(id)) return id;
+  }
+  return -1;
 }
 
 void SignalCounters::Clear() {
-  heap_pos_.clear();
-  heap_.clear();
+  key_.clear();
+  tracked_ = 0;
+  log_.clear();
   pending_.clear();
-}
-
-void SignalCounters::Place(size_t i, const Entry& entry) {
-  heap_[i] = entry;
-  heap_pos_[entry.id] = static_cast<int>(i);
-}
-
-// Both sifts move the entry through a hole: each level writes one entry and one position
-// instead of swapping two.
-void SignalCounters::SiftUp(size_t i) {
-  const Entry moving = heap_[i];
-  while (i > 0) {
-    const size_t parent = (i - 1) / kArity;
-    if (heap_[parent].key >= moving.key) break;
-    Place(i, heap_[parent]);
-    i = parent;
-  }
-  Place(i, moving);
-}
-
-void SignalCounters::SiftDown(size_t i) {
-  const size_t n = heap_.size();
-  const Entry moving = heap_[i];
-  while (true) {
-    const size_t first = FirstChild(i);
-    if (first >= n) break;
-    size_t largest = first;
-    const size_t end = std::min(first + kArity, n);
-    for (size_t c = first + 1; c < end; ++c) {
-      if (heap_[c].key > heap_[largest].key) largest = c;
-    }
-    if (heap_[largest].key <= moving.key) break;
-    Place(i, heap_[largest]);
-    i = largest;
-  }
-  Place(i, moving);
+  log_bound_ = initial_log_bound_;
 }
 
 }  // namespace neuralmesh

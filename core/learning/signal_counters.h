@@ -5,10 +5,26 @@
 // when Step 2 asks for the most active vertex. Section 3.3's remedy for the otherwise quadratic
 // Step 2 is taken one step further: a counter is stored as its logarithm referred to a common
 // time origin,
-//     key_i = ln c_i(t) - t ln(alpha_sc)   (independent of t between two wins of vertex i),
-// so the global multiplication by alpha_sc never touches memory, no counter underflows to zero
-// (the paper's c_M problem, Eq. 9), and an indexed max-heap over the keys finds the most active
-// vertex in O(log v). A win costs O(log v), amortised over the Basic Steps.
+//     key_i = ln c_i(t) - t ln(alpha_sc)   (independent of t between two touches of vertex i),
+// so the global multiplication by alpha_sc never touches memory and no counter underflows to
+// zero (the paper's c_M problem, Eq. 9).
+//
+// Finding the most active vertex without ordering all of them: a counter never exceeds
+// B = max(1 / (1 - alpha_sc), every value given to Add or Set) (a win turns c <= B into
+// alpha_sc c + 1 <= B), so a vertex last touched (won, Add, Set) at step t has
+//     key <= ln B - t ln(alpha_sc),
+// a bound that grows with t. The touches are kept in order in a log, each with that bound (a
+// running maximum, so that it never decreases along the log); the search walks the log from the
+// newest touch back and stops at the first touch whose bound is below the best eligible key
+// found: no vertex touched at or before it can beat that key. With the paper's alpha_sc = 0.95
+// the walk ends about ln(20) / -ln(0.95) = 58 steps' touches before the winner it returns,
+// whatever the mesh size; it goes further only past vertices that are not eligible. A win
+// costs O(1) (one entry by id, one appended to the log). The log keeps only the last touch of
+// each vertex once it grows past twice their number, so it stays O(v) in size for O(1)
+// amortised time per touch.
+//
+// (An indexed max-heap over the keys did this in O(log v) per win; on a large mesh each win's
+// sift to the top of the heap was several cache misses.)
 #ifndef NEURALMESH_CORE_LEARNING_SIGNAL_COUNTERS_H_
 #define NEURALMESH_CORE_LEARNING_SIGNAL_COUNTERS_H_
 
@@ -23,13 +39,15 @@ namespace neuralmesh {
 
 class SignalCounters {
  public:
+  // alpha_sc in (0, 1).
   explicit SignalCounters(double alpha_sc);
 
-  // Starts tracking `id` with counter value `value` (>= 0) at step `step`.
+  // Starts tracking `id` with counter value `value` (>= 0) at step `step`; sets the value of
+  // an id already tracked.
   void Add(int id, double value, uint64_t step);
   void Remove(int id);
   bool Contains(int id) const {
-    return id >= 0 && id < static_cast<int>(heap_pos_.size()) && heap_pos_[id] >= 0;
+    return id >= 0 && id < static_cast<int>(key_.size()) && key_[id] != kUntracked;
   }
 
   // Records that `id` won the Basic Step numbered `step`; applied lazily (Eq. 4).
@@ -42,36 +60,42 @@ class SignalCounters {
   // Overwrites the counter of a tracked id (used when a split divides it, Eq. 5-6).
   void Set(int id, double value, uint64_t step);
 
-  // The tracked id with the highest counter for which `eligible(id)` holds, or -1. Flushes
-  // first. Ineligible ids met on the way stay tracked.
+  // The tracked id with the highest counter for which `eligible(id)` holds, or -1 (ties: any).
+  // Flushes first. `eligible` is asked only of ids whose counter beats the best one so far.
   int MostActive(const std::function<bool(int)>& eligible);
 
-  size_t size() const { return heap_.size(); }
+  size_t size() const { return tracked_; }
+  // Entries in the touch log; for tests (at most about 2 size() + kLogSlack).
+  size_t log_size() const { return log_.size(); }
   void Clear();
 
  private:
-  double KeyOf(double value, uint64_t step) const;
-  void SiftUp(size_t i);
-  void SiftDown(size_t i);
-  void Update(int id, double key);
+  // A key no counter has (ln 0 is -inf); NaN would do as well but is harder to compare.
+  static constexpr double kUntracked = 1e308;
+  static constexpr size_t kLogSlack = 4096;
 
-  // The keys live in the heap entries, so that sifting reads only the heap (a win's sift
-  // touches a few random entries; on a large mesh each is a cache miss).
-  struct Entry {
-    double key;
-    int id;
+  struct LoggedTouch {
+    int32_t id;
+    // >= the key of every vertex whose last touch is this one or an earlier one (rounded up
+    // to a float: the bound only decides how far a search walks back).
+    float bound;
   };
-  // A win's key is nearly always the largest (keys grow with the time of the last win), so
-  // its sift runs to the top: a 4-ary heap halves the levels, and the misses, of a binary one.
-  static constexpr size_t kArity = 4;
-  static size_t FirstChild(size_t i) { return kArity * i + 1; }
-  // Writes `entry` at heap index i and records where its id now is.
-  void Place(size_t i, const Entry& entry);
+
+  double KeyOf(double value, uint64_t step) const;
+  // Sets the key of a tracked `id` touched at `step` and logs the touch (log_bound_ must
+  // already bound its counter).
+  void SetKey(int id, double key, uint64_t step);
+  // Keeps only the last touch of each tracked id (in order).
+  void CompactLog();
 
   double log_alpha_;
-  HugePageVector<int> heap_pos_;  // By id; -1 when not tracked.
-  HugePageVector<Entry> heap_;    // Max-heap by key.
+  double initial_log_bound_;    // ln(1 / (1 - alpha_sc)).
+  double log_bound_;            // ln B, see above.
+  HugePageVector<double> key_;  // By id; kUntracked when not tracked.
+  size_t tracked_ = 0;
+  std::vector<LoggedTouch> log_;
   std::vector<std::pair<int, uint64_t>> pending_;
+  std::vector<uint64_t> seen_;  // For CompactLog: a bit per id.
 };
 
 }  // namespace neuralmesh

@@ -70,10 +70,14 @@ TEST(SignalCountersTest, NoUnderflowAfterLongInactivity) {
       << "but the ordering survives: 1 was active last";
 }
 
-// Many ids, with removals, splits (Set) and wins in random order: the heap must always give the
-// id with the largest counter among the eligible ones, as a plain scan over all values does.
-TEST(SignalCountersTest, MostActiveMatchesAScanUnderAddRemoveAndSet) {
-  const double alpha = 0.95;
+// Many ids, with removals, splits (Set) and wins in random order, for a fast, the paper's and a
+// slow decay: MostActive must always give the id with the largest counter among the eligible
+// ones, as a plain scan over all values does. 30,000 touches of about 1,500 ids: the touch log
+// is compacted several times on the way.
+class SignalCountersScanTest : public testing::TestWithParam<double> {};
+
+TEST_P(SignalCountersScanTest, MostActiveMatchesAScanUnderAddRemoveAndSet) {
+  const double alpha = GetParam();
   const int n = 3000;
   SignalCounters counters(alpha);
   std::vector<bool> tracked(n, false);
@@ -115,7 +119,42 @@ TEST(SignalCountersTest, MostActiveMatchesAScanUnderAddRemoveAndSet) {
       }
     }
     ASSERT_EQ(got, expected) << "round " << round;
+    ASSERT_LE(counters.log_size(), 2 * counters.size() + 4096 + 1) << "round " << round;
   }
+}
+
+INSTANTIATE_TEST_SUITE_P(Decays, SignalCountersScanTest, testing::Values(0.5, 0.95, 0.999));
+
+// The most active eligible vertex was last touched long before every recent winner, which are
+// all ineligible: the search must walk back past them, and the log's compaction (10,000 wins
+// of 10 ids) must keep the old touches.
+TEST(SignalCountersTest, FindsAnOldEligibleVertexBehindIneligibleWinners) {
+  const double alpha = 0.95;
+  SignalCounters counters(alpha);
+  const double initial[5] = {0.5, 4.0, 2.0, 3.0, 1.0};
+  for (int id = 0; id < 5; ++id) counters.Add(id, initial[id], 0);
+  for (int id = 5; id < 15; ++id) counters.Add(id, 1.0, 0);
+  for (uint64_t step = 1; step <= 10000; ++step) {
+    counters.RecordWin(5 + static_cast<int>(step % 10), step);
+  }
+  auto old_only = [](int id) { return id < 5; };
+  EXPECT_EQ(counters.MostActive(old_only), 1);
+  EXPECT_LT(counters.log_size(), 4096u) << "the log was compacted (10,015 touches)";
+  counters.Remove(1);
+  EXPECT_EQ(counters.MostActive(old_only), 3);
+  EXPECT_EQ(counters.MostActive([](int id) { return id >= 5; }), 5)
+      << "the winner of step 10000 (10000 % 10 = 0) has the highest counter";
+}
+
+// Counters of 0 (ln 0 = -inf) still give an eligible vertex when no other is left.
+TEST(SignalCountersTest, ZeroCountersAreStillFound) {
+  SignalCounters counters(0.95);
+  counters.Add(0, 0.0, 3);
+  counters.Add(1, 0.0, 4);
+  counters.Add(2, 2.0, 4);
+  EXPECT_EQ(counters.MostActive([](int id) { return id != 2; }) < 2, true);
+  EXPECT_EQ(counters.MostActive([](int id) { return id == 0; }), 0);
+  EXPECT_EQ(counters.Value(0, 10), 0.0);
 }
 
 // A win long after the previous one takes a shortcut (the old counter is below what a double

@@ -1,5 +1,6 @@
 #include "core/learning/learner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -42,12 +43,12 @@ class Learner::Impl {
         mesh_(MakeInitialTetrahedron(target->Bounds())),
         octree_(target->Bounds()),
         counters_(options.alpha_sc) {
-    mesh_.add_property(last_win_);
+    mesh_.add_property(active_);
     mesh_.add_property(spared_until_);
     for (auto v : mesh_.vertices()) {
       octree_.Insert(v.idx(), mesh_.point(v));
       counters_.Add(v.idx(), 1.0, 0);
-      mesh_.property(last_win_, v) = 0;
+      mesh_.property(active_, v) = false;
       mesh_.property(spared_until_, v) = 0;
     }
     live_vertices_ = mesh_.n_vertices();
@@ -105,7 +106,7 @@ class Learner::Impl {
 
     ++step_;
     counters_.RecordWin(winner, step_);
-    mesh_.property(last_win_, w) = step_;
+    mesh_.property(active_, w) = true;
 
     if (step_ % static_cast<uint64_t>(options_.c_vs) == 0) {
       Clock::time_point t2;
@@ -205,7 +206,7 @@ class Learner::Impl {
     counters_.Set(id, counter * (1 - share0), step_);
     counters_.Add(v0.idx(), counter * share0, step_);
     // The new vertex counts as active: it must get a chance to win before Step 3 judges it.
-    mesh_.property(last_win_, v0) = step_;
+    mesh_.property(active_, v0) = true;
     mesh_.property(spared_until_, v0) = mesh_.property(spared_until_, v);  // Same strip.
     octree_.Insert(v0.idx(), mesh_.point(v0));
     if (lookahead_) lookahead_->RecordMove(mesh_.point(v0));
@@ -238,10 +239,7 @@ class Learner::Impl {
       mean_area = removed.mean_area;
       if (options_.merge_only_settled_boundaries) growing = removed.touched_vertices;
       // Inactive: not a winner since the last call of Step 3 (inactive_face_removal.h).
-      const uint64_t since = last_connectivity_step_;
-      auto inactive = [this, since](Mesh::VertexHandle v) {
-        return mesh_.property(last_win_, v) <= since;
-      };
+      auto inactive = [this](Mesh::VertexHandle v) { return !mesh_.property(active_, v); };
       std::vector<Mesh::VertexHandle>* grown =
           options_.merge_only_settled_boundaries ? &growing : nullptr;
       if (options_.cut_inactive_faces) {
@@ -279,7 +277,9 @@ class Learner::Impl {
       timings_.merging += Since(t0);
     }
     RecountDeletedFaces();
-    last_connectivity_step_ = step_;
+    // Every vertex is inactive again until it wins (the property is a bit vector).
+    auto& active = mesh_.property(active_).data_vector();
+    std::fill(active.begin(), active.end(), false);
     next_connectivity_step_ = step_ + std::max<uint64_t>(1, ConnectivityInterval());
     CompactInMortonOrder();
     rings_.InvalidateAll();  // Collapses, removals, merges and compaction changed rings.
@@ -298,7 +298,7 @@ class Learner::Impl {
     for (size_t i = 0; i < n; ++i) {
       const Mesh::VertexHandle v(static_cast<int>(i));
       if (mesh_.status(v).deleted()) continue;
-      if (mesh_.property(last_win_, v) > last_connectivity_step_) continue;
+      if (mesh_.property(active_, v)) continue;
       const Mesh::HalfedgeHandle h = BestCollapse(mesh_, v, live_vertices_);
       if (!h.is_valid()) {
         if (mesh_.is_boundary(v)) stuck_border_vertices_.push_back(v);
@@ -354,13 +354,14 @@ class Learner::Impl {
   // Made at the first Basic Step with at least lookahead_from_vertices_ vertices; kept since.
   std::optional<BasicStepLookahead> lookahead_;
   size_t lookahead_from_vertices_ = kLookaheadFromVertices;
-  OpenMesh::VPropHandleT<uint64_t> last_win_;
+  // Won, or made by a split, since the last call of Step 3 (Steps 3 and 4 act on the others).
+  // One bit per vertex, so that the Basic Step's write stays in cache on any mesh.
+  OpenMesh::VPropHandleT<bool> active_;
   // The last call of Step 4 that spares this vertex's faces (sewn_strip_grace_calls).
   OpenMesh::VPropHandleT<uint64_t> spared_until_;
   // Inactive boundary vertices that Step 3 could not collapse in this call.
   std::vector<Mesh::VertexHandle> stuck_border_vertices_;
   uint64_t step_ = 0;
-  uint64_t last_connectivity_step_ = 0;
   uint64_t next_connectivity_step_ = 0;
   size_t live_vertices_ = 0;
   size_t deleted_faces_ = 0;

@@ -86,10 +86,10 @@ struct RunResult {
 };
 
 RunResult RunOnce(const Workload& w, int bucket_size, bool verify) {
-  VertexOctree tree =
-      bucket_size > 0 ? VertexOctree(w.bounds, bucket_size) : VertexOctree(w.bounds);
   std::vector<Vec3> pos = w.points;
-  for (size_t i = 0; i < pos.size(); ++i) tree.Insert(static_cast<int>(i), pos[i]);
+  VertexOctree tree = bucket_size > 0 ? VertexOctree(w.bounds, &pos, bucket_size)
+                                      : VertexOctree(w.bounds, &pos);
+  for (size_t i = 0; i < pos.size(); ++i) tree.Insert(static_cast<int>(i));
   const size_t iterations = w.queries.size();
   RunResult r;
   // Query + moves, as in the learner.
@@ -100,7 +100,7 @@ RunResult RunOnce(const Workload& w, int bucket_size, bool verify) {
       const size_t j = it * kMovesPerStep + k;
       const int id = w.moved[j];
       pos[id] += w.offsets[j];
-      tree.Move(id, pos[id]);
+      tree.Move(id);
     }
   }
   r.ns_per_step = (ThreadCpuNs() - start) / iterations;

@@ -36,6 +36,8 @@ void BasicStepLookahead::StartStep(uint64_t step, const Sampler& target, Random&
     u.moved = BoundingBox();
   }
   target.PrefetchSample(rng);  // The next draw's point: a cache miss on large inputs.
+  // Step + kDepth, just drawn: the ids in the octree leaf around its sample.
+  octree.PrefetchNearest(Slot(step + kDepth).sample);
 
   // Step + 3: the search, on the leaf loaded during the last step.
   Upcoming& searched = Slot(step + 3);
@@ -50,7 +52,6 @@ void BasicStepLookahead::StartStep(uint64_t step, const Sampler& target, Random&
 
   // Step + 2: the winner's neighbours.
   if (const Upcoming& u = Slot(step + 2); HasWinner(u)) {
-    octree.PrefetchItem(u.winner);
     const VertexRingCache::RingView ring = rings.CachedRing(u.winner);
     for (int i = 0; i < ring.size; ++i) {
       rings.Prefetch(ring.neighbours[i]);
@@ -66,15 +67,15 @@ void BasicStepLookahead::ContinueStep(const VertexOctree& octree, const VertexRi
   if (const Upcoming& u = Slot(step_ + 1); HasWinner(u)) {
     const VertexRingCache::RingView ring = rings.CachedRing(u.winner);
     for (int i = 0; i < ring.size; ++i) {
-      octree.PrefetchItem(ring.neighbours[i]);
       const VertexRingCache::RingView second = rings.CachedRing(ring.neighbours[i]);
       for (int k = 0; k < second.size; ++k) {
         __builtin_prefetch(PointData(mesh, second.neighbours[k]));
       }
     }
   }
-  // Step + kDepth, drawn at the start of this step: the octree leaf around its sample.
-  octree.PrefetchNearest(Slot(step_ + kDepth).sample);
+  // Step + kDepth, drawn at the start of this step: the points of the octree leaf around its
+  // sample, whose ids have loaded since.
+  octree.PrefetchNearestPoints(Slot(step_ + kDepth).sample);
 }
 
 int BasicStepLookahead::Winner(const VertexOctree& octree, const Mesh& mesh) {

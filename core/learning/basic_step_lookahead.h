@@ -8,11 +8,12 @@
 // neighbourhoods meet. So the sample of step t is drawn at step t - 4 and one link of its chain
 // starts loading at each step in between:
 //
-//   step t-4: draw the sample s; midway through the step, load the octree leaf on s's side
+//   step t-4: draw the sample s and load the ids in the octree leaf on s's side; midway
+//             through the step, load their points
 //   step t-3: w <- the vertex nearest to s (its leaf is in cache now); load w's ring,
 //             position and octree location
 //   step t-2: load the rings, positions and octree locations of w's neighbours
-//   step t-1: midway, load the positions of their neighbours and the neighbours' octree entries
+//   step t-1: midway, load the positions of their neighbours
 //   step t:   the Basic Step, with winner w unless steps t-3 to t-1 moved w, or moved or
 //             inserted a vertex to within w's distance of s (tested against the bounding box
 //             of each step's moves); then the octree is searched again
@@ -48,8 +49,8 @@ class BasicStepLookahead {
 
   // Starts Basic Step `step` (first_step, then each next one, none skipped): draws the
   // samples up to step + kDepth from `target` with `rng`, searches the winner of step + 3 and
-  // starts the loads of step + 2. `octree`, `rings` and `mesh` must agree (the octree holds
-  // every vertex at its current position).
+  // starts the loads of step + 2 and step + kDepth. `octree`, `rings` and `mesh` must agree
+  // (the octree indexes the mesh's positions and has had every Move).
   void StartStep(uint64_t step, const Sampler& target, Random& rng, const VertexOctree& octree,
                  const VertexRingCache& rings, const Mesh& mesh);
   // Starts the loads of steps step + 1 and step + kDepth; called midway through the step

@@ -32,6 +32,13 @@ constexpr int kTimingSamplePeriod = 17;
 
 absl::Duration Since(Clock::time_point start) { return absl::FromChrono(Clock::now() - start); }
 
+// The mesh's positions as one vector (an OpenMesh property): the octree reads them by vertex
+// index. The vector object lives as long as the mesh; its storage may move as vertices are
+// added, which the octree allows.
+const std::vector<Vec3>* MeshPoints(const Mesh& mesh) {
+  return &mesh.property(mesh.points_pph()).data_vector();
+}
+
 }  // namespace
 
 class Learner::Impl {
@@ -41,12 +48,12 @@ class Learner::Impl {
         target_(target),
         rng_(options.seed),
         mesh_(MakeInitialTetrahedron(target->Bounds())),
-        octree_(target->Bounds()),
+        octree_(target->Bounds(), MeshPoints(mesh_)),
         counters_(options.alpha_sc) {
     mesh_.add_property(active_);
     mesh_.add_property(spared_until_);
     for (auto v : mesh_.vertices()) {
-      octree_.Insert(v.idx(), mesh_.point(v));
+      octree_.Insert(v.idx());
       counters_.Add(v.idx(), 1.0, 0);
       mesh_.property(active_, v) = false;
       mesh_.property(spared_until_, v) = 0;
@@ -94,12 +101,11 @@ class Learner::Impl {
       for (int i = 0; i < ring.size; ++i) octree_.PrefetchLocation(ring.neighbours[i]);
     }
     smoother_.Smooth(mesh_, rings_, w, options_.alpha_l, options_.c_l);
-    octree_.Move(winner, pw);
+    octree_.Move(winner);
     if (lookahead_) lookahead_->RecordMove(pw);
     for (const int q : smoother_.moved()) {
-      const Vec3& p = mesh_.point(Mesh::VertexHandle(q));
-      octree_.Move(q, p);
-      if (lookahead_) lookahead_->RecordMove(p);
+      octree_.Move(q);
+      if (lookahead_) lookahead_->RecordMove(mesh_.point(Mesh::VertexHandle(q)));
     }
     if (lookahead_) lookahead_->ContinueStep(octree_, rings_, mesh_);
     if (timed) timings_.smoothing += kTimingSamplePeriod * Since(t1);
@@ -208,7 +214,7 @@ class Learner::Impl {
     // The new vertex counts as active: it must get a chance to win before Step 3 judges it.
     mesh_.property(active_, v0) = true;
     mesh_.property(spared_until_, v0) = mesh_.property(spared_until_, v);  // Same strip.
-    octree_.Insert(v0.idx(), mesh_.point(v0));
+    octree_.Insert(v0.idx());
     if (lookahead_) lookahead_->RecordMove(mesh_.point(v0));
   }
 
@@ -334,9 +340,9 @@ class Learner::Impl {
     SortVerticesInMortonOrder(mesh_);
     SortEdgesByVertexIndex(mesh_);
     counters_.Clear();
-    octree_ = VertexOctree(target_->Bounds());
+    octree_ = VertexOctree(target_->Bounds(), MeshPoints(mesh_));
     for (auto v : mesh_.vertices()) {
-      octree_.Insert(v.idx(), mesh_.point(v));
+      octree_.Insert(v.idx());
       counters_.Add(v.idx(), mesh_.property(counter, v), step_);
     }
     mesh_.remove_property(counter);

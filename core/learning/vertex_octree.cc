@@ -63,8 +63,9 @@ int GrowSearchStack(int capacity, SearchEntry** stack, std::vector<SearchEntry>*
 
 }  // namespace
 
-VertexOctree::VertexOctree(const BoundingBox& initial_box, int bucket_size)
-    : bucket_size_(std::max(2, bucket_size)) {
+VertexOctree::VertexOctree(const BoundingBox& initial_box, const std::vector<Vec3>* points,
+                           int bucket_size)
+    : points_(points), bucket_size_(std::max(2, bucket_size)) {
   Vec3 center(0, 0, 0);
   double half = 1;
   if (!initial_box.empty()) {
@@ -127,7 +128,7 @@ int VertexOctree::NewBucket() {
   } else {
     b = static_cast<int>(bucket_next_.size());
     bucket_next_.push_back(-1);
-    items_.resize(items_.size() + static_cast<size_t>(bucket_size_));
+    ids_.resize(ids_.size() + static_cast<size_t>(bucket_size_));
   }
   bucket_next_[b] = -1;
   return b;
@@ -135,7 +136,7 @@ int VertexOctree::NewBucket() {
 
 void VertexOctree::FreeBucket(int b) { free_buckets_.push_back(b); }
 
-void VertexOctree::AppendToLeaf(int n, int id, const double p[3]) {
+void VertexOctree::AppendToLeaf(int n, int id) {
   if (node(n).child == kEmpty) node(n).child = LeafChild(NewBucket());
   int b = LeafBucket(node(n).child);
   int k = node(n).count;
@@ -147,14 +148,12 @@ void VertexOctree::AppendToLeaf(int n, int id, const double p[3]) {
     b = bucket_next_[b];
     k -= bucket_size_;
   }
-  Item& item = BucketItems(b)[k];
-  for (int i = 0; i < 3; ++i) item.p[i] = p[i];
-  item.id = id;
+  BucketIds(b)[k] = id;
   where_[id] = Location{b * bucket_size_ + k, n};
   ++node(n).count;
 }
 
-void VertexOctree::GrowRootToward(const Vec3& p) {
+void VertexOctree::GrowRootToward(const double p[3]) {
   // The new root doubles the old one; the old root becomes the child on the far side of p.
   double center[3];
   int octant = 0;
@@ -174,7 +173,7 @@ void VertexOctree::GrowRootToward(const Vec3& p) {
     int remaining = old.count;
     for (int b = LeafBucket(old.child); remaining > 0; b = bucket_next_[b]) {
       const int k = std::min(remaining, bucket_size_);
-      for (int j = 0; j < k; ++j) where_[BucketItems(b)[j].id].leaf = m;
+      for (int j = 0; j < k; ++j) where_[BucketIds(b)[j]].leaf = m;
       remaining -= k;
     }
   }
@@ -190,14 +189,14 @@ void VertexOctree::GrowRootToward(const Vec3& p) {
   root_half_ = half;
 }
 
-void VertexOctree::Insert(int id, const Vec3& p) {
+void VertexOctree::Insert(int id) {
   if (id >= static_cast<int>(where_.size())) {
     where_.resize(static_cast<size_t>(id) + 1, Location{-1, -1});
   }
   if (Contains(id)) Remove(id);
-  const double pos[3] = {p[0], p[1], p[2]};
+  const double* pos = PointOf(id);
   for (int guard = 0; !InCube(root_center_, root_half_, pos) && guard < 2048; ++guard) {
-    GrowRootToward(p);
+    GrowRootToward(pos);
   }
   InsertIntoTree(id, pos);
   ++size_;
@@ -215,7 +214,7 @@ void VertexOctree::InsertIntoTree(int id, const double p[3]) {
     } else if (nd.child != kEmpty && nd.count >= bucket_size_ && depth < kMaxDepth) {
       SplitLeaf(n);  // n is internal now; the next iteration descends into it.
     } else {
-      AppendToLeaf(n, id, p);
+      AppendToLeaf(n, id);
       return;
     }
   }
@@ -223,21 +222,19 @@ void VertexOctree::InsertIntoTree(int id, const double p[3]) {
 
 void VertexOctree::SplitLeaf(int n) {
   scratch_.clear();
-  GatherItems(n, scratch_);
+  GatherIds(n, scratch_);
   for (int b = LeafBucket(node(n).child); b >= 0; b = bucket_next_[b]) FreeBucket(b);
   double center[3], half;
   NodeCube(n, center, &half);
   const int block = NewBlock(n, center, half);
   node(n) = Node{block, static_cast<int32_t>(scratch_.size())};
-  for (const Item& item : scratch_) {
-    AppendToLeaf(block * 8 + Octant(center, item.p), item.id, item.p);
-  }
+  for (const int32_t id : scratch_) AppendToLeaf(block * 8 + Octant(center, PointOf(id)), id);
   // A child that received every point is full; the insertion that follows splits it again.
 }
 
 void VertexOctree::Remove(int id) {
   if (!Contains(id)) return;
-  const int hole = where_[id].item;
+  const int hole = where_[id].slot;
   const int n = where_[id].leaf;
   Node& leaf = node(n);
   // Fill the hole with the leaf's last item.
@@ -250,9 +247,9 @@ void VertexOctree::Remove(int id) {
     last = bucket_next_[last];
     k -= bucket_size_;
   }
-  const Item moved = BucketItems(last)[k];
-  items_[hole] = moved;
-  where_[moved.id].item = hole;
+  const int32_t moved = BucketIds(last)[k];
+  ids_[hole] = moved;
+  where_[moved].slot = hole;
   where_[id] = Location{-1, -1};
   if (k == 0 && before_last >= 0) {
     bucket_next_[before_last] = -1;
@@ -271,17 +268,17 @@ void VertexOctree::Remove(int id) {
   if (merge_at >= 0) CollapseSubtree(merge_at);
 }
 
-void VertexOctree::GatherItems(int n, std::vector<Item>& out) const {
+void VertexOctree::GatherIds(int n, std::vector<int32_t>& out) const {
   const Node& nd = node(n);
   if (nd.child >= 0) {
-    for (int o = 0; o < 8; ++o) GatherItems(nd.child * 8 + o, out);
+    for (int o = 0; o < 8; ++o) GatherIds(nd.child * 8 + o, out);
     return;
   }
   if (nd.child == kEmpty) return;
   int remaining = nd.count;
   for (int b = LeafBucket(nd.child); b >= 0 && remaining > 0; b = bucket_next_[b]) {
     const int m = std::min(remaining, bucket_size_);
-    out.insert(out.end(), BucketItems(b), BucketItems(b) + m);
+    out.insert(out.end(), BucketIds(b), BucketIds(b) + m);
     remaining -= m;
   }
 }
@@ -299,40 +296,49 @@ void VertexOctree::FreeSubtree(int n) {
 
 void VertexOctree::CollapseSubtree(int n) {
   scratch_.clear();
-  GatherItems(n, scratch_);
+  GatherIds(n, scratch_);
   FreeSubtree(n);
-  for (const Item& item : scratch_) AppendToLeaf(n, item.id, item.p);
+  for (const int32_t id : scratch_) AppendToLeaf(n, id);
 }
 
 // Move and Nearest, the octree's part of every Basic Step, are compiled for AVX2 as well as
 // for the baseline (avx2_clone.h): the same arithmetic in fewer instructions.
-NEURALMESH_AVX2_CLONE void VertexOctree::Move(int id, const Vec3& p) {
+NEURALMESH_AVX2_CLONE void VertexOctree::Move(int id) {
   if (Contains(id)) {
-    const Location at = where_[id];
     double center[3], half;
-    NodeCube(at.leaf, center, &half);
-    const double pos[3] = {p[0], p[1], p[2]};
-    if (InCube(center, half, pos)) {
-      Item& item = items_[at.item];
-      for (int i = 0; i < 3; ++i) item.p[i] = pos[i];
-      return;
-    }
+    NodeCube(where_[id].leaf, center, &half);
+    if (InCube(center, half, PointOf(id))) return;
   }
   Remove(id);
-  Insert(id, p);
+  Insert(id);
+}
+
+int VertexOctree::LeafOnSide(const double q[3]) const {
+  int n = 0;
+  while (node(n).child >= 0) {
+    const int block = node(n).child;
+    n = block * 8 + Octant(blocks_[block].center, q);
+  }
+  return node(n).count > 0 ? n : -1;
 }
 
 void VertexOctree::PrefetchNearest(const Vec3& q) const {
   const double qp[3] = {q[0], q[1], q[2]};
-  int n = 0;
-  while (node(n).child >= 0) {
-    const int block = node(n).child;
-    n = block * 8 + Octant(blocks_[block].center, qp);
-  }
-  if (node(n).count == 0) return;
-  const char* items = reinterpret_cast<const char*>(BucketItems(LeafBucket(node(n).child)));
-  const size_t bytes = sizeof(Item) * static_cast<size_t>(std::min(node(n).count, bucket_size_));
-  for (size_t offset = 0; offset < bytes; offset += 64) __builtin_prefetch(items + offset);
+  const int n = LeafOnSide(qp);
+  if (n < 0) return;
+  const char* ids = reinterpret_cast<const char*>(BucketIds(LeafBucket(node(n).child)));
+  const size_t bytes =
+      sizeof(int32_t) * static_cast<size_t>(std::min(node(n).count, bucket_size_));
+  for (size_t offset = 0; offset < bytes; offset += 64) __builtin_prefetch(ids + offset);
+}
+
+void VertexOctree::PrefetchNearestPoints(const Vec3& q) const {
+  const double qp[3] = {q[0], q[1], q[2]};
+  const int n = LeafOnSide(qp);
+  if (n < 0) return;
+  const int32_t* ids = BucketIds(LeafBucket(node(n).child));
+  const int m = std::min(node(n).count, bucket_size_);
+  for (int j = 0; j < m; ++j) __builtin_prefetch(PointOf(ids[j]));
 }
 
 // Inlined into both builds of Nearest.
@@ -341,27 +347,28 @@ __attribute__((always_inline)) inline void VertexOctree::ScanLeaf(const Node& le
                                                                   double* best_d2) const {
   int remaining = leaf.count;
   int b = LeafBucket(leaf.child);
-  const Item* found = nullptr;
+  int found = -1;
   // Squared distances are >= 0 (NaN only if coordinates overflow; then nothing is found).
   uint64_t found_bits = OrderedBits(*best_d2);
   while (true) {
-    const Item* items = BucketItems(b);
+    const int32_t* ids = BucketIds(b);
     const int m = std::min(remaining, bucket_size_);
     for (int j = 0; j < m; ++j) {
-      const double dx = items[j].p[0] - q[0];
-      const double dy = items[j].p[1] - q[1];
-      const double dz = items[j].p[2] - q[2];
+      const double* p = PointOf(ids[j]);
+      const double dx = p[0] - q[0];
+      const double dy = p[1] - q[1];
+      const double dz = p[2] - q[2];
       const uint64_t bits = OrderedBits(dx * dx + dy * dy + dz * dz);
       const bool closer = bits < found_bits;
-      found = closer ? &items[j] : found;
+      found = closer ? ids[j] : found;
       found_bits = closer ? bits : found_bits;
     }
     remaining -= m;
     if (remaining == 0) break;
     b = bucket_next_[b];
   }
-  if (found != nullptr) {
-    *best = found->id;
+  if (found >= 0) {
+    *best = found;
     std::memcpy(best_d2, &found_bits, sizeof found_bits);
   }
 }

@@ -9,12 +9,14 @@
 //
 // Layout and search (for speed: every Basic Step of the learner makes one query and about 7
 // moves): the children of a node are allocated together as one block of 8 compact nodes that
-// also holds their parent's cube, so a query reads one block per level; a leaf keeps copies of
-// its points' coordinates next to their ids in a fixed-size bucket, so scanning it reads a few
-// consecutive cache lines and no other array. A query first scans the leaf on q's side, then
-// searches depth-first (explicit stack, nearest octant first, pruned by cube distance) from the
-// lowest cube on that path that contains the ball the first leaf bounds. Leaves at the maximum
-// depth (many coincident points) chain further buckets.
+// also holds their parent's cube, so a query reads one block per level; a leaf keeps only the
+// ids of its points, in a fixed-size bucket, and reads their coordinates from the caller's
+// array of points (the learner's mesh positions, which the smoothing around the winner reads
+// too, so a search and the step after it share those cache lines). A move that stays in its
+// leaf then writes nothing. A query first scans the leaf on q's side, then searches
+// depth-first (explicit stack, nearest octant first, pruned by cube distance) from the lowest
+// cube on that path that contains the ball the first leaf bounds. Leaves at the maximum depth
+// (many coincident points) chain further buckets.
 #ifndef NEURALMESH_CORE_LEARNING_VERTEX_OCTREE_H_
 #define NEURALMESH_CORE_LEARNING_VERTEX_OCTREE_H_
 
@@ -29,17 +31,23 @@ namespace neuralmesh {
 
 class VertexOctree {
  public:
-  // `initial_box` sizes the root; it grows as needed. `bucket_size` (at least 2) is the
-  // capacity of a leaf (32 measured best or near-best from 1K to 100K points on a surface,
-  // bench/octree_bench.cc).
-  explicit VertexOctree(const BoundingBox& initial_box, int bucket_size = 32);
+  // Indexes points of `points` (by id), which the caller owns and keeps: the octree stores ids
+  // only and reads (*points)[id] whenever it compares or routes id, so the vector must outlive
+  // the octree (it may grow). `initial_box` sizes the root; it grows as needed. `bucket_size`
+  // (at least 2) is the capacity of a leaf (32 measured best or near-best from 1K to 100K
+  // points on a surface, bench/octree_bench.cc).
+  VertexOctree(const BoundingBox& initial_box, const std::vector<Vec3>* points,
+               int bucket_size = 32);
 
-  // Ids are small non-negative integers (vertex indices); `p` must be finite.
-  void Insert(int id, const Vec3& p);
+  // Ids are small non-negative integers (vertex indices) below points->size(); their points
+  // must be finite.
+  void Insert(int id);
   void Remove(int id);
-  void Move(int id, const Vec3& p);
+  // Call after (*points)[id] changed. Several points may change before their Moves; every
+  // changed point needs its Move before the next Nearest.
+  void Move(int id);
   bool Contains(int id) const {
-    return id >= 0 && id < static_cast<int>(where_.size()) && where_[id].item >= 0;
+    return id >= 0 && id < static_cast<int>(where_.size()) && where_[id].slot >= 0;
   }
 
   // A hint: starts loading where `id` is kept, for a caller that will Move it after other
@@ -47,18 +55,12 @@ class VertexOctree {
   void PrefetchLocation(int id) const {
     if (static_cast<size_t>(id) < where_.size()) __builtin_prefetch(&where_[id]);
   }
-
-  // A hint, once PrefetchLocation(id) has loaded: starts loading the point's own entry in its
-  // leaf, the other line Move reads.
-  void PrefetchItem(int id) const {
-    if (static_cast<size_t>(id) < where_.size() && where_[id].item >= 0) {
-      __builtin_prefetch(&items_[static_cast<size_t>(where_[id].item)]);
-    }
-  }
-  // A hint for a Nearest(q) to come: descends to the leaf on q's side (the upper levels of the
-  // tree are usually in cache) and starts loading the points it holds, which Nearest scans
-  // first.
+  // Hints for a Nearest(q) to come, in two stages a little apart: PrefetchNearest descends to
+  // the leaf on q's side (the upper levels of the tree are usually in cache) and starts loading
+  // the ids it holds; PrefetchNearestPoints, once those have loaded, starts loading their
+  // points. Nearest scans that leaf first.
   void PrefetchNearest(const Vec3& q) const;
+  void PrefetchNearestPoints(const Vec3& q) const;
 
   // The id of the point nearest to `q` (ties: any), or -1 when empty. Exact. With `distance2`,
   // also stores its squared distance to `q` there (dx^2 + dy^2 + dz^2 in that order).
@@ -85,19 +87,11 @@ class VertexOctree {
     int32_t next_free;
     Node nodes[8];
   };
-  // A leaf's points are kept in buckets of `bucket_size_` items; a leaf has one bucket except
-  // at the maximum depth, where further ones are chained. 32 bytes, so that an item never
-  // straddles two cache lines.
-  struct alignas(32) Item {
-    double p[3];
-    int32_t id;
-    int32_t unused;  // Padding.
-  };
-  // Where a point is kept. Move tests the new position against the leaf's cube, which follows
-  // from the leaf's block (usually in cache: the learner moves vertices near the one it has
-  // just searched for).
+  // Where a point is kept: its slot in ids_ and its leaf. Move tests the new position against
+  // the leaf's cube, which follows from the leaf's block (usually in cache: the learner moves
+  // vertices near the one it has just searched for).
   struct Location {
-    int32_t item;  // Index in items_, or -1 when absent.
+    int32_t slot;  // Index in ids_, or -1 when absent.
     int32_t leaf;
   };
   static constexpr int32_t kEmpty = -1;
@@ -109,20 +103,23 @@ class VertexOctree {
   int Parent(int n) const { return n == 0 ? -1 : blocks_[n >> 3].parent; }
   // The cube of node n (the root's is stored, the others follow from their block).
   void NodeCube(int n, double center[3], double* half) const;
-  Item* BucketItems(int b) { return &items_[static_cast<size_t>(b) * bucket_size_]; }
-  const Item* BucketItems(int b) const { return &items_[static_cast<size_t>(b) * bucket_size_]; }
+  int32_t* BucketIds(int b) { return &ids_[static_cast<size_t>(b) * bucket_size_]; }
+  const int32_t* BucketIds(int b) const { return &ids_[static_cast<size_t>(b) * bucket_size_]; }
+  const double* PointOf(int id) const { return (*points_)[static_cast<size_t>(id)].data(); }
+  // The leaf on q's side (non-empty), or -1.
+  int LeafOnSide(const double q[3]) const;
 
   int NewBlock(int parent, const double center[3], double half);
   void FreeBlock(int b);
   int NewBucket();
   void FreeBucket(int b);
-  // Appends (id, p) to leaf n (which may be empty), chaining a bucket if needed.
-  void AppendToLeaf(int n, int id, const double p[3]);
-  void GrowRootToward(const Vec3& p);
+  // Appends id to leaf n (which may be empty), chaining a bucket if needed.
+  void AppendToLeaf(int n, int id);
+  void GrowRootToward(const double p[3]);
   void InsertIntoTree(int id, const double p[3]);
   void SplitLeaf(int n);
   void CollapseSubtree(int n);
-  void GatherItems(int n, std::vector<Item>& out) const;
+  void GatherIds(int n, std::vector<int32_t>& out) const;
   void FreeSubtree(int n);
   // Updates (best, best_d2) with the points of a non-empty leaf.
   void ScanLeaf(const Node& leaf, const double q[3], int* best, double* best_d2) const;
@@ -130,7 +127,8 @@ class VertexOctree {
 
   HugePageVector<Block> blocks_;
   int free_blocks_ = -1;
-  HugePageVector<Item> items_;    // bucket_size_ items per bucket; fewer than 2^31 in all.
+  const std::vector<Vec3>* points_;
+  HugePageVector<int32_t> ids_;   // bucket_size_ ids per bucket; fewer than 2^31 in all.
   std::vector<int> bucket_next_;  // The next bucket of the same leaf, or -1.
   std::vector<int> free_buckets_;
   HugePageVector<Location> where_;  // By id.
@@ -141,7 +139,7 @@ class VertexOctree {
   double slack_ = 0;
   int bucket_size_;
   size_t size_ = 0;
-  std::vector<Item> scratch_;  // For SplitLeaf and CollapseSubtree.
+  std::vector<int32_t> scratch_;  // For SplitLeaf and CollapseSubtree.
 };
 
 }  // namespace neuralmesh

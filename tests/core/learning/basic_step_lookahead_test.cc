@@ -39,8 +39,8 @@ class CubeSampler : public Sampler {
 TEST(BasicStepLookaheadTest, WinnersAreThoseOfASearchAtTheStepItself) {
   Mesh mesh = testing::MustToMesh(testing::Icosphere(3));  // 642 vertices.
   const CubeSampler target;
-  VertexOctree octree(target.Bounds());
-  for (auto v : mesh.vertices()) octree.Insert(v.idx(), mesh.point(v));
+  VertexOctree octree(target.Bounds(), &mesh.property(mesh.points_pph()).data_vector());
+  for (auto v : mesh.vertices()) octree.Insert(v.idx());
   VertexRingCache rings;
   // Taking over at step 7, as the learner does once the mesh is large enough.
   constexpr uint64_t kFirst = 7;
@@ -65,14 +65,14 @@ TEST(BasicStepLookaheadTest, WinnersAreThoseOfASearchAtTheStepItself) {
     const Mesh::VertexHandle w(winner);
     Vec3& pw = mesh.point(w);
     pw = 0.7 * pw + 0.3 * lookahead.sample();
-    octree.Move(winner, pw);
+    octree.Move(winner);
     lookahead.RecordMove(pw);
     if (!mesh.is_isolated(w)) {
       const VertexRingCache::RingView ring = rings.Ring(mesh, winner);
       for (int i = 0; i < ring.size; ++i) {
         Vec3& q = mesh.point(Mesh::VertexHandle(ring.neighbours[i]));
         q += 0.01 * (pw - q);
-        octree.Move(ring.neighbours[i], q);
+        octree.Move(ring.neighbours[i]);
         lookahead.RecordMove(q);
       }
     }
@@ -83,13 +83,13 @@ TEST(BasicStepLookaheadTest, WinnersAreThoseOfASearchAtTheStepItself) {
       const int v = static_cast<int>(moves.NextIndex(mesh.n_vertices()));
       Vec3& p = mesh.point(Mesh::VertexHandle(v));
       p = recent[moves.NextIndex(recent.size())] + Vec3(1e-9, -2e-9, 3e-9);
-      octree.Move(v, p);
+      octree.Move(v);
       lookahead.RecordMove(p);
     }
     if (moves.NextIndex(50) == 0) {  // A split's new vertex (isolated here: only its position
                                      // matters to the search).
       const Mesh::VertexHandle added = mesh.add_vertex(recent.back() + Vec3(0, 1e-8, 0));
-      octree.Insert(added.idx(), mesh.point(added));
+      octree.Insert(added.idx());
       lookahead.RecordMove(mesh.point(added));
     }
     if (moves.NextIndex(997) == 0) lookahead.ForgetWinners();  // As after Steps 3-5.

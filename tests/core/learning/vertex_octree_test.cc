@@ -13,6 +13,39 @@
 namespace neuralmesh {
 namespace {
 
+// A VertexOctree over points this test owns, used as the learner uses it: a point changes in
+// the array first, then the tree is told (Insert, Move).
+class Tree {
+ public:
+  explicit Tree(const BoundingBox& box, int bucket_size = 32)
+      : tree_(box, &points_, bucket_size) {}
+  Tree(const Tree&) = delete;
+  Tree& operator=(const Tree&) = delete;
+
+  void Insert(int id, const Vec3& p) {
+    if (static_cast<size_t>(id) >= points_.size()) points_.resize(static_cast<size_t>(id) + 1);
+    points_[id] = p;
+    tree_.Insert(id);
+  }
+  void Move(int id, const Vec3& p) {
+    points_[id] = p;
+    tree_.Move(id);
+  }
+  void Remove(int id) { tree_.Remove(id); }
+  bool Contains(int id) const { return tree_.Contains(id); }
+  int Nearest(const Vec3& q) const { return tree_.Nearest(q); }
+  size_t size() const { return tree_.size(); }
+  int Depth() const { return tree_.Depth(); }
+
+  // For tests of the protocol itself.
+  std::vector<Vec3>& points() { return points_; }
+  VertexOctree& octree() { return tree_; }
+
+ private:
+  std::vector<Vec3> points_;  // Before tree_, which keeps its address.
+  VertexOctree tree_;
+};
+
 int BruteForceNearest(const std::vector<Vec3>& points, const std::vector<bool>& present,
                       const Vec3& q, double* best_d2) {
   int best = -1;
@@ -29,7 +62,7 @@ int BruteForceNearest(const std::vector<Vec3>& points, const std::vector<bool>& 
 }
 
 // Compares tree.Nearest(q) with brute force; returns a failure message or "".
-std::string CheckNearest(const VertexOctree& tree, const std::vector<Vec3>& points,
+std::string CheckNearest(const Tree& tree, const std::vector<Vec3>& points,
                          const std::vector<bool>& present, const Vec3& q) {
   double best_d2;
   const int expected = BruteForceNearest(points, present, q, &best_d2);
@@ -49,7 +82,7 @@ std::string CheckNearest(const VertexOctree& tree, const std::vector<Vec3>& poin
 
 // Random inserts, moves and removals of `num_ids` ids, with new points from `new_point` and
 // moves by `offset`; after every operation a query from `query` must match brute force.
-void RunRandomOperations(VertexOctree& tree, int num_ids, int num_ops, uint64_t seed,
+void RunRandomOperations(Tree& tree, int num_ids, int num_ops, uint64_t seed,
                          const std::function<Vec3(Random&)>& new_point,
                          const std::function<Vec3(Random&)>& offset,
                          const std::function<Vec3(Random&)>& query) {
@@ -91,7 +124,7 @@ TEST(VertexOctreeTest, EmptyTreeHasNoNearest) {
   BoundingBox box;
   box.Extend(Vec3(0, 0, 0));
   box.Extend(Vec3(1, 1, 1));
-  VertexOctree tree(box);
+  Tree tree(box);
   EXPECT_EQ(tree.Nearest(Vec3(0.5, 0.5, 0.5)), -1) << "an empty tree must answer -1";
 }
 
@@ -101,7 +134,7 @@ TEST(VertexOctreeTest, MatchesBruteForceUnderInsertMoveRemove) {
   BoundingBox box;
   box.Extend(Vec3(-1, -1, -1));
   box.Extend(Vec3(1, 1, 1));
-  VertexOctree tree(box, /*bucket_size=*/4);
+  Tree tree(box, /*bucket_size=*/4);
   Random rng(7);
   auto random_point = [&](double scale) {
     return Vec3(rng.NextDouble() - 0.5, rng.NextDouble() - 0.5, rng.NextDouble() - 0.5) *
@@ -146,7 +179,7 @@ TEST(VertexOctreeTest, DepthStaysLogarithmic) {
   BoundingBox box;
   box.Extend(Vec3(0, 0, 0));
   box.Extend(Vec3(1, 1, 1));
-  VertexOctree tree(box);
+  Tree tree(box);
   Random rng(3);
   for (int i = 0; i < 100000; ++i) {
     tree.Insert(i, Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble()));
@@ -162,7 +195,7 @@ TEST(VertexOctreeTest, MatchesBruteForceOnASurfaceForEveryBucketSize) {
     BoundingBox box;
     box.Extend(Vec3(-1, -1, -1));
     box.Extend(Vec3(1, 1, 1));
-    VertexOctree tree(box, bucket_size);
+    Tree tree(box, bucket_size);
     auto on_sphere = [](Random& rng) {
       const double z = 2 * rng.NextDouble() - 1;
       const double phi = 2 * M_PI * rng.NextDouble();
@@ -185,7 +218,7 @@ TEST(VertexOctreeTest, HandlesManyCoincidentPoints) {
   BoundingBox box;
   box.Extend(Vec3(0, 0, 0));
   box.Extend(Vec3(1, 1, 1));
-  VertexOctree tree(box, /*bucket_size=*/2);
+  Tree tree(box, /*bucket_size=*/2);
   const Vec3 spot(0.3, 0.6, 0.2);
   const int kCoincident = 100;
   for (int id = 0; id < kCoincident; ++id) tree.Insert(id, spot);
@@ -224,7 +257,7 @@ TEST(VertexOctreeTest, MatchesBruteForceOnTinyClusters) {
   BoundingBox box;
   box.Extend(Vec3(-1, -1, -1));
   box.Extend(Vec3(1, 1, 1));
-  VertexOctree tree(box, /*bucket_size=*/3);
+  Tree tree(box, /*bucket_size=*/3);
   const std::vector<Vec3> centers = {Vec3(0.1, 0.2, 0.3), Vec3(-0.5, 0.25, 0.125),
                                      Vec3(0.1, 0.2, 0.3 + 1e-6)};
   auto near_a_center = [&](Random& rng) {
@@ -248,7 +281,7 @@ TEST(VertexOctreeTest, RootGrowsTowardFarPoints) {
   BoundingBox box;
   box.Extend(Vec3(0.1, 0.1, 0.1));
   box.Extend(Vec3(0.3, 0.7, 0.2));
-  VertexOctree tree(box, /*bucket_size=*/4);
+  Tree tree(box, /*bucket_size=*/4);
   std::vector<Vec3> points;
   Random rng(23);
   for (int i = 0; i < 300; ++i) {
@@ -305,7 +338,7 @@ TEST(VertexOctreeTest, SearchesVeryDeepTrees) {
   BoundingBox box;
   box.Extend(Vec3(0, 0, 0));
   box.Extend(Vec3(1, 1, 1));
-  VertexOctree tree(box, /*bucket_size=*/2);
+  Tree tree(box, /*bucket_size=*/2);
   std::vector<Vec3> points;
   Random rng(31);
   for (int i = 0; i < 60; ++i) {
@@ -334,7 +367,7 @@ TEST(VertexOctreeTest, SearchesVeryDeepTrees) {
 
 // A tree built without a box (empty) starts from a unit cube and grows.
 TEST(VertexOctreeTest, EmptyInitialBoxGrows) {
-  VertexOctree tree{BoundingBox()};
+  Tree tree{BoundingBox()};
   std::vector<Vec3> points;
   std::vector<bool> present;
   Random rng(29);
@@ -348,6 +381,43 @@ TEST(VertexOctreeTest, EmptyInitialBoxGrows) {
     const Vec3 q =
         Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble()) * 120.0 - Vec3(40, 40, 40);
     ASSERT_EQ(CheckNearest(tree, points, present, q), "") << "query " << k;
+  }
+}
+
+// The learner's protocol: several points change in the array (the winner's ring after the
+// smoothing) before the tree hears of any; the Move of one may split or merge a leaf that holds
+// another whose Move is still to come (the split routes it by where it is now). Once every
+// changed point has had its Move, queries must be exact again.
+TEST(VertexOctreeTest, ExactAfterSeveralPointsChangeBeforeTheirMoves) {
+  for (int bucket_size : {2, 4, 32}) {
+    SCOPED_TRACE("bucket_size " + std::to_string(bucket_size));
+    BoundingBox box;
+    box.Extend(Vec3(-1, -1, -1));
+    box.Extend(Vec3(1, 1, 1));
+    Tree tree(box, bucket_size);
+    Random rng(41);
+    const int kIds = 500;
+    for (int id = 0; id < kIds; ++id) {
+      tree.Insert(id, Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble()) * 2.0 -
+                          Vec3(1, 1, 1));
+    }
+    const std::vector<bool> present(kIds, true);
+    std::vector<Vec3>& points = tree.points();
+    for (int round = 0; round < 3000; ++round) {
+      // Seven ids near one another in index, changed together, some across leaves.
+      const int first = static_cast<int>(rng.NextIndex(kIds - 7));
+      const double scale = rng.NextDouble() < 0.2 ? 0.5 : 0.02;
+      for (int k = 0; k < 7; ++k) {
+        points[first + k] +=
+            Vec3(rng.NextDouble() - 0.5, rng.NextDouble() - 0.5, rng.NextDouble() - 0.5) * scale;
+      }
+      for (int k = 6; k >= 0; --k) tree.octree().Move(first + k);
+      const Vec3 q(2 * rng.NextDouble() - 1, 2 * rng.NextDouble() - 1, 2 * rng.NextDouble() - 1);
+      ASSERT_EQ(CheckNearest(tree, points, present, q), "") << "round " << round;
+    }
+    for (int id = 0; id < kIds; ++id) {
+      ASSERT_EQ((points[tree.Nearest(points[id])] - points[id]).sqrnorm(), 0.0) << "id " << id;
+    }
   }
 }
 

@@ -61,6 +61,9 @@ class Learner::Impl {
     live_vertices_ = mesh_.n_vertices();
     next_connectivity_step_ = ConnectivityInterval();
   }
+  // The octree indexes mesh_'s own positions: a copy would index the original's.
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
 
   void Step() {
     // With timings on, one Basic Step in kTimingSamplePeriod is timed and counted that many

@@ -237,7 +237,7 @@ void VertexOctree::Remove(int id) {
   const int hole = where_[id].slot;
   const int n = where_[id].leaf;
   Node& leaf = node(n);
-  // Fill the hole with the leaf's last item.
+  // Fill the hole with the leaf's last id.
   const int head = LeafBucket(leaf.child);
   int last = head;
   int before_last = -1;

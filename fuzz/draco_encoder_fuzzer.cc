@@ -56,14 +56,14 @@ void CheckFailure(const absl::Status& status) {
 }
 
 // Half a grid step of the quantization, with slack for Draco's float arithmetic (its
-// dequantization adds q * step to the origin in float).
+// dequantization adds q * step to the origin in float). A fixed box's grid is the box as Draco
+// reads it (six decimals), which may be coarser than the one given.
 float Tolerance(const std::vector<Vec3f>& positions, const DracoOptions& options) {
   float range = 0, magnitude = 0;
   if (options.quantization_box.has_value()) {
-    range = options.quantization_box->range;
-    for (int c = 0; c < 3; ++c) {
-      magnitude = std::max(magnitude, std::abs(options.quantization_box->origin[c]));
-    }
+    const QuantizationBox box = neuralmesh::BoxAsDracoReadsIt(*options.quantization_box);
+    range = box.range;
+    for (int c = 0; c < 3; ++c) magnitude = std::max(magnitude, std::abs(box.origin[c]));
   } else {
     for (int c = 0; c < 3; ++c) {
       float lo = positions[0][c], hi = positions[0][c];

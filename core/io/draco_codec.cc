@@ -71,21 +71,8 @@ DracoGrid GridOfValues(const float* values, size_t count, int components) {
   return grid;
 }
 
-// The box Draco's encoder reads back from the one it is given: it passes the box's origin and
-// edge to its quantizer as text, with std::to_string's six decimals (draco::Options), so a
-// box of origin 1e-7 and edge 3e-9 reaches it as origin 0 and edge 0.
-QuantizationBox AsDracoReadsIt(const QuantizationBox& box) {
-  draco::Options text;
-  text.SetVector("origin", box.origin.data(), 3);
-  text.SetFloat("range", box.range);
-  QuantizationBox read;
-  text.GetVector("origin", 3, read.origin.data());
-  read.range = text.GetFloat("range");
-  return read;
-}
-
 // The value nearest to x, at or above it when `up`, else at or below, that Draco reads back
-// exactly (AsDracoReadsIt). Below 2^23 * 1e-6 floats are finer than six decimals, so the
+// exactly (BoxAsDracoReadsIt). Below 2^23 * 1e-6 floats are finer than six decimals, so the
 // candidates are whole millionths; above, floats are coarser and most read back unchanged.
 // (Should none of the first candidates qualify, the last is returned: it lies on the asked
 // side, and the encoders check boxes as Draco reads them anyway.)
@@ -94,7 +81,7 @@ float ValueDracoKeeps(double x, bool up) {
   // a candidate must come back from both.
   auto kept_on_side = [x, up](float candidate) {
     const QuantizationBox read =
-        AsDracoReadsIt(QuantizationBox{Vec3f(candidate, candidate, candidate), candidate});
+        BoxAsDracoReadsIt(QuantizationBox{Vec3f(candidate, candidate, candidate), candidate});
     return (up ? candidate >= x : candidate <= x) && read.origin[0] == candidate &&
            read.range == candidate;
   };
@@ -158,7 +145,7 @@ absl::Status CheckPositions(const std::vector<Vec3f>& positions, const DracoOpti
         "cannot quantize the positions with Draco: their bounding box spans ", problem));
   }
   const QuantizationBox& given = *options.quantization_box;
-  const QuantizationBox box = AsDracoReadsIt(given);
+  const QuantizationBox box = BoxAsDracoReadsIt(given);
   const auto describe = [&given, &box] {
     std::string text =
         absl::StrCat("the quantization box with origin (", given.origin[0], ", ", given.origin[1],
@@ -460,6 +447,18 @@ absl::StatusOr<Vec3f> ReadVec3(const draco::PointAttribute& attribute,
 }
 
 }  // namespace
+
+// Draco's encoder passes the box's origin and edge to its quantizer as text, with
+// std::to_string's six decimals (draco::Options).
+QuantizationBox BoxAsDracoReadsIt(const QuantizationBox& box) {
+  draco::Options text;
+  text.SetVector("origin", box.origin.data(), 3);
+  text.SetFloat("range", box.range);
+  QuantizationBox read;
+  text.GetVector("origin", 3, read.origin.data());
+  read.range = text.GetFloat("range");
+  return read;
+}
 
 QuantizationBox DracoExactBox(const QuantizationBox& box) {
   QuantizationBox exact;

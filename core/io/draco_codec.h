@@ -71,6 +71,11 @@ struct DracoOptions {
 // 1e-3 the grid gets coarser than asked. Callers that announce their grid use it.
 QuantizationBox DracoExactBox(const QuantizationBox& box);
 
+// The box Draco quantizes against when given `box`: its origin and edge rounded to six
+// decimals (a box of origin 1e-7 and edge 3e-9 becomes origin 0 and edge 0). DracoExactBox's
+// boxes come back unchanged.
+QuantizationBox BoxAsDracoReadsIt(const QuantizationBox& box);
+
 // Encodes `mesh` (positions and faces) with Edgebreaker; see shrink_small_meshes for meshes
 // under 64 vertices.
 // Returns INVALID_ARGUMENT when `options` is invalid, the mesh has no vertices or no

@@ -252,7 +252,21 @@ TEST(DracoCodecTest, ExactBoxesContainTheBoxAndAreKeptAsTheyAre) {
     const QuantizationBox again = DracoExactBox(exact);
     ASSERT_EQ(again.origin, exact.origin) << context;
     ASSERT_EQ(again.range, exact.range) << context;
+    const QuantizationBox read = BoxAsDracoReadsIt(exact);
+    ASSERT_EQ(read.origin, exact.origin) << context << ": Draco would read it differently";
+    ASSERT_EQ(read.range, exact.range) << context << ": Draco would read it differently";
   }
+}
+
+// What Draco makes of a box it is given: six decimals (the grid the server's fuzzed boxes
+// decode on, fuzz/corpus/draco_encoder_fuzzer/crash-box-read-with-six-decimals).
+TEST(DracoCodecTest, BoxAsDracoReadsItRoundsToSixDecimals) {
+  QuantizationBox box;
+  box.origin = Vec3f(-1.2888323e-05f, 1e-7f, 2.5f);
+  box.range = 1.35020528e-05f;
+  const QuantizationBox read = BoxAsDracoReadsIt(box);
+  EXPECT_EQ(read.origin, Vec3f(-1.3e-05f, 0.0f, 2.5f));
+  EXPECT_EQ(read.range, 1.4e-05f);
 }
 
 // Draco receives a fixed box as text with six decimals, so a box of edge 3e-9 reached it as

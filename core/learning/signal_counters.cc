@@ -90,7 +90,11 @@ void SignalCounters::Flush() {
       SetKey(id, 0.0 - time_term, step);  // KeyOf(1.0, step): log(1) is exactly 0.
       continue;
     }
-    SetKey(id, KeyOf(Value(id, step) + 1.0, step), step);
+    // A win keeps the counter at or below B unless it lands in the step of the id's last
+    // touch (not undecayed): then B grows with it. (KeyOf's arithmetic, the log taken once.)
+    const double log_after = std::log(Value(id, step) + 1.0);
+    log_bound_ = std::max(log_bound_, log_after);
+    SetKey(id, log_after - static_cast<double>(step) * log_alpha_, step);
   }
   pending_.clear();
 }

@@ -10,8 +10,9 @@
 // zero (the paper's c_M problem, Eq. 9).
 //
 // Finding the most active vertex without ordering all of them: a counter never exceeds
-// B = max(1 / (1 - alpha_sc), every value given to Add or Set) (a win turns c <= B into
-// alpha_sc c + 1 <= B), so a vertex last touched (won, Add, Set) at step t has
+// B = max(1 / (1 - alpha_sc), every value given to Add or Set, every value a win left) (a win
+// a step or more after the last touch turns c <= B into alpha_sc c + 1 <= B), so a vertex last
+// touched (won, Add, Set) at step t has
 //     key <= ln B - t ln(alpha_sc),
 // a bound that grows with t. The touches are kept in order in a log, each with that bound (a
 // running maximum, so that it never decreases along the log); the search walks the log from the

@@ -146,6 +146,19 @@ TEST(SignalCountersTest, FindsAnOldEligibleVertexBehindIneligibleWinners) {
       << "the winner of step 10000 (10000 % 10 = 0) has the highest counter";
 }
 
+// A win in the step of the counter's last touch is not decayed first: it can lift the counter
+// above every value given so far (20 + 1 here, with 1 / (1 - 0.95) = 20), and the search must
+// still walk back to it past a later, smaller counter.
+TEST(SignalCountersTest, AWinInTheStepOfTheLastTouchRaisesTheBound) {
+  SignalCounters counters(0.95);
+  counters.Add(0, 20.0, 5);
+  counters.RecordWin(0, 5);
+  counters.Flush();
+  EXPECT_DOUBLE_EQ(counters.Value(0, 5), 21.0);
+  counters.Add(1, 20.2, 5);
+  EXPECT_EQ(counters.MostActive([](int) { return true; }), 0);
+}
+
 // Counters of 0 (ln 0 = -inf) still give an eligible vertex when no other is left.
 TEST(SignalCountersTest, ZeroCountersAreStillFound) {
   SignalCounters counters(0.95);

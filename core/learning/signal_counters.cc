@@ -66,7 +66,7 @@ void SignalCounters::CompactLog() {
     const size_t id = static_cast<size_t>(touch.id);
     if (key_[id] == kUntracked || (seen_[id / 64] >> (id % 64) & 1) != 0) continue;
     seen_[id / 64] |= uint64_t{1} << (id % 64);
-    log_[--kept] = touch;  // kept > i: nothing unread is overwritten.
+    log_[--kept] = touch;  // Now kept >= i: nothing unread is overwritten.
   }
   log_.erase(log_.begin(), log_.begin() + static_cast<std::ptrdiff_t>(kept));
 }
@@ -91,7 +91,7 @@ void SignalCounters::Flush() {
       continue;
     }
     // A win keeps the counter at or below B unless it lands in the step of the id's last
-    // touch (not undecayed): then B grows with it. (KeyOf's arithmetic, the log taken once.)
+    // touch (nothing decayed yet): then B grows with it. (KeyOf's arithmetic, one log.)
     const double log_after = std::log(Value(id, step) + 1.0);
     log_bound_ = std::max(log_bound_, log_after);
     SetKey(id, log_after - static_cast<double>(step) * log_alpha_, step);

@@ -11,11 +11,6 @@ SignalCounters::SignalCounters(double alpha_sc)
       initial_log_bound_(-std::log1p(-alpha_sc)),
       log_bound_(initial_log_bound_) {}
 
-double SignalCounters::KeyOf(double value, uint64_t step) const {
-  if (!(value > 0)) return -std::numeric_limits<double>::infinity();
-  return std::log(value) - static_cast<double>(step) * log_alpha_;
-}
-
 double SignalCounters::Value(int id, uint64_t step) const {
   if (!Contains(id)) return 0;
   const double k = key_[id];
@@ -26,8 +21,7 @@ double SignalCounters::Value(int id, uint64_t step) const {
 void SignalCounters::Add(int id, double value, uint64_t step) {
   if (id >= static_cast<int>(key_.size())) key_.resize(static_cast<size_t>(id) + 1, kUntracked);
   if (!Contains(id)) ++tracked_;
-  log_bound_ = std::max(log_bound_, std::log(value));
-  SetKey(id, KeyOf(value, step), step);
+  SetValue(id, value, step);
 }
 
 void SignalCounters::Remove(int id) {
@@ -37,15 +31,20 @@ void SignalCounters::Remove(int id) {
 }
 
 void SignalCounters::Set(int id, double value, uint64_t step) {
-  if (!Contains(id)) return;
-  log_bound_ = std::max(log_bound_, std::log(value));
-  SetKey(id, KeyOf(value, step), step);
+  if (Contains(id)) SetValue(id, value, step);
+}
+
+void SignalCounters::SetValue(int id, double value, uint64_t step) {
+  // ln c, for the key and for B; a counter of 0 (or less) has the key -inf.
+  const double log_value = value > 0 ? std::log(value) : -std::numeric_limits<double>::infinity();
+  log_bound_ = std::max(log_bound_, log_value);
+  SetKey(id, log_value - static_cast<double>(step) * log_alpha_, step);
 }
 
 void SignalCounters::SetKey(int id, double key, uint64_t step) {
   key_[id] = key;
-  // The largest key a counter of at most B can have at this step, computed as KeyOf computes
-  // keys, plus a margin for their rounding.
+  // The largest key a counter of at most B can have at this step, computed as SetValue
+  // computes keys, plus a margin for their rounding.
   double bound = log_bound_ - static_cast<double>(step) * log_alpha_;
   bound += 1e-9 * (1 + std::abs(bound));
   if (!log_.empty()) bound = std::max(bound, static_cast<double>(log_.back().bound));
@@ -87,14 +86,12 @@ void SignalCounters::Flush() {
     // time); the common factor alpha^t stays implicit in the key.
     const double time_term = static_cast<double>(step) * log_alpha_;
     if (key_[id] + time_term < kNegligibleExponent) {
-      SetKey(id, 0.0 - time_term, step);  // KeyOf(1.0, step): log(1) is exactly 0.
+      SetKey(id, 0.0 - time_term, step);  // A value of 1: log(1) is exactly 0, and 1 <= B.
       continue;
     }
     // A win keeps the counter at or below B unless it lands in the step of the id's last
-    // touch (nothing decayed yet): then B grows with it. (KeyOf's arithmetic, one log.)
-    const double log_after = std::log(Value(id, step) + 1.0);
-    log_bound_ = std::max(log_bound_, log_after);
-    SetKey(id, log_after - static_cast<double>(step) * log_alpha_, step);
+    // touch (nothing decayed yet): SetValue raises B then.
+    SetValue(id, Value(id, step) + 1.0, step);
   }
   pending_.clear();
 }

@@ -82,7 +82,8 @@ class SignalCounters {
     float bound;
   };
 
-  double KeyOf(double value, uint64_t step) const;
+  // Sets the counter of a tracked `id` touched at `step`, raising B to it if needed.
+  void SetValue(int id, double value, uint64_t step);
   // Sets the key of a tracked `id` touched at `step` and logs the touch (log_bound_ must
   // already bound its counter).
   void SetKey(int id, double key, uint64_t step);

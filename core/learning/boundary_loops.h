@@ -17,6 +17,11 @@ using VertexLoop = std::vector<Mesh::VertexHandle>;
 // O(h).
 std::vector<VertexLoop> CollectBoundaryLoops(const Mesh& mesh);
 
+// The boundary loop that starts with the boundary half-edge `start`; with `visited` (indexed by
+// half-edge), marks its half-edges there. O(loop length).
+VertexLoop BoundaryLoopFrom(const Mesh& mesh, Mesh::HalfedgeHandle start,
+                            std::vector<bool>* visited = nullptr);
+
 }  // namespace neuralmesh
 
 #endif  // NEURALMESH_CORE_LEARNING_BOUNDARY_LOOPS_H_

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <set>
 #include <utility>
 #include <vector>
@@ -227,20 +228,6 @@ std::vector<VertexLoop> SlitCandidates(const Mesh& mesh, const VertexLoop& loop,
   return chains;
 }
 
-// The boundary loop through the boundary vertex `v`, in half-edge order (as
-// CollectBoundaryLoops lists it). OpenMesh keeps a boundary half-edge as v's outgoing one.
-VertexLoop LoopThrough(const Mesh& mesh, Mesh::VertexHandle v) {
-  VertexLoop loop;
-  const Mesh::HalfedgeHandle start = mesh.halfedge_handle(v);
-  if (!mesh.is_boundary(start)) return loop;
-  Mesh::HalfedgeHandle h = start;
-  do {
-    loop.push_back(mesh.from_vertex_handle(h));
-    h = mesh.next_halfedge_handle(h);
-  } while (h != start);
-  return loop;
-}
-
 // Cuts the bridge of the two faces on either side of the interior half-edge `h`, whose ends
 // lie on two different loops of `joined_vertices` vertices together, and fills the one loop
 // that the cut leaves (FillLoop) if it has at most `max_vertices`. When that loop has no
@@ -260,7 +247,9 @@ size_t CutBridgeAndFill(Mesh& mesh, Mesh::HalfedgeHandle h, size_t joined_vertic
   // As in CutInactiveBridges: the first removal leaves a pinch that the second one resolves.
   RemoveTriangle(mesh, bridge[0], nullptr);
   RemoveTriangle(mesh, bridge[1], nullptr);
-  const VertexLoop joined = LoopThrough(mesh, from);
+  // The loop through `from` (OpenMesh keeps a boundary half-edge as its outgoing one).
+  const Mesh::HalfedgeHandle out = mesh.halfedge_handle(from);
+  const VertexLoop joined = mesh.is_boundary(out) ? BoundaryLoopFrom(mesh, out) : VertexLoop();
   const bool one_loop = joined.size() >= joined_vertices &&
                         std::find(joined.begin(), joined.end(), to) != joined.end();
   const size_t added =
@@ -275,6 +264,23 @@ size_t CutBridgeAndFill(Mesh& mesh, Mesh::HalfedgeHandle h, size_t joined_vertic
     RemoveTriangle(mesh, second, nullptr);
   }
   return 0;
+}
+
+// The largest face (alpha_r E(Area), Eq. 2) and edge (alpha_m sqrt(E(Area)), Eq. 3) a filling
+// may have.
+struct FillLimits {
+  double max_area;
+  double max_edge;
+};
+
+// The limits for `options`, with E(Area) = `mean_area`, or that of the live faces when it is
+// <= 0; none when no face may be added (E(Area) is 0).
+std::optional<FillLimits> LimitsOf(const Mesh& mesh, const HoleClosingOptions& options,
+                                   double mean_area) {
+  if (mean_area <= 0) mean_area = MeanTriangleArea(mesh);
+  const FillLimits limits{options.alpha_r * mean_area, options.alpha_m * std::sqrt(mean_area)};
+  if (!(limits.max_area > 0)) return std::nullopt;
+  return limits;
 }
 
 }  // namespace
@@ -300,10 +306,9 @@ HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options,
   const std::vector<VertexLoop> loops =
       CollectLoops(mesh, static_cast<size_t>(options.max_loop_vertices));
   if (loops.empty()) return result;
-  if (mean_area <= 0) mean_area = MeanTriangleArea(mesh);
-  const double max_area = options.alpha_r * mean_area;
-  const double max_edge = options.alpha_m * std::sqrt(mean_area);
-  if (!(max_area > 0)) return result;
+  const std::optional<FillLimits> limits = LimitsOf(mesh, options, mean_area);
+  if (!limits) return result;
+  const auto [max_area, max_edge] = *limits;
   for (const VertexLoop& loop : loops) {
     const size_t added = FillLoop(mesh, loop, max_area, max_edge);
     if (added == 0) continue;
@@ -318,10 +323,9 @@ HoleClosingResult CloseBridgedHoles(Mesh& mesh, const HoleClosingOptions& option
   HoleClosingResult result;
   const std::vector<VertexLoop> loops = CollectBoundaryLoops(mesh);
   if (loops.size() < 2) return result;
-  if (mean_area <= 0) mean_area = MeanTriangleArea(mesh);
-  const double max_area = options.alpha_r * mean_area;
-  const double max_edge = options.alpha_m * std::sqrt(mean_area);
-  if (!(max_area > 0)) return result;
+  const std::optional<FillLimits> limits = LimitsOf(mesh, options, mean_area);
+  if (!limits) return result;
+  const auto [max_area, max_edge] = *limits;
   std::vector<int> loop_of(mesh.n_vertices(), -1);
   for (size_t i = 0; i < loops.size(); ++i) {
     for (auto v : loops[i]) loop_of[v.idx()] = static_cast<int>(i);
@@ -369,10 +373,9 @@ HoleClosingResult CloseBridgedHoles(Mesh& mesh, const HoleClosingOptions& option
 HoleClosingResult ZipBorderSlits(Mesh& mesh, const HoleClosingOptions& options,
                                  double mean_area) {
   HoleClosingResult result;
-  if (mean_area <= 0) mean_area = MeanTriangleArea(mesh);
-  const double max_area = options.alpha_r * mean_area;
-  const double max_edge = options.alpha_m * std::sqrt(mean_area);
-  if (!(max_area > 0)) return result;
+  const std::optional<FillLimits> limits = LimitsOf(mesh, options, mean_area);
+  if (!limits) return result;
+  const auto [max_area, max_edge] = *limits;
   // Each zip changes the loops, so they are collected again after it.
   for (size_t zips = 0; zips < kMaxSlitZipsPerCall; ++zips) {
     bool zipped = false;

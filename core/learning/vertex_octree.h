@@ -35,7 +35,8 @@ class VertexOctree {
   // only and reads (*points)[id] whenever it compares or routes id, so the vector must outlive
   // the octree (it may grow). `initial_box` sizes the root; it grows as needed. `bucket_size`
   // (at least 2) is the capacity of a leaf (32 measured best or near-best from 1K to 100K
-  // points on a surface, bench/octree_bench.cc).
+  // points on a surface in random order, bench/octree_bench.cc; the learner, whose points are
+  // in Morton order, uses 64: learner.cc).
   VertexOctree(const BoundingBox& initial_box, const std::vector<Vec3>* points,
                int bucket_size = 32);
 

@@ -37,11 +37,12 @@ void BasicStepLookahead::StartStep(uint64_t step, const Sampler& target, Random&
   }
   target.PrefetchSample(rng);  // The next draw's point: a cache miss on large inputs.
   // Step + kDepth, just drawn: the ids in the octree leaf around its sample.
-  octree.PrefetchNearest(Slot(step + kDepth).sample);
+  Upcoming& drawn = Slot(step + kDepth);
+  drawn.leaf = octree.PrefetchNearest(drawn.sample);
 
   // Step + 3: the search, on the leaf loaded during the last step.
   Upcoming& searched = Slot(step + 3);
-  searched.winner = octree.Nearest(searched.sample, &searched.distance2);
+  searched.winner = octree.Nearest(searched.sample, &searched.distance2, searched.leaf);
   if (searched.winner >= 0) {
     searched.searched_at = step;
     searched.generation = generation_;
@@ -75,7 +76,7 @@ void BasicStepLookahead::ContinueStep(const VertexOctree& octree, const VertexRi
   }
   // Step + kDepth, drawn at the start of this step: the points of the octree leaf around its
   // sample, whose ids have loaded since.
-  octree.PrefetchNearestPoints(Slot(step_ + kDepth).sample);
+  octree.PrefetchNearestPoints(Slot(step_ + kDepth).leaf);
 }
 
 int BasicStepLookahead::Winner(const VertexOctree& octree, const Mesh& mesh) {

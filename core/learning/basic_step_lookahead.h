@@ -80,6 +80,7 @@ class BasicStepLookahead {
  private:
   struct Upcoming {
     Vec3 sample;
+    OctreeLeafHint leaf;       // The octree leaf on the sample's side when it was drawn.
     int winner = -1;           // Found at the start of step `searched_at`, of generation
     uint64_t searched_at = 0;  // `generation`; -1: not searched.
     uint64_t generation = 0;

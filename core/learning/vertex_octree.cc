@@ -1,6 +1,7 @@
 #include "core/learning/vertex_octree.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -45,6 +46,13 @@ uint64_t OrderedBits(double x) {
   return bits;
 }
 
+// The first shape of a new octree: its own range of 2^32 values, so that no hint from another
+// octree (the learner replaces its octree at every Step 3) can match it.
+uint64_t NewShapeRange() {
+  static std::atomic<uint64_t> next{0};
+  return next.fetch_add(uint64_t{1} << 32, std::memory_order_relaxed);
+}
+
 struct SearchEntry {
   int node;
   double d2;  // Squared distance from the query to the node's cube.
@@ -65,7 +73,7 @@ int GrowSearchStack(int capacity, SearchEntry** stack, std::vector<SearchEntry>*
 
 VertexOctree::VertexOctree(const BoundingBox& initial_box, const std::vector<Vec3>* points,
                            int bucket_size)
-    : points_(points), bucket_size_(std::max(2, bucket_size)) {
+    : points_(points), shape_(NewShapeRange()), bucket_size_(std::max(2, bucket_size)) {
   Vec3 center(0, 0, 0);
   double half = 1;
   if (!initial_box.empty()) {
@@ -155,6 +163,7 @@ void VertexOctree::AppendToLeaf(int n, int id) {
 
 void VertexOctree::GrowRootToward(const double p[3]) {
   // The new root doubles the old one; the old root becomes the child on the far side of p.
+  ++shape_;
   double center[3];
   int octant = 0;
   for (int i = 0; i < 3; ++i) {
@@ -221,6 +230,7 @@ void VertexOctree::InsertIntoTree(int id, const double p[3]) {
 }
 
 void VertexOctree::SplitLeaf(int n) {
+  ++shape_;
   scratch_.clear();
   GatherIds(n, scratch_);
   for (int b = LeafBucket(node(n).child); b >= 0; b = bucket_next_[b]) FreeBucket(b);
@@ -295,6 +305,7 @@ void VertexOctree::FreeSubtree(int n) {
 }
 
 void VertexOctree::CollapseSubtree(int n) {
+  ++shape_;
   scratch_.clear();
   GatherIds(n, scratch_);
   FreeSubtree(n);
@@ -322,22 +333,22 @@ int VertexOctree::LeafOnSide(const double q[3]) const {
   return node(n).count > 0 ? n : -1;
 }
 
-void VertexOctree::PrefetchNearest(const Vec3& q) const {
+OctreeLeafHint VertexOctree::PrefetchNearest(const Vec3& q) const {
   const double qp[3] = {q[0], q[1], q[2]};
   const int n = LeafOnSide(qp);
-  if (n < 0) return;
+  if (n < 0) return OctreeLeafHint{};
   const char* ids = reinterpret_cast<const char*>(BucketIds(LeafBucket(node(n).child)));
   const size_t bytes =
       sizeof(int32_t) * static_cast<size_t>(std::min(node(n).count, bucket_size_));
   for (size_t offset = 0; offset < bytes; offset += 64) __builtin_prefetch(ids + offset);
+  return OctreeLeafHint{n, shape_};
 }
 
-void VertexOctree::PrefetchNearestPoints(const Vec3& q) const {
-  const double qp[3] = {q[0], q[1], q[2]};
-  const int n = LeafOnSide(qp);
-  if (n < 0) return;
-  const int32_t* ids = BucketIds(LeafBucket(node(n).child));
-  const int m = std::min(node(n).count, bucket_size_);
+void VertexOctree::PrefetchNearestPoints(const OctreeLeafHint& hint) const {
+  if (!Valid(hint)) return;
+  const Node& leaf = node(hint.node);
+  const int32_t* ids = BucketIds(LeafBucket(leaf.child));
+  const int m = std::min(leaf.count, bucket_size_);
   for (int j = 0; j < m; ++j) __builtin_prefetch(PointOf(ids[j]));
 }
 
@@ -373,7 +384,8 @@ __attribute__((always_inline)) inline void VertexOctree::ScanLeaf(const Node& le
   }
 }
 
-NEURALMESH_AVX2_CLONE int VertexOctree::Nearest(const Vec3& q, double* distance2) const {
+NEURALMESH_AVX2_CLONE int VertexOctree::Nearest(const Vec3& q, double* distance2,
+                                                const OctreeLeafHint& hint) const {
   if (size_ == 0) return -1;
   const double qp[3] = {q[0], q[1], q[2]};
   int best = -1;
@@ -386,35 +398,35 @@ NEURALMESH_AVX2_CLONE int VertexOctree::Nearest(const Vec3& q, double* distance2
   SearchEntry* stack = inline_stack;
   int capacity = kInlineSearchEntries;
 
-  // First straight down to the leaf on q's side: it most likely holds the answer. The path is
-  // kept (in the stack's storage) to find where the search must start.
-  int depth = 0;
-  stack[0].node = 0;
-  while (node(stack[depth].node).child >= 0) {
-    const int block = node(stack[depth].node).child;
-    const int c = block * 8 + Octant(blocks_[block].center, qp);
-    if (node(c).count == 0) break;
-    if (depth + 2 > capacity) capacity = GrowSearchStack(capacity, &stack, &heap_stack);
-    stack[++depth].node = c;
+  // First the leaf on q's side, the hint's or straight down: it most likely holds the answer.
+  int scanned = Valid(hint) ? hint.node : -1;
+  if (scanned < 0) {
+    int n = 0;
+    while (node(n).child >= 0) {
+      const int block = node(n).child;
+      const int c = block * 8 + Octant(blocks_[block].center, qp);
+      if (node(c).count == 0) break;
+      n = c;
+    }
+    if (node(n).child < 0 && node(n).count > 0) scanned = n;
   }
-  int scanned = -1;
   int start = 0;
-  if (node(stack[depth].node).child < 0 && node(stack[depth].node).count > 0) {
-    scanned = stack[depth].node;
+  if (scanned >= 0) {
     ScanLeaf(node(scanned), qp, &best, &best_d2);
     // Anything nearer lies in the ball of radius sqrt(best_d2) around q; the search starts at
-    // the lowest cube on the path that contains that ball (the test allows for its rounding).
+    // the lowest cube above that leaf that contains that ball (the test allows for its
+    // rounding).
     const double r = std::sqrt(best_d2) * (1 + 1e-12) + slack_;
-    for (int d = depth; d >= 0; --d) {
+    for (int n = scanned; n >= 0; n = Parent(n)) {
       double center[3], half;
-      NodeCube(stack[d].node, center, &half);
+      NodeCube(n, center, &half);
       bool inside = true;
       for (int i = 0; i < 3; ++i) {
         const double rounding = 1e-15 * (std::abs(qp[i]) + std::abs(center[i]) + half);
         inside &= std::abs(qp[i] - center[i]) + r + rounding <= half;
       }
       if (inside) {
-        start = stack[d].node;
+        start = n;
         break;
       }
     }

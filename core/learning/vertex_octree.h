@@ -29,6 +29,14 @@
 
 namespace neuralmesh {
 
+// The leaf of a VertexOctree on a query point's side, found ahead of the query
+// (VertexOctree::PrefetchNearest): it stays that leaf while the tree keeps its shape (no leaf
+// split or merged, the root not grown), whatever moves in between. `node` < 0: none.
+struct OctreeLeafHint {
+  int32_t node = -1;
+  uint64_t shape = 0;
+};
+
 class VertexOctree {
  public:
   // Indexes points of `points` (by id), which the caller owns and keeps: the octree stores ids
@@ -57,15 +65,17 @@ class VertexOctree {
     if (static_cast<size_t>(id) < where_.size()) __builtin_prefetch(&where_[id]);
   }
   // Hints for a Nearest(q) to come, in two stages a little apart: PrefetchNearest descends to
-  // the leaf on q's side (the upper levels of the tree are usually in cache) and starts loading
-  // the ids it holds; PrefetchNearestPoints, once those have loaded, starts loading their
-  // points. Nearest scans that leaf first.
-  void PrefetchNearest(const Vec3& q) const;
-  void PrefetchNearestPoints(const Vec3& q) const;
+  // the leaf on q's side (the upper levels of the tree are usually in cache), starts loading
+  // the ids it holds and returns that leaf; PrefetchNearestPoints, once those have loaded,
+  // starts loading their points. Nearest, given the hint, starts at that leaf without
+  // descending again.
+  OctreeLeafHint PrefetchNearest(const Vec3& q) const;
+  void PrefetchNearestPoints(const OctreeLeafHint& hint) const;
 
   // The id of the point nearest to `q` (ties: any), or -1 when empty. Exact. With `distance2`,
-  // also stores its squared distance to `q` there (dx^2 + dy^2 + dz^2 in that order).
-  int Nearest(const Vec3& q, double* distance2 = nullptr) const;
+  // also stores its squared distance to `q` there (dx^2 + dy^2 + dz^2 in that order). With a
+  // `hint` from PrefetchNearest(q) (a stale one is ignored), the same answer as without.
+  int Nearest(const Vec3& q, double* distance2 = nullptr, const OctreeLeafHint& hint = {}) const;
 
   size_t size() const { return size_; }
   // Depth of the deepest leaf; for tests and diagnostics.
@@ -109,6 +119,10 @@ class VertexOctree {
   const double* PointOf(int id) const { return (*points_)[static_cast<size_t>(id)].data(); }
   // The leaf on q's side (non-empty), or -1.
   int LeafOnSide(const double q[3]) const;
+  // Whether `hint` still names a non-empty leaf of this shape.
+  bool Valid(const OctreeLeafHint& hint) const {
+    return hint.node >= 0 && hint.shape == shape_ && node(hint.node).child < kEmpty;
+  }
 
   int NewBlock(int parent, const double center[3], double half);
   void FreeBlock(int b);
@@ -138,6 +152,9 @@ class VertexOctree {
   // Tolerance added to the cube of an old root: after the root grows, the old root's cube as
   // derived from the new root may differ from the stored one by a rounding error.
   double slack_ = 0;
+  // Changes whenever a leaf splits or merges or the root grows (OctreeLeafHint): a count of those
+  // events, starting from a value no other octree of the process has had.
+  uint64_t shape_;
   int bucket_size_;
   size_t size_ = 0;
   std::vector<int32_t> scratch_;  // For SplitLeaf and CollapseSubtree.

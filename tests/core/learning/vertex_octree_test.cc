@@ -33,7 +33,9 @@ class Tree {
   }
   void Remove(int id) { tree_.Remove(id); }
   bool Contains(int id) const { return tree_.Contains(id); }
-  int Nearest(const Vec3& q) const { return tree_.Nearest(q); }
+  int Nearest(const Vec3& q, const OctreeLeafHint& hint = {}) const {
+    return tree_.Nearest(q, nullptr, hint);
+  }
   size_t size() const { return tree_.size(); }
   int Depth() const { return tree_.Depth(); }
 
@@ -61,12 +63,13 @@ int BruteForceNearest(const std::vector<Vec3>& points, const std::vector<bool>& 
   return best;
 }
 
-// Compares tree.Nearest(q) with brute force; returns a failure message or "".
+// Compares tree.Nearest(q, hint) with brute force; returns a failure message or "".
 std::string CheckNearest(const Tree& tree, const std::vector<Vec3>& points,
-                         const std::vector<bool>& present, const Vec3& q) {
+                         const std::vector<bool>& present, const Vec3& q,
+                         const OctreeLeafHint& hint = {}) {
   double best_d2;
   const int expected = BruteForceNearest(points, present, q, &best_d2);
-  const int got = tree.Nearest(q);
+  const int got = tree.Nearest(q, hint);
   if (expected < 0) return got == -1 ? "" : "the tree answers for an empty set";
   if (got < 0 || got >= static_cast<int>(points.size()) || !present[got]) {
     return "the tree answers " + std::to_string(got) + ", which is not a live id";
@@ -418,6 +421,89 @@ TEST(VertexOctreeTest, ExactAfterSeveralPointsChangeBeforeTheirMoves) {
     for (int id = 0; id < kIds; ++id) {
       ASSERT_EQ((points[tree.Nearest(points[id])] - points[id]).sqrnorm(), 0.0) << "id " << id;
     }
+  }
+}
+
+}  // namespace
+}  // namespace neuralmesh
+
+namespace neuralmesh {
+namespace {
+
+// The learner's lookahead finds the leaf on a sample's side a step before it searches, and
+// moves, inserts and removes points in between: a search given that leaf must be exact
+// whatever changed since, leaves split and merged included, and give the id a search without
+// it gives while the tree keeps its shape.
+TEST(VertexOctreeTest, SearchesFromALeafFoundEarlierAreExact) {
+  BoundingBox box;
+  box.Extend(Vec3(0, 0, 0));
+  box.Extend(Vec3(1, 1, 1));
+  Tree tree(box, /*bucket_size=*/4);
+  Random rng(41);
+  std::vector<Vec3> points;
+  std::vector<bool> present;
+  for (int id = 0; id < 3000; ++id) {
+    points.push_back(Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble()));
+    present.push_back(true);
+    tree.Insert(id, points[id]);
+  }
+  int unchanged = 0;
+  int hinted = 0;
+  for (int round = 0; round < 3000; ++round) {
+    const Vec3 q(rng.NextDouble(), rng.NextDouble(), rng.NextDouble());
+    const OctreeLeafHint hint = tree.octree().PrefetchNearest(q);
+    hinted += hint.node >= 0 ? 1 : 0;  // -1 when the leaf on q's side is empty.
+    const int changes = round % 3 == 0 ? 0 : 1 + static_cast<int>(rng.NextDouble() * 40);
+    for (int k = 0; k < changes; ++k) {
+      const int id = static_cast<int>(rng.NextDouble() * static_cast<double>(points.size()));
+      const double kind = rng.NextDouble();
+      if (!present[id]) {
+        points[id] = Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble());
+        tree.Insert(id, points[id]);
+        present[id] = true;
+      } else if (kind < 0.2) {
+        tree.Remove(id);
+        present[id] = false;
+      } else if (kind < 0.6) {  // Next to q: into its leaf or the ones around it.
+        points[id] = q + Vec3(0.02 * rng.NextDouble() - 0.01, 0.02 * rng.NextDouble() - 0.01,
+                              0.02 * rng.NextDouble() - 0.01);
+        tree.Move(id, points[id]);
+      } else {
+        points[id] = Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble());
+        tree.Move(id, points[id]);
+      }
+    }
+    ASSERT_EQ(CheckNearest(tree, points, present, q, hint), "") << "round " << round;
+    if (changes == 0) {
+      ++unchanged;
+      ASSERT_EQ(tree.Nearest(q, hint), tree.Nearest(q)) << "round " << round;
+    }
+  }
+  EXPECT_EQ(unchanged, 1000);
+  EXPECT_GT(hinted, 1500) << "most queries should have had a leaf to start from";
+}
+
+// A hint from another octree (the learner builds a new one at every Step 3) names a leaf of
+// that tree, maybe past the end of this one's: it must be ignored.
+TEST(VertexOctreeTest, IgnoresALeafFoundInAnotherTree) {
+  BoundingBox box;
+  box.Extend(Vec3(0, 0, 0));
+  box.Extend(Vec3(1, 1, 1));
+  Tree large(box, /*bucket_size=*/2);
+  Tree small(box, /*bucket_size=*/2);
+  Random rng(43);
+  std::vector<Vec3> points;
+  for (int id = 0; id < 5000; ++id) {
+    points.push_back(Vec3(rng.NextDouble(), rng.NextDouble(), rng.NextDouble()));
+    large.Insert(id, points[id]);
+    if (id < 5) small.Insert(id, points[id]);
+  }
+  std::vector<bool> present(points.size(), false);
+  std::fill(present.begin(), present.begin() + 5, true);
+  for (int k = 0; k < 200; ++k) {
+    const Vec3 q(rng.NextDouble(), rng.NextDouble(), rng.NextDouble());
+    const OctreeLeafHint hint = large.octree().PrefetchNearest(q);
+    ASSERT_EQ(CheckNearest(small, points, present, q, hint), "") << "query " << k;
   }
 }
 

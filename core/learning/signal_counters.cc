@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/next_float.h"
+
 namespace neuralmesh {
 
 SignalCounters::SignalCounters(double alpha_sc)
@@ -41,7 +43,8 @@ void SignalCounters::SetValue(int id, double value, uint64_t step) {
   SetKey(id, log_value - static_cast<double>(step) * log_alpha_, step);
 }
 
-void SignalCounters::SetKey(int id, double key, uint64_t step) {
+// Inline: Flush sets a key for every win, 100 per split.
+inline void SignalCounters::SetKey(int id, double key, uint64_t step) {
   key_[id] = key;
   // The largest key a counter of at most B can have at this step, computed as SetValue
   // computes keys, plus a margin for their rounding.
@@ -50,7 +53,7 @@ void SignalCounters::SetKey(int id, double key, uint64_t step) {
   if (!log_.empty()) bound = std::max(bound, static_cast<double>(log_.back().bound));
   float rounded = static_cast<float>(bound);
   if (static_cast<double>(rounded) < bound) {
-    rounded = std::nextafter(rounded, std::numeric_limits<float>::infinity());
+    rounded = NextFloatUp(rounded);
   }
   log_.push_back(LoggedTouch{id, rounded});
   if (log_.size() > 2 * tracked_ + kLogSlack) CompactLog();

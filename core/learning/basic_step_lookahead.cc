@@ -36,13 +36,17 @@ void BasicStepLookahead::StartStep(uint64_t step, const Sampler& target, Random&
     u.moved = BoundingBox();
   }
   target.PrefetchSample(rng);  // The next draw's point: a cache miss on large inputs.
-  // Step + kDepth, just drawn: the ids in the octree leaf around its sample.
+  // Step + kDepth, just drawn: the octree's upper levels toward its sample (usually in cache).
   Upcoming& drawn = Slot(step + kDepth);
-  drawn.leaf = octree.PrefetchNearest(drawn.sample);
+  drawn.descent = OctreeDescent{};
+  octree.Descend(drawn.sample, kUpperLevels, &drawn.descent);
+  // Step + 3: on down to the leaf on its sample's side, whose ids start loading.
+  Upcoming& descending = Slot(step + 3);
+  octree.Descend(descending.sample, VertexOctree::kToLeaf, &descending.descent);
 
-  // Step + 3: the search, on the leaf loaded during the last step.
-  Upcoming& searched = Slot(step + 3);
-  searched.winner = octree.Nearest(searched.sample, &searched.distance2, searched.leaf);
+  // Step + 2: the search, on the leaf loaded during the last step.
+  Upcoming& searched = Slot(step + 2);
+  searched.winner = octree.Nearest(searched.sample, &searched.distance2, searched.descent);
   if (searched.winner >= 0) {
     searched.searched_at = step;
     searched.generation = generation_;
@@ -51,21 +55,8 @@ void BasicStepLookahead::StartStep(uint64_t step, const Sampler& target, Random&
     __builtin_prefetch(PointData(mesh, searched.winner));
   }
 
-  // Step + 2: the winner's neighbours.
-  if (const Upcoming& u = Slot(step + 2); HasWinner(u)) {
-    const VertexRingCache::RingView ring = rings.CachedRing(u.winner);
-    for (int i = 0; i < ring.size; ++i) {
-      rings.Prefetch(ring.neighbours[i]);
-      octree.PrefetchLocation(ring.neighbours[i]);
-      __builtin_prefetch(PointData(mesh, ring.neighbours[i]));
-    }
-  }
-}
-
-void BasicStepLookahead::ContinueStep(const VertexOctree& octree, const VertexRingCache& rings,
-                                      const Mesh& mesh) const {
-  // Step + 1: the neighbours' neighbours, whose positions the smoothing gathers.
-  if (const Upcoming& u = Slot(step_ + 1); HasWinner(u)) {
+  // Step + 1: its winner's neighbours' neighbours, whose positions the smoothing gathers.
+  if (const Upcoming& u = Slot(step + 1); HasWinner(u)) {
     const VertexRingCache::RingView ring = rings.CachedRing(u.winner);
     for (int i = 0; i < ring.size; ++i) {
       const VertexRingCache::RingView second = rings.CachedRing(ring.neighbours[i]);
@@ -74,9 +65,24 @@ void BasicStepLookahead::ContinueStep(const VertexOctree& octree, const VertexRi
       }
     }
   }
-  // Step + kDepth, drawn at the start of this step: the points of the octree leaf around its
-  // sample, whose ids have loaded since.
-  octree.PrefetchNearestPoints(Slot(step_ + kDepth).leaf);
+}
+
+void BasicStepLookahead::ContinueStep(const VertexOctree& octree, const VertexRingCache& rings,
+                                      const Mesh& mesh) {
+  // Step + kDepth: one level further down, whose block has loaded since the start of the step.
+  Upcoming& drawn = Slot(step_ + kDepth);
+  octree.Descend(drawn.sample, 1, &drawn.descent);
+  // Step + 3: the points of the leaf it reached, whose ids have loaded since.
+  octree.PrefetchNearestPoints(Slot(step_ + 3).descent);
+  // Step + 2: the neighbours of the winner found at the start of the step.
+  if (const Upcoming& u = Slot(step_ + 2); HasWinner(u)) {
+    const VertexRingCache::RingView ring = rings.CachedRing(u.winner);
+    for (int i = 0; i < ring.size; ++i) {
+      rings.Prefetch(ring.neighbours[i]);
+      octree.PrefetchLocation(ring.neighbours[i]);
+      __builtin_prefetch(PointData(mesh, ring.neighbours[i]));
+    }
+  }
 }
 
 int BasicStepLookahead::Winner(const VertexOctree& octree, const Mesh& mesh) {

@@ -6,17 +6,22 @@
 // neighbours, the positions of theirs (tangential_smoothing.h). Each link needs the one before
 // it, so one step cannot overlap them; but two steps' chains are independent unless their
 // neighbourhoods meet. So the sample of step t is drawn at step t - 4 and one link of its chain
-// starts loading at each step in between:
+// starts loading at the start and midway through each step in between:
 //
-//   step t-4: draw the sample s and load the ids in the octree leaf on s's side; midway
-//             through the step, load their points
-//   step t-3: w <- the vertex nearest to s (its leaf is in cache now); load w's ring,
-//             position and octree location
-//   step t-2: load the rings, positions and octree locations of w's neighbours
-//   step t-1: midway, load the positions of their neighbours
-//   step t:   the Basic Step, with winner w unless steps t-3 to t-1 moved w, or moved or
+//   step t-4: draw the sample s and descend the octree's upper levels toward it (in cache),
+//             loading the block of the level below; midway, one level down, loading the next
+//   step t-3: on down to the leaf on s's side (mostly one level), loading its ids; midway,
+//             their points
+//   step t-2: w <- the vertex nearest to s (its leaf is in cache now); load w's ring,
+//             position and octree location; midway, the rings, positions and octree
+//             locations of w's neighbours
+//   step t-1: load the positions of their neighbours
+//   step t:   the Basic Step, with winner w unless steps t-2 and t-1 moved w, or moved or
 //             inserted a vertex to within w's distance of s (tested against the bounding box
 //             of each step's moves); then the octree is searched again
+//
+// The descent is spread so because the octree's lower levels do not stay in cache on a large
+// mesh: taken at once, it waited on two or three of their blocks in a row.
 //
 // That is exactly the winner of a search at step t (ties apart: when two vertices are at the
 // same distance from s, either is nearest, and which one the octree returns depends on its
@@ -43,21 +48,23 @@ class BasicStepLookahead {
  public:
   // Basic Steps between drawing a sample and learning from it.
   static constexpr int kDepth = 4;
+  // Octree levels descended when a sample is drawn: the upper ones, which stay in cache (a
+  // 100K-vertex mesh's leaves are mostly five levels down).
+  static constexpr int kUpperLevels = 3;
 
   // Takes over the drawing of samples from Basic Step `first_step` on.
   explicit BasicStepLookahead(uint64_t first_step) : step_(first_step), drawn_(first_step) {}
 
   // Starts Basic Step `step` (first_step, then each next one, none skipped): draws the
-  // samples up to step + kDepth from `target` with `rng`, searches the winner of step + 3 and
-  // starts the loads of step + 2 and step + kDepth. `octree`, `rings` and `mesh` must agree
-  // (the octree indexes the mesh's positions and has had every Move).
+  // samples up to step + kDepth from `target` with `rng`, searches the winner of step + 2 and
+  // starts the loads of steps step + 1, step + 3 and step + kDepth. `octree`, `rings` and
+  // `mesh` must agree (the octree indexes the mesh's positions and has had every Move).
   void StartStep(uint64_t step, const Sampler& target, Random& rng, const VertexOctree& octree,
                  const VertexRingCache& rings, const Mesh& mesh);
-  // Starts the loads of steps step + 1 and step + kDepth; called midway through the step
-  // (after the smoothing), so that the processor's few buffers for outstanding misses are not
-  // all asked for at once: prefetches beyond them are dropped.
-  void ContinueStep(const VertexOctree& octree, const VertexRingCache& rings,
-                    const Mesh& mesh) const;
+  // Starts the loads of steps step + 2, step + 3 and step + kDepth; called midway through the
+  // step (after the smoothing and its octree moves), so that the processor's few buffers for
+  // outstanding misses are not all asked for at once: prefetches beyond them are dropped.
+  void ContinueStep(const VertexOctree& octree, const VertexRingCache& rings, const Mesh& mesh);
 
   // The sample of the step started last.
   const Vec3& sample() const { return Slot(step_).sample; }
@@ -67,7 +74,7 @@ class BasicStepLookahead {
 
   // How Winner answered, since construction.
   struct Counts {
-    uint64_t early_winners = 0;   // The winner found kDepth - 1 steps before.
+    uint64_t early_winners = 0;   // The winner found two steps before.
     uint64_t searched_again = 0;  // A new search: something moved near, or none was found.
   };
   const Counts& counts() const { return counts_; }
@@ -80,7 +87,7 @@ class BasicStepLookahead {
  private:
   struct Upcoming {
     Vec3 sample;
-    OctreeLeafHint leaf;       // The octree leaf on the sample's side when it was drawn.
+    OctreeDescent descent;     // Toward the leaf on the sample's side.
     int winner = -1;           // Found at the start of step `searched_at`, of generation
     uint64_t searched_at = 0;  // `generation`; -1: not searched.
     uint64_t generation = 0;

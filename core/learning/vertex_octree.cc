@@ -324,29 +324,31 @@ NEURALMESH_AVX2_CLONE void VertexOctree::Move(int id) {
   Insert(id);
 }
 
-int VertexOctree::LeafOnSide(const double q[3]) const {
-  int n = 0;
-  while (node(n).child >= 0) {
-    const int block = node(n).child;
-    n = block * 8 + Octant(blocks_[block].center, q);
-  }
-  return node(n).count > 0 ? n : -1;
-}
-
-OctreeLeafHint VertexOctree::PrefetchNearest(const Vec3& q) const {
+void VertexOctree::Descend(const Vec3& q, int levels, OctreeDescent* descent) const {
+  if (descent->node < 0 || descent->shape != shape_) *descent = OctreeDescent{0, shape_};
   const double qp[3] = {q[0], q[1], q[2]};
-  const int n = LeafOnSide(qp);
-  if (n < 0) return OctreeLeafHint{};
-  const char* ids = reinterpret_cast<const char*>(BucketIds(LeafBucket(node(n).child)));
-  const size_t bytes =
-      sizeof(int32_t) * static_cast<size_t>(std::min(node(n).count, bucket_size_));
-  for (size_t offset = 0; offset < bytes; offset += 64) __builtin_prefetch(ids + offset);
-  return OctreeLeafHint{n, shape_};
+  int n = descent->node;
+  for (int i = 0; i < levels && node(n).child >= 0; ++i) {
+    const int block = node(n).child;
+    n = block * 8 + Octant(blocks_[block].center, qp);
+  }
+  descent->node = n;
+  const Node& reached = node(n);
+  if (reached.child >= 0) {
+    const char* block = reinterpret_cast<const char*>(&blocks_[reached.child]);
+    __builtin_prefetch(block);
+    __builtin_prefetch(block + 64);
+  } else if (reached.child != kEmpty) {
+    const char* ids = reinterpret_cast<const char*>(BucketIds(LeafBucket(reached.child)));
+    const size_t bytes =
+        sizeof(int32_t) * static_cast<size_t>(std::min(reached.count, bucket_size_));
+    for (size_t offset = 0; offset < bytes; offset += 64) __builtin_prefetch(ids + offset);
+  }
 }
 
-void VertexOctree::PrefetchNearestPoints(const OctreeLeafHint& hint) const {
-  if (!Valid(hint)) return;
-  const Node& leaf = node(hint.node);
+void VertexOctree::PrefetchNearestPoints(const OctreeDescent& descent) const {
+  if (!AtLeaf(descent)) return;
+  const Node& leaf = node(descent.node);
   const int32_t* ids = BucketIds(LeafBucket(leaf.child));
   const int m = std::min(leaf.count, bucket_size_);
   for (int j = 0; j < m; ++j) __builtin_prefetch(PointOf(ids[j]));
@@ -385,7 +387,7 @@ __attribute__((always_inline)) inline void VertexOctree::ScanLeaf(const Node& le
 }
 
 NEURALMESH_AVX2_CLONE int VertexOctree::Nearest(const Vec3& q, double* distance2,
-                                                const OctreeLeafHint& hint) const {
+                                                const OctreeDescent& descent) const {
   if (size_ == 0) return -1;
   const double qp[3] = {q[0], q[1], q[2]};
   int best = -1;
@@ -398,8 +400,9 @@ NEURALMESH_AVX2_CLONE int VertexOctree::Nearest(const Vec3& q, double* distance2
   SearchEntry* stack = inline_stack;
   int capacity = kInlineSearchEntries;
 
-  // First the leaf on q's side, the hint's or straight down: it most likely holds the answer.
-  int scanned = Valid(hint) ? hint.node : -1;
+  // First the leaf on q's side, the descent's or straight down: it most likely holds the
+  // answer.
+  int scanned = AtLeaf(descent) ? descent.node : -1;
   if (scanned < 0) {
     int n = 0;
     while (node(n).child >= 0) {

@@ -29,10 +29,11 @@
 
 namespace neuralmesh {
 
-// The leaf of a VertexOctree on a query point's side, found ahead of the query
-// (VertexOctree::PrefetchNearest): it stays that leaf while the tree keeps its shape (no leaf
-// split or merged, the root not grown), whatever moves in between. `node` < 0: none.
-struct OctreeLeafHint {
+// A descent of a VertexOctree toward the leaf on a query point's side, taken ahead of the query
+// and a few levels at a time (VertexOctree::Descend): the node it has reached, which stays on
+// that path while the tree keeps its shape (no leaf split or merged, the root not grown),
+// whatever moves in between. `node` < 0: not started.
+struct OctreeDescent {
   int32_t node = -1;
   uint64_t shape = 0;
 };
@@ -64,18 +65,22 @@ class VertexOctree {
   void PrefetchLocation(int id) const {
     if (static_cast<size_t>(id) < where_.size()) __builtin_prefetch(&where_[id]);
   }
-  // Hints for a Nearest(q) to come, in two stages a little apart: PrefetchNearest descends to
-  // the leaf on q's side (the upper levels of the tree are usually in cache), starts loading
-  // the ids it holds and returns that leaf; PrefetchNearestPoints, once those have loaded,
-  // starts loading their points. Nearest, given the hint, starts at that leaf without
-  // descending again.
-  OctreeLeafHint PrefetchNearest(const Vec3& q) const;
-  void PrefetchNearestPoints(const OctreeLeafHint& hint) const;
+  // Hints for a Nearest(q) to come, each a little after the one before, so that what one
+  // starts loading has arrived when the next reads it. Descend goes down at most `levels` levels
+  // of the tree toward the leaf on q's side, from where `descent` stopped (from the root if it
+  // has not started or the tree has changed shape since), and starts loading what the next
+  // level down reads: the block of the children or, at a leaf, the ids it holds.
+  // PrefetchNearestPoints, at a leaf whose ids have loaded, starts loading their points.
+  // Nearest, given a descent that has reached its leaf, starts there.
+  static constexpr int kToLeaf = 1 << 30;
+  void Descend(const Vec3& q, int levels, OctreeDescent* descent) const;
+  void PrefetchNearestPoints(const OctreeDescent& descent) const;
 
   // The id of the point nearest to `q` (ties: any), or -1 when empty. Exact. With `distance2`,
   // also stores its squared distance to `q` there (dx^2 + dy^2 + dz^2 in that order). With a
-  // `hint` from PrefetchNearest(q) (a stale one is ignored), the same answer as without.
-  int Nearest(const Vec3& q, double* distance2 = nullptr, const OctreeLeafHint& hint = {}) const;
+  // `descent` toward q (one that has not reached its leaf, or is stale, is ignored), the same
+  // answer as without.
+  int Nearest(const Vec3& q, double* distance2 = nullptr, const OctreeDescent& descent = {}) const;
 
   size_t size() const { return size_; }
   // Depth of the deepest leaf; for tests and diagnostics.
@@ -117,11 +122,9 @@ class VertexOctree {
   int32_t* BucketIds(int b) { return &ids_[static_cast<size_t>(b) * bucket_size_]; }
   const int32_t* BucketIds(int b) const { return &ids_[static_cast<size_t>(b) * bucket_size_]; }
   const double* PointOf(int id) const { return (*points_)[static_cast<size_t>(id)].data(); }
-  // The leaf on q's side (non-empty), or -1.
-  int LeafOnSide(const double q[3]) const;
-  // Whether `hint` still names a non-empty leaf of this shape.
-  bool Valid(const OctreeLeafHint& hint) const {
-    return hint.node >= 0 && hint.shape == shape_ && node(hint.node).child < kEmpty;
+  // Whether `descent` has reached a non-empty leaf of this shape.
+  bool AtLeaf(const OctreeDescent& descent) const {
+    return descent.node >= 0 && descent.shape == shape_ && node(descent.node).child < kEmpty;
   }
 
   int NewBlock(int parent, const double center[3], double half);
@@ -152,7 +155,7 @@ class VertexOctree {
   // Tolerance added to the cube of an old root: after the root grows, the old root's cube as
   // derived from the new root may differ from the stored one by a rounding error.
   double slack_ = 0;
-  // Changes whenever a leaf splits or merges or the root grows (OctreeLeafHint): a count of those
+  // Changes whenever a leaf splits or merges or the root grows (OctreeDescent): a count of those
   // events, starting from a value no other octree of the process has had.
   uint64_t shape_;
   int bucket_size_;

@@ -46,8 +46,8 @@ uint64_t OrderedBits(double x) {
   return bits;
 }
 
-// The first shape of a new octree: its own range of 2^32 values, so that no hint from another
-// octree (the learner replaces its octree at every Step 3) can match it.
+// The first shape of a new octree: its own range of 2^32 values, so that no descent taken in
+// another octree (the learner replaces its octree at every Step 3) can match it.
 uint64_t NewShapeRange() {
   static std::atomic<uint64_t> next{0};
   return next.fetch_add(uint64_t{1} << 32, std::memory_order_relaxed);

@@ -424,12 +424,6 @@ TEST(VertexOctreeTest, ExactAfterSeveralPointsChangeBeforeTheirMoves) {
   }
 }
 
-}  // namespace
-}  // namespace neuralmesh
-
-namespace neuralmesh {
-namespace {
-
 // The learner's lookahead descends toward a sample's leaf a few levels at a time over two
 // steps and searches from that leaf a step later, moving, inserting and removing points in
 // between: a search given such a descent must be exact whatever changed since, leaves split

@@ -324,14 +324,20 @@ NEURALMESH_AVX2_CLONE void VertexOctree::Move(int id) {
   Insert(id);
 }
 
+// Inlined into Descend and into both builds of Nearest.
+__attribute__((always_inline)) inline int VertexOctree::DescendFrom(int n, const double q[3],
+                                                                     int levels) const {
+  for (int i = 0; i < levels && node(n).child >= 0; ++i) {
+    const int block = node(n).child;
+    n = block * 8 + Octant(blocks_[block].center, q);
+  }
+  return n;
+}
+
 void VertexOctree::Descend(const Vec3& q, int levels, OctreeDescent* descent) const {
   if (descent->node < 0 || descent->shape != shape_) *descent = OctreeDescent{0, shape_};
   const double qp[3] = {q[0], q[1], q[2]};
-  int n = descent->node;
-  for (int i = 0; i < levels && node(n).child >= 0; ++i) {
-    const int block = node(n).child;
-    n = block * 8 + Octant(blocks_[block].center, qp);
-  }
+  const int n = DescendFrom(descent->node, qp, levels);
   descent->node = n;
   const Node& reached = node(n);
   if (reached.child >= 0) {
@@ -404,14 +410,8 @@ NEURALMESH_AVX2_CLONE int VertexOctree::Nearest(const Vec3& q, double* distance2
   // answer.
   int scanned = AtLeaf(descent) ? descent.node : -1;
   if (scanned < 0) {
-    int n = 0;
-    while (node(n).child >= 0) {
-      const int block = node(n).child;
-      const int c = block * 8 + Octant(blocks_[block].center, qp);
-      if (node(c).count == 0) break;
-      n = c;
-    }
-    if (node(n).child < 0 && node(n).count > 0) scanned = n;
+    const int n = DescendFrom(0, qp, kToLeaf);
+    if (node(n).child < kEmpty) scanned = n;  // Else an empty leaf: the search starts at the root.
   }
   int start = 0;
   if (scanned >= 0) {

@@ -122,6 +122,8 @@ class VertexOctree {
   int32_t* BucketIds(int b) { return &ids_[static_cast<size_t>(b) * bucket_size_]; }
   const int32_t* BucketIds(int b) const { return &ids_[static_cast<size_t>(b) * bucket_size_]; }
   const double* PointOf(int id) const { return (*points_)[static_cast<size_t>(id)].data(); }
+  // The node `levels` levels below node n toward q, or the leaf on q's side if that is higher.
+  int DescendFrom(int n, const double q[3], int levels) const;
   // Whether `descent` has reached a non-empty leaf of this shape.
   bool AtLeaf(const OctreeDescent& descent) const {
     return descent.node >= 0 && descent.shape == shape_ && node(descent.node).child < kEmpty;

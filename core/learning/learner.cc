@@ -298,7 +298,8 @@ class Learner::Impl {
     auto& active = mesh_.property(active_).data_vector();
     std::fill(active.begin(), active.end(), false);
     next_connectivity_step_ = step_ + std::max<uint64_t>(1, ConnectivityInterval());
-    CompactInMortonOrder();
+    t0 = Clock::now();
+    Compact();
     rings_.InvalidateAll();  // Collapses, removals, merges and compaction changed rings.
     // Refilled at once, in vertex order: with the edges in vertex order too, the walks read the
     // half-edges nearly in sequence, where the Basic Steps' walks one at a time would miss
@@ -307,6 +308,7 @@ class Learner::Impl {
       if (!mesh_.is_isolated(v)) rings_.Ring(mesh_, v.idx());
     }
     if (lookahead_) lookahead_->ForgetWinners();  // And vertex indices.
+    timings_.compaction += Since(t0);
   }
 
   void CollapseInactive() {
@@ -343,13 +345,11 @@ class Learner::Impl {
   // Morton order, then the edges by their vertices (morton_vertex_order.h), keeps the data a
   // Basic Step touches close together; handles change, so the octree and the counters are
   // rebuilt: O(v log v) every C_ec v steps.
-  void CompactInMortonOrder() {
+  void Compact() {
     OpenMesh::VPropHandleT<double> counter;
     mesh_.add_property(counter);
     for (auto v : mesh_.vertices()) mesh_.property(counter, v) = counters_.Value(v.idx(), step_);
-    mesh_.garbage_collection();
-    SortVerticesInMortonOrder(mesh_);
-    SortEdgesByVertexIndex(mesh_);
+    CompactInMortonOrder(mesh_);
     counters_.Clear();
     octree_ = VertexOctree(target_->Bounds(), MeshPoints(mesh_), kOctreeBucketSize);
     for (auto v : mesh_.vertices()) {

@@ -60,6 +60,9 @@ struct LearnerTimings {
   absl::Duration collapse;       // Step 3.
   absl::Duration removal;        // Step 4.
   absl::Duration merging;        // Step 5.
+  // After Steps 3-5: deleted elements dropped, vertices renumbered in Morton order, the
+  // octree, the counters and the ring cache rebuilt.
+  absl::Duration compaction;
 };
 
 // When Run stops; the first criterion that holds wins. Zero means "no limit".

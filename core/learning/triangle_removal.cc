@@ -40,6 +40,22 @@ bool ComponentHasMoreFacesThan(const Mesh& mesh, Mesh::FaceHandle fh, size_t lim
   return false;
 }
 
+// The area of every face, by face index (0 for a deleted one), and in *mean their mean over the
+// live faces.
+std::vector<double> FaceAreas(const Mesh& mesh, double* mean) {
+  std::vector<double> areas(mesh.n_faces(), 0.0);
+  double total = 0;
+  size_t count = 0;
+  for (auto fh : mesh.faces()) {
+    const double area = TriangleArea(mesh, fh);
+    areas[static_cast<size_t>(fh.idx())] = area;
+    total += area;
+    ++count;
+  }
+  *mean = count == 0 ? 0.0 : total / static_cast<double>(count);
+  return areas;
+}
+
 }  // namespace
 
 absl::Status TriangleRemovalOptions::Validate() const {
@@ -51,13 +67,9 @@ absl::Status TriangleRemovalOptions::Validate() const {
 }
 
 double MeanTriangleArea(const Mesh& mesh) {
-  double total = 0;
-  size_t count = 0;
-  for (auto fh : mesh.faces()) {
-    total += TriangleArea(mesh, fh);
-    ++count;
-  }
-  return count == 0 ? 0.0 : total / static_cast<double>(count);
+  double mean;
+  FaceAreas(mesh, &mean);
+  return mean;
 }
 
 bool IsTriangleRemovalOk(const Mesh& mesh, Mesh::FaceHandle fh) {
@@ -99,7 +111,8 @@ TriangleRemovalResult RemoveLargeTriangles(
     Mesh& mesh, const TriangleRemovalOptions& options,
     const std::function<bool(Mesh::FaceHandle)>& spared) {
   TriangleRemovalResult result;
-  result.mean_area = MeanTriangleArea(mesh);
+  // Every face's area once: Eq. 2's mean and the comparisons with it read the same numbers.
+  const std::vector<double> areas = FaceAreas(mesh, &result.mean_area);
   const double threshold = options.alpha_r * result.mean_area;
 
   // Each large face is in one state; the heaps hold (area, face index), largest first, ties
@@ -116,7 +129,7 @@ TriangleRemovalResult RemoveLargeTriangles(
     (state == State::kFrontier ? frontier : seeds).emplace(area, index);
   };
   for (auto fh : mesh.faces()) {
-    const double area = TriangleArea(mesh, fh);
+    const double area = areas[static_cast<size_t>(fh.idx())];
     if (area > threshold && !(spared && spared(fh))) enqueue(fh.idx(), area);
   }
 

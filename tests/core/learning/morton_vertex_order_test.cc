@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <map>
 #include <set>
 #include <string>
 #include <utility>
@@ -77,134 +78,213 @@ TEST(MortonCodeTest, InterleavesTheAxesAndClamps) {
       << "points outside the box are clamped to it";
 }
 
-TEST(MortonVertexOrderTest, KeepsTheMeshAndMovesPropertiesWithTheirVertices) {
-  Mesh mesh = Shuffled(MustToMesh(Icosphere(3)), 7);
-  OpenMesh::VPropHandleT<int> tag;
-  mesh.add_property(tag);
-  for (auto v : mesh.vertices()) mesh.property(tag, v) = v.idx() * 10;
-  std::vector<Vec3> old_points;
-  for (auto v : mesh.vertices()) old_points.push_back(mesh.point(v));
-  const auto faces_before = FacesByPosition(mesh);
+// A position as a key: the test meshes' vertices have distinct positions, so a position names a
+// vertex however the mesh numbers it.
+std::vector<double> Key(const Vec3& p) { return {p[0], p[1], p[2]}; }
 
-  const std::vector<int> new_index = SortVerticesInMortonOrder(mesh);
+// The positions of a face's corners in the order its half-edge walk gives them.
+std::vector<std::vector<double>> FaceCorners(const Mesh& mesh, Mesh::FaceHandle f) {
+  std::vector<std::vector<double>> corners;
+  for (auto v : mesh.fv_range(f)) corners.push_back(Key(mesh.point(v)));
+  return corners;
+}
 
-  ASSERT_EQ(new_index.size(), old_points.size());
-  std::vector<int> sorted = new_index;
-  std::sort(sorted.begin(), sorted.end());
-  for (size_t i = 0; i < sorted.size(); ++i) {
-    ASSERT_EQ(sorted[i], static_cast<int>(i)) << "new indices are not a permutation";
+// The end points of a half-edge.
+std::vector<double> HalfedgeKey(const Mesh& mesh, Mesh::HalfedgeHandle h) {
+  std::vector<double> key = Key(mesh.point(mesh.from_vertex_handle(h)));
+  const std::vector<double> to = Key(mesh.point(mesh.to_vertex_handle(h)));
+  key.insert(key.end(), to.begin(), to.end());
+  return key;
+}
+
+// `mesh` with deleted elements in the middle of every kind: faces deleted (opening holes, their
+// isolated vertices deleted too, or kept isolated, then isolated twins added) and edges
+// collapsed.
+Mesh WithDeletions(Mesh mesh, bool keep_isolated_vertices) {
+  Random rng(17);
+  for (int i = 0; i < 6; ++i) {
+    const Mesh::FaceHandle f(static_cast<int>(rng.NextIndex(mesh.n_faces())));
+    if (!mesh.status(f).deleted()) mesh.delete_face(f, !keep_isolated_vertices);
   }
-  for (size_t old = 0; old < old_points.size(); ++old) {
-    const Mesh::VertexHandle v(new_index[old]);
-    EXPECT_EQ(mesh.point(v), old_points[old]) << "the point of old vertex " << old << " moved";
-    EXPECT_EQ(mesh.property(tag, v), static_cast<int>(old) * 10)
-        << "a caller's property did not follow old vertex " << old;
+  int collapsed = 0;
+  for (int tries = 0; tries < 200 && collapsed < 8; ++tries) {
+    const Mesh::HalfedgeHandle h(static_cast<int>(rng.NextIndex(mesh.n_halfedges())));
+    if (mesh.status(mesh.edge_handle(h)).deleted() || mesh.is_boundary(mesh.edge_handle(h)) ||
+        mesh.is_boundary(mesh.from_vertex_handle(h)) || !mesh.is_collapse_ok(h)) {
+      continue;
+    }
+    mesh.collapse(h);
+    ++collapsed;
   }
-  EXPECT_EQ(FacesByPosition(mesh), faces_before) << "the faces changed";
+  if (keep_isolated_vertices) {
+    // Twins of a few vertices, in the same Morton cell: the collection's order decides where
+    // they go (it moves them from the end into the first free slots).
+    for (int i = 0; i < 4; ++i) {
+      const Mesh::VertexHandle v(static_cast<int>(rng.NextIndex(mesh.n_vertices())));
+      if (!mesh.status(v).deleted()) mesh.add_vertex(mesh.point(v) + Vec3(1e-12, 0, 0));
+    }
+  }
+  return mesh;
+}
+
+TEST(CompactInMortonOrderTest, IsGarbageCollectionThenTheSortsElementForElement) {
+  for (const bool keep_isolated : {false, true}) {
+    const std::string context = keep_isolated ? "isolated vertices kept" : "none isolated";
+    Mesh mesh = WithDeletions(Shuffled(MustToMesh(Icosphere(3)), 7), keep_isolated);
+    // Properties of value types that move by one gather (int) and of others (strings), on
+    // every kind of element, each naming its element by position.
+    OpenMesh::VPropHandleT<int> vertex_number;
+    OpenMesh::VPropHandleT<std::string> vertex_name;
+    OpenMesh::EPropHandleT<std::vector<double>> edge_ends;
+    OpenMesh::HPropHandleT<std::vector<double>> halfedge_ends;
+    OpenMesh::HPropHandleT<int> halfedge_number;
+    OpenMesh::FPropHandleT<std::vector<std::vector<double>>> face_corners;
+    mesh.add_property(vertex_number);
+    mesh.add_property(vertex_name);
+    mesh.add_property(edge_ends);
+    mesh.add_property(halfedge_ends);
+    mesh.add_property(halfedge_number);
+    mesh.add_property(face_corners);
+    for (auto v : mesh.all_vertices()) {
+      mesh.property(vertex_number, v) = v.idx();
+      mesh.property(vertex_name, v) = "v" + std::to_string(v.idx());
+    }
+    for (auto e : mesh.edges()) {
+      mesh.property(edge_ends, e) = HalfedgeKey(mesh, mesh.halfedge_handle(e, 0));
+    }
+    for (auto h : mesh.all_halfedges()) mesh.property(halfedge_number, h) = h.idx();
+    for (auto h : mesh.halfedges()) mesh.property(halfedge_ends, h) = HalfedgeKey(mesh, h);
+    for (auto f : mesh.faces()) mesh.property(face_corners, f) = FaceCorners(mesh, f);
+    std::vector<std::vector<double>> old_positions;
+    std::vector<bool> old_deleted;
+    for (auto v : mesh.all_vertices()) {
+      old_positions.push_back(Key(mesh.point(v)));
+      old_deleted.push_back(mesh.status(v).deleted());
+    }
+    Mesh collected = mesh;
+    collected.garbage_collection();
+    std::map<std::vector<double>, int> collected_index;
+    for (auto v : collected.vertices()) collected_index[Key(collected.point(v))] = v.idx();
+    ASSERT_EQ(collected_index.size(), collected.n_vertices()) << context << ": positions repeat";
+
+    const std::vector<int> new_index = CompactInMortonOrder(mesh);
+
+    ASSERT_EQ(mesh.n_vertices(), collected.n_vertices()) << context;
+    ASSERT_EQ(mesh.n_edges(), collected.n_edges()) << context;
+    ASSERT_EQ(mesh.n_faces(), collected.n_faces()) << context;
+    if (!keep_isolated) {
+      ASSERT_TRUE(ValidateMesh(mesh).ok()) << context << ": " << ValidateMesh(mesh);
+    }
+    // Vertices: in Morton order, ties by their order after the collection; the returned map
+    // names each old vertex's new index; properties and links follow.
+    ASSERT_EQ(new_index.size(), old_positions.size()) << context;
+    for (size_t old = 0; old < old_positions.size(); ++old) {
+      if (old_deleted[old]) {
+        EXPECT_EQ(new_index[old], -1) << context << ": deleted vertex " << old << " got an index";
+        continue;
+      }
+      ASSERT_GE(new_index[old], 0) << context << ": live vertex " << old << " got none";
+      const Mesh::VertexHandle v(new_index[old]);
+      EXPECT_EQ(Key(mesh.point(v)), old_positions[old]) << context << ": vertex " << old;
+      EXPECT_EQ(mesh.property(vertex_number, v), static_cast<int>(old)) << context;
+      EXPECT_EQ(mesh.property(vertex_name, v), "v" + std::to_string(old)) << context;
+    }
+    Vec3 min = mesh.point(Mesh::VertexHandle(0)), max = min;
+    for (auto v : mesh.vertices()) {
+      min.minimize(mesh.point(v));
+      max.maximize(mesh.point(v));
+    }
+    for (size_t i = 1; i < mesh.n_vertices(); ++i) {
+      const Mesh::VertexHandle a(static_cast<int>(i - 1)), b(static_cast<int>(i));
+      const auto key = [&](Mesh::VertexHandle v) {
+        return std::make_pair(MortonCode(mesh.point(v), min, max),
+                              collected_index.at(Key(mesh.point(v))));
+      };
+      ASSERT_LT(key(a), key(b)) << context << ": vertices " << i - 1 << " and " << i;
+    }
+    for (auto v : mesh.vertices()) {
+      const Mesh::VertexHandle before(collected_index.at(Key(mesh.point(v))));
+      ASSERT_EQ(mesh.halfedge_handle(v).is_valid(), collected.halfedge_handle(before).is_valid())
+          << context << ": vertex " << v.idx();
+      if (!mesh.halfedge_handle(v).is_valid()) continue;
+      EXPECT_EQ(HalfedgeKey(mesh, mesh.halfedge_handle(v)),
+                HalfedgeKey(collected, collected.halfedge_handle(before)))
+          << context << ": vertex " << v.idx() << " starts its walks at another half-edge";
+    }
+    // Edges: by their new vertex indices; each keeps its half-edges, their properties, and the
+    // links of those to the next and previous half-edge and to the face.
+    std::pair<int, int> last(-1, -1);
+    for (auto e : mesh.edges()) {
+      const auto h = mesh.halfedge_handle(e, 0);
+      const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
+      const std::pair<int, int> key(std::min(a, b), std::max(a, b));
+      ASSERT_LT(last, key) << context << ": edge " << e.idx() << " is out of order";
+      last = key;
+      EXPECT_EQ(mesh.property(edge_ends, e), HalfedgeKey(mesh, h)) << context;
+    }
+    std::map<std::vector<double>, Mesh::HalfedgeHandle> collected_halfedge;
+    for (auto h : collected.halfedges()) collected_halfedge[HalfedgeKey(collected, h)] = h;
+    for (auto h : mesh.halfedges()) {
+      const Mesh::HalfedgeHandle before = collected_halfedge.at(HalfedgeKey(mesh, h));
+      EXPECT_EQ(mesh.property(halfedge_ends, h), HalfedgeKey(mesh, h)) << context;
+      EXPECT_EQ(mesh.property(halfedge_number, h), collected.property(halfedge_number, before))
+          << context << ": half-edge " << h.idx();
+      EXPECT_EQ(HalfedgeKey(mesh, mesh.next_halfedge_handle(h)),
+                HalfedgeKey(collected, collected.next_halfedge_handle(before)))
+          << context << ": half-edge " << h.idx();
+      EXPECT_EQ(mesh.prev_halfedge_handle(mesh.next_halfedge_handle(h)), h) << context;
+      EXPECT_EQ(mesh.is_boundary(h), collected.is_boundary(before)) << context;
+      if (!mesh.is_boundary(h)) {
+        EXPECT_EQ(FaceCorners(mesh, mesh.face_handle(h)),
+                  FaceCorners(collected, collected.face_handle(before)))
+            << context << ": half-edge " << h.idx() << " lies in another face";
+      }
+    }
+    // Faces: in the collection's order, each starting its walk where it did.
+    for (auto f : mesh.faces()) {
+      EXPECT_EQ(FaceCorners(mesh, f), FaceCorners(collected, f)) << context << ": face " << f.idx();
+      EXPECT_EQ(mesh.property(face_corners, f), FaceCorners(mesh, f)) << context;
+    }
+    EXPECT_EQ(testing::BoundaryLoopSizes(mesh), testing::BoundaryLoopSizes(collected)) << context;
+  }
+}
+
+TEST(CompactInMortonOrderTest, NumbersAlongTheCurveAndBringsNeighboursClose) {
+  Mesh mesh = Shuffled(MustToMesh(Icosphere(4)), 3);
+  const double scattered = MeanIndexDistance(mesh);
+  CompactInMortonOrder(mesh);
+  EXPECT_LT(MeanIndexDistance(mesh), scattered / 5)
+      << "neighbours are not much closer in index than in a random numbering";
   for (auto v : mesh.vertices()) {
-    EXPECT_EQ(mesh.from_vertex_handle(mesh.halfedge_handle(v)), v)
+    ASSERT_EQ(mesh.from_vertex_handle(mesh.halfedge_handle(v)), v)
         << "the outgoing half-edge of vertex " << v.idx() << " does not start at it";
   }
 }
 
-TEST(MortonVertexOrderTest, NumbersAlongTheCurveAndBringsNeighboursClose) {
-  Mesh mesh = Shuffled(MustToMesh(Icosphere(4)), 3);
-  const double scattered = MeanIndexDistance(mesh);
-  SortVerticesInMortonOrder(mesh);
-  Vec3 min = mesh.point(Mesh::VertexHandle(0)), max = min;
-  for (auto v : mesh.vertices()) {
-    min.minimize(mesh.point(v));
-    max.maximize(mesh.point(v));
-  }
-  for (size_t i = 1; i < mesh.n_vertices(); ++i) {
-    const Mesh::VertexHandle a(static_cast<int>(i - 1)), b(static_cast<int>(i));
-    ASSERT_LE(MortonCode(mesh.point(a), min, max), MortonCode(mesh.point(b), min, max))
-        << "vertices " << i - 1 << " and " << i << " are out of Morton order";
-  }
-  EXPECT_LT(MeanIndexDistance(mesh), scattered / 5)
-      << "neighbours are not much closer in index than in a random numbering";
-}
-
-TEST(MortonVertexOrderTest, KeepsBoundariesAndHandlesAnEmptyMesh) {
+TEST(CompactInMortonOrderTest, KeepsBoundariesAndHandlesAnEmptyMesh) {
   Mesh mesh = Shuffled(MustToMesh(GridPatch(12, 9)), 5);
   const auto loops = testing::BoundaryLoopSizes(mesh);
-  SortVerticesInMortonOrder(mesh);
+  const auto faces = FacesByPosition(mesh);
+  CompactInMortonOrder(mesh);
+  ASSERT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
   EXPECT_EQ(testing::BoundaryLoopSizes(mesh), loops) << "the border changed";
+  EXPECT_EQ(FacesByPosition(mesh), faces) << "the faces changed";
   for (auto v : mesh.vertices()) {
     if (!mesh.is_boundary(v)) continue;
     EXPECT_TRUE(mesh.is_boundary(mesh.halfedge_handle(v)))
         << "border vertex " << v.idx() << " lost its outgoing boundary half-edge";
   }
   Mesh empty;
-  EXPECT_TRUE(SortVerticesInMortonOrder(empty).empty()) << "an empty mesh has no vertices";
-}
-
-// Edge tags that name an edge by its end points' positions, and half-edge tags by its start.
-std::vector<double> EdgeKey(const Mesh& mesh, Mesh::HalfedgeHandle h) {
-  const Vec3& a = mesh.point(mesh.from_vertex_handle(h));
-  const Vec3& b = mesh.point(mesh.to_vertex_handle(h));
-  return {a[0], a[1], a[2], b[0], b[1], b[2]};
-}
-
-TEST(SortEdgesByVertexIndexTest, KeepsTheMeshAndMovesPropertiesWithTheirEdges) {
-  for (const bool with_border : {false, true}) {
-    const std::string context = with_border ? "grid patch" : "icosphere";
-    Mesh mesh = Shuffled(MustToMesh(with_border ? GridPatch(12, 9) : Icosphere(3)), 11);
-    SortVerticesInMortonOrder(mesh);
-    OpenMesh::EPropHandleT<std::vector<double>> edge_tag;
-    OpenMesh::HPropHandleT<std::vector<double>> halfedge_tag;
-    mesh.add_property(edge_tag);
-    mesh.add_property(halfedge_tag);
-    for (auto h : mesh.halfedges()) mesh.property(halfedge_tag, h) = EdgeKey(mesh, h);
-    for (auto e : mesh.edges())
-      mesh.property(edge_tag, e) = EdgeKey(mesh, mesh.halfedge_handle(e, 0));
-    const auto faces_before = FacesByPosition(mesh);
-    const auto loops_before = testing::BoundaryLoopSizes(mesh);
-    std::vector<std::vector<int>> rings_before;
-    for (auto v : mesh.vertices()) {
-      std::vector<int> ring;
-      for (auto u : mesh.vv_range(v)) ring.push_back(u.idx());
-      rings_before.push_back(ring);
-    }
-
-    SortEdgesByVertexIndex(mesh);
-
-    ASSERT_TRUE(ValidateMesh(mesh).ok()) << context << ": " << ValidateMesh(mesh);
-    EXPECT_EQ(FacesByPosition(mesh), faces_before) << context << ": the faces changed";
-    EXPECT_EQ(testing::BoundaryLoopSizes(mesh), loops_before) << context << ": the border changed";
-    for (auto v : mesh.vertices()) {
-      std::vector<int> ring;
-      for (auto u : mesh.vv_range(v)) ring.push_back(u.idx());
-      std::vector<int> expected = rings_before[v.idx()];
-      // The same neighbours in the same rotation; the walk may start elsewhere.
-      ASSERT_EQ(ring.size(), expected.size()) << context << ": vertex " << v.idx();
-      auto start = std::find(expected.begin(), expected.end(), ring.front());
-      ASSERT_NE(start, expected.end()) << context << ": vertex " << v.idx();
-      std::rotate(expected.begin(), start, expected.end());
-      EXPECT_EQ(ring, expected) << context << ": the ring of vertex " << v.idx() << " changed";
-      if (mesh.is_boundary(v)) {
-        EXPECT_TRUE(mesh.is_boundary(mesh.halfedge_handle(v)))
-            << context << ": border vertex " << v.idx() << " lost its boundary half-edge";
-      }
-    }
-    for (auto h : mesh.halfedges()) {
-      ASSERT_EQ(mesh.property(halfedge_tag, h), EdgeKey(mesh, h))
-          << context << ": a half-edge property did not follow half-edge " << h.idx();
-    }
-    std::pair<int, int> last(-1, -1);
-    for (auto e : mesh.edges()) {
-      const auto h = mesh.halfedge_handle(e, 0);
-      ASSERT_EQ(mesh.property(edge_tag, e), EdgeKey(mesh, h))
-          << context << ": an edge property did not follow edge " << e.idx();
-      const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
-      const std::pair<int, int> key(std::min(a, b), std::max(a, b));
-      ASSERT_LT(last, key) << context << ": edge " << e.idx() << " is out of order";
-      last = key;
-    }
-  }
-  Mesh empty;
-  SortEdgesByVertexIndex(empty);
+  EXPECT_TRUE(CompactInMortonOrder(empty).empty()) << "an empty mesh has no vertices";
   EXPECT_EQ(empty.n_edges(), 0u);
+  // Everything deleted: nothing is left.
+  Mesh gone = MustToMesh(Icosphere(1));
+  for (auto f : gone.faces()) gone.delete_face(f, true);
+  const std::vector<int> new_index = CompactInMortonOrder(gone);
+  EXPECT_EQ(gone.n_vertices() + gone.n_edges() + gone.n_faces(), 0u);
+  EXPECT_EQ(std::count(new_index.begin(), new_index.end(), -1),
+            static_cast<long>(new_index.size()))
+      << "a deleted vertex got an index";
 }
 
 }  // namespace

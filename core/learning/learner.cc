@@ -217,6 +217,12 @@ class Learner::Impl {
     // over) belongs to v0 or one of its neighbours.
     rings_.Invalidate(v0.idx());
     for (auto u : mesh_.vv_range(v0)) rings_.Invalidate(u.idx());
+    // And read again at once, while the half-edges the split wrote are in cache: the Basic
+    // Steps would read nearly all of them before the next Step 3, each walk then a chain of
+    // misses (0.97-0.98 of the time per Basic Step from 20K to 100K vertices, the same meshes).
+    changed_rings_.clear();
+    rings_.AppendRing(mesh_, v0.idx(), changed_rings_);
+    for (const int u : changed_rings_) rings_.Ring(mesh_, u);
     const double f1 = VoronoiAreaEstimate(mesh_, v);
     const double f0 = VoronoiAreaEstimate(mesh_, v0);
     const double share0 = (f0 + f1) > 0 ? f0 / (f0 + f1) : 0.5;
@@ -378,6 +384,7 @@ class Learner::Impl {
   OpenMesh::VPropHandleT<uint64_t> spared_until_;
   // Inactive boundary vertices that Step 3 could not collapse in this call.
   std::vector<Mesh::VertexHandle> stuck_border_vertices_;
+  std::vector<int> changed_rings_;  // SplitMostActive's scratch.
   uint64_t step_ = 0;
   uint64_t next_connectivity_step_ = 0;
   size_t live_vertices_ = 0;

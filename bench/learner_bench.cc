@@ -358,8 +358,8 @@ int Run() {
       last_target = target;
       last_us_per_step = us_per_step;
       std::printf(
-          "%10zu %8zu %9.2f %11llu %9llu %9.3f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %10.0f\n", n,
-          p.vertices, total_s, static_cast<unsigned long long>(p.basic_steps),
+          "%10zu %8zu %9.2f %11llu %9llu %9.3f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %10.0f\n",
+          n, p.vertices, total_s, static_cast<unsigned long long>(p.basic_steps),
           static_cast<unsigned long long>(window_steps), us_per_step, Seconds(t.winner_search),
           Seconds(t.smoothing), Seconds(t.split), Seconds(t.collapse), Seconds(t.removal),
           Seconds(t.merging), Seconds(t.compaction), static_cast<double>(p.basic_steps) / total_s);
@@ -394,8 +394,8 @@ int Run() {
       "winner search; smooth = Eq. 1, the C_L smoothing passes and the octree updates of "
       "the moved vertices; split = Step 2 with the counters; collapse, removal, merge = "
       "Steps 3, 4, 5; compact = after them, the vertices renumbered in Morton order and the "
-      "octree, counters and ring cache rebuilt). octree and smooth are estimates from one Basic Step in 17, timed; "
-      "total s is the wall time of the whole run.\n\n");
+      "octree, counters and ring cache rebuilt). octree and smooth are estimates from one Basic "
+      "Step in 17, timed; total s is the wall time of the whole run.\n\n");
   PrintMemoryLatency("after");
   return 0;
 }

@@ -1,12 +1,12 @@
 #include "core/learning/morton_vertex_order.h"
 
-#include <OpenMesh/Core/Utils/Property.hh>
-
 #include <algorithm>
 #include <cstdint>
 #include <type_traits>
 #include <utility>
 #include <vector>
+
+#include <OpenMesh/Core/Utils/Property.hh>
 
 namespace neuralmesh {
 namespace {
@@ -72,8 +72,8 @@ bool GatherIfOfType(OpenMesh::BaseProperty& property, const std::vector<int>& ol
 
 // Makes element k of `property` (`stride` values each, `old_count` elements) hold what element
 // old_of[k] held, and drops the elements old_of does not name.
-void GatherProperty(OpenMesh::BaseProperty& property, const std::vector<int>& old_of,
-                    size_t stride, size_t old_count) {
+void GatherProperty(OpenMesh::BaseProperty& property, const std::vector<int>& old_of, size_t stride,
+                    size_t old_count) {
   using OpenMesh::Attributes::StatusInfo;
   if (GatherIfOfType<StatusInfo>(property, old_of, stride) ||
       GatherIfOfType<Vec3>(property, old_of, stride) ||

@@ -43,10 +43,31 @@ bool ComponentHasMoreFacesThan(const Mesh& mesh, Mesh::FaceHandle fh, size_t lim
 // The area of every face, by face index (0 for a deleted one), and in *mean their mean over the
 // live faces.
 std::vector<double> FaceAreas(const Mesh& mesh, double* mean) {
+  // A face's corners are a chain of loads (its half-edge, the next one, three points) that
+  // miss on a large mesh, so each face's links start loading some faces ahead: Step 4 then
+  // takes 0.3 of its time at 100K vertices (15 against 43-56 million cycles a call).
+  constexpr int kLinksAhead = 24;
+  constexpr int kCornersAhead = 12;
+  const int num_faces = static_cast<int>(mesh.n_faces());
   std::vector<double> areas(mesh.n_faces(), 0.0);
   double total = 0;
   size_t count = 0;
+  // Only live faces' links are followed: a deleted face's may name a half-edge that is gone.
+  auto live = [&mesh, num_faces](int f) {
+    return f < num_faces && !mesh.status(Mesh::FaceHandle(f)).deleted();
+  };
   for (auto fh : mesh.faces()) {
+    if (live(fh.idx() + kLinksAhead)) {
+      const Mesh::FaceHandle ahead(fh.idx() + kLinksAhead);
+      __builtin_prefetch(&mesh.halfedge(mesh.halfedge_handle(ahead)));
+    }
+    if (live(fh.idx() + kCornersAhead)) {
+      const Mesh::HalfedgeHandle h =
+          mesh.halfedge_handle(Mesh::FaceHandle(fh.idx() + kCornersAhead));
+      __builtin_prefetch(&mesh.point(mesh.to_vertex_handle(h)));
+      __builtin_prefetch(&mesh.point(mesh.from_vertex_handle(h)));
+      __builtin_prefetch(&mesh.halfedge(mesh.next_halfedge_handle(h)));
+    }
     const double area = TriangleArea(mesh, fh);
     areas[static_cast<size_t>(fh.idx())] = area;
     total += area;

@@ -110,6 +110,31 @@ TEST(TriangleRemovalTest, SecondCallOnAMeshWithDeletedElements) {
   EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
 }
 
+TEST(TriangleRemovalTest, FacesDeletedByCollapsesAreSkipped) {
+  // Step 4 runs right after Step 3's collapses, before the deleted faces are collected; their
+  // links may name half-edges that are gone, and neither the mean nor the removal may read them.
+  Mesh mesh = MustToMesh(Icosphere(3));
+  Random rng(5);
+  int collapsed = 0;
+  for (int tries = 0; tries < 2000 && collapsed < 60; ++tries) {
+    const Mesh::HalfedgeHandle h(static_cast<int>(rng.NextIndex(mesh.n_halfedges())));
+    if (mesh.status(mesh.edge_handle(h)).deleted() || !mesh.is_collapse_ok(h)) continue;
+    mesh.collapse(h);
+    ++collapsed;
+  }
+  ASSERT_EQ(collapsed, 60);
+  ASSERT_LT(LiveFaces(mesh), mesh.n_faces()) << "no face was deleted";
+  double total = 0;
+  for (auto f : mesh.faces()) total += FaceArea(mesh, f);
+  const double mean = total / static_cast<double>(LiveFaces(mesh));
+  EXPECT_NEAR(MeanTriangleArea(mesh), mean, 1e-15 * mean) << "the mean of the live faces";
+  const size_t before = LiveFaces(mesh);
+  const TriangleRemovalResult result = RemoveLargeTriangles(mesh, TriangleRemovalOptions{});
+  EXPECT_NEAR(result.mean_area, mean, 1e-15 * mean);
+  EXPECT_EQ(LiveFaces(mesh), before - result.removed_faces);
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
 // A wheel of six faces around an interior centre, where two opposite faces are huge and the
 // others tiny, next to a sphere of ordinary faces that sets the mean area. Removing one huge
 // face puts the centre on a boundary; the other huge face then sits in the middle of the

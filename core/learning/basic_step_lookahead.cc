@@ -54,17 +54,6 @@ void BasicStepLookahead::StartStep(uint64_t step, const Sampler& target, Random&
     octree.PrefetchLocation(searched.winner);
     __builtin_prefetch(PointData(mesh, searched.winner));
   }
-
-  // Step + 1: its winner's neighbours' neighbours, whose positions the smoothing gathers.
-  if (const Upcoming& u = Slot(step + 1); HasWinner(u)) {
-    const VertexRingCache::RingView ring = rings.CachedRing(u.winner);
-    for (int i = 0; i < ring.size; ++i) {
-      const VertexRingCache::RingView second = rings.CachedRing(ring.neighbours[i]);
-      for (int k = 0; k < second.size; ++k) {
-        __builtin_prefetch(PointData(mesh, second.neighbours[k]));
-      }
-    }
-  }
 }
 
 void BasicStepLookahead::ContinueStep(const VertexOctree& octree, const VertexRingCache& rings,
@@ -74,12 +63,12 @@ void BasicStepLookahead::ContinueStep(const VertexOctree& octree, const VertexRi
   octree.Descend(drawn.sample, 1, &drawn.descent);
   // Step + 3: the points of the leaf it reached, whose ids have loaded since.
   octree.PrefetchNearestPoints(Slot(step_ + 3).descent);
-  // Step + 2: the neighbours of the winner found at the start of the step.
+  // Step + 2: the rings and positions of the neighbours of the winner found at the start of
+  // the step (their octree locations load at their own step, learner.cc).
   if (const Upcoming& u = Slot(step_ + 2); HasWinner(u)) {
     const VertexRingCache::RingView ring = rings.CachedRing(u.winner);
     for (int i = 0; i < ring.size; ++i) {
       rings.Prefetch(ring.neighbours[i]);
-      octree.PrefetchLocation(ring.neighbours[i]);
       __builtin_prefetch(PointData(mesh, ring.neighbours[i]));
     }
   }

@@ -13,15 +13,18 @@
 //   step t-3: on down to the leaf on s's side (mostly one level), loading its ids; midway,
 //             their points
 //   step t-2: w <- the vertex nearest to s (its leaf is in cache now); load w's ring,
-//             position and octree location; midway, the rings, positions and octree
-//             locations of w's neighbours
-//   step t-1: load the positions of their neighbours
+//             position and octree location; midway, the rings and positions of w's
+//             neighbours
 //   step t:   the Basic Step, with winner w unless steps t-2 and t-1 moved w, or moved or
 //             inserted a vertex to within w's distance of s (tested against the bounding box
 //             of each step's moves); then the octree is searched again
 //
 // The descent is spread so because the octree's lower levels do not stay in cache on a large
-// mesh: taken at once, it waited on two or three of their blocks in a row.
+// mesh: taken at once, it waited on two or three of their blocks in a row. The rest of the
+// chain is left to the step itself: the positions of the neighbours' neighbours lie mostly in
+// the leaf the search read, and the octree locations of w's neighbours load just before the
+// smoothing (learner.cc). Loading them here too, at step t-1 and midway through step t-2,
+// took 1.04-1.07 and 1.01-1.02 of the time per Basic Step from 50K to 100K vertices.
 //
 // That is exactly the winner of a search at step t (ties apart: when two vertices are at the
 // same distance from s, either is nearest, and which one the octree returns depends on its
@@ -57,7 +60,7 @@ class BasicStepLookahead {
 
   // Starts Basic Step `step` (first_step, then each next one, none skipped): draws the
   // samples up to step + kDepth from `target` with `rng`, searches the winner of step + 2 and
-  // starts the loads of steps step + 1, step + 3 and step + kDepth. `octree`, `rings` and
+  // starts the loads of steps step + 2, step + 3 and step + kDepth. `octree`, `rings` and
   // `mesh` must agree (the octree indexes the mesh's positions and has had every Move).
   void StartStep(uint64_t step, const Sampler& target, Random& rng, const VertexOctree& octree,
                  const VertexRingCache& rings, const Mesh& mesh);

@@ -60,15 +60,27 @@ inline void SignalCounters::SetKey(int id, double key, uint64_t step) {
 }
 
 void SignalCounters::CompactLog() {
-  seen_.assign((key_.size() + 63) / 64, 0);
+  // A bit per id whose touches are dropped: the untracked ids, marked first in one pass over
+  // the keys in order (on a large mesh, reading the key of each touch instead was a cache
+  // miss per touch, 10% of Step 2's time at 100K vertices), then each id whose last touch is
+  // kept.
+  const size_t ids = key_.size();
+  seen_.assign((ids + 63) / 64, 0);
+  for (size_t id = 0; id < ids; ++id) {
+    seen_[id / 64] |= uint64_t{key_[id] == kUntracked} << (id % 64);
+  }
   // Newest first: the first touch met of an id is its last one.
   size_t kept = log_.size();
   for (size_t i = log_.size(); i-- > 0;) {
     const LoggedTouch touch = log_[i];
     const size_t id = static_cast<size_t>(touch.id);
-    if (key_[id] == kUntracked || (seen_[id / 64] >> (id % 64) & 1) != 0) continue;
-    seen_[id / 64] |= uint64_t{1} << (id % 64);
-    log_[--kept] = touch;  // Now kept >= i: nothing unread is overwritten.
+    const uint64_t bit = uint64_t{1} << (id % 64);
+    const bool keep = (seen_[id / 64] & bit) == 0;
+    seen_[id / 64] |= bit;
+    // Written whether kept or not, without a branch (which half the touches would mispredict):
+    // kept > i, so this overwrites only touches already read, or this one.
+    log_[kept - 1] = touch;
+    kept -= keep ? 1 : 0;
   }
   log_.erase(log_.begin(), log_.begin() + static_cast<std::ptrdiff_t>(kept));
 }

@@ -109,11 +109,11 @@ class Learner {
   // steps ahead and what their steps read is loaded meanwhile (basic_step_lookahead.h): the
   // same mesh, faster once the mesh outgrows the caches, slower while it fits. Default
   // kLookaheadFromVertices; 0: from the start. A change after that step has no effect.
-  // Measured on this project's machine (learner-bench --ab_lookahead_from=0), since the
-  // learner's arrays are on huge pages: 12-21% more time per Basic Step below 30,000
-  // vertices, 5-9% more to 40,000, even to 50,000, 4-8% less to 70,000 and 10-16% less to
-  // 100,000.
-  static constexpr size_t kLookaheadFromVertices = 45000;
+  // Measured on this project's machine (learner-bench --ab_lookahead_from=0, session 13, on
+  // 100,000 and 5,000,000 points): 6-12% more time per Basic Step below 20,000 vertices,
+  // 1% less to 2% more from 20,000 to 25,000, 6% less to 4% more from 25,000 to 30,000, 4-10%
+  // less from 30,000 to 45,000 and 12-17% less above.
+  static constexpr size_t kLookaheadFromVertices = 30000;
   void SetLookaheadFromVertices(size_t vertices);
 
   // A compact copy of the current mesh (live vertices and faces only). O(v).

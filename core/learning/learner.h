@@ -110,9 +110,9 @@ class Learner {
   // same mesh, faster once the mesh outgrows the caches, slower while it fits. Default
   // kLookaheadFromVertices; 0: from the start. A change after that step has no effect.
   // Measured on this project's machine (learner-bench --ab_lookahead_from=0, session 13, on
-  // 100,000 and 5,000,000 points): 6-12% more time per Basic Step below 20,000 vertices,
-  // 1% less to 2% more from 20,000 to 25,000, 6% less to 4% more from 25,000 to 30,000, 4-10%
-  // less from 30,000 to 45,000 and 12-17% less above.
+  // 100,000 and 5,000,000 points): 4-12% more time per Basic Step below 20,000 vertices,
+  // 2% less to 3% more from 20,000 to 25,000, 6% less to 4% more from 25,000 to 30,000, 4-10%
+  // less from 30,000 to 45,000 and 12-18% less above.
   static constexpr size_t kLookaheadFromVertices = 30000;
   void SetLookaheadFromVertices(size_t vertices);
 

@@ -146,6 +146,39 @@ TEST(SignalCountersTest, FindsAnOldEligibleVertexBehindIneligibleWinners) {
       << "the winner of step 10000 (10000 % 10 = 0) has the highest counter";
 }
 
+// After the touch log has been compacted several times, under wins, removals and re-adds,
+// every tracked id is still in it: a search that only it passes finds it (and finds none for a
+// removed id), whether its last touch was recent or is older than every compaction.
+TEST(SignalCountersTest, CompactionKeepsEveryTrackedIdFindable) {
+  const int n = 2000;
+  SignalCounters counters(0.95);
+  std::vector<bool> tracked(n, true);
+  for (int id = 0; id < n; ++id) counters.Add(id, 1.0, 0);
+  Random rng(17);
+  uint64_t step = 0;
+  for (int round = 0; round < 400; ++round) {
+    for (int k = 0; k < 100; ++k) {
+      ++step;
+      // Most wins on a tenth of the ids, so that many ids keep only their first touch.
+      const int id = static_cast<int>(rng.NextIndex(rng.NextDouble() < 0.9 ? n / 10 : n));
+      if (tracked[id]) counters.RecordWin(id, step);
+    }
+    const int changed = static_cast<int>(rng.NextIndex(n));
+    if (tracked[changed]) {
+      counters.Remove(changed);
+    } else {
+      counters.Add(changed, 0.5, step);
+    }
+    tracked[changed] = !tracked[changed];
+    counters.Flush();
+  }
+  ASSERT_LT(counters.log_size(), 40000u) << "the log was compacted (40,000 wins)";
+  for (int id = 0; id < n; ++id) {
+    ASSERT_EQ(counters.MostActive([id](int v) { return v == id; }), tracked[id] ? id : -1)
+        << "id " << id;
+  }
+}
+
 // A win in the step of the counter's last touch is not decayed first: it can lift the counter
 // above every value given so far (20 + 1 here, with 1 / (1 - 0.95) = 20), and the search must
 // still walk back to it past a later, smaller counter.

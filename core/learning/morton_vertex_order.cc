@@ -8,6 +8,8 @@
 
 #include <OpenMesh/Core/Utils/Property.hh>
 
+#include "core/morton_code.h"
+
 namespace neuralmesh {
 namespace {
 

@@ -31,7 +31,6 @@
 #include <vector>
 
 #include "core/mesh.h"
-#include "core/morton_code.h"
 
 namespace neuralmesh {
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/mesh_validation.h"
+#include "core/morton_code.h"
 #include "core/random.h"
 #include "gtest/gtest.h"
 #include "tests/testing/shapes.h"

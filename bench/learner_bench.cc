@@ -13,9 +13,10 @@
 // "window" is the number of Basic Steps in that window. After each input, the ratio of the
 // last measured milestone's us/step to the first one's (issue 2 asks for at most 1.5 from 1K
 // to 100K vertices), again with the median of the first milestone's window over several fresh
-// runs (--first_window_repeats; that window lasts about 10 ms), and a fingerprint of the final
-// mesh (positions and faces): a change meant only to make the learner faster must leave it
-// unchanged.
+// runs (--first_window_repeats; that window lasts about 10 ms), then the ratio taken in pairs
+// of windows close in time (TimeWindowPairs), which the machine's drift moves far less, and a
+// fingerprint of the final mesh (positions and faces) before those pairs: a change meant only
+// to make the learner faster must leave it unchanged.
 // Under callgrind, only the windows are measured, so that instructions and cache misses per
 // Basic Step at one mesh size can be read off (one milestone per run; the windows of several
 // would add up):
@@ -36,6 +37,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -62,9 +64,10 @@
 ABSL_FLAG(std::string, points, "50000,5000000", "Point counts of the sampled input surfaces.");
 ABSL_FLAG(std::string, milestones, "1000,5000,20000,100000", "Vertex counts to time.");
 ABSL_FLAG(uint64_t, seed, 1, "Seed of the learner and of the point sampling.");
-ABSL_FLAG(int, first_window_repeats, 9,
+ABSL_FLAG(int, first_window_repeats, 21,
           "Fresh runs to the first milestone whose windows are timed again for the step-time "
-          "ratio (its window lasts about 10 ms, so one timing varies by 10-30%); 0: none.");
+          "ratio (its window lasts about 10 ms, so one timing varies by 10-30%), each paired "
+          "with a turn of the learner past the last milestone right after it; 0: none.");
 ABSL_FLAG(int64_t, lookahead_from, -1,
           "Look ahead from this many vertices on (Learner::SetLookaheadFromVertices); "
           "-1: the learner's default.");
@@ -250,33 +253,117 @@ int RunInTurns(FifoTurns& turns, const Sampler& sampler, size_t n,
   return 0;
 }
 
-// Learns on to 0.9 `target` vertices, then times the Basic Steps from there to `target` (the
-// window), marked for callgrind when `callgrind` is set. Returns us/step in the window, or a
-// negative value when learning failed; `window_steps`, if given, receives their number.
-double TimeWindowBelow(Learner& learner, size_t target, bool callgrind,
-                       uint64_t* window_steps = nullptr) {
-  StopCriteria to_window;
-  to_window.target_vertices = target * 9 / 10;
-  if (!learner.Run(to_window).ok()) return -1;
+// The median of `values` (not empty; the upper one of an even count).
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+// Time spent in Steps 3-5 and the compaction after them, which run once every C_ec v Basic
+// Steps (every call is timed).
+absl::Duration PeriodicStepsTime(const Learner& learner) {
+  const LearnerTimings t = learner.timings();
+  return t.collapse + t.removal + t.merging + t.compaction;
+}
+
+// A timed stretch of Basic Steps, with the Steps 2-5 they ran.
+struct Window {
+  double seconds = 0;
+  uint64_t steps = 0;
+  double periodic_seconds = 0;  // Of `seconds`, in Steps 3-5 and the compaction (timings on).
+  double us_per_step() const { return 1e6 * seconds / static_cast<double>(steps); }
+  // Without Steps 3-5 and the compaction: the Basic Steps and Step 2.
+  double us_per_step_between() const {
+    return 1e6 * (seconds - periodic_seconds) / static_cast<double>(steps);
+  }
+};
+
+// Runs `learner` to `stop` and times it, marked for callgrind when `callgrind` is set.
+std::optional<Window> TimeRun(Learner& learner, const StopCriteria& stop, bool callgrind) {
   const uint64_t steps_before = learner.progress().basic_steps;
-  const auto window_start = std::chrono::steady_clock::now();
+  const absl::Duration periodic_before = PeriodicStepsTime(learner);
+  const auto start = std::chrono::steady_clock::now();
   if (callgrind) {
     CALLGRIND_START_INSTRUMENTATION;
     CALLGRIND_TOGGLE_COLLECT;
   }
-  StopCriteria to_target;
-  to_target.target_vertices = target;
-  const bool ok = learner.Run(to_target).ok();
+  const bool ok = learner.Run(stop).ok();
   if (callgrind) {
     CALLGRIND_TOGGLE_COLLECT;
     CALLGRIND_STOP_INSTRUMENTATION;
   }
-  if (!ok) return -1;
-  const double window_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - window_start).count();
-  const uint64_t steps = learner.progress().basic_steps - steps_before;
-  if (window_steps != nullptr) *window_steps = steps;
-  return 1e6 * window_s / static_cast<double>(steps);
+  if (!ok) return std::nullopt;
+  Window window;
+  window.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  window.steps = learner.progress().basic_steps - steps_before;
+  window.periodic_seconds = Seconds(PeriodicStepsTime(learner) - periodic_before);
+  return window;
+}
+
+// Learns on to 0.9 `target` vertices, then times the Basic Steps from there to `target` (the
+// window; see TimeRun).
+std::optional<Window> TimeWindowBelow(Learner& learner, size_t target, bool callgrind) {
+  StopCriteria to_window;
+  to_window.target_vertices = target * 9 / 10;
+  if (!learner.Run(to_window).ok()) return std::nullopt;
+  StopCriteria to_target;
+  to_target.target_vertices = target;
+  return TimeRun(learner, to_target, callgrind);
+}
+
+// The step-time ratio in pairs of windows close in time, so that the machine's drift meets
+// both sides of each pair alike (here it moves the 100K step by up to 1.8 times within a
+// second): `pairs` times, a fresh learner's window below `first_target` vertices, then a turn of
+// kPairTurnSteps Basic Steps of `large`, a learner at its last milestone, after
+// kPairWarmUpSteps untimed ones: the fresh learner's samples, a cache line each from a large
+// input, evict much of what `large` had in cache (without the warm-up its turns at 100K
+// vertices took 1.1 times the table's window). `large` grows on, by 1.5% in 10 pairs at 100K.
+// A window of 10,000 Basic Steps at 1K vertices holds about one run of Steps 3-5 (they come
+// every C_ec v steps), a turn at 100K mostly none: so each side is compared without them, plus
+// their mean cost per Basic Step over a long stretch at its size (`first_periodic_us`: over
+// all the fresh windows; `last_periodic_us`: given, from the table's window).
+constexpr int kPairTurnSteps = 10000;
+constexpr int kPairWarmUpSteps = 5000;
+struct WindowPairs {
+  std::vector<Window> first;  // The fresh windows.
+  std::vector<Window> last;   // The turns of `large`, pair by pair.
+  double first_periodic_us = 0;
+  std::vector<double> ratios;  // Sorted.
+};
+std::optional<WindowPairs> TimeWindowPairs(const Sampler& sampler, uint64_t seed,
+                                           int64_t lookahead_from, size_t first_target, int pairs,
+                                           double last_periodic_us, Learner& large) {
+  WindowPairs windows;
+  for (int i = 0; i < pairs; ++i) {
+    // Not marked for callgrind: a run under it measures the windows of the table only.
+    auto fresh = MakeLearner(sampler, seed, lookahead_from);
+    fresh->EnableTimings(true);  // As `large` has them.
+    const std::optional<Window> window = TimeWindowBelow(*fresh, first_target, false);
+    if (!window) return std::nullopt;
+    windows.first.push_back(*window);
+    StopCriteria warm_up;
+    warm_up.max_basic_steps = kPairWarmUpSteps;
+    if (!large.Run(warm_up).ok()) return std::nullopt;
+    StopCriteria turn;
+    turn.max_basic_steps = kPairTurnSteps;
+    const std::optional<Window> timed_turn = TimeRun(large, turn, false);
+    if (!timed_turn) return std::nullopt;
+    windows.last.push_back(*timed_turn);
+  }
+  double periodic_seconds = 0;
+  uint64_t steps = 0;
+  for (const Window& w : windows.first) {
+    periodic_seconds += w.periodic_seconds;
+    steps += w.steps;
+  }
+  windows.first_periodic_us = 1e6 * periodic_seconds / static_cast<double>(steps);
+  for (int i = 0; i < pairs; ++i) {
+    windows.ratios.push_back((windows.last[i].us_per_step_between() + last_periodic_us) /
+                             (windows.first[i].us_per_step_between() + windows.first_periodic_us));
+  }
+  std::sort(windows.ratios.begin(), windows.ratios.end());
+  return windows;
 }
 
 int Run() {
@@ -333,7 +420,7 @@ int Run() {
     auto learner = MakeLearner(*sampler, seed, lookahead_from);
     learner->EnableTimings(true);
     const auto start = std::chrono::steady_clock::now();
-    double first_us_per_step = 0, last_us_per_step = 0;
+    std::optional<Window> first_window, last_window;
     size_t first_target = 0, last_target = 0;
     for (size_t target : milestones) {
       if (target > n / 2) {
@@ -344,50 +431,62 @@ int Run() {
         std::printf("%10zu %8zu   skipped: more than one vertex per two input points\n", n, target);
         continue;
       }
-      uint64_t window_steps = 0;
-      const double us_per_step = TimeWindowBelow(*learner, target, true, &window_steps);
-      if (us_per_step < 0) return 1;
+      const std::optional<Window> window = TimeWindowBelow(*learner, target, true);
+      if (!window) return 1;
       const double total_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const LearnerProgress p = learner->progress();
       const LearnerTimings t = learner->timings();
       if (first_target == 0) {
         first_target = target;
-        first_us_per_step = us_per_step;
+        first_window = window;
       }
       last_target = target;
-      last_us_per_step = us_per_step;
+      last_window = window;
       std::printf(
           "%10zu %8zu %9.2f %11llu %9llu %9.3f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %10.0f\n",
           n, p.vertices, total_s, static_cast<unsigned long long>(p.basic_steps),
-          static_cast<unsigned long long>(window_steps), us_per_step, Seconds(t.winner_search),
-          Seconds(t.smoothing), Seconds(t.split), Seconds(t.collapse), Seconds(t.removal),
-          Seconds(t.merging), Seconds(t.compaction), static_cast<double>(p.basic_steps) / total_s);
+          static_cast<unsigned long long>(window->steps), window->us_per_step(),
+          Seconds(t.winner_search), Seconds(t.smoothing), Seconds(t.split), Seconds(t.collapse),
+          Seconds(t.removal), Seconds(t.merging), Seconds(t.compaction),
+          static_cast<double>(p.basic_steps) / total_s);
       std::fflush(stdout);
     }
+    // Before the pairs of windows below, which take the learner past its last milestone.
+    const uint64_t fingerprint = Fingerprint(learner->mesh());
     if (last_target != first_target) {
+      const double last_us = last_window->us_per_step();
       std::printf("%10zu points: us/step at %zu vertices over us/step at %zu: %.2f\n", n,
-                  last_target, first_target, last_us_per_step / first_us_per_step);
+                  last_target, first_target, last_us / first_window->us_per_step());
       if (const int repeats = absl::GetFlag(FLAGS_first_window_repeats); repeats > 0) {
-        std::vector<double> windows = {first_us_per_step};
-        for (int i = 0; i < repeats; ++i) {
-          // Not marked for callgrind: a run under it measures the windows of the table only.
-          auto fresh = MakeLearner(*sampler, seed, lookahead_from);
-          const double window = TimeWindowBelow(*fresh, first_target, false);
-          if (window < 0) return 1;
-          windows.push_back(window);
-        }
-        std::sort(windows.begin(), windows.end());
-        const double median = windows[windows.size() / 2];
+        const size_t vertices_before = learner->num_vertices();
+        const double last_periodic_us =
+            1e6 * last_window->periodic_seconds / static_cast<double>(last_window->steps);
+        const std::optional<WindowPairs> pairs = TimeWindowPairs(
+            *sampler, seed, lookahead_from, first_target, repeats, last_periodic_us, *learner);
+        if (!pairs) return 1;
+        std::vector<double> first_us = {first_window->us_per_step()};
+        for (const Window& w : pairs->first) first_us.push_back(w.us_per_step());
+        const double first_median = Median(first_us);
         std::printf(
             "%10zu points: us/step at %zu vertices, median of %zu windows (%.3f to %.3f): %.3f; "
             "ratio %.2f\n",
-            n, first_target, windows.size(), windows.front(), windows.back(), median,
-            last_us_per_step / median);
+            n, first_target, first_us.size(), *std::min_element(first_us.begin(), first_us.end()),
+            *std::max_element(first_us.begin(), first_us.end()), first_median,
+            last_us / first_median);
+        const std::vector<double>& r = pairs->ratios;
+        std::printf(
+            "%10zu points: ratio in %d pairs of a fresh window at %zu vertices and, right after "
+            "it, %d Basic Steps on from %zu vertices (to %zu), Steps 3-5 counted at their mean "
+            "cost per Basic Step (%.3f us at %zu vertices, %.3f at %zu): median %.2f, quartiles "
+            "%.2f and %.2f\n",
+            n, repeats, first_target, kPairTurnSteps, vertices_before, learner->num_vertices(),
+            pairs->first_periodic_us, first_target, last_periodic_us, last_target, Median(r),
+            r[r.size() / 4], r[(3 * r.size()) / 4]);
       }
     }
     std::printf("%10zu points: mesh fingerprint %016llx\n", n,
-                static_cast<unsigned long long>(Fingerprint(learner->mesh())));
+                static_cast<unsigned long long>(fingerprint));
   }
   std::printf(
       "\nColumns octree..merge: seconds spent per step kind (octree = sampling and the "

@@ -202,14 +202,14 @@ class Learner::Impl {
   // to F_v (Eq. 5-6).
   void SplitMostActive() {
     const int most_active = counters_.MostActive(
-        [this](int v) { return CanSplitVertex(mesh_, Mesh::VertexHandle(v)); });
+        [this](int v) { return CanSplitVertex(mesh_, rings_, Mesh::VertexHandle(v)); });
     if (most_active < 0) return;
     const Mesh::VertexHandle v = options_.split_largest_cell_near_most_active
-                                     ? LargestCellNear(mesh_, Mesh::VertexHandle(most_active))
+                                     ? LargestCellNear(mesh_, rings_, Mesh::VertexHandle(most_active))
                                      : Mesh::VertexHandle(most_active);
     const int id = v.idx();
     const double counter = counters_.Value(id, step_);
-    const Mesh::VertexHandle v0 = SplitVertex(mesh_, v);
+    const Mesh::VertexHandle v0 = SplitVertex(mesh_, rings_, v);
     if (!v0.is_valid()) return;
     ++live_vertices_;
     ++progress_.splits;
@@ -225,8 +225,8 @@ class Learner::Impl {
       rings_.Invalidate(u);
       rings_.Ring(mesh_, u);
     }
-    const double f1 = VoronoiAreaEstimate(mesh_, v);
-    const double f0 = VoronoiAreaEstimate(mesh_, v0);
+    const double f1 = VoronoiAreaEstimate(mesh_, rings_, v);
+    const double f0 = VoronoiAreaEstimate(mesh_, rings_, v0);
     const double share0 = (f0 + f1) > 0 ? f0 / (f0 + f1) : 0.5;
     counters_.Set(id, counter * (1 - share0), step_);
     counters_.Add(v0.idx(), counter * share0, step_);

@@ -5,37 +5,23 @@
 #include <utility>
 #include <vector>
 
+#include "absl/container/inlined_vector.h"
+
 namespace neuralmesh {
 namespace {
 
-// The outgoing half-edges of v in rotation order, starting, for a boundary vertex, at its
-// outgoing boundary half-edge (OpenMesh keeps that one as the vertex's half-edge).
-void Star(const Mesh& mesh, Mesh::VertexHandle v, std::vector<Mesh::HalfedgeHandle>& out) {
-  out.clear();
-  const auto h0 = mesh.halfedge_handle(v);
-  auto h = h0;
-  do {
-    out.push_back(h);
-    h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
-  } while (h != h0);
-}
+int IndexOf(int u) { return u; }
+int IndexOf(Mesh::VertexHandle u) { return u.idx(); }
 
-}  // namespace
-
-bool CanSplitVertex(const Mesh& mesh, Mesh::VertexHandle v) {
-  if (!v.is_valid() || mesh.status(v).deleted() || !mesh.halfedge_handle(v).is_valid()) {
-    return false;
-  }
-  if (mesh.is_boundary(v)) return mesh.valence(v) > 4;
-  return true;
-}
-
-double VoronoiAreaEstimate(const Mesh& mesh, Mesh::VertexHandle v) {
+// F_v = l_v^2 (Eq. 5-6) from v's neighbours, a range of vertex handles or indices.
+template <typename NeighbourRange>
+double SquaredMeanEdgeLength(const Mesh& mesh, Mesh::VertexHandle v,
+                             const NeighbourRange& neighbours) {
   double sum = 0;
   int n = 0;
   const Vec3& p = mesh.point(v);
-  for (auto u : mesh.vv_range(v)) {
-    sum += (mesh.point(u) - p).norm();
+  for (const auto u : neighbours) {
+    sum += (mesh.point(Mesh::VertexHandle(IndexOf(u))) - p).norm();
     ++n;
   }
   if (n == 0) return 0;
@@ -43,40 +29,67 @@ double VoronoiAreaEstimate(const Mesh& mesh, Mesh::VertexHandle v) {
   return l * l;
 }
 
-Mesh::VertexHandle LargestCellNear(const Mesh& mesh, Mesh::VertexHandle center) {
-  Mesh::VertexHandle best = center;
-  double best_area = CanSplitVertex(mesh, center) ? VoronoiAreaEstimate(mesh, center) : -1;
-  for (auto u : mesh.vv_range(center)) {
-    if (!CanSplitVertex(mesh, u)) continue;
-    const double area = VoronoiAreaEstimate(mesh, u);
-    if (area > best_area) {
-      best_area = area;
-      best = u;
-    }
-  }
-  return best;
+// A cached ring as a range.
+struct RingRange {
+  const int32_t* first;
+  const int32_t* last;
+  const int32_t* begin() const { return first; }
+  const int32_t* end() const { return last; }
+};
+RingRange Range(const VertexRingCache::RingView& ring) {
+  return {ring.neighbours, ring.neighbours + ring.size};
 }
 
-Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
-  if (!CanSplitVertex(mesh, v)) return Mesh::VertexHandle();
-  std::vector<Mesh::HalfedgeHandle> star;
-  Star(mesh, v, star);
-  const int n = static_cast<int>(star.size());
+// Section 2.2: no split of a boundary vertex of valence 4 or less.
+bool SplittableStar(bool boundary, int valence) { return !boundary || valence > 4; }
+
+// Whether `v` is a live vertex with at least one edge.
+bool HasEdges(const Mesh& mesh, Mesh::VertexHandle v) {
+  return v.is_valid() && !mesh.status(v).deleted() && mesh.halfedge_handle(v).is_valid();
+}
+
+// The neighbours of v in rotation order, starting, for a boundary vertex, at the end of its
+// outgoing boundary half-edge (OpenMesh keeps that one as the vertex's half-edge): the order of
+// VertexRingCache's rings.
+using Neighbours = absl::InlinedVector<int32_t, 16>;
+Neighbours WalkNeighbours(const Mesh& mesh, Mesh::VertexHandle v) {
+  Neighbours out;
+  const auto h0 = mesh.halfedge_handle(v);
+  auto h = h0;
+  do {
+    out.push_back(mesh.to_vertex_handle(h).idx());
+    h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
+  } while (h != h0);
+  return out;
+}
+
+// The valence of a vertex and whether it is on the boundary.
+struct StarShape {
+  int valence;
+  bool boundary;
+};
+
+// SplitVertex of a splittable `v` with neighbours `u` (WalkNeighbours' order), on the
+// boundary or not; shape_of(w) gives the StarShape of a neighbour w.
+template <typename ShapeOf>
+Mesh::VertexHandle SplitStar(Mesh& mesh, Mesh::VertexHandle v, const Neighbours& u,
+                             bool boundary, const ShapeOf& shape_of) {
+  const int n = static_cast<int>(u.size());
   const Vec3& p = mesh.point(v);
 
   int longest = 0;
   double longest_len2 = -1;
   for (int i = 0; i < n; ++i) {
-    const double l2 = (mesh.point(mesh.to_vertex_handle(star[i])) - p).sqrnorm();
+    const double l2 = (mesh.point(Mesh::VertexHandle(u[i])) - p).sqrnorm();
     if (l2 > longest_len2) {
       longest_len2 = l2;
       longest = i;
     }
   }
-  const Vec3 midpoint = (p + mesh.point(mesh.to_vertex_handle(star[longest]))) * 0.5;
-  auto neighbour = [&](int i) { return mesh.to_vertex_handle(star[((i % n) + n) % n]); };
+  const Vec3 midpoint = (p + mesh.point(Mesh::VertexHandle(u[longest]))) * 0.5;
+  auto neighbour = [&](int i) { return Mesh::VertexHandle(u[((i % n) + n) % n]); };
 
-  if (!mesh.is_boundary(v)) {
+  if (!boundary) {
     // The new vertex takes the arc u[e-k2] .. u[e+k1] around e; k1 and k2 differ by at most
     // one ("traverse both directions from e equally"), and k1 + k2 - 1 neighbours lie strictly
     // inside the arc, (n-2)/2 of them so that the star is halved: valences become
@@ -89,8 +102,8 @@ Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
     // resolution, too sparse for Step 5 to see two facing borders as close. Above 5 it counts
     // again (from 5, not 4): free edges let border vertices that are never split themselves
     // grow into hubs of valence 20 and more.
-    auto deviation = [&](Mesh::VertexHandle w, int valence) {
-      const double d = mesh.is_boundary(w) ? std::max(0, valence - 5) : valence - 6;
+    auto deviation = [](bool on_boundary, int valence) {
+      const double d = on_boundary ? std::max(0, valence - 5) : valence - 6;
       return d * d;
     };
     int k1 = 1, k2 = 1;
@@ -101,9 +114,10 @@ Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
         const int b = total - a;
         if (a < 1 || b < 1) continue;
         const auto wl = neighbour(longest + a), wr = neighbour(longest - b);
-        const double cost = deviation(v, n - inner + 1) + deviation(v, inner + 3) +
-                            deviation(wl, static_cast<int>(mesh.valence(wl)) + 1) +
-                            deviation(wr, static_cast<int>(mesh.valence(wr)) + 1);
+        const StarShape l = shape_of(wl), r = shape_of(wr);
+        const double cost = deviation(false, n - inner + 1) + deviation(false, inner + 3) +
+                            deviation(l.boundary, l.valence + 1) +
+                            deviation(r.boundary, r.valence + 1);
         if (cost < best) {
           best = cost;
           k1 = a;
@@ -129,6 +143,72 @@ Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
     mesh.vertex_split(v0, v, Mesh::VertexHandle(), cut);  // v0 takes u[j..n-1].
   }
   return v0;
+}
+
+}  // namespace
+
+bool CanSplitVertex(const Mesh& mesh, Mesh::VertexHandle v) {
+  return HasEdges(mesh, v) &&
+         SplittableStar(mesh.is_boundary(v), static_cast<int>(mesh.valence(v)));
+}
+
+bool CanSplitVertex(const Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle v) {
+  if (!HasEdges(mesh, v)) return false;
+  const VertexRingCache::RingView ring = rings.Ring(mesh, v.idx());
+  return SplittableStar(ring.boundary, ring.size);
+}
+
+double VoronoiAreaEstimate(const Mesh& mesh, Mesh::VertexHandle v) {
+  return SquaredMeanEdgeLength(mesh, v, mesh.vv_range(v));
+}
+
+double VoronoiAreaEstimate(const Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle v) {
+  if (!HasEdges(mesh, v)) return 0;
+  return SquaredMeanEdgeLength(mesh, v, Range(rings.Ring(mesh, v.idx())));
+}
+
+Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
+                                   Mesh::VertexHandle center) {
+  Mesh::VertexHandle best = center;
+  double best_area = -1;
+  if (!HasEdges(mesh, center)) return best;
+  // A copy: reading the neighbours' rings may move where a ring is kept (VertexRingCache).
+  const VertexRingCache::RingView center_ring = rings.Ring(mesh, center.idx());
+  const absl::InlinedVector<int32_t, 16> neighbours(Range(center_ring).begin(),
+                                                    Range(center_ring).end());
+  if (SplittableStar(center_ring.boundary, center_ring.size)) {
+    best_area = SquaredMeanEdgeLength(mesh, center, neighbours);
+  }
+  for (const int32_t u : neighbours) {
+    // A neighbour is live and has an edge, to `center`.
+    const VertexRingCache::RingView ring = rings.Ring(mesh, u);
+    if (!SplittableStar(ring.boundary, ring.size)) continue;
+    const double area = SquaredMeanEdgeLength(mesh, Mesh::VertexHandle(u), Range(ring));
+    if (area > best_area) {
+      best_area = area;
+      best = Mesh::VertexHandle(u);
+    }
+  }
+  return best;
+}
+
+Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
+  if (!CanSplitVertex(mesh, v)) return Mesh::VertexHandle();
+  return SplitStar(mesh, v, WalkNeighbours(mesh, v), mesh.is_boundary(v),
+                   [&mesh](Mesh::VertexHandle w) {
+                     return StarShape{static_cast<int>(mesh.valence(w)), mesh.is_boundary(w)};
+                   });
+}
+
+Mesh::VertexHandle SplitVertex(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle v) {
+  if (!CanSplitVertex(mesh, rings, v)) return Mesh::VertexHandle();
+  // A copy: reading the neighbours' rings may move where a ring is kept (VertexRingCache).
+  const VertexRingCache::RingView ring = rings.Ring(mesh, v.idx());
+  const Neighbours neighbours(Range(ring).begin(), Range(ring).end());
+  return SplitStar(mesh, v, neighbours, ring.boundary, [&mesh, &rings](Mesh::VertexHandle w) {
+    const VertexRingCache::RingView star = rings.Ring(mesh, w.idx());
+    return StarShape{star.size, star.boundary};
+  });
 }
 
 }  // namespace neuralmesh

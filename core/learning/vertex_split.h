@@ -9,6 +9,7 @@
 #ifndef NEURALMESH_CORE_LEARNING_VERTEX_SPLIT_H_
 #define NEURALMESH_CORE_LEARNING_VERTEX_SPLIT_H_
 
+#include "core/learning/vertex_ring_cache.h"
 #include "core/mesh.h"
 
 namespace neuralmesh {
@@ -16,19 +17,27 @@ namespace neuralmesh {
 // Whether the paper allows splitting `v`: not a boundary vertex of valence <= 4 (Section 2.2),
 // and not an isolated or deleted vertex.
 bool CanSplitVertex(const Mesh& mesh, Mesh::VertexHandle v);
+// The same, reading v's ring from `rings` (which must agree with the mesh's connectivity)
+// instead of walking its half-edges. So do the overloads with `rings` below, with bitwise the
+// same results: a ring lists the neighbours in the order OpenMesh's vv_range visits them.
+// Step 2 runs them on a neighbourhood that the Basic Steps before it have just read.
+bool CanSplitVertex(const Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle v);
 
 // Splits `v` and returns the new vertex, or an invalid handle when !CanSplitVertex. Keeps the
 // mesh a valid manifold. O(valence).
 Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v);
+Mesh::VertexHandle SplitVertex(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle v);
 
 // F_v = l_v^2 with l_v the mean length of the edges at v (Eq. 5-6): the stand-in for the area of
 // v's restricted Voronoi cell by which a split divides the signal counter.
 double VoronoiAreaEstimate(const Mesh& mesh, Mesh::VertexHandle v);
+double VoronoiAreaEstimate(const Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle v);
 
 // Of `center` and its neighbours, the vertex that CanSplitVertex allows with the largest
 // VoronoiAreaEstimate (ties: `center` first, then rotation order), or `center` when none is
-// splittable. O(valence^2).
-Mesh::VertexHandle LargestCellNear(const Mesh& mesh, Mesh::VertexHandle center);
+// splittable. O(valence^2). Reads rings from `rings` (see CanSplitVertex).
+Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
+                                   Mesh::VertexHandle center);
 
 }  // namespace neuralmesh
 

@@ -1,8 +1,11 @@
 #include "core/learning/vertex_split.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <vector>
 
+#include "core/learning/vertex_ring_cache.h"
 #include "core/mesh_validation.h"
 #include "gtest/gtest.h"
 #include "tests/testing/shapes.h"
@@ -92,6 +95,66 @@ TEST(VertexSplitTest, VoronoiAreaEstimateIsSquaredMeanEdgeLength) {
   // Interior vertex: 4 edges of length 1/4 and 2 diagonals of length sqrt(2)/4.
   const double l = (4 * 0.25 + 2 * std::sqrt(2.0) * 0.25) / 6;
   EXPECT_NEAR(VoronoiAreaEstimate(mesh, Mesh::VertexHandle(12)), l * l, 1e-12) << "Eq. 5-6";
+}
+
+// A grid patch made irregular by splits (valences 3 to 9, inside and on the border).
+Mesh IrregularPatch() {
+  Mesh mesh = testing::MustToMesh(testing::GridPatch(6, 6));
+  for (const int v : {14, 15, 22, 3, 29, 14, 8, 36, 2}) SplitVertex(mesh, Mesh::VertexHandle(v));
+  return mesh;
+}
+
+// Every face's corners (vertex indices) and every position, in handle order.
+std::vector<double> Contents(const Mesh& mesh) {
+  std::vector<double> out;
+  for (auto v : mesh.vertices()) out.insert(out.end(), mesh.point(v).data(), mesh.point(v).data() + 3);
+  for (auto f : mesh.faces()) {
+    for (auto v : mesh.fv_range(f)) out.push_back(v.idx());
+  }
+  return out;
+}
+
+TEST(VertexSplitTest, RingCacheOverloadsGiveWhatHalfEdgeWalksGive) {
+  Mesh mesh = IrregularPatch();
+  ASSERT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+  mesh.add_vertex(Vec3(2, 2, 0));  // Isolated: never split, no area.
+  VertexRingCache rings;
+  std::array<int, 16> valences{};
+  for (auto v : mesh.vertices()) {
+    valences[std::min<size_t>(mesh.valence(v), 15)]++;
+    EXPECT_EQ(CanSplitVertex(mesh, rings, v), CanSplitVertex(mesh, v)) << v.idx();
+    // Bitwise: the rings list the neighbours in the order vv_range visits them.
+    EXPECT_EQ(VoronoiAreaEstimate(mesh, rings, v), VoronoiAreaEstimate(mesh, v)) << v.idx();
+    // LargestCellNear by its definition, from the half-edge walks.
+    Mesh::VertexHandle expected = v;
+    double best = CanSplitVertex(mesh, v) ? VoronoiAreaEstimate(mesh, v) : -1;
+    for (auto u : mesh.vv_range(v)) {
+      if (CanSplitVertex(mesh, u) && VoronoiAreaEstimate(mesh, u) > best) {
+        best = VoronoiAreaEstimate(mesh, u);
+        expected = u;
+      }
+    }
+    EXPECT_EQ(LargestCellNear(mesh, rings, v), expected) << v.idx();
+  }
+  EXPECT_GT(valences[3] + valences[4], 0);
+  EXPECT_GT(valences[7] + valences[8] + valences[9], 0) << "the splits made the patch irregular";
+
+  // The split itself: the same mesh whichever way it reads the stars.
+  int splits = 0, splittable = 0;
+  for (auto v : mesh.vertices()) {
+    splittable += CanSplitVertex(mesh, v) ? 1 : 0;
+    Mesh walked = mesh;
+    Mesh cached = mesh;
+    VertexRingCache cached_rings;
+    const Mesh::VertexHandle a = SplitVertex(walked, v);
+    const Mesh::VertexHandle b = SplitVertex(cached, cached_rings, v);
+    ASSERT_EQ(a, b) << v.idx();
+    EXPECT_EQ(Contents(walked), Contents(cached)) << v.idx();
+    splits += a.is_valid() ? 1 : 0;
+  }
+  EXPECT_EQ(splits, splittable);
+  EXPECT_GT(splits, 30);
+  EXPECT_LT(splits, static_cast<int>(mesh.n_vertices())) << "some border vertices are not split";
 }
 
 }  // namespace

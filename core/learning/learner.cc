@@ -204,9 +204,10 @@ class Learner::Impl {
     const int most_active = counters_.MostActive(
         [this](int v) { return CanSplitVertex(mesh_, rings_, Mesh::VertexHandle(v)); });
     if (most_active < 0) return;
+    const Mesh::VertexHandle most_active_vertex(most_active);
     const Mesh::VertexHandle v = options_.split_largest_cell_near_most_active
-                                     ? LargestCellNear(mesh_, rings_, Mesh::VertexHandle(most_active))
-                                     : Mesh::VertexHandle(most_active);
+                                     ? LargestCellNear(mesh_, rings_, most_active_vertex)
+                                     : most_active_vertex;
     const int id = v.idx();
     const double counter = counters_.Value(id, step_);
     const Mesh::VertexHandle v0 = SplitVertex(mesh_, rings_, v);

@@ -174,8 +174,7 @@ Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
   if (!HasEdges(mesh, center)) return best;
   // A copy: reading the neighbours' rings may move where a ring is kept (VertexRingCache).
   const VertexRingCache::RingView center_ring = rings.Ring(mesh, center.idx());
-  const absl::InlinedVector<int32_t, 16> neighbours(Range(center_ring).begin(),
-                                                    Range(center_ring).end());
+  const Neighbours neighbours(Range(center_ring).begin(), Range(center_ring).end());
   if (SplittableStar(center_ring.boundary, center_ring.size)) {
     best_area = SquaredMeanEdgeLength(mesh, center, neighbours);
   }

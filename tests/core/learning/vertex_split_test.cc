@@ -97,7 +97,7 @@ TEST(VertexSplitTest, VoronoiAreaEstimateIsSquaredMeanEdgeLength) {
   EXPECT_NEAR(VoronoiAreaEstimate(mesh, Mesh::VertexHandle(12)), l * l, 1e-12) << "Eq. 5-6";
 }
 
-// A grid patch made irregular by splits (valences 3 to 9, inside and on the border).
+// A grid patch made irregular by splits, inside and on the border.
 Mesh IrregularPatch() {
   Mesh mesh = testing::MustToMesh(testing::GridPatch(6, 6));
   for (const int v : {14, 15, 22, 3, 29, 14, 8, 36, 2}) SplitVertex(mesh, Mesh::VertexHandle(v));
@@ -107,7 +107,9 @@ Mesh IrregularPatch() {
 // Every face's corners (vertex indices) and every position, in handle order.
 std::vector<double> Contents(const Mesh& mesh) {
   std::vector<double> out;
-  for (auto v : mesh.vertices()) out.insert(out.end(), mesh.point(v).data(), mesh.point(v).data() + 3);
+  for (auto v : mesh.vertices()) {
+    out.insert(out.end(), mesh.point(v).data(), mesh.point(v).data() + 3);
+  }
   for (auto f : mesh.faces()) {
     for (auto v : mesh.fv_range(f)) out.push_back(v.idx());
   }

@@ -13,12 +13,7 @@ VertexRingCache::RingView VertexRingCache::Walk(const Mesh& mesh, int v) {
   const Mesh::VertexHandle vh(v);
   const bool boundary = mesh.is_boundary(vh);
   long_ring_.clear();
-  const Mesh::HalfedgeHandle start = mesh.halfedge_handle(vh);
-  Mesh::HalfedgeHandle h = start;
-  do {
-    long_ring_.push_back(mesh.to_vertex_handle(h).idx());
-    h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
-  } while (h != start);
+  WalkNeighbours(mesh, vh, long_ring_);
   const int valence = static_cast<int>(long_ring_.size());
   if (valence > kLongestCachedRing) return {long_ring_.data(), valence, boundary};
   line.valence = static_cast<uint8_t>(valence);

@@ -19,6 +19,19 @@
 
 namespace neuralmesh {
 
+// Appends the neighbours of `v` (a live vertex with at least one edge) to `out` in rotation
+// order, walking its half-edges: the order of VertexRingCache's rings (for a boundary vertex,
+// from the end of its outgoing boundary half-edge, which OpenMesh keeps as the vertex's own).
+template <typename Out>
+void WalkNeighbours(const Mesh& mesh, Mesh::VertexHandle v, Out& out) {
+  const Mesh::HalfedgeHandle start = mesh.halfedge_handle(v);
+  Mesh::HalfedgeHandle h = start;
+  do {
+    out.push_back(mesh.to_vertex_handle(h).idx());
+    h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
+  } while (h != start);
+}
+
 class VertexRingCache {
  public:
   // Appends the neighbours of `v` (a live vertex with at least one edge) to `out` in

@@ -2,42 +2,36 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
-#include <vector>
 
 #include "absl/container/inlined_vector.h"
+#include "absl/types/span.h"
 
 namespace neuralmesh {
 namespace {
 
-int IndexOf(int u) { return u; }
-int IndexOf(Mesh::VertexHandle u) { return u.idx(); }
+// Neighbours in rotation order (WalkNeighbours, VertexRingCache): a copy that stays valid
+// while other rings are read (which may move where a cached ring is kept).
+using Neighbours = absl::InlinedVector<int32_t, 16>;
 
-// F_v = l_v^2 (Eq. 5-6) from v's neighbours, a range of vertex handles or indices.
-template <typename NeighbourRange>
-double SquaredMeanEdgeLength(const Mesh& mesh, Mesh::VertexHandle v,
-                             const NeighbourRange& neighbours) {
-  double sum = 0;
-  int n = 0;
-  const Vec3& p = mesh.point(v);
-  for (const auto u : neighbours) {
-    sum += (mesh.point(Mesh::VertexHandle(IndexOf(u))) - p).norm();
-    ++n;
-  }
-  if (n == 0) return 0;
-  const double l = sum / n;
-  return l * l;
+Neighbours WalkedNeighbours(const Mesh& mesh, Mesh::VertexHandle v) {
+  Neighbours out;
+  WalkNeighbours(mesh, v, out);
+  return out;
 }
 
-// A cached ring as a range.
-struct RingRange {
-  const int32_t* first;
-  const int32_t* last;
-  const int32_t* begin() const { return first; }
-  const int32_t* end() const { return last; }
-};
-RingRange Range(const VertexRingCache::RingView& ring) {
-  return {ring.neighbours, ring.neighbours + ring.size};
+absl::Span<const int32_t> Span(const VertexRingCache::RingView& ring) {
+  return absl::MakeConstSpan(ring.neighbours, static_cast<size_t>(ring.size));
+}
+
+// F_v = l_v^2 (Eq. 5-6) from v's neighbours.
+double SquaredMeanEdgeLength(const Mesh& mesh, Mesh::VertexHandle v,
+                             absl::Span<const int32_t> neighbours) {
+  if (neighbours.empty()) return 0;
+  double sum = 0;
+  const Vec3& p = mesh.point(v);
+  for (const int32_t u : neighbours) sum += (mesh.point(Mesh::VertexHandle(u)) - p).norm();
+  const double l = sum / static_cast<double>(neighbours.size());
+  return l * l;
 }
 
 // Section 2.2: no split of a boundary vertex of valence 4 or less.
@@ -48,28 +42,13 @@ bool HasEdges(const Mesh& mesh, Mesh::VertexHandle v) {
   return v.is_valid() && !mesh.status(v).deleted() && mesh.halfedge_handle(v).is_valid();
 }
 
-// The neighbours of v in rotation order, starting, for a boundary vertex, at the end of its
-// outgoing boundary half-edge (OpenMesh keeps that one as the vertex's half-edge): the order of
-// VertexRingCache's rings.
-using Neighbours = absl::InlinedVector<int32_t, 16>;
-Neighbours WalkNeighbours(const Mesh& mesh, Mesh::VertexHandle v) {
-  Neighbours out;
-  const auto h0 = mesh.halfedge_handle(v);
-  auto h = h0;
-  do {
-    out.push_back(mesh.to_vertex_handle(h).idx());
-    h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
-  } while (h != h0);
-  return out;
-}
-
 // The valence of a vertex and whether it is on the boundary.
 struct StarShape {
   int valence;
   bool boundary;
 };
 
-// SplitVertex of a splittable `v` with neighbours `u` (WalkNeighbours' order), on the
+// SplitVertex of a splittable `v` with neighbours `u` (in rotation order), on the
 // boundary or not; shape_of(w) gives the StarShape of a neighbour w.
 template <typename ShapeOf>
 Mesh::VertexHandle SplitStar(Mesh& mesh, Mesh::VertexHandle v, const Neighbours& u,
@@ -159,12 +138,13 @@ bool CanSplitVertex(const Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle
 }
 
 double VoronoiAreaEstimate(const Mesh& mesh, Mesh::VertexHandle v) {
-  return SquaredMeanEdgeLength(mesh, v, mesh.vv_range(v));
+  if (!HasEdges(mesh, v)) return 0;
+  return SquaredMeanEdgeLength(mesh, v, WalkedNeighbours(mesh, v));
 }
 
 double VoronoiAreaEstimate(const Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle v) {
   if (!HasEdges(mesh, v)) return 0;
-  return SquaredMeanEdgeLength(mesh, v, Range(rings.Ring(mesh, v.idx())));
+  return SquaredMeanEdgeLength(mesh, v, Span(rings.Ring(mesh, v.idx())));
 }
 
 Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
@@ -172,9 +152,8 @@ Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
   Mesh::VertexHandle best = center;
   double best_area = -1;
   if (!HasEdges(mesh, center)) return best;
-  // A copy: reading the neighbours' rings may move where a ring is kept (VertexRingCache).
   const VertexRingCache::RingView center_ring = rings.Ring(mesh, center.idx());
-  const Neighbours neighbours(Range(center_ring).begin(), Range(center_ring).end());
+  const Neighbours neighbours(center_ring.neighbours, center_ring.neighbours + center_ring.size);
   if (SplittableStar(center_ring.boundary, center_ring.size)) {
     best_area = SquaredMeanEdgeLength(mesh, center, neighbours);
   }
@@ -182,7 +161,7 @@ Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
     // A neighbour is live and has an edge, to `center`.
     const VertexRingCache::RingView ring = rings.Ring(mesh, u);
     if (!SplittableStar(ring.boundary, ring.size)) continue;
-    const double area = SquaredMeanEdgeLength(mesh, Mesh::VertexHandle(u), Range(ring));
+    const double area = SquaredMeanEdgeLength(mesh, Mesh::VertexHandle(u), Span(ring));
     if (area > best_area) {
       best_area = area;
       best = Mesh::VertexHandle(u);
@@ -193,17 +172,17 @@ Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
 
 Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
   if (!CanSplitVertex(mesh, v)) return Mesh::VertexHandle();
-  return SplitStar(mesh, v, WalkNeighbours(mesh, v), mesh.is_boundary(v),
+  return SplitStar(mesh, v, WalkedNeighbours(mesh, v), mesh.is_boundary(v),
                    [&mesh](Mesh::VertexHandle w) {
                      return StarShape{static_cast<int>(mesh.valence(w)), mesh.is_boundary(w)};
                    });
 }
 
 Mesh::VertexHandle SplitVertex(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle v) {
-  if (!CanSplitVertex(mesh, rings, v)) return Mesh::VertexHandle();
-  // A copy: reading the neighbours' rings may move where a ring is kept (VertexRingCache).
+  if (!HasEdges(mesh, v)) return Mesh::VertexHandle();
   const VertexRingCache::RingView ring = rings.Ring(mesh, v.idx());
-  const Neighbours neighbours(Range(ring).begin(), Range(ring).end());
+  if (!SplittableStar(ring.boundary, ring.size)) return Mesh::VertexHandle();
+  const Neighbours neighbours(ring.neighbours, ring.neighbours + ring.size);
   return SplitStar(mesh, v, neighbours, ring.boundary, [&mesh, &rings](Mesh::VertexHandle w) {
     const VertexRingCache::RingView star = rings.Ring(mesh, w.idx());
     return StarShape{star.size, star.boundary};

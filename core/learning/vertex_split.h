@@ -19,8 +19,9 @@ namespace neuralmesh {
 bool CanSplitVertex(const Mesh& mesh, Mesh::VertexHandle v);
 // The same, reading v's ring from `rings` (which must agree with the mesh's connectivity)
 // instead of walking its half-edges. So do the overloads with `rings` below, with bitwise the
-// same results: a ring lists the neighbours in the order OpenMesh's vv_range visits them.
-// Step 2 runs them on a neighbourhood that the Basic Steps before it have just read.
+// same results: both read the neighbours in WalkNeighbours' order (vertex_ring_cache.h), which
+// is the order OpenMesh's vv_range visits them. Step 2 runs them on a neighbourhood that the
+// Basic Steps before it have just read.
 bool CanSplitVertex(const Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle v);
 
 // Splits `v` and returns the new vertex, or an invalid handle when !CanSplitVertex. Keeps the

@@ -294,8 +294,7 @@ std::optional<Window> TimeRun(Learner& learner, const StopCriteria& stop, bool c
   }
   if (!ok) return std::nullopt;
   Window window;
-  window.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  window.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   window.steps = learner.progress().basic_steps - steps_before;
   window.periodic_seconds = Seconds(PeriodicStepsTime(learner) - periodic_before);
   return window;
@@ -329,7 +328,7 @@ struct WindowPairs {
   std::vector<Window> first;  // The fresh windows.
   std::vector<Window> last;   // The turns of `large`, pair by pair.
   double first_periodic_us = 0;
-  std::vector<double> ratios;  // Sorted.
+  std::vector<double> ratios;  // Sorted: the median and quartiles are read off by index.
 };
 std::optional<WindowPairs> TimeWindowPairs(const Sampler& sampler, uint64_t seed,
                                            int64_t lookahead_from, size_t first_target, int pairs,
@@ -481,7 +480,7 @@ int Run() {
             "cost per Basic Step (%.3f us at %zu vertices, %.3f at %zu): median %.2f, quartiles "
             "%.2f and %.2f\n",
             n, repeats, first_target, kPairTurnSteps, vertices_before, learner->num_vertices(),
-            pairs->first_periodic_us, first_target, last_periodic_us, last_target, Median(r),
+            pairs->first_periodic_us, first_target, last_periodic_us, last_target, r[r.size() / 2],
             r[r.size() / 4], r[(3 * r.size()) / 4]);
       }
     }

@@ -51,8 +51,8 @@ struct StarShape {
 // SplitVertex of a splittable `v` with neighbours `u` (in rotation order), on the
 // boundary or not; shape_of(w) gives the StarShape of a neighbour w.
 template <typename ShapeOf>
-Mesh::VertexHandle SplitStar(Mesh& mesh, Mesh::VertexHandle v, const Neighbours& u,
-                             bool boundary, const ShapeOf& shape_of) {
+Mesh::VertexHandle SplitStar(Mesh& mesh, Mesh::VertexHandle v, const Neighbours& u, bool boundary,
+                             const ShapeOf& shape_of) {
   const int n = static_cast<int>(u.size());
   const Vec3& p = mesh.point(v);
 
@@ -171,11 +171,13 @@ Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
 }
 
 Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
-  if (!CanSplitVertex(mesh, v)) return Mesh::VertexHandle();
-  return SplitStar(mesh, v, WalkedNeighbours(mesh, v), mesh.is_boundary(v),
-                   [&mesh](Mesh::VertexHandle w) {
-                     return StarShape{static_cast<int>(mesh.valence(w)), mesh.is_boundary(w)};
-                   });
+  if (!HasEdges(mesh, v)) return Mesh::VertexHandle();
+  const Neighbours neighbours = WalkedNeighbours(mesh, v);
+  const bool boundary = mesh.is_boundary(v);
+  if (!SplittableStar(boundary, static_cast<int>(neighbours.size()))) return Mesh::VertexHandle();
+  return SplitStar(mesh, v, neighbours, boundary, [&mesh](Mesh::VertexHandle w) {
+    return StarShape{static_cast<int>(mesh.valence(w)), mesh.is_boundary(w)};
+  });
 }
 
 Mesh::VertexHandle SplitVertex(Mesh& mesh, VertexRingCache& rings, Mesh::VertexHandle v) {

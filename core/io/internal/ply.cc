@@ -372,7 +372,9 @@ absl::StatusOr<ParsedGeometry> ReadBody(const PlyHeader& header, Body& body, Fac
       NM_RETURN_IF_ERROR(ReadVertices(body, element, &out));
       have_vertices = true;
     } else if (element.name == "face" && faces == FaceHandling::kRead) {
-      faces_before_vertices = !have_vertices;
+      // Indices read before the vertex count was known are checked at the end, whatever
+      // face elements follow.
+      faces_before_vertices |= !have_vertices;
       NM_RETURN_IF_ERROR(ReadFaces(body, element, out.positions.size(), &out));
     } else {
       NM_RETURN_IF_ERROR(SkipElement(body, element));

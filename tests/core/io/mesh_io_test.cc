@@ -313,6 +313,12 @@ TEST(PlyReadTest, MalformedFilesAreRejectedWithAReason) {
       {"coordinate beyond float", std::string(kAsciiHeader) + "0 0 1e39\n1 0 0\n0 1 0\n3 0 1 2\n",
        "vertex 0 has a non-finite coordinate"},
       {"binary face index out of range", binary_bad_index, "uses vertex index 9"},
+      {"face index out of range in a face element before the vertices, another after",
+       "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\n"
+       "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+       "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+       "3 0 1 1000\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+       "triangle 0 uses vertex 1000; the file has 3 vertices"},
       {"binary NaN", binary_nan, "non-finite"},
       {"no vertex element",
        "ply\nformat ascii 1.0\nelement face 0\n"

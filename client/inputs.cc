@@ -114,6 +114,10 @@ absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t 
                                                uint64_t seed) {
   if (IsBuiltin(input)) {
     if (builtin_points == 0) return absl::InvalidArgumentError("--points must be > 0");
+    if (builtin_points > kMaxBuiltinUploadPoints) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "--points must be at most ", kMaxBuiltinUploadPoints, ", not ", builtin_points));
+    }
     NM_ASSIGN_OR_RETURN(const std::unique_ptr<ImplicitSurface> surface, MakeBuiltinSurface(input));
     return SamplePoints(*surface, builtin_points, seed);
   }

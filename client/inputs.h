@@ -41,8 +41,13 @@ struct TargetSpace {
 // sampling mode the input cannot provide; each message names the file.
 absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMode mode);
 
+// The most points LoadPointsForUpload samples from a builtin surface: the server's default
+// limit of points per session (neuralmesh-server --max_points_per_session), 1.6 GB here.
+inline constexpr size_t kMaxBuiltinUploadPoints = size_t{1} << 26;
+
 // The points of `input` for upload: a point cloud file as read, or `builtin_points` samples
-// of a builtin:NAME surface drawn with `seed`. Errors as LoadTargetSpace.
+// of a builtin:NAME surface drawn with `seed` (1 to kMaxBuiltinUploadPoints). Errors as
+// LoadTargetSpace.
 absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t builtin_points,
                                                uint64_t seed);
 

@@ -58,6 +58,10 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
                                  std::ostream& err) {
   NM_RETURN_IF_ERROR(options.learner.Validate());
   NM_RETURN_IF_ERROR(options.draco.Validate());
+  if (options.time_budget <= absl::ZeroDuration()) {
+    return absl::InvalidArgumentError(absl::StrCat("--time_budget must be positive, not ",
+                                                   absl::FormatDuration(options.time_budget)));
+  }
   NM_RETURN_IF_ERROR(CheckOutputPath(options.output));
   NM_ASSIGN_OR_RETURN(const std::vector<size_t> targets,
                       LodTargets(options.lods, options.vertices));

@@ -186,6 +186,10 @@ double MaxVertexDistance(const std::vector<Vec3>& vertices, const Surface& other
 
 absl::Status GeometricErrorOptions::Validate() const {
   if (samples == 0) return absl::InvalidArgumentError("samples must be positive");
+  if (samples > kMaxSamples) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("samples must be at most ", kMaxSamples, " per surface, not ", samples));
+  }
   if (threads < 0) return absl::InvalidArgumentError("threads must be >= 0");
   return absl::OkStatus();
 }

@@ -33,12 +33,17 @@
 namespace neuralmesh {
 
 struct GeometricErrorOptions {
+  // More samples than this are refused rather than allocated: the estimates converge long
+  // before (the default is 200,000), and each sample costs memory for its point, its normal and
+  // its closest point.
+  static constexpr size_t kMaxSamples = 20000000;
+
   size_t samples = 200000;  // Area-uniform samples per surface (besides its vertices).
   uint64_t seed = 1;        // Seeds the sampling; equal seeds give equal results.
   int threads = 0;          // Query threads; 0: one per hardware thread. Results do not
                             // depend on it.
 
-  // INVALID_ARGUMENT when samples == 0 or threads < 0.
+  // INVALID_ARGUMENT when samples is 0 or above kMaxSamples, or threads < 0.
   absl::Status Validate() const;
 };
 

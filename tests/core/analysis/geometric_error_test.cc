@@ -127,6 +127,10 @@ TEST(GeometricErrorTest, RejectsInvalidInput) {
   EXPECT_EQ(code(ComputeGeometricError(good, good, FewSamples(0))),
             absl::StatusCode::kInvalidArgument)
       << "zero samples must be rejected";
+  EXPECT_EQ(
+      code(ComputeGeometricError(good, good, FewSamples(GeometricErrorOptions::kMaxSamples + 1))),
+      absl::StatusCode::kInvalidArgument)
+      << "more samples than the bound must be refused, not allocated";
 }
 
 TEST(GeometricErrorTest, DistancesToMeshAreExact) {

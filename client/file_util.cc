@@ -1,9 +1,6 @@
 #include "client/file_util.h"
 
-#include <cerrno>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <system_error>
 
 #include "absl/strings/str_cat.h"
@@ -21,17 +18,6 @@ absl::Status CheckInputFile(const std::string& path, absl::string_view role) {
   }
   if (std::filesystem::is_regular_file(status) && std::filesystem::file_size(path, error) == 0) {
     return absl::InvalidArgumentError(absl::StrCat(role, " file '", path, "' is empty"));
-  }
-  return absl::OkStatus();
-}
-
-absl::Status WriteFileBytes(const std::string& path, absl::string_view bytes) {
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (file) file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  if (file) file.close();
-  if (!file) {
-    return absl::PermissionDeniedError(
-        absl::StrCat("cannot write '", path, "': ", std::strerror(errno)));
   }
   return absl::OkStatus();
 }

@@ -1,4 +1,5 @@
-// File checks and writes shared by the subcommands, with messages that name the file.
+// File checks shared by the subcommands, with messages that name the file (writes:
+// core/io/file_contents.h).
 #ifndef NEURALMESH_CLIENT_FILE_UTIL_H_
 #define NEURALMESH_CLIENT_FILE_UTIL_H_
 
@@ -13,10 +14,6 @@ namespace neuralmesh::client {
 // ("INPUT", "--reference"). NOT_FOUND when it does not exist; INVALID_ARGUMENT when it is a
 // directory or empty.
 absl::Status CheckInputFile(const std::string& path, absl::string_view role);
-
-// Writes `bytes` to `path`, replacing it. PERMISSION_DENIED (or the errno's code) naming the
-// file when it cannot be written.
-absl::Status WriteFileBytes(const std::string& path, absl::string_view bytes);
 
 }  // namespace neuralmesh::client
 

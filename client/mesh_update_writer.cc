@@ -5,8 +5,8 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "client/file_util.h"
 #include "core/io/draco_codec.h"
+#include "core/io/file_contents.h"
 #include "core/io/mesh_io.h"
 #include "core/status_macros.h"
 
@@ -58,7 +58,7 @@ absl::Status MeshUpdateWriter::Write(const v1::MeshUpdate& update) {
         is_final ? options_.stem : absl::StrCat(options_.stem, "_lod", update.vertex_count());
     const std::filesystem::path base = std::filesystem::path(options_.out_dir) / name;
     figures.path = base.string() + ".drc";
-    NM_RETURN_IF_ERROR(WriteFileBytes(figures.path, update.draco_mesh()));
+    NM_RETURN_IF_ERROR(WriteFileContents(figures.path, update.draco_mesh()));
     if (options_.ply) {
       absl::StatusOr<TriangleMesh> mesh = DecodeMesh(update.draco_mesh());
       if (!mesh.ok()) {

@@ -5,6 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "core/io/file_contents.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/geometry_data.h"
 #include "core/io/internal/obj.h"
@@ -95,7 +96,7 @@ bool IsSupportedMeshExtension(std::string_view path) {
 
 absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path) {
   NM_ASSIGN_OR_RETURN(const FileFormat format, MeshFormat(path));
-  NM_ASSIGN_OR_RETURN(const std::string data, io_internal::ReadFileContents(path));
+  NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
   absl::StatusOr<TriangleMesh> mesh = ParseMesh(format, data);
   if (!mesh.ok()) return io_internal::WithPath(mesh.status(), path);
   if (mesh->positions.empty()) {
@@ -141,7 +142,7 @@ absl::Status WriteMesh(const TriangleMesh& mesh, const std::string& path,
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
   }
-  return io_internal::WriteFileContents(path, data);
+  return WriteFileContents(path, data);
 }
 
 }  // namespace neuralmesh

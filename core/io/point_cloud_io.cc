@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "core/io/file_contents.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/geometry_data.h"
 #include "core/io/internal/obj.h"
@@ -78,7 +79,7 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path) {
   if (!IsReadable(format)) {
     return UnsupportedExtension(path, ".ply, .xyz, .txt, .pts, .obj, .off, .drc");
   }
-  NM_ASSIGN_OR_RETURN(const std::string data, io_internal::ReadFileContents(path));
+  NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
   absl::StatusOr<PointCloud> cloud = ParsePointCloud(format, data);
   if (!cloud.ok()) return io_internal::WithPath(cloud.status(), path);
   if (cloud->empty()) {
@@ -111,7 +112,7 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
     }
     data = *std::move(encoded);
   }
-  return io_internal::WriteFileContents(path, data);
+  return WriteFileContents(path, data);
 }
 
 }  // namespace neuralmesh

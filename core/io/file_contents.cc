@@ -1,0 +1,48 @@
+#include "core/io/file_contents.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+#include "absl/strings/str_cat.h"
+
+namespace neuralmesh {
+
+absl::StatusOr<std::string> ReadFileContents(const std::string& path) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    return absl::NotFoundError(absl::StrCat("cannot open '", path, "': ", std::strerror(errno)));
+  }
+  std::string contents;
+  char chunk[1 << 16];
+  size_t got = 0;
+  while ((got = std::fread(chunk, 1, sizeof(chunk), file)) > 0) contents.append(chunk, got);
+  // fread on a directory fails with EISDIR; report it like any other unreadable file.
+  const bool failed = std::ferror(file) != 0;
+  const int error = errno;
+  std::fclose(file);
+  if (failed) {
+    return absl::NotFoundError(absl::StrCat("cannot read '", path, "': ", std::strerror(error)));
+  }
+  if (contents.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat("'", path, "' is empty"));
+  }
+  return contents;
+}
+
+absl::Status WriteFileContents(const std::string& path, absl::string_view contents) {
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr) {
+    return absl::ErrnoToStatus(errno, absl::StrCat("cannot write '", path, "'"));
+  }
+  const size_t written = std::fwrite(contents.data(), 1, contents.size(), file);
+  int error = written == contents.size() ? 0 : errno;
+  if (std::fclose(file) != 0 && error == 0) error = errno;
+  if (written != contents.size() || error != 0) {
+    std::remove(path.c_str());
+    return absl::ErrnoToStatus(error != 0 ? error : EIO, absl::StrCat("cannot write '", path, "'"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace neuralmesh

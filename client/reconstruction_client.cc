@@ -4,6 +4,7 @@
 #include <grpcpp/security/credentials.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <thread>
 #include <utility>
@@ -26,6 +27,10 @@ std::string PackRange(const std::vector<T>& values, size_t begin, size_t end) {
   return bytes;
 }
 
+int ToMillis(absl::Duration d) {
+  return static_cast<int>(std::clamp<int64_t>(absl::ToInt64Milliseconds(d), 1, INT32_MAX));
+}
+
 gpr_timespec ToGprDeadline(absl::Duration timeout) {
   return gpr_time_add(gpr_now(GPR_CLOCK_MONOTONIC),
                       gpr_time_from_millis(absl::ToInt64Milliseconds(timeout), GPR_TIMESPAN));
@@ -42,11 +47,37 @@ v1::PointBatch PackPointBatch(const PointCloud& cloud, size_t begin, size_t end)
   return batch;
 }
 
+class ReconstructionClient::OpenStream {
+ public:
+  OpenStream(ReconstructionClient& client, grpc::ClientContext& context)
+      : client_(client), context_(context) {
+    absl::MutexLock lock(&client_.streams_mu_);
+    if (client_.streams_cancelled_) context_.TryCancel();
+    client_.open_streams_.push_back(&context_);
+  }
+  ~OpenStream() {
+    absl::MutexLock lock(&client_.streams_mu_);
+    auto& open = client_.open_streams_;
+    open.erase(std::find(open.begin(), open.end(), &context_));
+  }
+  OpenStream(const OpenStream&) = delete;
+  OpenStream& operator=(const OpenStream&) = delete;
+
+ private:
+  ReconstructionClient& client_;
+  grpc::ClientContext& context_;
+};
+
 absl::StatusOr<std::unique_ptr<ReconstructionClient>> ReconstructionClient::Connect(
     const std::string& address, const ClientOptions& options) {
   if (address.empty()) return absl::InvalidArgumentError("empty server address");
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_KEEPALIVE_TIME_MS, ToMillis(options.keepalive_time));
+  args.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, ToMillis(options.keepalive_timeout));
+  // Keep pinging while only the server sends (a Watch): gRPC stops after two pings otherwise.
+  args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
   std::shared_ptr<grpc::Channel> channel =
-      grpc::CreateChannel(address, grpc::InsecureChannelCredentials());
+      grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), args);
   if (!channel->WaitForConnected(ToGprDeadline(options.connect_timeout))) {
     return absl::UnavailableError(absl::StrCat("cannot reach a neuralmesh-server at ", address,
                                                " within ",
@@ -87,6 +118,7 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
   if (cloud.empty()) return absl::InvalidArgumentError("UploadPoints: no points to upload");
   if (batch_size == 0) return absl::InvalidArgumentError("UploadPoints: batch size must be > 0");
   grpc::ClientContext context;
+  const OpenStream open(*this, context);
   v1::UploadPointsResponse response;
   std::unique_ptr<grpc::ClientWriter<v1::UploadPointsRequest>> writer =
       stub_->UploadPoints(&context, &response);
@@ -109,6 +141,7 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
 absl::Status ReconstructionClient::Watch(const std::string& session_id, uint64_t after_sequence,
                                          const UpdateCallback& on_update) {
   grpc::ClientContext context;
+  const OpenStream open(*this, context);
   v1::WatchSessionRequest request;
   request.set_session_id(session_id);
   request.set_after_sequence(after_sequence);
@@ -134,6 +167,7 @@ absl::StatusOr<ReconstructResult> ReconstructionClient::Reconstruct(
   if (cloud.empty()) return absl::InvalidArgumentError("Reconstruct: no points to upload");
   if (batch_size == 0) return absl::InvalidArgumentError("Reconstruct: batch size must be > 0");
   grpc::ClientContext context;
+  const OpenStream open(*this, context);
   std::unique_ptr<grpc::ClientReaderWriter<v1::ReconstructRequest, v1::ReconstructResponse>>
       stream = stub_->Reconstruct(&context);
 
@@ -234,8 +268,13 @@ absl::StatusOr<v1::Session> ReconstructionClient::Finish(const std::string& sess
 }
 
 absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& session_id) {
+  return Cancel(session_id, options_.call_timeout);
+}
+
+absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& session_id,
+                                                         absl::Duration timeout) {
   grpc::ClientContext context;
-  SetDeadline(context, options_.call_timeout);
+  SetDeadline(context, timeout);
   v1::CancelSessionRequest request;
   request.set_session_id(session_id);
   v1::Session session;
@@ -266,6 +305,12 @@ absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& 
   const grpc::Status status = stub_->GetMesh(&context, request, &update);
   if (!status.ok()) return FromGrpcStatus(status, "GetMesh");
   return update;
+}
+
+void ReconstructionClient::CancelStreams() {
+  absl::MutexLock lock(&streams_mu_);
+  streams_cancelled_ = true;
+  for (grpc::ClientContext* context : open_streams_) context->TryCancel();
 }
 
 }  // namespace neuralmesh::client

@@ -27,8 +27,10 @@
 #include <string>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "core/point_cloud.h"
 #include "neuralmesh/v1/reconstruction.grpc.pb.h"
@@ -49,6 +51,13 @@ struct ClientOptions {
   absl::Duration connect_timeout = absl::Seconds(5);
   // Deadline of each simple rpc (not of UploadPoints, Watch, Reconstruct or a waiting GetMesh).
   absl::Duration call_timeout = absl::Seconds(30);
+  // While a call is open on a channel that Connect made, the client pings the server after
+  // `keepalive_time` without a frame from it and drops the connection when the ping is not
+  // answered within `keepalive_timeout`: a server that stops answering (frozen, or cut off
+  // without a reset) ends UploadPoints, Watch and Reconstruct with UNAVAILABLE instead of
+  // leaving them waiting forever. neuralmesh-server accepts pings up to once a second.
+  absl::Duration keepalive_time = absl::Seconds(20);
+  absl::Duration keepalive_timeout = absl::Seconds(10);
 };
 
 class ReconstructionClient {
@@ -118,6 +127,8 @@ class ReconstructionClient {
   absl::StatusOr<std::vector<v1::Session>> ListSessions();
   absl::StatusOr<v1::Session> Finish(const std::string& session_id);
   absl::StatusOr<v1::Session> Cancel(const std::string& session_id);
+  // The same with its own deadline (for a best-effort cancel that must not wait long).
+  absl::StatusOr<v1::Session> Cancel(const std::string& session_id, absl::Duration timeout);
   absl::Status Delete(const std::string& session_id);
 
   // GetMesh; with `wait`, blocks up to `timeout` until the mesh exists (DEADLINE_EXCEEDED
@@ -125,7 +136,15 @@ class ReconstructionClient {
   absl::StatusOr<v1::MeshUpdate> GetMesh(const std::string& session_id, v1::MeshVersion version,
                                          bool wait, absl::Duration timeout);
 
+  // Ends every UploadPoints, Watch and Reconstruct call of this client that is open, and any
+  // started later, at once and without waiting for the server: each returns CANCELLED. The
+  // sessions go on (Cancel stops one). For a client that is being interrupted.
+  void CancelStreams();
+
  private:
+  // Registers a streaming call's context for CancelStreams while the call is open.
+  class OpenStream;
+
   // A context whose deadline is `timeout` from now (none when infinite).
   static void SetDeadline(grpc::ClientContext& context, absl::Duration timeout);
 
@@ -133,6 +152,9 @@ class ReconstructionClient {
   ClientOptions options_;
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::ReconstructionService::Stub> stub_;
+  absl::Mutex streams_mu_;
+  std::vector<grpc::ClientContext*> open_streams_ ABSL_GUARDED_BY(streams_mu_);
+  bool streams_cancelled_ ABSL_GUARDED_BY(streams_mu_) = false;
 };
 
 // One batch of `cloud`, points [begin, end), as packed little-endian float32.

@@ -25,6 +25,9 @@ namespace neuralmesh::client {
 namespace {
 
 constexpr size_t kDefaultMaxVertices = 10000;
+// How long a cancel that only tidies up (after an interrupt or a failure) waits for the server:
+// a server that stopped answering must not hold the command for the usual call timeout.
+constexpr absl::Duration kTidyCancelTimeout = absl::Seconds(5);
 constexpr double kDefaultPointsPerVertex = 2;  // SessionConfig.points_per_vertex's default.
 
 absl::StatusOr<std::unique_ptr<ReconstructionClient>> ConnectTo(const std::string& server,
@@ -93,8 +96,8 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ConnectTo(options.server, options.connect_timeout));
   const std::string stem = InputStem(options.input);
-  // From here on Ctrl-C cancels the session (see `canceller` below), so that the server does
-  // not keep learning for nobody; the upload and the watch then end with the server's answer.
+  // From here on Ctrl-C ends the upload and the watch at once and cancels the session (see
+  // `canceller` below), so that the server does not keep learning for nobody.
   InterruptScope interrupt;
   NM_ASSIGN_OR_RETURN(const v1::Session session, client->CreateSession(config, stem));
   const std::string& id = session.session_id();
@@ -131,11 +134,16 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
 
   absl::Notification done;
   bool interrupted = false;
+  absl::Status interrupt_cancel;  // The server's answer to the cancel an interrupt sent.
+  const auto on_interrupt = [&] {
+    interrupted = true;
+    client->CancelStreams();
+    interrupt_cancel = client->Cancel(id, kTidyCancelTimeout).status();
+  };
   std::thread canceller([&] {
     while (!done.WaitForNotificationWithTimeout(absl::Milliseconds(100))) {
       if (InterruptScope::interrupted()) {
-        interrupted = true;
-        client->Cancel(id).IgnoreError();
+        on_interrupt();
         return;
       }
     }
@@ -143,6 +151,8 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   const auto stop_canceller = [&] {
     done.Notify();
     canceller.join();
+    // An interrupt in the last moments, after the canceller's last look.
+    if (!interrupted && InterruptScope::interrupted()) on_interrupt();
   };
 
   absl::StatusOr<v1::UploadPointsResponse> uploaded =
@@ -156,19 +166,24 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   }
   absl::Status status = uploaded.status();
   if (status.ok()) status = client->Finish(id).status();
-  if (!status.ok()) {
+  if (!status.ok() && !InterruptScope::interrupted()) {
     // Without a finished upload no final mesh can come: stop the server's work and the watch.
-    client->Cancel(id).IgnoreError();
+    client->Cancel(id, kTidyCancelTimeout).IgnoreError();
   }
   watcher.join();
   stop_canceller();
   learn_bar.Finish();
   if (interrupted) {
+    if (!interrupt_cancel.ok()) {
+      return absl::CancelledError(
+          absl::StrCat("interrupted; session ", id,
+                       " may go on: cancelling it failed: ", interrupt_cancel.message()));
+    }
     return absl::CancelledError(absl::StrCat("interrupted; session ", id, " cancelled"));
   }
   NM_RETURN_IF_ERROR(status);
   if (!write_status.ok()) {
-    client->Cancel(id).IgnoreError();
+    client->Cancel(id, kTidyCancelTimeout).IgnoreError();
     return write_status;
   }
   if (!writer.final_received()) return ExplainWatchEnd(watch_status, id);

@@ -1,12 +1,18 @@
 // End-to-end tests of the remote subcommands of build/bin/neuralmesh against a real
 // neuralmesh-server on 127.0.0.1, both run as subprocesses.
+#include <unistd.h>
+
+#include <csignal>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
+#include "absl/time/clock.h"
+#include "client/reconstruction_client.h"
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
 #include "tests/client/test_server.h"
@@ -119,6 +125,43 @@ TEST_F(RemoteCliTest, WatchingAnUnknownSessionFails) {
       {"watch", "no-such-session", "--server", server_->address(), "--out-dir", *dir_ + "/x"});
   EXPECT_NE(watch.exit_code, 0) << watch.Describe();
   EXPECT_TRUE(absl::StrContains(watch.err, "no-such-session")) << watch.err;
+}
+
+// Ctrl-C while the server does not answer: the command ends the upload and the watch at once,
+// tries to cancel the session for a few seconds, and says that the session may go on.
+TEST(RemoteCliInterruptTest, AnInterruptEndsTheCommandEvenWhenTheServerIsFrozen) {
+  std::string error;
+  std::unique_ptr<TestServer> server = TestServer::Start({}, &error);
+  ASSERT_NE(server, nullptr) << error;
+  const std::string dir = MakeTempDir("cli_interrupt");
+  BackgroundProcess cli(
+      "neuralmesh", {"reconstruct", "builtin:sphere", "--server", server->address(), "--out-dir",
+                     dir, "--vertices", "50000", "--points", "200000"});
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> observer =
+      client::ReconstructionClient::Connect(server->address());
+  ASSERT_TRUE(observer.ok()) << observer.status();
+  bool learning = false;
+  for (int i = 0; i < 200 && !learning && cli.Running(); ++i) {
+    absl::StatusOr<std::vector<client::v1::Session>> sessions = (*observer)->ListSessions();
+    learning = sessions.ok() && !sessions->empty() && sessions->front().vertex_count() > 0;
+    if (!learning) usleep(50 * 1000);
+  }
+  ASSERT_TRUE(learning) << "the session did not start learning: " << cli.Stderr();
+
+  server->Signal(SIGSTOP);
+  cli.Signal(SIGINT);
+  const absl::Time interrupted = absl::Now();
+  while (cli.Running() && absl::Now() - interrupted < absl::Seconds(30)) usleep(50 * 1000);
+  const absl::Duration took = absl::Now() - interrupted;
+  const bool ended = !cli.Running();
+  server->Signal(SIGCONT);
+  ASSERT_TRUE(ended) << "the command did not end within 30 s of Ctrl-C: " << cli.Stderr();
+  EXPECT_LT(took, absl::Seconds(15)) << "the cancel should give up after about 5 s";
+  EXPECT_EQ(cli.exit_code(), 1) << cli.Stderr();
+  EXPECT_TRUE(absl::StrContains(cli.Stderr(), "interrupted; session") &&
+              absl::StrContains(cli.Stderr(), "may go on"))
+      << cli.Stderr();
+  std::filesystem::remove_all(dir);
 }
 
 TEST(RemoteCliUnreachableTest, AnUnreachableServerFailsClearly) {

@@ -3,6 +3,7 @@
 #include "client/reconstruction_client.h"
 
 #include <cmath>
+#include <csignal>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -10,6 +11,8 @@
 #include <thread>
 #include <vector>
 
+#include "absl/synchronization/notification.h"
+#include "absl/time/clock.h"
 #include "core/io/draco_codec.h"
 #include "core/sampling/implicit_surfaces.h"
 #include "core/sampling/sample_points.h"
@@ -141,6 +144,83 @@ TEST_F(ReconstructionClientTest, CancelThenDeleteRemovesTheSession) {
   ASSERT_TRUE(client_->Delete(id).ok());
   EXPECT_TRUE(absl::IsNotFound(client_->GetSession(id).status()));
   EXPECT_TRUE(absl::IsNotFound(client_->Delete(id)));
+}
+
+// Watches a session in the background; the result is read after Join. A watch still open at
+// the end (a failed test) is ended with the client's CancelStreams.
+class BackgroundWatch {
+ public:
+  BackgroundWatch(ReconstructionClient& client, const std::string& session_id)
+      : client_(client), thread_([this, session_id] {
+          status_ = client_.Watch(session_id, 0, [](const v1::MeshUpdate&) { return true; });
+          ended_.Notify();
+        }) {}
+  ~BackgroundWatch() {
+    if (!ended_.HasBeenNotified()) client_.CancelStreams();
+    Join().IgnoreError();
+  }
+  // Whether the watch ended within `timeout`.
+  bool EndsWithin(absl::Duration timeout) { return ended_.WaitForNotificationWithTimeout(timeout); }
+  absl::Status Join() {
+    if (thread_.joinable()) thread_.join();
+    return status_;
+  }
+
+ private:
+  ReconstructionClient& client_;
+  absl::Status status_;
+  absl::Notification ended_;
+  std::thread thread_;
+};
+
+TEST_F(ReconstructionClientTest, CancelStreamsEndsOpenWatchesAtOnceAndLeavesTheSession) {
+  absl::StatusOr<v1::Session> session = client_->CreateSession(SmallConfig(100), "quiet");
+  ASSERT_TRUE(session.ok()) << session.status();
+  const std::string id = session->session_id();
+  // No points: the session never publishes a mesh, so the watch waits until it is ended.
+  BackgroundWatch watch(*client_, id);
+  EXPECT_FALSE(watch.EndsWithin(absl::Milliseconds(300))) << "nothing to end the watch yet";
+  client_->CancelStreams();
+  ASSERT_TRUE(watch.EndsWithin(absl::Seconds(5))) << "CancelStreams must end the watch";
+  const absl::Status ended = watch.Join();
+  EXPECT_TRUE(absl::IsCancelled(ended)) << ended;
+  const absl::Status later = client_->Watch(id, 0, [](const v1::MeshUpdate&) { return true; });
+  EXPECT_TRUE(absl::IsCancelled(later)) << "a watch started afterwards ends at once: " << later;
+
+  absl::StatusOr<v1::Session> after = client_->GetSession(id);
+  ASSERT_TRUE(after.ok()) << after.status();
+  EXPECT_EQ(after->state(), v1::SESSION_STATE_COLLECTING) << "the session itself goes on";
+  EXPECT_TRUE(client_->Delete(id).ok());
+}
+
+// With a keepalive ping every 1.2 s: a live server answers them and keeps a quiet watch open
+// (gRPC's default policy closes a connection after its third ping within 5 minutes without
+// data), and a server that stops answering ends the watch with UNAVAILABLE instead of leaving
+// it waiting.
+TEST(ReconstructionClientKeepaliveTest, AQuietWatchStaysOpenAndAFrozenServerEndsIt) {
+  std::string error;
+  std::unique_ptr<TestServer> server = TestServer::Start({}, &error);
+  ASSERT_NE(server, nullptr) << error;
+  ClientOptions options;
+  options.keepalive_time = absl::Milliseconds(1200);
+  options.keepalive_timeout = absl::Seconds(1);
+  absl::StatusOr<std::unique_ptr<ReconstructionClient>> client =
+      ReconstructionClient::Connect(server->address(), options);
+  ASSERT_TRUE(client.ok()) << client.status();
+  absl::StatusOr<v1::Session> session = (*client)->CreateSession(SmallConfig(100), "quiet");
+  ASSERT_TRUE(session.ok()) << session.status();
+
+  BackgroundWatch watch(**client, session->session_id());
+  EXPECT_FALSE(watch.EndsWithin(absl::Seconds(6)))
+      << "the server dropped a client that pinged a quiet watch: " << watch.Join();
+  server->Signal(SIGSTOP);
+  const absl::Time frozen = absl::Now();
+  const bool ended = watch.EndsWithin(absl::Seconds(20));
+  server->Signal(SIGCONT);
+  ASSERT_TRUE(ended) << "the watch of a frozen server did not end within 20 s";
+  const absl::Status status = watch.Join();
+  EXPECT_TRUE(absl::IsUnavailable(status)) << status;
+  EXPECT_LT(absl::Now() - frozen, absl::Seconds(10)) << "keepalive answers within about 2.2 s";
 }
 
 TEST_F(ReconstructionClientTest, StatusesKeepTheServersCodeAndNameTheCall) {

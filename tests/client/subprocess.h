@@ -133,8 +133,20 @@ class BackgroundProcess {
 
   // Whether it still runs.
   bool Running() {
-    if (pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) != 0) pid_ = -1;  // Exited and reaped.
+    int status = 0;
+    if (pid_ > 0 && waitpid(pid_, &status, WNOHANG) != 0) {  // Exited and reaped.
+      exit_code_ = WIFEXITED(status)     ? WEXITSTATUS(status)
+                   : WIFSIGNALED(status) ? 128 + WTERMSIG(status)
+                                         : -1;
+      pid_ = -1;
+    }
     return pid_ > 0;
+  }
+  // Its exit code as RunResult gives it, once Running() has seen it end; -1 before.
+  int exit_code() const { return exit_code_; }
+  // Sends `signal` without waiting (SIGSTOP freezes the process, SIGCONT resumes it).
+  void Signal(int signal) {
+    if (pid_ > 0) kill(pid_, signal);
   }
   // Sends `signal` and waits for the process to end; returns its exit code as RunResult does
   // (-1 when it had already ended).
@@ -166,6 +178,7 @@ class BackgroundProcess {
 
  private:
   pid_t pid_ = -1;
+  int exit_code_ = -1;
   std::string out_path_;
   std::string err_path_;
 };

@@ -45,6 +45,8 @@ class TestServer {
 
   const std::string& address() const { return address_; }
   std::string Stderr() const { return process_.Stderr(); }
+  // Sends `signal` to the server process (SIGSTOP: it stops answering, connections stay open).
+  void Signal(int signal) { process_.Signal(signal); }
 
  private:
   explicit TestServer(const std::vector<std::string>& args) : process_("neuralmesh-server", args) {}

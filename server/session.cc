@@ -7,7 +7,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/analysis/mesh_report.h"
+#include "core/status_macros.h"
 #include "server/proto_conversion.h"
+#include "server/quantization_cube.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -28,15 +30,6 @@ BoundingBox BoundsOf(absl::Span<const Vec3f> positions) {
   BoundingBox box;
   for (const Vec3f& p : positions) box.Extend(Vec3(p[0], p[1], p[2]));
   return box;
-}
-
-bool CubeContains(const QuantizationBox& box, const BoundingBox& bounds) {
-  for (int c = 0; c < 3; ++c) {
-    if (bounds.min[c] < box.origin[c] || bounds.max[c] > double{box.origin[c]} + box.range) {
-      return false;
-    }
-  }
-  return true;
 }
 
 }  // namespace
@@ -66,26 +59,6 @@ bool IsSpatiallyBiased(absl::Span<const Vec3f> arrival_sample) {
   return static_cast<double>(covered) < kCoverageThreshold * arrival_sample.size();
 }
 
-QuantizationBox QuantizationCube(const BoundingBox& bounds, double enlarge) {
-  const Vec3 center = bounds.center();
-  double edge = 0;
-  for (int c = 0; c < 3; ++c) edge = std::max(edge, bounds.max[c] - bounds.min[c]);
-  edge = edge > 0 ? edge * enlarge : 1.0;
-  QuantizationBox box;
-  box.range = static_cast<float>(edge);
-  for (int c = 0; c < 3; ++c) box.origin[c] = static_cast<float>(center[c] - edge / 2);
-  // The box every update announces is the one Draco quantizes against.
-  return DracoExactBox(box);
-}
-
-QuantizationBox GrowQuantizationCube(QuantizationBox box, const BoundingBox& bounds) {
-  while (!CubeContains(box, bounds)) {
-    for (int c = 0; c < 3; ++c) box.origin[c] -= box.range / 2;
-    box.range *= 2;
-  }
-  return DracoExactBox(box);
-}
-
 Session::Session(std::string id, std::string name, SessionConfig config, size_t max_points,
                  WorkerPool* pool, Executor* encoder)
     : id_(std::move(id)),
@@ -109,13 +82,35 @@ bool Session::AcceptsPointsLocked() const {
 size_t Session::AllowedVerticesLocked() const {
   if (final_vertices_ > 0) return final_vertices_;
   const double bound = std::floor(static_cast<double>(points_.size()) / config_.points_per_vertex);
-  return std::min(config_.target_vertices, static_cast<size_t>(bound));
+  // Compared in double: a tiny points_per_vertex makes `bound` too large for a size_t.
+  if (bound >= static_cast<double>(config_.target_vertices)) return config_.target_vertices;
+  return static_cast<size_t>(bound);
+}
+
+absl::StatusOr<QuantizationBox> Session::CubeWithLocked(const BoundingBox& batch_bounds,
+                                                        bool* grown) const {
+  const int bits = config_.draco.position_quantization_bits;
+  QuantizationBox box = box_;
+  if (!has_box_) {
+    NM_ASSIGN_OR_RETURN(box,
+                        config_.bounds.has_value()
+                            ? QuantizationCube(*config_.bounds, kDeclaredBoundsEnlargement, bits)
+                            : QuantizationCube(batch_bounds, kFirstBatchEnlargement, bits));
+  }
+  *grown = !CubeContains(box, batch_bounds);
+  if (!*grown) return box;
+  return GrowQuantizationCube(box, batch_bounds, bits);
 }
 
 absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch) {
   size_t total = 0;
   {
     absl::MutexLock ingest(&ingest_mu_);
+    // Quantization: the first data fixes the cube; later data outside it grows the cube. A
+    // batch that no cube Draco can use would hold is refused before anything changes.
+    const BoundingBox batch_bounds = BoundsOf(batch.positions);
+    QuantizationBox box;
+    bool grown = false;
     {
       absl::MutexLock lock(&mu_);
       if (!AcceptsPointsLocked()) {
@@ -124,6 +119,13 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch) {
                          " and accepts no more points"));
       }
       last_activity_ = absl::Now();
+      absl::StatusOr<QuantizationBox> cube = CubeWithLocked(batch_bounds, &grown);
+      if (!cube.ok()) {
+        return absl::Status(cube.status().code(),
+                            absl::StrCat(cube.status().message(), "; the session keeps its ",
+                                         points_.size(), " points accepted before"));
+      }
+      box = *cube;
     }
     const size_t first_index = points_.size();
     if (absl::Status status = points_.Append(batch); !status.ok()) {
@@ -134,18 +136,11 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch) {
     RecordArrivalSampleLocked(batch.positions, first_index);
     total = points_.size();
 
-    // Quantization: the first data fixes the cube; later data outside it grows the cube.
-    const BoundingBox batch_bounds = BoundsOf(batch.positions);
     absl::MutexLock lock(&mu_);
-    if (!has_box_) {
-      has_box_ = true;
-      box_ = config_.bounds.has_value() ? QuantizationCube(*config_.bounds, 1.1)
-                                        : QuantizationCube(batch_bounds, 2.0);
-    }
-    if (!CubeContains(box_, batch_bounds)) {
-      box_ = GrowQuantizationCube(box_, batch_bounds);
-      ++epoch_;
-    }
+    // Only ingestion changes the cube, and ingest_mu_ is held: box_ is as CubeWithLocked saw it.
+    has_box_ = true;
+    box_ = box;
+    if (grown) ++epoch_;
     learning_.set_points_received(total);
     learning_.set_allowed_vertices(AllowedVerticesLocked());
   }

@@ -39,6 +39,7 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "absl/types/span.h"
+#include "core/bounding_box.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner.h"
 #include "core/point_cloud.h"
@@ -58,14 +59,6 @@ namespace neuralmesh::server {
 // of the first half of the sample: biased when below 90%. Random order gives nearly 100%; a
 // scan, about 50%. Samples of fewer than 256 points count as biased (relearning them is cheap).
 bool IsSpatiallyBiased(absl::Span<const Vec3f> arrival_sample);
-
-// The cube all meshes of a session are quantized against, from the first data: the bounding
-// cube of `bounds` scaled by `enlarge` about its centre (a degenerate box gets edge 1), widened
-// to the nearest cube Draco keeps exactly (DracoExactBox).
-QuantizationBox QuantizationCube(const BoundingBox& bounds, double enlarge);
-
-// `box` grown 2x about its centre until it contains `bounds`, then widened as above.
-QuantizationBox GrowQuantizationCube(QuantizationBox box, const BoundingBox& bounds);
 
 class Session : public Schedulable, public std::enable_shared_from_this<Session> {
  public:
@@ -135,6 +128,11 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
 
   bool AcceptsPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   size_t AllowedVerticesLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // The quantization cube once a batch with `batch_bounds` is in, and in `grown` whether the
+  // present (or the first) cube had to grow for it; INVALID_ARGUMENT when no cube Draco can
+  // use holds the batch.
+  absl::StatusOr<QuantizationBox> CubeWithLocked(const BoundingBox& batch_bounds, bool* grown) const
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void RecordArrivalSampleLocked(absl::Span<const Vec3f> positions, size_t first_index)
       ABSL_EXCLUSIVE_LOCKS_REQUIRED(ingest_mu_);
   // Updates the learning counters after a Run (learning thread).

@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/status_macros.h"
+#include "server/quantization_cube.h"
 
 namespace neuralmesh::server {
 
@@ -95,6 +96,12 @@ absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& 
   }
   NM_RETURN_IF_ERROR(config.learner.Validate());
   NM_RETURN_IF_ERROR(config.draco.Validate());
+  if (config.bounds.has_value()) {
+    const absl::StatusOr<QuantizationBox> cube = QuantizationCube(
+        *config.bounds, kDeclaredBoundsEnlargement, config.draco.position_quantization_bits);
+    if (!cube.ok())
+      return absl::InvalidArgumentError(absl::StrCat("bounds: ", cube.status().message()));
+  }
   return absl::OkStatus();
 }
 

@@ -471,6 +471,24 @@ QuantizationBox DracoExactBox(const QuantizationBox& box) {
   return exact;
 }
 
+absl::Status CheckQuantizationBox(const QuantizationBox& box, int bits) {
+  if (!IsFinite(box.origin) || !std::isfinite(box.range) || !(box.range > 0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the quantization box with origin (", box.origin[0], ", ", box.origin[1], ", ",
+                     box.origin[2], ") and range ", box.range, " is not finite and positive"));
+  }
+  const QuantizationBox read = BoxAsDracoReadsIt(box);
+  DracoGrid grid;
+  for (int c = 0; c < 3; ++c) grid.origin[c] = read.origin[c];
+  grid.range = read.range;
+  const std::string problem = GridProblem(grid, 3, bits);
+  if (!problem.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("Draco cannot quantize against a cube of range ", problem));
+  }
+  return absl::OkStatus();
+}
+
 absl::Status DracoOptions::Validate() const {
   NM_RETURN_IF_ERROR(CheckRange("position_quantization_bits", position_quantization_bits, 1,
                                 kMaxQuantizationBits));

@@ -71,6 +71,11 @@ struct DracoOptions {
 // 1e-3 the grid gets coarser than asked. Callers that announce their grid use it.
 QuantizationBox DracoExactBox(const QuantizationBox& box);
 
+// OK when Draco can quantize positions against `box` (as it reads the box) at `bits` bits per
+// coordinate: finite, positive, and neither too small for a step nor reaching past the largest
+// float; else INVALID_ARGUMENT saying which.
+absl::Status CheckQuantizationBox(const QuantizationBox& box, int bits);
+
 // The box Draco quantizes against when given `box`: its origin and edge rounded to six
 // decimals (a box of origin 1e-7 and edge 3e-9 becomes origin 0 and edge 0). DracoExactBox's
 // boxes come back unchanged.

@@ -71,6 +71,14 @@ TEST(ResolveSessionConfigTest, RejectsInvalidOptionsNamingTheField) {
        "refresh_interval_ms"},
       {"quantization bits", [](SessionConfig& c) { c.draco.position_quantization_bits = 0; },
        "position_quantization_bits"},
+      {"bounds beyond what a float cube can hold",
+       [](SessionConfig& c) {
+         BoundingBox b;
+         b.min = Vec3(-3.3e38, 0, 0);
+         b.max = Vec3(3.3e38, 1, 1);
+         c.bounds = b;
+       },
+       "bounds: points from"},
       {"inverted bounds",
        [](SessionConfig& c) {
          BoundingBox b;

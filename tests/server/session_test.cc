@@ -195,6 +195,45 @@ TEST_F(SessionTest, BadBatchesAreRejectedAndTheSessionKeepsItsPoints) {
   EXPECT_EQ(session->Cancel("late").code(), absl::StatusCode::kFailedPrecondition);
 }
 
+// Coordinates so large that no quantization cube Draco can encode holds them: the batch is
+// refused at once (growing the cube toward them never ended before, with the session locked),
+// and the session goes on with its points. Slightly smaller ones still fit a usable cube.
+TEST_F(SessionTest, ABatchNoQuantizationCubeCanHoldIsRefused) {
+  SessionConfig config;
+  config.target_vertices = 50;
+  auto session = NewSession(config);
+  const PointCloud points = Torus(1000, 3);
+  ASSERT_TRUE(session->AddPoints(Slice(points, 0, 300)).ok());
+  for (const float far : {3.3e38f, 1.8e38f}) {
+    PointCloud huge = Slice(points, 300, 310);
+    huge.positions[2] = Vec3f(far, -far, far);
+    const absl::StatusOr<size_t> result = session->AddPoints(huge);
+    EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument)
+        << far << ": " << result.status();
+    EXPECT_THAT(std::string(result.status().message()),
+                HasSubstr("300 points accepted before"));
+  }
+  EXPECT_EQ(session->points_received(), 300u) << "refused batches add nothing";
+  ASSERT_TRUE(session->AddPoints(Slice(points, 300, 600)).ok()) << "the session goes on";
+  PointCloud large = Slice(points, 600, 610);
+  large.positions[2] = Vec3f(1e38f, -1e38f, 1e38f);
+  EXPECT_TRUE(session->AddPoints(large).ok()) << "a cube of range 2e38 is still usable";
+  EXPECT_EQ(session->points_received(), 610u);
+  ASSERT_TRUE(session->Cancel("done").ok());
+}
+
+TEST_F(SessionTest, ATinyPointsPerVertexAllowsTheWholeTarget) {
+  SessionConfig config;
+  config.target_vertices = 60;
+  config.points_per_vertex = 1e-18;  // 300 / 1e-18 is far beyond any size_t.
+  auto session = NewSession(config);
+  ASSERT_TRUE(session->AddPoints(Torus(300, 4)).ok());
+  EXPECT_EQ(session->ToProto().learning().allowed_vertices(), 60u);
+  ASSERT_TRUE(session->Finish().ok());
+  EXPECT_TRUE(recorder_.AwaitClose().ok());
+  EXPECT_EQ(recorder_.updates().back()->vertex_count(), 60u);
+}
+
 TEST_F(SessionTest, FinishNeedsPointsForATetrahedron) {
   SessionConfig config;
   config.target_vertices = 100;

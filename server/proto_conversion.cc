@@ -210,7 +210,13 @@ absl::StatusOr<PointCloud> PointBatchFromProto(const v1::PointBatch& batch,
       if (batch.draco_point_cloud().empty()) {
         return absl::InvalidArgumentError("the batch has no points (empty Draco data)");
       }
-      absl::StatusOr<PointCloud> decoded = DecodePointCloud(batch.draco_point_cloud());
+      absl::StatusOr<PointCloud> decoded =
+          DecodePointCloud(batch.draco_point_cloud(), max_batch_points);
+      if (absl::IsResourceExhausted(decoded.status())) {
+        return absl::ResourceExhaustedError(
+            absl::StrCat("PointBatch.draco_point_cloud: ", decoded.status().message(),
+                         " (this server takes at most ", max_batch_points, " points per batch)"));
+      }
       if (!decoded.ok()) {
         return absl::InvalidArgumentError(
             absl::StrCat("PointBatch.draco_point_cloud: ", decoded.status().message()));

@@ -338,8 +338,9 @@ std::vector<std::pair<const char*, uint64_t>> DeclaredCounts(const StreamStart& 
 // current encoders write (2.2 for meshes, 2.3 for point clouds; Draco 1.5 decodes the older
 // ones through legacy paths with counts of their own that it never checks: a 102-byte kd-tree
 // point cloud of version 2.1 made it fill 21 GB), and counts far beyond what the stream's size
-// can hold.
-absl::Status CheckStreamStart(std::string_view bytes) {
+// can hold; then, with RESOURCE_EXHAUSTED, points or vertices beyond `max_points` and faces
+// beyond twice that.
+absl::Status CheckStreamStart(std::string_view bytes, uint64_t max_points) {
   draco::DecoderBuffer buffer;
   const std::optional<StreamStart> start = ReadStreamStart(bytes, buffer);
   if (!start.has_value()) return absl::OkStatus();
@@ -359,6 +360,14 @@ absl::Status CheckStreamStart(std::string_view bytes) {
       return absl::InvalidArgumentError(absl::StrCat("corrupt Draco data: it declares ", count, " ",
                                                      what, " in only ", bytes.size(), " bytes"));
     }
+    constexpr uint64_t kUnlimited = std::numeric_limits<uint64_t>::max();
+    const bool faces = std::string_view(what) == "faces";
+    const uint64_t allowed =
+        faces ? (max_points > kUnlimited / 2 ? kUnlimited : 2 * max_points) : max_points;
+    if (count > allowed) {
+      return absl::ResourceExhaustedError(absl::StrCat("the Draco data declares ", count, " ", what,
+                                                       "; at most ", allowed, " are allowed"));
+    }
   }
   return absl::OkStatus();
 }
@@ -366,7 +375,8 @@ absl::Status CheckStreamStart(std::string_view bytes) {
 // Decodes `bytes` as the given geometry type. Draco sizes its arrays from counts in the
 // stream; a corrupt count can make an allocation throw, which must not escape this module.
 template <typename Geometry>
-absl::StatusOr<std::unique_ptr<Geometry>> DecodeDraco(std::string_view bytes) {
+absl::StatusOr<std::unique_ptr<Geometry>> DecodeDraco(
+    std::string_view bytes, uint64_t max_points = std::numeric_limits<uint64_t>::max()) {
   if (bytes.empty()) return absl::InvalidArgumentError("no Draco data: the buffer is empty");
   draco::DecoderBuffer buffer;
   buffer.Init(bytes.data(), bytes.size());
@@ -379,7 +389,7 @@ absl::StatusOr<std::unique_ptr<Geometry>> DecodeDraco(std::string_view bytes) {
   if (kWantMesh && type.value() != draco::TRIANGULAR_MESH) {
     return absl::InvalidArgumentError("the Draco data holds a point cloud, not a triangle mesh");
   }
-  NM_RETURN_IF_ERROR(CheckStreamStart(bytes));
+  NM_RETURN_IF_ERROR(CheckStreamStart(bytes, max_points));
   buffer.Init(bytes.data(), bytes.size());
   draco::Decoder decoder;
   try {
@@ -650,9 +660,9 @@ absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes) {
   return mesh;
 }
 
-absl::StatusOr<PointCloud> DecodePointCloud(std::string_view bytes) {
+absl::StatusOr<PointCloud> DecodePointCloud(std::string_view bytes, uint64_t max_points) {
   NM_ASSIGN_OR_RETURN(std::unique_ptr<draco::PointCloud> geometry,
-                      DecodeDraco<draco::PointCloud>(bytes));
+                      DecodeDraco<draco::PointCloud>(bytes, max_points));
   NM_ASSIGN_OR_RETURN(const draco::PointAttribute* positions, PositionAttribute(*geometry));
   const uint32_t n = geometry->num_points();
   if (n == 0) return absl::InvalidArgumentError("the Draco point cloud is empty");

@@ -14,6 +14,8 @@
 #ifndef NEURALMESH_CORE_IO_DRACO_CODEC_H_
 #define NEURALMESH_CORE_IO_DRACO_CODEC_H_
 
+#include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -107,8 +109,12 @@ absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes);
 // Decodes a Draco point cloud, or the points of a Draco mesh; restores normals (the NORMAL
 // attribute) and weights (the first one-component GENERIC attribute) when present.
 // Returns INVALID_ARGUMENT when `bytes` is not valid Draco data (as for DecodeMesh), has no
-// numeric positions, or decodes to a cloud that fails ValidatePointCloud.
-absl::StatusOr<PointCloud> DecodePointCloud(std::string_view bytes);
+// numeric positions, or decodes to a cloud that fails ValidatePointCloud; RESOURCE_EXHAUSTED,
+// before anything is decoded, when it declares more than `max_points` points (for a mesh:
+// vertices, or faces beyond twice that), so that a caller with a limit never allocates for
+// more (points that compress well declare millions in a few bytes).
+absl::StatusOr<PointCloud> DecodePointCloud(
+    std::string_view bytes, uint64_t max_points = std::numeric_limits<uint64_t>::max());
 
 }  // namespace neuralmesh
 

@@ -81,6 +81,24 @@ TEST(PointBatchFromProtoTest, OversizedBatchIsResourceExhausted) {
   EXPECT_THAT(std::string(result.status().message()), HasSubstr("at most 2"));
 }
 
+// The limit applies to the count a Draco batch declares, before it is decoded: identical points
+// compress to almost nothing, so a small message could otherwise make the server allocate for
+// billions of points.
+TEST(PointBatchFromProtoTest, OversizedDracoBatchIsRefusedBeforeDecoding) {
+  PointCloud many;
+  many.positions.assign(5000, Vec3f(1, 2, 3));
+  absl::StatusOr<std::string> bytes = EncodePointCloud(many, DracoOptions());
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  EXPECT_LT(bytes->size(), 1000u) << "5,000 identical points take a few hundred bytes";
+  v1::PointBatch batch;
+  batch.set_draco_point_cloud(*bytes);
+  absl::StatusOr<PointCloud> result = PointBatchFromProto(batch, 4999);
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted) << result.status();
+  EXPECT_THAT(std::string(result.status().message()), HasSubstr("declares 5000 points"));
+  EXPECT_THAT(std::string(result.status().message()), HasSubstr("at most 4999 points per batch"));
+  EXPECT_TRUE(PointBatchFromProto(batch, 5000).ok());
+}
+
 TEST(PointBatchFromProtoTest, DecodesDracoPointClouds) {
   PointCloud cloud = ThreePoints();
   cloud.weights = {1, 2, 4};

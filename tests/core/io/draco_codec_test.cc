@@ -388,6 +388,24 @@ TEST(DracoCodecTest, PointCloudWithoutOptionalAttributesDecodesWithout) {
   ExpectSameCloud(cloud, *decoded, QuantizationTolerance(2.0f, 11), 0, 0, "positions only");
 }
 
+TEST(DracoCodecTest, DecodePointCloudRefusesMoreDeclaredPointsThanAllowed) {
+  const PointCloud cloud = io_test::RandomCloud(300, 3, false, false);
+  const absl::StatusOr<std::string> bytes = EncodePointCloud(cloud, {});
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  const absl::Status refused = DecodePointCloud(*bytes, 299).status();
+  EXPECT_EQ(refused.code(), absl::StatusCode::kResourceExhausted) << refused;
+  EXPECT_THAT(std::string(refused.message()), HasSubstr("declares 300 points; at most 299"));
+  EXPECT_TRUE(DecodePointCloud(*bytes, 300).ok());
+
+  const TriangleMesh mesh = testing::Icosphere(2);  // 162 vertices, 320 faces.
+  const absl::StatusOr<std::string> mesh_bytes = EncodeMesh(mesh, {});
+  ASSERT_TRUE(mesh_bytes.ok()) << mesh_bytes.status();
+  EXPECT_EQ(DecodePointCloud(*mesh_bytes, 161).status().code(),
+            absl::StatusCode::kResourceExhausted)
+      << "a mesh's vertices count as points";
+  EXPECT_TRUE(DecodePointCloud(*mesh_bytes, 162).ok()) << "and its faces against twice that";
+}
+
 TEST(DracoCodecTest, DecodePointCloudAcceptsAMesh) {
   const TriangleMesh mesh = testing::Icosphere(2);
   const absl::StatusOr<std::string> bytes = EncodeMesh(mesh, {});

@@ -302,7 +302,9 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
 // learning ever waits for the writer.
 //
 // The end: when the client half-closes, the session is finished (no more points) and the call
-// waits for the channel to close after the final mesh, then finishes with OK. A bad batch, a
+// waits for the channel to close after the final mesh, then finishes with OK. A read also
+// fails when the client cancels or its connection drops: that ends the call, not the session,
+// which keeps its points and can be resumed (ReconstructStart.session_id). A bad batch, a
 // failed start, the session being cancelled or deleted, Abort at shutdown or the client going
 // away end the call with an error, and then nothing more is written (EndNow); Finish follows as
 // soon as no write is in flight. An outstanding read is completed by gRPC with
@@ -312,8 +314,9 @@ class ReconstructReactor final
       public UpdateSubscriber,
       public LiveReactor {
  public:
-  ReconstructReactor(SessionManager* manager, ReactorRegistry* reactors)
-      : manager_(manager), reactors_(reactors) {
+  ReconstructReactor(grpc::CallbackServerContext* context, SessionManager* manager,
+                     ReactorRegistry* reactors)
+      : context_(context), manager_(manager), reactors_(reactors) {
     registered_ = reactors_->Add(this);
     if (!registered_) {
       End(Unavailable());
@@ -328,7 +331,11 @@ class ReconstructReactor final
       if (writer_.has_end()) return;
     }
     if (!ok) {
-      HalfClosed();
+      if (context_->IsCancelled()) {
+        End(absl::CancelledError("the client cancelled the call or went away"));
+      } else {
+        HalfClosed();
+      }
       return;
     }
     absl::Status status = session_ == nullptr ? Start() : Points();
@@ -498,6 +505,7 @@ class ReconstructReactor final
     if (std::optional<absl::Status> end = writer_.TakeFinish()) Finish(ToGrpcStatus(*end));
   }
 
+  grpc::CallbackServerContext* const context_;
   SessionManager* const manager_;
   ReactorRegistry* const reactors_;
   bool registered_ = false;
@@ -634,7 +642,7 @@ grpc::ServerWriteReactor<v1::MeshUpdate>* ReconstructionService::WatchSession(
 
 grpc::ServerBidiReactor<v1::ReconstructRequest, v1::ReconstructResponse>*
 ReconstructionService::Reconstruct(grpc::CallbackServerContext* context) {
-  return new ReconstructReactor(manager_, reactors_);
+  return new ReconstructReactor(context, manager_, reactors_);
 }
 
 grpc::ServerUnaryReactor* ReconstructionService::GetSession(

@@ -406,6 +406,39 @@ TEST_F(ReconstructionServiceTest, ReconstructRejectsABadBatchAndTheSessionStays)
   EXPECT_EQ(stream2->Finish().error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 }
 
+// A client that cancels (or loses its connection) ends the call, not the session: the points
+// it sent stay, and the session is not finished on its behalf, so the upload can be resumed.
+TEST_F(ReconstructionServiceTest, ACancelledReconstructLeavesTheSessionOpen) {
+  const PointCloud points = TorusPoints(2000, 16);
+  for (int attempt = 0; attempt < 5; ++attempt) {
+    grpc::ClientContext context;
+    auto stream = stub_->Reconstruct(&context);
+    v1::ReconstructRequest start;
+    *start.mutable_start()->mutable_create() = CreateRequest(1000);
+    ASSERT_TRUE(stream->Write(start));
+    v1::ReconstructRequest batch;
+    *batch.mutable_points() = Batch(points, 0, 1000);
+    ASSERT_TRUE(stream->Write(batch));
+    std::string id;
+    uint64_t acknowledged = 0;
+    v1::ReconstructResponse response;
+    while (acknowledged < 1000 && stream->Read(&response)) {
+      if (response.has_session()) id = response.session().session_id();
+      if (response.has_ack()) acknowledged = response.ack().points_accepted();
+    }
+    ASSERT_EQ(acknowledged, 1000u);
+    context.TryCancel();
+    EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::CANCELLED);
+    absl::SleepFor(absl::Milliseconds(100));  // For the server to see the cancel.
+    const v1::Session session = testing::GetSession(*stub_, id);
+    EXPECT_EQ(session.learning().points_received(), 1000u);
+    EXPECT_TRUE(session.state() == v1::SESSION_STATE_COLLECTING ||
+                session.state() == v1::SESSION_STATE_LEARNING)
+        << "attempt " << attempt
+        << ": the cancel finished the session: " << v1::SessionState_Name(session.state());
+  }
+}
+
 TEST_F(ReconstructionServiceTest, GetMeshLatestFinalAndWaiting) {
   const std::string id = MustCreate(*stub_, CreateRequest(200));
   grpc::ClientContext context;

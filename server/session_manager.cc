@@ -67,17 +67,16 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(SessionConfig co
 
 absl::StatusOr<std::shared_ptr<Session>> SessionManager::Get(absl::string_view id) const {
   if (id.empty()) return absl::InvalidArgumentError("session_id is empty");
-  std::shared_ptr<Session> session;
-  {
-    absl::MutexLock lock(&mu_);
-    auto it = sessions_.find(std::string(id));
-    if (it == sessions_.end()) {
-      return absl::NotFoundError(absl::StrCat("no session with id \"", id, "\""));
-    }
-    session = it->second;
+  absl::MutexLock lock(&mu_);
+  if (shutdown_) return absl::UnavailableError("the server is shutting down");
+  auto it = sessions_.find(std::string(id));
+  if (it == sessions_.end()) {
+    return absl::NotFoundError(absl::StrCat("no session with id \"", id, "\""));
   }
-  session->Touch();
-  return session;
+  // Touched under the lock, so that the reaper, which checks idleness again under it before it
+  // deletes, never deletes a session a caller has just got.
+  it->second->Touch();
+  return it->second;
 }
 
 std::vector<std::shared_ptr<Session>> SessionManager::List() const {
@@ -89,13 +88,22 @@ std::vector<std::shared_ptr<Session>> SessionManager::List() const {
 }
 
 absl::Status SessionManager::Delete(absl::string_view id) {
+  return DeleteUnlessActive(id, std::nullopt);
+}
+
+absl::Status SessionManager::DeleteUnlessActive(absl::string_view id,
+                                                std::optional<absl::Time> idle_at) {
   if (id.empty()) return absl::InvalidArgumentError("session_id is empty");
   std::shared_ptr<Session> session;
   {
     absl::MutexLock lock(&mu_);
+    if (shutdown_) return absl::UnavailableError("the server is shutting down");
     auto it = sessions_.find(std::string(id));
     if (it == sessions_.end()) {
       return absl::NotFoundError(absl::StrCat("no session with id \"", id, "\""));
+    }
+    if (idle_at.has_value() && !it->second->IdleSince(*idle_at, limits_.idle_timeout)) {
+      return absl::FailedPreconditionError(absl::StrCat("session ", id, " is active again"));
     }
     session = std::move(it->second);
     sessions_.erase(it);
@@ -120,7 +128,7 @@ size_t SessionManager::ReapIdle(absl::Time now) {
   }
   size_t reaped = 0;
   for (const std::string& id : idle) {
-    if (Delete(id).ok()) ++reaped;
+    if (DeleteUnlessActive(id, now).ok()) ++reaped;
   }
   return reaped;
 }

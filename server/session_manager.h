@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -48,14 +49,16 @@ class SessionManager {
   absl::StatusOr<std::shared_ptr<Session>> Create(SessionConfig config, std::string name)
       ABSL_LOCKS_EXCLUDED(mu_);
 
-  // NOT_FOUND for an unknown id (INVALID_ARGUMENT for an empty one). Counts as activity.
+  // NOT_FOUND for an unknown id (INVALID_ARGUMENT for an empty one), UNAVAILABLE after
+  // Shutdown. Counts as activity.
   absl::StatusOr<std::shared_ptr<Session>> Get(absl::string_view id) const
       ABSL_LOCKS_EXCLUDED(mu_);
 
   // Every session, oldest first.
   std::vector<std::shared_ptr<Session>> List() const ABSL_LOCKS_EXCLUDED(mu_);
 
-  // Removes the session; its watchers end with NOT_FOUND. NOT_FOUND when unknown.
+  // Removes the session; its watchers end with NOT_FOUND. NOT_FOUND when unknown, UNAVAILABLE
+  // after Shutdown.
   absl::Status Delete(absl::string_view id) ABSL_LOCKS_EXCLUDED(mu_);
 
   // Deletes the sessions idle at `now` (see SessionLimits::idle_timeout); returns how many.
@@ -69,6 +72,10 @@ class SessionManager {
 
  private:
   void ReaperLoop() ABSL_LOCKS_EXCLUDED(mu_);
+  // Delete, or with `idle_at` only a session still idle at that time (checked under the lock;
+  // FAILED_PRECONDITION otherwise): a session touched since the reaper looked stays.
+  absl::Status DeleteUnlessActive(absl::string_view id, std::optional<absl::Time> idle_at)
+      ABSL_LOCKS_EXCLUDED(mu_);
   std::string NewIdLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 
   const SessionLimits limits_;

@@ -14,6 +14,7 @@
 #include "client/progress_bar.h"
 #include "core/analysis/mesh_report.h"
 #include "core/io/mesh_io.h"
+#include "core/learning/growth_watch.h"
 #include "core/learning/learner.h"
 #include "core/status_macros.h"
 
@@ -78,6 +79,9 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
   const size_t final_vertices = targets.back();
   bool header_printed = false;
   StopReason reason = StopReason::kTargetReached;
+  // A run whose mesh stops growing (too few points, all in one place) ends instead of spinning.
+  GrowthWatch growth(options.learner.c_vs, learner->num_vertices(), 0);
+  absl::Status stalled;
   for (size_t i = 0; i < targets.size(); ++i) {
     StopCriteria stop;
     stop.target_vertices = targets[i];
@@ -93,7 +97,9 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
       stop.time_budget = time_left;
       stop.observer = [&](const LearnerProgress& p) {
         bar.Update(p.vertices, final_vertices, absl::StrFormat("%d basic steps", p.basic_steps));
-        return !InterruptScope::interrupted();
+        if (InterruptScope::interrupted()) return false;
+        stalled = growth.Check(p.vertices, p.basic_steps);
+        return stalled.ok();
       };
       NM_ASSIGN_OR_RETURN(reason, learner->Run(stop));
     }
@@ -127,9 +133,14 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
   out << absl::StrFormat(
       "%s: %d vertices, %d faces, %d basic steps (%d splits, %d collapses) in %.2fs "
       "(%.0f steps/s); wrote %s\n",
-      StopReasonText(reason), progress.vertices, progress.faces, progress.basic_steps,
-      progress.splits, progress.collapses, seconds,
+      stalled.ok() ? StopReasonText(reason) : "stalled", progress.vertices, progress.faces,
+      progress.basic_steps, progress.splits, progress.collapses, seconds,
       seconds > 0 ? static_cast<double>(progress.basic_steps) / seconds : 0.0, options.output);
+  if (!stalled.ok()) {
+    return absl::Status(
+        stalled.code(),
+        absl::StrCat(stalled.message(), "; the mesh learned so far is in ", options.output));
+  }
   if (reason == StopReason::kObserver) {
     return absl::CancelledError(
         absl::StrCat("interrupted; the mesh learned so far is in ", options.output));

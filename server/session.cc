@@ -22,9 +22,6 @@ constexpr size_t kMaxArrivalSample = size_t{1} << 16;
 constexpr int kCoverageGrid = 8;
 constexpr double kCoverageThreshold = 0.9;
 constexpr size_t kMinCoverageSample = 256;
-// Learning counts as stalled after this many split intervals (C_vs Basic Steps each) without
-// a new largest vertex count; normal growth makes one every few splits.
-constexpr uint64_t kStallSplits = 2000;
 
 BoundingBox BoundsOf(absl::Span<const Vec3f> positions) {
   BoundingBox box;
@@ -350,8 +347,7 @@ SliceResult Session::RunSlice(absl::Time deadline) {
         return {SliceResult::kDone};
       }
       learner_ = *std::move(learner);
-      max_vertices_ = learner_->num_vertices();
-      steps_at_max_ = 0;
+      growth_.emplace(config_.learner.c_vs, learner_->num_vertices(), 0);
       absl::MutexLock lock(&mu_);
       if (state_ == v1::SESSION_STATE_COLLECTING) state_ = v1::SESSION_STATE_LEARNING;
     }
@@ -430,16 +426,10 @@ SliceResult Session::RunSlice(absl::Time deadline) {
       return {SliceResult::kDone};
     }
     UpdateLearningState();
-    const size_t grown = learner_->num_vertices();
-    const uint64_t steps = learner_->progress().basic_steps;
-    if (grown > max_vertices_) {
-      max_vertices_ = grown;
-      steps_at_max_ = steps;
-    } else if (steps - steps_at_max_ > kStallSplits * static_cast<uint64_t>(config_.learner.c_vs)) {
-      Fail(absl::FailedPreconditionError(absl::StrCat(
-          "learning stalled: the mesh has not grown past ", max_vertices_, " vertices in ",
-          steps - steps_at_max_, " Basic Steps (Step 3 collapses as many vertices as Step 2 ",
-          "splits); more points, another seed or a larger c_ec may help")));
+    if (absl::Status growth =
+            growth_->Check(learner_->num_vertices(), learner_->progress().basic_steps);
+        !growth.ok()) {
+      Fail(growth);
       return {SliceResult::kDone};
     }
   }

@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,7 @@
 #include "absl/types/span.h"
 #include "core/bounding_box.h"
 #include "core/io/draco_codec.h"
+#include "core/learning/growth_watch.h"
 #include "core/learning/learner.h"
 #include "core/point_cloud.h"
 #include "core/sampling/growing_point_cloud.h"
@@ -185,9 +187,7 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   absl::Duration learning_time_;
   absl::Time last_publish_time_ = absl::InfinitePast();
   uint64_t last_publish_steps_ = 0;
-  // Stall detection: the largest vertex count of the current learner and its step count then.
-  size_t max_vertices_ = 0;
-  uint64_t steps_at_max_ = 0;
+  std::optional<GrowthWatch> growth_;  // Stall detection for the current learner.
 };
 
 }  // namespace neuralmesh::server

@@ -173,6 +173,18 @@ TEST_F(CliErrorsTest, UploadOfTooManyBuiltinPoints) {
   EXPECT_TRUE(absl::StrContains(err, "--points must be at most 67108864")) << err;
 }
 
+TEST_F(CliErrorsTest, LearningThatStallsEndsWithTheMeshSoFar) {
+  std::string same;
+  for (int i = 0; i < 1000; ++i) same += "1 2 3\n";
+  const std::string input = WriteFile("same.xyz", same);
+  const std::string err =
+      ExpectFailure({"reconstruct", input, "-o", Output(), "--vertices", "200"});
+  EXPECT_TRUE(absl::StrContains(err, "learning stalled") &&
+              absl::StrContains(err, "the mesh learned so far is in " + Output()))
+      << err;
+  EXPECT_TRUE(std::filesystem::exists(Output()));
+}
+
 TEST_F(CliErrorsTest, UnknownCommand) {
   const std::string err = ExpectFailure({"reconstrukt"});
   EXPECT_TRUE(absl::StrContains(err, "unknown command 'reconstrukt'")) << err;

@@ -47,21 +47,22 @@ v1::PointBatch PackPointBatch(const PointCloud& cloud, size_t begin, size_t end)
   return batch;
 }
 
-class ReconstructionClient::OpenStream {
+class ReconstructionClient::OpenCall {
  public:
-  OpenStream(ReconstructionClient& client, grpc::ClientContext& context)
+  enum Kind { kSimple, kStream };
+  OpenCall(ReconstructionClient& client, grpc::ClientContext& context, Kind kind)
       : client_(client), context_(context) {
-    absl::MutexLock lock(&client_.streams_mu_);
-    if (client_.streams_cancelled_) context_.TryCancel();
-    client_.open_streams_.push_back(&context_);
+    absl::MutexLock lock(&client_.calls_mu_);
+    if (kind == kStream && client_.streams_cancelled_) context_.TryCancel();
+    client_.open_calls_.push_back(&context_);
   }
-  ~OpenStream() {
-    absl::MutexLock lock(&client_.streams_mu_);
-    auto& open = client_.open_streams_;
+  ~OpenCall() {
+    absl::MutexLock lock(&client_.calls_mu_);
+    auto& open = client_.open_calls_;
     open.erase(std::find(open.begin(), open.end(), &context_));
   }
-  OpenStream(const OpenStream&) = delete;
-  OpenStream& operator=(const OpenStream&) = delete;
+  OpenCall(const OpenCall&) = delete;
+  OpenCall& operator=(const OpenCall&) = delete;
 
  private:
   ReconstructionClient& client_;
@@ -102,6 +103,7 @@ void ReconstructionClient::SetDeadline(grpc::ClientContext& context, absl::Durat
 absl::StatusOr<v1::Session> ReconstructionClient::CreateSession(const v1::SessionConfig& config,
                                                                 const std::string& name) {
   grpc::ClientContext context;
+  const OpenCall open(*this, context, OpenCall::kSimple);
   SetDeadline(context, options_.call_timeout);
   v1::CreateSessionRequest request;
   *request.mutable_config() = config;
@@ -118,7 +120,7 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
   if (cloud.empty()) return absl::InvalidArgumentError("UploadPoints: no points to upload");
   if (batch_size == 0) return absl::InvalidArgumentError("UploadPoints: batch size must be > 0");
   grpc::ClientContext context;
-  const OpenStream open(*this, context);
+  const OpenCall open(*this, context, OpenCall::kStream);
   v1::UploadPointsResponse response;
   std::unique_ptr<grpc::ClientWriter<v1::UploadPointsRequest>> writer =
       stub_->UploadPoints(&context, &response);
@@ -141,7 +143,7 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
 absl::Status ReconstructionClient::Watch(const std::string& session_id, uint64_t after_sequence,
                                          const UpdateCallback& on_update) {
   grpc::ClientContext context;
-  const OpenStream open(*this, context);
+  const OpenCall open(*this, context, OpenCall::kStream);
   v1::WatchSessionRequest request;
   request.set_session_id(session_id);
   request.set_after_sequence(after_sequence);
@@ -167,7 +169,7 @@ absl::StatusOr<ReconstructResult> ReconstructionClient::Reconstruct(
   if (cloud.empty()) return absl::InvalidArgumentError("Reconstruct: no points to upload");
   if (batch_size == 0) return absl::InvalidArgumentError("Reconstruct: batch size must be > 0");
   grpc::ClientContext context;
-  const OpenStream open(*this, context);
+  const OpenCall open(*this, context, OpenCall::kStream);
   std::unique_ptr<grpc::ClientReaderWriter<v1::ReconstructRequest, v1::ReconstructResponse>>
       stream = stub_->Reconstruct(&context);
 
@@ -238,6 +240,7 @@ absl::StatusOr<ReconstructResult> ReconstructionClient::Reconstruct(
 
 absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& session_id) {
   grpc::ClientContext context;
+  const OpenCall open(*this, context, OpenCall::kSimple);
   SetDeadline(context, options_.call_timeout);
   v1::GetSessionRequest request;
   request.set_session_id(session_id);
@@ -249,6 +252,7 @@ absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& 
 
 absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions() {
   grpc::ClientContext context;
+  const OpenCall open(*this, context, OpenCall::kSimple);
   SetDeadline(context, options_.call_timeout);
   v1::ListSessionsResponse response;
   const grpc::Status status = stub_->ListSessions(&context, v1::ListSessionsRequest(), &response);
@@ -258,6 +262,7 @@ absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions() {
 
 absl::StatusOr<v1::Session> ReconstructionClient::Finish(const std::string& session_id) {
   grpc::ClientContext context;
+  const OpenCall open(*this, context, OpenCall::kSimple);
   SetDeadline(context, options_.call_timeout);
   v1::FinishSessionRequest request;
   request.set_session_id(session_id);
@@ -274,6 +279,7 @@ absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& sess
 absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& session_id,
                                                          absl::Duration timeout) {
   grpc::ClientContext context;
+  const OpenCall open(*this, context, OpenCall::kSimple);
   SetDeadline(context, timeout);
   v1::CancelSessionRequest request;
   request.set_session_id(session_id);
@@ -285,6 +291,7 @@ absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& sess
 
 absl::Status ReconstructionClient::Delete(const std::string& session_id) {
   grpc::ClientContext context;
+  const OpenCall open(*this, context, OpenCall::kSimple);
   SetDeadline(context, options_.call_timeout);
   v1::DeleteSessionRequest request;
   request.set_session_id(session_id);
@@ -296,6 +303,7 @@ absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& 
                                                              v1::MeshVersion version, bool wait,
                                                              absl::Duration timeout) {
   grpc::ClientContext context;
+  const OpenCall open(*this, context, OpenCall::kSimple);
   SetDeadline(context, timeout);
   v1::GetMeshRequest request;
   request.set_session_id(session_id);
@@ -307,10 +315,10 @@ absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& 
   return update;
 }
 
-void ReconstructionClient::CancelStreams() {
-  absl::MutexLock lock(&streams_mu_);
+void ReconstructionClient::CancelCalls() {
+  absl::MutexLock lock(&calls_mu_);
   streams_cancelled_ = true;
-  for (grpc::ClientContext* context : open_streams_) context->TryCancel();
+  for (grpc::ClientContext* context : open_calls_) context->TryCancel();
 }
 
 }  // namespace neuralmesh::client

@@ -136,14 +136,15 @@ class ReconstructionClient {
   absl::StatusOr<v1::MeshUpdate> GetMesh(const std::string& session_id, v1::MeshVersion version,
                                          bool wait, absl::Duration timeout);
 
-  // Ends every UploadPoints, Watch and Reconstruct call of this client that is open, and any
-  // started later, at once and without waiting for the server: each returns CANCELLED. The
-  // sessions go on (Cancel stops one). For a client that is being interrupted.
-  void CancelStreams();
+  // Ends every call of this client in flight at once, without waiting for the server: each
+  // returns CANCELLED; so does every UploadPoints, Watch and Reconstruct started later. Simple
+  // calls started later run as usual (so that the session can still be cancelled), and the
+  // sessions go on until then. For a client that is being interrupted.
+  void CancelCalls();
 
  private:
-  // Registers a streaming call's context for CancelStreams while the call is open.
-  class OpenStream;
+  // Registers a call's context for CancelCalls while the call is open.
+  class OpenCall;
 
   // A context whose deadline is `timeout` from now (none when infinite).
   static void SetDeadline(grpc::ClientContext& context, absl::Duration timeout);
@@ -152,9 +153,9 @@ class ReconstructionClient {
   ClientOptions options_;
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::ReconstructionService::Stub> stub_;
-  absl::Mutex streams_mu_;
-  std::vector<grpc::ClientContext*> open_streams_ ABSL_GUARDED_BY(streams_mu_);
-  bool streams_cancelled_ ABSL_GUARDED_BY(streams_mu_) = false;
+  absl::Mutex calls_mu_;
+  std::vector<grpc::ClientContext*> open_calls_ ABSL_GUARDED_BY(calls_mu_);
+  bool streams_cancelled_ ABSL_GUARDED_BY(calls_mu_) = false;
 };
 
 // One batch of `cloud`, points [begin, end), as packed little-endian float32.

@@ -137,7 +137,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   absl::Status interrupt_cancel;  // The server's answer to the cancel an interrupt sent.
   const auto on_interrupt = [&] {
     interrupted = true;
-    client->CancelStreams();
+    client->CancelCalls();
     interrupt_cancel = client->Cancel(id, kTidyCancelTimeout).status();
   };
   std::thread canceller([&] {

@@ -147,7 +147,7 @@ TEST_F(ReconstructionClientTest, CancelThenDeleteRemovesTheSession) {
 }
 
 // Watches a session in the background; the result is read after Join. A watch still open at
-// the end (a failed test) is ended with the client's CancelStreams.
+// the end (a failed test) is ended with the client's CancelCalls.
 class BackgroundWatch {
  public:
   BackgroundWatch(ReconstructionClient& client, const std::string& session_id)
@@ -156,7 +156,7 @@ class BackgroundWatch {
           ended_.Notify();
         }) {}
   ~BackgroundWatch() {
-    if (!ended_.HasBeenNotified()) client_.CancelStreams();
+    if (!ended_.HasBeenNotified()) client_.CancelCalls();
     Join().IgnoreError();
   }
   // Whether the watch ended within `timeout`.
@@ -173,15 +173,15 @@ class BackgroundWatch {
   std::thread thread_;
 };
 
-TEST_F(ReconstructionClientTest, CancelStreamsEndsOpenWatchesAtOnceAndLeavesTheSession) {
+TEST_F(ReconstructionClientTest, CancelCallsEndsOpenWatchesAtOnceAndLeavesTheSession) {
   absl::StatusOr<v1::Session> session = client_->CreateSession(SmallConfig(100), "quiet");
   ASSERT_TRUE(session.ok()) << session.status();
   const std::string id = session->session_id();
   // No points: the session never publishes a mesh, so the watch waits until it is ended.
   BackgroundWatch watch(*client_, id);
   EXPECT_FALSE(watch.EndsWithin(absl::Milliseconds(300))) << "nothing to end the watch yet";
-  client_->CancelStreams();
-  ASSERT_TRUE(watch.EndsWithin(absl::Seconds(5))) << "CancelStreams must end the watch";
+  client_->CancelCalls();
+  ASSERT_TRUE(watch.EndsWithin(absl::Seconds(5))) << "CancelCalls must end the watch";
   const absl::Status ended = watch.Join();
   EXPECT_TRUE(absl::IsCancelled(ended)) << ended;
   const absl::Status later = client_->Watch(id, 0, [](const v1::MeshUpdate&) { return true; });

@@ -657,7 +657,9 @@ grpc::ServerUnaryReactor* ReconstructionService::GetSession(
 grpc::ServerUnaryReactor* ReconstructionService::ListSessions(
     grpc::CallbackServerContext* context, const v1::ListSessionsRequest* request,
     v1::ListSessionsResponse* response) {
-  for (const std::shared_ptr<Session>& session : manager_->List()) {
+  absl::StatusOr<std::vector<std::shared_ptr<Session>>> sessions = manager_->List();
+  if (!sessions.ok()) return FinishUnary(context, sessions.status());
+  for (const std::shared_ptr<Session>& session : *sessions) {
     *response->add_sessions() = session->ToProto();
   }
   return FinishUnary(context, absl::OkStatus());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -104,9 +105,14 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch) {
   {
     absl::MutexLock ingest(&ingest_mu_);
     // Quantization: the first data fixes the cube; later data outside it grows the cube. A
-    // batch that no cube Draco can use would hold is refused before anything changes.
+    // batch that no cube Draco can use would hold is refused before anything changes. (A
+    // non-finite or empty batch has no cube to check: Append says what is wrong with it.)
     const BoundingBox batch_bounds = BoundsOf(batch.positions);
-    QuantizationBox box;
+    bool finite = true;
+    for (int c = 0; c < 3; ++c) {
+      finite &= std::isfinite(batch_bounds.min[c]) && std::isfinite(batch_bounds.max[c]);
+    }
+    std::optional<QuantizationBox> box;
     bool grown = false;
     {
       absl::MutexLock lock(&mu_);
@@ -116,13 +122,15 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch) {
                          " and accepts no more points"));
       }
       last_activity_ = absl::Now();
-      absl::StatusOr<QuantizationBox> cube = CubeWithLocked(batch_bounds, &grown);
-      if (!cube.ok()) {
-        return absl::Status(cube.status().code(),
-                            absl::StrCat(cube.status().message(), "; the session keeps its ",
-                                         points_.size(), " points accepted before"));
+      if (finite) {
+        absl::StatusOr<QuantizationBox> cube = CubeWithLocked(batch_bounds, &grown);
+        if (!cube.ok()) {
+          return absl::Status(cube.status().code(),
+                              absl::StrCat(cube.status().message(), "; the session keeps its ",
+                                           points_.size(), " points accepted before"));
+        }
+        box = *cube;
       }
-      box = *cube;
     }
     const size_t first_index = points_.size();
     if (absl::Status status = points_.Append(batch); !status.ok()) {
@@ -135,9 +143,11 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch) {
 
     absl::MutexLock lock(&mu_);
     // Only ingestion changes the cube, and ingest_mu_ is held: box_ is as CubeWithLocked saw it.
-    has_box_ = true;
-    box_ = box;
-    if (grown) ++epoch_;
+    if (box.has_value()) {
+      has_box_ = true;
+      box_ = *box;
+      if (grown) ++epoch_;
+    }
     learning_.set_points_received(total);
     learning_.set_allowed_vertices(AllowedVerticesLocked());
   }

@@ -79,8 +79,9 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Get(absl::string_view i
   return it->second;
 }
 
-std::vector<std::shared_ptr<Session>> SessionManager::List() const {
+absl::StatusOr<std::vector<std::shared_ptr<Session>>> SessionManager::List() const {
   absl::MutexLock lock(&mu_);
+  if (shutdown_) return absl::UnavailableError("the server is shutting down");
   std::vector<std::shared_ptr<Session>> out;
   out.reserve(order_.size());
   for (const auto& [index, id] : order_) out.push_back(sessions_.at(id));

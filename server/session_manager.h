@@ -54,8 +54,8 @@ class SessionManager {
   absl::StatusOr<std::shared_ptr<Session>> Get(absl::string_view id) const
       ABSL_LOCKS_EXCLUDED(mu_);
 
-  // Every session, oldest first.
-  std::vector<std::shared_ptr<Session>> List() const ABSL_LOCKS_EXCLUDED(mu_);
+  // Every session, oldest first; UNAVAILABLE after Shutdown.
+  absl::StatusOr<std::vector<std::shared_ptr<Session>>> List() const ABSL_LOCKS_EXCLUDED(mu_);
 
   // Removes the session; its watchers end with NOT_FOUND. NOT_FOUND when unknown, UNAVAILABLE
   // after Shutdown.

@@ -126,6 +126,14 @@ std::string GridProblem(const DracoGrid& grid, int components, int bits) {
   return "";
 }
 
+// GridProblem of a quantization box (as Draco reads it).
+std::string BoxProblem(const QuantizationBox& box, int bits) {
+  DracoGrid grid;
+  for (int c = 0; c < 3; ++c) grid.origin[c] = box.origin[c];
+  grid.range = box.range;
+  return GridProblem(grid, 3, bits);
+}
+
 // Checks that every position is finite, that Draco can quantize them (GridProblem) and, with a
 // fixed box, that each quantizes to a grid index inside [0, 2^bits - 1] of the box as Draco
 // reads it. A quarter step of slack lets callers use a box computed in float arithmetic whose
@@ -157,10 +165,7 @@ absl::Status CheckPositions(const std::vector<Vec3f>& positions, const DracoOpti
     }
     return text;
   };
-  DracoGrid grid;
-  for (int c = 0; c < 3; ++c) grid.origin[c] = box.origin[c];
-  grid.range = box.range;
-  const std::string problem = GridProblem(grid, 3, bits);
+  const std::string problem = BoxProblem(box, bits);
   if (!problem.empty()) {
     return absl::InvalidArgumentError(
         absl::StrCat("cannot quantize against ", describe(), ": its range is ", problem));
@@ -356,10 +361,7 @@ absl::Status CheckStreamStart(std::string_view bytes, uint64_t max_points) {
   const uint64_t limit =
       std::max<uint64_t>(kAlwaysAllowedElements, kMaxElementsPerByte * bytes.size());
   for (const auto& [what, count] : DeclaredCounts(*start, buffer)) {
-    if (count > limit) {
-      return absl::InvalidArgumentError(absl::StrCat("corrupt Draco data: it declares ", count, " ",
-                                                     what, " in only ", bytes.size(), " bytes"));
-    }
+    // The caller's limit first: data it refuses need not be judged corrupt.
     constexpr uint64_t kUnlimited = std::numeric_limits<uint64_t>::max();
     const bool faces = std::string_view(what) == "faces";
     const uint64_t allowed =
@@ -367,6 +369,10 @@ absl::Status CheckStreamStart(std::string_view bytes, uint64_t max_points) {
     if (count > allowed) {
       return absl::ResourceExhaustedError(absl::StrCat("the Draco data declares ", count, " ", what,
                                                        "; at most ", allowed, " are allowed"));
+    }
+    if (count > limit) {
+      return absl::InvalidArgumentError(absl::StrCat("corrupt Draco data: it declares ", count, " ",
+                                                     what, " in only ", bytes.size(), " bytes"));
     }
   }
   return absl::OkStatus();
@@ -487,11 +493,7 @@ absl::Status CheckQuantizationBox(const QuantizationBox& box, int bits) {
         absl::StrCat("the quantization box with origin (", box.origin[0], ", ", box.origin[1], ", ",
                      box.origin[2], ") and range ", box.range, " is not finite and positive"));
   }
-  const QuantizationBox read = BoxAsDracoReadsIt(box);
-  DracoGrid grid;
-  for (int c = 0; c < 3; ++c) grid.origin[c] = read.origin[c];
-  grid.range = read.range;
-  const std::string problem = GridProblem(grid, 3, bits);
+  const std::string problem = BoxProblem(BoxAsDracoReadsIt(box), bits);
   if (!problem.empty()) {
     return absl::InvalidArgumentError(
         absl::StrCat("Draco cannot quantize against a cube of range ", problem));

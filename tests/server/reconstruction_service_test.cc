@@ -48,6 +48,19 @@ class ReconstructionServiceTest : public ::testing::Test {
     return testing::UploadOne(*stub_, request, response != nullptr ? response : &ignored);
   }
 
+  // A Reconstruct call that has created a session of `target` vertices and sent `batch`.
+  std::unique_ptr<grpc::ClientReaderWriter<v1::ReconstructRequest, v1::ReconstructResponse>>
+  StartReconstruct(grpc::ClientContext& context, uint64_t target, const v1::PointBatch& batch) {
+    auto stream = stub_->Reconstruct(&context);
+    v1::ReconstructRequest start;
+    *start.mutable_start()->mutable_create() = CreateRequest(target);
+    EXPECT_TRUE(stream->Write(start));
+    v1::ReconstructRequest points;
+    *points.mutable_points() = batch;
+    EXPECT_TRUE(stream->Write(points));
+    return stream;
+  }
+
   std::unique_ptr<ReconstructionServer> server_;
   std::unique_ptr<v1::ReconstructionService::Stub> stub_;
 };
@@ -372,13 +385,9 @@ TEST_F(ReconstructionServiceTest, ReconstructDoesEverythingInOneCall) {
 TEST_F(ReconstructionServiceTest, ReconstructRejectsABadBatchAndTheSessionStays) {
   const PointCloud points = TorusPoints(2000, 15);
   grpc::ClientContext context;
-  auto stream = stub_->Reconstruct(&context);
-  v1::ReconstructRequest start;
-  *start.mutable_start()->mutable_create() = CreateRequest(100);
-  ASSERT_TRUE(stream->Write(start));
+  auto stream = StartReconstruct(context, 100, Batch(points, 0, 1000));
   v1::ReconstructRequest good;
   *good.mutable_points() = Batch(points, 0, 1000);
-  ASSERT_TRUE(stream->Write(good));
   v1::ReconstructRequest bad = good;
   bad.mutable_points()->mutable_packed()->mutable_positions()->resize(13);
   stream->Write(bad);
@@ -412,13 +421,7 @@ TEST_F(ReconstructionServiceTest, ACancelledReconstructLeavesTheSessionOpen) {
   const PointCloud points = TorusPoints(2000, 16);
   for (int attempt = 0; attempt < 5; ++attempt) {
     grpc::ClientContext context;
-    auto stream = stub_->Reconstruct(&context);
-    v1::ReconstructRequest start;
-    *start.mutable_start()->mutable_create() = CreateRequest(1000);
-    ASSERT_TRUE(stream->Write(start));
-    v1::ReconstructRequest batch;
-    *batch.mutable_points() = Batch(points, 0, 1000);
-    ASSERT_TRUE(stream->Write(batch));
+    auto stream = StartReconstruct(context, 1000, Batch(points, 0, 1000));
     std::string id;
     uint64_t acknowledged = 0;
     v1::ReconstructResponse response;
@@ -429,8 +432,13 @@ TEST_F(ReconstructionServiceTest, ACancelledReconstructLeavesTheSessionOpen) {
     ASSERT_EQ(acknowledged, 1000u);
     context.TryCancel();
     EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::CANCELLED);
-    absl::SleepFor(absl::Milliseconds(100));  // For the server to see the cancel.
-    const v1::Session session = testing::GetSession(*stub_, id);
+    // Once the server has seen the cancel, the call no longer watches the session.
+    v1::Session session = testing::GetSession(*stub_, id);
+    for (int i = 0; i < 500 && session.watchers() > 0; ++i) {
+      absl::SleepFor(absl::Milliseconds(10));
+      session = testing::GetSession(*stub_, id);
+    }
+    ASSERT_EQ(session.watchers(), 0u) << "the server did not end the cancelled call";
     EXPECT_EQ(session.learning().points_received(), 1000u);
     EXPECT_TRUE(session.state() == v1::SESSION_STATE_COLLECTING ||
                 session.state() == v1::SESSION_STATE_LEARNING)

@@ -34,6 +34,7 @@ TEST_F(SessionManagerTest, AfterShutdownCallsAreUnavailableNotNotFound) {
   manager.Shutdown(absl::UnavailableError("the server is shutting down"));
   EXPECT_TRUE(absl::IsUnavailable(manager.Get(id).status())) << manager.Get(id).status();
   EXPECT_TRUE(absl::IsUnavailable(manager.Delete(id)));
+  EXPECT_TRUE(absl::IsUnavailable(manager.List().status()));
   EXPECT_TRUE(absl::IsUnavailable(manager.Create(SmallConfig(), "late").status()));
 }
 

@@ -172,6 +172,8 @@ TEST_F(SessionTest, BadBatchesAreRejectedAndTheSessionKeepsItsPoints) {
   absl::StatusOr<size_t> result = session->AddPoints(nan);
   EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument) << result.status();
   EXPECT_THAT(std::string(result.status().message()), HasSubstr("300 points accepted before"));
+  EXPECT_THAT(std::string(result.status().message()),
+              HasSubstr("point 4 of the batch has a non-finite coordinate"));
 
   PointCloud inf = Slice(points, 300, 310);
   inf.positions[0][0] = INFINITY;

@@ -49,11 +49,13 @@ v1::PointBatch PackPointBatch(const PointCloud& cloud, size_t begin, size_t end)
 
 class ReconstructionClient::OpenCall {
  public:
-  enum Kind { kSimple, kStream };
-  OpenCall(ReconstructionClient& client, grpc::ClientContext& context, Kind kind)
+  // Whether the call runs after CancelCalls (a Cancel of the session) or is ended at once.
+  enum Kind { kEndedAfterCancelCalls, kRunsAfterCancelCalls };
+  OpenCall(ReconstructionClient& client, grpc::ClientContext& context,
+           Kind kind = kEndedAfterCancelCalls)
       : client_(client), context_(context) {
     absl::MutexLock lock(&client_.calls_mu_);
-    if (kind == kStream && client_.streams_cancelled_) context_.TryCancel();
+    if (kind == kEndedAfterCancelCalls && client_.calls_cancelled_) context_.TryCancel();
     client_.open_calls_.push_back(&context_);
   }
   ~OpenCall() {
@@ -103,7 +105,7 @@ void ReconstructionClient::SetDeadline(grpc::ClientContext& context, absl::Durat
 absl::StatusOr<v1::Session> ReconstructionClient::CreateSession(const v1::SessionConfig& config,
                                                                 const std::string& name) {
   grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kSimple);
+  const OpenCall open(*this, context);
   SetDeadline(context, options_.call_timeout);
   v1::CreateSessionRequest request;
   *request.mutable_config() = config;
@@ -120,7 +122,7 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
   if (cloud.empty()) return absl::InvalidArgumentError("UploadPoints: no points to upload");
   if (batch_size == 0) return absl::InvalidArgumentError("UploadPoints: batch size must be > 0");
   grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kStream);
+  const OpenCall open(*this, context);
   v1::UploadPointsResponse response;
   std::unique_ptr<grpc::ClientWriter<v1::UploadPointsRequest>> writer =
       stub_->UploadPoints(&context, &response);
@@ -143,7 +145,7 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
 absl::Status ReconstructionClient::Watch(const std::string& session_id, uint64_t after_sequence,
                                          const UpdateCallback& on_update) {
   grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kStream);
+  const OpenCall open(*this, context);
   v1::WatchSessionRequest request;
   request.set_session_id(session_id);
   request.set_after_sequence(after_sequence);
@@ -169,7 +171,7 @@ absl::StatusOr<ReconstructResult> ReconstructionClient::Reconstruct(
   if (cloud.empty()) return absl::InvalidArgumentError("Reconstruct: no points to upload");
   if (batch_size == 0) return absl::InvalidArgumentError("Reconstruct: batch size must be > 0");
   grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kStream);
+  const OpenCall open(*this, context);
   std::unique_ptr<grpc::ClientReaderWriter<v1::ReconstructRequest, v1::ReconstructResponse>>
       stream = stub_->Reconstruct(&context);
 
@@ -240,7 +242,7 @@ absl::StatusOr<ReconstructResult> ReconstructionClient::Reconstruct(
 
 absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& session_id) {
   grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kSimple);
+  const OpenCall open(*this, context);
   SetDeadline(context, options_.call_timeout);
   v1::GetSessionRequest request;
   request.set_session_id(session_id);
@@ -252,7 +254,7 @@ absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& 
 
 absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions() {
   grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kSimple);
+  const OpenCall open(*this, context);
   SetDeadline(context, options_.call_timeout);
   v1::ListSessionsResponse response;
   const grpc::Status status = stub_->ListSessions(&context, v1::ListSessionsRequest(), &response);
@@ -262,7 +264,7 @@ absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions() {
 
 absl::StatusOr<v1::Session> ReconstructionClient::Finish(const std::string& session_id) {
   grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kSimple);
+  const OpenCall open(*this, context);
   SetDeadline(context, options_.call_timeout);
   v1::FinishSessionRequest request;
   request.set_session_id(session_id);
@@ -279,7 +281,7 @@ absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& sess
 absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& session_id,
                                                          absl::Duration timeout) {
   grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kSimple);
+  const OpenCall open(*this, context, OpenCall::kRunsAfterCancelCalls);
   SetDeadline(context, timeout);
   v1::CancelSessionRequest request;
   request.set_session_id(session_id);
@@ -291,7 +293,7 @@ absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& sess
 
 absl::Status ReconstructionClient::Delete(const std::string& session_id) {
   grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kSimple);
+  const OpenCall open(*this, context);
   SetDeadline(context, options_.call_timeout);
   v1::DeleteSessionRequest request;
   request.set_session_id(session_id);
@@ -303,7 +305,7 @@ absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& 
                                                              v1::MeshVersion version, bool wait,
                                                              absl::Duration timeout) {
   grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kSimple);
+  const OpenCall open(*this, context);
   SetDeadline(context, timeout);
   v1::GetMeshRequest request;
   request.set_session_id(session_id);
@@ -317,7 +319,7 @@ absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& 
 
 void ReconstructionClient::CancelCalls() {
   absl::MutexLock lock(&calls_mu_);
-  streams_cancelled_ = true;
+  calls_cancelled_ = true;
   for (grpc::ClientContext* context : open_calls_) context->TryCancel();
 }
 

@@ -136,10 +136,9 @@ class ReconstructionClient {
   absl::StatusOr<v1::MeshUpdate> GetMesh(const std::string& session_id, v1::MeshVersion version,
                                          bool wait, absl::Duration timeout);
 
-  // Ends every call of this client in flight at once, without waiting for the server: each
-  // returns CANCELLED; so does every UploadPoints, Watch and Reconstruct started later. Simple
-  // calls started later run as usual (so that the session can still be cancelled), and the
-  // sessions go on until then. For a client that is being interrupted.
+  // Ends every call of this client in flight at once, without waiting for the server, and
+  // every call started later except Cancel: each returns CANCELLED. The sessions go on; Cancel
+  // still reaches the server, to stop one. For a client that is being interrupted.
   void CancelCalls();
 
  private:
@@ -155,7 +154,7 @@ class ReconstructionClient {
   std::unique_ptr<v1::ReconstructionService::Stub> stub_;
   absl::Mutex calls_mu_;
   std::vector<grpc::ClientContext*> open_calls_ ABSL_GUARDED_BY(calls_mu_);
-  bool streams_cancelled_ ABSL_GUARDED_BY(calls_mu_) = false;
+  bool calls_cancelled_ ABSL_GUARDED_BY(calls_mu_) = false;
 };
 
 // One batch of `cloud`, points [begin, end), as packed little-endian float32.

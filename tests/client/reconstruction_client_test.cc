@@ -173,7 +173,7 @@ class BackgroundWatch {
   std::thread thread_;
 };
 
-TEST_F(ReconstructionClientTest, CancelCallsEndsOpenWatchesAtOnceAndLeavesTheSession) {
+TEST_F(ReconstructionClientTest, CancelCallsEndsOpenAndLaterCallsButNotCancel) {
   absl::StatusOr<v1::Session> session = client_->CreateSession(SmallConfig(100), "quiet");
   ASSERT_TRUE(session.ok()) << session.status();
   const std::string id = session->session_id();
@@ -186,11 +186,18 @@ TEST_F(ReconstructionClientTest, CancelCallsEndsOpenWatchesAtOnceAndLeavesTheSes
   EXPECT_TRUE(absl::IsCancelled(ended)) << ended;
   const absl::Status later = client_->Watch(id, 0, [](const v1::MeshUpdate&) { return true; });
   EXPECT_TRUE(absl::IsCancelled(later)) << "a watch started afterwards ends at once: " << later;
+  EXPECT_TRUE(absl::IsCancelled(client_->Finish(id).status())) << "so does a simple call";
 
-  absl::StatusOr<v1::Session> after = client_->GetSession(id);
+  absl::StatusOr<std::unique_ptr<ReconstructionClient>> observer =
+      ReconstructionClient::Connect(server_->address());
+  ASSERT_TRUE(observer.ok()) << observer.status();
+  absl::StatusOr<v1::Session> after = (*observer)->GetSession(id);
   ASSERT_TRUE(after.ok()) << after.status();
   EXPECT_EQ(after->state(), v1::SESSION_STATE_COLLECTING) << "the session itself goes on";
-  EXPECT_TRUE(client_->Delete(id).ok());
+  absl::StatusOr<v1::Session> cancelled = client_->Cancel(id);
+  ASSERT_TRUE(cancelled.ok()) << "Cancel still reaches the server: " << cancelled.status();
+  EXPECT_EQ(cancelled->state(), v1::SESSION_STATE_CANCELLED);
+  EXPECT_TRUE((*observer)->Delete(id).ok());
 }
 
 // With a keepalive ping every 1.2 s: a live server answers them and keeps a quiet watch open

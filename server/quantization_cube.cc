@@ -13,7 +13,7 @@ bool IsFiniteBox(const QuantizationBox& box) {
          std::isfinite(box.origin[2]);
 }
 
-// DracoExactBox of a finite `box`, checked for Draco; `what` names the data in the message.
+// DracoExactBox of a finite `box`, checked for Draco; the message names `bounds`.
 absl::StatusOr<QuantizationBox> UsableCube(const QuantizationBox& box, int bits,
                                            const BoundingBox& bounds) {
   const auto refuse = [&](absl::string_view why) {

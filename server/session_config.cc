@@ -99,8 +99,9 @@ absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& 
   if (config.bounds.has_value()) {
     const absl::StatusOr<QuantizationBox> cube = QuantizationCube(
         *config.bounds, kDeclaredBoundsEnlargement, config.draco.position_quantization_bits);
-    if (!cube.ok())
+    if (!cube.ok()) {
       return absl::InvalidArgumentError(absl::StrCat("bounds: ", cube.status().message()));
+    }
   }
   return absl::OkStatus();
 }

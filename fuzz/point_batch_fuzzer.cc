@@ -16,7 +16,7 @@
 
 namespace {
 
-// Small enough that the fuzzer reaches the limit; the server's default is 4M.
+// Small enough that the fuzzer reaches the limit; the server's default is 2M.
 constexpr size_t kMaxBatchPoints = 4096;
 
 }  // namespace

@@ -34,6 +34,7 @@ const v1::MeshUpdate& LatestWinsWriter::StartUpdate() {
   in_flight_ = std::move(pending_);
   pending_.reset();
   writing_ = true;
+  final_written_ |= in_flight_->kind() == v1::UPDATE_KIND_FINAL;
   return *in_flight_;
 }
 
@@ -51,6 +52,10 @@ std::optional<absl::Status> LatestWinsWriter::TakeFinish() {
   if (!stopped_ && pending_ != nullptr) return std::nullopt;
   finished_ = true;
   return end_;
+}
+
+bool AcknowledgementGoesNext(const LatestWinsWriter& writer, bool last_write_was_update) {
+  return !writer.has_update() || last_write_was_update || writer.has_final_update();
 }
 
 }  // namespace neuralmesh::server

@@ -64,6 +64,12 @@ class LatestWinsWriter {
   bool CanWrite() const { return !writing_ && !stopped_ && !finished_; }
   // Whether an update waits to be written.
   bool has_update() const { return pending_ != nullptr; }
+  // Whether the update that waits is the session's final mesh.
+  bool has_final_update() const {
+    return pending_ != nullptr && pending_->kind() == v1::UPDATE_KIND_FINAL;
+  }
+  // Whether the final mesh has been handed to a write: nothing may follow it.
+  bool final_written() const { return final_written_; }
 
   // Starts the write of the waiting update and returns it; it stays alive until WriteDone.
   // Requires CanWrite() and has_update().
@@ -87,7 +93,15 @@ class LatestWinsWriter {
   bool writing_ = false;
   bool stopped_ = false;
   bool finished_ = false;
+  bool final_written_ = false;
 };
+
+// Reconstruct's rule for its acknowledgements (running point totals, latest wins like the
+// updates) when one and an update both wait: they alternate, so that neither starves, except
+// that the final mesh goes last, so an acknowledgement waiting with it goes first. Whether the
+// waiting acknowledgement goes next, given that the last write was an update or not. (One made
+// after the final mesh went out is dropped: see final_written.)
+bool AcknowledgementGoesNext(const LatestWinsWriter& writer, bool last_write_was_update);
 
 }  // namespace neuralmesh::server
 

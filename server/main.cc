@@ -27,7 +27,10 @@ ABSL_FLAG(absl::Duration, time_slice, absl::Milliseconds(20),
 ABSL_FLAG(int, max_sessions, 64, "Sessions held at once, in any state.");
 ABSL_FLAG(int64_t, max_points_per_session, int64_t{1} << 26,
           "Points one session accepts in total.");
-ABSL_FLAG(int64_t, max_batch_points, int64_t{1} << 22, "Points one batch may hold.");
+ABSL_FLAG(int64_t, max_batch_points,
+          static_cast<int64_t>(neuralmesh::server::SessionLimits().max_batch_points),
+          "Points one batch may hold. A packed batch takes 12 bytes a point, 28 with weights "
+          "and normals, and must also fit --max_message_bytes.");
 ABSL_FLAG(int, max_message_bytes, 64 << 20,
           "Largest gRPC message accepted or sent, in bytes.");
 ABSL_FLAG(absl::Duration, idle_timeout, absl::Minutes(30),
@@ -72,6 +75,18 @@ int main(int argc, char** argv) {
   options.limits.max_points_per_session = static_cast<size_t>(max_points);
   options.limits.max_batch_points = static_cast<size_t>(max_batch);
   options.limits.idle_timeout = absl::GetFlag(FLAGS_idle_timeout);
+  // PackedPoints: 12 bytes a point for the position, 4 for a weight, 12 for a normal.
+  constexpr int64_t kLargestPackedPointBytes = 28;
+  if (max_batch > options.max_message_bytes / kLargestPackedPointBytes) {
+    std::fprintf(stderr,
+                 "neuralmesh-server: warning: a packed batch of --max_batch_points=%lld points "
+                 "with weights and normals takes about %.0f bytes, more than "
+                 "--max_message_bytes=%d; gRPC refuses such messages before the server sees "
+                 "them\n",
+                 static_cast<long long>(max_batch),
+                 static_cast<double>(max_batch) * kLargestPackedPointBytes,
+                 options.max_message_bytes);
+  }
 
   absl::StatusOr<std::unique_ptr<neuralmesh::server::ReconstructionServer>> server =
       neuralmesh::server::ReconstructionServer::Start(options);

@@ -71,7 +71,15 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
   if (d.has_position_quantization_bits()) {
     config.draco.position_quantization_bits = d.position_quantization_bits().value();
   }
-  if (d.has_compression_speed()) config.draco.encode_speed = d.compression_speed().value();
+  if (d.has_compression_speed()) {
+    // Checked here, where the field has its API name (DracoOptions::Validate names its own).
+    const int speed = d.compression_speed().value();
+    if (speed < 0 || speed > kMaxDracoSpeed) {
+      return absl::InvalidArgumentError(absl::StrCat("DracoOptions.compression_speed is ", speed,
+                                                     "; it must be in [0, ", kMaxDracoSpeed, "]"));
+    }
+    config.draco.encode_speed = speed;
+  }
   if (d.has_decode_speed()) config.draco.decode_speed = d.decode_speed().value();
   if (proto.has_points_per_vertex()) {
     config.points_per_vertex = proto.points_per_vertex().value();

@@ -1,5 +1,6 @@
 #include "server/reconstruction_service.h"
 
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -32,14 +33,17 @@ grpc::ServerUnaryReactor* FinishUnary(grpc::CallbackServerContext* context,
   return reactor;
 }
 
-// Prefixes a batch error with where it happened and what was kept, keeping its code.
-absl::Status BatchError(const absl::Status& status, uint64_t batch_index, uint64_t points,
-                        uint64_t batches) {
+// Prefixes a batch error with where it happened and what the session keeps, keeping its code.
+// `batch_number` counts the call's batches from 1; `call_batches` and `call_points` are what
+// the call had added before it.
+absl::Status BatchError(const absl::Status& status, uint64_t batch_number, uint64_t call_batches,
+                        uint64_t call_points, size_t session_points) {
   return absl::Status(
       status.code(),
-      absl::StrCat("batch ", batch_index, " rejected: ", status.message(), " (this call had ",
-                   batches, " batches with ", points,
-                   " points accepted before; the session keeps them)"));
+      absl::StrCat("batch ", batch_number, " of this call rejected: ", status.message(),
+                   "; the session keeps its ", session_points, " points, ", call_points,
+                   " of them from the ", call_batches, call_batches == 1 ? " batch" : " batches",
+                   " this call sent before"));
 }
 
 // Resolves and ingests one batch into `session`. Returns the point count of the batch.
@@ -164,10 +168,14 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
 // pool meanwhile; the append never waits for it.
 //
 // The end: the client half-closes (OnReadDone(false)) and gets the counts with OK; a bad batch
-// finishes the call at once with its status (the batches before it stay in the session); Abort
-// at shutdown finishes with UNAVAILABLE while a read is outstanding, which gRPC completes
-// with OnReadDone(false), after which no read is started again.
+// finishes the call at once with its status (the batches before it stay in the session); so
+// does the session ending while the call is open (its update channel closes: deleted,
+// cancelled, failed or finished by another call), so that a call left open never keeps a
+// deleted session alive; Abort at shutdown finishes with UNAVAILABLE. gRPC completes a read
+// outstanding at Finish with OnReadDone(false), after which no read is started again. The
+// request is released after each batch, so an idle call holds no batch in memory.
 class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsRequest>,
+                            public UpdateSubscriber,
                             public LiveReactor {
  public:
   UploadReactor(SessionManager* manager, ReactorRegistry* reactors,
@@ -203,12 +211,34 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
       FinishOnce(absl::OkStatus());
       return;
     }
-    if (absl::Status status = HandleRequest(); !status.ok()) {
+    absl::Status status = HandleRequest();
+    request_ = v1::UploadPointsRequest();  // Frees the batch's memory (up to a message's size).
+    if (!status.ok()) {
       FinishOnce(status);
       return;
     }
     absl::MutexLock lock(&mu_);
     if (!finished_) StartRead(&request_);
+  }
+
+  // Mesh updates are not this call's business.
+  void OnUpdate(const MeshUpdatePtr&) override {}
+
+  // The session accepts no more points: the call ends now rather than at its next batch.
+  // Deletion and shutdown keep their codes; a session that finished, was cancelled or failed
+  // is FAILED_PRECONDITION, as a batch sent to it would be. (session_ was set before the
+  // subscription that leads here.)
+  void OnClose(const absl::Status& status) override {
+    const std::string why = status.ok() ? absl::StrCat("session ", session_->id(), " is finished")
+                                        : std::string(status.message());
+    const absl::StatusCode code = status.code() == absl::StatusCode::kNotFound ||
+                                          status.code() == absl::StatusCode::kUnavailable
+                                      ? status.code()
+                                      : absl::StatusCode::kFailedPrecondition;
+    absl::MutexLock lock(&mu_);
+    FinishLocked(absl::Status(
+        code, absl::StrCat(why, "; it accepts no more points (this call had added ", points_,
+                           " points in ", batches_, batches_ == 1 ? " batch)" : " batches)")));
   }
 
   void Abort(const absl::Status& status) override {
@@ -217,20 +247,23 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
   }
 
   void OnDone() override {
-    if (session_ != nullptr) session_->RemoveStream();
+    if (session_ != nullptr) {
+      if (subscribed_) session_->updates().Unsubscribe(handle_);
+      session_->RemoveStream();
+    }
     if (registered_) reactors_->Remove(this);
     delete this;
   }
 
  private:
   absl::Status HandleRequest() {
-    uint64_t index = 0, points = 0, batches = 0;
+    uint64_t points = 0, batches = 0;
     {
       absl::MutexLock lock(&mu_);
-      index = batches_ + rejected_;
       points = points_;
       batches = batches_;
     }
+    const uint64_t batch_number = batches + 1;
     if (session_ == nullptr) {
       if (request_.session_id().empty()) {
         return absl::InvalidArgumentError("the first message must set session_id");
@@ -240,21 +273,31 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
       session_ = *std::move(session);
       session_->AddStream();
     } else if (!request_.session_id().empty() && request_.session_id() != session_->id()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "message ", index, " names session \"", request_.session_id(),
-          "\" but this call uploads into \"", session_->id(), "\""));
+      return absl::InvalidArgumentError(
+          absl::StrCat("batch ", batch_number, " of this call names session ",
+                       QuotedSessionId(request_.session_id()), " but this call uploads into \"",
+                       session_->id(), "\""));
     }
     uint64_t total = 0;
     absl::StatusOr<size_t> accepted =
         Ingest(*session_, request_.batch(), manager_->limits().max_batch_points, &total);
     if (!accepted.ok()) {
-      ++rejected_;
-      return BatchError(accepted.status(), index, points, batches);
+      return BatchError(accepted.status(), batch_number, batches, points,
+                        session_->points_received());
     }
-    absl::MutexLock lock(&mu_);
-    points_ += *accepted;
-    ++batches_;
-    total_ = total;
+    {
+      absl::MutexLock lock(&mu_);
+      points_ += *accepted;
+      ++batches_;
+      total_ = total;
+    }
+    if (!subscribed_) {
+      // After the first batch, so that a session that had ended already refuses it in its own
+      // words. No update is wanted (the sequence filter passes none), only OnClose, which
+      // comes at once if the session ended since.
+      handle_ = session_->updates().Subscribe(this, std::numeric_limits<uint64_t>::max());
+      subscribed_ = true;
+    }
     return absl::OkStatus();
   }
 
@@ -273,10 +316,12 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
   ReactorRegistry* const reactors_;
   v1::UploadPointsResponse* const response_;
   bool registered_ = false;
-  // Read-side state: touched only by the constructor and OnReadDone, which gRPC serialises.
+  // Read-side state: touched only by the constructor and OnReadDone, which gRPC serialises,
+  // and by OnDone after every other reaction.
   v1::UploadPointsRequest request_;
   std::shared_ptr<Session> session_;
-  uint64_t rejected_ = 0;
+  uint64_t handle_ = 0;
+  bool subscribed_ = false;
 
   absl::Mutex mu_;
   bool finished_ ABSL_GUARDED_BY(mu_) = false;
@@ -296,7 +341,8 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
 // totals and updates are snapshots, so for both only the newest matters: `writer_`
 // (latest_wins_writer.h) keeps one waiting update, the reactor one waiting acknowledgement,
 // each replaced by a newer one while a write is in flight (latest wins, as in WatchSession),
-// and the reactor alternates between the two kinds when both wait so neither starves. The
+// and the reactor alternates between the two kinds when both wait so neither starves, except
+// that the final mesh always goes last (an acknowledgement waiting with it goes first). The
 // response being written lives in `out_` until OnWriteDone. Memory per call is therefore
 // bounded by a few responses however slowly the client reads, and neither ingestion nor
 // learning ever waits for the writer.
@@ -339,6 +385,7 @@ class ReconstructReactor final
       return;
     }
     absl::Status status = session_ == nullptr ? Start() : Points();
+    request_ = v1::ReconstructRequest();  // Frees the batch's memory (up to a message's size).
     if (!status.ok()) {
       End(status);
       return;
@@ -430,18 +477,18 @@ class ReconstructReactor final
   }
 
   absl::Status Points() {
-    const uint64_t index = batches_ + rejected_ + 1;  // Request 0 was the start.
+    const uint64_t batch_number = batches_ + 1;
     if (request_.kind_case() != v1::ReconstructRequest::kPoints) {
       return absl::InvalidArgumentError(
-          absl::StrCat("request ", index, " is not a point batch; only the first request ",
-                       "may be a ReconstructStart"));
+          absl::StrCat("request ", batch_number + 1, " of this call is not a point batch; only ",
+                       "the first request may be a ReconstructStart"));
     }
     uint64_t total = 0;
     absl::StatusOr<size_t> accepted =
         Ingest(*session_, request_.points(), manager_->limits().max_batch_points, &total);
     if (!accepted.ok()) {
-      ++rejected_;
-      return BatchError(accepted.status(), index, points_, batches_);
+      return BatchError(accepted.status(), batch_number, batches_, points_,
+                        session_->points_received());
     }
     points_ += *accepted;
     ++batches_;
@@ -482,13 +529,17 @@ class ReconstructReactor final
     MaybeWriteLocked();
   }
 
+  // The final mesh is the last response: an acknowledgement waiting with it goes first, and one
+  // made after it was written (a batch accepted just before another call finished the
+  // session) is dropped.
   void MaybeWriteLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+    if (writer_.final_written()) pending_ack_.reset();
     if (writer_.CanWrite()) {
       if (pending_session_.has_value()) {
         *out_.mutable_session() = *std::move(pending_session_);
         pending_session_.reset();
         writer_.StartOther();
-      } else if (pending_ack_.has_value() && (!writer_.has_update() || last_was_update_)) {
+      } else if (pending_ack_.has_value() && AcknowledgementGoesNext(writer_, last_was_update_)) {
         *out_.mutable_ack() = *std::move(pending_ack_);
         pending_ack_.reset();
         last_was_update_ = false;
@@ -517,7 +568,6 @@ class ReconstructReactor final
   bool subscribed_ = false;
   uint64_t points_ = 0;
   uint64_t batches_ = 0;
-  uint64_t rejected_ = 0;
 
   absl::Mutex mu_;
   LatestWinsWriter writer_ ABSL_GUARDED_BY(mu_);

@@ -124,20 +124,12 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch) {
       last_activity_ = absl::Now();
       if (finite) {
         absl::StatusOr<QuantizationBox> cube = CubeWithLocked(batch_bounds, &grown);
-        if (!cube.ok()) {
-          return absl::Status(cube.status().code(),
-                              absl::StrCat(cube.status().message(), "; the session keeps its ",
-                                           points_.size(), " points accepted before"));
-        }
+        if (!cube.ok()) return cube.status();
         box = *cube;
       }
     }
     const size_t first_index = points_.size();
-    if (absl::Status status = points_.Append(batch); !status.ok()) {
-      return absl::Status(status.code(),
-                          absl::StrCat(status.message(), "; the session keeps its ",
-                                       first_index, " points accepted before"));
-    }
+    NM_RETURN_IF_ERROR(points_.Append(batch));
     RecordArrivalSampleLocked(batch.positions, first_index);
     total = points_.size();
 

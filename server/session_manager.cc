@@ -12,8 +12,18 @@ namespace neuralmesh::server {
 namespace {
 
 constexpr size_t kMaxNameBytes = 256;
+constexpr size_t kMaxQuotedIdBytes = 64;
+
+absl::Status UnknownSession(absl::string_view id) {
+  return absl::NotFoundError(absl::StrCat("no session with id ", QuotedSessionId(id)));
+}
 
 }  // namespace
+
+std::string QuotedSessionId(absl::string_view id) {
+  if (id.size() <= kMaxQuotedIdBytes) return absl::StrCat("\"", id, "\"");
+  return absl::StrCat("\"", id.substr(0, kMaxQuotedIdBytes), "...\" (", id.size(), " bytes)");
+}
 
 SessionManager::SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder)
     : limits_(limits), pool_(pool), encoder_(encoder) {
@@ -71,7 +81,7 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Get(absl::string_view i
   if (shutdown_) return absl::UnavailableError("the server is shutting down");
   auto it = sessions_.find(std::string(id));
   if (it == sessions_.end()) {
-    return absl::NotFoundError(absl::StrCat("no session with id \"", id, "\""));
+    return UnknownSession(id);
   }
   // Touched under the lock, so that the reaper, which checks idleness again under it before it
   // deletes, never deletes a session a caller has just got.
@@ -101,7 +111,7 @@ absl::Status SessionManager::DeleteUnlessActive(absl::string_view id,
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
     auto it = sessions_.find(std::string(id));
     if (it == sessions_.end()) {
-      return absl::NotFoundError(absl::StrCat("no session with id \"", id, "\""));
+      return UnknownSession(id);
     }
     if (idle_at.has_value() && !it->second->IdleSince(*idle_at, limits_.idle_timeout)) {
       return absl::FailedPreconditionError(absl::StrCat("session ", id, " is active again"));

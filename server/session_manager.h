@@ -28,11 +28,19 @@ namespace neuralmesh::server {
 struct SessionLimits {
   size_t max_sessions = 64;                // Sessions held at once, in any state.
   size_t max_points_per_session = 1u << 26;  // 67M points.
-  size_t max_batch_points = 1u << 22;      // 4M points per batch.
+  // Points per batch: 2M, so that a packed batch of as many points with weights and normals
+  // (28 bytes a point) fits the default message limit of 64 MiB.
+  size_t max_batch_points = 1u << 21;
   // Sessions without an open stream and without activity (RPCs, learning) for this long are
   // deleted. InfiniteDuration: never.
   absl::Duration idle_timeout = absl::Minutes(30);
 };
+
+// `id`, as a client sent it, quoted for a status message: cut to its first 64 bytes, with its
+// length, when longer (ids the server makes have 18), so that an error about a bogus id never
+// outgrows the client's metadata limit (8 KB by default), which turns it into
+// RESOURCE_EXHAUSTED.
+std::string QuotedSessionId(absl::string_view id);
 
 class SessionManager {
  public:

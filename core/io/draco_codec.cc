@@ -508,8 +508,8 @@ absl::Status DracoOptions::Validate() const {
       CheckRange("normal_quantization_bits", normal_quantization_bits, 2, kMaxQuantizationBits));
   NM_RETURN_IF_ERROR(
       CheckRange("weight_quantization_bits", weight_quantization_bits, 1, kMaxQuantizationBits));
-  NM_RETURN_IF_ERROR(CheckRange("encode_speed", encode_speed, 0, 10));
-  NM_RETURN_IF_ERROR(CheckRange("decode_speed", decode_speed, 0, 10));
+  NM_RETURN_IF_ERROR(CheckRange("encode_speed", encode_speed, 0, kMaxDracoSpeed));
+  NM_RETURN_IF_ERROR(CheckRange("decode_speed", decode_speed, 0, kMaxDracoSpeed));
   if (quantization_box.has_value()) {
     const QuantizationBox& box = *quantization_box;
     if (!IsFinite(box.origin)) {

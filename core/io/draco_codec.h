@@ -41,14 +41,16 @@ struct QuantizationBox {
 // at 28); at 30 bits its mesh encoder crashes. More than 24 bits, a float's significand, add
 // no precision to float positions.
 inline constexpr int kMaxQuantizationBits = 24;
+// Draco's speed settings run from 0 (smallest output) to this (fastest).
+inline constexpr int kMaxDracoSpeed = 10;
 
 struct DracoOptions {
   int position_quantization_bits = 11;  // 1..kMaxQuantizationBits.
   int normal_quantization_bits = 10;    // 2..kMaxQuantizationBits; point-cloud normals.
   int weight_quantization_bits = 16;    // 1..kMaxQuantizationBits; point weights, against
                                         // their own min..max.
-  int encode_speed = 5;                 // 0 (smallest output) .. 10 (fastest).
-  int decode_speed = 5;                 // 0 .. 10.
+  int encode_speed = 5;                 // 0 (smallest output) .. kMaxDracoSpeed (fastest).
+  int decode_speed = 5;                 // 0 .. kMaxDracoSpeed.
   // Meshes under 64 vertices are also encoded at speeds 0 and 10, and the shortest stream is
   // kept. Draco's fixed cost (about 70 bytes) dominates such meshes, and which settings save
   // most varies from mesh to mesh (a few bytes at 10-30 vertices); each try takes about 0.1 ms. Every variant decodes to the same mesh,

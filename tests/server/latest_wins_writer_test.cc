@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <optional>
+#include <utility>
 
 namespace neuralmesh::server {
 namespace {
@@ -141,6 +142,28 @@ TEST(LatestWinsWriterTest, OtherMessagesShareTheOneOutstandingWrite) {
   EXPECT_EQ(Step(writer), 1u);
   writer.WriteDone();
   EXPECT_TRUE(writer.TakeFinish().has_value());
+}
+
+// Reconstruct's acknowledgements alternate with updates, but the final mesh is the last
+// response: a slow reader once got an acknowledgement after it.
+TEST(LatestWinsWriterTest, AnAcknowledgementNeverFollowsTheFinalMesh) {
+  LatestWinsWriter writer;
+  EXPECT_TRUE(AcknowledgementGoesNext(writer, false)) << "no update waits";
+  writer.Offer(Update(1));
+  EXPECT_FALSE(AcknowledgementGoesNext(writer, false)) << "after an acknowledgement, the update";
+  EXPECT_TRUE(AcknowledgementGoesNext(writer, true)) << "after an update, the acknowledgement";
+
+  auto final_update = std::make_shared<v1::MeshUpdate>();
+  final_update->set_sequence(2);
+  final_update->set_kind(v1::UPDATE_KIND_FINAL);
+  writer.Offer(std::move(final_update));
+  EXPECT_TRUE(writer.has_final_update());
+  EXPECT_TRUE(AcknowledgementGoesNext(writer, false))
+      << "an acknowledgement waiting with the final mesh goes before it, whatever went last";
+  EXPECT_FALSE(writer.final_written());
+  ASSERT_EQ(Step(writer), 2u);
+  EXPECT_TRUE(writer.final_written()) << "nothing may be written after this";
+  EXPECT_FALSE(writer.has_final_update());
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <string>
 #include <thread>
@@ -126,6 +127,11 @@ TEST_F(ReconstructionServiceTest, InvalidOptionsAreInvalidArgumentNamingTheField
   }
   {
     v1::CreateSessionRequest r = CreateRequest(100);
+    r.mutable_config()->mutable_draco()->mutable_compression_speed()->set_value(11);
+    cases.push_back({"compression speed 11", r, "DracoOptions.compression_speed is 11"});
+  }
+  {
+    v1::CreateSessionRequest r = CreateRequest(100);
     r.mutable_config()->mutable_points_per_vertex()->set_value(-1);
     cases.push_back({"negative points_per_vertex", r, "points_per_vertex"});
   }
@@ -165,10 +171,10 @@ TEST_F(ReconstructionServiceTest, EveryBadInputGetsItsStatusAndTheSessionGoesOn)
     PointCloud bad;
     bad.positions = {Vec3f(0, 0, 0), Vec3f(std::nanf(""), 0, 0)};
     cases.push_back({"NaN coordinate", Request(id, testing::Batch(bad, 0, 2)),
-                     grpc::StatusCode::INVALID_ARGUMENT, "batch 0 rejected"});
+                     grpc::StatusCode::INVALID_ARGUMENT, "batch 1 of this call rejected"});
     bad.positions[1] = Vec3f(0, INFINITY, 0);
     cases.push_back({"infinite coordinate", Request(id, testing::Batch(bad, 0, 2)),
-                     grpc::StatusCode::INVALID_ARGUMENT, "1000 points accepted before"});
+                     grpc::StatusCode::INVALID_ARGUMENT, "the session keeps its 1000 points"});
   }
   {
     v1::PointBatch batch = Batch(points, 1000, 1010);
@@ -220,8 +226,10 @@ TEST_F(ReconstructionServiceTest, EveryBadInputGetsItsStatusAndTheSessionGoesOn)
     writer->WritesDone();
     grpc::Status status = writer->Finish();
     EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-    EXPECT_THAT(status.error_message(), HasSubstr("batch 1 rejected"));
-    EXPECT_THAT(status.error_message(), HasSubstr("1 batches with 500 points accepted before"));
+    EXPECT_THAT(status.error_message(), HasSubstr("batch 2 of this call rejected"));
+    EXPECT_THAT(status.error_message(),
+                HasSubstr("the session keeps its 1500 points, 500 of them from the 1 batch this "
+                          "call sent before"));
   }
   EXPECT_EQ(testing::GetSession(*stub_, id).learning().points_received(), 1500u);
 
@@ -399,7 +407,7 @@ TEST_F(ReconstructionServiceTest, ReconstructRejectsABadBatchAndTheSessionStays)
   }
   grpc::Status status = stream->Finish();
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_THAT(status.error_message(), HasSubstr("batch 2 rejected"));
+  EXPECT_THAT(status.error_message(), HasSubstr("batch 2 of this call rejected"));
   ASSERT_FALSE(id.empty());
   v1::Session session = testing::GetSession(*stub_, id);
   EXPECT_EQ(session.learning().points_received(), 1000u) << "the good batch stays";
@@ -526,6 +534,66 @@ TEST_F(ReconstructionServiceTest, CancelAndDeleteEndWatchers) {
   watcher2.join();
   EXPECT_EQ(watch_status.error_code(), grpc::StatusCode::NOT_FOUND);
   EXPECT_THAT(watch_status.error_message(), HasSubstr("deleted"));
+}
+
+// An upload left open must not outlive its session: deleting the session once left the call
+// open, holding the deleted session's points, until the client sent its next batch. Deletion,
+// cancellation and another call's finish now end it at once, with what it had added.
+TEST_F(ReconstructionServiceTest, AnOpenUploadEndsWhenItsSessionEnds) {
+  const PointCloud points = TorusPoints(2000, 19);
+  enum class End { kDelete, kCancel, kFinish };
+  for (const End end : {End::kDelete, End::kCancel, End::kFinish}) {
+    const std::string id = MustCreate(*stub_, CreateRequest(200));
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
+    v1::UploadPointsResponse response;
+    auto writer = stub_->UploadPoints(&context, &response);
+    ASSERT_TRUE(writer->Write(Request(id, Batch(points, 0, 1000))));
+    while (testing::GetSession(*stub_, id).learning().points_received() < 1000) {
+      absl::SleepFor(absl::Milliseconds(5));
+    }
+    grpc::ClientContext control;
+    switch (end) {
+      case End::kDelete: {
+        v1::DeleteSessionRequest request;
+        request.set_session_id(id);
+        v1::DeleteSessionResponse deleted;
+        ASSERT_TRUE(stub_->DeleteSession(&control, request, &deleted).ok());
+        break;
+      }
+      case End::kCancel: {
+        v1::CancelSessionRequest request;
+        request.set_session_id(id);
+        v1::Session session;
+        ASSERT_TRUE(stub_->CancelSession(&control, request, &session).ok());
+        break;
+      }
+      case End::kFinish:
+        ASSERT_TRUE(testing::Finish(*stub_, id).ok());
+        break;
+    }
+    // No WritesDone: the server ends the call by itself.
+    const grpc::Status status = writer->Finish();
+    const grpc::StatusCode expected =
+        end == End::kDelete ? grpc::StatusCode::NOT_FOUND : grpc::StatusCode::FAILED_PRECONDITION;
+    EXPECT_EQ(status.error_code(), expected) << status.error_message();
+    EXPECT_THAT(status.error_message(), HasSubstr("accepts no more points"));
+    EXPECT_THAT(status.error_message(), HasSubstr("this call had added 1000 points in 1 batch"));
+  }
+}
+
+// Ids are echoed in status messages; a bogus one of any length must still get NOT_FOUND, not
+// a message too large for the client's metadata limit (RESOURCE_EXHAUSTED from 9 KB on).
+TEST_F(ReconstructionServiceTest, AnUnknownIdOfAnyLengthIsNotFoundWithAShortMessage) {
+  const std::string id(10000, 'x');
+  grpc::ClientContext context;
+  v1::GetSessionRequest request;
+  request.set_session_id(id);
+  v1::Session session;
+  const grpc::Status status = stub_->GetSession(&context, request, &session);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("(10000 bytes)"));
+  EXPECT_LT(status.error_message().size(), 200u);
 }
 
 TEST_F(ReconstructionServiceTest, ShutdownEndsEveryOpenStream) {

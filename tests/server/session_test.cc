@@ -171,7 +171,6 @@ TEST_F(SessionTest, BadBatchesAreRejectedAndTheSessionKeepsItsPoints) {
   nan.positions[4][1] = std::nanf("");
   absl::StatusOr<size_t> result = session->AddPoints(nan);
   EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument) << result.status();
-  EXPECT_THAT(std::string(result.status().message()), HasSubstr("300 points accepted before"));
   EXPECT_THAT(std::string(result.status().message()),
               HasSubstr("point 4 of the batch has a non-finite coordinate"));
 
@@ -212,8 +211,6 @@ TEST_F(SessionTest, ABatchNoQuantizationCubeCanHoldIsRefused) {
     const absl::StatusOr<size_t> result = session->AddPoints(huge);
     EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument)
         << far << ": " << result.status();
-    EXPECT_THAT(std::string(result.status().message()),
-                HasSubstr("300 points accepted before"));
   }
   EXPECT_EQ(session->points_received(), 300u) << "refused batches add nothing";
   ASSERT_TRUE(session->AddPoints(Slice(points, 300, 600)).ok()) << "the session goes on";

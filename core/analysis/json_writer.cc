@@ -6,14 +6,58 @@
 #include "absl/strings/str_cat.h"
 
 namespace neuralmesh {
+namespace {
+
+// The length of the well-formed UTF-8 sequence that starts at value[i] (RFC 3629: no overlong
+// forms, no surrogates, nothing above U+10FFFF), or 0 when none does. Requires value[i] >= 0x80.
+size_t Utf8SequenceLength(absl::string_view value, size_t i) {
+  const auto byte = [&](size_t k) { return static_cast<unsigned char>(value[k]); };
+  const unsigned char lead = byte(i);
+  size_t length = 0;
+  unsigned char second_min = 0x80, second_max = 0xbf;
+  if (lead >= 0xc2 && lead <= 0xdf) {
+    length = 2;
+  } else if (lead >= 0xe0 && lead <= 0xef) {
+    length = 3;
+    if (lead == 0xe0) second_min = 0xa0;
+    if (lead == 0xed) second_max = 0x9f;
+  } else if (lead >= 0xf0 && lead <= 0xf4) {
+    length = 4;
+    if (lead == 0xf0) second_min = 0x90;
+    if (lead == 0xf4) second_max = 0x8f;
+  } else {
+    return 0;
+  }
+  if (value.size() - i < length) return 0;
+  if (byte(i + 1) < second_min || byte(i + 1) > second_max) return 0;
+  for (size_t k = i + 2; k < i + length; ++k) {
+    if (byte(k) < 0x80 || byte(k) > 0xbf) return 0;
+  }
+  return length;
+}
+
+}  // namespace
 
 std::string JsonWriter::Quote(absl::string_view value) {
   static constexpr char kHex[] = "0123456789abcdef";
   std::string out;
   out.reserve(value.size() + 2);
   out.push_back('"');
-  for (const char ch : value) {
+  for (size_t i = 0; i < value.size(); ++i) {
+    const char ch = value[i];
     const unsigned char c = static_cast<unsigned char>(ch);
+    if (c >= 0x80) {
+      // JSON text is UTF-8: a byte that starts no well-formed sequence (a file name in
+      // Latin-1, say) becomes U+FFFD, the replacement character, instead of invalid output.
+      const size_t length = Utf8SequenceLength(value, i);
+      if (length == 0) {
+        out += "\\ufffd";
+      } else {
+        out.append(value.data() + i, length);
+        i += length - 1;
+      }
+      continue;
+    }
     switch (c) {
       case '"':
         out += "\\\"";

@@ -51,7 +51,8 @@ class JsonWriter {
   // JSON value (misuse, unclosed containers, or nothing written).
   absl::StatusOr<std::string> Finish() const;
 
-  // `value` as a quoted JSON string literal: ", \ and control characters escaped.
+  // `value` as a quoted JSON string literal: ", \ and control characters escaped, and each byte
+  // that starts no well-formed UTF-8 sequence written as \ufffd (the replacement character).
   static std::string Quote(absl::string_view value);
 
  private:

@@ -1,6 +1,7 @@
 #include "core/analysis/triangle_tree.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -60,6 +61,43 @@ inline double TriangleBoxDistance2(const Vec3f& a, const Vec3f& b, const Vec3f& 
   return BoxDistance2(lo, hi, p);
 }
 
+// The faces of `mesh` without repeats, in index order: of the faces with the same corner
+// positions in the same cyclic order, the first. A box is nearer to a point off the plane of
+// its triangle than the triangle is, so copies of a triangle never prune each other and a
+// query used to test every copy: a reference of 5,000 copies of one face took 85 s to
+// evaluate. Copies give the same distances, and the first gives the same face as before.
+// (A copy of opposite orientation is kept: its normal differs.) O(f log f).
+std::vector<uint32_t> DistinctFaces(const TriangleMesh& mesh) {
+  using Key = std::array<float, 9>;
+  const size_t n = mesh.faces.size();
+  std::vector<Key> keys(n);
+  for (size_t f = 0; f < n; ++f) {
+    std::array<Vec3f, 3> corners;
+    for (int i = 0; i < 3; ++i) corners[i] = mesh.positions[mesh.faces[f][i]];
+    const auto less = [](const Vec3f& a, const Vec3f& b) {
+      return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+    };
+    // The cyclic rotation that starts at the smallest corner.
+    const int first =
+        static_cast<int>(std::min_element(corners.begin(), corners.end(), less) - corners.begin());
+    for (int i = 0; i < 3; ++i) {
+      const Vec3f& c = corners[(first + i) % 3];
+      for (int j = 0; j < 3; ++j) keys[f][3 * i + j] = c[j];
+    }
+  }
+  std::vector<uint32_t> order(n);
+  for (size_t f = 0; f < n; ++f) order[f] = static_cast<uint32_t>(f);
+  std::sort(order.begin(), order.end(), [&keys](uint32_t a, uint32_t b) {
+    return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
+  });
+  std::vector<uint32_t> kept;
+  kept.reserve(n);
+  for (size_t k = 0; k < n; ++k) {
+    if (k == 0 || keys[order[k]] != keys[order[k - 1]]) kept.push_back(order[k]);
+  }
+  std::sort(kept.begin(), kept.end());
+  return kept;
+}
 
 }  // namespace
 
@@ -93,17 +131,19 @@ absl::StatusOr<TriangleTree> TriangleTree::Build(const TriangleMesh& mesh) {
     float centroid[3];
     uint32_t face;
   };
-  std::vector<Item> items(n);
-  for (size_t f = 0; f < n; ++f) {
+  const std::vector<uint32_t> kept = DistinctFaces(mesh);
+  const size_t m = kept.size();
+  std::vector<Item> items(m);
+  for (size_t k = 0; k < m; ++k) {
     Box box;
-    for (uint32_t v : mesh.faces[f]) box.Extend(mesh.positions[v].data());
-    for (int i = 0; i < 3; ++i) items[f].centroid[i] = 0.5f * (box.lo[i] + box.hi[i]);
-    items[f].face = static_cast<uint32_t>(f);
+    for (uint32_t v : mesh.faces[kept[k]]) box.Extend(mesh.positions[v].data());
+    for (int i = 0; i < 3; ++i) items[k].centroid[i] = 0.5f * (box.lo[i] + box.hi[i]);
+    items[k].face = kept[k];
   }
 
   TriangleTree tree;
-  tree.nodes_.reserve(n);  // Leaves hold at least 2 triangles, so nodes < n.
-  tree.triangles_.resize(n);
+  tree.nodes_.reserve(m);  // Leaves hold at least 2 triangles, so nodes < m.
+  tree.triangles_.resize(m);
   // Recursion depth is bounded by log2(n) (median split). Returns the node's index.
   auto build = [&](auto&& self, uint32_t begin, uint32_t end) -> uint32_t {
     const uint32_t index = static_cast<uint32_t>(tree.nodes_.size());
@@ -148,7 +188,7 @@ absl::StatusOr<TriangleTree> TriangleTree::Build(const TriangleMesh& mesh) {
     node.count = 0;
     return index;
   };
-  build(build, 0, static_cast<uint32_t>(n));
+  build(build, 0, static_cast<uint32_t>(m));
 
   const Node& root = tree.nodes_[0];
   tree.bounds_.Extend(Vec3(root.lo[0], root.lo[1], root.lo[2]));

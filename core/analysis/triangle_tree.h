@@ -31,8 +31,9 @@ class TriangleTree {
   };
 
   // Builds the tree over every face of `mesh` (degenerate faces included: they are segments
-  // or points). Returns INVALID_ARGUMENT when the mesh has no faces (or more than 2^32 - 1),
-  // a face index is out of range, or a position is not finite. O(f log f).
+  // or points), holding copies of a face (the same corners in the same cyclic order) once: the
+  // first, whose index the queries report. Returns INVALID_ARGUMENT when the mesh has no faces (or
+  // more than 2^32 - 1), a face index is out of range, or a position is not finite. O(f log f).
   static absl::StatusOr<TriangleTree> Build(const TriangleMesh& mesh);
 
   // The nearest point of the surface to `p`. Exact. A non-finite `p` gives an infinite
@@ -55,7 +56,7 @@ class TriangleTree {
   std::vector<ClosestPointResult> ClosestPoints(absl::Span<const Vec3> points,
                                                 const BatchOptions& options) const;
 
-  size_t num_triangles() const { return triangles_.size(); }
+  size_t num_triangles() const { return triangles_.size(); }  // Distinct faces held.
   const BoundingBox& bounds() const { return bounds_; }
 
  private:

@@ -37,9 +37,10 @@ absl::StatusOr<AliasTable> AliasTable::Build(absl::Span<const T> weights) {
   std::vector<double> scaled(n);
   std::vector<uint32_t> small;
   std::vector<uint32_t> large;
-  const double scale = static_cast<double>(n) / sum;
   for (size_t i = 0; i < n; ++i) {
-    scaled[i] = static_cast<double>(weights[i]) * scale;
+    // Divided first: n / sum overflows to infinity when the sum is subnormal, and a weight of
+    // zero times infinity is NaN, which was filed as large and drawn.
+    scaled[i] = static_cast<double>(weights[i]) / sum * static_cast<double>(n);
     (scaled[i] < 1.0 ? small : large).push_back(static_cast<uint32_t>(i));
   }
   while (!small.empty() && !large.empty()) {

@@ -65,6 +65,24 @@ TEST(JsonWriterTest, EscapesQuotesBackslashesAndControlCharacters) {
   EXPECT_EQ(parsed->members[0].second.text, nasty) << "string value did not round-trip";
 }
 
+// A file name in Latin-1 (caf\xe9.obj) once went into `eval --json` as a raw byte, and the
+// output was not valid UTF-8, so not JSON. Ill-formed bytes become U+FFFD; well-formed
+// sequences of every length pass through.
+TEST(JsonWriterTest, BytesThatAreNotUtf8BecomeTheReplacementCharacter) {
+  EXPECT_EQ(JsonWriter::Quote("caf\xe9.obj"), "\"caf\\ufffd.obj\"");
+  const std::string good = "\xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80";  // e-acute, euro, emoji.
+  EXPECT_EQ(JsonWriter::Quote(good), "\"" + good + "\"");
+  // Overlong, a surrogate, above U+10FFFF, a lone continuation, a cut-off sequence.
+  for (const std::string bad :
+       {"\xc0\xaf", "\xed\xa0\x80", "\xf4\x90\x80\x80", "\x80", "\xe2\x82"}) {
+    const std::string quoted = JsonWriter::Quote(bad);
+    for (const char c : quoted) {
+      EXPECT_LT(static_cast<unsigned char>(c), 0x80) << "a raw byte is left in " << quoted;
+    }
+    EXPECT_NE(quoted.find("\\ufffd"), std::string::npos) << quoted;
+  }
+}
+
 TEST(JsonWriterTest, DoublesRoundTripAndNonFiniteBecomesNull) {
   const double values[] = {0.0,       1.0,    -2.5,          0.1,
                            1.0 / 3.0, 1e-300, 6.02214076e23, std::numeric_limits<double>::max()};

@@ -95,6 +95,14 @@ TEST(AliasTableTest, DeterministicForSeed) {
   }
 }
 
+// n / sum overflowed for a subnormal sum, and the weight-zero entry was drawn half the time.
+TEST(AliasTableTest, AWeightOfZeroIsNeverDrawnEvenBesideSubnormalOnes) {
+  const absl::StatusOr<AliasTable> table = AliasTable::Create(std::vector<double>{0, 1e-320});
+  ASSERT_TRUE(table.ok()) << table.status();
+  Random rng(5);
+  for (int i = 0; i < 10000; ++i) ASSERT_EQ(table->Draw(rng), 1u) << "draw " << i;
+}
+
 TEST(AliasTableTest, RejectsInvalidWeights) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();

@@ -49,7 +49,8 @@ ABSL_FLAG(int32_t, c_l, kLearnerDefaults.c_l,
 ABSL_FLAG(int32_t, c_vs, kLearnerDefaults.c_vs,
           "C_vs (Section 2.2): Basic Steps between two vertex splits, >= 1.");
 ABSL_FLAG(double, c_ec, kLearnerDefaults.c_ec,
-          "C_ec (Section 2.2): the half-edge collapse step runs every C_ec * v Basic Steps, > 0.");
+          "C_ec (Section 2.2): the half-edge collapse step runs every C_ec * v Basic Steps, > 0 "
+          "(v counted as at least C_vs, not in the paper).");
 ABSL_FLAG(double, alpha_sc, kLearnerDefaults.alpha_sc,
           "alpha_sc (Section 2.2, Eq. 4): signal counter decay, in (0, 1).");
 ABSL_FLAG(double, alpha_r, kLearnerDefaults.alpha_r,

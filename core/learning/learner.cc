@@ -245,7 +245,6 @@ class Learner::Impl {
     CollapseInactive();
     timings_.collapse += Since(t0);
     ++progress_.connectivity_calls;
-    double mean_area = 0;
     std::vector<Mesh::VertexHandle> growing;  // Boundary vertices Step 4 has just cut to.
     if (options_.remove_triangles) {
       t0 = Clock::now();
@@ -262,7 +261,6 @@ class Learner::Impl {
           });
       for (auto v : removed.removed_vertices) ForgetVertex(v);
       progress_.removed_triangles += removed.removed_faces;
-      mean_area = removed.mean_area;
       if (options_.merge_only_settled_boundaries) growing = removed.touched_vertices;
       // Inactive: not a winner since the last call of Step 3 (inactive_face_removal.h).
       auto inactive = [this](Mesh::VertexHandle v) { return !mesh_.property(active_, v); };
@@ -294,7 +292,10 @@ class Learner::Impl {
       merging.hole_closing.alpha_r = options_.alpha_r;
       merging.hole_closing.alpha_m = options_.alpha_m;
       merging.hole_closing.max_loop_vertices = options_.max_closed_hole_vertices;
-      const BoundaryMergingResult merged = MergeCloseBoundaries(mesh_, merging, mean_area, growing);
+      // E(Area) of Eq. 3 is that of the mesh Step 5 sees: after Step 4's removals (which take
+      // the largest faces, so the mean before them is larger) and the cuts. 0: measured there.
+      const BoundaryMergingResult merged =
+          MergeCloseBoundaries(mesh_, merging, /*mean_area=*/0, growing);
       progress_.merged_boundaries += merged.merges;
       for (auto vh : merged.sewn_vertices) {
         mesh_.property(spared_until_, vh) =

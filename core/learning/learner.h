@@ -6,10 +6,12 @@
 //     s <- Sample(P); w <- nearest vertex of M to s             (octree, exact)
 //     w <- (1 - alpha_w) w + alpha_w s                          (Eq. 1)
 //     C_L times: tangential Laplacian smoothing of 1-ring(w)     (alpha_L)
-//     every C_vs steps: split the vertex with the highest signal counter (Eq. 4-6)
-//     every C_ec v steps: collapse every vertex that has not won since the last call
-//                         (Eq. 10-11), then remove triangles (Eq. 2), then merge
+//     every C_vs steps: split the vertex with the highest signal counter, or by default
+//                       the one of its closed 1-ring with the largest F_v (Eq. 4-6)
+//     every C_ec max(v, C_vs) steps: collapse every vertex that has not won since the last
+//                         call (Eq. 10-11), then remove triangles (Eq. 2), then merge
 //                         boundaries (Eq. 3)
+// The departures from the paper are documented in learner_options.h.
 //
 // Costs: a Basic Step is O(log v); a split O(log v) (lazy counters, Section 3.3); Steps 3-5
 // are O(v) and run every C_ec v steps, so a whole run to v vertices is O(v log v).

@@ -8,7 +8,7 @@
 namespace neuralmesh {
 namespace {
 
-constexpr size_t kLargestMaxPoints = size_t{1} << 34;
+constexpr size_t kLargestMaxPoints = size_t{1} << 32;
 
 bool IsFinite(const Vec3f& v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
@@ -50,6 +50,42 @@ void GrowingPointCloud::Fill(std::vector<std::unique_ptr<T[]>>& chunks, size_t b
     std::fill_n(chunk.get() + offset, count, value);
     i += count;
   }
+}
+
+void GrowingPointCloud::WeightClass::Add(uint32_t point) {
+  const int j = ChunkOf(written);
+  if (chunks[j] == nullptr) chunks[j].reset(new uint32_t[kFirstClassChunk << j]);
+  chunks[j][written - ChunkStart(j)] = point;
+  ++written;
+}
+
+void GrowingPointCloud::Classify(size_t begin, size_t end, absl::Span<const float> weights) {
+  for (size_t i = begin; i < end; ++i) {
+    const float w = weights.empty() ? 1.0f : weights[i - begin];
+    if (w == 0.0f) continue;
+    // U = 2^e, or 2^(e-1) when w = 2^(e-1) exactly: the smallest power of two >= w.
+    int e;
+    if (std::frexp(w, &e) == 0.5f) --e;
+    std::unique_ptr<WeightClass>& c = classes_[e - kMinClassExponent];
+    if (c == nullptr) {
+      c = std::make_unique<WeightClass>();
+      class_list_[class_list_written_] = c.get();
+      class_bounds_[class_list_written_] = std::ldexp(1.0, e);
+      ++class_list_written_;
+    }
+    c->Add(static_cast<uint32_t>(i));
+  }
+}
+
+void GrowingPointCloud::PublishClasses() {
+  for (size_t p = 0; p < class_list_written_; ++p) {
+    const size_t written = class_list_[p]->written;
+    if (class_counts_[p].load(std::memory_order_relaxed) != written) {
+      class_counts_[p].store(written, std::memory_order_release);
+    }
+  }
+  // After the counts: a reader that sees a class listed sees its first members.
+  class_list_size_.store(class_list_written_, std::memory_order_release);
 }
 
 absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
@@ -101,10 +137,12 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
         "every weight of the first batch is zero: there would be nothing to sample");
   }
 
-  // Earlier points weigh 1 and have a zero normal; they get them before the flag that lets
-  // readers look for them.
+  // Earlier points weigh 1 and have a zero normal; they get them, and the weight-1 class, before
+  // the flag that lets readers look for them.
   if (!weights.empty() && !has_weights_.load(std::memory_order_relaxed)) {
     Fill(weight_chunks_, 0, old_size, 1.0f);
+    Classify(0, old_size, {});
+    PublishClasses();
     has_weights_.store(true, std::memory_order_release);
   }
   if (!normals.empty() && !has_normals_.load(std::memory_order_relaxed)) {
@@ -113,17 +151,13 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
   }
 
   Store(position_chunks_, old_size, positions);
-  float max_weight = max_weight_.load(std::memory_order_relaxed);
-  if (has_weights_.load(std::memory_order_relaxed)) {
+  const bool weighted = has_weights_.load(std::memory_order_relaxed);
+  if (weighted) {
     if (weights.empty()) {
       Fill(weight_chunks_, old_size, old_size + n, 1.0f);
-      max_weight = std::max(max_weight, 1.0f);
     } else {
       Store(weight_chunks_, old_size, weights);
-      max_weight = std::max(max_weight, batch_max_weight);
     }
-  } else {
-    max_weight = std::max(max_weight, 1.0f);
   }
   if (has_normals_.load(std::memory_order_relaxed)) {
     if (normals.empty()) {
@@ -132,12 +166,17 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
       Store(normal_chunks_, old_size, normals);
     }
   }
-  max_weight_.store(max_weight, std::memory_order_release);
   {
     std::lock_guard<std::mutex> bounds_lock(bounds_mu_);
     bounds_.Extend(batch_bounds);
   }
+  // The batch's points join their classes after size_ counts them, so that a sample is always
+  // below size(); those of a first batch before, as a reader samples as soon as size_ is not 0
+  // and must find a class with members then.
+  if (weighted) Classify(old_size, old_size + n, weights);
+  if (weighted && old_size == 0) PublishClasses();
   size_.store(old_size + n, std::memory_order_release);
+  if (weighted && old_size != 0) PublishClasses();
   return absl::OkStatus();
 }
 
@@ -145,17 +184,68 @@ absl::Status GrowingPointCloud::Append(const PointCloud& batch) {
   return Append(batch.positions, batch.weights, batch.normals);
 }
 
+double GrowingPointCloud::LoadClassCounts(size_t classes, size_t* counts) const {
+  double total = 0;
+  for (size_t p = 0; p < classes; ++p) {
+    counts[p] = class_counts_[p].load(std::memory_order_acquire);
+    total += static_cast<double>(counts[p]) * class_bounds_[p];
+  }
+  return total;
+}
+
+size_t GrowingPointCloud::PickClass(Random& rng, const size_t* counts, size_t classes,
+                                    double total) const {
+  if (classes == 1) return 0;
+  // Summed in the same order as LoadClassCounts' total; the last class takes what rounding
+  // leaves over.
+  const double r = rng.NextDouble() * total;
+  double below = 0;
+  size_t p = 0;
+  for (; p + 1 < classes; ++p) {
+    below += static_cast<double>(counts[p]) * class_bounds_[p];
+    if (r < below) break;
+  }
+  return p;
+}
+
 Vec3 GrowingPointCloud::Sample(Random& rng) const {
   const size_t n = size_.load(std::memory_order_acquire);
   if (n == 0) return Vec3(0.0, 0.0, 0.0);
   if (!has_weights_.load(std::memory_order_acquire)) return Vec3(PositionAt(rng.NextIndex(n)));
-  // Loaded after size_, so it bounds the weight of every point below n; a larger value from a
-  // batch still being written only costs extra rejections. Constant for the whole draw.
-  const double max_weight = max_weight_.load(std::memory_order_acquire);
+  // One snapshot of the classes for the whole draw, so that every try picks from the same
+  // distribution; members published meanwhile wait for the next sample. Every listed class has
+  // members, and one at least is listed once has_weights_ is set.
+  const size_t classes = class_list_size_.load(std::memory_order_acquire);
+  size_t counts[kNumClasses];
+  const double total = LoadClassCounts(classes, counts);
+  if (!(total > 0)) return Vec3(0.0, 0.0, 0.0);  // Unreachable, but never loop on nothing.
   while (true) {
-    const size_t i = rng.NextIndex(n);
-    if (rng.NextDouble() * max_weight < WeightAt(i)) return Vec3(PositionAt(i));
+    // The class at list position p with probability counts[p] * U_p / total, then a uniform
+    // member, kept with probability w / U in (1/2, 1] (exact: U is a power of two).
+    const size_t p = PickClass(rng, counts, classes, total);
+    const uint32_t i = class_list_[p]->MemberRef(rng.NextIndex(counts[p]));
+    const float w = WeightAt(i);
+    const double bound = class_bounds_[p];
+    if (w == bound || rng.NextDouble() * bound < w) return Vec3(PositionAt(i));
   }
+}
+
+void GrowingPointCloud::PrefetchSample(const Random& rng) const {
+  const size_t n = size_.load(std::memory_order_acquire);
+  if (n == 0) return;
+  Random peek = rng;
+  if (!has_weights_.load(std::memory_order_acquire)) {
+    __builtin_prefetch(&PositionAt(peek.NextIndex(n)));
+    return;
+  }
+  // The first try's member: its point's weight and position can only start loading once it is
+  // in, one cache miss after the other, unless it is already there.
+  const size_t classes = class_list_size_.load(std::memory_order_acquire);
+  size_t counts[kNumClasses];
+  const double total = LoadClassCounts(classes, counts);
+  if (!(total > 0)) return;
+  const size_t p = PickClass(peek, counts, classes, total);
+  __builtin_prefetch(&class_list_[p]->MemberRef(peek.NextIndex(counts[p])));
 }
 
 BoundingBox GrowingPointCloud::Bounds() const {

@@ -9,16 +9,25 @@
 //
 // Sampling is uniform over the points appended so far until the first batch with weights
 // arrives; from then on point i is drawn with probability w_i / sum(w), points of batches
-// without weights weighing 1 (Section 4.1, per-point confidence). The weighted draw is a
-// rejection against the running maximum weight: a uniform index i is kept with probability
-// w_i / w_max, so a sample costs w_max / mean(w) draws in expectation, independent of the
-// number of points (1 when all weights are equal, 10 when one in ten points weighs 10 and the
-// rest almost nothing).
+// without weights weighing 1 (Section 4.1, per-point confidence). Each point of weight w > 0
+// belongs to a weight class, the one whose bound U is the smallest power of two >= w; 278
+// classes cover every finite float, denormals included, and points of weight 0 are in none. A
+// weighted draw picks a class with probability count * U / sum(count * U) over the classes in
+// use, a uniform member of it, and keeps that member with probability w / U, else tries again.
+// The result is exactly proportional to weight, and since w / U > 1/2 a sample takes at most
+// 2 tries in expectation however skewed the weights are (a point of weight 1 among a million of
+// weight 0, or 1e30 among 1e-30), each try a pass over the classes in use and at most 3 random
+// draws. A class keeps its members' indices in chunks of geometrically growing size that never
+// move, with a count published like the size: a weighted batch's points join their classes just
+// after the size counts them. So a reader may see part of a batch whose Append has not returned
+// (counted by size() but not yet all drawable); every point it can draw is fully stored, below
+// size() and inside Bounds().
 #ifndef NEURALMESH_CORE_SAMPLING_GROWING_POINT_CLOUD_H_
 #define NEURALMESH_CORE_SAMPLING_GROWING_POINT_CLOUD_H_
 
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -35,9 +44,10 @@ namespace neuralmesh {
 
 class GrowingPointCloud : public Sampler {
  public:
-  // `max_points`: capacity, fixed for the object's life; values above 2^34 are lowered to
-  // 2^34 (see max_points()). The chunk directory costs 24 bytes per 65536 points of capacity
-  // (768 KiB at the default); point memory is only allocated as points arrive.
+  // `max_points`: capacity, fixed for the object's life; values above 2^32 are lowered to
+  // 2^32 (see max_points(); the weight classes number points with 32 bits). The chunk directory
+  // costs 24 bytes per 65536 points of capacity (768 KiB at the default); point memory is only
+  // allocated as points arrive, and so is a weight class's, about 4 to 8 bytes per member.
   explicit GrowingPointCloud(size_t max_points = size_t{1} << 31);
 
   GrowingPointCloud(const GrowingPointCloud&) = delete;
@@ -60,9 +70,15 @@ class GrowingPointCloud : public Sampler {
   size_t max_points() const { return max_points_; }
 
   // Uniform over the points so far, or proportional to weight once any batch carried weights
-  // (points without weights weigh 1). Expected O(w_max / mean(w)) draws, O(1) when weightless.
-  // Only called when !empty(); returns the origin otherwise.
+  // (points without weights weigh 1). O(1) whatever the weights: one random draw when
+  // weightless; when weighted, at most 2 tries in expectation, each a pass over the weight
+  // classes in use (at most 278) and at most 3 draws. A point that size() already counts may
+  // not be drawable yet while its batch is being appended (see the top of this file). Only
+  // called when !empty(); returns the origin otherwise.
   Vec3 Sample(Random& rng) const override;
+  // Starts loading the point (weighted: the class member) that the next Sample(rng) tries
+  // first.
+  void PrefetchSample(const Random& rng) const override;
   bool empty() const override { return size() == 0; }
 
   // The bounding box of all points so far. Takes a small lock that appends hold only while
@@ -86,6 +102,36 @@ class GrowingPointCloud : public Sampler {
     return normal_chunks_[i >> kChunkBits][i & (kChunkSize - 1)];
   }
 
+  // Weight classes. Class k holds the points of weight w with U / 2 < w <= U, U = 2^(k +
+  // kMinClassExponent): from the smallest denormal, 2^-149, to U = 2^128 > FLT_MAX.
+  static constexpr int kMinClassExponent = -149;
+  static constexpr int kMaxClassExponent = 128;
+  static constexpr int kNumClasses = kMaxClassExponent - kMinClassExponent + 1;
+  // A class's chunk j holds kFirstClassChunk << j members: 25 of them hold 2^32.
+  static constexpr int kFirstClassChunkBits = 8;
+  static constexpr size_t kFirstClassChunk = size_t{1} << kFirstClassChunkBits;
+  static constexpr int kClassChunks = 25;
+
+  // A class's members, in chunks written before the release store of the class's count that
+  // makes their first member visible, and never changed afterwards, like the point chunks.
+  struct WeightClass {
+    // The chunk holding member `slot`, and the first slot of chunk j.
+    static int ChunkOf(size_t slot) {
+      return 63 - __builtin_clzll((slot >> kFirstClassChunkBits) + 1);
+    }
+    static size_t ChunkStart(int j) { return ((size_t{1} << j) - 1) << kFirstClassChunkBits; }
+
+    const uint32_t& MemberRef(size_t slot) const {
+      const int j = ChunkOf(slot);
+      return chunks[j][slot - ChunkStart(j)];
+    }
+    // Stores a member after the `written` ones; readers see it once the count covers it.
+    void Add(uint32_t point);
+
+    std::unique_ptr<uint32_t[]> chunks[kClassChunks];
+    size_t written = 0;  // Members stored; only the appending thread uses it.
+  };
+
   // Writer-side helpers, called with append_mu_ held.
   template <typename T>
   static void Store(std::vector<std::unique_ptr<T[]>>& chunks, size_t begin,
@@ -93,6 +139,18 @@ class GrowingPointCloud : public Sampler {
   template <typename T>
   static void Fill(std::vector<std::unique_ptr<T[]>>& chunks, size_t begin, size_t end,
                    const T& value);
+  // Adds points begin.. to their classes (weight 1 where `weights` is empty, else
+  // weights[i - begin]; points of weight 0 to none) without publishing them.
+  void Classify(size_t begin, size_t end, absl::Span<const float> weights);
+  // Publishes the members added so far and the classes they opened.
+  void PublishClasses();
+
+  // Reader-side helpers of Sample and PrefetchSample. Loads the counts of the first `classes`
+  // listed classes and returns sum(count * U).
+  double LoadClassCounts(size_t classes, size_t* counts) const;
+  // A list position below `classes`, p with probability counts[p] * U_p / total (one draw,
+  // none when there is one class).
+  size_t PickClass(Random& rng, const size_t* counts, size_t classes, double total) const;
 
   const size_t max_points_;
 
@@ -105,12 +163,24 @@ class GrowingPointCloud : public Sampler {
   std::vector<std::unique_ptr<Vec3f[]>> normal_chunks_;
 
   std::atomic<size_t> size_{0};
-  // Set (release) once every visible point has a weight (normal) stored; before size_ grows
-  // over the first batch that carried them.
+  // Set (release) once every visible point has a weight (normal) stored, and its class when
+  // its weight is positive; before size_ grows over the first batch that carried them.
   std::atomic<bool> has_weights_{false};
   std::atomic<bool> has_normals_{false};
-  // The largest weight stored so far, raised before size_ publishes the points that carry it.
-  std::atomic<float> max_weight_{0.0f};
+
+  // The weight classes by number k, allocated on first use; only the appending thread uses them.
+  std::unique_ptr<WeightClass> classes_[kNumClasses];
+  // The classes in use, in order of first use: at list position p, the class, its bound U (a
+  // double: 2^128 is no float) and its count of members visible to readers, kept in arrays so
+  // that a sample reads a few cache lines. Entries below class_list_size_ are written before
+  // it is stored (release), and only counts change afterwards, each count growing by release
+  // stores after its members are written; a listed class has members. Once has_weights_ is
+  // set, a class at least is listed.
+  const WeightClass* class_list_[kNumClasses] = {};
+  double class_bounds_[kNumClasses] = {};
+  std::atomic<size_t> class_counts_[kNumClasses] = {};
+  std::atomic<size_t> class_list_size_{0};
+  size_t class_list_written_ = 0;  // Only the appending thread uses it.
 
   // std::mutex rather than absl::Mutex: Debian's Abseil is not built with ThreadSanitizer,
   // which then cannot see the hand-offs of an absl::Mutex and reports false races; it does

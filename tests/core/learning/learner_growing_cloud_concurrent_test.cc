@@ -18,10 +18,17 @@ namespace neuralmesh {
 namespace {
 
 // Learns a sphere while another thread streams its points in; `lookahead_from` as in
-// Learner::SetLookaheadFromVertices (samples drawn ahead read the cloud earlier).
-void LearnWhilePointsStreamIn(size_t lookahead_from) {
+// Learner::SetLookaheadFromVertices (samples drawn ahead read the cloud earlier). With
+// `weighted`, the batches after the first carry weights spread over many weight classes (some
+// zero), so that the learner samples by weight while classes grow and new ones open.
+void LearnWhilePointsStreamIn(size_t lookahead_from, bool weighted = false) {
   auto sphere = MakeSphere(Vec3(0, 0, 0), 1.0).value();
   const PointCloud all = SamplePoints(*sphere, 40000, 9);
+  std::vector<float> weights(all.size());
+  for (size_t i = 0; i < weights.size(); ++i) {
+    weights[i] =
+        i % 11 == 0 ? 0.0f : std::ldexp(1.0f + (i % 3) / 3.0f, static_cast<int>(i % 41) - 20);
+  }
   GrowingPointCloud cloud;
   const size_t kBatch = 400;
   ASSERT_TRUE(cloud.Append(absl::MakeConstSpan(all.positions).subspan(0, kBatch)).ok());
@@ -30,7 +37,9 @@ void LearnWhilePointsStreamIn(size_t lookahead_from) {
   std::thread writer([&] {
     for (size_t start = kBatch; start < all.size(); start += kBatch) {
       const absl::Status s =
-          cloud.Append(absl::MakeConstSpan(all.positions).subspan(start, kBatch));
+          weighted ? cloud.Append(absl::MakeConstSpan(all.positions).subspan(start, kBatch),
+                                  absl::MakeConstSpan(weights).subspan(start, kBatch))
+                   : cloud.Append(absl::MakeConstSpan(all.positions).subspan(start, kBatch));
       EXPECT_TRUE(s.ok()) << s;
       std::this_thread::yield();
     }
@@ -68,6 +77,14 @@ TEST(LearnerGrowingCloudConcurrentTest, LearnsWhilePointsStreamIn) {
 
 TEST(LearnerGrowingCloudConcurrentTest, LearnsWhilePointsStreamInLookingAhead) {
   LearnWhilePointsStreamIn(0);
+}
+
+TEST(LearnerGrowingCloudConcurrentTest, LearnsWhileWeightedPointsStreamIn) {
+  LearnWhilePointsStreamIn(std::numeric_limits<size_t>::max(), /*weighted=*/true);
+}
+
+TEST(LearnerGrowingCloudConcurrentTest, LearnsWhileWeightedPointsStreamInLookingAhead) {
+  LearnWhilePointsStreamIn(0, /*weighted=*/true);
 }
 
 }  // namespace

@@ -61,6 +61,7 @@ void Read(const GrowingPointCloud& cloud, const std::atomic<bool>& done, uint64_
     }
     last_size = size_before;
     if (size_before == 0) continue;
+    cloud.PrefetchSample(rng);  // Reads what Sample reads, as the learner does.
     const Vec3 p = cloud.Sample(rng);
     ++report->samples;
     const size_t size_after = cloud.size();
@@ -164,6 +165,47 @@ TEST(GrowingPointCloudConcurrentTest, WeightsArrivingMidwayStayConsistent) {
   for (int i = 0; i < kTotalPoints; ++i) {
     const float expected = !weighted_point[i] ? 1.0f : i % 7 == 0 ? 0.0f : 1.0f + i % 3;
     ASSERT_EQ(copy.weights[i], expected) << "weight of point " << i;
+  }
+  ExpectClean(reports);
+}
+
+// Every batch carries weights, from the first on, spread over many weight classes (2^-40 to
+// 2^40, exact powers of two and values between them) with a zero weight for every seventh
+// point, point 0 included (so a sample of the origin out of nothing shows as a failure): new
+// classes appear while readers sample, and each batch adds to classes that readers are reading.
+TEST(GrowingPointCloudConcurrentTest, WeightClassesGrowWhileSampled) {
+  GrowingPointCloud cloud;
+  const std::vector<int> starts = BatchStarts();
+  auto weight_of = [](int i) {
+    return i % 7 == 0 ? 0.0f : std::ldexp(1.0f + (i % 5) / 5.0f, i % 81 - 40);
+  };
+  auto allowed = [&weight_of](int i) { return weight_of(i) > 0; };
+
+  std::atomic<bool> done{false};
+  std::vector<ReaderReport> reports(kReaders);
+  std::vector<std::thread> readers;
+  for (int r = 0; r < kReaders; ++r) {
+    readers.emplace_back([&, r] { Read(cloud, done, 400 + r, allowed, &reports[r]); });
+  }
+  absl::Status writer_status;
+  for (size_t b = 0; b + 1 < starts.size() && writer_status.ok(); ++b) {
+    std::vector<Vec3f> batch;
+    std::vector<float> weights;
+    for (int i = starts[b]; i < starts[b + 1]; ++i) {
+      batch.push_back(PointFor(i));
+      weights.push_back(weight_of(i));
+    }
+    writer_status = cloud.Append(batch, weights);
+  }
+  done.store(true, std::memory_order_release);
+  for (std::thread& reader : readers) reader.join();
+
+  EXPECT_TRUE(writer_status.ok()) << writer_status;
+  ASSERT_EQ(cloud.size(), static_cast<size_t>(kTotalPoints)) << "every batch should be in";
+  const PointCloud copy = cloud.Copy();
+  ASSERT_EQ(copy.weights.size(), copy.size()) << "every batch had weights";
+  for (int i = 0; i < kTotalPoints; ++i) {
+    ASSERT_EQ(copy.weights[i], weight_of(i)) << "weight of point " << i;
   }
   ExpectClean(reports);
 }

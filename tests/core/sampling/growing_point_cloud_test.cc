@@ -1,8 +1,10 @@
 #include "core/sampling/growing_point_cloud.h"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "core/random.h"
@@ -115,6 +117,168 @@ TEST(GrowingPointCloudTest, DeterministicForSeed) {
   }
 }
 
+TEST(GrowingPointCloudTest, PrefetchingLeavesTheSequenceAlone) {
+  GrowingPointCloud cloud;
+  Random unused(1);
+  cloud.PrefetchSample(unused);  // Nothing to load on an empty cloud.
+  ASSERT_TRUE(cloud.Append(LinePoints(0, 100)).ok()) << "batch without weights";
+  for (bool weighted : {false, true}) {
+    if (weighted) {
+      std::vector<float> weights(100);
+      for (int i = 0; i < 100; ++i) weights[i] = i % 4 == 0 ? 0.0f : 0.1f * i;
+      ASSERT_TRUE(cloud.Append(LinePoints(100, 200), weights).ok()) << "weighted batch";
+    }
+    Random plain(7);
+    Random prefetching(7);
+    for (int i = 0; i < 1000; ++i) {
+      cloud.PrefetchSample(prefetching);
+      ASSERT_EQ(cloud.Sample(plain), cloud.Sample(prefetching))
+          << "prefetching changed sample " << i << " (weighted: " << weighted << ")";
+    }
+  }
+}
+
+// How many NextU64 calls took `before` to `after`, if at most `limit`; -1 otherwise. Two states
+// are taken as equal when their next two outputs are (a false match has probability 2^-128).
+int DrawsBetween(Random before, const Random& after, int limit) {
+  for (int k = 0; k <= limit; ++k) {
+    Random a = before;
+    Random b = after;
+    if (a.NextU64() == b.NextU64() && a.NextU64() == b.NextU64()) return k;
+    before.NextU64();
+  }
+  return -1;
+}
+
+// Samples `cloud` `draws` times and expects every sample to be point `heavy`, counting the RNG
+// draws each sample takes: a rejection against the largest weight takes about size() of them
+// on a skewed cloud, the weight classes a few whatever the weights.
+void ExpectHeavyPointDrawnCheaply(const GrowingPointCloud& cloud, int heavy, int draws,
+                                  const std::string& what) {
+  // The weight classes take 3 draws per try at most and accept at least half of the tries.
+  constexpr int kMaxDrawsPerSample = 200;
+  constexpr double kMaxMeanDraws = 8.0;
+  Random rng(42);
+  long total_draws = 0;
+  int others = 0;
+  for (int s = 0; s < draws; ++s) {
+    const Random before = rng;
+    const Vec3 p = cloud.Sample(rng);
+    const int draws_taken = DrawsBetween(before, rng, kMaxDrawsPerSample);
+    ASSERT_GE(draws_taken, 0) << what << ": sample " << s << " took more than "
+                              << kMaxDrawsPerSample << " random draws";
+    total_draws += draws_taken;
+    if (std::lround(p[0]) != heavy) ++others;
+  }
+  EXPECT_EQ(others, 0) << what << ": points other than the heavy one were drawn";
+  EXPECT_LE(total_draws / static_cast<double>(draws), kMaxMeanDraws)
+      << what << ": too many random draws per sample";
+}
+
+// One point of weight 1 among a million of weight 0, and one of 1e30 among a million of 1e-30:
+// a sample must not cost a million draws (a client could hold the learner for seconds).
+TEST(GrowingPointCloudTest, SkewedWeightsSampleInConstantTime) {
+  constexpr int kPoints = 1000000;
+  constexpr int kHeavy = 123457;
+  const std::vector<Vec3f> positions = LinePoints(0, kPoints);
+  {
+    GrowingPointCloud cloud;
+    std::vector<float> weights(kPoints, 0.0f);
+    weights[kHeavy] = 1.0f;
+    ASSERT_TRUE(cloud.Append(positions, weights).ok()) << "one point of weight 1";
+    ExpectHeavyPointDrawnCheaply(cloud, kHeavy, 10000, "weights 1 and 0");
+  }
+  {
+    GrowingPointCloud cloud;
+    std::vector<float> weights(kPoints, 1e-30f);
+    weights[kHeavy] = 1e30f;
+    ASSERT_TRUE(cloud.Append(positions, weights).ok()) << "one point of weight 1e30";
+    ExpectHeavyPointDrawnCheaply(cloud, kHeavy, 10000, "weights 1e30 and 1e-30");
+  }
+  {
+    // The heavy point comes last, in a batch of its own, after the light ones.
+    GrowingPointCloud cloud;
+    ASSERT_TRUE(cloud.Append(positions, std::vector<float>(kPoints, std::ldexp(1.0f, -100))).ok())
+        << "a million points of weight 2^-100";
+    ASSERT_TRUE(cloud.Append(LinePoints(kPoints, kPoints + 1), std::vector<float>{3e38f}).ok())
+        << "one point of weight 3e38";
+    ExpectHeavyPointDrawnCheaply(cloud, kPoints, 10000, "weights 3e38 and 2^-100");
+  }
+}
+
+// Draws `draws` samples and compares each point's count with its share of the total weight by
+// a chi-square test (the 99.9% quantile, fixed seed: the test is deterministic).
+void ExpectProportionalToWeight(const GrowingPointCloud& cloud, const std::vector<double>& weights,
+                                int draws, uint64_t seed, const std::string& what) {
+  const std::map<int, int> counts = CountIndices(cloud, draws, seed);
+  double total_weight = 0;
+  for (double w : weights) total_weight += w;
+  double chi_square = 0;
+  int cells = 0;
+  for (size_t i = 0; i < weights.size(); ++i) {
+    const auto it = counts.find(static_cast<int>(i));
+    const int observed = it == counts.end() ? 0 : it->second;
+    if (weights[i] == 0) {
+      EXPECT_EQ(observed, 0) << what << ": point " << i << " of weight 0 was drawn";
+      continue;
+    }
+    const double expected = draws * weights[i] / total_weight;
+    chi_square += (observed - expected) * (observed - expected) / expected;
+    ++cells;
+    // A gross error (a wrong class bound halves or doubles a point's share) shows on its own.
+    EXPECT_NEAR(observed / expected, 1.0, 5.0 / std::sqrt(expected))
+        << what << ": point " << i << " of weight " << weights[i] << " drawn " << observed
+        << " times, expected " << expected;
+  }
+  // 99.9% quantiles of the chi-square distribution by degrees of freedom (cells - 1).
+  const std::map<int, double> kQuantile999 = {{2, 13.82}, {5, 20.52}, {20, 45.31}};
+  ASSERT_EQ(kQuantile999.count(cells - 1), 1u) << what << ": no quantile for " << cells << " cells";
+  EXPECT_LT(chi_square, kQuantile999.at(cells - 1))
+      << what << ": the counts do not follow the weights";
+}
+
+TEST(GrowingPointCloudTest, DrawsInProportionToWeightAcrossClasses) {
+  // Exact powers of two (drawn without an acceptance test), weights just above them (accepted
+  // about half the time), just below them, and weights spread over several classes; one batch
+  // without weights (weight 1) in the middle and a point of weight 0.
+  const float above_one = std::nextafter(1.0f, 2.0f);
+  const float above_four = std::nextafter(4.0f, 8.0f);
+  const std::vector<float> first = {1.0f,  above_one, 2.0f, 0.75f,      0.5f, 0.0f,
+                                    0.26f, 3.0f,      4.0f, above_four, 7.9f};
+  const std::vector<float> last = {
+      std::nextafter(2.0f, 0.0f), 0.125f, 0.1875f, 6.0f, 8.0f, 1.5f, 5.0f};
+  GrowingPointCloud cloud;
+  ASSERT_TRUE(cloud.Append(LinePoints(0, 11), first).ok()) << "first weighted batch";
+  ASSERT_TRUE(cloud.Append(LinePoints(11, 15)).ok()) << "batch without weights";
+  ASSERT_TRUE(cloud.Append(LinePoints(15, 22), last).ok()) << "second weighted batch";
+  std::vector<double> weights(first.begin(), first.end());
+  weights.insert(weights.end(), 4, 1.0);
+  weights.insert(weights.end(), last.begin(), last.end());
+  ExpectProportionalToWeight(cloud, weights, 1000000, 5, "several classes");
+
+  // Points without weights before the first weighted batch weigh 1.
+  GrowingPointCloud late;
+  ASSERT_TRUE(late.Append(LinePoints(0, 3)).ok()) << "batch without weights";
+  ASSERT_TRUE(late.Append(LinePoints(3, 6), std::vector<float>{0.5f, 2.0f, 3.0f}).ok())
+      << "weighted batch";
+  ExpectProportionalToWeight(late, {1, 1, 1, 0.5, 2, 3}, 300000, 6, "weights arriving late");
+}
+
+TEST(GrowingPointCloudTest, DrawsInProportionToExtremeWeights) {
+  // The smallest denormals and the largest floats have classes of their own like any weight.
+  const float tiny = std::numeric_limits<float>::denorm_min();
+  GrowingPointCloud small;
+  ASSERT_TRUE(small.Append(LinePoints(0, 4), std::vector<float>{tiny, 2 * tiny, 3 * tiny, 0}).ok())
+      << "denormal weights";
+  ExpectProportionalToWeight(small, {1, 2, 3, 0}, 300000, 7, "denormal weights");
+
+  const float huge = std::numeric_limits<float>::max();
+  GrowingPointCloud large;
+  ASSERT_TRUE(large.Append(LinePoints(0, 3), std::vector<float>{huge, huge / 2, huge / 4}).ok())
+      << "the largest weights";
+  ExpectProportionalToWeight(large, {4, 2, 1}, 300000, 8, "the largest weights");
+}
+
 TEST(GrowingPointCloudTest, RejectsInvalidBatchesAndAppendsNothing) {
   GrowingPointCloud cloud;
   ASSERT_TRUE(cloud.Append(LinePoints(0, 3)).ok()) << "initial batch";
@@ -164,9 +328,9 @@ TEST(GrowingPointCloudTest, OverCapacityIsResourceExhausted) {
   EXPECT_EQ(cloud.size(), 5u) << "the cloud is full";
 }
 
-TEST(GrowingPointCloudTest, CapacityIsClampedTo2To34) {
+TEST(GrowingPointCloudTest, CapacityIsClampedTo2To32) {
   GrowingPointCloud cloud(std::numeric_limits<size_t>::max());
-  EXPECT_EQ(cloud.max_points(), size_t{1} << 34) << "huge capacities are lowered to 2^34";
+  EXPECT_EQ(cloud.max_points(), size_t{1} << 32) << "huge capacities are lowered to 2^32";
 }
 
 TEST(GrowingPointCloudTest, AllZeroWeightsOnlyRejectedWhenNothingCouldBeSampled) {

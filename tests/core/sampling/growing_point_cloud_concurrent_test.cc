@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -126,24 +127,21 @@ TEST(GrowingPointCloudConcurrentTest, ReadersOnlySeeFullyWrittenPoints) {
   ExpectClean(reports);
 }
 
-// Weights switch on halfway through: the earlier points are given weight 1 while readers
-// sample, and points whose index is a multiple of 7 in weighted batches weigh zero.
-TEST(GrowingPointCloudConcurrentTest, WeightsArrivingMidwayStayConsistent) {
+// Appends every batch, point i with the weight `weight_of(i)` (none: a batch without weights;
+// the points of a batch agree), while readers sample from seeds seed, seed + 1, ...; then
+// checks that every batch is in, that the weights read back (1 where a batch had none) and
+// what the readers saw.
+template <typename WeightOf>
+void AppendWeightedWhileSampled(uint64_t seed, WeightOf weight_of) {
   GrowingPointCloud cloud;
   const std::vector<int> starts = BatchStarts();
-  const size_t first_weighted = starts.size() / 2;
-  // Odd batches from the middle on carry weights; the others do not (weight 1).
-  std::vector<bool> weighted_point(kTotalPoints, false);
-  for (size_t b = first_weighted; b + 1 < starts.size(); b += 2) {
-    for (int i = starts[b]; i < starts[b + 1]; ++i) weighted_point[i] = true;
-  }
-  auto allowed = [&weighted_point](int i) { return !(weighted_point[i] && i % 7 == 0); };
+  auto allowed = [&weight_of](int i) { return weight_of(i).value_or(1.0f) > 0; };
 
   std::atomic<bool> done{false};
   std::vector<ReaderReport> reports(kReaders);
   std::vector<std::thread> readers;
   for (int r = 0; r < kReaders; ++r) {
-    readers.emplace_back([&, r] { Read(cloud, done, 200 + r, allowed, &reports[r]); });
+    readers.emplace_back([&, r] { Read(cloud, done, seed + r, allowed, &reports[r]); });
   }
   absl::Status writer_status;
   for (size_t b = 0; b + 1 < starts.size() && writer_status.ok(); ++b) {
@@ -151,7 +149,7 @@ TEST(GrowingPointCloudConcurrentTest, WeightsArrivingMidwayStayConsistent) {
     std::vector<float> weights;
     for (int i = starts[b]; i < starts[b + 1]; ++i) {
       batch.push_back(PointFor(i));
-      if (weighted_point[i]) weights.push_back(i % 7 == 0 ? 0.0f : 1.0f + i % 3);
+      if (const std::optional<float> w = weight_of(i)) weights.push_back(*w);
     }
     writer_status = cloud.Append(batch, weights);
   }
@@ -163,10 +161,25 @@ TEST(GrowingPointCloudConcurrentTest, WeightsArrivingMidwayStayConsistent) {
   const PointCloud copy = cloud.Copy();
   ASSERT_EQ(copy.weights.size(), copy.size()) << "weights were switched on";
   for (int i = 0; i < kTotalPoints; ++i) {
-    const float expected = !weighted_point[i] ? 1.0f : i % 7 == 0 ? 0.0f : 1.0f + i % 3;
-    ASSERT_EQ(copy.weights[i], expected) << "weight of point " << i;
+    ASSERT_EQ(copy.weights[i], weight_of(i).value_or(1.0f)) << "weight of point " << i;
   }
   ExpectClean(reports);
+}
+
+// Weights switch on halfway through: the earlier points are given weight 1 while readers
+// sample, and points whose index is a multiple of 7 in weighted batches weigh zero.
+TEST(GrowingPointCloudConcurrentTest, WeightsArrivingMidwayStayConsistent) {
+  const std::vector<int> starts = BatchStarts();
+  const size_t first_weighted = starts.size() / 2;
+  // Odd batches from the middle on carry weights; the others do not (weight 1).
+  std::vector<bool> weighted_point(kTotalPoints, false);
+  for (size_t b = first_weighted; b + 1 < starts.size(); b += 2) {
+    for (int i = starts[b]; i < starts[b + 1]; ++i) weighted_point[i] = true;
+  }
+  AppendWeightedWhileSampled(200, [&weighted_point](int i) -> std::optional<float> {
+    if (!weighted_point[i]) return std::nullopt;
+    return i % 7 == 0 ? 0.0f : 1.0f + i % 3;
+  });
 }
 
 // Every batch carries weights, from the first on, spread over many weight classes (2^-40 to
@@ -174,40 +187,9 @@ TEST(GrowingPointCloudConcurrentTest, WeightsArrivingMidwayStayConsistent) {
 // point, point 0 included (so a sample of the origin out of nothing shows as a failure): new
 // classes appear while readers sample, and each batch adds to classes that readers are reading.
 TEST(GrowingPointCloudConcurrentTest, WeightClassesGrowWhileSampled) {
-  GrowingPointCloud cloud;
-  const std::vector<int> starts = BatchStarts();
-  auto weight_of = [](int i) {
+  AppendWeightedWhileSampled(400, [](int i) -> std::optional<float> {
     return i % 7 == 0 ? 0.0f : std::ldexp(1.0f + (i % 5) / 5.0f, i % 81 - 40);
-  };
-  auto allowed = [&weight_of](int i) { return weight_of(i) > 0; };
-
-  std::atomic<bool> done{false};
-  std::vector<ReaderReport> reports(kReaders);
-  std::vector<std::thread> readers;
-  for (int r = 0; r < kReaders; ++r) {
-    readers.emplace_back([&, r] { Read(cloud, done, 400 + r, allowed, &reports[r]); });
-  }
-  absl::Status writer_status;
-  for (size_t b = 0; b + 1 < starts.size() && writer_status.ok(); ++b) {
-    std::vector<Vec3f> batch;
-    std::vector<float> weights;
-    for (int i = starts[b]; i < starts[b + 1]; ++i) {
-      batch.push_back(PointFor(i));
-      weights.push_back(weight_of(i));
-    }
-    writer_status = cloud.Append(batch, weights);
-  }
-  done.store(true, std::memory_order_release);
-  for (std::thread& reader : readers) reader.join();
-
-  EXPECT_TRUE(writer_status.ok()) << writer_status;
-  ASSERT_EQ(cloud.size(), static_cast<size_t>(kTotalPoints)) << "every batch should be in";
-  const PointCloud copy = cloud.Copy();
-  ASSERT_EQ(copy.weights.size(), copy.size()) << "every batch had weights";
-  for (int i = 0; i < kTotalPoints; ++i) {
-    ASSERT_EQ(copy.weights[i], weight_of(i)) << "weight of point " << i;
-  }
-  ExpectClean(reports);
+  });
 }
 
 // Two writers append concurrently: appends serialise, each batch lands contiguously, and

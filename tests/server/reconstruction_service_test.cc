@@ -85,15 +85,10 @@ TEST_F(ReconstructionServiceTest, CreateGetListAndDelete) {
   ASSERT_EQ(list.sessions_size(), 1);
   EXPECT_EQ(list.sessions(0).session_id(), id);
 
-  grpc::ClientContext delete_context;
-  v1::DeleteSessionRequest del;
-  del.set_session_id(id);
-  v1::DeleteSessionResponse deleted;
-  ASSERT_TRUE(stub_->DeleteSession(&delete_context, del, &deleted).ok());
+  ASSERT_TRUE(testing::Delete(*stub_, id).ok());
   testing::GetSession(*stub_, id, &status);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
-  grpc::ClientContext again;
-  EXPECT_EQ(stub_->DeleteSession(&again, del, &deleted).error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(testing::Delete(*stub_, id).error_code(), grpc::StatusCode::NOT_FOUND);
 }
 
 TEST_F(ReconstructionServiceTest, InvalidOptionsAreInvalidArgumentNamingTheField) {
@@ -257,11 +252,8 @@ TEST_F(ReconstructionServiceTest, EveryBadInputGetsItsStatusAndTheSessionGoesOn)
   EXPECT_EQ(testing::Finish(*stub_, id).error_code(), grpc::StatusCode::FAILED_PRECONDITION);
 
   const std::string cancelled = MustCreate(*stub_, CreateRequest(200));
-  grpc::ClientContext cancel_context;
-  v1::CancelSessionRequest cancel;
-  cancel.set_session_id(cancelled);
   v1::Session session;
-  ASSERT_TRUE(stub_->CancelSession(&cancel_context, cancel, &session).ok());
+  ASSERT_TRUE(testing::Cancel(*stub_, cancelled, &session).ok());
   EXPECT_EQ(session.state(), v1::SESSION_STATE_CANCELLED);
   status = UploadOne(Request(cancelled, Batch(points, 0, 10)));
   EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << "cancelled session";
@@ -488,11 +480,7 @@ TEST_F(ReconstructionServiceTest, GetMeshLatestFinalAndWaiting) {
     cancelled_status = testing::WaitFinal(*stub_, other, &unused);
   });
   absl::SleepFor(absl::Milliseconds(100));
-  grpc::ClientContext cancel_context;
-  v1::CancelSessionRequest cancel;
-  cancel.set_session_id(other);
-  v1::Session session;
-  ASSERT_TRUE(stub_->CancelSession(&cancel_context, cancel, &session).ok());
+  ASSERT_TRUE(testing::Cancel(*stub_, other).ok());
   waiter2.join();
   EXPECT_EQ(cancelled_status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
 
@@ -511,26 +499,17 @@ TEST_F(ReconstructionServiceTest, CancelAndDeleteEndWatchers) {
   grpc::Status watch_status;
   std::thread watcher([&] { watch_status = testing::WatchAll(*stub_, id, &updates); });
   absl::SleepFor(absl::Milliseconds(200));
-  grpc::ClientContext context;
-  v1::CancelSessionRequest cancel;
-  cancel.set_session_id(id);
-  v1::Session session;
-  ASSERT_TRUE(stub_->CancelSession(&context, cancel, &session).ok());
+  ASSERT_TRUE(testing::Cancel(*stub_, id).ok());
   watcher.join();
   EXPECT_EQ(watch_status.error_code(), grpc::StatusCode::CANCELLED)
       << watch_status.error_message();
-  grpc::ClientContext again;
-  EXPECT_TRUE(stub_->CancelSession(&again, cancel, &session).ok()) << "cancel is idempotent";
+  EXPECT_TRUE(testing::Cancel(*stub_, id).ok()) << "cancel is idempotent";
 
   const std::string id2 = MustCreate(*stub_, CreateRequest(100000));
   ASSERT_TRUE(testing::Upload(*stub_, id2, TorusPoints(20000, 18), 4, &response).ok());
   std::thread watcher2([&] { watch_status = testing::WatchAll(*stub_, id2, &updates); });
   absl::SleepFor(absl::Milliseconds(200));
-  grpc::ClientContext delete_context;
-  v1::DeleteSessionRequest del;
-  del.set_session_id(id2);
-  v1::DeleteSessionResponse deleted;
-  ASSERT_TRUE(stub_->DeleteSession(&delete_context, del, &deleted).ok());
+  ASSERT_TRUE(testing::Delete(*stub_, id2).ok());
   watcher2.join();
   EXPECT_EQ(watch_status.error_code(), grpc::StatusCode::NOT_FOUND);
   EXPECT_THAT(watch_status.error_message(), HasSubstr("deleted"));
@@ -552,26 +531,10 @@ TEST_F(ReconstructionServiceTest, AnOpenUploadEndsWhenItsSessionEnds) {
     while (testing::GetSession(*stub_, id).learning().points_received() < 1000) {
       absl::SleepFor(absl::Milliseconds(5));
     }
-    grpc::ClientContext control;
-    switch (end) {
-      case End::kDelete: {
-        v1::DeleteSessionRequest request;
-        request.set_session_id(id);
-        v1::DeleteSessionResponse deleted;
-        ASSERT_TRUE(stub_->DeleteSession(&control, request, &deleted).ok());
-        break;
-      }
-      case End::kCancel: {
-        v1::CancelSessionRequest request;
-        request.set_session_id(id);
-        v1::Session session;
-        ASSERT_TRUE(stub_->CancelSession(&control, request, &session).ok());
-        break;
-      }
-      case End::kFinish:
-        ASSERT_TRUE(testing::Finish(*stub_, id).ok());
-        break;
-    }
+    const grpc::Status ended = end == End::kDelete   ? testing::Delete(*stub_, id)
+                               : end == End::kCancel ? testing::Cancel(*stub_, id)
+                                                     : testing::Finish(*stub_, id);
+    ASSERT_TRUE(ended.ok()) << ended.error_message();
     // No WritesDone: the server ends the call by itself.
     const grpc::Status status = writer->Finish();
     const grpc::StatusCode expected =

@@ -133,6 +133,23 @@ inline grpc::Status Finish(v1::ReconstructionService::Stub& stub, const std::str
   return stub.FinishSession(&context, request, &session);
 }
 
+inline grpc::Status Cancel(v1::ReconstructionService::Stub& stub, const std::string& id,
+                           v1::Session* session_out = nullptr) {
+  grpc::ClientContext context;
+  v1::CancelSessionRequest request;
+  request.set_session_id(id);
+  v1::Session session;
+  return stub.CancelSession(&context, request, session_out != nullptr ? session_out : &session);
+}
+
+inline grpc::Status Delete(v1::ReconstructionService::Stub& stub, const std::string& id) {
+  grpc::ClientContext context;
+  v1::DeleteSessionRequest request;
+  request.set_session_id(id);
+  v1::DeleteSessionResponse response;
+  return stub.DeleteSession(&context, request, &response);
+}
+
 inline grpc::Status WaitFinal(v1::ReconstructionService::Stub& stub, const std::string& id,
                               v1::MeshUpdate* update, absl::Duration timeout = absl::Seconds(60)) {
   grpc::ClientContext context;

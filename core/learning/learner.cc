@@ -201,13 +201,9 @@ class Learner::Impl {
   // split_largest_cell_near_most_active); the split vertex's counter is shared in proportion
   // to F_v (Eq. 5-6).
   void SplitMostActive() {
-    const int most_active = counters_.MostActive(
-        [this](int v) { return CanSplitVertex(mesh_, rings_, Mesh::VertexHandle(v)); });
-    if (most_active < 0) return;
-    const Mesh::VertexHandle most_active_vertex(most_active);
-    const Mesh::VertexHandle v = options_.split_largest_cell_near_most_active
-                                     ? LargestCellNear(mesh_, rings_, most_active_vertex)
-                                     : most_active_vertex;
+    const Mesh::VertexHandle v =
+        ChooseSplitVertex(mesh_, rings_, counters_, options_.split_largest_cell_near_most_active);
+    if (!v.is_valid()) return;
     const int id = v.idx();
     const double counter = counters_.Value(id, step_);
     const Mesh::VertexHandle v0 = SplitVertex(mesh_, rings_, v);

@@ -68,7 +68,8 @@ class SignalCounters {
   void Set(int id, double value, uint64_t step);
 
   // The tracked id with the highest counter for which `eligible(id)` holds, or -1 (ties: any).
-  // Flushes first. `eligible` is asked only of ids whose counter beats the best one so far.
+  // Flushes first. `eligible` is asked only of ids whose counter beats the best one so far,
+  // so the id returned is the last one it accepted.
   int MostActive(const std::function<bool(int)>& eligible);
 
   size_t size() const { return tracked_; }

@@ -170,6 +170,21 @@ Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
   return best;
 }
 
+Mesh::VertexHandle ChooseSplitVertex(const Mesh& mesh, VertexRingCache& rings,
+                                     SignalCounters& counters, bool largest_cell_near) {
+  Mesh::VertexHandle chosen;
+  // MostActive returns the last id its callback accepted.
+  counters.MostActive([&](int id) {
+    const Mesh::VertexHandle most_active(id);
+    const Mesh::VertexHandle v =
+        largest_cell_near ? LargestCellNear(mesh, rings, most_active) : most_active;
+    if (!CanSplitVertex(mesh, rings, v)) return false;
+    chosen = v;
+    return true;
+  });
+  return chosen;
+}
+
 Mesh::VertexHandle SplitVertex(Mesh& mesh, Mesh::VertexHandle v) {
   if (!HasEdges(mesh, v)) return Mesh::VertexHandle();
   const Neighbours neighbours = WalkedNeighbours(mesh, v);

@@ -9,6 +9,7 @@
 #ifndef NEURALMESH_CORE_LEARNING_VERTEX_SPLIT_H_
 #define NEURALMESH_CORE_LEARNING_VERTEX_SPLIT_H_
 
+#include "core/learning/signal_counters.h"
 #include "core/learning/vertex_ring_cache.h"
 #include "core/mesh.h"
 
@@ -39,6 +40,14 @@ double VoronoiAreaEstimate(const Mesh& mesh, VertexRingCache& rings, Mesh::Verte
 // splittable. O(valence^2). Reads rings from `rings` (see CanSplitVertex).
 Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
                                    Mesh::VertexHandle center);
+
+// Step 2's choice (learner_options.h, split_largest_cell_near_most_active): the vertex to
+// split for the most active vertex of `counters` that has one. With `largest_cell_near`, the
+// LargestCellNear of the most active vertex whose closed 1-ring holds a splittable vertex, so a
+// border vertex of valence <= 4 still leads to a split next to it; without, the most active
+// splittable vertex itself (the paper's rule). Invalid when no tracked vertex qualifies.
+Mesh::VertexHandle ChooseSplitVertex(const Mesh& mesh, VertexRingCache& rings,
+                                     SignalCounters& counters, bool largest_cell_near);
 
 }  // namespace neuralmesh
 

@@ -97,6 +97,35 @@ TEST(VertexSplitTest, VoronoiAreaEstimateIsSquaredMeanEdgeLength) {
   EXPECT_NEAR(VoronoiAreaEstimate(mesh, Mesh::VertexHandle(12)), l * l, 1e-12) << "Eq. 5-6";
 }
 
+TEST(VertexSplitTest, AnUnsplittableMostActiveVertexStillPlacesTheSplitNextToIt) {
+  // The most active vertex (1, 0) is on the border with valence 3; (2, 2) is interior and less
+  // active. By default the split goes to the largest cell next to the most active vertex;
+  // the paper's rule splits the most active splittable vertex.
+  Mesh mesh = testing::MustToMesh(testing::GridPatch(4, 4));
+  const Mesh::VertexHandle most_active(1), interior(12);
+  ASSERT_FALSE(CanSplitVertex(mesh, most_active));
+  VertexRingCache rings;
+  SignalCounters counters(0.95);
+  counters.Add(most_active.idx(), 5.0, 0);
+  counters.Add(interior.idx(), 1.0, 0);
+
+  const Mesh::VertexHandle chosen = ChooseSplitVertex(mesh, rings, counters, true);
+  ASSERT_TRUE(chosen.is_valid());
+  EXPECT_TRUE(CanSplitVertex(mesh, chosen));
+  EXPECT_TRUE(mesh.find_halfedge(most_active, chosen).is_valid())
+      << "chose " << chosen.idx() << ", not a neighbour of the most active vertex";
+  EXPECT_EQ(chosen, LargestCellNear(mesh, rings, most_active));
+
+  EXPECT_EQ(ChooseSplitVertex(mesh, rings, counters, false), interior) << "the paper's rule";
+
+  SignalCounters only_border(0.95);
+  only_border.Add(most_active.idx(), 5.0, 0);
+  EXPECT_FALSE(ChooseSplitVertex(mesh, rings, only_border, false).is_valid());
+  EXPECT_EQ(ChooseSplitVertex(mesh, rings, only_border, true), chosen);
+  SignalCounters none(0.95);
+  EXPECT_FALSE(ChooseSplitVertex(mesh, rings, none, true).is_valid());
+}
+
 // A grid patch made irregular by splits, inside and on the border.
 Mesh IrregularPatch() {
   Mesh mesh = testing::MustToMesh(testing::GridPatch(6, 6));

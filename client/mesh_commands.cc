@@ -1,4 +1,5 @@
 // RunStats and RunEval (declared in client/local_commands.h).
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/inputs.h"
 #include "client/local_commands.h"
@@ -26,8 +27,14 @@ absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
   GeometricErrorOptions error_options;
   if (options.samples > 0) error_options.samples = options.samples;
   error_options.seed = options.seed;
-  NM_ASSIGN_OR_RETURN(const GeometricError error,
-                      ComputeGeometricError(mesh, reference, error_options));
+  NM_RETURN_IF_ERROR(error_options.Validate());
+  absl::StatusOr<GeometricError> computed = ComputeGeometricError(mesh, reference, error_options);
+  if (!computed.ok()) {  // Names the two files: the error speaks of "the reconstruction".
+    return absl::Status(computed.status().code(),
+                        absl::StrCat("MESH '", options.mesh, "' against --reference '",
+                                     options.reference, "': ", computed.status().message()));
+  }
+  const GeometricError& error = *computed;
   if (options.json) {
     JsonWriter json(2);
     json.BeginObject();

@@ -150,6 +150,15 @@ TEST_F(CliErrorsTest, EvalAgainstAnEmptyReference) {
   EXPECT_TRUE(absl::StrContains(err, empty) && absl::StrContains(err, "empty")) << err;
 }
 
+TEST_F(CliErrorsTest, EvalOfAFlatMeshNamesBothFiles) {
+  const std::string mesh = WriteFile("tri.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const std::string line = WriteFile("line.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n2 0 0\n3 0 1 2\n");
+  const std::string err = ExpectFailure({"eval", mesh, "--reference", line});
+  EXPECT_TRUE(absl::StrContains(
+      err, "MESH '" + mesh + "' against --reference '" + line + "': the reference has zero area"))
+      << err;
+}
+
 TEST_F(CliErrorsTest, NonPositiveTimeBudget) {
   for (const char* budget : {"0s", "-5s"}) {
     const std::string err = ExpectFailure({"reconstruct", "builtin:sphere", "-o", Output(),

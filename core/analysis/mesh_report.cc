@@ -393,15 +393,21 @@ std::string MeshReportToText(const MeshReport& r) {
                     r.boundary_loop_lengths.size() > kMaxLengths ? ", ..." : "", ")");
   }
   out += "\n";
-  absl::StrAppendFormat(&out, "%-22s %10s  (edge: %s, vertex: %s, %u non-manifold vertices)\n",
+  // Every reason manifold() can be false is named, faces that are not triangles included.
+  absl::StrAppendFormat(&out, "%-22s %10s  (edge: %s, vertex: %s, %u non-manifold vertices",
                         "manifold", yes_no(r.manifold()), yes_no(r.edge_manifold),
                         yes_no(r.vertex_manifold), r.non_manifold_vertices);
+  if (r.degenerate_faces > 0) absl::StrAppend(&out, ", ", r.degenerate_faces, " degenerate faces");
+  if (r.invalid_faces > 0) absl::StrAppend(&out, ", ", r.invalid_faces, " invalid faces");
+  out += ")\n";
   absl::StrAppendFormat(&out, "%-22s %10s\n", "oriented", yes_no(r.oriented));
   absl::StrAppendFormat(&out, "%-22s %10s\n", "closed", yes_no(r.closed));
-  absl::StrAppendFormat(&out, "%-22s %7d %7d %7d %7d %7d %7d %7s\n",
-                        absl::StrCat("valence (", r.interior_vertices, " interior)"), 4, 5, 6, 7, 8,
-                        9, "other");
-  absl::StrAppendFormat(&out, "%-22s", "share %");
+  // Both rows' labels get the width of the longer one, so the columns stay under each other.
+  const std::string valence_label = absl::StrCat("valence (", r.interior_vertices, " interior)");
+  const int label_width = std::max<int>(22, static_cast<int>(valence_label.size()));
+  absl::StrAppendFormat(&out, "%-*s %7d %7d %7d %7d %7d %7d %7s\n", label_width, valence_label, 4,
+                        5, 6, 7, 8, 9, "other");
+  absl::StrAppendFormat(&out, "%-*s", label_width, "share %");
   for (double share : r.valence_share) absl::StrAppendFormat(&out, " %7.1f", share);
   out += "\n";
   return out;

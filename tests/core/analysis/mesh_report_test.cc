@@ -376,6 +376,32 @@ TEST(MeshReportTest, TextContainsTableAndKeyFacts) {
                                                               << open;
 }
 
+TEST(MeshReportTest, TextNamesWhyAMeshWithoutBadEdgesIsNotManifold) {
+  TriangleMesh mesh = GridPatch(2, 2);
+  mesh.faces.push_back({0, 0, 1});
+  mesh.faces.push_back({0, 1, 999});
+  const std::string text = MeshReportToText(ComputeMeshReport(mesh));
+  EXPECT_NE(text.find("(edge: yes, vertex: yes, 0 non-manifold vertices, 1 degenerate faces, "
+                      "1 invalid faces)"),
+            std::string::npos)
+      << text;
+}
+
+TEST(MeshReportTest, TextValenceColumnsStayAlignedForLargeMeshes) {
+  for (const size_t interior : {size_t{12}, size_t{1234567}, size_t{123456789012}}) {
+    MeshReport r;
+    r.interior_vertices = interior;
+    const std::string text = MeshReportToText(r);
+    const size_t header = text.find("valence (");
+    const size_t shares = text.find("share %");
+    ASSERT_NE(header, std::string::npos) << text;
+    ASSERT_NE(shares, std::string::npos) << text;
+    const size_t header_length = text.find('\n', header) - header;
+    const size_t shares_length = text.find('\n', shares) - shares;
+    EXPECT_EQ(header_length, shares_length) << "columns shifted:\n" << text;
+  }
+}
+
 TEST(MeshReportTest, JsonIsValidAndMatchesReport) {
   const MeshReport r = ComputeMeshReport(OpenCylinder(10, 3));
   for (int indent : {0, 2}) {

@@ -128,7 +128,10 @@ class Learner::Impl {
     if (step_ % static_cast<uint64_t>(options_.c_vs) == 0) {
       Clock::time_point t2;
       if (timings_on_) t2 = Clock::now();  // Every split is timed: they are rare.
-      for (int i = 0; i < options_.splits_per_step; ++i) SplitMostActive();
+      for (int i = 0; i < options_.splits_per_step; ++i) {
+        if (split_cap_ > 0 && live_vertices_ >= split_cap_) break;  // Run's target is met.
+        SplitMostActive();
+      }
       if (timings_on_) timings_.split += Since(t2);
     }
     if (step_ >= next_connectivity_step_) ConnectivityAndTopology();
@@ -142,6 +145,13 @@ class Learner::Impl {
           "or an observer");
     }
     const uint64_t poll = std::max<uint64_t>(1, stop.poll_interval);
+    // With splits_per_step > 1, a Step 2 call stops splitting at the target, which is then met
+    // exactly; only while Run runs.
+    split_cap_ = stop.target_vertices;
+    struct ClearCap {
+      size_t& cap;
+      ~ClearCap() { cap = 0; }
+    } clear_cap{split_cap_};
     const Clock::time_point start = Clock::now();
     const uint64_t first_step = step_;
     auto finish = [&](StopReason reason) -> absl::StatusOr<StopReason> {
@@ -385,6 +395,7 @@ class Learner::Impl {
   // Inactive boundary vertices that Step 3 could not collapse in this call.
   std::vector<Mesh::VertexHandle> stuck_border_vertices_;
   std::vector<int> changed_rings_;  // SplitMostActive's scratch.
+  size_t split_cap_ = 0;            // Step 2 splits no further than this many vertices (0: none).
   uint64_t step_ = 0;
   uint64_t next_connectivity_step_ = 0;
   size_t live_vertices_ = 0;

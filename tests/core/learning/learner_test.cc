@@ -101,6 +101,61 @@ TEST(LearnerTest, VertexDensityFollowsTheSampleDensity) {
   EXPECT_GT(ratio, 2.3) << upper << " vertices on the dense half";
 }
 
+// Always the same point, inside the box [-1, 1]^3 it reports.
+class FixedPoint : public Sampler {
+ public:
+  explicit FixedPoint(const Vec3& p) : p_(p) {}
+  Vec3 Sample(Random&) const override { return p_; }
+  bool empty() const override { return false; }
+  BoundingBox Bounds() const override {
+    BoundingBox box;
+    box.Extend(Vec3(-1, -1, -1));
+    box.Extend(Vec3(1, 1, 1));
+    return box;
+  }
+
+ private:
+  Vec3 p_;
+};
+
+TEST(LearnerTest, TheWinnerMovesAlphaWOfTheWayToTheSample) {
+  // Eq. 1 alone (no smoothing): the nearest vertex moves, the others stay.
+  const Vec3 s(0.5, 0.25, 0.125);
+  FixedPoint target(s);
+  LearnerOptions options;
+  options.c_l = 0;
+  options.alpha_w = 0.25;
+  auto learner = Learner::Create(options, &target).value();
+  std::vector<Vec3> before;
+  for (auto v : learner->mesh().vertices()) before.push_back(learner->mesh().point(v));
+  size_t winner = 0;
+  for (size_t i = 1; i < before.size(); ++i) {
+    if ((before[i] - s).sqrnorm() < (before[winner] - s).sqrnorm()) winner = i;
+  }
+  StopCriteria stop;
+  stop.max_basic_steps = 1;
+  ASSERT_EQ(learner->Run(stop).value(), StopReason::kStepBudget);
+  for (auto v : learner->mesh().vertices()) {
+    const size_t i = v.idx();
+    const Vec3 expected = i == winner ? 0.75 * before[i] + 0.25 * s : before[i];
+    EXPECT_LT((learner->mesh().point(v) - expected).norm(), 1e-12) << "vertex " << i;
+  }
+}
+
+TEST(LearnerTest, SeveralSplitsPerStepStillMeetTheTargetExactly) {
+  auto sphere = UnitSphere();
+  LearnerOptions options;
+  options.splits_per_step = 4;
+  auto learner = Learner::Create(options, sphere.get()).value();
+  for (const size_t target : {size_t{101}, size_t{503}, size_t{1002}}) {
+    StopCriteria stop;
+    stop.target_vertices = target;
+    ASSERT_EQ(learner->Run(stop).value(), StopReason::kTargetReached);
+    EXPECT_EQ(learner->num_vertices(), target);
+    EXPECT_EQ(learner->Snapshot().positions.size(), target);
+  }
+}
+
 TEST(LearnerTest, SameSeedReproducesTheMeshExactly) {
   auto sphere = UnitSphere();
   auto a = LearnTo(*sphere, 800, 42)->Snapshot();

@@ -34,6 +34,10 @@ absl::Status CheckOutputPath(const std::string& output) {
     return absl::NotFoundError(
         absl::StrCat("the directory of OUTPUT, '", parent.string(), "', does not exist"));
   }
+  if (std::filesystem::is_directory(output, error)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("OUTPUT '", output, "' is a directory; name a file in it"));
+  }
   return absl::OkStatus();
 }
 

@@ -157,10 +157,19 @@ neuralmesh::LearnerOptions LearnerFromFlags() {
   return o;
 }
 
-neuralmesh::DracoOptions DracoFromFlags() {
+// Checked here so that a bad value is named by its flag, not by DracoOptions' field.
+absl::StatusOr<neuralmesh::DracoOptions> DracoFromFlags() {
   neuralmesh::DracoOptions o;
   o.position_quantization_bits = absl::GetFlag(FLAGS_quantization_bits);
   o.encode_speed = absl::GetFlag(FLAGS_encode_speed);
+  auto check = [](const char* flag, int value, int min, int max) {
+    if (value >= min && value <= max) return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", flag, " is ", value, "; it must be in [", min, ", ", max, "]"));
+  };
+  NM_RETURN_IF_ERROR(check("quantization_bits", o.position_quantization_bits, 1,
+                           neuralmesh::kMaxQuantizationBits));
+  NM_RETURN_IF_ERROR(check("encode_speed", o.encode_speed, 0, neuralmesh::kMaxDracoSpeed));
   return o;
 }
 
@@ -189,7 +198,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.vertices = absl::GetFlag(FLAGS_vertices);
     o.lods = lods;
     o.learner = LearnerFromFlags();
-    o.draco = DracoFromFlags();
+    NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
     o.batch_size = absl::GetFlag(FLAGS_batch_size);
     o.builtin_points = absl::GetFlag(FLAGS_points);
     o.ply = absl::GetFlag(FLAGS_ply);
@@ -211,7 +220,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
                       neuralmesh::client::ParseSamplingMode(absl::GetFlag(FLAGS_sampling)));
   o.time_budget = absl::GetFlag(FLAGS_time_budget);
   o.max_steps = absl::GetFlag(FLAGS_max_steps);
-  o.draco = DracoFromFlags();
+  NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
   o.progress = progress;
   return neuralmesh::client::RunLocalReconstruct(o, std::cout, std::cerr);
 }

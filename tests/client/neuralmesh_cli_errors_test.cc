@@ -159,6 +159,27 @@ TEST_F(CliErrorsTest, EvalOfAFlatMeshNamesBothFiles) {
       << err;
 }
 
+TEST_F(CliErrorsTest, OutputThatIsADirectoryIsRefusedBeforeLearning) {
+  const std::string dir = dir_ + "/taken.ply";
+  std::filesystem::create_directory(dir);
+  const RunResult run = RunNeuralmesh(
+      {"reconstruct", "builtin:sphere", "-o", dir, "--vertices", "100000", "--time_budget", "60s"});
+  EXPECT_NE(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.err, "OUTPUT '" + dir + "' is a directory")) << run.Describe();
+  EXPECT_FALSE(absl::StrContains(run.out, "learning ")) << "refused before learning:\n"
+                                                        << run.Describe();
+}
+
+TEST_F(CliErrorsTest, DracoFlagsOutOfRangeAreNamedByTheirFlags) {
+  const std::string drc = dir_ + "/out.drc";
+  std::string err = ExpectFailure({"reconstruct", "builtin:sphere", "-o", drc, "--vertices", "100",
+                                   "--quantization_bits", "25"});
+  EXPECT_TRUE(absl::StrContains(err, "--quantization_bits is 25; it must be in [1, 24]")) << err;
+  err = ExpectFailure(
+      {"reconstruct", "builtin:sphere", "-o", drc, "--vertices", "100", "--encode_speed", "11"});
+  EXPECT_TRUE(absl::StrContains(err, "--encode_speed is 11; it must be in [0, 10]")) << err;
+}
+
 TEST_F(CliErrorsTest, NonPositiveTimeBudget) {
   for (const char* budget : {"0s", "-5s"}) {
     const std::string err = ExpectFailure({"reconstruct", "builtin:sphere", "-o", Output(),

@@ -54,6 +54,7 @@
 #include "absl/flags/parse.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "bench/bench_flags.h"
 #include "bench/count_list.h"
 #include "bench/memory_latency.h"
 #include "core/learning/learner.h"
@@ -502,6 +503,9 @@ int Run() {
 }  // namespace neuralmesh
 
 int main(int argc, char** argv) {
-  absl::ParseCommandLine(argc, argv);
+  neuralmesh::ParseBenchFlags(
+      argc, argv,
+      "Times the Neural Meshes learner to 1K-100K vertices on 50,000 and 5M points "
+      "(issue 2's benchmark); prints a table, see bench/learner_bench.cc");
   return neuralmesh::Run();
 }

@@ -20,6 +20,7 @@
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
+#include "bench/bench_flags.h"
 #include "bench/count_list.h"
 #include "core/bounding_box.h"
 #include "core/learning/vertex_octree.h"
@@ -159,6 +160,9 @@ int Run() {
 }  // namespace neuralmesh
 
 int main(int argc, char** argv) {
-  absl::ParseCommandLine(argc, argv);
+  neuralmesh::ParseBenchFlags(
+      argc, argv,
+      "Times the vertex octree's nearest-vertex queries and moves at several sizes; "
+      "see bench/octree_bench.cc");
   return neuralmesh::Run();
 }

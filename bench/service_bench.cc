@@ -24,6 +24,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "bench/bench_flags.h"
 #include "core/learning/learner.h"
 #include "core/sampling/growing_point_cloud.h"
 #include "core/sampling/implicit_surfaces.h"
@@ -340,7 +341,10 @@ void MeasureLearning(v1::ReconstructionService::Stub& stub, const PointCloud& po
 }  // namespace neuralmesh
 
 int main(int argc, char** argv) {
-  absl::ParseCommandLine(argc, argv);
+  neuralmesh::ParseBenchFlags(
+      argc, argv,
+      "Measures the reconstruction service over loopback: ingest, first-mesh latency, "
+      "Draco sizes and learning rates; see bench/service_bench.cc");
   using namespace neuralmesh;
   ServerOptions options;
   options.address = "127.0.0.1:0";

@@ -7,8 +7,9 @@
 
 namespace neuralmesh {
 
-// A regular tetrahedron, outward oriented, centred on `box` with its vertices on the sphere
-// through the box's corners. A degenerate box (one point) gives a unit-size tetrahedron there.
+// A regular tetrahedron, outward oriented, centred on `box`, whose inscribed sphere is the
+// sphere through the box's corners, so every point of the box is inside it. A degenerate box
+// (one point) gives the tetrahedron around the unit sphere there.
 Mesh MakeInitialTetrahedron(const BoundingBox& box);
 
 }  // namespace neuralmesh

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The main job: builds neuralmesh and neuralmesh-server, starts the server on a free port of
-# 127.0.0.1, reconstructs the built-in torus through it (100000 points sampled from the
-# implicit surface, streamed in batches; 5000 vertices), writes every level of detail to
-# out/demo as .drc and .ply, prints the LOD table and stops the server.
+# The main job: builds everything (CLI, server, tests, benchmarks), starts neuralmesh-server on
+# a free port of 127.0.0.1, reconstructs the built-in torus through it (100000 points sampled
+# from the implicit surface, streamed in batches; 5000 vertices), writes every level of detail
+# to out/demo as .drc and .ply, prints the LOD table and stops the server.
 #
 # Usage: scripts/run-demo.sh            (from anywhere; paths are relative to the repository)
 # Environment: BUILD_DIR (default build), JOBS (parallel build jobs, default: all cores),
@@ -27,7 +27,7 @@ elif command -v ninja >/dev/null 2>&1; then
 else
   cmake -S . -B "${BUILD_DIR}" >/dev/null
 fi
-cmake --build "${BUILD_DIR}" --target neuralmesh neuralmesh-server -j "${JOBS}"
+cmake --build "${BUILD_DIR}" -j "${JOBS}"
 CLI="${BUILD_DIR}/bin/neuralmesh"
 SERVER="${BUILD_DIR}/bin/neuralmesh-server"
 

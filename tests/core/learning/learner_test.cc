@@ -156,6 +156,46 @@ TEST(LearnerTest, SeveralSplitsPerStepStillMeetTheTargetExactly) {
   }
 }
 
+// A unit sphere whose lower half stops being sampled (mirrored up) once `upper_only` is set.
+class SphereLosingItsLowerHalf : public Sampler {
+ public:
+  Vec3 Sample(Random& rng) const override {
+    Vec3 p = sphere_->Sample(rng);
+    if (upper_only && p[2] < 0) p[2] = -p[2];
+    return p;
+  }
+  bool empty() const override { return false; }
+  BoundingBox Bounds() const override { return sphere_->Bounds(); }
+
+  bool upper_only = false;
+
+ private:
+  std::unique_ptr<ImplicitSurface> sphere_ = UnitSphere();
+};
+
+size_t VerticesBelow(const Mesh& mesh, double z) {
+  size_t n = 0;
+  for (auto v : mesh.vertices()) n += mesh.point(v)[2] < z ? 1 : 0;
+  return n;
+}
+
+TEST(LearnerTest, StepThreeCollapsesTheVerticesThatStopWinning) {
+  // Section 2.2, Step 3: every C_ec v Basic Steps, the vertices that have not won since the
+  // last call are collapsed. Once the lower half is no longer sampled, its vertices never win.
+  SphereLosingItsLowerHalf target;
+  auto learner = LearnTo(target, 1000, 2);
+  const size_t before = VerticesBelow(learner->mesh(), -0.5);
+  EXPECT_GT(before, 150u) << "a quarter of the sphere's area lies below z = -0.5";
+  target.upper_only = true;
+  StopCriteria stop;
+  stop.max_basic_steps = 60000;  // At least three calls of Step 3 (C_ec v <= 20,000).
+  ASSERT_EQ(learner->Run(stop).value(), StopReason::kStepBudget);
+  const size_t after = VerticesBelow(learner->mesh(), -0.5);
+  EXPECT_LT(after, before / 4) << before << " vertices below z = -0.5 before, " << after
+                               << " after";
+  EXPECT_TRUE(ValidateMesh(learner->mesh()).ok()) << ValidateMesh(learner->mesh());
+}
+
 TEST(LearnerTest, SameSeedReproducesTheMeshExactly) {
   auto sphere = UnitSphere();
   auto a = LearnTo(*sphere, 800, 42)->Snapshot();

@@ -371,6 +371,9 @@ std::string MeshReportToText(const MeshReport& r) {
   std::string out;
   absl::StrAppendFormat(&out, "%-22s %10u  (%u isolated)\n", "vertices", r.vertices,
                         r.isolated_vertices);
+  if (r.faces == 0 && r.isolated_vertices > 0) {
+    out += "(no faces: a point cloud; the counts below describe an empty surface)\n";
+  }
   absl::StrAppendFormat(&out, "%-22s %10u  (%u degenerate, %u duplicate, %u invalid)\n", "faces",
                         r.faces, r.degenerate_faces, r.duplicate_faces, r.invalid_faces);
   absl::StrAppendFormat(&out, "%-22s %10u  (%u boundary, %u non-manifold, %u misoriented)\n",

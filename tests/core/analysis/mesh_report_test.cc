@@ -387,6 +387,14 @@ TEST(MeshReportTest, TextNamesWhyAMeshWithoutBadEdgesIsNotManifold) {
       << text;
 }
 
+TEST(MeshReportTest, TextSaysWhenThereAreNoFaces) {
+  TriangleMesh cloud;
+  cloud.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0)};
+  EXPECT_NE(MeshReportToText(ComputeMeshReport(cloud)).find("no faces: a point cloud"),
+            std::string::npos);
+  EXPECT_EQ(MeshReportToText(ComputeMeshReport(Icosphere(1))).find("no faces"), std::string::npos);
+}
+
 TEST(MeshReportTest, TextValenceColumnsStayAlignedForLargeMeshes) {
   for (const size_t interior : {size_t{12}, size_t{1234567}, size_t{123456789012}}) {
     MeshReport r;

@@ -8,9 +8,7 @@ Mesh MakeInitialTetrahedron(const BoundingBox& box) {
   const Vec3 center = box.empty() ? Vec3(0, 0, 0) : box.center();
   double radius = box.diagonal() * 0.5;
   if (!(radius > 0) || !std::isfinite(radius)) radius = 1;
-  // The tetrahedron's inscribed sphere (a third of its circumradius) holds the sphere through
-  // the box's corners, so the data lie inside it.
-  const double s = 3 * radius / std::sqrt(3.0);
+  const double s = radius / std::sqrt(3.0);
   Mesh mesh;
   const Mesh::VertexHandle v[4] = {mesh.add_vertex(center + Vec3(s, s, s)),
                                    mesh.add_vertex(center + Vec3(s, -s, -s)),

@@ -17,7 +17,7 @@ double OutsideDistance(const Mesh& mesh, Mesh::FaceHandle f, const Vec3& p) {
   return (p - corners[0]) | normal;
 }
 
-TEST(InitialMeshTest, TheTetrahedronIsClosedOrientedOutwardAndHoldsTheWholeBox) {
+TEST(InitialMeshTest, ARegularTetrahedronOrientedOutwardOnTheSphereThroughTheBoxCorners) {
   BoundingBox box;
   box.Extend(Vec3(-1, 2, 0.5));
   box.Extend(Vec3(3, 2.5, 4));
@@ -25,24 +25,25 @@ TEST(InitialMeshTest, TheTetrahedronIsClosedOrientedOutwardAndHoldsTheWholeBox) 
   ASSERT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
   ASSERT_EQ(mesh.n_vertices(), 4u);
   ASSERT_EQ(mesh.n_faces(), 4u);
-  for (auto v : mesh.vertices()) EXPECT_FALSE(mesh.is_boundary(v));
-  // Every corner of the box is inside every face's plane, the box's centre most of all.
-  for (int corner = 0; corner < 8; ++corner) {
-    const Vec3 p((corner & 1) ? box.max[0] : box.min[0], (corner & 2) ? box.max[1] : box.min[1],
-                 (corner & 4) ? box.max[2] : box.min[2]);
-    for (auto f : mesh.faces()) EXPECT_LE(OutsideDistance(mesh, f, p), 1e-9) << corner;
+  for (auto v : mesh.vertices()) {
+    EXPECT_FALSE(mesh.is_boundary(v));
+    EXPECT_NEAR((mesh.point(v) - box.center()).norm(), box.diagonal() / 2, 1e-9);
   }
-  // Its inscribed sphere is the sphere through the box's corners: centred on the box.
+  for (auto e : mesh.edges()) {  // Regular: every edge sqrt(8/3) times the circumradius.
+    EXPECT_NEAR(mesh.calc_edge_length(e), std::sqrt(8.0 / 3.0) * box.diagonal() / 2, 1e-9);
+  }
+  // Outward: the centre is behind every face, at the inscribed radius, a third of the
+  // circumradius.
   for (auto f : mesh.faces()) {
-    EXPECT_NEAR(OutsideDistance(mesh, f, box.center()), -box.diagonal() / 2, 1e-9);
+    EXPECT_NEAR(OutsideDistance(mesh, f, box.center()), -box.diagonal() / 6, 1e-9);
   }
 }
 
-TEST(InitialMeshTest, AOnePointBoxGetsAUnitSizeTetrahedronAroundIt) {
+TEST(InitialMeshTest, AOnePointBoxGetsAUnitSizeTetrahedronThere) {
   BoundingBox box;
   box.Extend(Vec3(5, 6, 7));
   const Mesh mesh = MakeInitialTetrahedron(box);
-  for (auto f : mesh.faces()) EXPECT_NEAR(OutsideDistance(mesh, f, Vec3(5, 6, 7)), -1, 1e-9);
+  for (auto v : mesh.vertices()) EXPECT_NEAR((mesh.point(v) - Vec3(5, 6, 7)).norm(), 1, 1e-9);
 }
 
 }  // namespace

@@ -214,8 +214,7 @@ class Learner::Impl {
     const Mesh::VertexHandle v =
         ChooseSplitVertex(mesh_, rings_, counters_, options_.split_largest_cell_near_most_active);
     if (!v.is_valid()) return;
-    const int id = v.idx();
-    const double counter = counters_.Value(id, step_);
+    const double counter = counters_.Value(v.idx(), step_);
     const Mesh::VertexHandle v0 = SplitVertex(mesh_, rings_, v);
     if (!v0.is_valid()) return;
     ++live_vertices_;
@@ -232,11 +231,7 @@ class Learner::Impl {
       rings_.Invalidate(u);
       rings_.Ring(mesh_, u);
     }
-    const double f1 = VoronoiAreaEstimate(mesh_, rings_, v);
-    const double f0 = VoronoiAreaEstimate(mesh_, rings_, v0);
-    const double share0 = (f0 + f1) > 0 ? f0 / (f0 + f1) : 0.5;
-    counters_.Set(id, counter * (1 - share0), step_);
-    counters_.Add(v0.idx(), counter * share0, step_);
+    ShareSplitCounter(mesh_, rings_, counters_, v, v0, counter, step_);
     // The new vertex counts as active: it must get a chance to win before Step 3 judges it.
     mesh_.property(active_, v0) = true;
     mesh_.property(spared_until_, v0) = mesh_.property(spared_until_, v);  // Same strip.

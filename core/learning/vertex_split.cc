@@ -170,6 +170,15 @@ Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
   return best;
 }
 
+void ShareSplitCounter(const Mesh& mesh, VertexRingCache& rings, SignalCounters& counters,
+                       Mesh::VertexHandle v, Mesh::VertexHandle v0, double counter, uint64_t step) {
+  const double f1 = VoronoiAreaEstimate(mesh, rings, v);
+  const double f0 = VoronoiAreaEstimate(mesh, rings, v0);
+  const double share0 = (f0 + f1) > 0 ? f0 / (f0 + f1) : 0.5;
+  counters.Set(v.idx(), counter * (1 - share0), step);
+  counters.Add(v0.idx(), counter * share0, step);
+}
+
 Mesh::VertexHandle ChooseSplitVertex(const Mesh& mesh, VertexRingCache& rings,
                                      SignalCounters& counters, bool largest_cell_near) {
   Mesh::VertexHandle chosen;

@@ -41,6 +41,12 @@ double VoronoiAreaEstimate(const Mesh& mesh, VertexRingCache& rings, Mesh::Verte
 Mesh::VertexHandle LargestCellNear(const Mesh& mesh, VertexRingCache& rings,
                                    Mesh::VertexHandle center);
 
+// Eq. 5-6: after `v` was split into `v` and `v0`, v's counter (`counter`, its value before the
+// split) is shared in proportion to F_v (VoronoiAreaEstimate): v0 gets counter F_v0 / (F_v +
+// F_v0) and starts being tracked, v keeps the rest (each half when both F are 0); at `step`.
+void ShareSplitCounter(const Mesh& mesh, VertexRingCache& rings, SignalCounters& counters,
+                       Mesh::VertexHandle v, Mesh::VertexHandle v0, double counter, uint64_t step);
+
 // Step 2's choice (learner_options.h, split_largest_cell_near_most_active): the vertex to
 // split for the most active vertex of `counters` that has one. With `largest_cell_near`, the
 // LargestCellNear of the most active vertex whose closed 1-ring holds a splittable vertex, so a

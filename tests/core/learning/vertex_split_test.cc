@@ -97,6 +97,26 @@ TEST(VertexSplitTest, VoronoiAreaEstimateIsSquaredMeanEdgeLength) {
   EXPECT_NEAR(VoronoiAreaEstimate(mesh, Mesh::VertexHandle(12)), l * l, 1e-12) << "Eq. 5-6";
 }
 
+TEST(VertexSplitTest, TheCounterIsSharedInProportionToTheCellEstimates) {
+  Mesh mesh = testing::MustToMesh(testing::GridPatch(4, 4));
+  const Mesh::VertexHandle v(12);
+  mesh.point(Mesh::VertexHandle(13)) += Vec3(0.2, 0, 0);  // v0 takes the longer edges.
+  VertexRingCache rings;
+  SignalCounters counters(0.95);
+  counters.Add(v.idx(), 3.0, 7);
+  const Mesh::VertexHandle v0 = SplitVertex(mesh, rings, v);
+  ASSERT_TRUE(v0.is_valid());
+  rings.Invalidate(v.idx());
+  rings.Invalidate(v0.idx());
+  for (auto u : mesh.vv_range(v0)) rings.Invalidate(u.idx());
+  ShareSplitCounter(mesh, rings, counters, v, v0, 3.0, 7);
+  const double f = VoronoiAreaEstimate(mesh, v), f0 = VoronoiAreaEstimate(mesh, v0);
+  ASSERT_GT(f0, f * 1.01) << "the two cells must differ for the test to tell shares apart";
+  EXPECT_NEAR(counters.Value(v0.idx(), 7), 3.0 * f0 / (f + f0), 1e-12) << "Eq. 5-6";
+  EXPECT_NEAR(counters.Value(v.idx(), 7), 3.0 * f / (f + f0), 1e-12);
+  EXPECT_TRUE(counters.Contains(v0.idx()));
+}
+
 TEST(VertexSplitTest, AnUnsplittableMostActiveVertexStillPlacesTheSplitNextToIt) {
   // The most active vertex (1, 0) is on the border with valence 3; (2, 2) is interior and less
   // active. By default the split goes to the largest cell next to the most active vertex;

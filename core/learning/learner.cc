@@ -73,7 +73,9 @@ class Learner::Impl {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 
-  void Step() {
+  // Step 2 splits no further than `vertex_target` vertices (0: no limit), so that Run meets its
+  // target exactly with splits_per_step > 1.
+  void Step(size_t vertex_target = 0) {
     // With timings on, one Basic Step in kTimingSamplePeriod is timed and counted that many
     // times: a clock read costs about 50 ns here, as much as 3% of a Basic Step, and reading
     // it three times per step inflated the total that the timings are meant to break down.
@@ -129,7 +131,7 @@ class Learner::Impl {
       Clock::time_point t2;
       if (timings_on_) t2 = Clock::now();  // Every split is timed: they are rare.
       for (int i = 0; i < options_.splits_per_step; ++i) {
-        if (split_cap_ > 0 && live_vertices_ >= split_cap_) break;  // Run's target is met.
+        if (vertex_target > 0 && live_vertices_ >= vertex_target) break;
         SplitMostActive();
       }
       if (timings_on_) timings_.split += Since(t2);
@@ -145,13 +147,6 @@ class Learner::Impl {
           "or an observer");
     }
     const uint64_t poll = std::max<uint64_t>(1, stop.poll_interval);
-    // With splits_per_step > 1, a Step 2 call stops splitting at the target, which is then met
-    // exactly; only while Run runs.
-    split_cap_ = stop.target_vertices;
-    struct ClearCap {
-      size_t& cap;
-      ~ClearCap() { cap = 0; }
-    } clear_cap{split_cap_};
     const Clock::time_point start = Clock::now();
     const uint64_t first_step = step_;
     auto finish = [&](StopReason reason) -> absl::StatusOr<StopReason> {
@@ -166,7 +161,7 @@ class Learner::Impl {
         if (target_->empty()) {
           return absl::FailedPreconditionError("the target space has no points to sample");
         }
-        Step();
+        Step(stop.target_vertices);
         if (stop.target_vertices > 0 && live_vertices_ >= stop.target_vertices) {
           return finish(StopReason::kTargetReached);
         }
@@ -390,7 +385,6 @@ class Learner::Impl {
   // Inactive boundary vertices that Step 3 could not collapse in this call.
   std::vector<Mesh::VertexHandle> stuck_border_vertices_;
   std::vector<int> changed_rings_;  // SplitMostActive's scratch.
-  size_t split_cap_ = 0;            // Step 2 splits no further than this many vertices (0: none).
   uint64_t step_ = 0;
   uint64_t next_connectivity_step_ = 0;
   size_t live_vertices_ = 0;

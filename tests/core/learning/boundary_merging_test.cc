@@ -1,6 +1,7 @@
 #include "core/learning/boundary_merging.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <string>
@@ -346,6 +347,44 @@ TEST(BoundaryMergingTest, ThresholdFollowsTheGivenMeanArea) {
   const BoundaryMergingResult result = MergeCloseBoundaries(mesh, BoundaryMergingOptions{}, 1e-4);
   EXPECT_EQ(result.merges, 0u) << "the caller's E(Area) must set the threshold";
   EXPECT_EQ(Count(mesh).boundary_loops, 4u) << "boundaries changed";
+}
+
+// The learner calls Step 5 with mean_area 0 right after Step 4, whose removed faces are still in
+// the mesh, marked deleted (the largest ones: Eq. 2). E(Area) of Eq. 3 must then be the mean of
+// the faces that are left. A far tetrahedron of side 100 raises the mean face area from about
+// 0.13 to about 60 (threshold 5 sqrt(60) ~ 39), so rims 5 apart merge while it is live, and must
+// not once its faces are deleted.
+TEST(BoundaryMergingTest, MeasuredMeanAreaLeavesOutDeletedFaces) {
+  TriangleMesh shape;
+  AppendTube(shape, 12, 7, 1.0, 0.0, 3.0, 0.0);
+  AppendTube(shape, 12, 7, 1.0, 8.0, 11.0, 0.0);
+  const uint32_t base = static_cast<uint32_t>(shape.positions.size());
+  const double side = 100, far = 1000;
+  const double h = side / std::sqrt(2.0);  // Corners of a cube of side h: a regular tetrahedron.
+  shape.positions.emplace_back(far, 0, 0);
+  shape.positions.emplace_back(far + h, h, 0);
+  shape.positions.emplace_back(far + h, 0, h);
+  shape.positions.emplace_back(far, h, h);
+  for (const auto& f :
+       std::vector<std::array<uint32_t, 3>>{{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}}) {
+    shape.faces.push_back({base + f[0], base + f[1], base + f[2]});
+  }
+
+  Mesh live = MustToMesh(shape);
+  EXPECT_GE(MergeCloseBoundaries(live, BoundaryMergingOptions{}, 0).merges, 1u)
+      << "with the tetrahedron's faces live the threshold is about 39: the rims 5 apart merge";
+
+  Mesh removed = MustToMesh(shape);
+  for (auto fh : removed.faces()) {
+    if (removed.point(removed.to_vertex_handle(removed.halfedge_handle(fh)))[0] > far / 2) {
+      removed.delete_face(fh, /*delete_isolated_vertices=*/true);
+    }
+  }
+  const BoundaryMergingResult result = MergeCloseBoundaries(removed, BoundaryMergingOptions{}, 0);
+  EXPECT_EQ(result.merges, 0u) << "deleted faces must not count in E(Area)";
+  EXPECT_EQ(Count(removed).boundary_loops, 4u) << "boundaries changed";
+  EXPECT_EQ(Count(removed).faces, 2u * 12 * 6 * 2) << "only the tubes' faces are left";
+  EXPECT_TRUE(ValidateMesh(removed).ok()) << ValidateMesh(removed);
 }
 
 // Tube A's top rim is close to both tube B's bottom rim (0.1) and to the bottom rim of the

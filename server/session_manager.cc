@@ -102,6 +102,10 @@ absl::Status SessionManager::Delete(absl::string_view id) {
   return DeleteUnlessActive(id, std::nullopt);
 }
 
+absl::Status SessionManager::DeleteIfIdle(absl::string_view id, absl::Time idle_at) {
+  return DeleteUnlessActive(id, idle_at);
+}
+
 absl::Status SessionManager::DeleteUnlessActive(absl::string_view id,
                                                 std::optional<absl::Time> idle_at) {
   if (id.empty()) return absl::InvalidArgumentError("session_id is empty");
@@ -139,7 +143,7 @@ size_t SessionManager::ReapIdle(absl::Time now) {
   }
   size_t reaped = 0;
   for (const std::string& id : idle) {
-    if (DeleteUnlessActive(id, now).ok()) ++reaped;
+    if (DeleteIfIdle(id, now).ok()) ++reaped;
   }
   return reaped;
 }

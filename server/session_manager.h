@@ -70,7 +70,13 @@ class SessionManager {
   absl::Status Delete(absl::string_view id) ABSL_LOCKS_EXCLUDED(mu_);
 
   // Deletes the sessions idle at `now` (see SessionLimits::idle_timeout); returns how many.
+  // Lists them first, then deletes each with DeleteIfIdle.
   size_t ReapIdle(absl::Time now) ABSL_LOCKS_EXCLUDED(mu_);
+
+  // Deletes the session only if it is idle at `idle_at`, checked under the registry's lock:
+  // FAILED_PRECONDITION when it was touched since (or has an open stream), so that a session
+  // used between ReapIdle's listing and its deletion stays. Otherwise as Delete.
+  absl::Status DeleteIfIdle(absl::string_view id, absl::Time idle_at) ABSL_LOCKS_EXCLUDED(mu_);
 
   // Stops the reaper and terminates every session with `status` (their streams end with it).
   // Idempotent.
@@ -80,8 +86,7 @@ class SessionManager {
 
  private:
   void ReaperLoop() ABSL_LOCKS_EXCLUDED(mu_);
-  // Delete, or with `idle_at` only a session still idle at that time (checked under the lock;
-  // FAILED_PRECONDITION otherwise): a session touched since the reaper looked stays.
+  // Delete, or with `idle_at` DeleteIfIdle.
   absl::Status DeleteUnlessActive(absl::string_view id, std::optional<absl::Time> idle_at)
       ABSL_LOCKS_EXCLUDED(mu_);
   std::string NewIdLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);

@@ -559,6 +559,62 @@ TEST_F(ReconstructionServiceTest, AnUnknownIdOfAnyLengthIsNotFoundWithAShortMess
   EXPECT_LT(status.error_message().size(), 200u);
 }
 
+// Sessions without an open stream or a call for --idle_timeout are deleted: an idle one goes, a
+// watched one stays while its watcher is connected, and GetSession, a call, keeps one alive.
+TEST(ReconstructionServiceIdleTimeoutTest, IdleSessionsAreDeletedWatchedOnesStay) {
+  ServerOptions options;
+  options.limits.idle_timeout = absl::Seconds(1);  // The reaper looks every 250 ms.
+  std::unique_ptr<ReconstructionServer> server = StartServer(/*listen=*/false, options);
+  ASSERT_NE(server, nullptr);
+  auto stub = InProcessStub(*server);
+  // ListSessions is no call on a session: it keeps none alive.
+  auto listed = [&] {
+    grpc::ClientContext context;
+    v1::ListSessionsResponse list;
+    EXPECT_TRUE(stub->ListSessions(&context, v1::ListSessionsRequest(), &list).ok());
+    std::vector<std::string> ids;
+    for (const v1::Session& session : list.sessions()) ids.push_back(session.session_id());
+    return ids;
+  };
+  auto wait_until_listed_only = [&](const std::vector<std::string>& ids) {
+    const absl::Time give_up = absl::Now() + absl::Seconds(20);
+    while (listed() != ids && absl::Now() < give_up) absl::SleepFor(absl::Milliseconds(20));
+    return listed();
+  };
+
+  const std::string idle = MustCreate(*stub, CreateRequest(1000));
+  const std::string watched = MustCreate(*stub, CreateRequest(1000));
+  const std::string polled = MustCreate(*stub, CreateRequest(1000));
+  grpc::ClientContext watch_context;
+  v1::WatchSessionRequest watch_request;
+  watch_request.set_session_id(watched);
+  auto watcher = stub->WatchSession(&watch_context, watch_request);
+
+  // `polled` gets a GetSession every 50 ms for at least 2 s (2 timeouts) and until `idle` is
+  // gone.
+  const absl::Time polled_from = absl::Now();
+  const absl::Time give_up = polled_from + absl::Seconds(20);
+  while (absl::Now() < polled_from + absl::Seconds(2) ||
+         (::testing::Value(listed(), ::testing::Contains(idle)) && absl::Now() < give_up)) {
+    grpc::Status status;
+    testing::GetSession(*stub, polled, &status);
+    ASSERT_TRUE(status.ok()) << "polled every 50 ms, so never idle: " << status.error_message();
+    absl::SleepFor(absl::Milliseconds(50));
+  }
+  EXPECT_THAT(listed(), ::testing::UnorderedElementsAre(watched, polled));
+  grpc::Status status;
+  testing::GetSession(*stub, idle, &status);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND) << status.error_message();
+
+  EXPECT_THAT(wait_until_listed_only({watched}), ::testing::ElementsAre(watched));
+  absl::SleepFor(absl::Seconds(2));
+  EXPECT_THAT(listed(), ::testing::ElementsAre(watched)) << "its watcher is still connected";
+  watch_context.TryCancel();
+  EXPECT_EQ(watcher->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  EXPECT_THAT(wait_until_listed_only({}), ::testing::IsEmpty()) << "the watcher has left";
+  server->Shutdown(absl::Seconds(2));
+}
+
 TEST_F(ReconstructionServiceTest, ShutdownEndsEveryOpenStream) {
   const std::string id = MustCreate(*stub_, CreateRequest(100000));
   v1::UploadPointsResponse response;

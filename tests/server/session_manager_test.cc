@@ -3,7 +3,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <string>
+#include <vector>
+
+#include "absl/time/clock.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -36,6 +40,98 @@ TEST_F(SessionManagerTest, AfterShutdownCallsAreUnavailableNotNotFound) {
   EXPECT_TRUE(absl::IsUnavailable(manager.Delete(id)));
   EXPECT_TRUE(absl::IsUnavailable(manager.List().status()));
   EXPECT_TRUE(absl::IsUnavailable(manager.Create(SmallConfig(), "late").status()));
+}
+
+// An idle timeout the reaper thread never reaches in a test: the tests call ReapIdle with
+// times of their own.
+SessionLimits HourLimits() {
+  SessionLimits limits;
+  limits.idle_timeout = absl::Hours(1);
+  return limits;
+}
+
+std::vector<std::string> ListedIds(const SessionManager& manager) {
+  const std::vector<std::shared_ptr<Session>> sessions = manager.List().value();
+  std::vector<std::string> ids;
+  for (const auto& session : sessions) ids.push_back(session->id());
+  return ids;
+}
+
+TEST_F(SessionManagerTest, ReapIdleDeletesSessionsIdleForTheTimeout) {
+  SessionManager manager(HourLimits(), &pool_, &encoder_);
+  std::shared_ptr<Session> a = manager.Create(SmallConfig(), "a").value();
+  std::shared_ptr<Session> b = manager.Create(SmallConfig(), "b").value();
+  EXPECT_EQ(manager.ReapIdle(absl::Now() + absl::Minutes(59)), 0u) << "idle for less than an hour";
+  EXPECT_THAT(ListedIds(manager), ::testing::ElementsAre(a->id(), b->id()));
+
+  EXPECT_EQ(manager.ReapIdle(absl::Now() + absl::Hours(2)), 2u);
+  EXPECT_THAT(ListedIds(manager), ::testing::IsEmpty());
+  EXPECT_TRUE(absl::IsNotFound(manager.Get(a->id()).status())) << manager.Get(a->id()).status();
+  ASSERT_TRUE(a->updates().close_status().has_value()) << "a reaped session's watchers end";
+  EXPECT_TRUE(absl::IsNotFound(*a->updates().close_status())) << *a->updates().close_status();
+  EXPECT_THAT(a->updates().close_status()->message(), ::testing::HasSubstr("was deleted"));
+}
+
+TEST_F(SessionManagerTest, OpenStreamsKeepASessionFromIdlingOut) {
+  SessionManager manager(HourLimits(), &pool_, &encoder_);
+  std::shared_ptr<Session> watched = manager.Create(SmallConfig(), "watched").value();
+  std::shared_ptr<Session> unwatched = manager.Create(SmallConfig(), "unwatched").value();
+  watched->AddStream();
+  EXPECT_EQ(manager.ReapIdle(absl::Now() + absl::Hours(2)), 1u);
+  EXPECT_THAT(ListedIds(manager), ::testing::ElementsAre(watched->id()));
+  EXPECT_FALSE(watched->updates().close_status().has_value());
+
+  watched->RemoveStream();
+  EXPECT_EQ(manager.ReapIdle(absl::Now() + absl::Minutes(30)), 0u)
+      << "closing the stream is activity: the timeout runs from then";
+  EXPECT_EQ(manager.ReapIdle(absl::Now() + absl::Hours(2)), 1u);
+  EXPECT_THAT(ListedIds(manager), ::testing::IsEmpty());
+}
+
+// ReapIdle lists the idle sessions, then deletes each one after looking again under the lock: a
+// session used in between (here: Get, which every RPC on a session calls) stays.
+TEST_F(SessionManagerTest, ASessionUsedAfterTheReaperListedItStays) {
+  SessionManager manager(HourLimits(), &pool_, &encoder_);
+  std::shared_ptr<Session> session = manager.Create(SmallConfig(), "s").value();
+  const absl::Time listed_at = absl::Now() + absl::Hours(1);
+  ASSERT_TRUE(session->IdleSince(listed_at, absl::Hours(1))) << "the reaper would list it";
+  absl::SleepFor(absl::Milliseconds(2));
+  ASSERT_TRUE(manager.Get(session->id()).ok());
+
+  const absl::Status status = manager.DeleteIfIdle(session->id(), listed_at);
+  EXPECT_TRUE(absl::IsFailedPrecondition(status)) << status;
+  EXPECT_THAT(ListedIds(manager), ::testing::ElementsAre(session->id()));
+  EXPECT_FALSE(session->updates().close_status().has_value()) << "its watchers go on";
+
+  EXPECT_TRUE(manager.DeleteIfIdle(session->id(), absl::Now() + absl::Hours(2)).ok());
+  EXPECT_THAT(ListedIds(manager), ::testing::IsEmpty());
+  EXPECT_TRUE(absl::IsNotFound(manager.DeleteIfIdle(session->id(), absl::Now())));
+}
+
+// The reaper thread, with a timeout of 50 ms (it looks every 12.5 ms): an idle session goes
+// within seconds; one with an open stream stays until the stream closes.
+TEST_F(SessionManagerTest, TheReaperThreadDeletesIdleSessions) {
+  SessionLimits limits;
+  limits.idle_timeout = absl::Milliseconds(50);
+  SessionManager manager(limits, &pool_, &encoder_);
+  std::shared_ptr<Session> watched = manager.Create(SmallConfig(), "watched").value();
+  watched->AddStream();
+  std::shared_ptr<Session> idle = manager.Create(SmallConfig(), "idle").value();
+  auto wait_until_listed_only = [&](std::vector<std::string> ids) {
+    const absl::Time give_up = absl::Now() + absl::Seconds(20);
+    while (ListedIds(manager) != ids && absl::Now() < give_up) {
+      absl::SleepFor(absl::Milliseconds(5));
+    }
+    return ListedIds(manager);
+  };
+  EXPECT_THAT(wait_until_listed_only({watched->id()}), ::testing::ElementsAre(watched->id()));
+  ASSERT_TRUE(idle->updates().close_status().has_value());
+  EXPECT_TRUE(absl::IsNotFound(*idle->updates().close_status()));
+
+  absl::SleepFor(absl::Milliseconds(200));  // 4 timeouts, 16 looks of the reaper.
+  EXPECT_THAT(ListedIds(manager), ::testing::ElementsAre(watched->id()));
+  watched->RemoveStream();
+  EXPECT_THAT(wait_until_listed_only({}), ::testing::IsEmpty());
 }
 
 }  // namespace

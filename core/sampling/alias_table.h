@@ -31,10 +31,19 @@ class AliasTable {
   static absl::StatusOr<AliasTable> Create(absl::Span<const float> weights);
 
   // Draws index i with probability weights[i] / sum(weights). O(1): one NextIndex and one
-  // NextDouble from `rng`, nothing else.
+  // NextDouble from `rng`, nothing else: always two NextU64, so that the state after one draw
+  // tells the next one.
   size_t Draw(Random& rng) const {
     const uint64_t cell = rng.NextIndex(prob_.size());
     return rng.NextDouble() < prob_[cell] ? cell : alias_[cell];
+  }
+
+  // Starts loading the cell that Draw(rng) reads (a cache miss on a large table).
+  void PrefetchDraw(const Random& rng) const {
+    Random peek = rng;
+    const uint64_t cell = peek.NextIndex(prob_.size());
+    __builtin_prefetch(&prob_[cell]);
+    __builtin_prefetch(&alias_[cell]);
   }
 
   // The number of weights, including those of weight zero.

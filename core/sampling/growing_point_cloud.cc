@@ -52,10 +52,10 @@ void GrowingPointCloud::Fill(std::vector<std::unique_ptr<T[]>>& chunks, size_t b
   }
 }
 
-void GrowingPointCloud::WeightClass::Add(uint32_t point) {
+void GrowingPointCloud::WeightClass::Add(uint32_t point, float weight) {
   const int j = ChunkOf(written);
-  if (chunks[j] == nullptr) chunks[j].reset(new uint32_t[kFirstClassChunk << j]);
-  chunks[j][written - ChunkStart(j)] = point;
+  if (chunks[j] == nullptr) chunks[j].reset(new Member[kFirstClassChunk << j]);
+  chunks[j][written - ChunkStart(j)] = Member{point, weight};
   ++written;
 }
 
@@ -73,7 +73,7 @@ void GrowingPointCloud::Classify(size_t begin, size_t end, absl::Span<const floa
       class_bounds_[class_list_written_] = std::ldexp(1.0, e);
       ++class_list_written_;
     }
-    c->Add(static_cast<uint32_t>(i));
+    c->Add(static_cast<uint32_t>(i), w);
   }
 }
 
@@ -184,49 +184,58 @@ absl::Status GrowingPointCloud::Append(const PointCloud& batch) {
   return Append(batch.positions, batch.weights, batch.normals);
 }
 
-double GrowingPointCloud::LoadClassCounts(size_t classes, size_t* counts) const {
-  double total = 0;
-  for (size_t p = 0; p < classes; ++p) {
-    counts[p] = class_counts_[p].load(std::memory_order_acquire);
-    total += static_cast<double>(counts[p]) * class_bounds_[p];
+void GrowingPointCloud::LoadClasses(ClassSnapshot* snapshot) const {
+  snapshot->classes = class_list_size_.load(std::memory_order_acquire);
+  double sum = 0;
+  for (size_t p = 0; p < snapshot->classes; ++p) {
+    snapshot->counts[p] = class_counts_[p].load(std::memory_order_acquire);
+    sum += static_cast<double>(snapshot->counts[p]) * class_bounds_[p];
+    snapshot->cumulative[p] = sum;
   }
-  return total;
 }
 
-size_t GrowingPointCloud::PickClass(Random& rng, const size_t* counts, size_t classes,
-                                    double total) const {
-  if (classes == 1) return 0;
-  // Summed in the same order as LoadClassCounts' total; the last class takes what rounding
-  // leaves over.
-  const double r = rng.NextDouble() * total;
-  double below = 0;
+size_t GrowingPointCloud::PickClass(Random& rng, const ClassSnapshot& snapshot) {
+  if (snapshot.classes == 1) return 0;
+  // The last class takes what rounding leaves over.
+  const double r = rng.NextDouble() * snapshot.total();
   size_t p = 0;
-  for (; p + 1 < classes; ++p) {
-    below += static_cast<double>(counts[p]) * class_bounds_[p];
-    if (r < below) break;
-  }
+  while (p + 1 < snapshot.classes && !(r < snapshot.cumulative[p])) ++p;
   return p;
 }
 
-Vec3 GrowingPointCloud::Sample(Random& rng) const {
+const GrowingPointCloud::Member& GrowingPointCloud::PickMember(Random& tries,
+                                                               const ClassSnapshot& snapshot,
+                                                               double* bound) const {
+  const size_t p = PickClass(tries, snapshot);
+  *bound = class_bounds_[p];
+  return class_list_[p]->MemberRef(tries.NextIndex(snapshot.counts[p]));
+}
+
+bool GrowingPointCloud::Keep(Random& tries, const Member& member, double bound) {
+  return member.weight == bound || tries.NextDouble() * bound < member.weight;
+}
+
+Vec3 GrowingPointCloud::Sample(Random& rng, int* tries_taken) const {
+  if (tries_taken != nullptr) *tries_taken = 1;
   const size_t n = size_.load(std::memory_order_acquire);
   if (n == 0) return Vec3(0.0, 0.0, 0.0);
   if (!has_weights_.load(std::memory_order_acquire)) return Vec3(PositionAt(rng.NextIndex(n)));
   // One snapshot of the classes for the whole draw, so that every try picks from the same
   // distribution; members published meanwhile wait for the next sample. Every listed class has
   // members, and one at least is listed once has_weights_ is set.
-  const size_t classes = class_list_size_.load(std::memory_order_acquire);
-  size_t counts[kNumClasses];
-  const double total = LoadClassCounts(classes, counts);
-  if (!(total > 0)) return Vec3(0.0, 0.0, 0.0);  // Unreachable, but never loop on nothing.
-  while (true) {
+  ClassSnapshot snapshot;
+  LoadClasses(&snapshot);
+  Random tries(rng.NextU64());  // One draw of `rng` per sample, however many tries it takes.
+  if (!(snapshot.total() > 0)) return Vec3(0.0, 0.0, 0.0);  // Unreachable; never loop on nothing.
+  for (int try_count = 1;; ++try_count) {
     // The class at list position p with probability counts[p] * U_p / total, then a uniform
     // member, kept with probability w / U in (1/2, 1] (exact: U is a power of two).
-    const size_t p = PickClass(rng, counts, classes, total);
-    const uint32_t i = class_list_[p]->MemberRef(rng.NextIndex(counts[p]));
-    const float w = WeightAt(i);
-    const double bound = class_bounds_[p];
-    if (w == bound || rng.NextDouble() * bound < w) return Vec3(PositionAt(i));
+    double bound;
+    const Member& member = PickMember(tries, snapshot, &bound);
+    if (Keep(tries, member, bound)) {
+      if (tries_taken != nullptr) *tries_taken = try_count;
+      return Vec3(PositionAt(member.point));
+    }
   }
 }
 
@@ -238,14 +247,25 @@ void GrowingPointCloud::PrefetchSample(const Random& rng) const {
     __builtin_prefetch(&PositionAt(peek.NextIndex(n)));
     return;
   }
-  // The first try's member: its point's weight and position can only start loading once it is
-  // in, one cache miss after the other, unless it is already there.
-  const size_t classes = class_list_size_.load(std::memory_order_acquire);
-  size_t counts[kNumClasses];
-  const double total = LoadClassCounts(classes, counts);
-  if (!(total > 0)) return;
-  const size_t p = PickClass(peek, counts, classes, total);
-  __builtin_prefetch(&class_list_[p]->MemberRef(peek.NextIndex(counts[p])));
+  // A weighted sample reads a member, then its point, one cache miss after the other: loaded
+  // over two calls, one Basic Step apart. Each sample takes one draw of `rng`, so the sample
+  // after the next one is known too.
+  ClassSnapshot snapshot;
+  LoadClasses(&snapshot);
+  if (!(snapshot.total() > 0)) return;
+  Random next_tries(peek.NextU64());
+  Random later_tries(peek.NextU64());
+  double bound;
+  // The sample after the next one: its first try's member starts loading.
+  __builtin_prefetch(&PickMember(later_tries, snapshot, &bound));
+  // The next sample: its first try's member, loaded by the last call, is read; its point starts
+  // loading, or when the try fails, the next try's member.
+  const Member& member = PickMember(next_tries, snapshot, &bound);
+  if (Keep(next_tries, member, bound)) {
+    __builtin_prefetch(&PositionAt(member.point));
+  } else {
+    __builtin_prefetch(&PickMember(next_tries, snapshot, &bound));
+  }
 }
 
 BoundingBox GrowingPointCloud::Bounds() const {

@@ -17,8 +17,10 @@
 // The result is exactly proportional to weight, and since w / U > 1/2 a sample takes at most
 // 2 tries in expectation however skewed the weights are (a point of weight 1 among a million of
 // weight 0, or 1e30 among 1e-30), each try a pass over the classes in use and at most 3 random
-// draws. A class keeps its members' indices in chunks of geometrically growing size that never
-// move, with a count published like the size: a weighted batch's points join their classes just
+// draws from a generator that one draw of the caller's seeds, so that every sample takes one
+// draw of it and the sampler can load two samples ahead (PrefetchSample). A class keeps its
+// members (index and weight) in chunks of geometrically growing size that never move, with a
+// count published like the size: a weighted batch's points join their classes just
 // after the size counts them. So a reader may see part of a batch whose Append has not returned
 // (counted by size() but not yet all drawable); every point it can draw is fully stored, below
 // size() and inside Bounds().
@@ -47,7 +49,7 @@ class GrowingPointCloud : public Sampler {
   // `max_points`: capacity, fixed for the object's life; values above 2^32 are lowered to
   // 2^32 (see max_points(); the weight classes number points with 32 bits). The chunk directory
   // costs 24 bytes per 65536 points of capacity (768 KiB at the default); point memory is only
-  // allocated as points arrive, and so is a weight class's, about 4 to 8 bytes per member.
+  // allocated as points arrive, and so is a weight class's, about 8 to 16 bytes per member.
   explicit GrowingPointCloud(size_t max_points = size_t{1} << 31);
 
   GrowingPointCloud(const GrowingPointCloud&) = delete;
@@ -71,13 +73,17 @@ class GrowingPointCloud : public Sampler {
 
   // Uniform over the points so far, or proportional to weight once any batch carried weights
   // (points without weights weigh 1). O(1) whatever the weights: one random draw when
-  // weightless; when weighted, at most 2 tries in expectation, each a pass over the weight
-  // classes in use (at most 278) and at most 3 draws. A point that size() already counts may
-  // not be drawable yet while its batch is being appended (see the top of this file). Only
-  // called when !empty(); returns the origin otherwise.
-  Vec3 Sample(Random& rng) const override;
-  // Starts loading the point (weighted: the class member) that the next Sample(rng) tries
-  // first.
+  // weightless; when weighted, one draw that seeds at most 2 tries in expectation, each a pass
+  // over the weight classes in use (at most 278) and at most 3 draws. A point that size() already
+  // counts may not be drawable yet while its batch is being appended (see the top of this file).
+  // Only called when !empty(); returns the origin otherwise.
+  Vec3 Sample(Random& rng) const override { return Sample(rng, nullptr); }
+  // As Sample(rng); `tries`, when not null, gets the number of tries the draw took (1 unless
+  // weighted).
+  Vec3 Sample(Random& rng, int* tries) const;
+  // Starts loading the point that the next Sample(rng) returns. Weighted, it reads that
+  // sample's first member, which the last call started loading, and starts loading its point
+  // (or the next try's member) and the first member of the sample after it.
   void PrefetchSample(const Random& rng) const override;
   bool empty() const override { return size() == 0; }
 
@@ -112,6 +118,13 @@ class GrowingPointCloud : public Sampler {
   static constexpr size_t kFirstClassChunk = size_t{1} << kFirstClassChunkBits;
   static constexpr int kClassChunks = 25;
 
+  // A member of a weight class: a point and its weight, side by side, so that a try of a
+  // weighted draw reads one cache line before it knows whether it keeps the point.
+  struct Member {
+    uint32_t point;
+    float weight;
+  };
+
   // A class's members, in chunks written before the release store of the class's count that
   // makes their first member visible, and never changed afterwards, like the point chunks.
   struct WeightClass {
@@ -121,14 +134,14 @@ class GrowingPointCloud : public Sampler {
     }
     static size_t ChunkStart(int j) { return ((size_t{1} << j) - 1) << kFirstClassChunkBits; }
 
-    const uint32_t& MemberRef(size_t slot) const {
+    const Member& MemberRef(size_t slot) const {
       const int j = ChunkOf(slot);
       return chunks[j][slot - ChunkStart(j)];
     }
     // Stores a member after the `written` ones; readers see it once the count covers it.
-    void Add(uint32_t point);
+    void Add(uint32_t point, float weight);
 
-    std::unique_ptr<uint32_t[]> chunks[kClassChunks];
+    std::unique_ptr<Member[]> chunks[kClassChunks];
     size_t written = 0;  // Members stored; only the appending thread uses it.
   };
 
@@ -145,12 +158,24 @@ class GrowingPointCloud : public Sampler {
   // Publishes the members added so far and the classes they opened.
   void PublishClasses();
 
-  // Reader-side helpers of Sample and PrefetchSample. Loads the counts of the first `classes`
-  // listed classes and returns sum(count * U).
-  double LoadClassCounts(size_t classes, size_t* counts) const;
-  // A list position below `classes`, p with probability counts[p] * U_p / total (one draw,
-  // none when there is one class).
-  size_t PickClass(Random& rng, const size_t* counts, size_t classes, double total) const;
+  // The weight classes as one draw sees them: the counts of the listed classes and the running
+  // sums of count * U, for Sample and PrefetchSample.
+  struct ClassSnapshot {
+    size_t classes = 0;
+    size_t counts[kNumClasses];
+    double cumulative[kNumClasses];  // Over list positions 0..p.
+    double total() const { return classes == 0 ? 0.0 : cumulative[classes - 1]; }
+  };
+  void LoadClasses(ClassSnapshot* snapshot) const;
+  // A list position p below snapshot.classes, with probability counts[p] * U_p / total (one
+  // draw, none when there is one class).
+  static size_t PickClass(Random& rng, const ClassSnapshot& snapshot);
+  // One try's member: a class by PickClass, then a uniform member of it; `bound` gets the
+  // class's U.
+  const Member& PickMember(Random& tries, const ClassSnapshot& snapshot, double* bound) const;
+  // Whether a try keeps `member`: with probability weight / bound (one draw unless they are
+  // equal).
+  static bool Keep(Random& tries, const Member& member, double bound);
 
   const size_t max_points_;
 

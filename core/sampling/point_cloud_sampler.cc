@@ -70,6 +70,12 @@ Vec3 WeightedPointCloudSampler::Sample(Random& rng) const {
   return Vec3(cloud_->positions[table_.Draw(rng)]);
 }
 
+void WeightedPointCloudSampler::PrefetchSample(const Random& rng) const {
+  Random peek = rng;
+  __builtin_prefetch(&cloud_->positions[table_.Draw(peek)]);
+  table_.PrefetchDraw(peek);  // Draw takes a fixed number of draws: peek is the next state.
+}
+
 absl::StatusOr<std::unique_ptr<Sampler>> MakePointCloudSampler(
     std::shared_ptr<const PointCloud> cloud) {
   if (cloud != nullptr && !cloud->weights.empty()) {

@@ -51,6 +51,10 @@ class WeightedPointCloudSampler final : public Sampler {
   static absl::StatusOr<std::unique_ptr<Sampler>> Create(std::shared_ptr<const PointCloud> cloud);
 
   Vec3 Sample(Random& rng) const override;  // O(1): one alias-table draw.
+  // A draw reads a table cell, then the point it names, one cache miss after the other: loaded
+  // over two calls, one Basic Step apart. Reads the next draw's cell, which the last call
+  // started loading, starts loading its point, and the cell of the draw after it.
+  void PrefetchSample(const Random& rng) const override;
   bool empty() const override { return false; }
   BoundingBox Bounds() const override { return bounds_; }
   const PointCloud& cloud() const { return *cloud_; }

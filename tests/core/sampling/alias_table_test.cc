@@ -95,6 +95,23 @@ TEST(AliasTableTest, DeterministicForSeed) {
   }
 }
 
+// WeightedPointCloudSampler::PrefetchSample loads the draw after the next one, whose generator
+// state it knows only because every draw takes the same two numbers.
+TEST(AliasTableTest, EveryDrawTakesTwoRandomNumbers) {
+  absl::StatusOr<AliasTable> table = AliasTable::Create(std::vector<double>{1, 0, 1e-9, 8, 3});
+  ASSERT_TRUE(table.ok()) << table.status();
+  Random rng(5);
+  for (int i = 0; i < 1000; ++i) {
+    Random two_on = rng;
+    two_on.NextU64();
+    two_on.NextU64();
+    table->PrefetchDraw(rng);
+    table->Draw(rng);
+    Random after = rng;
+    ASSERT_EQ(after.NextU64(), two_on.NextU64()) << "draw " << i;
+  }
+}
+
 // n / sum overflowed for a subnormal sum, and the weight-zero entry was drawn half the time.
 TEST(AliasTableTest, AWeightOfZeroIsNeverDrawnEvenBesideSubnormalOnes) {
   const absl::StatusOr<AliasTable> table = AliasTable::Create(std::vector<double>{0, 1e-320});

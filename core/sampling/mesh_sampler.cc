@@ -172,4 +172,25 @@ Vec3 MeshSampler::Sample(Random& rng) const {
   return a + (b - a) * (s * (1.0 - u)) + (c - a) * (s * u);
 }
 
+void MeshSampler::PrefetchSample(const Random& rng) const {
+  // Every draw takes the alias table's two random numbers and two more for the point in the
+  // triangle, so the states of the draws after the next one are known.
+  auto skip_point_in_triangle = [](Random& r) {
+    r.NextDouble();
+    r.NextDouble();
+  };
+  Random peek = rng;
+  // The next draw: its cell and its face were loaded by the last two calls; its corners start
+  // loading.
+  for (uint32_t corner : mesh_->faces[table_.Draw(peek)]) {
+    __builtin_prefetch(&mesh_->positions[corner]);
+  }
+  skip_point_in_triangle(peek);
+  // The one after: its cell, loaded by the last call, is read; its face starts loading.
+  __builtin_prefetch(&mesh_->faces[table_.Draw(peek)]);
+  skip_point_in_triangle(peek);
+  // The one after that: its cell starts loading.
+  table_.PrefetchDraw(peek);
+}
+
 }  // namespace neuralmesh

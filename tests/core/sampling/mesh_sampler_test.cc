@@ -151,6 +151,19 @@ TEST(MeshSamplerTest, DeterministicForSeed) {
   }
 }
 
+TEST(MeshSamplerTest, PrefetchingLeavesTheSequenceAlone) {
+  absl::StatusOr<std::unique_ptr<Sampler>> sampler =
+      MeshSampler::Create(Share(testing::Icosphere(2)));
+  ASSERT_TRUE(sampler.ok()) << sampler.status();
+  Random plain(4);
+  Random prefetching(4);
+  for (int i = 0; i < 1000; ++i) {
+    (*sampler)->PrefetchSample(prefetching);
+    ASSERT_EQ((*sampler)->Sample(plain), (*sampler)->Sample(prefetching))
+        << "prefetching changed sample " << i;
+  }
+}
+
 TEST(MeshSamplerTest, BoundsAreThoseOfTheFaces) {
   TriangleMesh mesh = TwoTriangles();
   mesh.positions.emplace_back(100, 100, 100);  // Not used by any face.

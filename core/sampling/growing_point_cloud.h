@@ -20,10 +20,10 @@
 // draws from a generator that one draw of the caller's seeds, so that every sample takes one
 // draw of it and the sampler can load two samples ahead (PrefetchSample). A class keeps its
 // members (index and weight) in chunks of geometrically growing size that never move, with a
-// count published like the size: a weighted batch's points join their classes just
-// after the size counts them. So a reader may see part of a batch whose Append has not returned
-// (counted by size() but not yet all drawable); every point it can draw is fully stored, below
-// size() and inside Bounds().
+// count published like the size: a weighted batch's points join their classes just after the
+// size counts them. So a reader may see part of a batch whose Append has not returned (counted
+// by size() but not yet all drawable); every point it can draw is fully stored, below size()
+// and inside Bounds().
 #ifndef NEURALMESH_CORE_SAMPLING_GROWING_POINT_CLOUD_H_
 #define NEURALMESH_CORE_SAMPLING_GROWING_POINT_CLOUD_H_
 

@@ -151,16 +151,22 @@ TEST(MeshSamplerTest, DeterministicForSeed) {
   }
 }
 
-TEST(MeshSamplerTest, PrefetchingLeavesTheSequenceAlone) {
+// PrefetchSample loads the draws after the next one, whose generator states it knows only
+// because every draw takes four random numbers.
+TEST(MeshSamplerTest, PrefetchingLeavesTheSequenceAloneAndEveryDrawTakesFourNumbers) {
   absl::StatusOr<std::unique_ptr<Sampler>> sampler =
       MeshSampler::Create(Share(testing::Icosphere(2)));
   ASSERT_TRUE(sampler.ok()) << sampler.status();
   Random plain(4);
   Random prefetching(4);
   for (int i = 0; i < 1000; ++i) {
+    Random four_on = plain;
+    for (int k = 0; k < 4; ++k) four_on.NextU64();
     (*sampler)->PrefetchSample(prefetching);
     ASSERT_EQ((*sampler)->Sample(plain), (*sampler)->Sample(prefetching))
         << "prefetching changed sample " << i;
+    Random after = plain;
+    ASSERT_EQ(after.NextU64(), four_on.NextU64()) << "draw " << i;
   }
 }
 

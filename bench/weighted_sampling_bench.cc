@@ -214,7 +214,7 @@ int Run() {
 int main(int argc, char** argv) {
   neuralmesh::ParseBenchFlags(
       argc, argv,
-      "Times the learner on a growing point cloud without and with weights; see "
-      "bench/weighted_sampling_bench.cc");
+      "Times the learner on point clouds without and with weights and on a mesh sampled by "
+      "area; see bench/weighted_sampling_bench.cc");
   return neuralmesh::Run();
 }

@@ -206,6 +206,31 @@ TEST(GrowingPointCloudTest, SkewedWeightsSampleInConstantTime) {
   }
 }
 
+// Weights spread log-uniformly over six decades: a rejection against the largest weight would
+// take about 14 tries per sample (the largest weight over the mean), the weight classes fewer
+// than 2 (each try is kept with probability w / U > 1/2; here about 0.72 on average).
+TEST(GrowingPointCloudTest, SpreadWeightsTakeFewTries) {
+  constexpr int kPoints = 100000;
+  constexpr int kDraws = 100000;
+  std::vector<float> weights;
+  Random weight_rng(3);
+  for (int i = 0; i < kPoints; ++i) {
+    weights.push_back(static_cast<float>(std::pow(10.0, -6.0 * weight_rng.NextDouble())));
+  }
+  GrowingPointCloud cloud;
+  ASSERT_TRUE(cloud.Append(LinePoints(0, kPoints), weights).ok()) << "weighted batch";
+  Random rng(11);
+  long total_tries = 0;
+  for (int s = 0; s < kDraws; ++s) {
+    int tries = 0;
+    cloud.Sample(rng, &tries);
+    total_tries += tries;
+  }
+  const double mean_tries = total_tries / static_cast<double>(kDraws);
+  EXPECT_GE(mean_tries, 1.0);
+  EXPECT_LT(mean_tries, 1.6) << "each try is kept with probability above 1/2, about 0.72 here";
+}
+
 // Draws `draws` samples and compares each point's count with its share of the total weight by
 // a chi-square test (the 99.9% quantile, fixed seed: the test is deterministic).
 void ExpectProportionalToWeight(const GrowingPointCloud& cloud, const std::vector<double>& weights,

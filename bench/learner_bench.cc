@@ -57,6 +57,7 @@
 #include "absl/flags/parse.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "bench/band_timer.h"
 #include "bench/bench_flags.h"
 #include "bench/count_list.h"
 #include "bench/memory_latency.h"
@@ -114,46 +115,6 @@ void PrintMemoryLatency(const char* when) {
   std::fflush(stdout);
 }
 
-// Wall time and Basic Steps per band of vertex counts (between two milestones), taken in turns
-// of 20,000 Basic Steps so that two learners, or two processes, can alternate and the
-// machine's drift, which is large here, hits both alike.
-class BandTimer {
- public:
-  explicit BandTimer(std::vector<size_t> bands)
-      : bands_(std::move(bands)), seconds_(bands_.size()), steps_(bands_.size()) {}
-  bool done(const Learner& learner) const { return band_of(learner) >= bands_.size(); }
-  // One turn of `learner`; false when it fails.
-  bool Turn(Learner& learner) {
-    const size_t band = band_of(learner);
-    StopCriteria turn;
-    turn.max_basic_steps = kTurnSteps;
-    turn.target_vertices = bands_.back();
-    const uint64_t before = learner.progress().basic_steps;
-    const auto start = std::chrono::steady_clock::now();
-    if (!learner.Run(turn).ok()) return false;
-    seconds_[band] +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    steps_[band] += learner.progress().basic_steps - before;
-    return true;
-  }
-  const std::vector<size_t>& bands() const { return bands_; }
-  double us_per_step(size_t band) const { return 1e6 * seconds_[band] / steps_[band]; }
-  double seconds(size_t band) const { return seconds_[band]; }
-  uint64_t steps(size_t band) const { return steps_[band]; }
-
-  static constexpr uint64_t kTurnSteps = 20000;
-
- private:
-  size_t band_of(const Learner& learner) const {
-    size_t band = 0;
-    while (band < bands_.size() && learner.num_vertices() >= bands_[band]) ++band;
-    return band;
-  }
-  std::vector<size_t> bands_;
-  std::vector<double> seconds_;
-  std::vector<uint64_t> steps_;
-};
-
 // A learner with the paper's parameters and `seed`, looking ahead from `lookahead_from`
 // vertices on (-1: the learner's default).
 std::unique_ptr<Learner> MakeLearner(const Sampler& sampler, uint64_t seed,
@@ -188,7 +149,7 @@ int CompareLookahead(const Sampler& sampler, size_t n, const std::vector<size_t>
   const std::vector<size_t> bands = ReachableMilestones(milestones, n);
   BandTimer timer_a(bands), timer_b(bands);
   while (!timer_a.done(*a)) {
-    if (!timer_a.Turn(*a) || !timer_b.Turn(*b)) return 1;
+    if (!timer_a.Turn(*a).ok() || !timer_b.Turn(*b).ok()) return 1;
     if (a->num_vertices() != b->num_vertices()) {
       std::printf("the two learners diverged: %zu and %zu vertices\n", a->num_vertices(),
                   b->num_vertices());
@@ -226,19 +187,8 @@ int CompareInputSizesInTurns(const std::vector<size_t>& point_counts,
     learners.push_back(MakeLearner(*sampler, seed, lookahead_from));
     timers.emplace_back(bands);
   }
-  for (bool all_done = false; !all_done;) {
-    all_done = true;
-    for (size_t i = 0; i < learners.size(); ++i) {
-      if (timers[i].done(*learners[i])) continue;
-      if (!timers[i].Turn(*learners[i])) return 1;
-      all_done = false;
-    }
-  }
-  auto seconds_to_target = [&](size_t i) {
-    double seconds = 0;
-    for (size_t b = 0; b < bands.size(); ++b) seconds += timers[i].seconds(b);
-    return seconds;
-  };
+  if (!TakeTurns(learners, timers).ok()) return 1;
+  auto seconds_to_target = [&](size_t i) { return timers[i].total_seconds(); };
   for (size_t i = 1; i < learners.size(); ++i) {
     std::printf(
         "%10zu points: %.2f s to %zu vertices, taking turns of %llu Basic Steps with a fresh "
@@ -288,7 +238,7 @@ int RunInTurns(FifoTurns& turns, const Sampler& sampler, size_t n,
   BandTimer timer(ReachableMilestones(milestones, n));
   while (!timer.done(*learner)) {
     turns.Wait();
-    const bool ok = timer.Turn(*learner);
+    const bool ok = timer.Turn(*learner).ok();
     turns.Pass();
     if (!ok) return 1;
   }

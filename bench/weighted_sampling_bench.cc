@@ -12,7 +12,6 @@
 // A weighted draw reads a table cell or a class member (a cache miss on a large cloud) and then
 // the point it names (another); a mesh's draw reads a cell, a face, then its corners. Each
 // sampler's PrefetchSample loads them over as many Basic Steps.
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -23,6 +22,7 @@
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
+#include "bench/band_timer.h"
 #include "bench/bench_flags.h"
 #include "core/learning/learner.h"
 #include "core/random.h"
@@ -41,20 +41,17 @@ ABSL_FLAG(uint64_t, seed, 1, "Seed of the points, the weights and the learners."
 namespace neuralmesh {
 namespace {
 
-constexpr uint64_t kTurnSteps = 20000;
-
 struct Weighting {
   std::string name;
   // Draws the weight of one point; empty for a cloud without weights.
   std::function<float(Random&)> weight;
 };
 
+// One learner's target space, by name, and the sampler its learner draws from.
 struct Contender {
   std::string target_space;
   std::string weights;
   std::unique_ptr<Sampler> sampler;
-  std::unique_ptr<Learner> learner;
-  double seconds = 0;
 };
 
 // The torus as a mesh of about `faces` triangles: a grid over its two angles, twice as many
@@ -102,24 +99,16 @@ absl::StatusOr<std::unique_ptr<Sampler>> MakeSampler(bool growing, const PointCl
   return MakePointCloudSampler(std::move(cloud));
 }
 
-// Adds a learner with the paper's parameters on `sampler`; false (with a message) when the
-// sampler could not be made.
+// Adds a contender on `sampler`; false (with a message) when the sampler could not be made.
 bool AddContender(std::string target_space, std::string weights,
-                  absl::StatusOr<std::unique_ptr<Sampler>> sampler, uint64_t seed,
+                  absl::StatusOr<std::unique_ptr<Sampler>> sampler,
                   std::vector<Contender>& contenders) {
   if (!sampler.ok()) {
     std::fprintf(stderr, "weighted-sampling-bench: %s\n",
                  std::string(sampler.status().message()).c_str());
     return false;
   }
-  Contender c;
-  c.target_space = std::move(target_space);
-  c.weights = std::move(weights);
-  c.sampler = *std::move(sampler);
-  LearnerOptions options;
-  options.seed = seed;
-  c.learner = Learner::Create(options, c.sampler.get()).value();
-  contenders.push_back(std::move(c));
+  contenders.push_back({std::move(target_space), std::move(weights), *std::move(sampler)});
   return true;
 }
 
@@ -155,55 +144,50 @@ int Run() {
         for (uint64_t i = 0; i < n; ++i) weights.push_back(weighting.weight(weight_rng));
       }
       if (!AddContender(growing ? "GrowingPointCloud" : "PointCloudSampler", weighting.name,
-                        MakeSampler(growing, points, std::move(weights)), seed, contenders)) {
+                        MakeSampler(growing, points, std::move(weights)), contenders)) {
         return 1;
       }
     }
   }
   if (!AddContender("MeshSampler", "triangle area",
-                    MeshSampler::Create(std::make_shared<const TriangleMesh>(TorusMesh(n))), seed,
+                    MeshSampler::Create(std::make_shared<const TriangleMesh>(TorusMesh(n))),
                     contenders)) {
     return 1;
   }
 
-  for (bool all_done = false; !all_done;) {
-    all_done = true;
-    for (Contender& c : contenders) {
-      if (c.learner->num_vertices() >= vertices) continue;
-      all_done = false;
-      StopCriteria turn;
-      turn.max_basic_steps = kTurnSteps;
-      turn.target_vertices = vertices;
-      const auto start = std::chrono::steady_clock::now();
-      if (absl::StatusOr<StopReason> stop = c.learner->Run(turn); !stop.ok()) {
-        std::fprintf(stderr, "weighted-sampling-bench: %s, %s: %s\n", c.target_space.c_str(),
-                     c.weights.c_str(),
-                     std::string(stop.status().message()).c_str());
-        return 1;
-      }
-      c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    }
+  std::vector<std::unique_ptr<Learner>> learners;
+  std::vector<BandTimer> timers;
+  for (const Contender& c : contenders) {
+    LearnerOptions options;
+    options.seed = seed;
+    learners.push_back(Learner::Create(options, c.sampler.get()).value());
+    timers.emplace_back(std::vector<size_t>{vertices});
+  }
+  if (absl::Status status = TakeTurns(learners, timers); !status.ok()) {
+    std::fprintf(stderr, "weighted-sampling-bench: %s\n", std::string(status.message()).c_str());
+    return 1;
   }
 
-  std::printf("%llu torus points to %llu vertices, paper parameters, one thread, turns of %llu "
-              "Basic Steps\n\n",
-              static_cast<unsigned long long>(n), static_cast<unsigned long long>(vertices),
-              static_cast<unsigned long long>(kTurnSteps));
+  std::printf(
+      "%llu torus points to %llu vertices, paper parameters, one thread, turns of %llu "
+      "Basic Steps\n\n",
+      static_cast<unsigned long long>(n), static_cast<unsigned long long>(vertices),
+      static_cast<unsigned long long>(BandTimer::kTurnSteps));
   std::printf("%-18s %-27s %8s %12s %8s %14s\n", "target space", "weights", "seconds",
               "Basic Steps", "us/step", "vs no weights");
-  auto us_per_step = [](const Contender& c) {
-    return 1e6 * c.seconds / static_cast<double>(c.learner->progress().basic_steps);
+  auto us_per_step = [&](size_t i) {
+    return 1e6 * timers[i].total_seconds() / static_cast<double>(timers[i].total_steps());
   };
   double base_us = 0;
-  for (const Contender& c : contenders) {
-    const uint64_t steps = c.learner->progress().basic_steps;
-    const double us = us_per_step(c);
+  for (size_t i = 0; i < contenders.size(); ++i) {
+    const Contender& c = contenders[i];
+    const double us = us_per_step(i);
     if (c.weights == weightings[0].name) base_us = us;
     // The mesh against the points of the loaded file without weights, the first row.
-    if (c.target_space == "MeshSampler") base_us = us_per_step(contenders[0]);
+    if (c.target_space == "MeshSampler") base_us = us_per_step(0);
     std::printf("%-18s %-27s %8.2f %12llu %8.3f %14.2f\n", c.target_space.c_str(),
-                c.weights.c_str(), c.seconds, static_cast<unsigned long long>(steps), us,
-                us / base_us);
+                c.weights.c_str(), timers[i].total_seconds(),
+                static_cast<unsigned long long>(timers[i].total_steps()), us, us / base_us);
   }
   return 0;
 }

@@ -566,12 +566,13 @@ TEST(ReconstructionServiceIdleTimeoutTest, IdleSessionsAreDeletedWatchedOnesStay
   options.limits.idle_timeout = absl::Seconds(1);  // The reaper looks every 250 ms.
   std::unique_ptr<ReconstructionServer> server = StartServer(/*listen=*/false, options);
   ASSERT_NE(server, nullptr);
-  auto stub = InProcessStub(*server);
+  // The generated client class of the service (gRPC calls it a stub), over an in-process channel.
+  auto client = InProcessStub(*server);
   // ListSessions is no call on a session: it keeps none alive.
   auto listed = [&] {
     grpc::ClientContext context;
     v1::ListSessionsResponse list;
-    EXPECT_TRUE(stub->ListSessions(&context, v1::ListSessionsRequest(), &list).ok());
+    EXPECT_TRUE(client->ListSessions(&context, v1::ListSessionsRequest(), &list).ok());
     std::vector<std::string> ids;
     for (const v1::Session& session : list.sessions()) ids.push_back(session.session_id());
     return ids;
@@ -582,13 +583,13 @@ TEST(ReconstructionServiceIdleTimeoutTest, IdleSessionsAreDeletedWatchedOnesStay
     return listed();
   };
 
-  const std::string idle = MustCreate(*stub, CreateRequest(1000));
-  const std::string watched = MustCreate(*stub, CreateRequest(1000));
-  const std::string polled = MustCreate(*stub, CreateRequest(1000));
+  const std::string idle = MustCreate(*client, CreateRequest(1000));
+  const std::string watched = MustCreate(*client, CreateRequest(1000));
+  const std::string polled = MustCreate(*client, CreateRequest(1000));
   grpc::ClientContext watch_context;
   v1::WatchSessionRequest watch_request;
   watch_request.set_session_id(watched);
-  auto watcher = stub->WatchSession(&watch_context, watch_request);
+  auto watcher = client->WatchSession(&watch_context, watch_request);
 
   // `polled` gets a GetSession every 50 ms for at least 2 s (2 timeouts) and until `idle` is
   // gone.
@@ -597,13 +598,13 @@ TEST(ReconstructionServiceIdleTimeoutTest, IdleSessionsAreDeletedWatchedOnesStay
   while (absl::Now() < polled_from + absl::Seconds(2) ||
          (::testing::Value(listed(), ::testing::Contains(idle)) && absl::Now() < give_up)) {
     grpc::Status status;
-    testing::GetSession(*stub, polled, &status);
+    testing::GetSession(*client, polled, &status);
     ASSERT_TRUE(status.ok()) << "polled every 50 ms, so never idle: " << status.error_message();
     absl::SleepFor(absl::Milliseconds(50));
   }
   EXPECT_THAT(listed(), ::testing::UnorderedElementsAre(watched, polled));
   grpc::Status status;
-  testing::GetSession(*stub, idle, &status);
+  testing::GetSession(*client, idle, &status);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND) << status.error_message();
 
   EXPECT_THAT(wait_until_listed_only({watched}), ::testing::ElementsAre(watched));

@@ -85,6 +85,12 @@ ABSL_FLAG(bool, cut_inactive_faces, kLearnerDefaults.cut_inactive_faces,
           "After Step 4: cut out faces over no data that Steps 3 and 4 cannot remove, a "
           "bridge between two holes and the faces of a border vertex Step 3 could not "
           "collapse (--nocut_inactive_faces).");
+ABSL_FLAG(std::string, initial_mesh,
+          std::string(neuralmesh::InitialMeshName(kLearnerDefaults.initial_mesh)),
+          "The mesh learning starts from: tetrahedron (the paper's; closed surfaces and open "
+          "ones that curve round) or disc (a flat disc in the data's best-fit plane whose "
+          "border is never refilled: open, nearly flat sheets such as one range scan, a "
+          "terrain or a facade).");
 
 // Local learning.
 ABSL_FLAG(std::string, sampling, "uniform",
@@ -132,8 +138,10 @@ absl::Status ExpectPositional(const ParsedArgs& args, size_t n, const std::strin
       absl::StrCat("unexpected argument '", args.positional[n], "' (expected ", names, ")"));
 }
 
-neuralmesh::LearnerOptions LearnerFromFlags() {
+absl::StatusOr<neuralmesh::LearnerOptions> LearnerFromFlags() {
   neuralmesh::LearnerOptions o;
+  NM_ASSIGN_OR_RETURN(o.initial_mesh,
+                      neuralmesh::ParseInitialMesh(absl::GetFlag(FLAGS_initial_mesh)));
   o.alpha_w = absl::GetFlag(FLAGS_alpha_w);
   o.alpha_l = absl::GetFlag(FLAGS_alpha_l);
   o.c_l = absl::GetFlag(FLAGS_c_l);
@@ -197,7 +205,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.out_dir = absl::GetFlag(FLAGS_out_dir);
     o.vertices = absl::GetFlag(FLAGS_vertices);
     o.lods = lods;
-    o.learner = LearnerFromFlags();
+    NM_ASSIGN_OR_RETURN(o.learner, LearnerFromFlags());
     NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
     o.batch_size = absl::GetFlag(FLAGS_batch_size);
     o.builtin_points = absl::GetFlag(FLAGS_points);
@@ -215,7 +223,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
   o.output = absl::GetFlag(FLAGS_output);
   o.vertices = absl::GetFlag(FLAGS_vertices);
   o.lods = lods;
-  o.learner = LearnerFromFlags();
+  NM_ASSIGN_OR_RETURN(o.learner, LearnerFromFlags());
   NM_ASSIGN_OR_RETURN(o.sampling,
                       neuralmesh::client::ParseSamplingMode(absl::GetFlag(FLAGS_sampling)));
   o.time_budget = absl::GetFlag(FLAGS_time_budget);
@@ -266,7 +274,8 @@ std::vector<Subcommand> Commands() {
       "alpha_sc", "alpha_r", "alpha_m", "remove_triangles", "merge_boundaries",
       "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
-      "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "sampling",
+      "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
+      "sampling",
       "time_budget",
       "max_steps", "quantization_bits", "encode_speed", "progress", "server", "out-dir",
       "batch-size", "points", "ply", "connect_timeout"};

@@ -24,6 +24,9 @@ v1::LearnerOptions ToProto(const LearnerOptions& options) {
   proto.mutable_sewn_strip_grace_calls()->set_value(options.sewn_strip_grace_calls);
   proto.mutable_min_merged_loop_vertices()->set_value(options.min_merged_loop_vertices);
   proto.mutable_cut_inactive_faces()->set_value(options.cut_inactive_faces);
+  proto.set_initial_mesh(options.initial_mesh == InitialMesh::kDisc
+                             ? v1::INITIAL_MESH_DISC
+                             : v1::INITIAL_MESH_TETRAHEDRON);
   proto.mutable_seed()->set_value(options.seed);
   return proto;
 }

@@ -61,6 +61,17 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
     o.min_merged_loop_vertices = l.min_merged_loop_vertices().value();
   }
   if (l.has_cut_inactive_faces()) o.cut_inactive_faces = l.cut_inactive_faces().value();
+  switch (l.initial_mesh()) {
+    case v1::INITIAL_MESH_TETRAHEDRON:
+      o.initial_mesh = InitialMesh::kTetrahedron;
+      break;
+    case v1::INITIAL_MESH_DISC:
+      o.initial_mesh = InitialMesh::kDisc;
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat("LearnerOptions.initial_mesh has the unknown value ", l.initial_mesh()));
+  }
 
   config.target_vertices = proto.target_vertices();
   config.lod_milestones.assign(proto.lod_milestones().begin(), proto.lod_milestones().end());
@@ -132,6 +143,8 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
   l.mutable_sewn_strip_grace_calls()->set_value(o.sewn_strip_grace_calls);
   l.mutable_min_merged_loop_vertices()->set_value(o.min_merged_loop_vertices);
   l.mutable_cut_inactive_faces()->set_value(o.cut_inactive_faces);
+  l.set_initial_mesh(o.initial_mesh == InitialMesh::kDisc ? v1::INITIAL_MESH_DISC
+                                                          : v1::INITIAL_MESH_TETRAHEDRON);
 
   proto.set_target_vertices(config.target_vertices);
   for (size_t m : config.lod_milestones) proto.add_lod_milestones(m);

@@ -24,4 +24,26 @@ VertexLoop BoundaryLoopFrom(const Mesh& mesh, Mesh::HalfedgeHandle start,
   return loop;
 }
 
+double LoopPerimeter(const Mesh& mesh, const VertexLoop& loop) {
+  double perimeter = 0;
+  for (size_t i = 0; i < loop.size(); ++i) {
+    const size_t next = i + 1 == loop.size() ? 0 : i + 1;
+    perimeter += (mesh.point(loop[next]) - mesh.point(loop[i])).norm();
+  }
+  return perimeter;
+}
+
+int LongestLoop(const Mesh& mesh, const std::vector<VertexLoop>& loops) {
+  int longest = -1;
+  double longest_perimeter = -1;
+  for (size_t i = 0; i < loops.size(); ++i) {
+    const double perimeter = LoopPerimeter(mesh, loops[i]);
+    if (perimeter > longest_perimeter) {
+      longest = static_cast<int>(i);
+      longest_perimeter = perimeter;
+    }
+  }
+  return longest;
+}
+
 }  // namespace neuralmesh

@@ -22,6 +22,13 @@ std::vector<VertexLoop> CollectBoundaryLoops(const Mesh& mesh);
 VertexLoop BoundaryLoopFrom(const Mesh& mesh, Mesh::HalfedgeHandle start,
                             std::vector<bool>* visited = nullptr);
 
+// The sum of the lengths of a loop's edges.
+double LoopPerimeter(const Mesh& mesh, const VertexLoop& loop);
+
+// The index in `loops` of the loop of greatest perimeter, the first among equals; -1 when
+// `loops` is empty.
+int LongestLoop(const Mesh& mesh, const std::vector<VertexLoop>& loops);
+
 }  // namespace neuralmesh
 
 #endif  // NEURALMESH_CORE_LEARNING_BOUNDARY_LOOPS_H_

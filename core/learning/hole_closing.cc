@@ -23,9 +23,12 @@ constexpr double kMinSlitPathToChord = 3;
 constexpr size_t kMaxSlitCandidatesPerLoop = 8;
 constexpr size_t kMaxSlitZipsPerCall = 64;
 
-// The boundary loops with at most `max_vertices` vertices (boundary_loops.h).
-std::vector<VertexLoop> CollectLoops(const Mesh& mesh, size_t max_vertices) {
+// The boundary loops with at most `max_vertices` vertices (boundary_loops.h), without the one
+// of greatest perimeter when `keep_longest_open`.
+std::vector<VertexLoop> CollectLoops(const Mesh& mesh, size_t max_vertices,
+                                     bool keep_longest_open) {
   std::vector<VertexLoop> loops = CollectBoundaryLoops(mesh);
+  if (keep_longest_open && !loops.empty()) loops.erase(loops.begin() + LongestLoop(mesh, loops));
   loops.erase(std::remove_if(loops.begin(), loops.end(),
                              [max_vertices](const VertexLoop& loop) {
                                return loop.size() > max_vertices;
@@ -304,7 +307,8 @@ absl::Status HoleClosingOptions::Validate() const {
 HoleClosingResult CloseSmallHoles(Mesh& mesh, const HoleClosingOptions& options, double mean_area) {
   HoleClosingResult result;
   const std::vector<VertexLoop> loops =
-      CollectLoops(mesh, static_cast<size_t>(options.max_loop_vertices));
+      CollectLoops(mesh, static_cast<size_t>(options.max_loop_vertices),
+                   options.keep_longest_loop_open);
   if (loops.empty()) return result;
   const std::optional<FillLimits> limits = LimitsOf(mesh, options, mean_area);
   if (!limits) return result;
@@ -346,6 +350,7 @@ HoleClosingResult CloseBridgedHoles(Mesh& mesh, const HoleClosingOptions& option
   // whichever bridge goes, and a band of faces one triangle wide between two holes, every
   // edge across it a bridge, would otherwise cost a triangulation per edge.
   std::vector<bool> closed(loops.size(), false);
+  if (options.keep_longest_loop_open) closed[LongestLoop(mesh, loops)] = true;
   std::set<std::pair<int, int>> tried;
   for (const auto& [v, u] : bridges) {
     const int a = loop_of[v.idx()];

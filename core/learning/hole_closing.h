@@ -81,6 +81,11 @@ struct HoleClosingOptions {
   double alpha_m = 5;
   // Loops with more vertices are never closed. >= 3. It bounds the O(k^3) work per loop.
   int max_loop_vertices = 256;
+  // Never fill the boundary loop of greatest perimeter (the first found among equals), nor
+  // close it together with another through a bridge (CloseBridgedHoles): with the learner's
+  // disc start (LearnerOptions::initial_mesh) it is the open sheet's own border. Slits in it
+  // are still zipped (ZipBorderSlits), which leaves it open.
+  bool keep_longest_loop_open = false;
 
   // Returns INVALID_ARGUMENT unless alpha_r and alpha_m are finite and positive and
   // max_loop_vertices >= 3.

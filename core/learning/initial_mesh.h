@@ -1,8 +1,11 @@
-// The initial neural mesh (Section 1.2): a regular tetrahedron around the data.
+// The initial neural mesh: a regular tetrahedron around the data (Section 1.2), or, for data
+// that form an open sheet, a flat disc in their best-fit plane (not in the paper; see
+// LearnerOptions::initial_mesh).
 #ifndef NEURALMESH_CORE_LEARNING_INITIAL_MESH_H_
 #define NEURALMESH_CORE_LEARNING_INITIAL_MESH_H_
 
 #include "core/bounding_box.h"
+#include "core/learning/best_fit_plane.h"
 #include "core/mesh.h"
 
 namespace neuralmesh {
@@ -14,6 +17,15 @@ namespace neuralmesh {
 // inscribed sphere holds the box; the same speed, but on seeds 1-60 of the topology tests
 // genus-2 seed 33 kept an extra handle (59 of 60 against 60 of 60).
 Mesh MakeInitialTetrahedron(const BoundingBox& box);
+
+// A disc of six triangles around one interior vertex at plane.center: a regular hexagon in the
+// plane whose corners lie plane.radius from the centre (1 when the radius is 0 or not finite),
+// the first along plane.u, oriented so that its faces' normals are plane.normal. Its border
+// becomes the sheet's: its corners lie on the circle that holds the data's projection, and the
+// first Basic Steps pull them in onto the data. The two sheets of topology_learning_test, seeds
+// 1-30, one border and one layer in: 28 and 29 runs with this radius; 28 and 29 at 0.8 times
+// it; 27 and 24 at 1.25 times; 12 and 27 at half (the rest folded over themselves).
+Mesh MakeInitialDisc(const BestFitPlane& plane);
 
 }  // namespace neuralmesh
 

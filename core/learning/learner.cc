@@ -47,6 +47,23 @@ const std::vector<Vec3>* MeshPoints(const Mesh& mesh) {
   return &mesh.property(mesh.points_pph()).data_vector();
 }
 
+// The samples the disc start fits its plane to, and the generator they are drawn with: its own,
+// so that the learner's sequence is the same whichever initial mesh it starts from.
+constexpr int kDiscPlaneSamples = 4096;
+constexpr uint64_t kDiscPlaneSeedMix = 0x9e3779b97f4a7c15ull;
+
+Mesh MakeInitialMesh(const LearnerOptions& options, const Sampler& target) {
+  switch (options.initial_mesh) {
+    case InitialMesh::kDisc: {
+      Random rng(options.seed ^ kDiscPlaneSeedMix);
+      return MakeInitialDisc(FitPlane(target, rng, kDiscPlaneSamples));
+    }
+    case InitialMesh::kTetrahedron:
+      break;
+  }
+  return MakeInitialTetrahedron(target.Bounds());
+}
+
 }  // namespace
 
 class Learner::Impl {
@@ -55,7 +72,7 @@ class Learner::Impl {
       : options_(options),
         target_(target),
         rng_(options.seed),
-        mesh_(MakeInitialTetrahedron(target->Bounds())),
+        mesh_(MakeInitialMesh(options, *target)),
         octree_(target->Bounds(), MeshPoints(mesh_), kOctreeBucketSize),
         counters_(options.alpha_sc) {
     mesh_.add_property(active_);
@@ -288,6 +305,7 @@ class Learner::Impl {
       merging.hole_closing.alpha_r = options_.alpha_r;
       merging.hole_closing.alpha_m = options_.alpha_m;
       merging.hole_closing.max_loop_vertices = options_.max_closed_hole_vertices;
+      merging.hole_closing.keep_longest_loop_open = options_.initial_mesh == InitialMesh::kDisc;
       // E(Area) of Eq. 3 is that of the mesh Step 5 sees: after Step 4's removals (which take
       // the largest faces, so the mean before them is larger) and the cuts. 0: measured there.
       const BoundaryMergingResult merged =

@@ -14,6 +14,24 @@ absl::Status OutOfRange(const char* name, double value, const char* range) {
 
 }  // namespace
 
+absl::string_view InitialMeshName(InitialMesh mesh) {
+  switch (mesh) {
+    case InitialMesh::kTetrahedron:
+      return "tetrahedron";
+    case InitialMesh::kDisc:
+      return "disc";
+  }
+  return "unknown";
+}
+
+absl::StatusOr<InitialMesh> ParseInitialMesh(absl::string_view name) {
+  for (InitialMesh mesh : {InitialMesh::kTetrahedron, InitialMesh::kDisc}) {
+    if (name == InitialMeshName(mesh)) return mesh;
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("initial_mesh '", name, "' is unknown; use tetrahedron or disc"));
+}
+
 absl::Status LearnerOptions::Validate() const {
   if (!(alpha_w > 0 && alpha_w <= 1)) return OutOfRange("alpha_w", alpha_w, "(0, 1]");
   if (!(alpha_l >= 0 && alpha_l <= 1)) return OutOfRange("alpha_l", alpha_l, "[0, 1]");
@@ -31,6 +49,9 @@ absl::Status LearnerOptions::Validate() const {
   }
   if (max_closed_hole_vertices < 3 || max_closed_hole_vertices > 1000) {
     return OutOfRange("max_closed_hole_vertices", max_closed_hole_vertices, "[3, 1000]");
+  }
+  if (initial_mesh != InitialMesh::kTetrahedron && initial_mesh != InitialMesh::kDisc) {
+    return OutOfRange("initial_mesh", static_cast<int>(initial_mesh), "{tetrahedron, disc}");
   }
   if (splits_per_step < 1 || splits_per_step > 1000) {
     return OutOfRange("splits_per_step", splits_per_step, "[1, 1000]");

@@ -27,6 +27,7 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   options.sewn_strip_grace_calls = 0;
   options.min_merged_loop_vertices = 5;
   options.cut_inactive_faces = false;
+  options.initial_mesh = InitialMesh::kDisc;
   const v1::LearnerOptions proto = ToProto(options);
   EXPECT_EQ(proto.alpha_w().value(), 0.1);
   EXPECT_EQ(proto.alpha_l().value(), 0.2);
@@ -54,6 +55,8 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   EXPECT_EQ(proto.min_merged_loop_vertices().value(), 5);
   ASSERT_TRUE(proto.has_cut_inactive_faces());
   EXPECT_FALSE(proto.cut_inactive_faces().value());
+  EXPECT_EQ(proto.initial_mesh(), v1::INITIAL_MESH_DISC);
+  EXPECT_EQ(ToProto(LearnerOptions{}).initial_mesh(), v1::INITIAL_MESH_TETRAHEDRON);
 }
 
 TEST(ClientProtoConversionTest, DracoSpeedBecomesCompressionSpeed) {

@@ -126,6 +126,13 @@ TEST_F(CliErrorsTest, UnknownSamplingMode) {
   EXPECT_TRUE(absl::StrContains(err, "gaussian")) << err;
 }
 
+TEST_F(CliErrorsTest, UnknownInitialMesh) {
+  const std::string err = ExpectFailure({"reconstruct", "builtin:sphere", "-o", Output(),
+                                         "--vertices", "100", "--initial_mesh", "cube"});
+  EXPECT_TRUE(absl::StrContains(err, "'cube'") && absl::StrContains(err, "tetrahedron or disc"))
+      << err;
+}
+
 TEST_F(CliErrorsTest, MeshSamplingOfAPointCloud) {
   const std::string cloud = WriteFile("cloud.off", "OFF\n4 0 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
   const std::string err = ExpectFailure(

@@ -128,6 +128,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   proto.mutable_learner()->mutable_sewn_strip_grace_calls()->set_value(0);
   proto.mutable_learner()->mutable_min_merged_loop_vertices()->set_value(3);
   proto.mutable_learner()->mutable_cut_inactive_faces()->set_value(false);
+  proto.mutable_learner()->set_initial_mesh(v1::INITIAL_MESH_DISC);
   proto.mutable_refresh_interval_ms()->set_value(0);
   proto.mutable_draco()->mutable_position_quantization_bits()->set_value(14);
   config = SessionConfigFromProto(proto);
@@ -138,6 +139,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(config->learner.sewn_strip_grace_calls, 0) << "0 is the paper's rule, not unset";
   EXPECT_EQ(config->learner.min_merged_loop_vertices, 3);
   EXPECT_FALSE(config->learner.cut_inactive_faces);
+  EXPECT_EQ(config->learner.initial_mesh, InitialMesh::kDisc);
   EXPECT_EQ(config->refresh_interval, absl::ZeroDuration()) << "0 turns refreshes off";
   EXPECT_EQ(config->draco.position_quantization_bits, 14);
 
@@ -151,7 +153,20 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(again->learner.sewn_strip_grace_calls, 0);
   EXPECT_EQ(again->learner.min_merged_loop_vertices, 3);
   EXPECT_FALSE(again->learner.cut_inactive_faces);
+  EXPECT_EQ(again->learner.initial_mesh, InitialMesh::kDisc);
   EXPECT_EQ(again->draco.position_quantization_bits, 14);
+}
+
+TEST(SessionConfigFromProtoTest, UnknownInitialMeshIsInvalidArgument) {
+  v1::SessionConfig proto;
+  proto.set_target_vertices(1000);
+  EXPECT_EQ(SessionConfigFromProto(proto)->learner.initial_mesh, InitialMesh::kTetrahedron)
+      << "unset is the paper's tetrahedron";
+  proto.mutable_learner()->set_initial_mesh(static_cast<v1::InitialMesh>(9));
+  const absl::StatusOr<SessionConfig> config = SessionConfigFromProto(proto);
+  EXPECT_EQ(config.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(config.status().message().find("initial_mesh"), absl::string_view::npos)
+      << config.status();
 }
 
 }  // namespace

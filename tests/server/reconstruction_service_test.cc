@@ -10,7 +10,9 @@
 #include <thread>
 #include <vector>
 
+#include "core/analysis/mesh_report.h"
 #include "core/io/draco_codec.h"
+#include "core/random.h"
 #include "tests/server/server_test_support.h"
 
 namespace neuralmesh::server {
@@ -129,6 +131,11 @@ TEST_F(ReconstructionServiceTest, InvalidOptionsAreInvalidArgumentNamingTheField
     v1::CreateSessionRequest r = CreateRequest(100);
     r.mutable_config()->mutable_points_per_vertex()->set_value(-1);
     cases.push_back({"negative points_per_vertex", r, "points_per_vertex"});
+  }
+  {
+    v1::CreateSessionRequest r = CreateRequest(100);
+    r.mutable_config()->mutable_learner()->set_initial_mesh(static_cast<v1::InitialMesh>(9));
+    cases.push_back({"unknown initial mesh", r, "initial_mesh"});
   }
   for (const Case& c : cases) {
     grpc::ClientContext context;
@@ -380,6 +387,54 @@ TEST_F(ReconstructionServiceTest, ReconstructDoesEverythingInOneCall) {
   ASSERT_TRUE(responses.back().has_update());
   EXPECT_EQ(responses.back().update().kind(), v1::UPDATE_KIND_FINAL);
   EXPECT_EQ(responses.back().update().vertex_count(), 300u);
+}
+
+// A client that asks for the disc start gets it: points of a flat square come back as one
+// sheet with one border (from the tetrahedron they come back in two layers, README).
+TEST_F(ReconstructionServiceTest, ADiscStartGivesAFlatSquareOneBorder) {
+  Random rng(21);
+  PointCloud points;
+  for (int i = 0; i < 20000; ++i) {
+    points.positions.emplace_back(rng.NextDouble(), rng.NextDouble(), 0.f);
+  }
+  grpc::ClientContext context;
+  auto stream = stub_->Reconstruct(&context);
+  v1::ReconstructRequest start;
+  *start.mutable_start()->mutable_create() = CreateRequest(2000);
+  start.mutable_start()->mutable_create()->mutable_config()->mutable_learner()->set_initial_mesh(
+      v1::INITIAL_MESH_DISC);
+  ASSERT_TRUE(stream->Write(start));
+  for (size_t b = 0; b < 4; ++b) {
+    v1::ReconstructRequest request;
+    *request.mutable_points() = Batch(points, b * 5000, (b + 1) * 5000);
+    ASSERT_TRUE(stream->Write(request));
+  }
+  stream->WritesDone();
+  v1::ReconstructResponse response;
+  v1::MeshUpdate last;
+  while (stream->Read(&response)) {
+    if (response.has_update()) last = response.update();
+  }
+  grpc::Status status = stream->Finish();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(last.kind(), v1::UPDATE_KIND_FINAL);
+  absl::StatusOr<TriangleMesh> mesh = DecodeMesh(last.draco_mesh());
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  const MeshReport report = ComputeMeshReport(*mesh);
+  EXPECT_EQ(report.boundary_loops, 1u);
+  EXPECT_EQ(report.genus, 0);
+  EXPECT_TRUE(report.manifold());
+  double up = 0;  // The area facing +z and -z: one layer faces one way.
+  double down = 0;
+  for (const auto& f : mesh->faces) {
+    const Vec3f a = mesh->positions[f[0]];
+    const Vec3f b = mesh->positions[f[1]];
+    const Vec3f c = mesh->positions[f[2]];
+    const double z = 0.5 * OpenMesh::cross(b - a, c - a)[2];
+    (z > 0 ? up : down) += std::abs(z);
+  }
+  EXPECT_LT(std::min(up, down), 0.01 * (up + down))
+      << "area facing up " << up << ", down " << down << ": two layers";
 }
 
 TEST_F(ReconstructionServiceTest, ReconstructRejectsABadBatchAndTheSessionStays) {

@@ -4,6 +4,7 @@
 #include <functional>
 #include <vector>
 
+#include "core/learning/initial_mesh.h"
 #include "core/learning/triangle_removal.h"
 #include "core/mesh_validation.h"
 #include "gtest/gtest.h"
@@ -169,6 +170,53 @@ TEST(HoleClosingTest, BorderOfAnOpenSurfaceIsNeverClosed) {
   EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({16}));
 }
 
+// The learner's disc start: a hexagon of six triangles whose border is the sheet's own. Filled
+// (it passes every test of a small hole), it made the sheet a closed pancake of two layers.
+TEST(HoleClosingTest, KeepLongestLoopOpenLeavesTheOnlyBorderOfADiscOpen) {
+  BestFitPlane plane;
+  plane.center = Vec3(0, 0, 0);
+  plane.u = Vec3(1, 0, 0);
+  plane.v = Vec3(0, 1, 0);
+  plane.normal = Vec3(0, 0, 1);
+  plane.radius = 1;
+  Mesh disc = MakeInitialDisc(plane);
+  Mesh filled = disc;
+  EXPECT_EQ(CloseSmallHoles(filled, HoleClosingOptions{}, 0).closed_holes, 1u)
+      << "without the option the border is a small hole like any other";
+  EXPECT_TRUE(BoundaryLoopSizes(filled).empty());
+
+  HoleClosingOptions options;
+  options.keep_longest_loop_open = true;
+  EXPECT_EQ(CloseSmallHoles(disc, options, 0).closed_holes, 0u);
+  EXPECT_EQ(BoundaryLoopSizes(disc), std::vector<size_t>({6}));
+  EXPECT_EQ(disc.n_faces(), 6u);
+}
+
+// A hole inside a sheet is still filled; only the border, the loop of greatest perimeter, stays.
+TEST(HoleClosingTest, KeepLongestLoopOpenStillFillsAHoleInside) {
+  Mesh mesh = MustToMesh(GridPatch(6, 6));
+  // Vertex (3, 3), inside, valence 6: remove its faces, starting next to the growing hole.
+  const Mesh::VertexHandle centre(3 * 7 + 3);
+  std::vector<Mesh::FaceHandle> fan;
+  for (auto fh : mesh.vf_range(centre)) fan.push_back(fh);
+  ASSERT_EQ(fan.size(), 6u);
+  while (!fan.empty()) {
+    auto it = std::find_if(fan.begin(), fan.end(),
+                           [&](Mesh::FaceHandle fh) { return IsTriangleRemovalOk(mesh, fh); });
+    ASSERT_NE(it, fan.end());
+    RemoveTriangle(mesh, *it, nullptr);
+    fan.erase(it);
+  }
+  ASSERT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({6, 24}));
+  HoleClosingOptions options;
+  options.keep_longest_loop_open = true;
+  options.max_loop_vertices = 32;  // The border would be closable by its size alone.
+  const HoleClosingResult result = CloseSmallHoles(mesh, options, 0);
+  EXPECT_EQ(result.closed_holes, 1u);
+  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({24}));
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+}
+
 TEST(HoleClosingTest, LoopAroundASingleTriangleIsNotDoubled) {
   // A lone triangle (a component of one face) has a 3-vertex border; closing it would put a
   // second face on the same three vertices, leaving vertices of valence 2.
@@ -257,6 +305,17 @@ TEST(HoleClosingTest, TwoHolesSplitByABridgeAreClosedAsOne) {
   for (auto fh : mesh.faces()) {
     EXPECT_LE(mesh.calc_face_area(fh), 7 * mean_area) << "a filling triangle Step 4 would cut";
   }
+}
+
+TEST(HoleClosingTest, KeepLongestLoopOpenKeepsTheLongestLoopOutOfBridgedPairs) {
+  Mesh mesh = BridgedHoles();
+  const double mean_area = MeanTriangleArea(mesh);
+  HoleClosingOptions options;
+  options.keep_longest_loop_open = true;
+  EXPECT_EQ(CloseBridgedHoles(mesh, options, mean_area).closed_holes, 0u)
+      << "one of the two loops is the longest: the pair must be left alone";
+  EXPECT_EQ(BoundaryLoopSizes(mesh), std::vector<size_t>({15, 15}));
+  EXPECT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
 }
 
 TEST(HoleClosingTest, BridgedHolesWiderThanStepFiveBridgesAreLeftAsTheyWere) {

@@ -46,5 +46,51 @@ TEST(InitialMeshTest, AOnePointBoxGetsAUnitSizeTetrahedronThere) {
   for (auto v : mesh.vertices()) EXPECT_NEAR((mesh.point(v) - Vec3(5, 6, 7)).norm(), 1, 1e-9);
 }
 
+BestFitPlane TiltedPlane(double radius) {
+  BestFitPlane plane;
+  plane.center = Vec3(1, 2, 3);
+  plane.u = Vec3(1, 1, 0).normalized();
+  plane.normal = Vec3(1, -1, 1).normalized();
+  plane.v = OpenMesh::cross(plane.normal, plane.u);
+  plane.radius = radius;
+  return plane;
+}
+
+TEST(InitialMeshTest, ADiscIsAHexagonInThePlaneFacingAlongItsNormal) {
+  const BestFitPlane plane = TiltedPlane(2.5);
+  const Mesh mesh = MakeInitialDisc(plane);
+  ASSERT_TRUE(ValidateMesh(mesh).ok()) << ValidateMesh(mesh);
+  ASSERT_EQ(mesh.n_vertices(), 7u);
+  ASSERT_EQ(mesh.n_faces(), 6u);
+  int interior = 0;
+  for (auto v : mesh.vertices()) {
+    const Vec3 d = mesh.point(v) - plane.center;
+    EXPECT_NEAR(OpenMesh::dot(d, plane.normal), 0, 1e-12) << "off the plane";
+    if (mesh.is_boundary(v)) {
+      EXPECT_NEAR(d.norm(), 2.5, 1e-12) << "a corner off the circle of the data's radius";
+    } else {
+      ++interior;
+      EXPECT_NEAR(d.norm(), 0, 1e-12) << "the interior vertex is the centre";
+      EXPECT_EQ(mesh.valence(v), 6u);
+    }
+  }
+  EXPECT_EQ(interior, 1) << "one interior vertex, which Step 2 can split";
+  EXPECT_NEAR(OpenMesh::dot(mesh.point(Mesh::VertexHandle(1)) - plane.center, plane.u), 2.5, 1e-12)
+      << "the first corner lies along u";
+  for (auto f : mesh.faces()) {
+    EXPECT_NEAR(OpenMesh::dot(mesh.calc_face_normal(f), plane.normal), 1, 1e-12)
+        << "a face turned away from the plane's normal";
+  }
+}
+
+TEST(InitialMeshTest, ADiscOfRadiusZeroGetsRadiusOne) {
+  const Mesh mesh = MakeInitialDisc(TiltedPlane(0));
+  for (auto v : mesh.vertices()) {
+    if (mesh.is_boundary(v)) {
+      EXPECT_NEAR((mesh.point(v) - Vec3(1, 2, 3)).norm(), 1, 1e-12);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace neuralmesh

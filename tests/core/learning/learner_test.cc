@@ -209,6 +209,45 @@ TEST(LearnerTest, SameSeedReproducesTheMeshExactly) {
   EXPECT_NE(a.positions, c.positions) << "a different seed should give a different mesh";
 }
 
+TEST(LearnerTest, InitialMeshNamesParseBackAndUnknownOnesAreRejected) {
+  for (InitialMesh mesh : {InitialMesh::kTetrahedron, InitialMesh::kDisc}) {
+    EXPECT_EQ(ParseInitialMesh(InitialMeshName(mesh)).value(), mesh);
+  }
+  const absl::StatusOr<InitialMesh> cube = ParseInitialMesh("cube");
+  EXPECT_EQ(cube.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(cube.status().message().find("tetrahedron or disc"), absl::string_view::npos)
+      << cube.status();
+}
+
+// The disc start: the learner begins from the 7-vertex disc in the data's plane, and a seed
+// reproduces the whole run, the plane's fit included.
+TEST(LearnerTest, ADiscStartBeginsFlatAndASeedReproducesIt) {
+  PointCloud cloud;
+  Random data_rng(11);
+  for (int i = 0; i < 20000; ++i) {
+    cloud.positions.emplace_back(data_rng.NextDouble(), 0.5 * data_rng.NextDouble(), 0.f);
+  }
+  auto sampler = MakePointCloudSampler(std::make_shared<const PointCloud>(std::move(cloud)));
+  ASSERT_TRUE(sampler.ok()) << sampler.status();
+  LearnerOptions options;
+  options.initial_mesh = InitialMesh::kDisc;
+  auto start = Learner::Create(options, sampler->get());
+  ASSERT_TRUE(start.ok()) << start.status();
+  const MeshReport first = ComputeMeshReport((*start)->Snapshot());
+  EXPECT_EQ(first.vertices, 7u);
+  EXPECT_EQ(first.boundary_loops, 1u);
+  for (const Vec3f& p : (*start)->Snapshot().positions) EXPECT_NEAR(p[2], 0, 1e-6);
+
+  auto a = LearnTo(**sampler, 1500, 5, options)->Snapshot();
+  auto b = LearnTo(**sampler, 1500, 5, options)->Snapshot();
+  ASSERT_EQ(a.faces, b.faces) << "same seed, different connectivity";
+  ASSERT_EQ(a.positions, b.positions) << "same seed, different positions";
+  const MeshReport report = ComputeMeshReport(a);
+  EXPECT_EQ(report.boundary_loops, 1u) << "the sheet's border must stay open";
+  EXPECT_EQ(report.genus, 0);
+  EXPECT_TRUE(report.manifold());
+}
+
 // The lookahead (basic_step_lookahead.h) only changes when things are loaded: a learner that
 // looks ahead from the start, one that starts midway and one that never does learn the same
 // mesh, through splits, collapses and Steps 4-5 (a torus has holes cut and sewn on its way).
@@ -293,6 +332,9 @@ TEST(LearnerTest, InvalidOptionsAndEmptyTargetsAreRejected) {
   o = {};
   o.min_merged_loop_vertices = 2;
   expect_invalid(o, "min_merged_loop_vertices");
+  o = {};
+  o.initial_mesh = static_cast<InitialMesh>(7);
+  expect_invalid(o, "initial_mesh");
   EXPECT_EQ(Learner::Create(LearnerOptions{}, nullptr).status().code(),
             absl::StatusCode::kInvalidArgument);
 }

@@ -35,7 +35,7 @@ struct LearnerOptions {
   // closed pancake of two layers. The two sheets of topology_learning_test (a tilted, noisy
   // 1 x 0.5 rectangle and a height field with 8% relief; one border and one layer wanted),
   // seeds 1-10: 0 and 5 pass from the tetrahedron (two layers, up to 9 loops), 10 and 10 from
-  // the disc; seeds 1-30 from the disc: 28 and 29 (the others fold over themselves while the
+  // the disc; seeds 1-60 from the disc: 57 and 59 (the others fold over themselves while the
   // mesh has under 100 vertices). Not for closed surfaces: a disc has no way to close.
   InitialMesh initial_mesh = InitialMesh::kTetrahedron;
 

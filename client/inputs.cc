@@ -1,5 +1,6 @@
 #include "client/inputs.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <utility>
 
@@ -60,8 +61,21 @@ absl::StatusOr<SamplingMode> ParseSamplingMode(absl::string_view name) {
                                                  "'; use uniform, weighted, area or curvature"));
 }
 
-absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMode mode) {
+absl::StatusOr<size_t> RemoveOutliers(PointCloud& cloud, const OutlierOptions& options) {
+  NM_ASSIGN_OR_RETURN(const std::vector<bool> outlier, FindStatisticalOutliers(cloud, options));
+  const size_t removed = static_cast<size_t>(std::count(outlier.begin(), outlier.end(), true));
+  if (removed > 0) cloud = WithoutPoints(cloud, outlier);
+  return removed;
+}
+
+absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMode mode,
+                                            const std::optional<OutlierOptions>& outliers) {
   TargetSpace target;
+  if (outliers.has_value() &&
+      (IsBuiltin(input) || mode == SamplingMode::kArea || mode == SamplingMode::kCurvature)) {
+    return absl::InvalidArgumentError(
+        "--remove_outliers applies to point cloud inputs (uniform or weighted sampling)");
+  }
   if (IsBuiltin(input)) {
     if (mode != SamplingMode::kUniform) {
       return absl::InvalidArgumentError(
@@ -99,14 +113,20 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
         absl::StrCat("INPUT '", input, "' has no per-point weights for --sampling weighted"));
   }
   const size_t points = cloud.size();
+  std::string removed_outliers;
+  if (outliers.has_value()) {
+    absl::StatusOr<size_t> removed = RemoveOutliers(cloud, *outliers);
+    if (!removed.ok()) return InFile(removed.status(), "INPUT", input);
+    removed_outliers = absl::StrCat(", outliers removed: ", *removed);
+  }
   auto shared = std::make_shared<const PointCloud>(std::move(cloud));
   absl::StatusOr<std::unique_ptr<Sampler>> sampler = mode == SamplingMode::kWeighted
                                                          ? WeightedPointCloudSampler::Create(shared)
                                                          : UniformPointCloudSampler::Create(shared);
   if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
   target.sampler = *std::move(sampler);
-  target.description =
-      absl::StrCat(points, " points of ", input, " (", ModeName(mode), " sampling)");
+  target.description = absl::StrCat(points, " points of ", input, " (", ModeName(mode), " sampling",
+                                    removed_outliers, ")");
   return target;
 }
 

@@ -7,10 +7,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "core/analysis/statistical_outliers.h"
 #include "core/point_cloud.h"
 #include "core/sampling/sampler.h"
 #include "core/triangle_mesh.h"
@@ -39,7 +41,15 @@ struct TargetSpace {
 // file for area and curvature sampling. Returns NOT_FOUND for a missing file and
 // INVALID_ARGUMENT for an empty or malformed one, an unknown extension or builtin name, or a
 // sampling mode the input cannot provide; each message names the file.
-absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMode mode);
+// With `outliers` set, a point cloud's statistical outliers are removed first
+// (statistical_outliers.h) and the description says how many; INVALID_ARGUMENT for another
+// kind of input.
+absl::StatusOr<TargetSpace> LoadTargetSpace(
+    const std::string& input, SamplingMode mode,
+    const std::optional<OutlierOptions>& outliers = std::nullopt);
+
+// Removes the statistical outliers of `cloud` (statistical_outliers.h); returns how many went.
+absl::StatusOr<size_t> RemoveOutliers(PointCloud& cloud, const OutlierOptions& options);
 
 // The most points LoadPointsForUpload samples from a builtin surface: the server's default
 // limit of points per session (neuralmesh-server --max_points_per_session), 1.6 GB here.

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "absl/status/status.h"
 #include "absl/time/time.h"
 #include "client/inputs.h"
+#include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
 
@@ -24,6 +26,7 @@ struct LocalReconstructOptions {
   std::vector<size_t> lods;  // Milestones below `vertices`, each written beside `output`.
   LearnerOptions learner;
   SamplingMode sampling = SamplingMode::kUniform;
+  std::optional<OutlierOptions> outliers;  // Set: remove a point cloud's outliers first.
   absl::Duration time_budget = absl::InfiniteDuration();  // For the whole run.
   uint64_t max_steps = 0;  // Basic Steps for the whole run; 0: no limit.
   DracoOptions draco;      // For .drc outputs.

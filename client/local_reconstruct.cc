@@ -70,7 +70,8 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
   NM_RETURN_IF_ERROR(CheckOutputPath(options.output));
   NM_ASSIGN_OR_RETURN(const std::vector<size_t> targets,
                       LodTargets(options.lods, options.vertices));
-  NM_ASSIGN_OR_RETURN(const TargetSpace target, LoadTargetSpace(options.input, options.sampling));
+  NM_ASSIGN_OR_RETURN(const TargetSpace target,
+                      LoadTargetSpace(options.input, options.sampling, options.outliers));
   NM_ASSIGN_OR_RETURN(std::unique_ptr<Learner> learner,
                       Learner::Create(options.learner, target.sampler.get()));
   out << "learning " << target.description << " to " << options.vertices << " vertices (seed "

@@ -1,8 +1,10 @@
 // neuralmesh: Neural Meshes surface reconstruction (Ivrissimtzis, Jeong, Seidel) on the
 // command line, locally or through a neuralmesh-server. This file holds the flags and the
 // dispatch only; the commands live in the neuralmesh_client library.
+#include <cmath>
 #include <cstdint>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "client/lod_plan.h"
 #include "client/progress_bar.h"
 #include "client/remote_commands.h"
+#include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
 #include "core/status_macros.h"
@@ -92,6 +95,19 @@ ABSL_FLAG(std::string, initial_mesh,
           "border is never refilled: open, nearly flat sheets such as one range scan, a "
           "terrain or a facade).");
 
+// Input clean-up.
+ABSL_FLAG(bool, remove_outliers, false,
+          "Remove a point cloud's statistical outliers before learning or upload: points whose "
+          "mean distance to their --outlier_neighbours nearest points exceeds the mean of "
+          "that distance by more than --outlier_std_ratio standard deviations (as PCL and "
+          "Open3D define them). Not in the paper.");
+ABSL_FLAG(int32_t, outlier_neighbours, neuralmesh::OutlierOptions{}.neighbours,
+          "With --remove_outliers: the neighbours each point's mean distance is taken over, "
+          "in [1, 256].");
+ABSL_FLAG(double, outlier_std_ratio, neuralmesh::OutlierOptions{}.std_ratio,
+          "With --remove_outliers: how many standard deviations above the mean distance "
+          "make an outlier, > 0.");
+
 // Local learning.
 ABSL_FLAG(std::string, sampling, "uniform",
           "How INPUT is sampled: uniform or weighted (a point cloud; weighted uses its "
@@ -165,6 +181,23 @@ absl::StatusOr<neuralmesh::LearnerOptions> LearnerFromFlags() {
   return o;
 }
 
+// Unset without --remove_outliers; checked here so that a bad value is named by its flag.
+absl::StatusOr<std::optional<neuralmesh::OutlierOptions>> OutliersFromFlags() {
+  if (!absl::GetFlag(FLAGS_remove_outliers)) return std::nullopt;
+  neuralmesh::OutlierOptions o;
+  o.neighbours = absl::GetFlag(FLAGS_outlier_neighbours);
+  o.std_ratio = absl::GetFlag(FLAGS_outlier_std_ratio);
+  if (o.neighbours < 1 || o.neighbours > 256) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--outlier_neighbours is ", o.neighbours, "; it must be in [1, 256]"));
+  }
+  if (!(o.std_ratio > 0) || !std::isfinite(o.std_ratio)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--outlier_std_ratio is ", o.std_ratio, "; it must be finite and > 0"));
+  }
+  return o;
+}
+
 // Checked here so that a bad value is named by its flag, not by DracoOptions' field.
 absl::StatusOr<neuralmesh::DracoOptions> DracoFromFlags() {
   neuralmesh::DracoOptions o;
@@ -206,6 +239,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.vertices = absl::GetFlag(FLAGS_vertices);
     o.lods = lods;
     NM_ASSIGN_OR_RETURN(o.learner, LearnerFromFlags());
+    NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
     NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
     o.batch_size = absl::GetFlag(FLAGS_batch_size);
     o.builtin_points = absl::GetFlag(FLAGS_points);
@@ -224,6 +258,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
   o.vertices = absl::GetFlag(FLAGS_vertices);
   o.lods = lods;
   NM_ASSIGN_OR_RETURN(o.learner, LearnerFromFlags());
+  NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
   NM_ASSIGN_OR_RETURN(o.sampling,
                       neuralmesh::client::ParseSamplingMode(absl::GetFlag(FLAGS_sampling)));
   o.time_budget = absl::GetFlag(FLAGS_time_budget);
@@ -275,8 +310,7 @@ std::vector<Subcommand> Commands() {
       "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
-      "sampling",
-      "time_budget",
+      "remove_outliers", "outlier_neighbours", "outlier_std_ratio", "sampling", "time_budget",
       "max_steps", "quantization_bits", "encode_speed", "progress", "server", "out-dir",
       "batch-size", "points", "ply", "connect_timeout"};
   // clang-format on

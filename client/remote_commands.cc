@@ -75,9 +75,13 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   NM_RETURN_IF_ERROR(options.draco.Validate());
   if (options.out_dir.empty()) return absl::InvalidArgumentError("--out-dir DIR is required");
   if (options.batch_size == 0) return absl::InvalidArgumentError("--batch-size must be > 0");
-  NM_ASSIGN_OR_RETURN(
-      const PointCloud cloud,
-      LoadPointsForUpload(options.input, options.builtin_points, options.learner.seed));
+  NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointsForUpload(options.input, options.builtin_points,
+                                                            options.learner.seed));
+  if (options.outliers.has_value()) {
+    const size_t points = cloud.size();
+    NM_ASSIGN_OR_RETURN(const size_t removed, RemoveOutliers(cloud, *options.outliers));
+    out << "outliers removed: " << removed << " of " << points << " points\n";
+  }
   const size_t affordable = static_cast<size_t>(std::floor(cloud.size() / kDefaultPointsPerVertex));
   const size_t target =
       options.vertices > 0 ? options.vertices : std::min(kDefaultMaxVertices, affordable);

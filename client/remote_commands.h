@@ -5,12 +5,14 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
+#include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
 
@@ -23,6 +25,7 @@ struct RemoteReconstructOptions {
   size_t vertices = 0;       // Final vertex count; 0: one vertex per 2 points, at most 10000.
   std::vector<size_t> lods;  // Milestones; empty: the server's 1-2-5 series.
   LearnerOptions learner;
+  std::optional<OutlierOptions> outliers;  // Set: remove the points' outliers before upload.
   DracoOptions draco;              // Quantization bits and encode speed of the server's meshes.
   size_t batch_size = 10000;       // Points per uploaded batch.
   size_t builtin_points = 100000;  // Points sampled from a builtin:NAME input.

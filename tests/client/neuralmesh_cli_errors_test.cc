@@ -133,6 +133,19 @@ TEST_F(CliErrorsTest, UnknownInitialMesh) {
       << err;
 }
 
+TEST_F(CliErrorsTest, RemoveOutliersOfABuiltinSurfaceOrWithBadSettings) {
+  std::string err = ExpectFailure(
+      {"reconstruct", "builtin:sphere", "-o", Output(), "--vertices", "100", "--remove_outliers"});
+  EXPECT_TRUE(absl::StrContains(err, "point cloud inputs")) << err;
+  const std::string cloud = WriteFile("cloud.xyz", "0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
+  err = ExpectFailure({"reconstruct", cloud, "-o", Output(), "--vertices", "100",
+                       "--remove_outliers", "--outlier_neighbours", "0"});
+  EXPECT_TRUE(absl::StrContains(err, "--outlier_neighbours is 0")) << err;
+  err = ExpectFailure({"reconstruct", cloud, "-o", Output(), "--vertices", "100",
+                       "--remove_outliers", "--outlier_std_ratio", "-1"});
+  EXPECT_TRUE(absl::StrContains(err, "--outlier_std_ratio is -1")) << err;
+}
+
 TEST_F(CliErrorsTest, MeshSamplingOfAPointCloud) {
   const std::string cloud = WriteFile("cloud.off", "OFF\n4 0 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
   const std::string err = ExpectFailure(

@@ -7,8 +7,10 @@
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
+#include "core/io/point_cloud_io.h"
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
+#include "tests/testing/shapes.h"
 
 namespace neuralmesh::testing {
 namespace {
@@ -174,6 +176,23 @@ TEST_F(LocalCliTest, ReconstructsAPointCloudFileAndRemeshesAMesh) {
   EXPECT_TRUE(std::filesystem::exists(remeshed)) << remesh.Describe();
 }
 
+// A stray point 100 radii from a sphere's 20,000: the learner pulls a spike out to it (README,
+// Status); --remove_outliers takes it out first, and the mesh stays on the sphere.
+TEST_F(LocalCliTest, RemoveOutliersTakesAStrayPointOutBeforeLearning) {
+  const std::string cloud = *dir_ + "/sphere_and_stray.xyz";
+  ASSERT_TRUE(WritePointCloud(UnitSpherePointsAndAStray(20000, 4, Vec3f(100, 0, 0)), cloud).ok());
+  const std::string mesh = *dir_ + "/sphere_without_stray.ply";
+  const RunResult run =
+      RunNeuralmesh({"reconstruct", cloud, "-o", mesh, "--vertices", "1000", "--remove_outliers"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "outliers removed: 1)")) << run.out;
+  const RunResult eval = RunNeuralmesh({"eval", mesh, "--reference", "builtin:sphere", "--json"});
+  ASSERT_EQ(eval.exit_code, 0) << eval.Describe();
+  double hausdorff = 0;
+  ASSERT_TRUE(absl::SimpleAtod(JsonValue(eval.out, "hausdorff"), &hausdorff)) << eval.out;
+  EXPECT_LT(hausdorff, 0.01) << "a spike toward the stray point is left: " << eval.out;
+}
+
 TEST_F(LocalCliTest, AnInterruptWritesTheMeshLearnedSoFar) {
   const std::string path = *dir_ + "/interrupted.ply";
   BackgroundProcess run("neuralmesh",
@@ -209,6 +228,10 @@ TEST(LocalCliHelpTest, HelpDocumentsEveryReconstructFlag) {
                            "--merge_boundaries",
                            "--splits_per_step",
                            "--sampling",
+                           "--initial_mesh",
+                           "--remove_outliers",
+                           "--outlier_neighbours",
+                           "--outlier_std_ratio",
                            "--time_budget",
                            "--max_steps",
                            "--quantization_bits",

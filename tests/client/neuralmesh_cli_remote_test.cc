@@ -13,9 +13,11 @@
 #include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
 #include "client/reconstruction_client.h"
+#include "core/io/point_cloud_io.h"
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
 #include "tests/client/test_server.h"
+#include "tests/testing/shapes.h"
 
 namespace neuralmesh::testing {
 namespace {
@@ -94,6 +96,28 @@ TEST_F(RemoteCliTest, TheFinalMeshIsAClosedSphere) {
   ASSERT_EQ(stats.exit_code, 0) << stats.Describe();
   EXPECT_TRUE(absl::StrContains(stats.out, "\"closed\": true")) << stats.out;
   EXPECT_TRUE(absl::StrContains(stats.out, "\"genus\": 0")) << stats.out;
+}
+
+// --remove_outliers works on what is uploaded: a stray point 100 radii away never reaches the
+// server, and the final mesh stays on the sphere.
+TEST_F(RemoteCliTest, RemoveOutliersFiltersTheUpload) {
+  const std::string cloud = *dir_ + "/sphere_and_stray.ply";
+  ASSERT_TRUE(WritePointCloud(UnitSpherePointsAndAStray(4000, 9, Vec3f(100, 0, 0)), cloud).ok());
+  const RunResult run =
+      RunNeuralmesh({"reconstruct", cloud, "--server", server_->address(), "--out-dir",
+                     *dir_ + "/filtered", "--vertices", "400", "--remove_outliers"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "outliers removed: 1 of 4001 points")) << run.out;
+  const RunResult eval = RunNeuralmesh({"eval", *dir_ + "/filtered/sphere_and_stray.drc",
+                                        "--reference", "builtin:sphere", "--json"});
+  ASSERT_EQ(eval.exit_code, 0) << eval.Describe();
+  const size_t at = eval.out.find("\"hausdorff\": ");
+  ASSERT_NE(at, std::string::npos) << eval.out;
+  double hausdorff = 0;
+  ASSERT_TRUE(
+      absl::SimpleAtod(eval.out.substr(at + 13, eval.out.find(',', at) - at - 13), &hausdorff))
+      << eval.out;
+  EXPECT_LT(hausdorff, 0.05) << "a spike toward the stray point is left: " << eval.out;
 }
 
 TEST_F(RemoteCliTest, SessionsListsTheFinishedSession) {

@@ -5,6 +5,8 @@
 #include <map>
 #include <utility>
 
+#include "core/sampling/implicit_surfaces.h"
+#include "core/sampling/sample_points.h"
 #include "gtest/gtest.h"
 
 namespace neuralmesh::testing {
@@ -51,6 +53,12 @@ TriangleMesh Icosphere(int levels, double radius) {
   }
   for (Vec3f& p : m.positions) p *= static_cast<float>(radius);
   return m;
+}
+
+PointCloud UnitSpherePointsAndAStray(size_t n, uint64_t seed, const Vec3f& stray) {
+  PointCloud cloud = SamplePoints(*MakeSphere(Vec3(0, 0, 0), 1.0).value(), n, seed);
+  cloud.positions.push_back(stray);
+  return cloud;
 }
 
 TriangleMesh GridPatch(int nx, int ny) {

@@ -3,9 +3,11 @@
 #define NEURALMESH_TESTS_TESTING_SHAPES_H_
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "core/mesh.h"
+#include "core/point_cloud.h"
 #include "core/triangle_mesh.h"
 
 namespace neuralmesh::testing {
@@ -13,6 +15,9 @@ namespace neuralmesh::testing {
 // A unit icosahedron subdivided `levels` times and projected to the sphere of `radius`:
 // 10 * 4^levels + 2 vertices, closed, genus 0.
 TriangleMesh Icosphere(int levels, double radius = 1.0);
+
+// `n` points drawn uniformly from the unit sphere with `seed`, then one stray point at `stray`.
+PointCloud UnitSpherePointsAndAStray(size_t n, uint64_t seed, const Vec3f& stray);
 
 // A regular triangulated grid of (nx+1) x (ny+1) vertices on the square [0,1]^2 at z = 0:
 // an open disc with one boundary loop.

@@ -1,0 +1,134 @@
+#include "core/analysis/statistical_outliers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/random.h"
+#include "core/sampling/implicit_surfaces.h"
+#include "gtest/gtest.h"
+
+namespace neuralmesh {
+namespace {
+
+PointCloud SpherePoints(size_t n, uint64_t seed) {
+  auto sphere = MakeSphere(Vec3(0, 0, 0), 1.0).value();
+  Random rng(seed);
+  PointCloud cloud;
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p = sphere->Sample(rng);
+    cloud.positions.emplace_back(p[0], p[1], p[2]);
+  }
+  return cloud;
+}
+
+// The definition, by brute force: mean distance to the k nearest other points, then the limit
+// mean + ratio * sample standard deviation.
+std::vector<bool> BruteForceOutliers(const PointCloud& cloud, int k, double ratio) {
+  const size_t n = cloud.size();
+  std::vector<double> mean_distance(n);
+  for (size_t i = 0; i < n; ++i) {
+    std::vector<float> d2;
+    for (size_t j = 0; j < n; ++j) {
+      if (j != i) d2.push_back((cloud.positions[j] - cloud.positions[i]).sqrnorm());
+    }
+    std::partial_sort(d2.begin(), d2.begin() + k, d2.end());
+    double sum = 0;
+    for (int j = 0; j < k; ++j) sum += std::sqrt(d2[j]);
+    mean_distance[i] = sum / k;
+  }
+  double mean = 0;
+  for (double d : mean_distance) mean += d / n;
+  double squares = 0;
+  for (double d : mean_distance) squares += (d - mean) * (d - mean);
+  const double limit = mean + ratio * std::sqrt(squares / (n - 1));
+  std::vector<bool> outlier(n);
+  for (size_t i = 0; i < n; ++i) outlier[i] = mean_distance[i] > limit;
+  return outlier;
+}
+
+// Strays from 1.5 to 1,000 radii from a unit sphere, in two clouds: the farthest widen the
+// deviation enough to hide the nearest (one pass, as PCL and Open3D define it).
+TEST(StatisticalOutliersTest, StrayPointsAreFoundAndTheSurfaceIsKept) {
+  for (const std::vector<Vec3f>& strays :
+       {std::vector<Vec3f>{Vec3f(30, 0, 0), Vec3f(0, -100, 0), Vec3f(0, 0, 1000)},
+        std::vector<Vec3f>{Vec3f(2, 2, 2), Vec3f(-1.5f, 0.3f, 0.2f), Vec3f(0, 0, 3)}}) {
+    PointCloud cloud = SpherePoints(20000, 1);
+    for (const Vec3f& p : strays) cloud.positions.push_back(p);
+    const auto outlier = FindStatisticalOutliers(cloud, OutlierOptions{});
+    ASSERT_TRUE(outlier.ok()) << outlier.status();
+    for (size_t i = 20000; i < cloud.size(); ++i) {
+      EXPECT_TRUE((*outlier)[i]) << "stray at " << cloud.positions[i];
+    }
+    const size_t surface_flagged = std::count(outlier->begin(), outlier->begin() + 20000, true);
+    EXPECT_LT(surface_flagged, 100u) << "more than 0.5% of the sphere's points taken for outliers";
+  }
+}
+
+TEST(StatisticalOutliersTest, AgreesWithTheDefinitionComputedByBruteForce) {
+  Random rng(5);
+  PointCloud cloud = SpherePoints(1500, 2);
+  for (int i = 0; i < 15; ++i) {  // Points scattered in the box around the sphere.
+    cloud.positions.emplace_back(4 * rng.NextDouble() - 2, 4 * rng.NextDouble() - 2,
+                                 4 * rng.NextDouble() - 2);
+  }
+  for (int k : {1, 4, 16}) {
+    for (double ratio : {1.0, 3.0}) {
+      OutlierOptions options;
+      options.neighbours = k;
+      options.std_ratio = ratio;
+      const auto outlier = FindStatisticalOutliers(cloud, options);
+      ASSERT_TRUE(outlier.ok()) << outlier.status();
+      EXPECT_EQ(*outlier, BruteForceOutliers(cloud, k, ratio)) << "k " << k << ", ratio " << ratio;
+    }
+  }
+}
+
+TEST(StatisticalOutliersTest, ThreadsDoNotChangeTheResult) {
+  PointCloud cloud = SpherePoints(30000, 3);
+  cloud.positions.emplace_back(5.f, 5.f, 5.f);
+  OutlierOptions one;
+  one.threads = 1;
+  OutlierOptions four;
+  four.threads = 4;
+  EXPECT_EQ(FindStatisticalOutliers(cloud, one).value(),
+            FindStatisticalOutliers(cloud, four).value());
+}
+
+TEST(StatisticalOutliersTest, ACloudOfAtMostKPointsHasNoOutliers) {
+  PointCloud cloud;
+  for (int i = 0; i < 16; ++i) cloud.positions.emplace_back(i == 0 ? 1000.f : 0.f, i, 0.f);
+  const auto outlier = FindStatisticalOutliers(cloud, OutlierOptions{});
+  ASSERT_TRUE(outlier.ok());
+  EXPECT_EQ(*outlier, std::vector<bool>(16, false));
+  EXPECT_TRUE(FindStatisticalOutliers(PointCloud{}, OutlierOptions{})->empty());
+}
+
+TEST(StatisticalOutliersTest, InvalidOptionsAreRejectedNamingTheField) {
+  OutlierOptions options;
+  options.neighbours = 0;
+  absl::Status status = FindStatisticalOutliers(SpherePoints(100, 1), options).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(status.message().find("neighbours"), absl::string_view::npos) << status;
+  options = {};
+  options.std_ratio = 0;
+  status = FindStatisticalOutliers(SpherePoints(100, 1), options).status();
+  EXPECT_NE(status.message().find("std_ratio"), absl::string_view::npos) << status;
+}
+
+TEST(StatisticalOutliersTest, WithoutPointsKeepsWeightsAndNormalsWithTheirPoints) {
+  PointCloud cloud;
+  for (int i = 0; i < 4; ++i) {
+    cloud.positions.emplace_back(i, 0.f, 0.f);
+    cloud.weights.push_back(10.f * i);
+    cloud.normals.emplace_back(0.f, 0.f, i);
+  }
+  const PointCloud kept = WithoutPoints(cloud, {false, true, false, true});
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_EQ(kept.positions[1], Vec3f(2, 0, 0));
+  EXPECT_EQ(kept.weights, std::vector<float>({0.f, 20.f}));
+  EXPECT_EQ(kept.normals[1], Vec3f(0, 0, 2));
+}
+
+}  // namespace
+}  // namespace neuralmesh

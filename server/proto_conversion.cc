@@ -116,6 +116,13 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
       return absl::InvalidArgumentError(
           absl::StrCat("final_pass has the unknown value ", proto.final_pass()));
   }
+  if (proto.has_outlier_removal()) {
+    const v1::OutlierRemoval& o = proto.outlier_removal();
+    OutlierOptions outliers;
+    if (o.has_neighbours()) outliers.neighbours = o.neighbours().value();
+    if (o.has_std_ratio()) outliers.std_ratio = o.std_ratio().value();
+    config.outlier_removal = outliers;
+  }
   return config;
 }
 
@@ -174,6 +181,11 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
     case FinalPass::kContinue:
       proto.set_final_pass(v1::FINAL_PASS_CONTINUE);
       break;
+  }
+  if (config.outlier_removal.has_value()) {
+    v1::OutlierRemoval& o = *proto.mutable_outlier_removal();
+    o.mutable_neighbours()->set_value(config.outlier_removal->neighbours);
+    o.mutable_std_ratio()->set_value(config.outlier_removal->std_ratio);
   }
   return proto;
 }

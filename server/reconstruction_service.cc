@@ -46,15 +46,24 @@ absl::Status BatchError(const absl::Status& status, uint64_t batch_number, uint6
                    " this call sent before"));
 }
 
-// Resolves and ingests one batch into `session`. Returns the point count of the batch.
-absl::StatusOr<size_t> Ingest(Session& session, const v1::PointBatch& batch,
-                              size_t max_batch_points, uint64_t* total) {
+// What one batch added to a session.
+struct Ingested {
+  size_t accepted = 0;  // Points of the batch accepted.
+  size_t removed = 0;   // Points of the batch dropped as outliers.
+  size_t total = 0;     // The session's running total of accepted points.
+};
+
+// Resolves and ingests one batch into `session`.
+absl::StatusOr<Ingested> Ingest(Session& session, const v1::PointBatch& batch,
+                                size_t max_batch_points) {
   absl::StatusOr<PointCloud> cloud = PointBatchFromProto(batch, max_batch_points);
   if (!cloud.ok()) return cloud.status();
-  absl::StatusOr<size_t> running = session.AddPoints(*cloud);
+  Ingested ingested;
+  absl::StatusOr<size_t> running = session.AddPoints(*cloud, &ingested.removed);
   if (!running.ok()) return running.status();
-  *total = *running;
-  return cloud->size();
+  ingested.total = *running;
+  ingested.accepted = cloud->size() - ingested.removed;
+  return ingested;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -205,6 +214,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
         if (finished_) return;
         response_->set_session_id(session_->id());
         response_->set_points_accepted(points_);
+        response_->set_points_removed(removed_);
         response_->set_batches_accepted(batches_);
         response_->set_total_points(total_);
       }
@@ -278,18 +288,18 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
                        QuotedSessionId(request_.session_id()), " but this call uploads into \"",
                        session_->id(), "\""));
     }
-    uint64_t total = 0;
-    absl::StatusOr<size_t> accepted =
-        Ingest(*session_, request_.batch(), manager_->limits().max_batch_points, &total);
-    if (!accepted.ok()) {
-      return BatchError(accepted.status(), batch_number, batches, points,
+    absl::StatusOr<Ingested> ingested =
+        Ingest(*session_, request_.batch(), manager_->limits().max_batch_points);
+    if (!ingested.ok()) {
+      return BatchError(ingested.status(), batch_number, batches, points,
                         session_->points_received());
     }
     {
       absl::MutexLock lock(&mu_);
-      points_ += *accepted;
+      points_ += ingested->accepted;
+      removed_ += ingested->removed;
       ++batches_;
-      total_ = total;
+      total_ = ingested->total;
     }
     if (!subscribed_) {
       // After the first batch, so that a session that had ended already refuses it in its own
@@ -326,6 +336,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
   absl::Mutex mu_;
   bool finished_ ABSL_GUARDED_BY(mu_) = false;
   uint64_t points_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t removed_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t batches_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t total_ ABSL_GUARDED_BY(mu_) = 0;
 };
@@ -483,19 +494,20 @@ class ReconstructReactor final
           absl::StrCat("request ", batch_number + 1, " of this call is not a point batch; only ",
                        "the first request may be a ReconstructStart"));
     }
-    uint64_t total = 0;
-    absl::StatusOr<size_t> accepted =
-        Ingest(*session_, request_.points(), manager_->limits().max_batch_points, &total);
-    if (!accepted.ok()) {
-      return BatchError(accepted.status(), batch_number, batches_, points_,
+    absl::StatusOr<Ingested> ingested =
+        Ingest(*session_, request_.points(), manager_->limits().max_batch_points);
+    if (!ingested.ok()) {
+      return BatchError(ingested.status(), batch_number, batches_, points_,
                         session_->points_received());
     }
-    points_ += *accepted;
+    points_ += ingested->accepted;
+    removed_ += ingested->removed;
     ++batches_;
     v1::PointsAck ack;
     ack.set_batches_accepted(batches_);
     ack.set_points_accepted(points_);
-    ack.set_total_points(total);
+    ack.set_points_removed(removed_);
+    ack.set_total_points(ingested->total);
     absl::MutexLock lock(&mu_);
     pending_ack_ = std::move(ack);
     MaybeWriteLocked();
@@ -567,6 +579,7 @@ class ReconstructReactor final
   uint64_t handle_ = 0;
   bool subscribed_ = false;
   uint64_t points_ = 0;
+  uint64_t removed_ = 0;
   uint64_t batches_ = 0;
 
   absl::Mutex mu_;

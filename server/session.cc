@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/analysis/mesh_report.h"
+#include "core/analysis/statistical_outliers.h"
 #include "core/status_macros.h"
 #include "server/proto_conversion.h"
 #include "server/quantization_cube.h"
@@ -28,6 +29,13 @@ BoundingBox BoundsOf(absl::Span<const Vec3f> positions) {
   BoundingBox box;
   for (const Vec3f& p : positions) box.Extend(Vec3(p[0], p[1], p[2]));
   return box;
+}
+
+bool AllFinite(absl::Span<const Vec3f> positions) {
+  for (const Vec3f& p : positions) {
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -66,6 +74,10 @@ Session::Session(std::string id, std::string name, SessionConfig config, size_t 
       pool_(pool),
       encoder_(encoder),
       points_(max_points) {
+  if (config_.outlier_removal.has_value()) {
+    absl::MutexLock ingest(&ingest_mu_);
+    outlier_filter_ = std::make_unique<StreamingOutlierFilter>(*config_.outlier_removal);
+  }
   absl::MutexLock lock(&mu_);
   last_activity_ = create_time_;
   learning_.set_allowed_vertices(0);
@@ -75,6 +87,12 @@ Session::~Session() = default;
 
 bool Session::AcceptsPointsLocked() const {
   return state_ == v1::SESSION_STATE_COLLECTING || state_ == v1::SESSION_STATE_LEARNING;
+}
+
+absl::Status Session::AcceptingPointsLocked() const {
+  if (AcceptsPointsLocked()) return absl::OkStatus();
+  return absl::FailedPreconditionError(absl::StrCat(
+      "session ", id_, " is ", v1::SessionState_Name(state_), " and accepts no more points"));
 }
 
 size_t Session::AllowedVerticesLocked() const {
@@ -100,38 +118,51 @@ absl::StatusOr<QuantizationBox> Session::CubeWithLocked(const BoundingBox& batch
   return GrowQuantizationCube(box, batch_bounds, bits);
 }
 
-absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch) {
+absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* removed) {
+  if (removed != nullptr) *removed = 0;
   size_t total = 0;
   {
     absl::MutexLock ingest(&ingest_mu_);
-    // Quantization: the first data fixes the cube; later data outside it grows the cube. A
-    // batch that no cube Draco can use would hold is refused before anything changes. (A
-    // non-finite or empty batch has no cube to check: Append says what is wrong with it.)
-    const BoundingBox batch_bounds = BoundsOf(batch.positions);
-    bool finite = true;
-    for (int c = 0; c < 3; ++c) {
-      finite &= std::isfinite(batch_bounds.min[c]) && std::isfinite(batch_bounds.max[c]);
+    {
+      absl::MutexLock lock(&mu_);  // Checked again below; here to spare the filter's work.
+      NM_RETURN_IF_ERROR(AcceptingPointsLocked());
     }
+    BoundingBox batch_bounds = BoundsOf(batch.positions);
+    const bool finite = AllFinite(batch.positions);
+    // Outliers go before anything else sees the batch: a stray point would grow the
+    // quantization cube. (A non-finite batch is left to Append, which says what is wrong.)
+    std::vector<bool> outliers;
+    size_t outlier_count = 0;
+    if (outlier_filter_ != nullptr && finite && !batch.positions.empty()) {
+      outliers = outlier_filter_->FindOutliers(batch.positions);
+      outlier_count = static_cast<size_t>(std::count(outliers.begin(), outliers.end(), true));
+    }
+    const PointCloud kept = outlier_count > 0 ? WithoutPoints(batch, outliers) : PointCloud();
+    const PointCloud& appended = outlier_count > 0 ? kept : batch;
+    if (outlier_count > 0) batch_bounds = BoundsOf(appended.positions);
+    // Quantization: the first data fixes the cube; later data outside it grows the cube. A
+    // batch that no cube Draco can use would hold is refused before anything changes.
     std::optional<QuantizationBox> box;
     bool grown = false;
     {
       absl::MutexLock lock(&mu_);
-      if (!AcceptsPointsLocked()) {
-        return absl::FailedPreconditionError(
-            absl::StrCat("session ", id_, " is ", v1::SessionState_Name(state_),
-                         " and accepts no more points"));
-      }
+      NM_RETURN_IF_ERROR(AcceptingPointsLocked());
       last_activity_ = absl::Now();
-      if (finite) {
+      if (finite && !appended.positions.empty()) {
         absl::StatusOr<QuantizationBox> cube = CubeWithLocked(batch_bounds, &grown);
         if (!cube.ok()) return cube.status();
         box = *cube;
       }
     }
     const size_t first_index = points_.size();
-    NM_RETURN_IF_ERROR(points_.Append(batch));
-    RecordArrivalSampleLocked(batch.positions, first_index);
+    // A batch of outliers only: nothing to append (Append refuses an empty batch).
+    if (!(outlier_count > 0 && appended.positions.empty())) {
+      NM_RETURN_IF_ERROR(points_.Append(appended));
+    }
+    if (outlier_filter_ != nullptr) outlier_filter_->Add(batch.positions);
+    RecordArrivalSampleLocked(appended.positions, first_index);
     total = points_.size();
+    if (removed != nullptr) *removed = outlier_count;
 
     absl::MutexLock lock(&mu_);
     // Only ingestion changes the cube, and ingest_mu_ is held: box_ is as CubeWithLocked saw it.
@@ -141,6 +172,8 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch) {
       if (grown) ++epoch_;
     }
     learning_.set_points_received(total);
+    learning_.set_points_removed_as_outliers(learning_.points_removed_as_outliers() +
+                                             outlier_count);
     learning_.set_allowed_vertices(AllowedVerticesLocked());
   }
   Wake();

@@ -40,6 +40,7 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "absl/types/span.h"
+#include "core/analysis/streaming_outlier_filter.h"
 #include "core/bounding_box.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/growth_watch.h"
@@ -78,11 +79,15 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   const SessionConfig& config() const { return config_; }
   absl::Time create_time() const { return create_time_; }
 
-  // Appends one batch, all or nothing, and wakes the learner. Returns the session's running
-  // total. FAILED_PRECONDITION when the session no longer accepts points (finishing, finished,
-  // cancelled, failed); INVALID_ARGUMENT for non-finite values or mismatched weights/normals;
-  // RESOURCE_EXHAUSTED when the session's point limit would be exceeded.
-  absl::StatusOr<size_t> AddPoints(const PointCloud& batch) ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
+  // Appends one batch, all or nothing, and wakes the learner. With outlier removal configured,
+  // the batch's outliers (streaming_outlier_filter.h) are dropped first and their count goes
+  // to `*removed` when it is not null (0 otherwise); the rest is appended. Returns the
+  // session's running total. FAILED_PRECONDITION when the session no longer accepts points
+  // (finishing, finished, cancelled, failed); INVALID_ARGUMENT for non-finite values or
+  // mismatched weights/normals; RESOURCE_EXHAUSTED when the session's point limit would be
+  // exceeded. On error nothing is appended or removed.
+  absl::StatusOr<size_t> AddPoints(const PointCloud& batch, size_t* removed = nullptr)
+      ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
 
   // No more points: learn to the final vertex count and publish the final mesh.
   // FAILED_PRECONDITION when already finishing, finished, cancelled or failed, or when the
@@ -129,6 +134,8 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   };
 
   bool AcceptsPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // OK, or FAILED_PRECONDITION naming the state in which the session refuses points.
+  absl::Status AcceptingPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   size_t AllowedVerticesLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // The quantization cube once a batch with `batch_bounds` is in, and in `grown` whether the
   // present (or the first) cube had to grow for it; INVALID_ARGUMENT when no cube Draco can
@@ -164,6 +171,9 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   absl::Mutex ingest_mu_ ABSL_ACQUIRED_BEFORE(mu_);
   std::vector<Vec3f> arrival_sample_ ABSL_GUARDED_BY(ingest_mu_);
   size_t arrival_stride_ ABSL_GUARDED_BY(ingest_mu_) = 1;
+  // Set when the configuration asks for outlier removal; knows every point of every batch
+  // taken in, outliers included.
+  std::unique_ptr<StreamingOutlierFilter> outlier_filter_ ABSL_GUARDED_BY(ingest_mu_);
 
   mutable absl::Mutex mu_;
   v1::SessionState state_ ABSL_GUARDED_BY(mu_) = v1::SESSION_STATE_COLLECTING;

@@ -96,6 +96,12 @@ absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& 
   }
   NM_RETURN_IF_ERROR(config.learner.Validate());
   NM_RETURN_IF_ERROR(config.draco.Validate());
+  if (config.outlier_removal.has_value()) {
+    const absl::Status valid = config.outlier_removal->Validate();
+    if (!valid.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat("outlier_removal: ", valid.message()));
+    }
+  }
   if (config.bounds.has_value()) {
     const absl::StatusOr<QuantizationBox> cube = QuantizationCube(
         *config.bounds, kDeclaredBoundsEnlargement, config.draco.position_quantization_bits);

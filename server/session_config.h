@@ -9,6 +9,7 @@
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
+#include "core/analysis/statistical_outliers.h"
 #include "core/bounding_box.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
@@ -53,6 +54,8 @@ struct SessionConfig {
   // Where the data lies, if the client knows; seeds the quantization box.
   std::optional<BoundingBox> bounds;
   FinalPass final_pass = FinalPass::kAuto;
+  // Drop each batch's statistical outliers before accepting it; unset: accept every point.
+  std::optional<OutlierOptions> outlier_removal;
 };
 
 // The 1-2-5 series from kFirstDefaultMilestone, 50, 100, 200, 500, 1000, ... below `target`,
@@ -61,10 +64,11 @@ std::vector<size_t> DefaultLodMilestones(size_t target);
 
 // Validates `config` and fills in the milestones (the default series when empty, the target
 // appended when missing). INVALID_ARGUMENT naming the first offending field: a target below 4,
-// above kMaxTargetVertices or unreachable within `max_points_per_session` points, milestones not strictly increasing,
-// below 4, above the target or more than 256 of them, a refresh interval between 0 and 10 ms,
-// points_per_vertex not finite and positive, bounds not finite or inverted, and whatever
-// LearnerOptions::Validate and DracoOptions::Validate reject.
+// above kMaxTargetVertices or unreachable within `max_points_per_session` points, milestones not
+// strictly increasing, below 4, above the target or more than 256 of them, a refresh interval
+// between 0 and 10 ms, points_per_vertex not finite and positive, bounds not finite or inverted,
+// and whatever LearnerOptions::Validate, DracoOptions::Validate and OutlierOptions::Validate
+// reject.
 absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& config);
 
 }  // namespace neuralmesh::server

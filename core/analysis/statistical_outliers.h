@@ -14,6 +14,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/types/span.h"
 #include "core/point_cloud.h"
 
 namespace neuralmesh {
@@ -32,6 +33,11 @@ struct OutlierOptions {
 // O(k log n) per point on well spread data. INVALID_ARGUMENT for invalid options.
 absl::StatusOr<std::vector<bool>> FindStatisticalOutliers(const PointCloud& cloud,
                                                           const OutlierOptions& options);
+
+// The distance above which a point is an outlier: mean + std_ratio * the sample standard
+// deviation of `mean_distances` (each point's mean distance to its k nearest neighbours).
+// Infinity for fewer than 2 distances.
+double OutlierDistanceLimit(absl::Span<const double> mean_distances, double std_ratio);
 
 // `cloud` without the points flagged in `drop` (one flag per point), weights and normals kept
 // with their points.

@@ -121,6 +121,8 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(config->refresh_interval, kDefaultRefreshInterval);
   EXPECT_EQ(config->points_per_vertex, kDefaultPointsPerVertex);
   EXPECT_FALSE(config->bounds.has_value());
+  EXPECT_FALSE(config->outlier_removal.has_value()) << "unset: every point is accepted";
+  EXPECT_FALSE(SessionConfigToProto(*config).has_outlier_removal());
 
   proto.mutable_learner()->mutable_alpha_l()->set_value(0);  // A valid zero, not "unset".
   proto.mutable_learner()->mutable_remove_triangles()->set_value(false);
@@ -131,6 +133,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   proto.mutable_learner()->set_initial_mesh(v1::INITIAL_MESH_DISC);
   proto.mutable_refresh_interval_ms()->set_value(0);
   proto.mutable_draco()->mutable_position_quantization_bits()->set_value(14);
+  proto.mutable_outlier_removal()->mutable_std_ratio()->set_value(2.5);
   config = SessionConfigFromProto(proto);
   ASSERT_TRUE(config.ok());
   EXPECT_EQ(config->learner.alpha_l, 0.0);
@@ -142,6 +145,9 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(config->learner.initial_mesh, InitialMesh::kDisc);
   EXPECT_EQ(config->refresh_interval, absl::ZeroDuration()) << "0 turns refreshes off";
   EXPECT_EQ(config->draco.position_quantization_bits, 14);
+  ASSERT_TRUE(config->outlier_removal.has_value()) << "an empty message turns it on";
+  EXPECT_EQ(config->outlier_removal->neighbours, OutlierOptions().neighbours);
+  EXPECT_EQ(config->outlier_removal->std_ratio, 2.5);
 
   // The echo has every field set and reads back to the same configuration.
   v1::SessionConfig echo = SessionConfigToProto(*config);
@@ -155,6 +161,10 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_FALSE(again->learner.cut_inactive_faces);
   EXPECT_EQ(again->learner.initial_mesh, InitialMesh::kDisc);
   EXPECT_EQ(again->draco.position_quantization_bits, 14);
+  EXPECT_TRUE(echo.outlier_removal().has_neighbours());
+  ASSERT_TRUE(again->outlier_removal.has_value());
+  EXPECT_EQ(again->outlier_removal->neighbours, OutlierOptions().neighbours);
+  EXPECT_EQ(again->outlier_removal->std_ratio, 2.5);
 }
 
 TEST(SessionConfigFromProtoTest, UnknownInitialMeshIsInvalidArgument) {

@@ -137,6 +137,16 @@ TEST_F(ReconstructionServiceTest, InvalidOptionsAreInvalidArgumentNamingTheField
     r.mutable_config()->mutable_learner()->set_initial_mesh(static_cast<v1::InitialMesh>(9));
     cases.push_back({"unknown initial mesh", r, "initial_mesh"});
   }
+  {
+    v1::CreateSessionRequest r = CreateRequest(100);
+    r.mutable_config()->mutable_outlier_removal()->mutable_neighbours()->set_value(0);
+    cases.push_back({"0 outlier neighbours", r, "outlier_removal: outlier neighbours = 0"});
+  }
+  {
+    v1::CreateSessionRequest r = CreateRequest(100);
+    r.mutable_config()->mutable_outlier_removal()->mutable_std_ratio()->set_value(-1);
+    cases.push_back({"negative outlier std_ratio", r, "outlier_removal: outlier std_ratio"});
+  }
   for (const Case& c : cases) {
     grpc::ClientContext context;
     v1::Session session;
@@ -435,6 +445,104 @@ TEST_F(ReconstructionServiceTest, ADiscStartGivesAFlatSquareOneBorder) {
   }
   EXPECT_LT(std::min(up, down), 0.01 * (up + down))
       << "area facing up " << up << ", down " << down << ": two layers";
+}
+
+// Sphere points streamed in batches with two strays, one inside a batch and one alone in its
+// own: with outlier removal the session drops them (and few surface points) before they count,
+// so the quantization cube stays near the sphere and the mesh has no spike; without it, the
+// stray at 100 radii grows the cube past 100.
+TEST_F(ReconstructionServiceTest, OutlierRemovalDropsStraysBeforeTheSessionTakesThem) {
+  const PointCloud sphere = testing::SpherePoints(20000, 23);
+  std::vector<PointCloud> batches(21);
+  for (size_t i = 0; i < sphere.size(); ++i) {
+    batches[i / 1000].positions.push_back(sphere.positions[i]);
+  }
+  batches[7].positions.emplace_back(100.f, 0.f, 0.f);
+  batches[20].positions.emplace_back(0.f, 0.f, -50.f);  // A stray alone in its batch.
+  auto upload = [&](const std::string& id, v1::UploadPointsResponse* response) {
+    grpc::ClientContext context;
+    auto writer = stub_->UploadPoints(&context, response);
+    for (const PointCloud& batch : batches) {
+      v1::UploadPointsRequest request;
+      request.set_session_id(id);
+      *request.mutable_batch() = PointCloudToPackedBatch(batch);
+      EXPECT_TRUE(writer->Write(request));
+    }
+    writer->WritesDone();
+    return writer->Finish();
+  };
+
+  v1::CreateSessionRequest create = CreateRequest(2000);
+  create.mutable_config()->mutable_outlier_removal();  // Set, with the defaults.
+  const std::string id = MustCreate(*stub_, create);
+  v1::UploadPointsResponse response;
+  const grpc::Status status = upload(id, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.points_accepted() + response.points_removed(), 20002u);
+  EXPECT_GE(response.points_removed(), 2u);
+  EXPECT_LE(response.points_removed(), 2u + 100u) << "at most 0.5% of the sphere";
+  v1::Session session = testing::GetSession(*stub_, id);
+  EXPECT_EQ(session.config().outlier_removal().neighbours().value(), 16) << "defaults echoed";
+  EXPECT_DOUBLE_EQ(session.config().outlier_removal().std_ratio().value(), 3.0);
+  EXPECT_EQ(session.learning().points_received(), response.points_accepted());
+  EXPECT_EQ(session.learning().points_removed_as_outliers(), response.points_removed());
+  EXPECT_LT(session.quantization_box().range(), 10.f);
+  v1::UploadPointsRequest nan;  // Refused as without outlier removal, nothing added.
+  nan.set_session_id(id);
+  PointCloud nan_points = batches[0];
+  nan_points.positions[5][1] = std::nanf("");
+  *nan.mutable_batch() = PointCloudToPackedBatch(nan_points);
+  v1::UploadPointsResponse refused;
+  EXPECT_EQ(testing::UploadOne(*stub_, nan, &refused).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(testing::GetSession(*stub_, id).learning().points_received(),
+            response.points_accepted());
+  ASSERT_TRUE(testing::Finish(*stub_, id).ok());
+  v1::MeshUpdate final_mesh;
+  const grpc::Status waited = testing::WaitFinal(*stub_, id, &final_mesh);
+  ASSERT_TRUE(waited.ok()) << waited.error_message();
+  absl::StatusOr<TriangleMesh> mesh = DecodeMesh(final_mesh.draco_mesh());
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  auto unit_sphere = MakeSphere(Vec3(0, 0, 0), 1.0);
+  ASSERT_TRUE(unit_sphere.ok());
+  EXPECT_LT(testing::MaxVertexDistance(*mesh, **unit_sphere), 0.05) << "no spike";
+  EXPECT_EQ(ComputeMeshReport(*mesh).genus, 0);
+
+  const std::string unfiltered = MustCreate(*stub_, CreateRequest(2000));
+  v1::UploadPointsResponse taken_all;
+  ASSERT_TRUE(upload(unfiltered, &taken_all).ok());
+  EXPECT_EQ(taken_all.points_accepted(), 20002u);
+  EXPECT_EQ(taken_all.points_removed(), 0u);
+  EXPECT_GT(testing::GetSession(*stub_, unfiltered).quantization_box().range(), 100.f);
+  ASSERT_TRUE(testing::Delete(*stub_, unfiltered).ok());
+}
+
+// A Reconstruct call's acknowledgements count the points outlier removal dropped.
+TEST_F(ReconstructionServiceTest, ReconstructAcksCountRemovedOutliers) {
+  PointCloud points = testing::SpherePoints(3000, 24);
+  points.positions.emplace_back(0.f, 30.f, 0.f);
+  grpc::ClientContext context;
+  auto stream = stub_->Reconstruct(&context);
+  v1::ReconstructRequest start;
+  *start.mutable_start()->mutable_create() = CreateRequest(500);
+  start.mutable_start()->mutable_create()->mutable_config()->mutable_outlier_removal();
+  ASSERT_TRUE(stream->Write(start));
+  v1::ReconstructRequest request;
+  *request.mutable_points() = Batch(points, 0, points.size());
+  ASSERT_TRUE(stream->Write(request));
+  stream->WritesDone();
+  v1::ReconstructResponse response;
+  v1::PointsAck ack;
+  while (stream->Read(&response)) {
+    if (response.has_ack()) ack = response.ack();
+  }
+  const grpc::Status status = stream->Finish();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(ack.batches_accepted(), 1u);
+  EXPECT_GE(ack.points_removed(), 1u);
+  EXPECT_LE(ack.points_removed(), 1u + 15u);
+  EXPECT_EQ(ack.points_accepted() + ack.points_removed(), 3001u);
+  EXPECT_EQ(ack.total_points(), ack.points_accepted());
 }
 
 TEST_F(ReconstructionServiceTest, ReconstructRejectsABadBatchAndTheSessionStays) {

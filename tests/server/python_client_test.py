@@ -158,11 +158,16 @@ def main():
     check(faces == final.face_count, "draco_decoder read %d faces, expected %d" %
           (faces, final.face_count))
 
-    # Reconstruct: points in, meshes out, in one bidirectional call.
+    # Reconstruct: points in, meshes out, in one bidirectional call, with outlier removal
+    # dropping a stray point sent alone in the last batch.
+    config = pb.SessionConfig(target_vertices=100)
+    config.outlier_removal.SetInParent()
+    stray = struct.pack("<3f", 0.0, 0.0, 40.0)
+
     def stream():
         yield pb.ReconstructRequest(start=pb.ReconstructStart(
-            create=pb.CreateSessionRequest(config=pb.SessionConfig(target_vertices=100))))
-        for chunk in batches[:4]:
+            create=pb.CreateSessionRequest(config=config)))
+        for chunk in batches[:4] + [stray]:
             yield pb.ReconstructRequest(points=pb.PointBatch(
                 packed=pb.PackedPoints(positions=chunk)))
 
@@ -171,6 +176,11 @@ def main():
     check(responses[-1].WhichOneof("kind") == "update" and
           responses[-1].update.kind == pb.UPDATE_KIND_FINAL and
           responses[-1].update.vertex_count == 100, "Reconstruct did not end with the final mesh")
+    acks = [r.ack for r in responses if r.WhichOneof("kind") == "ack"]
+    check(acks and acks[-1].points_removed >= 1 and
+          acks[-1].points_accepted + acks[-1].points_removed == 2401,
+          "outlier removal: the last ack counts %d accepted, %d removed" %
+          ((acks[-1].points_accepted, acks[-1].points_removed) if acks else (0, 0)))
 
     listed = stub.ListSessions(pb.ListSessionsRequest(), timeout=10)
     check(len(listed.sessions) == 2, "ListSessions returned %d sessions" % len(listed.sessions))

@@ -129,6 +129,15 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* remov
     }
     BoundingBox batch_bounds = BoundsOf(batch.positions);
     const bool finite = AllFinite(batch.positions);
+    // The filter keeps every point received, outliers too: they count toward the limit.
+    if (outlier_filter_ != nullptr &&
+        batch.positions.size() >
+            points_.max_points() - std::min(points_.max_points(), outlier_filter_->size())) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "receiving ", batch.positions.size(), " more points would exceed the session's limit of ",
+          points_.max_points(), " points received, outliers included (", outlier_filter_->size(),
+          " so far)"));
+    }
     // Outliers go before anything else sees the batch: a stray point would grow the
     // quantization cube. (A non-finite batch is left to Append, which says what is wrong.)
     std::vector<bool> outliers;

@@ -85,7 +85,8 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // session's running total. FAILED_PRECONDITION when the session no longer accepts points
   // (finishing, finished, cancelled, failed); INVALID_ARGUMENT for non-finite values or
   // mismatched weights/normals; RESOURCE_EXHAUSTED when the session's point limit would be
-  // exceeded. On error nothing is appended or removed.
+  // exceeded (with outlier removal, by the points received, outliers included). On error
+  // nothing is appended or removed.
   absl::StatusOr<size_t> AddPoints(const PointCloud& batch, size_t* removed = nullptr)
       ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
 

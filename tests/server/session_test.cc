@@ -196,6 +196,32 @@ TEST_F(SessionTest, BadBatchesAreRejectedAndTheSessionKeepsItsPoints) {
   EXPECT_EQ(session->Cancel("late").code(), absl::StatusCode::kFailedPrecondition);
 }
 
+// With outlier removal the session keeps every point received, dropped ones too (they are
+// the neighbours later batches are judged against), so they count toward its point limit: a
+// client sending only outliers cannot grow it without bound.
+TEST_F(SessionTest, OutliersCountTowardThePointLimit) {
+  SessionConfig config;
+  config.target_vertices = 50;
+  config.outlier_removal = OutlierOptions{};
+  auto session = NewSession(config, /*max_points=*/1000);
+  const PointCloud points = Torus(990, 3);
+  size_t removed = 0;
+  ASSERT_TRUE(session->AddPoints(points, &removed).ok());
+  const size_t accepted = session->points_received();
+  EXPECT_EQ(accepted + removed, 990u);
+  for (int i = 1; i <= 10; ++i) {
+    PointCloud stray;
+    stray.positions.emplace_back(1000.f * static_cast<float>(i), 0.f, 0.f);
+    ASSERT_TRUE(session->AddPoints(stray, &removed).ok());
+    EXPECT_EQ(removed, 1u) << "stray " << i;
+  }
+  EXPECT_EQ(session->points_received(), accepted);
+  const absl::StatusOr<size_t> full = session->AddPoints(Slice(points, 0, 1));
+  EXPECT_EQ(full.status().code(), absl::StatusCode::kResourceExhausted) << full.status();
+  EXPECT_THAT(std::string(full.status().message()), HasSubstr("outliers included"));
+  EXPECT_EQ(session->points_received(), accepted) << "the refused batch adds nothing";
+}
+
 // Coordinates so large that no quantization cube Draco can encode holds them: the batch is
 // refused at once (growing the cube toward them never ended before, with the session locked),
 // and the session goes on with its points. Slightly smaller ones still fit a usable cube.

@@ -206,7 +206,10 @@ absl::StatusOr<ReconstructResult> ReconstructionClient::Reconstruct(
         break;
       case v1::ReconstructResponse::kAck:
         result.last_ack = response.ack();
-        if (progress) progress(result.last_ack.points_accepted(), cloud.size());
+        if (progress) {  // Points the server dropped as outliers were received all the same.
+          progress(result.last_ack.points_accepted() + result.last_ack.points_removed(),
+                   cloud.size());
+        }
         break;
       case v1::ReconstructResponse::kUpdate: {
         const bool final = response.update().kind() == v1::UPDATE_KIND_FINAL;

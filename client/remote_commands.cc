@@ -233,6 +233,7 @@ absl::Status RunSessions(const std::string& server, bool json, std::ostream& out
       writer.Key("name").String(s.name());
       writer.Key("state").String(StateName(s.state()));
       writer.Key("points_received").Uint(s.learning().points_received());
+      writer.Key("points_removed_as_outliers").Uint(s.learning().points_removed_as_outliers());
       writer.Key("vertices").Uint(s.vertex_count());
       writer.Key("faces").Uint(s.face_count());
       writer.Key("target_vertices").Uint(s.config().target_vertices());

@@ -261,6 +261,27 @@ class ReconstructCallTest : public ::testing::Test {
   std::unique_ptr<ReconstructionClient> client_;
 };
 
+// With outlier removal on the server, the progress still reaches every point sent: the
+// dropped ones were received all the same.
+TEST_F(ReconstructCallTest, ProgressCountsThePointsTheServerDroppedAsOutliers) {
+  PointCloud cloud = SpherePoints(3000);
+  cloud.positions.emplace_back(0.f, 0.f, 60.f);
+  v1::SessionConfig config;
+  config.set_target_vertices(300);
+  config.mutable_outlier_removal();
+  uint64_t last_progress = 0;
+  absl::StatusOr<ReconstructResult> result = client_->Reconstruct(
+      config, "sphere", cloud, /*batch_size=*/1000, [](const v1::MeshUpdate&) { return true; },
+      [&](uint64_t received, uint64_t total) {
+        EXPECT_EQ(total, 3001u);
+        last_progress = received;
+      });
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_GE(result->last_ack.points_removed(), 1u) << "the stray";
+  EXPECT_EQ(result->last_ack.points_accepted() + result->last_ack.points_removed(), 3001u);
+  EXPECT_EQ(last_progress, 3001u);
+}
+
 TEST_F(ReconstructCallTest, StreamsASphereAndReceivesCoarseToFineMeshes) {
   const PointCloud cloud = SpherePoints(20000);
   v1::SessionConfig config;

@@ -12,6 +12,7 @@
 #include "absl/synchronization/mutex.h"
 #include "server/grpc_status.h"
 #include "server/latest_wins_writer.h"
+#include "server/off_thread_work.h"
 #include "server/proto_conversion.h"
 #include "server/update_channel.h"
 
@@ -174,7 +175,8 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
 // validation and the append into the point cloud, all proportional to the batch) and only then
 // starts the next read, so a client that sends faster than the session appends is held back by
 // gRPC's flow-control window instead of filling server memory. Learning runs on the worker
-// pool meanwhile; the append never waits for it.
+// pool meanwhile; the append never waits for it. Batches of a session that filters outliers
+// are ingested on the filter executor instead (off_thread_work.h), which starts the next read.
 //
 // The end: the client half-closes (OnReadDone(false)) and gets the counts with OK; a bad batch
 // finishes the call at once with its status (the batches before it stay in the session); so
@@ -187,9 +189,13 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
                             public UpdateSubscriber,
                             public LiveReactor {
  public:
-  UploadReactor(SessionManager* manager, ReactorRegistry* reactors,
+  UploadReactor(SessionManager* manager, ReactorRegistry* reactors, Executor* filter,
                 v1::UploadPointsResponse* response)
-      : manager_(manager), reactors_(reactors), response_(response) {
+      : manager_(manager),
+        reactors_(reactors),
+        filter_(filter),
+        response_(response),
+        work_([this] { CleanUpAndDelete(); }) {
     registered_ = reactors_->Add(this);
     if (!registered_) {
       FinishOnce(Unavailable());
@@ -221,14 +227,12 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
       FinishOnce(absl::OkStatus());
       return;
     }
-    absl::Status status = HandleRequest();
-    request_ = v1::UploadPointsRequest();  // Frees the batch's memory (up to a message's size).
-    if (!status.ok()) {
-      FinishOnce(status);
-      return;
+    absl::Status status = ResolveSession();
+    if (status.ok() && session_->filters_outliers()) {
+      if (work_.Run(*filter_, [this] { ContinueAfter(IngestBatchUnlessFinished()); })) return;
+      status = Unavailable();
     }
-    absl::MutexLock lock(&mu_);
-    if (!finished_) StartRead(&request_);
+    ContinueAfter(status.ok() ? IngestBatch() : status);
   }
 
   // Mesh updates are not this call's business.
@@ -257,6 +261,13 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
   }
 
   void OnDone() override {
+    if (work_.ReleaseOnDone()) CleanUpAndDelete();
+  }
+
+ private:
+  // After OnDone and the last batch ingested off gRPC's threads (OffThreadWork), which may
+  // still subscribe to the session's channel after the call has ended.
+  void CleanUpAndDelete() {
     if (session_ != nullptr) {
       if (subscribed_) session_->updates().Unsubscribe(handle_);
       session_->RemoveStream();
@@ -265,12 +276,24 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
     delete this;
   }
 
- private:
-  absl::Status HandleRequest() {
-    uint64_t points = 0, batches = 0;
+  // Ends the handling of a read: frees the batch's memory (up to a message's size) and starts
+  // the next read, or finishes the call with `status`.
+  void ContinueAfter(const absl::Status& status) {
+    request_ = v1::UploadPointsRequest();
+    if (!status.ok()) {
+      FinishOnce(status);
+      return;
+    }
+    absl::MutexLock lock(&mu_);
+    if (!finished_) StartRead(&request_);
+  }
+
+  // The session the call uploads into: named by its first message, and any later message
+  // that names one must name the same.
+  absl::Status ResolveSession() {
+    uint64_t batches = 0;
     {
       absl::MutexLock lock(&mu_);
-      points = points_;
       batches = batches_;
     }
     const uint64_t batch_number = batches + 1;
@@ -288,6 +311,28 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
                        QuotedSessionId(request_.session_id()), " but this call uploads into \"",
                        session_->id(), "\""));
     }
+    return absl::OkStatus();
+  }
+
+  // Off gRPC's threads (off_thread_work.h) the call may have ended while the batch waited;
+  // then it is not ingested, as no response could count it.
+  absl::Status IngestBatchUnlessFinished() {
+    {
+      absl::MutexLock lock(&mu_);
+      if (finished_) return absl::OkStatus();
+    }
+    return IngestBatch();
+  }
+
+  // Ingests request_'s batch into session_ (resolved).
+  absl::Status IngestBatch() {
+    uint64_t points = 0, batches = 0;
+    {
+      absl::MutexLock lock(&mu_);
+      points = points_;
+      batches = batches_;
+    }
+    const uint64_t batch_number = batches + 1;
     absl::StatusOr<Ingested> ingested =
         Ingest(*session_, request_.batch(), manager_->limits().max_batch_points);
     if (!ingested.ok()) {
@@ -324,7 +369,9 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
 
   SessionManager* const manager_;
   ReactorRegistry* const reactors_;
+  Executor* const filter_;
   v1::UploadPointsResponse* const response_;
+  OffThreadWork work_;
   bool registered_ = false;
   // Read-side state: touched only by the constructor and OnReadDone, which gRPC serialises,
   // and by OnDone after every other reaction.
@@ -345,7 +392,8 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
 // Reconstruct: bidirectional stream, points in and meshes out.
 //
 // Flow control, reads. As in UploadPoints: one outstanding read; the next read starts after the
-// batch is ingested, so gRPC's window paces a fast sender.
+// batch is ingested (on the filter executor for a session that filters outliers), so gRPC's
+// window paces a fast sender.
 //
 // Flow control, writes. Three kinds of response compete for the one outstanding write: the
 // session (once, first), acknowledgements and mesh updates. Acknowledgements carry running
@@ -372,8 +420,12 @@ class ReconstructReactor final
       public LiveReactor {
  public:
   ReconstructReactor(grpc::CallbackServerContext* context, SessionManager* manager,
-                     ReactorRegistry* reactors)
-      : context_(context), manager_(manager), reactors_(reactors) {
+                     ReactorRegistry* reactors, Executor* filter)
+      : context_(context),
+        manager_(manager),
+        reactors_(reactors),
+        filter_(filter),
+        work_([this] { CleanUpAndDelete(); }) {
     registered_ = reactors_->Add(this);
     if (!registered_) {
       End(Unavailable());
@@ -395,14 +447,12 @@ class ReconstructReactor final
       }
       return;
     }
-    absl::Status status = session_ == nullptr ? Start() : Points();
-    request_ = v1::ReconstructRequest();  // Frees the batch's memory (up to a message's size).
-    if (!status.ok()) {
-      End(status);
+    if (session_ != nullptr && session_->filters_outliers()) {
+      if (work_.Run(*filter_, [this] { ContinueAfter(PointsUnlessEnded()); })) return;
+      ContinueAfter(Unavailable());
       return;
     }
-    absl::MutexLock lock(&mu_);
-    if (!writer_.has_end()) StartRead(&request_);
+    ContinueAfter(session_ == nullptr ? Start() : Points());
   }
 
   void OnUpdate(const MeshUpdatePtr& update) override {
@@ -430,6 +480,12 @@ class ReconstructReactor final
   void OnCancel() override { End(absl::CancelledError("the client cancelled the call")); }
 
   void OnDone() override {
+    if (work_.ReleaseOnDone()) CleanUpAndDelete();
+  }
+
+ private:
+  // After OnDone and the last batch ingested off gRPC's threads (OffThreadWork).
+  void CleanUpAndDelete() {
     if (session_ != nullptr) {
       if (subscribed_) session_->updates().Unsubscribe(handle_);
       session_->RemoveStream();
@@ -438,7 +494,28 @@ class ReconstructReactor final
     delete this;
   }
 
- private:
+  // Ends the handling of a read: frees the batch's memory (up to a message's size) and starts
+  // the next read, or ends the call with `status`.
+  void ContinueAfter(const absl::Status& status) {
+    request_ = v1::ReconstructRequest();
+    if (!status.ok()) {
+      End(status);
+      return;
+    }
+    absl::MutexLock lock(&mu_);
+    if (!writer_.has_end()) StartRead(&request_);
+  }
+
+  // Off gRPC's threads (off_thread_work.h) the call may have ended while the batch waited;
+  // then it is not ingested, as no acknowledgement could count it.
+  absl::Status PointsUnlessEnded() {
+    {
+      absl::MutexLock lock(&mu_);
+      if (writer_.has_end()) return absl::OkStatus();
+    }
+    return Points();
+  }
+
   // The first request: create or attach, then subscribe to the session's meshes.
   absl::Status Start() {
     if (request_.kind_case() != v1::ReconstructRequest::kStart) {
@@ -571,6 +648,8 @@ class ReconstructReactor final
   grpc::CallbackServerContext* const context_;
   SessionManager* const manager_;
   ReactorRegistry* const reactors_;
+  Executor* const filter_;
+  OffThreadWork work_;
   bool registered_ = false;
   // Read-side state: touched by the constructor and OnReadDone (serialised by gRPC), and by
   // OnDone after every other reaction.
@@ -678,8 +757,9 @@ class GetMeshReactor final : public grpc::ServerUnaryReactor,
 
 }  // namespace
 
-ReconstructionService::ReconstructionService(SessionManager* manager, ReactorRegistry* reactors)
-    : manager_(manager), reactors_(reactors) {}
+ReconstructionService::ReconstructionService(SessionManager* manager, ReactorRegistry* reactors,
+                                             Executor* filter)
+    : manager_(manager), reactors_(reactors), filter_(filter) {}
 
 grpc::ServerUnaryReactor* ReconstructionService::CreateSession(
     grpc::CallbackServerContext* context, const v1::CreateSessionRequest* request,
@@ -695,7 +775,7 @@ grpc::ServerUnaryReactor* ReconstructionService::CreateSession(
 
 grpc::ServerReadReactor<v1::UploadPointsRequest>* ReconstructionService::UploadPoints(
     grpc::CallbackServerContext* context, v1::UploadPointsResponse* response) {
-  return new UploadReactor(manager_, reactors_, response);
+  return new UploadReactor(manager_, reactors_, filter_, response);
 }
 
 grpc::ServerWriteReactor<v1::MeshUpdate>* ReconstructionService::WatchSession(
@@ -705,7 +785,7 @@ grpc::ServerWriteReactor<v1::MeshUpdate>* ReconstructionService::WatchSession(
 
 grpc::ServerBidiReactor<v1::ReconstructRequest, v1::ReconstructResponse>*
 ReconstructionService::Reconstruct(grpc::CallbackServerContext* context) {
-  return new ReconstructReactor(context, manager_, reactors_);
+  return new ReconstructReactor(context, manager_, reactors_, filter_);
 }
 
 grpc::ServerUnaryReactor* ReconstructionService::GetSession(

@@ -7,6 +7,7 @@
 #include <cstddef>
 
 #include "neuralmesh/v1/reconstruction.grpc.pb.h"
+#include "server/executor.h"
 #include "server/reactor_registry.h"
 #include "server/session_manager.h"
 
@@ -14,8 +15,10 @@ namespace neuralmesh::server {
 
 class ReconstructionService final : public v1::ReconstructionService::CallbackService {
  public:
-  // `manager` and `reactors` must outlive the service.
-  ReconstructionService(SessionManager* manager, ReactorRegistry* reactors);
+  // `manager`, `reactors` and `filter` must outlive the service; `filter` runs the ingestion of
+  // batches into sessions that filter outliers (off_thread_work.h), and must outlive every
+  // task queued on it, dropping the queued ones at its shutdown if it likes.
+  ReconstructionService(SessionManager* manager, ReactorRegistry* reactors, Executor* filter);
 
   grpc::ServerUnaryReactor* CreateSession(grpc::CallbackServerContext* context,
                                           const v1::CreateSessionRequest* request,
@@ -48,6 +51,7 @@ class ReconstructionService final : public v1::ReconstructionService::CallbackSe
  private:
   SessionManager* const manager_;
   ReactorRegistry* const reactors_;
+  Executor* const filter_;
 };
 
 }  // namespace neuralmesh::server

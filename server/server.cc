@@ -25,10 +25,10 @@ ReconstructionServer::ReconstructionServer(const ServerOptions& options) : optio
 
 absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Start(
     const ServerOptions& options) {
-  if (options.worker_threads < 1 || options.encoder_threads < 1) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("worker_threads (", options.worker_threads, ") and encoder_threads (",
-                     options.encoder_threads, ") must be at least 1"));
+  if (options.worker_threads < 1 || options.encoder_threads < 1 || options.filter_threads < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "worker_threads (", options.worker_threads, "), encoder_threads (", options.encoder_threads,
+        ") and filter_threads (", options.filter_threads, ") must be at least 1"));
   }
   if (options.time_slice <= absl::ZeroDuration()) {
     return absl::InvalidArgumentError("time_slice must be positive");
@@ -51,11 +51,12 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   std::unique_ptr<ReconstructionServer> server(new ReconstructionServer(options));
   server->pool_ = std::make_unique<WorkerPool>(options.worker_threads, options.time_slice);
   server->encoder_ = std::make_unique<Executor>(options.encoder_threads);
+  server->filter_ = std::make_unique<Executor>(options.filter_threads);
   server->reactors_ = std::make_unique<ReactorRegistry>();
   server->manager_ = std::make_unique<SessionManager>(options.limits, server->pool_.get(),
                                                       server->encoder_.get());
-  server->service_ =
-      std::make_unique<ReconstructionService>(server->manager_.get(), server->reactors_.get());
+  server->service_ = std::make_unique<ReconstructionService>(
+      server->manager_.get(), server->reactors_.get(), server->filter_.get());
 
   // Both switches are process-wide and must be set before the builder is created.
   grpc::EnableDefaultHealthCheckService(true);
@@ -135,6 +136,8 @@ void ReconstructionServer::Shutdown(absl::Duration grace) {
     server_->Shutdown(absl::ToChronoTime(absl::Now() + std::min(grace, kUnaryGrace)));
     server_->Wait();
   }
+  // Batches still waiting to be filtered belong to calls that have ended: dropped.
+  if (filter_ != nullptr) filter_->Shutdown();
   if (pool_ != nullptr) pool_->Shutdown();
   if (encoder_ != nullptr) encoder_->Shutdown();
   absl::MutexLock lock(&shutdown_mu_);

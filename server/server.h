@@ -26,6 +26,8 @@ struct ServerOptions {
   std::string address = "127.0.0.1:0";
   int worker_threads = 2;                            // Learning threads, shared by all sessions.
   int encoder_threads = 1;                           // Draco encoding threads.
+  // Threads that ingest the batches of sessions that filter outliers, off gRPC's threads.
+  int filter_threads = 1;
   absl::Duration time_slice = absl::Milliseconds(20);  // Learning per session per turn.
   int max_message_bytes = 64 << 20;                  // Both directions.
   SessionLimits limits;
@@ -66,6 +68,7 @@ class ReconstructionServer {
   const ServerOptions options_;
   std::unique_ptr<WorkerPool> pool_;
   std::unique_ptr<Executor> encoder_;
+  std::unique_ptr<Executor> filter_;
   std::unique_ptr<ReactorRegistry> reactors_;
   std::unique_ptr<SessionManager> manager_;
   std::unique_ptr<ReconstructionService> service_;

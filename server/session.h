@@ -77,6 +77,9 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   const std::string& id() const { return id_; }
   const std::string& name() const { return name_; }
   const SessionConfig& config() const { return config_; }
+  // Whether AddPoints filters outliers (SessionConfig::outlier_removal): work proportional to
+  // the batch times log^2 of the points so far, too long for a gRPC callback thread.
+  bool filters_outliers() const { return config_.outlier_removal.has_value(); }
   absl::Time create_time() const { return create_time_; }
 
   // Appends one batch, all or nothing, and wakes the learner. With outlier removal configured,

@@ -2,8 +2,9 @@
 // it while it grows, and the channel its meshes are published on.
 //
 // Threads:
-//  * Ingestion (AddPoints) runs on gRPC threads, concurrently with learning: the point cloud
-//    takes appends while the learner samples it.
+//  * Ingestion (AddPoints) runs on gRPC threads (on the server's filter executor for a session
+//    that filters outliers), concurrently with learning: the point cloud takes appends while
+//    the learner samples it.
 //  * Learning runs in time slices on the WorkerPool (RunSlice); the pool runs one slice of a
 //    session at a time, so the learner and the members marked "learning thread" below are
 //    touched by one thread at a time without a lock (the pool's mutex orders the slices).

@@ -81,6 +81,29 @@ TEST(ServiceConcurrentTest, EightSessionsOnTwoWorkersStayIsolatedAndAllProgress)
   }
 }
 
+// A server whose sessions may take batches of 300,000 points, and sessions that filter
+// outliers: filtering such a batch takes about 2 s.
+class FilteringServiceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ServerOptions options;
+    options.limits.max_batch_points = 400000;
+    server_ = testing::StartServer(false, options);
+    ASSERT_NE(server_, nullptr);
+    stub_ = testing::InProcessStub(*server_);
+  }
+
+  std::string FilteredSession() {
+    v1::CreateSessionRequest create = testing::CreateRequest(1000);
+    create.mutable_config()->mutable_points_per_vertex()->set_value(300);
+    create.mutable_config()->mutable_outlier_removal();
+    return testing::MustCreate(*stub_, create);
+  }
+
+  std::unique_ptr<ReconstructionServer> server_;
+  std::unique_ptr<v1::ReconstructionService::Stub> stub_;
+};
+
 // Filtering a batch for outliers takes seconds for a few hundred thousand points. gRPC runs
 // every reaction of the server on a few threads of its own, so were the filter run there,
 // four such uploads would hold up every other call (a GetSession waited 20 s behind three
@@ -88,37 +111,29 @@ TEST(ServiceConcurrentTest, EightSessionsOnTwoWorkersStayIsolatedAndAllProgress)
 // server's filter executor instead. Four uploads of 300,000 points each take about 2 s of
 // filtering each, one after the other on the filter thread; meanwhile another session's calls
 // are answered at once.
-TEST(ServiceConcurrentTest, FilteringOutliersDoesNotHoldUpOtherCalls) {
-  ServerOptions options;
-  options.limits.max_batch_points = 400000;
-  std::unique_ptr<ReconstructionServer> server = testing::StartServer(false, options);
-  ASSERT_NE(server, nullptr);
-  auto stub = testing::InProcessStub(*server);
+TEST_F(FilteringServiceTest, FilteringOutliersDoesNotHoldUpOtherCalls) {
   const PointCloud points = testing::SpherePoints(300000, 31);
-  const std::string other = testing::MustCreate(*stub, testing::CreateRequest(100));
+  const std::string other = testing::MustCreate(*stub_, testing::CreateRequest(100));
 
   constexpr int kUploads = 4;
   std::vector<std::thread> uploads;
   std::vector<grpc::Status> statuses(kUploads);
   std::vector<v1::UploadPointsResponse> responses(kUploads);
   for (int i = 0; i < kUploads; ++i) {
-    v1::CreateSessionRequest create = testing::CreateRequest(1000);
-    create.mutable_config()->mutable_points_per_vertex()->set_value(300);
-    create.mutable_config()->mutable_outlier_removal();
-    const std::string id = testing::MustCreate(*stub, create);
+    const std::string id = FilteredSession();
     uploads.emplace_back(
-        [&, i, id] { statuses[i] = testing::Upload(*stub, id, points, 1, &responses[i]); });
+        [&, i, id] { statuses[i] = testing::Upload(*stub_, id, points, 1, &responses[i]); });
   }
   absl::SleepFor(absl::Milliseconds(500));  // The uploads have arrived and are being filtered.
   absl::Duration slowest;
   for (int probe = 0; probe < 5; ++probe) {
     const absl::Time start = absl::Now();
     grpc::Status status;
-    testing::GetSession(*stub, other, &status);
+    testing::GetSession(*stub_, other, &status);
     ASSERT_TRUE(status.ok()) << status.error_message();
     v1::UploadPointsResponse response;
     ASSERT_TRUE(
-        testing::Upload(*stub, other, testing::SpherePoints(500, probe), 1, &response).ok());
+        testing::Upload(*stub_, other, testing::SpherePoints(500, probe), 1, &response).ok());
     slowest = std::max(slowest, absl::Now() - start);
     absl::SleepFor(absl::Milliseconds(100));
   }
@@ -134,42 +149,31 @@ TEST(ServiceConcurrentTest, FilteringOutliersDoesNotHoldUpOtherCalls) {
 // The call may end while its batch is being filtered off gRPC's threads: the session deleted,
 // or the server shutting down. The call ends with the reason at once, and the reactor lives
 // until the filter is done with it (run these under AddressSanitizer to see that it does).
-TEST(ServiceConcurrentTest, CallsEndWhileTheirBatchIsFiltered) {
-  ServerOptions options;
-  options.limits.max_batch_points = 400000;
-  std::unique_ptr<ReconstructionServer> server = testing::StartServer(false, options);
-  ASSERT_NE(server, nullptr);
-  auto stub = testing::InProcessStub(*server);
+TEST_F(FilteringServiceTest, CallsEndWhileTheirBatchIsFiltered) {
   const PointCloud points = testing::SpherePoints(300000, 32);
-  auto filtered_session = [&] {
-    v1::CreateSessionRequest create = testing::CreateRequest(1000);
-    create.mutable_config()->mutable_points_per_vertex()->set_value(300);
-    create.mutable_config()->mutable_outlier_removal();
-    return testing::MustCreate(*stub, create);
-  };
 
-  const std::string deleted = filtered_session();
+  const std::string deleted = FilteredSession();
   grpc::Status deleted_status;
   std::thread upload([&] {
     v1::UploadPointsResponse response;
-    deleted_status = testing::Upload(*stub, deleted, points, 1, &response);
+    deleted_status = testing::Upload(*stub_, deleted, points, 1, &response);
   });
   absl::SleepFor(absl::Milliseconds(800));  // The batch is being filtered (about 2 s).
-  ASSERT_TRUE(testing::Delete(*stub, deleted).ok());
+  ASSERT_TRUE(testing::Delete(*stub_, deleted).ok());
   upload.join();
   // NOT_FOUND from the deletion; FAILED_PRECONDITION if the batch reached the session after.
   EXPECT_TRUE(deleted_status.error_code() == grpc::StatusCode::NOT_FOUND ||
               deleted_status.error_code() == grpc::StatusCode::FAILED_PRECONDITION)
       << deleted_status.error_code() << ": " << deleted_status.error_message();
 
-  const std::string shut_down = filtered_session();
+  const std::string shut_down = FilteredSession();
   grpc::Status shut_down_status;
   std::thread last_upload([&] {
     v1::UploadPointsResponse response;
-    shut_down_status = testing::Upload(*stub, shut_down, points, 2, &response);
+    shut_down_status = testing::Upload(*stub_, shut_down, points, 2, &response);
   });
   absl::SleepFor(absl::Milliseconds(800));
-  server->Shutdown(absl::Seconds(1));
+  server_->Shutdown(absl::Seconds(1));
   last_upload.join();
   EXPECT_TRUE(shut_down_status.error_code() == grpc::StatusCode::UNAVAILABLE ||
               shut_down_status.error_code() == grpc::StatusCode::FAILED_PRECONDITION)

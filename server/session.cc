@@ -127,7 +127,6 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* remov
       absl::MutexLock lock(&mu_);  // Checked again below; here to spare the filter's work.
       NM_RETURN_IF_ERROR(AcceptingPointsLocked());
     }
-    BoundingBox batch_bounds = BoundsOf(batch.positions);
     const bool finite = AllFinite(batch.positions);
     // The filter keeps every point received, outliers too: they count toward the limit.
     if (outlier_filter_ != nullptr &&
@@ -148,7 +147,7 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* remov
     }
     const PointCloud kept = outlier_count > 0 ? WithoutPoints(batch, outliers) : PointCloud();
     const PointCloud& appended = outlier_count > 0 ? kept : batch;
-    if (outlier_count > 0) batch_bounds = BoundsOf(appended.positions);
+    const BoundingBox batch_bounds = BoundsOf(appended.positions);
     // Quantization: the first data fixes the cube; later data outside it grows the cube. A
     // batch that no cube Draco can use would hold is refused before anything changes.
     std::optional<QuantizationBox> box;

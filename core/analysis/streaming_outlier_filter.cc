@@ -37,9 +37,14 @@ std::vector<bool> StreamingOutlierFilter::FindOutliers(absl::Span<const Vec3f> b
     mean_distance[i] = MeanDistance(heap);
   }
   // The reference population: the batch, and when it is small the points seen before.
-  std::vector<double> reference = mean_distance;
-  if (m < kReferencePoints) reference.insert(reference.end(), reference_.begin(), reference_.end());
-  const double limit = OutlierDistanceLimit(reference, options_.std_ratio);
+  double limit = 0;
+  if (m < kReferencePoints) {
+    std::vector<double> reference = mean_distance;
+    reference.insert(reference.end(), reference_.begin(), reference_.end());
+    limit = OutlierDistanceLimit(reference, options_.std_ratio);
+  } else {
+    limit = OutlierDistanceLimit(mean_distance, options_.std_ratio);
+  }
   for (size_t i = 0; i < m; ++i) outlier[i] = mean_distance[i] > limit;
   return outlier;
 }

@@ -8,13 +8,13 @@
 // was measured among the points seen when their number was at most 1/16 below what it is now
 // (remeasured as it grows). So a batch of one point is judged by the density the cloud has
 // now at the cost of a few searches, and a batch that is one region of a scan is judged with
-// the neighbours its edges have in earlier batches. The seen
-// points include the outliers dropped before, as FindStatisticalOutliers counts every point of
-// the cloud: left out, a random gap in the data would stay sparse while the rest fills in, and
-// ever more points falling into it would be dropped (on 20,000 sphere points sent one at a
-// time, 1.8% instead of 0.3%). While the seen points and the batch together number at most
-// k, nothing is an outlier (there is nothing to compare with); on a whole cloud sent as one
-// batch the two filters agree exactly.
+// the neighbours its edges have in earlier batches. The seen points include the outliers
+// dropped before, as FindStatisticalOutliers counts every point of the cloud: left out, a
+// random gap in the data would stay sparse while the rest fills in, and ever more points
+// falling into it would be dropped (on 20,000 sphere points sent one at a time, 1.8% instead
+// of 0.3%). While the seen points and the batch together number at most k, nothing is an
+// outlier (there is nothing to compare with); on a whole cloud sent as one batch the two
+// filters agree exactly.
 //
 // The seen points are indexed by a logarithmic forest of static k-d trees (Bentley and Saxe):
 // trees over consecutive ranges of the seen points whose sizes at least double from the

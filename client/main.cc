@@ -67,8 +67,9 @@ ABSL_FLAG(bool, merge_boundaries, kLearnerDefaults.merge_boundaries,
 ABSL_FLAG(int32_t, splits_per_step, kLearnerDefaults.splits_per_step,
           "Vertex splits per call of Step 2 (Section 3.3), >= 1.");
 ABSL_FLAG(bool, close_small_holes, kLearnerDefaults.close_small_holes,
-          "Step 5: refill holes, and zip slits in longer borders, where the filling passes "
-          "Step 4's area test and bridges no more than Step 5 would (--noclose_small_holes).");
+          "Step 5: refill holes, and zip slits and cracks in longer borders, where the filling "
+          "passes Step 4's area test and bridges no more than Step 5 would "
+          "(--noclose_small_holes).");
 ABSL_FLAG(int32_t, max_closed_hole_vertices, kLearnerDefaults.max_closed_hole_vertices,
           "The largest boundary loop, in vertices, that close_small_holes refills, >= 3.");
 ABSL_FLAG(bool, merge_only_settled_boundaries, kLearnerDefaults.merge_only_settled_boundaries,

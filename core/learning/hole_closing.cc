@@ -286,6 +286,33 @@ std::optional<FillLimits> LimitsOf(const Mesh& mesh, const HoleClosingOptions& o
   return limits;
 }
 
+// Whether the border half-edges h = a -> t and t -> b end in the tip of a crack that the
+// triangle (a, t, b) closes (see CloseCrackTips in the header).
+bool IsCrackTip(const Mesh& mesh, Mesh::HalfedgeHandle h, const FillLimits& limits) {
+  const Mesh::HalfedgeHandle next = mesh.next_halfedge_handle(h);
+  const Mesh::VertexHandle a = mesh.from_vertex_handle(h);
+  const Mesh::VertexHandle t = mesh.to_vertex_handle(h);
+  const Mesh::VertexHandle b = mesh.to_vertex_handle(next);
+  // A loop of 3 is a hole (CloseSmallHoles).
+  if (a == b || mesh.to_vertex_handle(mesh.next_halfedge_handle(next)) == a) return false;
+  const Vec3& pa = mesh.point(a);
+  const Vec3& pt = mesh.point(t);
+  const Vec3& pb = mesh.point(b);
+  if (OpenMesh::dot(pa - pt, pb - pt) < 0) return false;  // Wider than 90 degrees.
+  if ((pa - pb).sqrnorm() > limits.max_edge * limits.max_edge) return false;
+  const Vec3 normal = OpenMesh::cross(pt - pa, pb - pa);
+  if (0.5 * normal.norm() > limits.max_area) return false;
+  // On the empty side: the triangle faces the way of the faces along both edges.
+  for (const Mesh::HalfedgeHandle side : {h, next}) {
+    const Mesh::FaceHandle across = mesh.opposite_face_handle(side);
+    if (!across.is_valid() || !(OpenMesh::dot(normal, mesh.calc_face_normal(across)) > 0)) {
+      return false;
+    }
+  }
+  // t becomes interior, and a - b must be a new edge.
+  return mesh.valence(t) >= 3 && !mesh.find_halfedge(a, b).is_valid();
+}
+
 }  // namespace
 
 absl::Status HoleClosingOptions::Validate() const {
@@ -375,9 +402,39 @@ HoleClosingResult CloseBridgedHoles(Mesh& mesh, const HoleClosingOptions& option
   return result;
 }
 
-HoleClosingResult ZipBorderSlits(Mesh& mesh, const HoleClosingOptions& options,
+HoleClosingResult CloseCrackTips(Mesh& mesh, const HoleClosingOptions& options,
                                  double mean_area) {
   HoleClosingResult result;
+  const std::optional<FillLimits> limits = LimitsOf(mesh, options, mean_area);
+  if (!limits) return result;
+  // Border half-edges a -> t to look at; each closed tip puts the two that may form the next
+  // one back: the new border edge a -> b and the one into a.
+  std::vector<Mesh::HalfedgeHandle> pending;
+  for (const Mesh::HalfedgeHandle h : mesh.halfedges()) {
+    if (!mesh.status(h).deleted() && mesh.is_boundary(h)) pending.push_back(h);
+  }
+  while (!pending.empty()) {
+    const Mesh::HalfedgeHandle h = pending.back();
+    pending.pop_back();
+    if (mesh.status(h).deleted() || !mesh.is_boundary(h) || !IsCrackTip(mesh, h, *limits)) {
+      continue;
+    }
+    const Mesh::VertexHandle a = mesh.from_vertex_handle(h);
+    const Mesh::VertexHandle t = mesh.to_vertex_handle(h);
+    const Mesh::VertexHandle b = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
+    if (!mesh.add_face(a, t, b).is_valid()) continue;
+    ++result.closed_holes;
+    ++result.added_faces;
+    const Mesh::HalfedgeHandle border = mesh.find_halfedge(a, b);
+    pending.push_back(border);
+    pending.push_back(mesh.prev_halfedge_handle(border));
+  }
+  return result;
+}
+
+HoleClosingResult ZipBorderSlits(Mesh& mesh, const HoleClosingOptions& options,
+                                 double mean_area) {
+  HoleClosingResult result = CloseCrackTips(mesh, options, mean_area);
   const std::optional<FillLimits> limits = LimitsOf(mesh, options, mean_area);
   if (!limits) return result;
   const auto [max_area, max_edge] = *limits;

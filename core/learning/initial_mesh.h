@@ -26,7 +26,8 @@ Mesh MakeInitialTetrahedron(const BoundingBox& box);
 // 1-30, one border and one layer in: 28 and 29 runs with this radius; 28 and 29 at 0.8 times
 // it; 27 and 24 at 1.25 times; 12 and 27 at half (the rest folded over themselves). A finer
 // start, a triangulated hexagon of 2, 3 or 5 rings, did as well and no better: 57-59 of 60 on
-// seeds 1-30, 58 of 60 on seeds 31-60 (this disc: 57 and 59).
+// seeds 1-30, 58 of 60 on seeds 31-60 (this disc: 57 and 59). All of these were measured
+// before Step 5 closed crack tips (hole_closing.h), which most of the failures were.
 Mesh MakeInitialDisc(const BestFitPlane& plane);
 
 }  // namespace neuralmesh

@@ -35,8 +35,8 @@ struct LearnerOptions {
   // closed pancake of two layers. The two sheets of topology_learning_test (a tilted, noisy
   // 1 x 0.5 rectangle and a height field with 8% relief; one border and one layer wanted),
   // seeds 1-10: 0 and 5 pass from the tetrahedron (two layers, up to 9 loops), 10 and 10 from
-  // the disc; seeds 1-60 from the disc: 57 and 59 (the others fold over themselves while the
-  // mesh has under 100 vertices). Not for closed surfaces: a disc has no way to close.
+  // the disc; seeds 1-260 from the disc: 259 and 259 (240 and 252 before Step 5 closed crack
+  // tips, hole_closing.h). Not for closed surfaces: a disc has no way to close.
   InitialMesh initial_mesh = InitialMesh::kTetrahedron;
 
   // Basic Step (Section 2.1).
@@ -85,7 +85,10 @@ struct LearnerOptions {
   // alpha_m sqrt(E(Area)) while the border between them is at least 3 times as long. And two
   // loops joined by a bridge of two triangles are closed as one hole when the loop left by
   // cutting the bridge has such a filling (CloseBridgedHoles): sewn together by Step 5, they
-  // would make a handle whose tunnel is the bridge.
+  // would make a handle whose tunnel is the bridge. Before the slits, the tips of cracks are
+  // closed one triangle at a time (CloseCrackTips): a border vertex whose two border
+  // neighbours lie within 90 degrees of each other on its empty side gets the triangle between
+  // them, so a crack of any length zips up from its tip.
   bool close_small_holes = true;
   int max_closed_hole_vertices = 256;  // >= 3: longer loops are never closed (O(k^3) work).
   // Not in the paper (boundary_merging.h): Step 5 leaves alone a loop that Step 4 has cut into

@@ -280,9 +280,8 @@ TEST(HoleClosingTest, StraightBordersAndTonguesAreNotZipped) {
   for (auto fh : mesh.faces()) EXPECT_GT(mesh.calc_face_normal(fh)[2], 0);
 }
 
-// A crack one edge wide and 30 deep in a 40 x 40 grid (edge 0.025): its loop runs 61 edges
-// round it, more than a slit's chain may span (48), so only its tip qualifies, and closing the
-// tip makes the next one, up to the mouth.
+// A crack one edge wide and 30 deep in a 40 x 40 grid (edge 0.025), longer than the chains
+// ZipBorderSlits fills (48 edges): closing its tip makes the next one, up to the mouth.
 TEST(HoleClosingTest, CrackLongerThanAChainIsClosedFromItsTip) {
   Mesh mesh = MustToMesh(GridPatch(40, 40));
   const double mean_area = MeanTriangleArea(mesh);

@@ -286,31 +286,17 @@ std::optional<FillLimits> LimitsOf(const Mesh& mesh, const HoleClosingOptions& o
   return limits;
 }
 
-// Whether the border half-edges h = a -> t and t -> b end in the tip of a crack that the
-// triangle (a, t, b) closes (see CloseCrackTips in the header).
-bool IsCrackTip(const Mesh& mesh, Mesh::HalfedgeHandle h, const FillLimits& limits) {
+// Whether the border half-edges h = a -> t and t -> b turn back at t as at the tip of a crack:
+// a and b within 90 degrees of each other as seen from t, in a loop of more than 3 vertices
+// (a loop of 3 is a hole, CloseSmallHoles'). Whether the triangle (a, t, b) may close it is
+// FillLoop's test of the chain a, t, b (see CloseCrackTips in the header).
+bool IsCrackTip(const Mesh& mesh, Mesh::HalfedgeHandle h) {
   const Mesh::HalfedgeHandle next = mesh.next_halfedge_handle(h);
   const Mesh::VertexHandle a = mesh.from_vertex_handle(h);
   const Mesh::VertexHandle t = mesh.to_vertex_handle(h);
-  const Mesh::VertexHandle b = mesh.to_vertex_handle(next);
-  // A loop of 3 is a hole (CloseSmallHoles).
-  if (a == b || mesh.to_vertex_handle(mesh.next_halfedge_handle(next)) == a) return false;
-  const Vec3& pa = mesh.point(a);
+  if (mesh.to_vertex_handle(mesh.next_halfedge_handle(next)) == a) return false;
   const Vec3& pt = mesh.point(t);
-  const Vec3& pb = mesh.point(b);
-  if (OpenMesh::dot(pa - pt, pb - pt) < 0) return false;  // Wider than 90 degrees.
-  if ((pa - pb).sqrnorm() > limits.max_edge * limits.max_edge) return false;
-  const Vec3 normal = OpenMesh::cross(pt - pa, pb - pa);
-  if (0.5 * normal.norm() > limits.max_area) return false;
-  // On the empty side: the triangle faces the way of the faces along both edges.
-  for (const Mesh::HalfedgeHandle side : {h, next}) {
-    const Mesh::FaceHandle across = mesh.opposite_face_handle(side);
-    if (!across.is_valid() || !(OpenMesh::dot(normal, mesh.calc_face_normal(across)) > 0)) {
-      return false;
-    }
-  }
-  // t becomes interior, and a - b must be a new edge.
-  return mesh.valence(t) >= 3 && !mesh.find_halfedge(a, b).is_valid();
+  return OpenMesh::dot(mesh.point(a) - pt, mesh.point(mesh.to_vertex_handle(next)) - pt) >= 0;
 }
 
 }  // namespace
@@ -416,13 +402,11 @@ HoleClosingResult CloseCrackTips(Mesh& mesh, const HoleClosingOptions& options,
   while (!pending.empty()) {
     const Mesh::HalfedgeHandle h = pending.back();
     pending.pop_back();
-    if (mesh.status(h).deleted() || !mesh.is_boundary(h) || !IsCrackTip(mesh, h, *limits)) {
-      continue;
-    }
+    if (mesh.status(h).deleted() || !mesh.is_boundary(h) || !IsCrackTip(mesh, h)) continue;
     const Mesh::VertexHandle a = mesh.from_vertex_handle(h);
-    const Mesh::VertexHandle t = mesh.to_vertex_handle(h);
     const Mesh::VertexHandle b = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
-    if (!mesh.add_face(a, t, b).is_valid()) continue;
+    const VertexLoop tip = {a, mesh.to_vertex_handle(h), b};
+    if (FillLoop(mesh, tip, limits->max_area, limits->max_edge, /*closed=*/false) == 0) continue;
     ++result.closed_holes;
     ++result.added_faces;
     const Mesh::HalfedgeHandle border = mesh.find_halfedge(a, b);

@@ -108,6 +108,10 @@ ABSL_FLAG(int32_t, outlier_neighbours, neuralmesh::OutlierOptions{}.neighbours,
 ABSL_FLAG(double, outlier_std_ratio, neuralmesh::OutlierOptions{}.std_ratio,
           "With --remove_outliers: how many standard deviations above the mean distance "
           "make an outlier, > 0.");
+ABSL_FLAG(bool, outliers_on_server, false,
+          "With --remove_outliers and --server: the session removes the outliers as the batches "
+          "arrive (SessionConfig.outlier_removal), as for a client that streams a scan, instead "
+          "of this command filtering the whole file before upload.");
 
 // Local learning.
 ABSL_FLAG(std::string, sampling, "uniform",
@@ -241,6 +245,10 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.lods = lods;
     NM_ASSIGN_OR_RETURN(o.learner, LearnerFromFlags());
     NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
+    o.outliers_on_server = absl::GetFlag(FLAGS_outliers_on_server);
+    if (o.outliers_on_server && !o.outliers.has_value()) {
+      return absl::InvalidArgumentError("--outliers_on_server needs --remove_outliers");
+    }
     NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
     o.batch_size = absl::GetFlag(FLAGS_batch_size);
     o.builtin_points = absl::GetFlag(FLAGS_points);
@@ -249,9 +257,9 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
     return neuralmesh::client::RunRemoteReconstruct(o, std::cout, std::cerr);
   }
-  NM_RETURN_IF_ERROR(RejectFlags(args,
-                                 {"out-dir", "batch-size", "points", "ply", "connect_timeout"},
-                                 "needs --server (a local reconstruct writes -o OUTPUT)"));
+  NM_RETURN_IF_ERROR(RejectFlags(
+      args, {"out-dir", "batch-size", "points", "ply", "connect_timeout", "outliers_on_server"},
+      "needs --server (a local reconstruct writes -o OUTPUT)"));
   if (!args.Has("vertices")) return absl::InvalidArgumentError("--vertices N is required");
   neuralmesh::client::LocalReconstructOptions o;
   o.input = args.positional[0];
@@ -311,9 +319,9 @@ std::vector<Subcommand> Commands() {
       "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
-      "remove_outliers", "outlier_neighbours", "outlier_std_ratio", "sampling", "time_budget",
-      "max_steps", "quantization_bits", "encode_speed", "progress", "server", "out-dir",
-      "batch-size", "points", "ply", "connect_timeout"};
+      "remove_outliers", "outlier_neighbours", "outlier_std_ratio", "outliers_on_server",
+      "sampling", "time_budget", "max_steps", "quantization_bits", "encode_speed", "progress",
+      "server", "out-dir", "batch-size", "points", "ply", "connect_timeout"};
   // clang-format on
   return {
       {"reconstruct",

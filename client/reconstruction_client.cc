@@ -207,7 +207,7 @@ absl::StatusOr<ReconstructResult> ReconstructionClient::Reconstruct(
       case v1::ReconstructResponse::kAck:
         result.last_ack = response.ack();
         if (progress) {  // Points the server dropped as outliers were received all the same.
-          progress(result.last_ack.points_accepted() + result.last_ack.points_removed(),
+          progress(result.last_ack.points_accepted() + result.last_ack.points_held_back(),
                    cloud.size());
         }
         break;

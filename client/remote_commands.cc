@@ -77,10 +77,11 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   if (options.batch_size == 0) return absl::InvalidArgumentError("--batch-size must be > 0");
   NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointsForUpload(options.input, options.builtin_points,
                                                             options.learner.seed));
-  if (options.outliers.has_value()) {
-    const size_t points = cloud.size();
+  const size_t points_read = cloud.size();
+  const bool outliers_on_server = options.outliers.has_value() && options.outliers_on_server;
+  if (options.outliers.has_value() && !outliers_on_server) {
     NM_ASSIGN_OR_RETURN(const size_t removed, RemoveOutliers(cloud, *options.outliers));
-    out << "outliers removed: " << removed << " of " << points << " points\n";
+    out << "outliers removed: " << removed << " of " << points_read << " points\n";
   }
   const size_t affordable = static_cast<size_t>(std::floor(cloud.size() / kDefaultPointsPerVertex));
   const size_t target =
@@ -94,8 +95,15 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     for (size_t m : milestones) config.add_lod_milestones(m);
   }
   *config.mutable_draco() = ToProto(options.draco);
-  // All points are known before the upload: one quantization cube for the whole session.
-  *config.mutable_bounds() = ToProto(BoundsOf(cloud));
+  if (outliers_on_server) {
+    // The session's cube grows with what it accepts: bounds taken here would hold the strays.
+    v1::OutlierRemoval& removal = *config.mutable_outlier_removal();
+    removal.mutable_neighbours()->set_value(options.outliers->neighbours);
+    removal.mutable_std_ratio()->set_value(options.outliers->std_ratio);
+  } else {
+    // All points are known before the upload: one quantization cube for the whole session.
+    *config.mutable_bounds() = ToProto(BoundsOf(cloud));
+  }
 
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ConnectTo(options.server, options.connect_timeout));
@@ -169,7 +177,17 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     upload_bar.Finish();
   }
   absl::Status status = uploaded.status();
-  if (status.ok()) status = client->Finish(id).status();
+  if (status.ok()) {
+    absl::StatusOr<v1::Session> finished = client->Finish(id);
+    status = finished.status();
+    if (finished.ok() && outliers_on_server) {
+      const v1::LearningState& learning = finished->learning();
+      absl::MutexLock lock(&mu);
+      out << "outliers removed by the server: " << learning.points_removed_as_outliers() << " of "
+          << points_read << " points (" << learning.outliers_accepted_later()
+          << " more held back on arrival and accepted later)\n";
+    }
+  }
   if (!status.ok() && !InterruptScope::interrupted()) {
     // Without a finished upload no final mesh can come: stop the server's work and the watch.
     client->Cancel(id, kTidyCancelTimeout).IgnoreError();
@@ -234,6 +252,8 @@ absl::Status RunSessions(const std::string& server, bool json, std::ostream& out
       writer.Key("state").String(StateName(s.state()));
       writer.Key("points_received").Uint(s.learning().points_received());
       writer.Key("points_removed_as_outliers").Uint(s.learning().points_removed_as_outliers());
+      writer.Key("outliers_held").Uint(s.learning().outliers_held());
+      writer.Key("outliers_accepted_later").Uint(s.learning().outliers_accepted_later());
       writer.Key("vertices").Uint(s.vertex_count());
       writer.Key("faces").Uint(s.face_count());
       writer.Key("target_vertices").Uint(s.config().target_vertices());

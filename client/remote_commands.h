@@ -25,7 +25,8 @@ struct RemoteReconstructOptions {
   size_t vertices = 0;       // Final vertex count; 0: one vertex per 2 points, at most 10000.
   std::vector<size_t> lods;  // Milestones; empty: the server's 1-2-5 series.
   LearnerOptions learner;
-  std::optional<OutlierOptions> outliers;  // Set: remove the points' outliers before upload.
+  std::optional<OutlierOptions> outliers;  // Set: remove the points' outliers before upload,
+  bool outliers_on_server = false;         // or, when this is set, the session as they arrive.
   DracoOptions draco;              // Quantization bits and encode speed of the server's meshes.
   size_t batch_size = 10000;       // Points per uploaded batch.
   size_t builtin_points = 100000;  // Points sampled from a builtin:NAME input.

@@ -31,6 +31,16 @@ struct BoundingBox {
     return p[0] >= min[0] && p[0] <= max[0] && p[1] >= min[1] && p[1] <= max[1] &&
            p[2] >= min[2] && p[2] <= max[2];
   }
+  // The squared distance from `p` to the box: 0 inside, infinity for an empty box.
+  double SquaredDistance(const Vec3& p) const {
+    if (empty()) return std::numeric_limits<double>::infinity();
+    double sum = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = std::max({min[i] - p[i], 0.0, p[i] - max[i]});
+      sum += d * d;
+    }
+    return sum;
+  }
 };
 
 }  // namespace neuralmesh

@@ -49,9 +49,9 @@ absl::Status BatchError(const absl::Status& status, uint64_t batch_number, uint6
 
 // What one batch added to a session.
 struct Ingested {
-  size_t accepted = 0;  // Points of the batch accepted.
-  size_t removed = 0;   // Points of the batch dropped as outliers.
-  size_t total = 0;     // The session's running total of accepted points.
+  size_t accepted = 0;   // Points of the batch accepted.
+  size_t held_back = 0;  // Points of the batch held back as outliers.
+  size_t total = 0;      // The session's running total of accepted points.
 };
 
 // Resolves and ingests one batch into `session`.
@@ -60,10 +60,10 @@ absl::StatusOr<Ingested> Ingest(Session& session, const v1::PointBatch& batch,
   absl::StatusOr<PointCloud> cloud = PointBatchFromProto(batch, max_batch_points);
   if (!cloud.ok()) return cloud.status();
   Ingested ingested;
-  absl::StatusOr<size_t> running = session.AddPoints(*cloud, &ingested.removed);
+  absl::StatusOr<size_t> running = session.AddPoints(*cloud, &ingested.held_back);
   if (!running.ok()) return running.status();
   ingested.total = *running;
-  ingested.accepted = cloud->size() - ingested.removed;
+  ingested.accepted = cloud->size() - ingested.held_back;
   return ingested;
 }
 
@@ -220,7 +220,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
         if (finished_) return;
         response_->set_session_id(session_->id());
         response_->set_points_accepted(points_);
-        response_->set_points_removed(removed_);
+        response_->set_points_held_back(held_back_);
         response_->set_batches_accepted(batches_);
         response_->set_total_points(total_);
       }
@@ -342,7 +342,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
     {
       absl::MutexLock lock(&mu_);
       points_ += ingested->accepted;
-      removed_ += ingested->removed;
+      held_back_ += ingested->held_back;
       ++batches_;
       total_ = ingested->total;
     }
@@ -383,7 +383,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
   absl::Mutex mu_;
   bool finished_ ABSL_GUARDED_BY(mu_) = false;
   uint64_t points_ ABSL_GUARDED_BY(mu_) = 0;
-  uint64_t removed_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t held_back_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t batches_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t total_ ABSL_GUARDED_BY(mu_) = 0;
 };
@@ -578,12 +578,12 @@ class ReconstructReactor final
                         session_->points_received());
     }
     points_ += ingested->accepted;
-    removed_ += ingested->removed;
+    held_back_ += ingested->held_back;
     ++batches_;
     v1::PointsAck ack;
     ack.set_batches_accepted(batches_);
     ack.set_points_accepted(points_);
-    ack.set_points_removed(removed_);
+    ack.set_points_held_back(held_back_);
     ack.set_total_points(ingested->total);
     absl::MutexLock lock(&mu_);
     pending_ack_ = std::move(ack);
@@ -658,7 +658,7 @@ class ReconstructReactor final
   uint64_t handle_ = 0;
   bool subscribed_ = false;
   uint64_t points_ = 0;
-  uint64_t removed_ = 0;
+  uint64_t held_back_ = 0;
   uint64_t batches_ = 0;
 
   absl::Mutex mu_;

@@ -31,13 +31,6 @@ BoundingBox BoundsOf(absl::Span<const Vec3f> positions) {
   return box;
 }
 
-bool AllFinite(absl::Span<const Vec3f> positions) {
-  for (const Vec3f& p : positions) {
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) return false;
-  }
-  return true;
-}
-
 }  // namespace
 
 bool IsSpatiallyBiased(absl::Span<const Vec3f> arrival_sample) {
@@ -118,8 +111,8 @@ absl::StatusOr<QuantizationBox> Session::CubeWithLocked(const BoundingBox& batch
   return GrowQuantizationCube(box, batch_bounds, bits);
 }
 
-absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* removed) {
-  if (removed != nullptr) *removed = 0;
+absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* held_back) {
+  if (held_back != nullptr) *held_back = 0;
   size_t total = 0;
   {
     absl::MutexLock ingest(&ingest_mu_);
@@ -127,7 +120,8 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* remov
       absl::MutexLock lock(&mu_);  // Checked again below; here to spare the filter's work.
       NM_RETURN_IF_ERROR(AcceptingPointsLocked());
     }
-    const bool finite = AllFinite(batch.positions);
+    NM_RETURN_IF_ERROR(
+        GrowingPointCloud::ValidateBatch(batch.positions, batch.weights, batch.normals));
     // The filter keeps every point received, outliers too: they count toward the limit.
     if (outlier_filter_ != nullptr &&
         batch.positions.size() >
@@ -138,16 +132,21 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* remov
           " so far)"));
     }
     // Outliers go before anything else sees the batch: a stray point would grow the
-    // quantization cube. (A non-finite batch is left to Append, which says what is wrong.)
-    std::vector<bool> outliers;
-    size_t outlier_count = 0;
-    if (outlier_filter_ != nullptr && finite && !batch.positions.empty()) {
-      outliers = outlier_filter_->FindOutliers(batch.positions);
-      outlier_count = static_cast<size_t>(std::count(outliers.begin(), outliers.end(), true));
+    // quantization cube. Points held back before that pass now join the batch.
+    OutlierJudgement judgement;
+    size_t held_count = 0;
+    PointCloud filtered;
+    const PointCloud* appended = &batch;
+    if (outlier_filter_ != nullptr) {
+      judgement = outlier_filter_->Judge(batch.positions);
+      held_count =
+          static_cast<size_t>(std::count(judgement.held.begin(), judgement.held.end(), true));
+      if (held_count > 0 || !judgement.released.empty()) {
+        filtered = held_count > 0 ? WithoutPoints(batch, judgement.held) : batch;
+        held_outliers_.AppendTo(judgement.released, &filtered);
+        appended = &filtered;
+      }
     }
-    const PointCloud kept = outlier_count > 0 ? WithoutPoints(batch, outliers) : PointCloud();
-    const PointCloud& appended = outlier_count > 0 ? kept : batch;
-    const BoundingBox batch_bounds = BoundsOf(appended.positions);
     // Quantization: the first data fixes the cube; later data outside it grows the cube. A
     // batch that no cube Draco can use would hold is refused before anything changes.
     std::optional<QuantizationBox> box;
@@ -156,21 +155,25 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* remov
       absl::MutexLock lock(&mu_);
       NM_RETURN_IF_ERROR(AcceptingPointsLocked());
       last_activity_ = absl::Now();
-      if (finite && !appended.positions.empty()) {
-        absl::StatusOr<QuantizationBox> cube = CubeWithLocked(batch_bounds, &grown);
+      if (!appended->positions.empty()) {
+        absl::StatusOr<QuantizationBox> cube =
+            CubeWithLocked(BoundsOf(appended->positions), &grown);
         if (!cube.ok()) return cube.status();
         box = *cube;
       }
     }
     const size_t first_index = points_.size();
-    // A batch of outliers only: nothing to append (Append refuses an empty batch).
-    if (!(outlier_count > 0 && appended.positions.empty())) {
-      NM_RETURN_IF_ERROR(points_.Append(appended));
+    // A batch of outliers only: nothing to append.
+    if (!appended->positions.empty()) NM_RETURN_IF_ERROR(points_.Append(*appended));
+    if (outlier_filter_ != nullptr) {
+      held_outliers_.Hold(batch, judgement.held, static_cast<uint32_t>(outlier_filter_->size()));
+      held_outliers_.Forget(judgement.released);
+      held_outliers_.Forget(judgement.dropped);
+      outlier_filter_->Add(batch.positions, judgement);
     }
-    if (outlier_filter_ != nullptr) outlier_filter_->Add(batch.positions);
-    RecordArrivalSampleLocked(appended.positions, first_index);
+    RecordArrivalSampleLocked(appended->positions, first_index);
     total = points_.size();
-    if (removed != nullptr) *removed = outlier_count;
+    if (held_back != nullptr) *held_back = held_count;
 
     absl::MutexLock lock(&mu_);
     // Only ingestion changes the cube, and ingest_mu_ is held: box_ is as CubeWithLocked saw it.
@@ -181,7 +184,10 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* remov
     }
     learning_.set_points_received(total);
     learning_.set_points_removed_as_outliers(learning_.points_removed_as_outliers() +
-                                             outlier_count);
+                                             judgement.dropped.size());
+    learning_.set_outliers_accepted_later(learning_.outliers_accepted_later() +
+                                          judgement.released.size());
+    learning_.set_outliers_held(held_outliers_.size());
     learning_.set_allowed_vertices(AllowedVerticesLocked());
   }
   Wake();
@@ -226,6 +232,14 @@ absl::Status Session::Finish() {
     final_vertices_ = final_vertices;
     state_ = v1::SESSION_STATE_FINISHING;
     learning_.set_allowed_vertices(final_vertices_);
+    // No point will come near the held ones any more: their verdicts stand.
+    if (outlier_filter_ != nullptr) {
+      const std::vector<uint32_t> dropped = outlier_filter_->DropHeld();
+      held_outliers_.Forget(dropped);
+      learning_.set_points_removed_as_outliers(learning_.points_removed_as_outliers() +
+                                               dropped.size());
+      learning_.set_outliers_held(0);
+    }
   }
   Wake();
   return absl::OkStatus();

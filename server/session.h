@@ -51,6 +51,7 @@
 #include "core/triangle_mesh.h"
 #include "neuralmesh/v1/reconstruction.pb.h"
 #include "server/executor.h"
+#include "server/held_outliers.h"
 #include "server/session_config.h"
 #include "server/update_channel.h"
 #include "server/worker_pool.h"
@@ -84,19 +85,20 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   absl::Time create_time() const { return create_time_; }
 
   // Appends one batch, all or nothing, and wakes the learner. With outlier removal configured,
-  // the batch's outliers (streaming_outlier_filter.h) are dropped first and their count goes
-  // to `*removed` when it is not null (0 otherwise); the rest is appended. Returns the
-  // session's running total. FAILED_PRECONDITION when the session no longer accepts points
-  // (finishing, finished, cancelled, failed); INVALID_ARGUMENT for non-finite values or
-  // mismatched weights/normals; RESOURCE_EXHAUSTED when the session's point limit would be
-  // exceeded (with outlier removal, by the points received, outliers included). On error
-  // nothing is appended or removed.
-  absl::StatusOr<size_t> AddPoints(const PointCloud& batch, size_t* removed = nullptr)
+  // the batch's outliers (streaming_outlier_filter.h) are held back and their count goes to
+  // `*held_back` when it is not null (0 otherwise); the rest is appended, with the points held
+  // back by earlier batches that the filter now accepts. Returns the session's running total.
+  // FAILED_PRECONDITION when the session no longer accepts points (finishing, finished,
+  // cancelled, failed); INVALID_ARGUMENT for non-finite values or mismatched weights/normals;
+  // RESOURCE_EXHAUSTED when the session's point limit would be exceeded (with outlier removal,
+  // by the points received, outliers included). On error nothing changes.
+  absl::StatusOr<size_t> AddPoints(const PointCloud& batch, size_t* held_back = nullptr)
       ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
 
-  // No more points: learn to the final vertex count and publish the final mesh.
-  // FAILED_PRECONDITION when already finishing, finished, cancelled or failed, or when the
-  // points received are too few for the initial tetrahedron.
+  // No more points: learn to the final vertex count and publish the final mesh. The points
+  // outlier removal still holds back are dropped. FAILED_PRECONDITION when already finishing,
+  // finished, cancelled or failed, or when the points received are too few for the initial
+  // tetrahedron.
   absl::Status Finish() ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
 
   // Stops learning; watchers end with CANCELLED and `reason`. Cancelling a cancelled session is
@@ -179,6 +181,8 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // Set when the configuration asks for outlier removal; knows every point of every batch
   // taken in, outliers included.
   std::unique_ptr<StreamingOutlierFilter> outlier_filter_ ABSL_GUARDED_BY(ingest_mu_);
+  // The points the filter holds back, whole.
+  HeldOutliers held_outliers_ ABSL_GUARDED_BY(ingest_mu_);
 
   mutable absl::Mutex mu_;
   v1::SessionState state_ ABSL_GUARDED_BY(mu_) = v1::SESSION_STATE_COLLECTING;

@@ -3,10 +3,15 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "core/bounding_box.h"
+
 namespace neuralmesh {
 namespace {
 
 constexpr uint32_t kSkipNone = UINT32_MAX;
+
+// A held point that fails this many judgements after its arrival is dropped for good.
+constexpr uint32_t kJudgementsToDrop = 4;
 
 }  // namespace
 
@@ -21,19 +26,23 @@ void StreamingOutlierFilter::SearchSeen(const Vec3f& query, uint32_t skip,
   }
 }
 
-std::vector<bool> StreamingOutlierFilter::FindOutliers(absl::Span<const Vec3f> batch) const {
+OutlierJudgement StreamingOutlierFilter::Judge(absl::Span<const Vec3f> batch) const {
   const size_t m = batch.size();
   const size_t k = static_cast<size_t>(options_.neighbours);
-  std::vector<bool> outlier(m, false);
-  if (points_.size() + m <= k) return outlier;
+  OutlierJudgement judgement;
+  judgement.held.assign(m, false);
+  judgement.still_held_ = held_;
+  if (m == 0 || points_.size() + m <= k) return judgement;
 
   const PointKdTree batch_tree(batch, 0, static_cast<uint32_t>(m));
   NeighbourHeap heap;
   // The batch's points, each skipping itself among the batch.
   std::vector<double> mean_distance(m);
+  std::vector<float> radius_squared(m);
   for (size_t i = 0; i < m; ++i) {
     SearchSeen(batch[i], kSkipNone, &heap);
     batch_tree.Search(batch, batch[i], static_cast<uint32_t>(i), k, &heap);
+    radius_squared[i] = heap.top().first;
     mean_distance[i] = MeanDistance(heap);
   }
   // The reference population: the batch, and when it is small the points seen before.
@@ -45,11 +54,54 @@ std::vector<bool> StreamingOutlierFilter::FindOutliers(absl::Span<const Vec3f> b
   } else {
     limit = OutlierDistanceLimit(mean_distance, options_.std_ratio);
   }
-  for (size_t i = 0; i < m; ++i) outlier[i] = mean_distance[i] > limit;
-  return outlier;
+
+  // The points held before: each is judged again when the batch brings the k/4-th point closer
+  // to it than its k-th neighbour was when last judged (nothing else changes its mean
+  // distance), against the reference's limit, which does not follow the batch's spread.
+  const double held_limit =
+      reference_.size() >= 2 ? OutlierDistanceLimit(reference_, options_.std_ratio) : limit;
+  const uint32_t arrivals_to_judge = std::max<uint32_t>(1, static_cast<uint32_t>(k / 4));
+  BoundingBox box;
+  for (const Vec3f& p : batch) box.Extend(Vec3(p));
+  std::vector<OutlierJudgement::HeldPoint> still_held;
+  for (OutlierJudgement::HeldPoint held : held_) {
+    const Vec3f& q = points_[held.index];
+    // With a margin: the searches measure in floats, the box in doubles.
+    if (box.SquaredDistance(Vec3(q)) > 1.0001 * static_cast<double>(held.radius_squared)) {
+      still_held.push_back(held);
+      continue;
+    }
+    batch_tree.Search(batch, q, kSkipNone, arrivals_to_judge - held.arrivals, &heap);
+    for (; !heap.empty(); heap.pop()) held.arrivals += heap.top().first < held.radius_squared;
+    if (held.arrivals < arrivals_to_judge) {
+      still_held.push_back(held);
+      continue;
+    }
+    SearchSeen(q, held.index, &heap);
+    batch_tree.Search(batch, q, kSkipNone, k, &heap);
+    held.radius_squared = heap.top().first;
+    held.arrivals = 0;
+    if (MeanDistance(heap) <= held_limit) {
+      judgement.released.push_back(held.index);
+    } else if (++held.failures == kJudgementsToDrop) {
+      judgement.dropped.push_back(held.index);
+    } else {
+      still_held.push_back(held);
+    }
+  }
+  // The batch's own outliers, after the earlier ones: still_held stays in arrival order.
+  const auto first_index = static_cast<uint32_t>(points_.size());
+  for (size_t i = 0; i < m; ++i) {
+    if (mean_distance[i] <= limit) continue;
+    judgement.held[i] = true;
+    still_held.push_back({first_index + static_cast<uint32_t>(i), radius_squared[i], 0, 0});
+  }
+  judgement.still_held_ = std::move(still_held);
+  return judgement;
 }
 
-void StreamingOutlierFilter::Add(absl::Span<const Vec3f> batch) {
+void StreamingOutlierFilter::Add(absl::Span<const Vec3f> batch, const OutlierJudgement& judgement) {
+  held_ = judgement.still_held_;
   const auto begin = static_cast<uint32_t>(points_.size());
   points_.insert(points_.end(), batch.begin(), batch.end());
   const auto end = static_cast<uint32_t>(points_.size());
@@ -65,6 +117,14 @@ void StreamingOutlierFilter::Add(absl::Span<const Vec3f> batch) {
   if (points_.size() - reference_measured_at_ > points_.size() / 16 || reference_.empty()) {
     MeasureReference();
   }
+}
+
+std::vector<uint32_t> StreamingOutlierFilter::DropHeld() {
+  std::vector<uint32_t> dropped;
+  dropped.reserve(held_.size());
+  for (const OutlierJudgement::HeldPoint& held : held_) dropped.push_back(held.index);
+  held_.clear();
+  return dropped;
 }
 
 void StreamingOutlierFilter::MeasureReference() {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "core/status_macros.h"
 
 namespace neuralmesh {
 namespace {
@@ -88,9 +89,9 @@ void GrowingPointCloud::PublishClasses() {
   class_list_size_.store(class_list_written_, std::memory_order_release);
 }
 
-absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
-                                       absl::Span<const float> weights,
-                                       absl::Span<const Vec3f> normals) {
+absl::Status GrowingPointCloud::ValidateBatch(absl::Span<const Vec3f> positions,
+                                              absl::Span<const float> weights,
+                                              absl::Span<const Vec3f> normals) {
   const size_t n = positions.size();
   if (!weights.empty() && weights.size() != n) {
     return absl::InvalidArgumentError(
@@ -100,21 +101,17 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
     return absl::InvalidArgumentError(
         absl::StrCat("the batch has ", normals.size(), " normals for ", n, " points"));
   }
-  BoundingBox batch_bounds;
   for (size_t i = 0; i < n; ++i) {
     if (!IsFinite(positions[i])) {
       return absl::InvalidArgumentError(
           absl::StrCat("point ", i, " of the batch has a non-finite coordinate"));
     }
-    batch_bounds.Extend(Vec3(positions[i]));
   }
-  float batch_max_weight = 0.0f;
   for (size_t i = 0; i < weights.size(); ++i) {
     if (!std::isfinite(weights[i]) || weights[i] < 0) {
       return absl::InvalidArgumentError(absl::StrCat("weight ", i, " of the batch is ", weights[i],
                                                      "; weights must be finite and >= 0"));
     }
-    batch_max_weight = std::max(batch_max_weight, weights[i]);
   }
   for (size_t i = 0; i < normals.size(); ++i) {
     if (!IsFinite(normals[i])) {
@@ -122,6 +119,18 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
           absl::StrCat("normal ", i, " of the batch has a non-finite component"));
     }
   }
+  return absl::OkStatus();
+}
+
+absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
+                                       absl::Span<const float> weights,
+                                       absl::Span<const Vec3f> normals) {
+  NM_RETURN_IF_ERROR(ValidateBatch(positions, weights, normals));
+  const size_t n = positions.size();
+  BoundingBox batch_bounds;
+  for (const Vec3f& p : positions) batch_bounds.Extend(Vec3(p));
+  float batch_max_weight = 0.0f;
+  for (const float w : weights) batch_max_weight = std::max(batch_max_weight, w);
   if (n == 0) return absl::OkStatus();
 
   std::lock_guard<std::mutex> lock(append_mu_);

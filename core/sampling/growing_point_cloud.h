@@ -67,6 +67,12 @@ class GrowingPointCloud : public Sampler {
                       absl::Span<const Vec3f> normals = {});
   absl::Status Append(const PointCloud& batch);
 
+  // The checks of Append that concern the batch alone: INVALID_ARGUMENT for non-finite values
+  // or weights/normals whose count does not match the positions (weights: finite, >= 0).
+  static absl::Status ValidateBatch(absl::Span<const Vec3f> positions,
+                                    absl::Span<const float> weights,
+                                    absl::Span<const Vec3f> normals);
+
   // The number of points visible to readers. Never decreases.
   size_t size() const { return size_.load(std::memory_order_acquire); }
   size_t max_points() const { return max_points_; }

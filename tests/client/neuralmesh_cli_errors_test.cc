@@ -144,6 +144,12 @@ TEST_F(CliErrorsTest, RemoveOutliersOfABuiltinSurfaceOrWithBadSettings) {
   err = ExpectFailure({"reconstruct", cloud, "-o", Output(), "--vertices", "100",
                        "--remove_outliers", "--outlier_std_ratio", "-1"});
   EXPECT_TRUE(absl::StrContains(err, "--outlier_std_ratio is -1")) << err;
+  err = ExpectFailure({"reconstruct", cloud, "-o", Output(), "--vertices", "100",
+                       "--remove_outliers", "--outliers_on_server"});
+  EXPECT_TRUE(absl::StrContains(err, "--outliers_on_server needs --server")) << err;
+  err = ExpectFailure({"reconstruct", cloud, "--server", "127.0.0.1:1", "--out-dir", Output(),
+                       "--outliers_on_server"});
+  EXPECT_TRUE(absl::StrContains(err, "--outliers_on_server needs --remove_outliers")) << err;
 }
 
 TEST_F(CliErrorsTest, MeshSamplingOfAPointCloud) {

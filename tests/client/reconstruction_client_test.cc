@@ -277,8 +277,8 @@ TEST_F(ReconstructCallTest, ProgressCountsThePointsTheServerDroppedAsOutliers) {
         last_progress = received;
       });
   ASSERT_TRUE(result.ok()) << result.status();
-  EXPECT_GE(result->last_ack.points_removed(), 1u) << "the stray";
-  EXPECT_EQ(result->last_ack.points_accepted() + result->last_ack.points_removed(), 3001u);
+  EXPECT_GE(result->last_ack.points_held_back(), 1u) << "the stray";
+  EXPECT_EQ(result->last_ack.points_accepted() + result->last_ack.points_held_back(), 3001u);
   EXPECT_EQ(last_progress, 3001u);
 }
 

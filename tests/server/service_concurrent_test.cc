@@ -142,7 +142,7 @@ TEST_F(FilteringServiceTest, FilteringOutliersDoesNotHoldUpOtherCalls) {
   for (std::thread& t : uploads) t.join();
   for (int i = 0; i < kUploads; ++i) {
     ASSERT_TRUE(statuses[i].ok()) << statuses[i].error_message();
-    EXPECT_EQ(responses[i].points_accepted() + responses[i].points_removed(), 300000u);
+    EXPECT_EQ(responses[i].points_accepted() + responses[i].points_held_back(), 300000u);
   }
 }
 

@@ -181,6 +181,17 @@ def main():
           acks[-1].points_accepted + acks[-1].points_held_back == 2401,
           "outlier removal: the last ack counts %d accepted, %d held back" %
           ((acks[-1].points_accepted, acks[-1].points_held_back) if acks else (0, 0)))
+    # Finished: nothing is held any more, and every point held back was accepted later or
+    # removed; the stray, which nothing came near, was removed.
+    learning = stub.GetSession(pb.GetSessionRequest(
+        session_id=responses[0].session.session_id), timeout=10).learning
+    check(learning.outliers_held == 0 and learning.points_removed_as_outliers >= 1 and
+          learning.points_removed_as_outliers + learning.outliers_accepted_later ==
+          acks[-1].points_held_back and
+          learning.points_received == acks[-1].points_accepted + learning.outliers_accepted_later,
+          "outlier removal: the finished session counts %d held, %d removed, %d accepted later" %
+          (learning.outliers_held, learning.points_removed_as_outliers,
+           learning.outliers_accepted_later))
 
     listed = stub.ListSessions(pb.ListSessionsRequest(), timeout=10)
     check(len(listed.sessions) == 2, "ListSessions returned %d sessions" % len(listed.sessions))

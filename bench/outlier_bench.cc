@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "absl/flags/flag.h"
@@ -56,10 +57,10 @@ void StreamRow(const std::vector<Vec3f>& positions, size_t batch_size, const std
   for (size_t begin = 0; begin < n; begin += batch_size) {
     const auto batch =
         absl::MakeConstSpan(positions).subspan(begin, std::min(batch_size, n - begin));
-    const OutlierJudgement judgement = filter.Judge(batch);
+    OutlierJudgement judgement = filter.Judge(batch);
     dropped += judgement.dropped.size();
     released += judgement.released.size();
-    filter.Add(batch, judgement);
+    filter.Add(batch, std::move(judgement));
   }
   dropped += filter.DropHeld().size();
   PrintRow(order + " in batches of " + std::to_string(batch_size), n, SecondsSince(start), dropped,

@@ -135,6 +135,8 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* held_
     // quantization cube. Points held back before that pass now join the batch.
     OutlierJudgement judgement;
     size_t held_count = 0;
+    size_t released = 0;  // Points held back before that pass now.
+    size_t dropped = 0;   // Points held back before that are outliers for good.
     PointCloud filtered;
     const PointCloud* appended = &batch;
     if (outlier_filter_ != nullptr) {
@@ -169,7 +171,9 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* held_
       held_outliers_.Hold(batch, judgement.held, static_cast<uint32_t>(outlier_filter_->size()));
       held_outliers_.Forget(judgement.released);
       held_outliers_.Forget(judgement.dropped);
-      outlier_filter_->Add(batch.positions, judgement);
+      released = judgement.released.size();
+      dropped = judgement.dropped.size();
+      outlier_filter_->Add(batch.positions, std::move(judgement));
     }
     RecordArrivalSampleLocked(appended->positions, first_index);
     total = points_.size();
@@ -183,10 +187,8 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* held_
       if (grown) ++epoch_;
     }
     learning_.set_points_received(total);
-    learning_.set_points_removed_as_outliers(learning_.points_removed_as_outliers() +
-                                             judgement.dropped.size());
-    learning_.set_outliers_accepted_later(learning_.outliers_accepted_later() +
-                                          judgement.released.size());
+    learning_.set_points_removed_as_outliers(learning_.points_removed_as_outliers() + dropped);
+    learning_.set_outliers_accepted_later(learning_.outliers_accepted_later() + released);
     learning_.set_outliers_held(held_outliers_.size());
     learning_.set_allowed_vertices(AllowedVerticesLocked());
   }

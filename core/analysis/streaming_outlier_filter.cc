@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <utility>
 
 #include "core/bounding_box.h"
 
@@ -100,8 +101,8 @@ OutlierJudgement StreamingOutlierFilter::Judge(absl::Span<const Vec3f> batch) co
   return judgement;
 }
 
-void StreamingOutlierFilter::Add(absl::Span<const Vec3f> batch, const OutlierJudgement& judgement) {
-  held_ = judgement.still_held_;
+void StreamingOutlierFilter::Add(absl::Span<const Vec3f> batch, OutlierJudgement judgement) {
+  held_ = std::move(judgement.still_held_);
   const auto begin = static_cast<uint32_t>(points_.size());
   points_.insert(points_.end(), batch.begin(), batch.end());
   const auto end = static_cast<uint32_t>(points_.size());

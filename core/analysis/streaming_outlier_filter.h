@@ -87,9 +87,10 @@ class StreamingOutlierFilter {
   OutlierJudgement Judge(absl::Span<const Vec3f> batch) const;
 
   // Adds every point of `batch`, outliers included, to the points seen, and keeps the held
-  // points as `judgement`, which Judge(batch) returned with no other Add in between, says.
-  // O(m log^2 n) amortised for m points, n seen.
-  void Add(absl::Span<const Vec3f> batch, const OutlierJudgement& judgement);
+  // points as `judgement`, which Judge(batch) returned with no other Add in between, says
+  // (moved in, its held points are taken over, not copied). O(m log^2 n) amortised for m
+  // points, n seen.
+  void Add(absl::Span<const Vec3f> batch, OutlierJudgement judgement);
 
   // Ends the stream: returns the points still held (ascending), which are outliers for good,
   // and holds none any more.

@@ -18,6 +18,7 @@
 #include "client/lod_plan.h"
 #include "client/progress_bar.h"
 #include "client/remote_commands.h"
+#include "client/web/run_view.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
@@ -140,6 +141,14 @@ ABSL_FLAG(bool, ply, false, "Also write each mesh received from the server as .p
 ABSL_FLAG(absl::Duration, connect_timeout, absl::Seconds(5),
           "How long to wait for the server to accept the connection.");
 
+// Viewer.
+ABSL_FLAG(std::string, listen, neuralmesh::client::web::ViewOptions().listen,
+          "view: HOST:PORT where browsers connect (port 0: any free port). Bind 0.0.0.0 only "
+          "on a trusted network: the viewer shows every session of the server.");
+ABSL_FLAG(std::string, web_root, "",
+          "view: the folder with the viewer's static/ and node_modules/three; empty: the "
+          "client/web folder of the source tree it was built from.");
+
 // Reports.
 ABSL_FLAG(bool, json, false, "Print JSON instead of text.");
 ABSL_FLAG(std::string, reference, "", "eval: the reference surface, a mesh file or builtin:NAME.");
@@ -177,8 +186,7 @@ absl::StatusOr<neuralmesh::LearnerOptions> LearnerFromFlags() {
   o.close_small_holes = absl::GetFlag(FLAGS_close_small_holes);
   o.max_closed_hole_vertices = absl::GetFlag(FLAGS_max_closed_hole_vertices);
   o.merge_only_settled_boundaries = absl::GetFlag(FLAGS_merge_only_settled_boundaries);
-  o.split_largest_cell_near_most_active =
-      absl::GetFlag(FLAGS_split_largest_cell_near_most_active);
+  o.split_largest_cell_near_most_active = absl::GetFlag(FLAGS_split_largest_cell_near_most_active);
   o.sewn_strip_grace_calls = absl::GetFlag(FLAGS_sewn_strip_grace_calls);
   o.min_merged_loop_vertices = absl::GetFlag(FLAGS_min_merged_loop_vertices);
   o.cut_inactive_faces = absl::GetFlag(FLAGS_cut_inactive_faces);
@@ -311,6 +319,16 @@ absl::Status Sessions(const ParsedArgs& args) {
                                          std::cout, absl::GetFlag(FLAGS_connect_timeout));
 }
 
+absl::Status View(const ParsedArgs& args) {
+  NM_RETURN_IF_ERROR(ExpectPositional(args, 0, "no arguments"));
+  neuralmesh::client::web::ViewOptions o;
+  o.server = absl::GetFlag(FLAGS_server);
+  o.listen = absl::GetFlag(FLAGS_listen);
+  o.web_root = absl::GetFlag(FLAGS_web_root);
+  o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
+  return neuralmesh::client::web::RunView(o, std::cout);
+}
+
 std::vector<Subcommand> Commands() {
   // clang-format off
   const std::vector<std::string> reconstruct = {
@@ -360,6 +378,16 @@ std::vector<Subcommand> Commands() {
        "",
        {"server", "json", "connect_timeout"},
        Sessions},
+      {"view",
+       "view --server HOST:PORT [--listen HOST:PORT]",
+       "Serves a live 3D viewer of the server's sessions to web browsers.",
+       "Serves a web page (http://HOST:PORT/ of --listen) that lists the sessions of the\n"
+       "server and shows the chosen one's mesh as it learns: each published mesh is fetched\n"
+       "Draco-encoded, decoded in the browser and drawn with three.js, coarse to fine, until\n"
+       "the final mesh. Open http://HOST:PORT/?session=ID to go straight to a session. Runs\n"
+       "until Ctrl-C.",
+       {"server", "listen", "web_root", "connect_timeout"},
+       View},
   };
 }
 

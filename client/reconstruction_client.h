@@ -72,6 +72,9 @@ class ReconstructionClient {
   ReconstructionClient(std::shared_ptr<grpc::Channel> channel, const ClientOptions& options);
 
   const std::string& address() const { return address_; }
+  // The channel, for more clients of the same connection (each with its own CancelCalls).
+  const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
+  const ClientOptions& options() const { return options_; }
 
   // CreateSession. INVALID_ARGUMENT for an invalid config, RESOURCE_EXHAUSTED when the server
   // is full.

@@ -5,7 +5,6 @@
 #include <memory>
 #include <thread>
 
-#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/synchronization/mutex.h"
@@ -18,6 +17,7 @@
 #include "client/progress_bar.h"
 #include "client/proto_conversion.h"
 #include "client/reconstruction_client.h"
+#include "client/session_json.h"
 #include "core/analysis/json_writer.h"
 #include "core/status_macros.h"
 
@@ -42,13 +42,6 @@ BoundingBox BoundsOf(const PointCloud& cloud) {
   BoundingBox box;
   for (const Vec3f& p : cloud.positions) box.Extend(Vec3(p[0], p[1], p[2]));
   return box;
-}
-
-std::string StateName(v1::SessionState state) {
-  std::string name = v1::SessionState_Name(state);
-  const std::string prefix = "SESSION_STATE_";
-  if (name.rfind(prefix, 0) == 0) name = name.substr(prefix.size());
-  return absl::AsciiStrToLower(name);
 }
 
 // The end of a watch as the user should read it.
@@ -245,24 +238,7 @@ absl::Status RunSessions(const std::string& server, bool json, std::ostream& out
   if (json) {
     JsonWriter writer(2);
     writer.BeginArray();
-    for (const v1::Session& s : sessions) {
-      writer.BeginObject();
-      writer.Key("session_id").String(s.session_id());
-      writer.Key("name").String(s.name());
-      writer.Key("state").String(StateName(s.state()));
-      writer.Key("points_received").Uint(s.learning().points_received());
-      writer.Key("points_removed_as_outliers").Uint(s.learning().points_removed_as_outliers());
-      writer.Key("outliers_held").Uint(s.learning().outliers_held());
-      writer.Key("outliers_accepted_later").Uint(s.learning().outliers_accepted_later());
-      writer.Key("vertices").Uint(s.vertex_count());
-      writer.Key("faces").Uint(s.face_count());
-      writer.Key("target_vertices").Uint(s.config().target_vertices());
-      writer.Key("basic_steps").Uint(s.learning().basic_steps());
-      writer.Key("latest_sequence").Uint(s.latest_sequence());
-      writer.Key("watchers").Uint(s.watchers());
-      writer.Key("error").String(s.error());
-      writer.EndObject();
-    }
+    for (const v1::Session& s : sessions) WriteSessionJson(s, writer);
     writer.EndArray();
     NM_ASSIGN_OR_RETURN(const std::string text, writer.Finish());
     out << text << "\n";
@@ -272,8 +248,9 @@ absl::Status RunSessions(const std::string& server, bool json, std::ostream& out
                          "points", "vertices", "faces", "target", "updates");
   for (const v1::Session& s : sessions) {
     out << absl::StrFormat("%-20s %-16s %-10s %10d %9d %9d %9d %8d\n", s.session_id(), s.name(),
-                           StateName(s.state()), s.learning().points_received(), s.vertex_count(),
-                           s.face_count(), s.config().target_vertices(), s.latest_sequence());
+                           SessionStateName(s.state()), s.learning().points_received(),
+                           s.vertex_count(), s.face_count(), s.config().target_vertices(),
+                           s.latest_sequence());
   }
   out << sessions.size() << (sessions.size() == 1 ? " session\n" : " sessions\n");
   return absl::OkStatus();

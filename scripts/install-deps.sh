@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package that building, testing and running neuralmesh needs.
+# Installs every Debian 12 package that building, testing and running neuralmesh needs, and
+# the live viewer's three.js from the npm registry into client/web/node_modules (`npm ci`, the
+# version pinned by client/web/package-lock.json).
 # Idempotent: when everything is already installed it only checks and returns.
 #
 # Usage: scripts/install-deps.sh [EXTRA_PACKAGE...]
@@ -17,8 +19,13 @@ packages=(
   libbenchmark-dev
   # Tests and tools: the reference Draco binaries, an independent Python gRPC client.
   draco python3 python3-grpcio python3-grpc-tools python3-protobuf
+  # The live viewer's browser test: headless Chromium driven over the DevTools protocol.
+  chromium python3-websocket
   "$@"
 )
+# npm, for the viewer's three.js: Debian's, unless the machine already has one (Node.js from
+# another source brings its own npm, which Debian's package would conflict with).
+if ! command -v npm >/dev/null 2>&1; then packages+=(npm); fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -29,12 +36,21 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"
-  exit 0
+else
+  echo "install-deps: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-echo "install-deps: installing ${missing[*]}"
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# three.js for the viewer, once per change of the lock file.
+web="$(cd "$(dirname "$0")/.." && pwd)/client/web"
+if cmp -s "${web}/package-lock.json" "${web}/node_modules/.installed-package-lock.json"; then
+  echo "install-deps: client/web/node_modules up to date"
+else
+  echo "install-deps: npm ci in client/web"
+  (cd "${web}" && npm ci --no-audit --no-fund --loglevel=error)
+  cp "${web}/package-lock.json" "${web}/node_modules/.installed-package-lock.json"
+fi

@@ -82,3 +82,6 @@ say "Reconstructing builtin:torus to ${VERTICES} vertices through ${ADDRESS}"
 echo
 echo "Levels of detail written to ${OUT_DIR}:"
 grep -E '^(kind|lod|final) ' "${LOG_DIR}/reconstruct.out"
+echo
+echo "To watch a reconstruction live in a browser: build/bin/neuralmesh view --server HOST:PORT,"
+echo "then open http://127.0.0.1:8080/ (README, Watching in a browser)."

@@ -1,0 +1,34 @@
+#include "client/session_json.h"
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/string_view.h"
+#include "absl/strings/strip.h"
+
+namespace neuralmesh::client {
+
+std::string SessionStateName(neuralmesh::v1::SessionState state) {
+  absl::string_view name = neuralmesh::v1::SessionState_Name(state);
+  absl::ConsumePrefix(&name, "SESSION_STATE_");
+  return absl::AsciiStrToLower(name);
+}
+
+void WriteSessionJson(const neuralmesh::v1::Session& s, JsonWriter& json) {
+  json.BeginObject();
+  json.Key("session_id").String(s.session_id());
+  json.Key("name").String(s.name());
+  json.Key("state").String(SessionStateName(s.state()));
+  json.Key("points_received").Uint(s.learning().points_received());
+  json.Key("points_removed_as_outliers").Uint(s.learning().points_removed_as_outliers());
+  json.Key("outliers_held").Uint(s.learning().outliers_held());
+  json.Key("outliers_accepted_later").Uint(s.learning().outliers_accepted_later());
+  json.Key("vertices").Uint(s.vertex_count());
+  json.Key("faces").Uint(s.face_count());
+  json.Key("target_vertices").Uint(s.config().target_vertices());
+  json.Key("basic_steps").Uint(s.learning().basic_steps());
+  json.Key("latest_sequence").Uint(s.latest_sequence());
+  json.Key("watchers").Uint(s.watchers());
+  json.Key("error").String(s.error());
+  json.EndObject();
+}
+
+}  // namespace neuralmesh::client

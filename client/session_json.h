@@ -1,0 +1,22 @@
+// A session as the client shows it: its state's short name and its JSON form, shared by
+// `neuralmesh sessions` and the live viewer's /api/sessions.
+#ifndef NEURALMESH_CLIENT_SESSION_JSON_H_
+#define NEURALMESH_CLIENT_SESSION_JSON_H_
+
+#include <string>
+
+#include "core/analysis/json_writer.h"
+#include "neuralmesh/v1/reconstruction.pb.h"
+
+namespace neuralmesh::client {
+
+// "learning", "finished", ...: the enum name without SESSION_STATE_, lower-cased.
+std::string SessionStateName(neuralmesh::v1::SessionState state);
+
+// Writes `session` as one JSON object: id, name, state, point and outlier counts, mesh size,
+// target, Basic Steps, latest update sequence, watchers and error.
+void WriteSessionJson(const neuralmesh::v1::Session& session, JsonWriter& json);
+
+}  // namespace neuralmesh::client
+
+#endif  // NEURALMESH_CLIENT_SESSION_JSON_H_

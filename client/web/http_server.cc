@@ -1,0 +1,216 @@
+#include "client/web/http_server.h"
+
+#include <netdb.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <string>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace neuralmesh::client::web {
+namespace {
+
+void SetTimeout(int fd, int option, absl::Duration timeout) {
+  timeval tv = absl::ToTimeval(timeout);
+  setsockopt(fd, SOL_SOCKET, option, &tv, sizeof(tv));
+}
+
+// Writes all of `data`; false when the peer went away or stopped reading.
+bool SendAll(int fd, absl::string_view data) {
+  while (!data.empty()) {
+    const ssize_t sent = send(fd, data.data(), data.size(), MSG_NOSIGNAL);
+    if (sent < 0 && errno == EINTR) continue;
+    if (sent <= 0) return false;
+    data.remove_prefix(static_cast<size_t>(sent));
+  }
+  return true;
+}
+
+void Respond(int fd, const HttpResponse& response, bool with_body) {
+  if (SendAll(fd, SerializeHttpResponseHead(response)) && with_body) SendAll(fd, response.body);
+}
+
+// Reads until the end of the request head. NOT_FOUND when the peer closed or timed out before
+// sending one, RESOURCE_EXHAUSTED when the head is too long.
+absl::StatusOr<std::string> ReadRequestHead(int fd) {
+  std::string bytes;
+  char buffer[4096];
+  while (true) {
+    const ssize_t got = recv(fd, buffer, sizeof(buffer), 0);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) return absl::NotFoundError("no request");
+    bytes.append(buffer, static_cast<size_t>(got));
+    const size_t end = FindEndOfHead(bytes);
+    if (end != 0 && end <= kMaxRequestHeadBytes) {
+      bytes.resize(end);
+      return bytes;
+    }
+    if (bytes.size() > kMaxRequestHeadBytes) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat("the request head is longer than ", kMaxRequestHeadBytes, " bytes"));
+    }
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const std::string& host, int port,
+                                                              HttpHandler handler,
+                                                              const HttpServerOptions& options) {
+  if (port < 0 || port > 65535) {
+    return absl::InvalidArgumentError(absl::StrCat("port ", port, " is not in [0, 65535]"));
+  }
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  const std::string service = std::to_string(port);
+  if (const int error =
+          getaddrinfo(host.empty() ? nullptr : host.c_str(), service.c_str(), &hints, &found);
+      error != 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot resolve host \"", host, "\": ", gai_strerror(error)));
+  }
+  std::string last_error = "no address";
+  int fd = -1;
+  for (addrinfo* a = found; a != nullptr && fd < 0; a = a->ai_next) {
+    fd = socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) {
+      last_error = std::strerror(errno);
+      continue;
+    }
+    const int yes = 1;
+    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+    if (bind(fd, a->ai_addr, a->ai_addrlen) != 0 || listen(fd, 64) != 0) {
+      last_error = std::strerror(errno);
+      close(fd);
+      fd = -1;
+    }
+  }
+  freeaddrinfo(found);
+  if (fd < 0) {
+    return absl::UnavailableError(
+        absl::StrCat("cannot listen on ", host, ":", port, ": ", last_error));
+  }
+  sockaddr_storage bound{};
+  socklen_t length = sizeof(bound);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&bound), &length);
+  const int bound_port =
+      ntohs(bound.ss_family == AF_INET6 ? reinterpret_cast<sockaddr_in6*>(&bound)->sin6_port
+                                        : reinterpret_cast<sockaddr_in*>(&bound)->sin_port);
+  const int wake = eventfd(0, EFD_CLOEXEC);
+  if (wake < 0) {
+    close(fd);
+    return absl::InternalError(absl::StrCat("eventfd: ", std::strerror(errno)));
+  }
+  auto server = std::unique_ptr<HttpServer>(
+      new HttpServer(fd, wake, bound_port, std::move(handler), options));
+  server->accept_thread_ = std::thread([s = server.get()] { s->AcceptLoop(); });
+  return server;
+}
+
+HttpServer::HttpServer(int listen_fd, int wake_fd, int port, HttpHandler handler,
+                       const HttpServerOptions& options)
+    : listen_fd_(listen_fd),
+      wake_fd_(wake_fd),
+      port_(port),
+      handler_(std::move(handler)),
+      options_(options) {}
+
+HttpServer::~HttpServer() {
+  Shutdown();
+  close(wake_fd_);
+}
+
+void HttpServer::Shutdown() {
+  {
+    absl::MutexLock lock(&mu_);
+    if (shut_down_) return;
+    shut_down_ = true;
+    for (int fd : open_fds_) shutdown(fd, SHUT_RDWR);
+  }
+  const uint64_t one = 1;
+  (void)!write(wake_fd_, &one, sizeof(one));
+  accept_thread_.join();
+  close(listen_fd_);
+  absl::MutexLock lock(&mu_);
+  mu_.Await(absl::Condition(
+      +[](std::set<int>* fds) { return fds->empty(); }, &open_fds_));
+}
+
+void HttpServer::AcceptLoop() {
+  while (true) {
+    pollfd fds[2] = {{listen_fd_, POLLIN, 0}, {wake_fd_, POLLIN, 0}};
+    if (poll(fds, 2, -1) < 0) {
+      if (errno == EINTR) continue;
+      return;
+    }
+    if (fds[1].revents != 0) return;
+    const int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
+    if (fd < 0) continue;  // The peer gave up, or descriptors ran out: the next one may work.
+    SetTimeout(fd, SO_RCVTIMEO, options_.read_timeout);
+    SetTimeout(fd, SO_SNDTIMEO, absl::Seconds(30));
+    {
+      absl::MutexLock lock(&mu_);
+      if (shut_down_) {
+        close(fd);
+        return;
+      }
+      if (static_cast<int>(open_fds_.size()) >= options_.max_connections) {
+        Respond(
+            fd,
+            TextResponse(503, absl::StrCat("the viewer serves at most ", options_.max_connections,
+                                           " connections at once: try again")),
+            true);
+        close(fd);
+        continue;
+      }
+      open_fds_.insert(fd);
+    }
+    std::thread([this, fd] { Serve(fd); }).detach();
+  }
+}
+
+void HttpServer::Serve(int fd) {
+  absl::StatusOr<std::string> head = ReadRequestHead(fd);
+  if (head.ok()) {
+    absl::StatusOr<HttpRequest> request = ParseHttpRequestHead(*head);
+    if (!request.ok()) {
+      Respond(fd, TextResponse(400, request.status().message()), true);
+    } else if (request->method != "GET" && request->method != "HEAD") {
+      HttpResponse response = TextResponse(
+          405, absl::StrCat("method ", request->method, " is not allowed: use GET or HEAD"));
+      response.headers.emplace_back("Allow", "GET, HEAD");
+      Respond(fd, response, true);
+    } else {
+      Respond(fd, handler_(*request), request->method == "GET");
+    }
+  } else if (absl::IsResourceExhausted(head.status())) {
+    Respond(fd, TextResponse(431, head.status().message()), true);
+  }
+  // A lingering close: closing with unread bytes (the rest of a refused request) would reset
+  // the connection, and the client could lose the answer. Read what the client still sends
+  // until it closes its side, for at most a second.
+  shutdown(fd, SHUT_WR);
+  SetTimeout(fd, SO_RCVTIMEO, absl::Seconds(1));
+  char discard[4096];
+  for (size_t drained = 0; drained < (size_t{1} << 20);) {
+    const ssize_t got = recv(fd, discard, sizeof(discard), 0);
+    if (got <= 0) break;
+    drained += static_cast<size_t>(got);
+  }
+  absl::MutexLock lock(&mu_);
+  open_fds_.erase(fd);
+  close(fd);
+}
+
+}  // namespace neuralmesh::client::web

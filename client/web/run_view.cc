@@ -1,0 +1,72 @@
+#include "client/web/run_view.h"
+
+#include <memory>
+#include <utility>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "client/interrupt.h"
+#include "client/reconstruction_client.h"
+#include "client/web/http_server.h"
+#include "client/web/viewer_service.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh::client::web {
+namespace {
+
+struct HostPort {
+  std::string host;
+  int port = 0;
+};
+
+// "HOST:PORT" or "[IPV6]:PORT".
+absl::StatusOr<HostPort> ParseListenAddress(const std::string& address) {
+  const size_t colon = address.rfind(':');
+  HostPort parsed;
+  if (colon == std::string::npos || colon == 0 ||
+      !absl::SimpleAtoi(address.substr(colon + 1), &parsed.port) || parsed.port < 0 ||
+      parsed.port > 65535) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--listen=", address, " is not HOST:PORT (for example 127.0.0.1:8080; port 0: any)"));
+  }
+  parsed.host = address.substr(0, colon);
+  if (parsed.host.size() >= 2 && parsed.host.front() == '[' && parsed.host.back() == ']') {
+    parsed.host = parsed.host.substr(1, parsed.host.size() - 2);
+  }
+  return parsed;
+}
+
+}  // namespace
+
+std::string DefaultWebRoot() { return NEURALMESH_WEB_ROOT; }
+
+absl::Status RunView(const ViewOptions& options, std::ostream& out) {
+  if (options.server.empty()) return absl::InvalidArgumentError("--server HOST:PORT is required");
+  const std::string web_root = options.web_root.empty() ? DefaultWebRoot() : options.web_root;
+  NM_RETURN_IF_ERROR(CheckWebRoot(web_root));
+  NM_ASSIGN_OR_RETURN(const HostPort listen, ParseListenAddress(options.listen));
+  ClientOptions client_options;
+  client_options.connect_timeout = options.connect_timeout;
+  NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
+                      ReconstructionClient::Connect(options.server, client_options));
+
+  ViewerOptions viewer_options;
+  viewer_options.web_root = web_root;
+  ViewerService viewer(std::move(client), viewer_options);
+  NM_ASSIGN_OR_RETURN(
+      std::unique_ptr<HttpServer> http,
+      HttpServer::Start(listen.host, listen.port,
+                        [&viewer](const HttpRequest& request) { return viewer.Handle(request); }));
+  const bool ipv6 = listen.host.find(':') != std::string::npos;
+  out << "viewer: http://" << (ipv6 ? "[" : "") << listen.host << (ipv6 ? "]" : "") << ":"
+      << http->port() << "/ (sessions of " << options.server << "); Ctrl-C stops it" << std::endl;
+
+  InterruptScope interrupt;
+  while (!InterruptScope::interrupted()) absl::SleepFor(absl::Milliseconds(100));
+  viewer.Stop();
+  http->Shutdown();
+  return absl::OkStatus();
+}
+
+}  // namespace neuralmesh::client::web

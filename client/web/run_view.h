@@ -1,0 +1,32 @@
+// `neuralmesh view`: serves the live viewer of one neuralmesh-server's sessions over HTTP
+// (client/web/viewer_service.h) until SIGINT or SIGTERM.
+#ifndef NEURALMESH_CLIENT_WEB_RUN_VIEW_H_
+#define NEURALMESH_CLIENT_WEB_RUN_VIEW_H_
+
+#include <ostream>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/time/time.h"
+
+namespace neuralmesh::client::web {
+
+struct ViewOptions {
+  std::string server;                     // The neuralmesh-server, HOST:PORT.
+  std::string listen = "127.0.0.1:8080";  // Where browsers connect, HOST:PORT (port 0: any).
+  std::string web_root;                   // Empty: the source tree's client/web.
+  absl::Duration connect_timeout = absl::Seconds(5);
+};
+
+// The client/web folder of the source tree this binary was built from.
+std::string DefaultWebRoot();
+
+// Checks the web root, connects to the server, listens, prints
+// "viewer: http://HOST:PORT/ (sessions of SERVER)" and serves until interrupted. Errors:
+// NOT_FOUND for a web root without the viewer's files, INVALID_ARGUMENT for a malformed
+// --listen, UNAVAILABLE when the server cannot be reached or the address cannot be bound.
+absl::Status RunView(const ViewOptions& options, std::ostream& out);
+
+}  // namespace neuralmesh::client::web
+
+#endif  // NEURALMESH_CLIENT_WEB_RUN_VIEW_H_

@@ -1,0 +1,279 @@
+#include "client/web/viewer_service.h"
+
+#include <filesystem>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+#include "absl/time/clock.h"
+#include "client/session_json.h"
+#include "core/analysis/json_writer.h"
+#include "core/io/file_contents.h"
+
+namespace neuralmesh::client::web {
+namespace {
+
+// At most this many sessions are watched at once for browsers.
+constexpr size_t kMaxRelays = 256;
+
+// The files CheckWebRoot requires: the page, its script, and three.js with its Draco decoder.
+const char* const kRequiredFiles[] = {
+    "static/index.html",
+    "static/viewer.js",
+    "node_modules/three/build/three.module.js",
+    "node_modules/three/examples/jsm/loaders/DRACOLoader.js",
+    "node_modules/three/examples/jsm/libs/draco/draco_decoder.wasm",
+};
+
+HttpResponse ErrorResponse(int status, absl::string_view message) {
+  JsonWriter json;
+  json.BeginObject().Key("error").String(message).EndObject();
+  return JsonResponse(status, json.text());
+}
+
+// The HTTP status that tells a browser what a failed call to the server means.
+int HttpStatusOf(const absl::Status& status) {
+  switch (status.code()) {
+    case absl::StatusCode::kNotFound:
+      return 404;
+    case absl::StatusCode::kInvalidArgument:
+      return 400;
+    case absl::StatusCode::kCancelled:
+    case absl::StatusCode::kAborted:
+      return 410;
+    case absl::StatusCode::kDeadlineExceeded:
+      return 504;
+    case absl::StatusCode::kResourceExhausted:
+      return 503;
+    default:
+      return 502;
+  }
+}
+
+std::string ContentTypeOf(absl::string_view file) {
+  if (absl::EndsWith(file, ".html")) return "text/html; charset=utf-8";
+  if (absl::EndsWith(file, ".js")) return "text/javascript; charset=utf-8";
+  if (absl::EndsWith(file, ".css")) return "text/css; charset=utf-8";
+  if (absl::EndsWith(file, ".wasm")) return "application/wasm";
+  if (absl::EndsWith(file, ".json")) return "application/json";
+  return "application/octet-stream";
+}
+
+// Whether `path` is a relative path of plain names: letters, digits, '.', '_', '-', no name
+// starting with a dot (so no "..", no hidden files), no empty names.
+bool IsPlainRelativePath(absl::string_view path) {
+  if (path.empty()) return false;
+  for (absl::string_view name : absl::StrSplit(path, '/')) {
+    if (name.empty() || name[0] == '.') return false;
+    for (char c : name) {
+      if (!absl::ascii_isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+std::string KindName(v1::UpdateKind kind) {
+  absl::string_view name = v1::UpdateKind_Name(kind);
+  absl::ConsumePrefix(&name, "UPDATE_KIND_");
+  return absl::AsciiStrToLower(name);
+}
+
+HttpResponse MeshResponse(const v1::MeshUpdate& update) {
+  HttpResponse response;
+  response.content_type = "application/x-draco";
+  response.body = update.draco_mesh();
+  auto add = [&response](absl::string_view name, const auto& value) {
+    response.headers.emplace_back(absl::StrCat("X-Neuralmesh-", name), absl::StrCat(value));
+  };
+  add("Sequence", update.sequence());
+  add("Kind", KindName(update.kind()));
+  add("Vertices", update.vertex_count());
+  add("Faces", update.face_count());
+  add("Lod-Milestone", update.lod_milestone());
+  add("State", SessionStateName(update.state()));
+  add("Points-Received", update.learning().points_received());
+  add("Basic-Steps", update.learning().basic_steps());
+  add("Genus", update.report().genus());
+  add("Boundaries", update.report().boundary_loops());
+  return response;
+}
+
+}  // namespace
+
+absl::Status CheckWebRoot(const std::string& web_root) {
+  for (const char* file : kRequiredFiles) {
+    const std::filesystem::path path = std::filesystem::path(web_root) / file;
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(path, error)) {
+      return absl::NotFoundError(absl::StrCat(
+          "the viewer's file ", path.string(),
+          " is missing: run scripts/install-deps.sh (it "
+          "installs three.js with `npm ci` in client/web), or point --web_root at a folder "
+          "that has static/ and node_modules/three"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+ViewerService::ViewerService(std::unique_ptr<ReconstructionClient> client, ViewerOptions options)
+    : client_(std::move(client)), options_(std::move(options)) {}
+
+ViewerService::~ViewerService() { Stop(); }
+
+void ViewerService::Stop() {
+  std::map<std::string, std::shared_ptr<MeshRelay>> relays;
+  {
+    absl::MutexLock lock(&mu_);
+    stopped_ = true;
+    relays.swap(relays_);
+  }
+  for (auto& [id, relay] : relays) relay->Stop();
+}
+
+HttpResponse ViewerService::Handle(const HttpRequest& request) {
+  absl::string_view path = request.path;
+  if (path == "/" || path == "/index.html") return ServeFile("static/index.html");
+  if (absl::ConsumePrefix(&path, "/static/")) {
+    if (!IsPlainRelativePath(path) || absl::StrContains(path, '/')) {
+      return ErrorResponse(404, absl::StrCat("no such file: ", request.path));
+    }
+    return ServeFile(absl::StrCat("static/", path));
+  }
+  if (absl::ConsumePrefix(&path, "/vendor/three/")) {
+    if (!IsPlainRelativePath(path) ||
+        !(absl::StartsWith(path, "build/") || absl::StartsWith(path, "examples/jsm/"))) {
+      return ErrorResponse(404, absl::StrCat("no such file: ", request.path));
+    }
+    return ServeFile(absl::StrCat("node_modules/three/", path));
+  }
+  if (path == "/api/sessions") return ListSessions();
+  if (absl::ConsumePrefix(&path, "/api/sessions/")) {
+    const std::vector<absl::string_view> parts = absl::StrSplit(path, '/');
+    if (parts.size() == 1 && !parts[0].empty()) return GetSession(std::string(parts[0]));
+    if (parts.size() == 2 && !parts[0].empty() && parts[1] == "mesh") {
+      return GetMesh(std::string(parts[0]), request);
+    }
+  }
+  return ErrorResponse(404, absl::StrCat("no such page: ", request.path));
+}
+
+HttpResponse ViewerService::ServeFile(const std::string& file) const {
+  absl::StatusOr<std::string> contents =
+      ReadFileContents((std::filesystem::path(options_.web_root) / file).string());
+  if (!contents.ok()) return ErrorResponse(404, absl::StrCat("no such file: ", file));
+  HttpResponse response;
+  response.content_type = ContentTypeOf(file);
+  response.body = *std::move(contents);
+  return response;
+}
+
+HttpResponse ViewerService::ListSessions() {
+  absl::StatusOr<std::vector<v1::Session>> sessions = client_->ListSessions();
+  if (!sessions.ok()) {
+    return ErrorResponse(HttpStatusOf(sessions.status()), sessions.status().message());
+  }
+  JsonWriter json;
+  json.BeginArray();
+  for (const v1::Session& session : *sessions) WriteSessionJson(session, json);
+  json.EndArray();
+  return JsonResponse(200, json.text());
+}
+
+HttpResponse ViewerService::GetSession(const std::string& session_id) {
+  absl::StatusOr<v1::Session> session = client_->GetSession(session_id);
+  if (!session.ok()) {
+    return ErrorResponse(HttpStatusOf(session.status()), session.status().message());
+  }
+  JsonWriter json;
+  WriteSessionJson(*session, json);
+  return JsonResponse(200, json.text());
+}
+
+std::shared_ptr<MeshRelay> ViewerService::RelayFor(const std::string& session_id) {
+  std::vector<std::shared_ptr<MeshRelay>> idle;
+  std::shared_ptr<MeshRelay> relay;
+  {
+    absl::MutexLock lock(&mu_);
+    if (stopped_) return nullptr;
+    const absl::Time now = absl::Now();
+    for (auto it = relays_.begin(); it != relays_.end();) {
+      if (now - it->second->last_used() > options_.relay_idle_timeout) {
+        idle.push_back(std::move(it->second));
+        it = relays_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    auto found = relays_.find(session_id);
+    if (found != relays_.end()) {
+      // A watch cut off by a lost connection is tried again; other ends are the session's.
+      const MeshRelay::State state = found->second->Peek();
+      if (!(state.ended && absl::IsUnavailable(state.end_status))) relay = found->second;
+      if (relay == nullptr) {
+        idle.push_back(std::move(found->second));
+        relays_.erase(found);
+      }
+    }
+    if (relay == nullptr && relays_.size() < kMaxRelays) {
+      relay = std::make_shared<MeshRelay>(client_->channel(), client_->options(), session_id);
+      relays_[session_id] = relay;
+    }
+  }
+  for (auto& old : idle) old->Stop();
+  return relay;
+}
+
+HttpResponse ViewerService::GetMesh(const std::string& session_id, const HttpRequest& request) {
+  uint64_t after = 0;
+  if (auto it = request.query.find("after");
+      it != request.query.end() && !absl::SimpleAtoi(it->second, &after)) {
+    return ErrorResponse(
+        400, absl::StrCat("after=", it->second, " is not a sequence number (a whole number >= 0)"));
+  }
+  bool watched = false;
+  {
+    absl::MutexLock lock(&mu_);
+    if (stopped_) return ErrorResponse(503, "the viewer is shutting down");
+    watched = relays_.count(session_id) != 0;
+  }
+  if (!watched) {
+    // Only sessions that exist get a watch: an unknown id costs one call, not a stream.
+    absl::StatusOr<v1::Session> session = client_->GetSession(session_id);
+    if (!session.ok()) {
+      return ErrorResponse(HttpStatusOf(session.status()), session.status().message());
+    }
+  }
+  std::shared_ptr<MeshRelay> relay = RelayFor(session_id);
+  if (relay == nullptr) {
+    return ErrorResponse(503, absl::StrCat("the viewer watches at most ", kMaxRelays,
+                                           " sessions at once, or is shutting down"));
+  }
+  const MeshRelay::State state = relay->WaitForNewer(after, options_.poll_timeout);
+  if (state.latest != nullptr && state.latest->sequence() > after) {
+    return MeshResponse(*state.latest);
+  }
+  {
+    absl::MutexLock lock(&mu_);
+    if (stopped_) return ErrorResponse(503, "the viewer is shutting down");
+  }
+  if (!state.ended) {
+    HttpResponse response;
+    response.status = 204;
+    return response;
+  }
+  if (state.end_status.ok()) {
+    return ErrorResponse(
+        410, absl::StrCat("session ", session_id, " has ended: its last mesh was sequence ",
+                          state.latest == nullptr ? 0 : state.latest->sequence()));
+  }
+  return ErrorResponse(HttpStatusOf(state.end_status), state.end_status.message());
+}
+
+}  // namespace neuralmesh::client::web

@@ -1,0 +1,82 @@
+// What `neuralmesh view` serves over HTTP: the viewer's page and scripts, and a small API over
+// one neuralmesh-server's sessions that a browser can read:
+//
+//   GET /                              the viewer (static/index.html)
+//   GET /static/NAME                   its scripts and styles (client/web/static/)
+//   GET /vendor/three/PATH             three.js and its Draco decoder (client/web/node_modules)
+//   GET /api/sessions                  JSON array of every session (ListSessions)
+//   GET /api/sessions/ID               JSON of one session (GetSession)
+//   GET /api/sessions/ID/mesh?after=N  the first published mesh with a sequence above N
+//                                      (default 0), as Draco bytes, waiting for it up to the
+//                                      poll timeout (a long poll)
+//
+// The mesh answer is 200 with the Draco-encoded mesh as the body (application/x-draco, exactly
+// the bytes of MeshUpdate.draco_mesh) and its figures in X-Neuralmesh-* headers (Sequence,
+// Kind, Vertices, Faces, Lod-Milestone, State, Points-Received, Basic-Steps, Genus,
+// Boundaries); 204 when no newer mesh came within the poll timeout (poll again); 410 when the
+// session's stream is over and the mesh with sequence N was its last (final, or the session
+// was cancelled or failed; the body says which); 404 for an unknown session; 400 for a
+// malformed `after`; 502 when the server cannot be reached. Errors have a JSON body
+// {"error": "..."}.
+#ifndef NEURALMESH_CLIENT_WEB_VIEWER_SERVICE_H_
+#define NEURALMESH_CLIENT_WEB_VIEWER_SERVICE_H_
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/status/status.h"
+#include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
+#include "client/reconstruction_client.h"
+#include "client/web/http_message.h"
+#include "client/web/mesh_relay.h"
+
+namespace neuralmesh::client::web {
+
+struct ViewerOptions {
+  // The folder holding static/ and node_modules/three (client/web in the source tree).
+  std::string web_root;
+  // How long a mesh request waits for a newer mesh before answering 204.
+  absl::Duration poll_timeout = absl::Seconds(20);
+  // A session's watch is dropped when no browser has asked for its meshes for this long.
+  absl::Duration relay_idle_timeout = absl::Seconds(60);
+};
+
+// OK when `web_root` holds the viewer's page and three.js; otherwise NOT_FOUND naming the
+// missing file and how to install it.
+absl::Status CheckWebRoot(const std::string& web_root);
+
+class ViewerService {
+ public:
+  // Serves the sessions of the server that `client` is connected to.
+  ViewerService(std::unique_ptr<ReconstructionClient> client, ViewerOptions options);
+  // Stop().
+  ~ViewerService();
+
+  // Answers one request; thread-safe, and mesh requests block up to the poll timeout.
+  HttpResponse Handle(const HttpRequest& request);
+
+  // Ends every watch and wakes every waiting mesh request; later requests for meshes get 503.
+  void Stop();
+
+ private:
+  HttpResponse ServeFile(const std::string& file) const;
+  HttpResponse ListSessions();
+  HttpResponse GetSession(const std::string& session_id);
+  HttpResponse GetMesh(const std::string& session_id, const HttpRequest& request);
+  // The relay of `session_id`, made when missing or ended long enough ago; drops idle ones.
+  std::shared_ptr<MeshRelay> RelayFor(const std::string& session_id);
+
+  const std::unique_ptr<ReconstructionClient> client_;
+  const ViewerOptions options_;
+
+  absl::Mutex mu_;
+  std::map<std::string, std::shared_ptr<MeshRelay>> relays_ ABSL_GUARDED_BY(mu_);
+  bool stopped_ ABSL_GUARDED_BY(mu_) = false;
+};
+
+}  // namespace neuralmesh::client::web
+
+#endif  // NEURALMESH_CLIENT_WEB_VIEWER_SERVICE_H_

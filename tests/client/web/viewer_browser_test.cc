@@ -1,0 +1,132 @@
+// The live viewer in a real browser: headless Chromium (software WebGL) opens the page that
+// `neuralmesh view` serves while a session learns on a neuralmesh server, and
+// viewer_browser_driver.py reads what the page shows through the DevTools protocol. Checks
+// that the page decodes every Draco mesh it gets to the server's counts, refines coarse to
+// fine, ends on the final mesh, and draws it.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "tests/client/subprocess.h"
+#include "tests/server/server_test_support.h"
+
+namespace neuralmesh::client::web {
+namespace {
+
+namespace st = ::neuralmesh::server::testing;
+using ::neuralmesh::testing::BackgroundProcess;
+
+struct ShownMesh {
+  uint64_t sequence = 0;
+  std::string kind;
+  uint64_t vertices = 0, faces = 0, server_vertices = 0, server_faces = 0, frames = 0;
+};
+
+// `neuralmesh view` on a free port; its port once it says where it listens, or 0.
+int WaitForViewerPort(BackgroundProcess& viewer) {
+  const std::regex line("viewer: http://127\\.0\\.0\\.1:([0-9]+)/");
+  for (int i = 0; i < 200; ++i) {
+    std::smatch match;
+    const std::string out = viewer.Stdout();
+    if (std::regex_search(out, match, line)) return std::stoi(match[1].str());
+    if (!viewer.Running()) return 0;
+    absl::SleepFor(absl::Milliseconds(50));
+  }
+  return 0;
+}
+
+TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh) {
+  if (std::system("command -v chromium > /dev/null && /usr/bin/python3 -c 'import websocket'") !=
+      0) {
+    FAIL() << "chromium and Debian's python3-websocket are required (scripts/install-deps.sh)";
+  }
+  std::unique_ptr<server::ReconstructionServer> server = st::StartServer(/*listen=*/true);
+  ASSERT_NE(server, nullptr);
+  auto stub = st::NetworkStub(*server);
+  v1::CreateSessionRequest request = st::CreateRequest(8000, /*refresh_ms=*/100);
+  request.set_name("browser");
+  const std::string id = st::MustCreate(*stub, request);
+
+  BackgroundProcess viewer("neuralmesh",
+                           {"view", "--server=" + server->target(), "--listen=127.0.0.1:0"});
+  const int port = WaitForViewerPort(viewer);
+  ASSERT_NE(port, 0) << "neuralmesh view did not start: " << viewer.Stderr();
+
+  const std::string dir = testing::MakeTempDir("browser");
+  const std::string ready = dir + "/ready", out = dir + "/out", err = dir + "/err";
+  const std::string command =
+      absl::StrCat("/usr/bin/python3 tests/client/web/viewer_browser_driver.py --timeout=90 --url=",
+                   "'http://127.0.0.1:", port, "/?session=", id, "' --ready_file=", ready, " > ",
+                   out, " 2> ", err);
+  int driver_exit = -1;
+  std::thread driver([&] { driver_exit = std::system(command.c_str()); });
+
+  // Points go in only once the page watches, in batches, so that it sees the mesh grow.
+  for (int i = 0; i < 600 && !std::filesystem::exists(ready); ++i) {
+    absl::SleepFor(absl::Milliseconds(50));
+  }
+  EXPECT_TRUE(std::filesystem::exists(ready)) << "the page never started watching";
+  const PointCloud points = st::TorusPoints(40000, 11);
+  for (size_t part = 0; part < 8; ++part) {
+    PointCloud batch;
+    batch.positions.assign(points.positions.begin() + part * 5000,
+                           points.positions.begin() + (part + 1) * 5000);
+    v1::UploadPointsResponse response;
+    ASSERT_TRUE(st::Upload(*stub, id, batch, 1, &response).ok());
+    absl::SleepFor(absl::Milliseconds(250));
+  }
+  ASSERT_TRUE(st::Finish(*stub, id).ok());
+  driver.join();
+
+  const std::string output = testing::ReadWholeFile(out);
+  ASSERT_EQ(driver_exit, 0) << "the browser driver failed:\n"
+                            << output << testing::ReadWholeFile(err);
+  std::vector<ShownMesh> shown;
+  std::string end_line;
+  double coverage = -1;
+  std::istringstream lines(output);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::string word;
+    words >> word;
+    if (word == "mesh") {
+      ShownMesh m;
+      words >> m.sequence >> m.kind >> m.vertices >> m.faces >> m.server_vertices >>
+          m.server_faces >> m.frames;
+      shown.push_back(m);
+    } else if (word == "end") {
+      end_line = line;
+    } else if (word == "coverage") {
+      words >> coverage;
+    }
+  }
+  SCOPED_TRACE(output);
+  ASSERT_GE(shown.size(), 2u) << "the page showed the mesh as it learned, not only the end";
+  for (size_t i = 0; i < shown.size(); ++i) {
+    EXPECT_EQ(shown[i].vertices, shown[i].server_vertices) << "decoded in the browser";
+    EXPECT_EQ(shown[i].faces, shown[i].server_faces);
+    if (i > 0) EXPECT_GT(shown[i].sequence, shown[i - 1].sequence);
+  }
+  EXPECT_LT(shown.front().vertices, shown.back().vertices) << "coarse to fine";
+  EXPECT_EQ(shown.back().kind, "final");
+  EXPECT_EQ(shown.back().vertices, 8000u);
+  EXPECT_GT(shown.back().frames, 0u) << "the final mesh was drawn";
+  EXPECT_EQ(end_line, absl::StrCat("end gone true ", shown.size(), " \"\""))
+      << "the stream ended after the final mesh, with WebGL and without errors";
+  EXPECT_GT(coverage, 0.05) << "the torus covers part of the canvas";
+
+  EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << "Ctrl-C stops the viewer cleanly";
+}
+
+}  // namespace
+}  // namespace neuralmesh::client::web

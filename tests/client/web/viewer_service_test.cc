@@ -1,0 +1,284 @@
+// Tests of the live viewer's HTTP side (client/web/viewer_service.h, http_server.h) against an
+// in-process neuralmesh server, through real HTTP on 127.0.0.1.
+#include "client/web/viewer_service.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "client/web/http_server.h"
+#include "client/web/run_view.h"
+#include "core/io/draco_codec.h"
+#include "core/sampling/implicit_surfaces.h"
+#include "tests/client/web/http_test_client.h"
+#include "tests/server/server_test_support.h"
+
+namespace neuralmesh::client::web {
+namespace {
+
+using ::neuralmesh::testing::HttpGet;
+using ::neuralmesh::testing::HttpReply;
+using ::neuralmesh::testing::SendRawHttp;
+using ::testing::HasSubstr;
+namespace st = ::neuralmesh::server::testing;
+
+uint64_t HeaderNumber(const HttpReply& reply, const std::string& name) {
+  uint64_t value = 0;
+  auto it = reply.headers.find(name);
+  EXPECT_TRUE(it != reply.headers.end() && absl::SimpleAtoi(it->second, &value))
+      << name << " is missing or not a number";
+  return value;
+}
+
+class ViewerServiceTest : public ::testing::Test {
+ protected:
+  void SetUp() override { StartViewer(absl::Milliseconds(300)); }
+  void TearDown() override { StopViewer(); }
+
+  void StartViewer(absl::Duration poll_timeout) {
+    server_ = st::StartServer(/*listen=*/false);
+    ASSERT_NE(server_, nullptr);
+    stub_ = st::InProcessStub(*server_);
+    ViewerOptions options;
+    options.web_root = DefaultWebRoot();
+    options.poll_timeout = poll_timeout;
+    viewer_ = std::make_unique<ViewerService>(
+        std::make_unique<ReconstructionClient>(server_->InProcessChannel(), ClientOptions{}),
+        options);
+    absl::StatusOr<std::unique_ptr<HttpServer>> http = HttpServer::Start(
+        "127.0.0.1", 0, [this](const HttpRequest& r) { return viewer_->Handle(r); });
+    ASSERT_TRUE(http.ok()) << http.status();
+    http_ = *std::move(http);
+    port_ = http_->port();
+  }
+
+  void StopViewer() {
+    if (viewer_ != nullptr) viewer_->Stop();
+    http_.reset();
+    viewer_.reset();
+    stub_.reset();
+    server_.reset();
+  }
+
+  std::string MeshTarget(const std::string& id, uint64_t after) {
+    return absl::StrCat("/api/sessions/", id, "/mesh?after=", after);
+  }
+
+  std::unique_ptr<server::ReconstructionServer> server_;
+  std::unique_ptr<v1::ReconstructionService::Stub> stub_;
+  std::unique_ptr<ViewerService> viewer_;
+  std::unique_ptr<HttpServer> http_;
+  int port_ = 0;
+};
+
+TEST_F(ViewerServiceTest, ServesThePageAndItsScriptsOnly) {
+  ASSERT_TRUE(CheckWebRoot(DefaultWebRoot()).ok())
+      << CheckWebRoot(DefaultWebRoot()) << " (scripts/install-deps.sh installs three.js)";
+  const HttpReply page = HttpGet(port_, "/");
+  EXPECT_EQ(page.status, 200);
+  EXPECT_EQ(page.Header("content-type"), "text/html; charset=utf-8");
+  EXPECT_THAT(page.body, HasSubstr("/static/viewer.js"));
+  EXPECT_EQ(HttpGet(port_, "/static/viewer.js").Header("content-type"),
+            "text/javascript; charset=utf-8");
+  const HttpReply wasm = HttpGet(port_, "/vendor/three/examples/jsm/libs/draco/draco_decoder.wasm");
+  EXPECT_EQ(wasm.status, 200);
+  EXPECT_EQ(wasm.Header("content-type"), "application/wasm");
+  EXPECT_EQ(wasm.body.substr(0, 4), std::string("\0asm", 4)) << "a WebAssembly module";
+  EXPECT_EQ(HttpGet(port_, "/vendor/three/build/three.module.js").status, 200);
+
+  for (const std::string target :
+       {"/static/../CMakeLists.txt", "/static/%2e%2e/CMakeLists.txt", "/static/.gitignore",
+        "/static/sub/x.js", "/vendor/three/package.json", "/vendor/three/build/../../../x",
+        "/vendor/three/examples/jsm/.x", "/static/", "/nowhere", "/api/nothing"}) {
+    const HttpReply reply = HttpGet(port_, target);
+    EXPECT_EQ(reply.status, 404) << target;
+    EXPECT_EQ(reply.Header("content-type"), "application/json") << target;
+    EXPECT_THAT(reply.body, HasSubstr("\"error\":\"no such ")) << target;
+  }
+}
+
+TEST_F(ViewerServiceTest, AnswersMalformedRequestsWithTheirStatus) {
+  HttpReply reply = SendRawHttp(port_, "NONSENSE\r\n\r\n");
+  EXPECT_EQ(reply.status, 400);
+  EXPECT_THAT(reply.body, HasSubstr("malformed request line"));
+  reply = SendRawHttp(port_, "GET / HTTP/1.1\r\nContent-Length: 3\r\n\r\nabc");
+  EXPECT_EQ(reply.status, 400);
+  reply = SendRawHttp(port_, "POST /api/sessions HTTP/1.1\r\nContent-Length: 0\r\n\r\n");
+  EXPECT_EQ(reply.status, 405);
+  EXPECT_EQ(reply.Header("allow"), "GET, HEAD");
+  reply = SendRawHttp(port_,
+                      "GET /" + std::string(kMaxRequestHeadBytes + 10, 'a') + " HTTP/1.1\r\n\r\n");
+  EXPECT_EQ(reply.status, 431);
+  reply = SendRawHttp(port_, "HEAD / HTTP/1.1\r\n\r\n");
+  EXPECT_EQ(reply.status, 200);
+  EXPECT_TRUE(reply.body.empty()) << "a HEAD response has no body";
+  EXPECT_GT(HeaderNumber(reply, "content-length"), 0u);
+  // The server still answers after all that.
+  EXPECT_EQ(HttpGet(port_, "/api/sessions").status, 200);
+}
+
+TEST_F(ViewerServiceTest, ListsTheSessionsAsJson) {
+  EXPECT_EQ(HttpGet(port_, "/api/sessions").body, "[]");
+  v1::CreateSessionRequest request = st::CreateRequest(500);
+  request.set_name("scan \"7\"");
+  const std::string id = st::MustCreate(*stub_, request);
+  const HttpReply list = HttpGet(port_, "/api/sessions");
+  EXPECT_EQ(list.status, 200);
+  EXPECT_EQ(list.Header("content-type"), "application/json");
+  EXPECT_THAT(list.body, HasSubstr(absl::StrCat("\"session_id\":\"", id, "\"")));
+  EXPECT_THAT(list.body, HasSubstr("\"name\":\"scan \\\"7\\\"\"")) << "escaped";
+  EXPECT_THAT(list.body, HasSubstr("\"target_vertices\":500"));
+  const HttpReply one = HttpGet(port_, "/api/sessions/" + id);
+  EXPECT_EQ(one.status, 200);
+  EXPECT_THAT(one.body, HasSubstr("\"state\":\"collecting\""));
+  const HttpReply unknown = HttpGet(port_, "/api/sessions/s-unknown");
+  EXPECT_EQ(unknown.status, 404);
+  EXPECT_THAT(unknown.body, HasSubstr("s-unknown"));
+}
+
+TEST_F(ViewerServiceTest, LongPollsFollowALiveSessionCoarseToFineToItsFinalMesh) {
+  v1::CreateSessionRequest request = st::CreateRequest(2000, /*refresh_ms=*/50);
+  for (uint64_t lod : {250, 500, 1000}) request.mutable_config()->add_lod_milestones(lod);
+  request.mutable_config()->add_lod_milestones(2000);
+  const std::string id = st::MustCreate(*stub_, request);
+
+  const HttpReply early = HttpGet(port_, MeshTarget(id, 0));
+  EXPECT_EQ(early.status, 204) << "no mesh before the first points, within the poll timeout";
+  EXPECT_TRUE(early.body.empty());
+
+  const PointCloud points = st::TorusPoints(40000, 3);
+  std::thread upload([&] {
+    v1::UploadPointsResponse response;
+    for (size_t part = 0; part < 4; ++part) {
+      PointCloud quarter;
+      quarter.positions.assign(points.positions.begin() + part * 10000,
+                               points.positions.begin() + (part + 1) * 10000);
+      ASSERT_TRUE(st::Upload(*stub_, id, quarter, 5, &response).ok());
+      absl::SleepFor(absl::Milliseconds(100));
+    }
+    ASSERT_TRUE(st::Finish(*stub_, id).ok());
+  });
+
+  std::vector<uint64_t> sequences;
+  std::vector<uint64_t> vertex_counts;
+  HttpReply last_mesh;
+  uint64_t after = 0;
+  const absl::Time deadline = absl::Now() + absl::Seconds(60);
+  while (absl::Now() < deadline) {
+    const HttpReply reply = HttpGet(port_, MeshTarget(id, after));
+    if (reply.status == 204) continue;
+    if (reply.status == 410) {
+      EXPECT_THAT(reply.body, HasSubstr(absl::StrCat("its last mesh was sequence ", after)));
+      break;
+    }
+    ASSERT_EQ(reply.status, 200) << reply.body;
+    EXPECT_EQ(reply.Header("content-type"), "application/x-draco");
+    const uint64_t sequence = HeaderNumber(reply, "x-neuralmesh-sequence");
+    EXPECT_GT(sequence, after) << "only newer meshes";
+    absl::StatusOr<TriangleMesh> mesh = DecodeMesh(reply.body);
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    EXPECT_EQ(mesh->positions.size(), HeaderNumber(reply, "x-neuralmesh-vertices"));
+    EXPECT_EQ(mesh->faces.size(), HeaderNumber(reply, "x-neuralmesh-faces"));
+    sequences.push_back(sequence);
+    vertex_counts.push_back(mesh->positions.size());
+    after = sequence;
+    last_mesh = reply;
+  }
+  upload.join();
+  ASSERT_GE(sequences.size(), 2u) << "the browser sees the mesh refine, not only the end";
+  EXPECT_LT(vertex_counts.front(), vertex_counts.back()) << "coarse to fine";
+  EXPECT_EQ(last_mesh.Header("x-neuralmesh-kind"), "final");
+  EXPECT_EQ(last_mesh.Header("x-neuralmesh-state"), "finished");
+  EXPECT_EQ(HeaderNumber(last_mesh, "x-neuralmesh-genus"), 1u);
+  EXPECT_EQ(HeaderNumber(last_mesh, "x-neuralmesh-points-received"), 40000u);
+  absl::StatusOr<TriangleMesh> final_mesh = DecodeMesh(last_mesh.body);
+  ASSERT_TRUE(final_mesh.ok());
+  EXPECT_EQ(final_mesh->positions.size(), 2000u);
+  absl::StatusOr<std::unique_ptr<ImplicitSurface>> torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4);
+  ASSERT_TRUE(torus.ok());
+  EXPECT_LT(st::MaxVertexDistance(*final_mesh, **torus), 0.02)
+      << "the bytes a browser gets are the learned torus";
+
+  // A page opened later gets the final mesh first, then the end.
+  const HttpReply late = HttpGet(port_, MeshTarget(id, 0));
+  EXPECT_EQ(late.status, 200);
+  EXPECT_EQ(HeaderNumber(late, "x-neuralmesh-sequence"), sequences.back());
+  EXPECT_EQ(HttpGet(port_, MeshTarget(id, sequences.back())).status, 410);
+}
+
+TEST_F(ViewerServiceTest, ACancelledSessionEndsThePollWithGoneAndSaysWhy) {
+  const std::string id = st::MustCreate(*stub_, st::CreateRequest(20000, 50));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(st::Upload(*stub_, id, st::SpherePoints(20000, 4), 2, &response).ok());
+  HttpReply reply = HttpGet(port_, MeshTarget(id, 0));
+  ASSERT_EQ(reply.status, 200) << "a mesh exists once points are in";
+  ASSERT_TRUE(st::Cancel(*stub_, id).ok());
+  uint64_t after = HeaderNumber(reply, "x-neuralmesh-sequence");
+  for (int i = 0; i < 50; ++i) {
+    reply = HttpGet(port_, MeshTarget(id, after));
+    if (reply.status != 200 && reply.status != 204) break;
+    if (reply.status == 200) after = HeaderNumber(reply, "x-neuralmesh-sequence");
+  }
+  EXPECT_EQ(reply.status, 410);
+  EXPECT_THAT(reply.body, HasSubstr("cancelled"));
+}
+
+TEST_F(ViewerServiceTest, RejectsUnknownSessionsAndMalformedSequenceNumbers) {
+  HttpReply reply = HttpGet(port_, MeshTarget("s-missing", 0));
+  EXPECT_EQ(reply.status, 404);
+  EXPECT_THAT(reply.body, HasSubstr("s-missing"));
+  const std::string id = st::MustCreate(*stub_, st::CreateRequest(500));
+  for (const std::string after : {"x", "-1", "1.5", "99999999999999999999999"}) {
+    reply = HttpGet(port_, absl::StrCat("/api/sessions/", id, "/mesh?after=", after));
+    EXPECT_EQ(reply.status, 400) << after;
+    EXPECT_THAT(reply.body, HasSubstr("is not a sequence number")) << after;
+  }
+}
+
+TEST_F(ViewerServiceTest, StopWakesAWaitingPollAtOnce) {
+  StopViewer();
+  StartViewer(absl::Seconds(30));
+  const std::string id = st::MustCreate(*stub_, st::CreateRequest(500));
+  HttpReply reply;
+  absl::Time answered;
+  std::thread poll([&] {
+    reply = HttpGet(port_, MeshTarget(id, 0));
+    answered = absl::Now();
+  });
+  absl::SleepFor(absl::Milliseconds(300));
+  const absl::Time stopped = absl::Now();
+  viewer_->Stop();
+  poll.join();
+  EXPECT_EQ(reply.status, 503);
+  EXPECT_THAT(reply.body, HasSubstr("shutting down"));
+  EXPECT_LT(answered - stopped, absl::Seconds(5)) << "not after the 30 s poll timeout";
+}
+
+TEST(ViewerServiceWithoutServerTest, AnUnreachableServerIsABadGateway) {
+  ClientOptions options;
+  options.call_timeout = absl::Seconds(2);
+  ViewerOptions viewer_options;
+  viewer_options.web_root = DefaultWebRoot();
+  ViewerService viewer(
+      std::make_unique<ReconstructionClient>(
+          grpc::CreateChannel("127.0.0.1:1", grpc::InsecureChannelCredentials()), options),
+      viewer_options);
+  HttpRequest request;
+  request.method = "GET";
+  request.path = "/api/sessions";
+  const HttpResponse response = viewer.Handle(request);
+  EXPECT_EQ(response.status, 502);
+  EXPECT_THAT(response.body, HasSubstr("ListSessions"));
+  request.path = "/api/sessions/s-1/mesh";
+  EXPECT_EQ(viewer.Handle(request).status, 502);
+}
+
+}  // namespace
+}  // namespace neuralmesh::client::web

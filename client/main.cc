@@ -384,8 +384,8 @@ std::vector<Subcommand> Commands() {
        "Serves a web page (http://HOST:PORT/ of --listen) that lists the sessions of the\n"
        "server and shows the chosen one's mesh as it learns: each published mesh is fetched\n"
        "Draco-encoded, decoded in the browser and drawn with three.js, coarse to fine, until\n"
-       "the final mesh. Open http://HOST:PORT/?session=ID to go straight to a session. Runs\n"
-       "until Ctrl-C.",
+       "the final mesh. It opens on the newest session still learning;\n"
+       "http://HOST:PORT/?session=ID goes straight to a session. Runs until Ctrl-C.",
        {"server", "listen", "web_root", "connect_timeout"},
        View},
   };

@@ -223,6 +223,8 @@ function markCurrent() {
   }
 }
 
+let autoPicked = false;  // The first list has been looked at for a session to follow.
+
 async function refreshSessions() {
   let sessions;
   try {
@@ -234,6 +236,12 @@ async function refreshSessions() {
     sessionsError.textContent = `Cannot list the sessions: ${error.message}`;
     sessionsError.hidden = false;
     return;
+  }
+  if (!autoPicked) {
+    // Opened without ?session=: follow the newest session that is still learning, if any.
+    autoPicked = true;
+    const live = sessions.filter((s) => ['collecting', 'learning', 'finishing'].includes(s.state));
+    if (following === null && live.length > 0) choose(live[live.length - 1].session_id);
   }
   sessionList.replaceChildren(...sessions.map((s) => {
     const item = document.createElement('li');
@@ -260,7 +268,10 @@ window.addEventListener('popstate', () => {
 // ---- Start ---------------------------------------------------------------------------------
 
 const requested = new URLSearchParams(window.location.search).get('session');
-if (requested !== null) follow(requested);
+if (requested !== null) {
+  autoPicked = true;
+  follow(requested);
+}
 refreshSessions();
 // The list refreshes every 3 s while the page is visible.
 setInterval(() => { if (!document.hidden) refreshSessions(); }, 3000);

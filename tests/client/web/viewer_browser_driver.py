@@ -10,9 +10,11 @@ Chromium could not be driven, 2 on a timeout.
 
 At the end it takes a screenshot and prints "coverage F": the share of the canvas's pixels
 that show the mesh (the surface's blue or its edges; the background is grey), and with
---screenshot=PATH saves the PNG.
+--screenshot=PATH saves the PNG. With --stop_when_watching it prints "watching SESSION" once
+the page follows a session, and stops there.
 
 Usage: viewer_browser_driver.py --url=URL --ready_file=PATH [--timeout=60] [--screenshot=PATH]
+                                [--stop_when_watching]
 """
 import argparse
 import base64
@@ -148,6 +150,7 @@ def main():
     parser.add_argument("--ready_file", required=True)
     parser.add_argument("--timeout", type=float, default=60)
     parser.add_argument("--screenshot")
+    parser.add_argument("--stop_when_watching", action="store_true")
     args = parser.parse_args()
 
     profile = tempfile.mkdtemp(prefix="neuralmesh-chromium-")
@@ -167,6 +170,9 @@ def main():
                     with open(args.ready_file, "w") as ready_file:
                         ready_file.write("ready\n")
                     ready = True
+                    if args.stop_when_watching:
+                        print("watching %s" % status["session"], flush=True)
+                        return 0
                 sequence = int(status.get("sequence", "0"))
                 if sequence > 0 and sequence not in shown:
                     shown.add(sequence)

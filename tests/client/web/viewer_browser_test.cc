@@ -128,5 +128,34 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
   EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << "Ctrl-C stops the viewer cleanly";
 }
 
+TEST(ViewerBrowserTest, ThePageOpensOnTheNewestSessionStillLearning) {
+  std::unique_ptr<server::ReconstructionServer> server = st::StartServer(/*listen=*/true);
+  ASSERT_NE(server, nullptr);
+  auto stub = st::NetworkStub(*server);
+  const std::string finished = st::MustCreate(*stub, st::CreateRequest(500));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(st::Upload(*stub, finished, st::SpherePoints(2000, 1), 1, &response).ok());
+  ASSERT_TRUE(st::Finish(*stub, finished).ok());
+  const std::string older = st::MustCreate(*stub, st::CreateRequest(500));
+  const std::string newest = st::MustCreate(*stub, st::CreateRequest(500));
+  v1::MeshUpdate final_mesh;
+  ASSERT_TRUE(st::WaitFinal(*stub, finished, &final_mesh).ok());
+  const std::string newer_finished = st::MustCreate(*stub, st::CreateRequest(500));
+  ASSERT_TRUE(st::Cancel(*stub, newer_finished).ok());
+
+  BackgroundProcess viewer("neuralmesh",
+                           {"view", "--server=" + server->target(), "--listen=127.0.0.1:0"});
+  const int port = WaitForViewerPort(viewer);
+  ASSERT_NE(port, 0) << "neuralmesh view did not start: " << viewer.Stderr();
+  const std::string dir = testing::MakeTempDir("browser_newest");
+  const std::string command = absl::StrCat(
+      "/usr/bin/python3 tests/client/web/viewer_browser_driver.py --timeout=60 "
+      "--stop_when_watching --url=http://127.0.0.1:",
+      port, "/ --ready_file=", dir, "/ready > ", dir, "/out 2> ", dir, "/err");
+  ASSERT_EQ(std::system(command.c_str()), 0) << testing::ReadWholeFile(dir + "/err");
+  EXPECT_EQ(testing::ReadWholeFile(dir + "/out"), absl::StrCat("watching ", newest, "\n"))
+      << "not the older live one (" << older << "), nor the finished or cancelled ones";
+}
+
 }  // namespace
 }  // namespace neuralmesh::client::web

@@ -63,7 +63,10 @@ absl::Status RunView(const ViewOptions& options, std::ostream& out) {
       << http->port() << "/ (sessions of " << options.server << "); Ctrl-C stops it" << std::endl;
 
   InterruptScope interrupt;
-  while (!InterruptScope::interrupted()) absl::SleepFor(absl::Milliseconds(100));
+  for (int tick = 1; !InterruptScope::interrupted(); ++tick) {
+    absl::SleepFor(absl::Milliseconds(100));
+    if (tick % 50 == 0) viewer.DropIdleRelays();
+  }
   viewer.Stop();
   http->Shutdown();
   return absl::OkStatus();

@@ -196,12 +196,10 @@ HttpResponse ViewerService::GetSession(const std::string& session_id) {
   return JsonResponse(200, json.text());
 }
 
-std::shared_ptr<MeshRelay> ViewerService::RelayFor(const std::string& session_id) {
+void ViewerService::DropIdleRelays() {
   std::vector<std::shared_ptr<MeshRelay>> idle;
-  std::shared_ptr<MeshRelay> relay;
   {
     absl::MutexLock lock(&mu_);
-    if (stopped_) return nullptr;
     const absl::Time now = absl::Now();
     for (auto it = relays_.begin(); it != relays_.end();) {
       if (now - it->second->last_used() > options_.relay_idle_timeout) {
@@ -211,13 +209,24 @@ std::shared_ptr<MeshRelay> ViewerService::RelayFor(const std::string& session_id
         ++it;
       }
     }
+  }
+  for (auto& relay : idle) relay->Stop();
+}
+
+std::shared_ptr<MeshRelay> ViewerService::RelayFor(const std::string& session_id) {
+  DropIdleRelays();
+  std::shared_ptr<MeshRelay> lost;
+  std::shared_ptr<MeshRelay> relay;
+  {
+    absl::MutexLock lock(&mu_);
+    if (stopped_) return nullptr;
     auto found = relays_.find(session_id);
     if (found != relays_.end()) {
       // A watch cut off by a lost connection is tried again; other ends are the session's.
       const MeshRelay::State state = found->second->Peek();
       if (!(state.ended && absl::IsUnavailable(state.end_status))) relay = found->second;
       if (relay == nullptr) {
-        idle.push_back(std::move(found->second));
+        lost = std::move(found->second);
         relays_.erase(found);
       }
     }
@@ -226,7 +235,7 @@ std::shared_ptr<MeshRelay> ViewerService::RelayFor(const std::string& session_id
       relays_[session_id] = relay;
     }
   }
-  for (auto& old : idle) old->Stop();
+  if (lost != nullptr) lost->Stop();
   return relay;
 }
 

@@ -58,6 +58,10 @@ class ViewerService {
   // Answers one request; thread-safe, and mesh requests block up to the poll timeout.
   HttpResponse Handle(const HttpRequest& request);
 
+  // Ends the watches no browser has asked about for relay_idle_timeout (each holds a stream on
+  // the server). Mesh requests do it too; call it now and then when they may stop coming.
+  void DropIdleRelays();
+
   // Ends every watch and wakes every waiting mesh request; later requests for meshes get 503.
   void Stop();
 

@@ -42,13 +42,15 @@ class ViewerServiceTest : public ::testing::Test {
   void SetUp() override { StartViewer(absl::Milliseconds(300)); }
   void TearDown() override { StopViewer(); }
 
-  void StartViewer(absl::Duration poll_timeout) {
+  void StartViewer(absl::Duration poll_timeout,
+                   absl::Duration relay_idle_timeout = absl::Seconds(60)) {
     server_ = st::StartServer(/*listen=*/false);
     ASSERT_NE(server_, nullptr);
     stub_ = st::InProcessStub(*server_);
     ViewerOptions options;
     options.web_root = DefaultWebRoot();
     options.poll_timeout = poll_timeout;
+    options.relay_idle_timeout = relay_idle_timeout;
     viewer_ = std::make_unique<ViewerService>(
         std::make_unique<ReconstructionClient>(server_->InProcessChannel(), ClientOptions{}),
         options);
@@ -259,6 +261,33 @@ TEST_F(ViewerServiceTest, StopWakesAWaitingPollAtOnce) {
   EXPECT_EQ(reply.status, 503);
   EXPECT_THAT(reply.body, HasSubstr("shutting down"));
   EXPECT_LT(answered - stopped, absl::Seconds(5)) << "not after the 30 s poll timeout";
+}
+
+TEST_F(ViewerServiceTest, BrowsersShareOneWatchPerSessionAndIdleWatchesAreDropped) {
+  StopViewer();
+  StartViewer(absl::Milliseconds(300), /*relay_idle_timeout=*/absl::Milliseconds(500));
+  const std::string id = st::MustCreate(*stub_, st::CreateRequest(20000, 50));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(st::Upload(*stub_, id, st::SpherePoints(20000, 4), 2, &response).ok());
+  auto watchers = [&] { return st::GetSession(*stub_, id).watchers(); };
+
+  // The upload's call may still be counted for a moment after it returned.
+  for (int i = 0; i < 100 && watchers() != 0; ++i) absl::SleepFor(absl::Milliseconds(20));
+  ASSERT_EQ(watchers(), 0u);
+  for (int page = 0; page < 3; ++page) EXPECT_EQ(HttpGet(port_, MeshTarget(id, 0)).status, 200);
+  EXPECT_EQ(watchers(), 1u) << "three pages, one WatchSession stream";
+
+  absl::SleepFor(absl::Milliseconds(700));
+  viewer_->DropIdleRelays();
+  uint32_t left = 1;
+  for (int i = 0; i < 100 && left != 0; ++i) {
+    absl::SleepFor(absl::Milliseconds(20));
+    left = watchers();
+  }
+  EXPECT_EQ(left, 0u) << "the stream of a session nobody looks at is closed";
+  EXPECT_EQ(HttpGet(port_, MeshTarget(id, 0)).status, 200) << "and opened again on demand";
+  EXPECT_EQ(watchers(), 1u);
+  ASSERT_TRUE(st::Cancel(*stub_, id).ok());
 }
 
 TEST(ViewerServiceWithoutServerTest, AnUnreachableServerIsABadGateway) {

@@ -102,6 +102,7 @@ HttpResponse MeshResponse(const v1::MeshUpdate& update) {
   add("Basic-Steps", update.learning().basic_steps());
   add("Genus", update.report().genus());
   add("Boundaries", update.report().boundary_loops());
+  add("Snapshot-Time-Us", update.snapshot_time_us());
   return response;
 }
 

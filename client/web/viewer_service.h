@@ -13,7 +13,7 @@
 // The mesh answer is 200 with the Draco-encoded mesh as the body (application/x-draco, exactly
 // the bytes of MeshUpdate.draco_mesh) and its figures in X-Neuralmesh-* headers (Sequence,
 // Kind, Vertices, Faces, Lod-Milestone, State, Points-Received, Basic-Steps, Genus,
-// Boundaries); 204 when no newer mesh came within the poll timeout (poll again); 410 when the
+// Boundaries, Snapshot-Time-Us: when the server took the mesh, microseconds since the epoch); 204 when no newer mesh came within the poll timeout (poll again); 410 when the
 // session's stream is over and the mesh with sequence N was its last (final, or the session
 // was cancelled or failed; the body says which); 404 for an unknown session; 400 for a
 // malformed `after`; 502 when the server cannot be reached. Errors have a JSON body

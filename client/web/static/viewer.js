@@ -129,7 +129,9 @@ function describe(figures) {
   return `session ${figures.session}: ${figures.kind} mesh #${figures.sequence}\n` +
          `${figures.vertices} vertices, ${figures.faces} faces, genus ${figures.genus}, ` +
          `${figures.boundaries} boundaries\n` +
-         `${figures.points} points received, ${figures.steps} basic steps, ${figures.state}`;
+         `${figures.points} points received, ${figures.steps} basic steps, ${figures.state}\n` +
+         `${(figures.bytes / 1024).toFixed(1)} KB of Draco, here ${figures.delayMs} ms after ` +
+         'the server took it';
 }
 
 // ---- Following a session -------------------------------------------------------------------
@@ -167,6 +169,8 @@ async function follow(sessionId) {
     if (response.status === 204) continue;  // No newer mesh yet: ask again.
     if (response.status === 200) {
       const buffer = await response.arrayBuffer();
+      const arrived = Date.now();
+      const bytes = buffer.byteLength;  // The decoder takes the buffer over (it is detached).
       const header = (name) => response.headers.get(`X-Neuralmesh-${name}`);
       let geometry;
       try {
@@ -184,12 +188,16 @@ async function follow(sessionId) {
         faces: geometry.index === null ? 0 : geometry.index.count / 3,
         genus: header('Genus'), boundaries: header('Boundaries'), state: header('State'),
         points: header('Points-Received'), steps: header('Basic-Steps'),
+        // From the server's snapshot to the bytes here (clocks of one machine, or in sync).
+        delayMs: Math.max(0, Math.round(arrived - Number(header('Snapshot-Time-Us')) / 1000)),
+        bytes,
       };
       showGeometry(geometry);
       Object.assign(statusElement.dataset, {
         sequence: String(sequence), kind: figures.kind, vertices: String(figures.vertices),
         faces: String(figures.faces), serverVertices: header('Vertices'),
-        serverFaces: header('Faces'),
+        serverFaces: header('Faces'), delayMs: String(figures.delayMs),
+        bytes: String(figures.bytes),
         meshes: String(Number(statusElement.dataset.meshes) + 1),
       });
       showStatus(describe(figures));

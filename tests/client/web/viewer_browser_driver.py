@@ -4,7 +4,8 @@
 Starts Chromium (software WebGL) with the DevTools protocol on, opens URL, and reads the
 viewer's #status element every 50 ms until the page says the session's stream has ended (or
 --timeout passes). Writes "ready" to --ready_file once the page is watching, then one line per
-mesh the page showed ("mesh SEQUENCE KIND VERTICES FACES SERVER_VERTICES SERVER_FACES FRAMES")
+mesh the page showed ("mesh SEQUENCE KIND VERTICES FACES SERVER_VERTICES SERVER_FACES FRAMES
+DRACO_BYTES DELAY_MS", the delay from the server's snapshot to the bytes' arrival)
 and a last line "end ENDED WEBGL MESHES ERROR" to stdout. Exits 0 when it got that far, 1 when
 Chromium could not be driven, 2 on a timeout.
 
@@ -176,10 +177,11 @@ def main():
                 sequence = int(status.get("sequence", "0"))
                 if sequence > 0 and sequence not in shown:
                     shown.add(sequence)
-                    print("mesh %d %s %s %s %s %s %s" % (
+                    print("mesh %d %s %s %s %s %s %s %s %s" % (
                         sequence, status.get("kind"), status.get("vertices"), status.get("faces"),
                         status.get("serverVertices"), status.get("serverFaces"),
-                        status.get("frames", "0")), flush=True)
+                        status.get("frames", "0"), status.get("bytes"), status.get("delayMs")),
+                        flush=True)
                 if status.get("ended"):
                     print("end %s %s %s %s" % (status["ended"], status.get("webgl"),
                                                status.get("meshes"),

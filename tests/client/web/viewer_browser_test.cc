@@ -30,6 +30,7 @@ struct ShownMesh {
   uint64_t sequence = 0;
   std::string kind;
   uint64_t vertices = 0, faces = 0, server_vertices = 0, server_faces = 0, frames = 0;
+  uint64_t draco_bytes = 0, delay_ms = 0;
 };
 
 // `neuralmesh view` on a free port; its port once it says where it listens, or 0.
@@ -102,7 +103,7 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
     if (word == "mesh") {
       ShownMesh m;
       words >> m.sequence >> m.kind >> m.vertices >> m.faces >> m.server_vertices >>
-          m.server_faces >> m.frames;
+          m.server_faces >> m.frames >> m.draco_bytes >> m.delay_ms;
       shown.push_back(m);
     } else if (word == "end") {
       end_line = line;
@@ -115,6 +116,8 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
   for (size_t i = 0; i < shown.size(); ++i) {
     EXPECT_EQ(shown[i].vertices, shown[i].server_vertices) << "decoded in the browser";
     EXPECT_EQ(shown[i].faces, shown[i].server_faces);
+    EXPECT_GT(shown[i].draco_bytes, 0u);
+    EXPECT_LT(shown[i].delay_ms, 30000u) << "the page got each mesh while it was recent";
     if (i > 0) EXPECT_GT(shown[i].sequence, shown[i - 1].sequence);
   }
   EXPECT_LT(shown.front().vertices, shown.back().vertices) << "coarse to fine";

@@ -184,6 +184,9 @@ TEST_F(ViewerServiceTest, LongPollsFollowALiveSessionCoarseToFineToItsFinalMesh)
     EXPECT_EQ(reply.Header("content-type"), "application/x-draco");
     const uint64_t sequence = HeaderNumber(reply, "x-neuralmesh-sequence");
     EXPECT_GT(sequence, after) << "only newer meshes";
+    const uint64_t taken = HeaderNumber(reply, "x-neuralmesh-snapshot-time-us");
+    EXPECT_LE(taken, static_cast<uint64_t>(absl::ToUnixMicros(absl::Now())));
+    EXPECT_GT(taken, static_cast<uint64_t>(absl::ToUnixMicros(absl::Now() - absl::Minutes(1))));
     absl::StatusOr<TriangleMesh> mesh = DecodeMesh(reply.body);
     ASSERT_TRUE(mesh.ok()) << mesh.status();
     EXPECT_EQ(mesh->positions.size(), HeaderNumber(reply, "x-neuralmesh-vertices"));

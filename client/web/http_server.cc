@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cstring>
 #include <string>
+#include <system_error>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -176,7 +177,14 @@ void HttpServer::AcceptLoop() {
       }
       open_fds_.insert(fd);
     }
-    std::thread([this, fd] { Serve(fd); }).detach();
+    try {
+      std::thread([this, fd] { Serve(fd); }).detach();
+    } catch (const std::system_error&) {  // No thread to be had: refuse this one.
+      Respond(fd, TextResponse(503, "the viewer cannot start a thread: try again"), true);
+      absl::MutexLock lock(&mu_);
+      open_fds_.erase(fd);
+      close(fd);
+    }
   }
 }
 

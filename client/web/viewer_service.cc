@@ -1,6 +1,7 @@
 #include "client/web/viewer_service.h"
 
 #include <filesystem>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -232,8 +233,12 @@ std::shared_ptr<MeshRelay> ViewerService::RelayFor(const std::string& session_id
       }
     }
     if (relay == nullptr && relays_.size() < kMaxRelays) {
-      relay = std::make_shared<MeshRelay>(client_->channel(), client_->options(), session_id);
-      relays_[session_id] = relay;
+      try {
+        relay = std::make_shared<MeshRelay>(client_->channel(), client_->options(), session_id);
+        relays_[session_id] = relay;
+      } catch (const std::system_error&) {
+        // No thread for the watch: the request gets 503, as when the viewer is full.
+      }
     }
   }
   if (lost != nullptr) lost->Stop();
@@ -263,7 +268,8 @@ HttpResponse ViewerService::GetMesh(const std::string& session_id, const HttpReq
   std::shared_ptr<MeshRelay> relay = RelayFor(session_id);
   if (relay == nullptr) {
     return ErrorResponse(503, absl::StrCat("the viewer watches at most ", kMaxRelays,
-                                           " sessions at once, or is shutting down"));
+                                           " sessions at once, is out of threads, or is "
+                                           "shutting down"));
   }
   const MeshRelay::State state = relay->WaitForNewer(after, options_.poll_timeout);
   if (state.latest != nullptr && state.latest->sequence() > after) {

@@ -124,8 +124,15 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
   EXPECT_EQ(shown.back().kind, "final");
   EXPECT_EQ(shown.back().vertices, 8000u);
   EXPECT_GT(shown.back().frames, 0u) << "the final mesh was drawn";
-  EXPECT_EQ(end_line, absl::StrCat("end gone true ", shown.size(), " \"\""))
-      << "the stream ended after the final mesh, with WebGL and without errors";
+  std::istringstream end(end_line);
+  std::string word, ended, webgl, error;
+  size_t meshes = 0;
+  end >> word >> ended >> webgl >> meshes >> error;
+  EXPECT_EQ(ended, "gone") << "the stream ended after the final mesh";
+  EXPECT_EQ(webgl, "true");
+  EXPECT_EQ(error, "\"\"") << "no error on the page";
+  // The driver looks every 50 ms, so it may miss a mesh the page showed between two looks.
+  EXPECT_GE(meshes, shown.size());
   EXPECT_GT(coverage, 0.05) << "the torus covers part of the canvas";
 
   EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << "Ctrl-C stops the viewer cleanly";

@@ -137,6 +137,7 @@ function describe(figures) {
 // ---- Following a session -------------------------------------------------------------------
 
 let following = null;  // The id of the session being followed.
+let generation = 0;    // Bumped by each follow(); an older loop sees it changed and stops.
 
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
@@ -150,13 +151,15 @@ async function errorText(response) {
 
 async function follow(sessionId) {
   following = sessionId;
+  const mine = ++generation;
+  const current = () => generation === mine;
   framed = false;
   Object.assign(statusElement.dataset, {
     session: sessionId, sequence: '0', meshes: '0', ended: '', error: '',
   });
   showStatus(`session ${sessionId}: waiting for its first mesh...`);
   let sequence = 0;
-  while (following === sessionId) {
+  while (current()) {
     let response;
     try {
       response = await fetch(`/api/sessions/${encodeURIComponent(sessionId)}/mesh?after=${sequence}`);
@@ -165,7 +168,7 @@ async function follow(sessionId) {
       await sleep(2000);
       continue;
     }
-    if (following !== sessionId) return;
+    if (!current()) return;
     if (response.status === 204) continue;  // No newer mesh yet: ask again.
     if (response.status === 200) {
       const buffer = await response.arrayBuffer();
@@ -180,7 +183,7 @@ async function follow(sessionId) {
         showStatus(`session ${sessionId}: mesh #${header('Sequence')} could not be decoded`);
         return;
       }
-      if (following !== sessionId) return;
+      if (!current()) return;
       sequence = Number(header('Sequence'));
       const figures = {
         session: sessionId, sequence, kind: header('Kind'),
@@ -219,8 +222,8 @@ function choose(sessionId) {
   const url = new URL(window.location.href);
   url.searchParams.set('session', sessionId);
   window.history.pushState({}, '', url);
-  markCurrent();
   follow(sessionId);
+  markCurrent();
 }
 
 // ---- Session list --------------------------------------------------------------------------

@@ -6,10 +6,21 @@
 
 namespace neuralmesh::client {
 
-std::string SessionStateName(neuralmesh::v1::SessionState state) {
-  absl::string_view name = neuralmesh::v1::SessionState_Name(state);
-  absl::ConsumePrefix(&name, "SESSION_STATE_");
+namespace {
+
+std::string ShortEnumName(absl::string_view name, absl::string_view prefix) {
+  absl::ConsumePrefix(&name, prefix);
   return absl::AsciiStrToLower(name);
+}
+
+}  // namespace
+
+std::string SessionStateName(neuralmesh::v1::SessionState state) {
+  return ShortEnumName(neuralmesh::v1::SessionState_Name(state), "SESSION_STATE_");
+}
+
+std::string UpdateKindName(neuralmesh::v1::UpdateKind kind) {
+  return ShortEnumName(neuralmesh::v1::UpdateKind_Name(kind), "UPDATE_KIND_");
 }
 
 void WriteSessionJson(const neuralmesh::v1::Session& s, JsonWriter& json) {

@@ -80,12 +80,6 @@ bool IsPlainRelativePath(absl::string_view path) {
   return true;
 }
 
-std::string KindName(v1::UpdateKind kind) {
-  absl::string_view name = v1::UpdateKind_Name(kind);
-  absl::ConsumePrefix(&name, "UPDATE_KIND_");
-  return absl::AsciiStrToLower(name);
-}
-
 HttpResponse MeshResponse(const v1::MeshUpdate& update) {
   HttpResponse response;
   response.content_type = "application/x-draco";
@@ -94,7 +88,7 @@ HttpResponse MeshResponse(const v1::MeshUpdate& update) {
     response.headers.emplace_back(absl::StrCat("X-Neuralmesh-", name), absl::StrCat(value));
   };
   add("Sequence", update.sequence());
-  add("Kind", KindName(update.kind()));
+  add("Kind", UpdateKindName(update.kind()));
   add("Vertices", update.vertex_count());
   add("Faces", update.face_count());
   add("Lod-Milestone", update.lod_milestone());
@@ -216,7 +210,6 @@ void ViewerService::DropIdleRelays() {
 }
 
 std::shared_ptr<MeshRelay> ViewerService::RelayFor(const std::string& session_id) {
-  DropIdleRelays();
   std::shared_ptr<MeshRelay> lost;
   std::shared_ptr<MeshRelay> relay;
   {

@@ -13,10 +13,11 @@
 // The mesh answer is 200 with the Draco-encoded mesh as the body (application/x-draco, exactly
 // the bytes of MeshUpdate.draco_mesh) and its figures in X-Neuralmesh-* headers (Sequence,
 // Kind, Vertices, Faces, Lod-Milestone, State, Points-Received, Basic-Steps, Genus,
-// Boundaries, Snapshot-Time-Us: when the server took the mesh, microseconds since the epoch); 204 when no newer mesh came within the poll timeout (poll again); 410 when the
-// session's stream is over and the mesh with sequence N was its last (final, or the session
-// was cancelled or failed; the body says which); 404 for an unknown session; 400 for a
-// malformed `after`; 502 when the server cannot be reached. Errors have a JSON body
+// Boundaries, Snapshot-Time-Us: when the server took the mesh, microseconds since the epoch); 204
+// when no newer mesh came within the poll timeout (poll again); 410 when the session's stream is
+// over and the mesh with sequence N was its last (final, or the session was cancelled or failed;
+// the body says which); 404 for an unknown session; 400 for a malformed `after`; 502 when the
+// server cannot be reached. Errors have a JSON body
 // {"error": "..."}.
 #ifndef NEURALMESH_CLIENT_WEB_VIEWER_SERVICE_H_
 #define NEURALMESH_CLIENT_WEB_VIEWER_SERVICE_H_
@@ -59,7 +60,7 @@ class ViewerService {
   HttpResponse Handle(const HttpRequest& request);
 
   // Ends the watches no browser has asked about for relay_idle_timeout (each holds a stream on
-  // the server). Mesh requests do it too; call it now and then when they may stop coming.
+  // the server). The owner calls it now and then (RunView: every 5 s).
   void DropIdleRelays();
 
   // Ends every watch and wakes every waiting mesh request; later requests for meshes get 503.
@@ -70,7 +71,7 @@ class ViewerService {
   HttpResponse ListSessions();
   HttpResponse GetSession(const std::string& session_id);
   HttpResponse GetMesh(const std::string& session_id, const HttpRequest& request);
-  // The relay of `session_id`, made when missing or ended long enough ago; drops idle ones.
+  // The relay of `session_id`, made when missing or when its watch lost the connection.
   std::shared_ptr<MeshRelay> RelayFor(const std::string& session_id);
 
   const std::unique_ptr<ReconstructionClient> client_;

@@ -32,8 +32,10 @@ OutlierJudgement StreamingOutlierFilter::Judge(absl::Span<const Vec3f> batch) co
   const size_t k = static_cast<size_t>(options_.neighbours);
   OutlierJudgement judgement;
   judgement.held.assign(m, false);
-  judgement.still_held_ = held_;
-  if (m == 0 || points_.size() + m <= k) return judgement;
+  if (m == 0 || points_.size() + m <= k) {
+    judgement.still_held_ = held_;
+    return judgement;
+  }
 
   const PointKdTree batch_tree(batch, 0, static_cast<uint32_t>(m));
   NeighbourHeap heap;

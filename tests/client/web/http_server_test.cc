@@ -14,7 +14,7 @@
 
 #include "absl/synchronization/notification.h"
 #include "absl/time/clock.h"
-#include "tests/client/web/http_test_client.h"
+#include "tests/client/web/viewer_test_support.h"
 
 namespace neuralmesh::client::web {
 namespace {

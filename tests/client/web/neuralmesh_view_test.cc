@@ -4,13 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <csignal>
-#include <regex>
 #include <string>
 
-#include "absl/time/clock.h"
 #include "tests/client/subprocess.h"
 #include "tests/client/test_server.h"
-#include "tests/client/web/http_test_client.h"
+#include "tests/client/web/viewer_test_support.h"
 
 namespace neuralmesh::testing {
 namespace {
@@ -45,14 +43,7 @@ TEST(NeuralmeshViewTest, ServesTheSessionsOfTheServerUntilSigterm) {
   ASSERT_NE(server, nullptr) << error;
   BackgroundProcess viewer("neuralmesh",
                            {"view", "--server=" + server->address(), "--listen=127.0.0.1:0"});
-  const std::regex line("viewer: http://127\\.0\\.0\\.1:([0-9]+)/ \\(sessions of ");
-  int port = 0;
-  for (int i = 0; i < 200 && port == 0; ++i) {
-    std::smatch match;
-    const std::string out = viewer.Stdout();
-    if (std::regex_search(out, match, line)) port = std::stoi(match[1].str());
-    absl::SleepFor(absl::Milliseconds(50));
-  }
+  const int port = WaitForViewerPort(viewer);
   ASSERT_NE(port, 0) << viewer.Stderr();
   const RunResult busy = RunNeuralmesh(
       {"view", "--server=" + server->address(), "--listen=127.0.0.1:" + std::to_string(port)});

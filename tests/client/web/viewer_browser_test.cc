@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -18,6 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "tests/client/subprocess.h"
+#include "tests/client/web/viewer_test_support.h"
 #include "tests/server/server_test_support.h"
 
 namespace neuralmesh::client::web {
@@ -25,6 +25,7 @@ namespace {
 
 namespace st = ::neuralmesh::server::testing;
 using ::neuralmesh::testing::BackgroundProcess;
+using ::neuralmesh::testing::WaitForViewerPort;
 
 struct ShownMesh {
   uint64_t sequence = 0;
@@ -33,19 +34,6 @@ struct ShownMesh {
   uint64_t draco_bytes = 0, delay_ms = 0;
 };
 
-// `neuralmesh view` on a free port; its port once it says where it listens, or 0.
-int WaitForViewerPort(BackgroundProcess& viewer) {
-  const std::regex line("viewer: http://127\\.0\\.0\\.1:([0-9]+)/");
-  for (int i = 0; i < 200; ++i) {
-    std::smatch match;
-    const std::string out = viewer.Stdout();
-    if (std::regex_search(out, match, line)) return std::stoi(match[1].str());
-    if (!viewer.Running()) return 0;
-    absl::SleepFor(absl::Milliseconds(50));
-  }
-  return 0;
-}
-
 TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh) {
   if (std::system("command -v chromium > /dev/null && /usr/bin/python3 -c 'import websocket'") !=
       0) {
@@ -53,10 +41,10 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
   }
   std::unique_ptr<server::ReconstructionServer> server = st::StartServer(/*listen=*/true);
   ASSERT_NE(server, nullptr);
-  auto stub = st::NetworkStub(*server);
+  auto service = st::NetworkStub(*server);
   v1::CreateSessionRequest request = st::CreateRequest(8000, /*refresh_ms=*/100);
   request.set_name("browser");
-  const std::string id = st::MustCreate(*stub, request);
+  const std::string id = st::MustCreate(*service, request);
 
   BackgroundProcess viewer("neuralmesh",
                            {"view", "--server=" + server->target(), "--listen=127.0.0.1:0"});
@@ -83,10 +71,10 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
     batch.positions.assign(points.positions.begin() + part * 5000,
                            points.positions.begin() + (part + 1) * 5000);
     v1::UploadPointsResponse response;
-    ASSERT_TRUE(st::Upload(*stub, id, batch, 1, &response).ok());
+    ASSERT_TRUE(st::Upload(*service, id, batch, 1, &response).ok());
     absl::SleepFor(absl::Milliseconds(250));
   }
-  ASSERT_TRUE(st::Finish(*stub, id).ok());
+  ASSERT_TRUE(st::Finish(*service, id).ok());
   driver.join();
 
   const std::string output = testing::ReadWholeFile(out);
@@ -141,17 +129,17 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
 TEST(ViewerBrowserTest, ThePageOpensOnTheNewestSessionStillLearning) {
   std::unique_ptr<server::ReconstructionServer> server = st::StartServer(/*listen=*/true);
   ASSERT_NE(server, nullptr);
-  auto stub = st::NetworkStub(*server);
-  const std::string finished = st::MustCreate(*stub, st::CreateRequest(500));
+  auto service = st::NetworkStub(*server);
+  const std::string finished = st::MustCreate(*service, st::CreateRequest(500));
   v1::UploadPointsResponse response;
-  ASSERT_TRUE(st::Upload(*stub, finished, st::SpherePoints(2000, 1), 1, &response).ok());
-  ASSERT_TRUE(st::Finish(*stub, finished).ok());
-  const std::string older = st::MustCreate(*stub, st::CreateRequest(500));
-  const std::string newest = st::MustCreate(*stub, st::CreateRequest(500));
+  ASSERT_TRUE(st::Upload(*service, finished, st::SpherePoints(2000, 1), 1, &response).ok());
+  ASSERT_TRUE(st::Finish(*service, finished).ok());
+  const std::string older = st::MustCreate(*service, st::CreateRequest(500));
+  const std::string newest = st::MustCreate(*service, st::CreateRequest(500));
   v1::MeshUpdate final_mesh;
-  ASSERT_TRUE(st::WaitFinal(*stub, finished, &final_mesh).ok());
-  const std::string newer_finished = st::MustCreate(*stub, st::CreateRequest(500));
-  ASSERT_TRUE(st::Cancel(*stub, newer_finished).ok());
+  ASSERT_TRUE(st::WaitFinal(*service, finished, &final_mesh).ok());
+  const std::string newer_finished = st::MustCreate(*service, st::CreateRequest(500));
+  ASSERT_TRUE(st::Cancel(*service, newer_finished).ok());
 
   BackgroundProcess viewer("neuralmesh",
                            {"view", "--server=" + server->target(), "--listen=127.0.0.1:0"});

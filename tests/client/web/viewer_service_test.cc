@@ -17,7 +17,7 @@
 #include "client/web/run_view.h"
 #include "core/io/draco_codec.h"
 #include "core/sampling/implicit_surfaces.h"
-#include "tests/client/web/http_test_client.h"
+#include "tests/client/web/viewer_test_support.h"
 #include "tests/server/server_test_support.h"
 
 namespace neuralmesh::client::web {
@@ -46,7 +46,7 @@ class ViewerServiceTest : public ::testing::Test {
                    absl::Duration relay_idle_timeout = absl::Seconds(60)) {
     server_ = st::StartServer(/*listen=*/false);
     ASSERT_NE(server_, nullptr);
-    stub_ = st::InProcessStub(*server_);
+    service_ = st::InProcessStub(*server_);
     ViewerOptions options;
     options.web_root = DefaultWebRoot();
     options.poll_timeout = poll_timeout;
@@ -65,7 +65,7 @@ class ViewerServiceTest : public ::testing::Test {
     if (viewer_ != nullptr) viewer_->Stop();
     http_.reset();
     viewer_.reset();
-    stub_.reset();
+    service_.reset();
     server_.reset();
   }
 
@@ -74,7 +74,7 @@ class ViewerServiceTest : public ::testing::Test {
   }
 
   std::unique_ptr<server::ReconstructionServer> server_;
-  std::unique_ptr<v1::ReconstructionService::Stub> stub_;
+  std::unique_ptr<v1::ReconstructionService::Stub> service_;
   std::unique_ptr<ViewerService> viewer_;
   std::unique_ptr<HttpServer> http_;
   int port_ = 0;
@@ -130,7 +130,7 @@ TEST_F(ViewerServiceTest, ListsTheSessionsAsJson) {
   EXPECT_EQ(HttpGet(port_, "/api/sessions").body, "[]");
   v1::CreateSessionRequest request = st::CreateRequest(500);
   request.set_name("scan \"7\"");
-  const std::string id = st::MustCreate(*stub_, request);
+  const std::string id = st::MustCreate(*service_, request);
   const HttpReply list = HttpGet(port_, "/api/sessions");
   EXPECT_EQ(list.status, 200);
   EXPECT_EQ(list.Header("content-type"), "application/json");
@@ -149,7 +149,7 @@ TEST_F(ViewerServiceTest, LongPollsFollowALiveSessionCoarseToFineToItsFinalMesh)
   v1::CreateSessionRequest request = st::CreateRequest(2000, /*refresh_ms=*/50);
   for (uint64_t lod : {250, 500, 1000}) request.mutable_config()->add_lod_milestones(lod);
   request.mutable_config()->add_lod_milestones(2000);
-  const std::string id = st::MustCreate(*stub_, request);
+  const std::string id = st::MustCreate(*service_, request);
 
   const HttpReply early = HttpGet(port_, MeshTarget(id, 0));
   EXPECT_EQ(early.status, 204) << "no mesh before the first points, within the poll timeout";
@@ -162,10 +162,10 @@ TEST_F(ViewerServiceTest, LongPollsFollowALiveSessionCoarseToFineToItsFinalMesh)
       PointCloud quarter;
       quarter.positions.assign(points.positions.begin() + part * 10000,
                                points.positions.begin() + (part + 1) * 10000);
-      ASSERT_TRUE(st::Upload(*stub_, id, quarter, 5, &response).ok());
+      ASSERT_TRUE(st::Upload(*service_, id, quarter, 5, &response).ok());
       absl::SleepFor(absl::Milliseconds(100));
     }
-    ASSERT_TRUE(st::Finish(*stub_, id).ok());
+    ASSERT_TRUE(st::Finish(*service_, id).ok());
   });
 
   std::vector<uint64_t> sequences;
@@ -219,12 +219,12 @@ TEST_F(ViewerServiceTest, LongPollsFollowALiveSessionCoarseToFineToItsFinalMesh)
 }
 
 TEST_F(ViewerServiceTest, ACancelledSessionEndsThePollWithGoneAndSaysWhy) {
-  const std::string id = st::MustCreate(*stub_, st::CreateRequest(20000, 50));
+  const std::string id = st::MustCreate(*service_, st::CreateRequest(20000, 50));
   v1::UploadPointsResponse response;
-  ASSERT_TRUE(st::Upload(*stub_, id, st::SpherePoints(20000, 4), 2, &response).ok());
+  ASSERT_TRUE(st::Upload(*service_, id, st::SpherePoints(20000, 4), 2, &response).ok());
   HttpReply reply = HttpGet(port_, MeshTarget(id, 0));
   ASSERT_EQ(reply.status, 200) << "a mesh exists once points are in";
-  ASSERT_TRUE(st::Cancel(*stub_, id).ok());
+  ASSERT_TRUE(st::Cancel(*service_, id).ok());
   uint64_t after = HeaderNumber(reply, "x-neuralmesh-sequence");
   for (int i = 0; i < 50; ++i) {
     reply = HttpGet(port_, MeshTarget(id, after));
@@ -239,7 +239,7 @@ TEST_F(ViewerServiceTest, RejectsUnknownSessionsAndMalformedSequenceNumbers) {
   HttpReply reply = HttpGet(port_, MeshTarget("s-missing", 0));
   EXPECT_EQ(reply.status, 404);
   EXPECT_THAT(reply.body, HasSubstr("s-missing"));
-  const std::string id = st::MustCreate(*stub_, st::CreateRequest(500));
+  const std::string id = st::MustCreate(*service_, st::CreateRequest(500));
   for (const std::string after : {"x", "-1", "1.5", "99999999999999999999999"}) {
     reply = HttpGet(port_, absl::StrCat("/api/sessions/", id, "/mesh?after=", after));
     EXPECT_EQ(reply.status, 400) << after;
@@ -250,7 +250,7 @@ TEST_F(ViewerServiceTest, RejectsUnknownSessionsAndMalformedSequenceNumbers) {
 TEST_F(ViewerServiceTest, StopWakesAWaitingPollAtOnce) {
   StopViewer();
   StartViewer(absl::Seconds(30));
-  const std::string id = st::MustCreate(*stub_, st::CreateRequest(500));
+  const std::string id = st::MustCreate(*service_, st::CreateRequest(500));
   HttpReply reply;
   absl::Time answered;
   std::thread poll([&] {
@@ -269,10 +269,10 @@ TEST_F(ViewerServiceTest, StopWakesAWaitingPollAtOnce) {
 TEST_F(ViewerServiceTest, BrowsersShareOneWatchPerSessionAndIdleWatchesAreDropped) {
   StopViewer();
   StartViewer(absl::Milliseconds(300), /*relay_idle_timeout=*/absl::Milliseconds(500));
-  const std::string id = st::MustCreate(*stub_, st::CreateRequest(20000, 50));
+  const std::string id = st::MustCreate(*service_, st::CreateRequest(20000, 50));
   v1::UploadPointsResponse response;
-  ASSERT_TRUE(st::Upload(*stub_, id, st::SpherePoints(20000, 4), 2, &response).ok());
-  auto watchers = [&] { return st::GetSession(*stub_, id).watchers(); };
+  ASSERT_TRUE(st::Upload(*service_, id, st::SpherePoints(20000, 4), 2, &response).ok());
+  auto watchers = [&] { return st::GetSession(*service_, id).watchers(); };
 
   // The upload's call may still be counted for a moment after it returned.
   for (int i = 0; i < 100 && watchers() != 0; ++i) absl::SleepFor(absl::Milliseconds(20));
@@ -290,7 +290,7 @@ TEST_F(ViewerServiceTest, BrowsersShareOneWatchPerSessionAndIdleWatchesAreDroppe
   EXPECT_EQ(left, 0u) << "the stream of a session nobody looks at is closed";
   EXPECT_EQ(HttpGet(port_, MeshTarget(id, 0)).status, 200) << "and opened again on demand";
   EXPECT_EQ(watchers(), 1u);
-  ASSERT_TRUE(st::Cancel(*stub_, id).ok());
+  ASSERT_TRUE(st::Cancel(*service_, id).ok());
 }
 
 TEST(ViewerServiceWithoutServerTest, AnUnreachableServerIsABadGateway) {

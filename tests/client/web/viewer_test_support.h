@@ -1,7 +1,8 @@
-// A raw HTTP/1.1 client for the viewer's tests: sends bytes to 127.0.0.1:PORT and reads the
-// whole response (the viewer closes each connection after its answer).
-#ifndef NEURALMESH_TESTS_CLIENT_WEB_HTTP_TEST_CLIENT_H_
-#define NEURALMESH_TESTS_CLIENT_WEB_HTTP_TEST_CLIENT_H_
+// For the viewer's tests: a raw HTTP/1.1 client that sends bytes to 127.0.0.1:PORT and reads
+// the whole response (the viewer closes each connection after its answer), and the wait for a
+// `neuralmesh view` process to say where it listens.
+#ifndef NEURALMESH_TESTS_CLIENT_WEB_VIEWER_TEST_SUPPORT_H_
+#define NEURALMESH_TESTS_CLIENT_WEB_VIEWER_TEST_SUPPORT_H_
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -9,12 +10,15 @@
 #include <unistd.h>
 
 #include <map>
+#include <regex>
 #include <string>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
+#include "absl/time/clock.h"
+#include "tests/client/subprocess.h"
 
 namespace neuralmesh::testing {
 
@@ -71,6 +75,20 @@ inline HttpReply HttpGet(int port, const std::string& target) {
   return SendRawHttp(port, "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
 }
 
+// The port of `viewer` (neuralmesh view --listen=127.0.0.1:0) once it prints its URL, or 0
+// when it exits or says nothing within 10 s.
+inline int WaitForViewerPort(BackgroundProcess& viewer) {
+  const std::regex line("viewer: http://127\\.0\\.0\\.1:([0-9]+)/ \\(sessions of ");
+  for (int i = 0; i < 200; ++i) {
+    std::smatch match;
+    const std::string out = viewer.Stdout();
+    if (std::regex_search(out, match, line)) return std::stoi(match[1].str());
+    if (!viewer.Running()) return 0;
+    absl::SleepFor(absl::Milliseconds(50));
+  }
+  return 0;
+}
+
 }  // namespace neuralmesh::testing
 
-#endif  // NEURALMESH_TESTS_CLIENT_WEB_HTTP_TEST_CLIENT_H_
+#endif  // NEURALMESH_TESTS_CLIENT_WEB_VIEWER_TEST_SUPPORT_H_

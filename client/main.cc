@@ -11,6 +11,7 @@
 #include "absl/flags/flag.h"
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/ascii.h"
 #include "absl/time/time.h"
 #include "client/command_line.h"
 #include "client/inputs.h"
@@ -20,6 +21,7 @@
 #include "client/remote_commands.h"
 #include "client/web/run_view.h"
 #include "core/analysis/statistical_outliers.h"
+#include "core/io/file_contents.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
 #include "core/status_macros.h"
@@ -140,6 +142,19 @@ ABSL_FLAG(uint64_t, points, 100000,
 ABSL_FLAG(bool, ply, false, "Also write each mesh received from the server as .ply.");
 ABSL_FLAG(absl::Duration, connect_timeout, absl::Seconds(5),
           "How long to wait for the server to accept the connection.");
+ABSL_FLAG(bool, tls, false,
+          "Connect over TLS, checking the server's certificate against the system's CAs (or "
+          "--tls_ca_file's).");
+ABSL_FLAG(std::string, tls_ca_file, "",
+          "PEM file with the CAs that sign the server's certificate, instead of the system's; "
+          "implies --tls.");
+ABSL_FLAG(std::string, tls_cert_file, "",
+          "PEM file with this client's certificate, for servers that require one (mutual "
+          "TLS); implies --tls and needs --tls_key_file.");
+ABSL_FLAG(std::string, tls_key_file, "", "PEM file with the private key of --tls_cert_file.");
+ABSL_FLAG(std::string, access_token_file, "",
+          "File holding the access token the server asks for (sent as 'authorization: Bearer "
+          "TOKEN' with every call); needs TLS. Keep it readable by its owner only.");
 
 // Viewer.
 ABSL_FLAG(std::string, listen, neuralmesh::client::web::ViewOptions().listen,
@@ -227,6 +242,51 @@ absl::StatusOr<neuralmesh::DracoOptions> DracoFromFlags() {
   return o;
 }
 
+constexpr const char* kConnectionFlags[] = {"connect_timeout", "tls", "tls_ca_file",
+                                            "tls_cert_file", "tls_key_file",
+                                            "access_token_file"};
+
+// How to reach the server: --connect_timeout, TLS and the access token.
+absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
+  neuralmesh::client::ClientOptions o;
+  o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
+  neuralmesh::client::ClientSecurity& security = o.security;
+  struct FileFlag {
+    const char* flag;
+    std::string path;
+    std::string* contents;
+  };
+  const FileFlag files[] = {
+      {"tls_ca_file", absl::GetFlag(FLAGS_tls_ca_file), &security.tls.root_certificates},
+      {"tls_cert_file", absl::GetFlag(FLAGS_tls_cert_file), &security.tls.certificate_chain},
+      {"tls_key_file", absl::GetFlag(FLAGS_tls_key_file), &security.tls.private_key},
+      {"access_token_file", absl::GetFlag(FLAGS_access_token_file), &security.access_token}};
+  for (const FileFlag& file : files) {
+    if (file.path.empty()) continue;
+    absl::StatusOr<std::string> contents = neuralmesh::ReadFileContents(file.path);
+    if (!contents.ok()) {
+      return absl::Status(contents.status().code(),
+                          absl::StrCat("--", file.flag, ": ", contents.status().message()));
+    }
+    *file.contents = *std::move(contents);
+  }
+  security.access_token = std::string(absl::StripAsciiWhitespace(security.access_token));
+  security.tls.enabled = absl::GetFlag(FLAGS_tls) || !security.tls.root_certificates.empty() ||
+                         !security.tls.certificate_chain.empty();
+  if (!security.access_token.empty() && !security.tls.enabled) {
+    return absl::InvalidArgumentError(
+        "--access_token_file needs TLS (--tls or --tls_ca_file): the token must not cross the "
+        "network in the clear");
+  }
+  return o;
+}
+
+// The flags of a command that connects to a server, and `flags`.
+std::vector<std::string> WithConnectionFlags(std::vector<std::string> flags) {
+  for (const char* f : kConnectionFlags) flags.push_back(f);
+  return flags;
+}
+
 // Flags that only one of the two kinds of reconstruct accepts.
 absl::Status RejectFlags(const ParsedArgs& args, const std::vector<std::string>& flags,
                          const std::string& why) {
@@ -262,11 +322,11 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.builtin_points = absl::GetFlag(FLAGS_points);
     o.ply = absl::GetFlag(FLAGS_ply);
     o.progress = progress;
-    o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
+    NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
     return neuralmesh::client::RunRemoteReconstruct(o, std::cout, std::cerr);
   }
   NM_RETURN_IF_ERROR(RejectFlags(
-      args, {"out-dir", "batch-size", "points", "ply", "connect_timeout", "outliers_on_server"},
+      args, WithConnectionFlags({"out-dir", "batch-size", "points", "ply", "outliers_on_server"}),
       "needs --server (a local reconstruct writes -o OUTPUT)"));
   if (!args.Has("vertices")) return absl::InvalidArgumentError("--vertices N is required");
   neuralmesh::client::LocalReconstructOptions o;
@@ -309,14 +369,15 @@ absl::Status Watch(const ParsedArgs& args) {
   o.server = absl::GetFlag(FLAGS_server);
   o.out_dir = absl::GetFlag(FLAGS_out_dir);
   o.ply = absl::GetFlag(FLAGS_ply);
-  o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
+  NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
   return neuralmesh::client::RunWatch(o, std::cout);
 }
 
 absl::Status Sessions(const ParsedArgs& args) {
   NM_RETURN_IF_ERROR(ExpectPositional(args, 0, "no arguments"));
+  NM_ASSIGN_OR_RETURN(const neuralmesh::client::ClientOptions connection, ConnectionFromFlags());
   return neuralmesh::client::RunSessions(absl::GetFlag(FLAGS_server), absl::GetFlag(FLAGS_json),
-                                         std::cout, absl::GetFlag(FLAGS_connect_timeout));
+                                         std::cout, connection);
 }
 
 absl::Status View(const ParsedArgs& args) {
@@ -325,7 +386,7 @@ absl::Status View(const ParsedArgs& args) {
   o.server = absl::GetFlag(FLAGS_server);
   o.listen = absl::GetFlag(FLAGS_listen);
   o.web_root = absl::GetFlag(FLAGS_web_root);
-  o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
+  NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
   return neuralmesh::client::web::RunView(o, std::cout);
 }
 
@@ -339,7 +400,7 @@ std::vector<Subcommand> Commands() {
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
       "remove_outliers", "outlier_neighbours", "outlier_std_ratio", "outliers_on_server",
       "sampling", "time_budget", "max_steps", "quantization_bits", "encode_speed", "progress",
-      "server", "out-dir", "batch-size", "points", "ply", "connect_timeout"};
+      "server", "out-dir", "batch-size", "points", "ply"};
   // clang-format on
   return {
       {"reconstruct",
@@ -351,7 +412,7 @@ std::vector<Subcommand> Commands() {
        "--sampling area|curvature, or builtin:sphere|torus|genus2. Locally it writes OUTPUT and\n"
        "one OUTPUT_lod<N> file per --lod; with --server it uploads the points and saves each\n"
        "mesh the server publishes into --out-dir. Prints the figures of every level.",
-       reconstruct, Reconstruct},
+       WithConnectionFlags(reconstruct), Reconstruct},
       {"stats",
        "stats MESH [--json]",
        "Prints the mesh report of a mesh.",
@@ -370,13 +431,13 @@ std::vector<Subcommand> Commands() {
        "watch SESSION --server HOST:PORT --out-dir DIR [--ply]",
        "Watches a server session until it ends, saving every milestone and the final mesh.",
        "",
-       {"server", "out-dir", "ply", "connect_timeout"},
+       WithConnectionFlags({"server", "out-dir", "ply"}),
        Watch},
       {"sessions",
        "sessions --server HOST:PORT [--json]",
        "Lists the sessions of a server.",
        "",
-       {"server", "json", "connect_timeout"},
+       WithConnectionFlags({"server", "json"}),
        Sessions},
       {"view",
        "view --server HOST:PORT [--listen HOST:PORT]",
@@ -386,7 +447,7 @@ std::vector<Subcommand> Commands() {
        "Draco-encoded, decoded in the browser and drawn with three.js, coarse to fine, until\n"
        "the final mesh. It opens on the newest session still learning;\n"
        "http://HOST:PORT/?session=ID goes straight to a session. Runs until Ctrl-C.",
-       {"server", "listen", "web_root", "connect_timeout"},
+       WithConnectionFlags({"server", "listen", "web_root"}),
        View},
   };
 }

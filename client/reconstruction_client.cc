@@ -9,6 +9,7 @@
 #include <thread>
 #include <utility>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "client/grpc_status.h"
 
@@ -34,6 +35,30 @@ int ToMillis(absl::Duration d) {
 gpr_timespec ToGprDeadline(absl::Duration timeout) {
   return gpr_time_add(gpr_now(GPR_CLOCK_MONOTONIC),
                       gpr_time_from_millis(absl::ToInt64Milliseconds(timeout), GPR_TIMESPAN));
+}
+
+// Why the channel has no connection, as gRPC tells it to a call that fails at once (connection
+// refused, a TLS handshake that failed and why), with a guess at the cause where gRPC only saw
+// the server close the connection; empty when the call tells nothing.
+std::string LastConnectionError(const std::shared_ptr<grpc::Channel>& channel,
+                                const ClientSecurity& security) {
+  grpc::ClientContext context;
+  context.set_deadline(ToGprDeadline(absl::Seconds(1)));
+  v1::ListSessionsResponse response;
+  const grpc::Status status = v1::ReconstructionService::NewStub(channel)->ListSessions(
+      &context, v1::ListSessionsRequest(), &response);
+  if (status.error_code() != grpc::StatusCode::UNAVAILABLE || status.error_message().empty()) {
+    return "";
+  }
+  std::string hint;
+  if (absl::StrContains(status.error_message(), "Socket closed")) {
+    if (!security.tls.enabled) {
+      hint = "; does the server want TLS (--tls, --tls_ca_file)?";
+    } else if (security.tls.certificate_chain.empty()) {
+      hint = "; does the server want a client certificate (--tls_cert_file, --tls_key_file)?";
+    }
+  }
+  return absl::StrCat(" (", status.error_message(), hint, ")");
 }
 
 }  // namespace
@@ -79,12 +104,14 @@ absl::StatusOr<std::unique_ptr<ReconstructionClient>> ReconstructionClient::Conn
   args.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, ToMillis(options.keepalive_timeout));
   // Keep pinging while only the server sends (a Watch): gRPC stops after two pings otherwise.
   args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
-  std::shared_ptr<grpc::Channel> channel =
-      grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), args);
+  absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> credentials =
+      MakeChannelCredentials(options.security);
+  if (!credentials.ok()) return credentials.status();
+  std::shared_ptr<grpc::Channel> channel = grpc::CreateCustomChannel(address, *credentials, args);
   if (!channel->WaitForConnected(ToGprDeadline(options.connect_timeout))) {
-    return absl::UnavailableError(absl::StrCat("cannot reach a neuralmesh-server at ", address,
-                                               " within ",
-                                               absl::FormatDuration(options.connect_timeout)));
+    return absl::UnavailableError(absl::StrCat(
+        "cannot reach a neuralmesh-server at ", address, " within ",
+        absl::FormatDuration(options.connect_timeout), LastConnectionError(channel, options.security)));
   }
   auto client = std::make_unique<ReconstructionClient>(std::move(channel), options);
   client->address_ = address;

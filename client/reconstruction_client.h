@@ -32,6 +32,7 @@
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
+#include "client/channel_credentials.h"
 #include "core/point_cloud.h"
 #include "neuralmesh/v1/reconstruction.grpc.pb.h"
 
@@ -58,13 +59,17 @@ struct ClientOptions {
   // leaving them waiting forever. neuralmesh-server accepts pings up to once a second.
   absl::Duration keepalive_time = absl::Seconds(20);
   absl::Duration keepalive_timeout = absl::Seconds(10);
+  // TLS and the access token of the channel that Connect opens (none: plaintext).
+  ClientSecurity security;
 };
 
 class ReconstructionClient {
  public:
-  // Opens an insecure channel to `address` ("host:port") and waits until it is connected.
-  // Returns UNAVAILABLE naming the address when no server answers within
-  // `options.connect_timeout`, INVALID_ARGUMENT for an empty address.
+  // Opens a channel to `address` ("host:port"), secured as `options.security` says, and waits
+  // until it is connected. Returns UNAVAILABLE naming the address and gRPC's last error (no
+  // server there, a failed TLS handshake) when no connection is made within
+  // `options.connect_timeout`; INVALID_ARGUMENT for an empty address or security parts that
+  // do not go together.
   static absl::StatusOr<std::unique_ptr<ReconstructionClient>> Connect(
       const std::string& address, const ClientOptions& options = {});
 

@@ -31,10 +31,8 @@ constexpr absl::Duration kTidyCancelTimeout = absl::Seconds(5);
 constexpr double kDefaultPointsPerVertex = 2;  // SessionConfig.points_per_vertex's default.
 
 absl::StatusOr<std::unique_ptr<ReconstructionClient>> ConnectTo(const std::string& server,
-                                                                absl::Duration timeout) {
+                                                                const ClientOptions& options) {
   if (server.empty()) return absl::InvalidArgumentError("--server HOST:PORT is required");
-  ClientOptions options;
-  options.connect_timeout = timeout;
   return ReconstructionClient::Connect(server, options);
 }
 
@@ -99,7 +97,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   }
 
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
-                      ConnectTo(options.server, options.connect_timeout));
+                      ConnectTo(options.server, options.connection));
   const std::string stem = InputStem(options.input);
   // From here on Ctrl-C ends the upload and the watch at once and cancels the session (see
   // `canceller` below), so that the server does not keep learning for nobody.
@@ -217,7 +215,7 @@ absl::Status RunWatch(const WatchOptions& options, std::ostream& out) {
   if (options.session_id.empty()) return absl::InvalidArgumentError("missing SESSION id");
   if (options.out_dir.empty()) return absl::InvalidArgumentError("--out-dir DIR is required");
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
-                      ConnectTo(options.server, options.connect_timeout));
+                      ConnectTo(options.server, options.connection));
   MeshUpdateWriter writer({options.out_dir, options.session_id, options.ply}, out);
   absl::Status write_status;
   const absl::Status watch_status =
@@ -231,9 +229,9 @@ absl::Status RunWatch(const WatchOptions& options, std::ostream& out) {
 }
 
 absl::Status RunSessions(const std::string& server, bool json, std::ostream& out,
-                         absl::Duration connect_timeout) {
+                         const ClientOptions& connection) {
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
-                      ConnectTo(server, connect_timeout));
+                      ConnectTo(server, connection));
   NM_ASSIGN_OR_RETURN(const std::vector<v1::Session> sessions, client->ListSessions());
   if (json) {
     JsonWriter writer(2);

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
-#include "absl/time/time.h"
+#include "client/reconstruction_client.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
@@ -32,7 +32,7 @@ struct RemoteReconstructOptions {
   size_t builtin_points = 100000;  // Points sampled from a builtin:NAME input.
   bool ply = false;                // Also write each LOD as .ply.
   bool progress = false;           // Draw progress bars on `err`.
-  absl::Duration connect_timeout = absl::Seconds(5);
+  ClientOptions connection;        // Connect timeout, TLS, access token.
 };
 
 // Creates a session, watches it while the input streams up in batches, finishes it and
@@ -48,7 +48,7 @@ struct WatchOptions {
   std::string server;
   std::string out_dir;
   bool ply = false;
-  absl::Duration connect_timeout = absl::Seconds(5);
+  ClientOptions connection;
 };
 
 // Watches a session until it ends, saving and printing updates as RunRemoteReconstruct does
@@ -57,7 +57,7 @@ absl::Status RunWatch(const WatchOptions& options, std::ostream& out);
 
 // Lists the server's sessions as a table, or as JSON.
 absl::Status RunSessions(const std::string& server, bool json, std::ostream& out,
-                         absl::Duration connect_timeout = absl::Seconds(5));
+                         const ClientOptions& connection = {});
 
 }  // namespace neuralmesh::client
 

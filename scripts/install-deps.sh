@@ -17,8 +17,9 @@ packages=(
   libabsl-dev libdraco-dev libopenmesh-dev libgtest-dev libgmock-dev
   # Benchmarks.
   libbenchmark-dev
-  # Tests and tools: the reference Draco binaries, an independent Python gRPC client.
-  draco python3 python3-grpcio python3-grpc-tools python3-protobuf
+  # Tests and tools: the reference Draco binaries, an independent Python gRPC client, and
+  # openssl for the throw-away certificates of the TLS tests.
+  draco python3 python3-grpcio python3-grpc-tools python3-protobuf openssl
   # The live viewer's browser test: headless Chromium driven over the DevTools protocol.
   chromium python3-websocket
   "$@"

@@ -12,8 +12,13 @@
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "absl/flags/usage_config.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
+#include "core/io/file_contents.h"
+#include "core/status_macros.h"
+#include "server/access_tokens.h"
 #include "server/server.h"
 
 ABSL_FLAG(std::string, host, "127.0.0.1",
@@ -39,21 +44,108 @@ ABSL_FLAG(int, max_message_bytes, 64 << 20,
 ABSL_FLAG(absl::Duration, idle_timeout, absl::Minutes(30),
           "Delete sessions that had no open stream and no activity (calls, learning) for this "
           "long; 'inf' never does.");
+ABSL_FLAG(std::string, tls_cert_file, "",
+          "PEM file with the server's TLS certificate (then any intermediates); set: the port "
+          "speaks TLS only. Needs --tls_key_file.");
+ABSL_FLAG(std::string, tls_key_file, "", "PEM file with the private key of --tls_cert_file.");
+ABSL_FLAG(std::string, tls_client_ca_file, "",
+          "PEM file with the CAs that sign client certificates; set: mutual TLS, every client "
+          "must present a certificate signed by one of them. Needs --tls_cert_file.");
+ABSL_FLAG(std::string, access_tokens_file, "",
+          "File of access tokens, one per line ('#' starts a comment line; each at least 16 "
+          "printable characters); set: every call except health checks must carry "
+          "'authorization: Bearer TOKEN' with one of them. Needs --tls_cert_file. SIGHUP "
+          "reads the file again (calls already running go on).");
 ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(5),
           "On SIGTERM/SIGINT, how long calls may take to end before they are cancelled.");
 
+namespace {
+
+// The contents of the file a flag names ("" when the flag is empty); the message names the flag.
+absl::StatusOr<std::string> ReadFlagFile(const char* flag, const std::string& path) {
+  if (path.empty()) return std::string();
+  absl::StatusOr<std::string> contents = neuralmesh::ReadFileContents(path);
+  if (!contents.ok()) {
+    return absl::Status(contents.status().code(),
+                        absl::StrCat("--", flag, ": ", contents.status().message()));
+  }
+  return contents;
+}
+
+// The tokens of --access_tokens_file, which is set.
+absl::StatusOr<std::vector<std::string>> AccessTokensFromFlag() {
+  NM_ASSIGN_OR_RETURN(const std::string text,
+                      ReadFlagFile("access_tokens_file", absl::GetFlag(FLAGS_access_tokens_file)));
+  absl::StatusOr<std::vector<std::string>> tokens = neuralmesh::server::ParseAccessTokens(text);
+  if (!tokens.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--access_tokens_file: ", tokens.status().message()));
+  }
+  return tokens;
+}
+
+absl::StatusOr<neuralmesh::server::ServerSecurity> SecurityFromFlags() {
+  neuralmesh::server::ServerSecurity security;
+  struct PemFlag {
+    const char* flag;
+    std::string path;
+    std::string* contents;
+  };
+  const PemFlag pem_flags[] = {
+      {"tls_cert_file", absl::GetFlag(FLAGS_tls_cert_file), &security.tls.certificate_chain},
+      {"tls_key_file", absl::GetFlag(FLAGS_tls_key_file), &security.tls.private_key},
+      {"tls_client_ca_file", absl::GetFlag(FLAGS_tls_client_ca_file),
+       &security.tls.client_ca_certificates}};
+  for (const PemFlag& pem : pem_flags) {
+    NM_ASSIGN_OR_RETURN(*pem.contents, ReadFlagFile(pem.flag, pem.path));
+  }
+  if (!absl::GetFlag(FLAGS_access_tokens_file).empty()) {
+    NM_ASSIGN_OR_RETURN(security.access_tokens, AccessTokensFromFlag());
+  }
+  return security;
+}
+
+// On SIGHUP: the tokens of --access_tokens_file replace the server's, or, when the file is
+// now wrong, the old ones stay and the reason is printed.
+void ReloadAccessTokens(neuralmesh::server::ReconstructionServer& server) {
+  if (absl::GetFlag(FLAGS_access_tokens_file).empty()) {
+    std::printf("neuralmesh-server: SIGHUP received; no --access_tokens_file to read again\n");
+    return;
+  }
+  absl::StatusOr<std::vector<std::string>> tokens = AccessTokensFromFlag();
+  absl::Status replaced = tokens.ok() ? server.ReplaceAccessTokens(*tokens) : tokens.status();
+  if (replaced.ok()) {
+    std::printf("neuralmesh-server: SIGHUP received; %zu access tokens read again\n",
+                tokens->size());
+  } else {
+    std::fprintf(stderr, "neuralmesh-server: SIGHUP received; the old access tokens stay: %s\n",
+                 std::string(replaced.message()).c_str());
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  // --help lists the flags of this file (absl's default looks for a file named after the
+  // program, which has none).
+  absl::FlagsUsageConfig usage;
+  usage.contains_help_flags = [](absl::string_view file) {
+    return absl::EndsWith(file, "server/main.cc");
+  };
+  usage.contains_helpshort_flags = usage.contains_help_flags;
+  absl::SetFlagsUsageConfig(usage);
   absl::SetProgramUsageMessage(
       "Serves Neural Meshes surface reconstruction over gRPC (neuralmesh.v1).\n"
       "Usage: neuralmesh-server [--host=127.0.0.1] [--port=50051] [flags]");
   absl::ParseCommandLine(argc, argv);
 
-  // Block the shutdown signals in every thread (gRPC's and ours inherit this mask) and take
-  // them synchronously on one thread below.
+  // Block the shutdown signals and SIGHUP in every thread (gRPC's and ours inherit this mask)
+  // and take them synchronously on one thread below.
   sigset_t signals;
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   neuralmesh::server::ServerOptions options;
@@ -79,6 +171,12 @@ int main(int argc, char** argv) {
   options.limits.max_points_per_session = static_cast<size_t>(max_points);
   options.limits.max_batch_points = static_cast<size_t>(max_batch);
   options.limits.idle_timeout = absl::GetFlag(FLAGS_idle_timeout);
+  absl::StatusOr<neuralmesh::server::ServerSecurity> security = SecurityFromFlags();
+  if (!security.ok()) {
+    std::fprintf(stderr, "neuralmesh-server: %s\n", security.status().ToString().c_str());
+    return 2;
+  }
+  options.security = *std::move(security);
   // PackedPoints: 12 bytes a point for the position, 4 for a weight, 12 for a normal.
   constexpr int64_t kLargestPackedPointBytes = 28;
   if (max_batch > options.max_message_bytes / kLargestPackedPointBytes) {
@@ -98,12 +196,22 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "neuralmesh-server: %s\n", server.status().ToString().c_str());
     return 1;
   }
-  std::printf("neuralmesh-server listening on %s:%d (%d worker threads)\n",
-              absl::GetFlag(FLAGS_host).c_str(), (*server)->port(), options.worker_threads);
+  const neuralmesh::server::ServerSecurity& secured = options.security;
+  std::printf("neuralmesh-server listening on %s:%d (%d worker threads; %s%s)\n",
+              absl::GetFlag(FLAGS_host).c_str(), (*server)->port(), options.worker_threads,
+              !secured.tls.enabled()                            ? "plaintext"
+              : secured.tls.client_ca_certificates.empty()      ? "TLS"
+                                                                : "mutual TLS",
+              secured.access_tokens.empty()
+                  ? ""
+                  : absl::StrCat(", ", secured.access_tokens.size(), " access tokens").c_str());
   std::fflush(stdout);
 
   int signal_number = 0;
-  sigwait(&signals, &signal_number);
+  while (sigwait(&signals, &signal_number) == 0 && signal_number == SIGHUP) {
+    ReloadAccessTokens(**server);
+    std::fflush(stdout);
+  }
   std::printf("neuralmesh-server: %s received, shutting down\n",
               signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
   std::fflush(stdout);

@@ -48,7 +48,11 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
     return absl::InvalidArgumentError("idle_timeout must be positive");
   }
 
+  absl::StatusOr<PortCredentials> credentials = MakeServerCredentials(options.security);
+  if (!credentials.ok()) return credentials.status();
+
   std::unique_ptr<ReconstructionServer> server(new ReconstructionServer(options));
+  server->token_checker_ = credentials->token_checker;
   server->pool_ = std::make_unique<WorkerPool>(options.worker_threads, options.time_slice);
   server->encoder_ = std::make_unique<Executor>(options.encoder_threads);
   server->filter_ = std::make_unique<Executor>(options.filter_threads);
@@ -64,8 +68,7 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
 
   grpc::ServerBuilder builder;
   if (!options.address.empty()) {
-    builder.AddListeningPort(options.address, grpc::InsecureServerCredentials(),
-                             &server->port_);
+    builder.AddListeningPort(options.address, credentials->credentials, &server->port_);
   }
   builder.SetMaxReceiveMessageSize(options.max_message_bytes);
   builder.SetMaxSendMessageSize(options.max_message_bytes);
@@ -83,8 +86,12 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   server->server_ = builder.BuildAndStart();
   if (server->server_ == nullptr || (!options.address.empty() && server->port_ == 0)) {
     server->server_.reset();
-    return absl::UnavailableError(
-        absl::StrCat("cannot listen on \"", options.address, "\" (in use or not local?)"));
+    return absl::UnavailableError(absl::StrCat(
+        "cannot listen on \"", options.address, "\" (",
+        options.security.tls.enabled()
+            ? "in use, not local, or gRPC rejected the TLS certificate or key: are both PEM, "
+              "and is the key the certificate's?)"
+            : "in use or not local?)"));
   }
   grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
   if (health != nullptr) {
@@ -109,6 +116,14 @@ std::shared_ptr<grpc::Channel> ReconstructionServer::InProcessChannel() {
   args.SetMaxReceiveMessageSize(options_.max_message_bytes);
   args.SetMaxSendMessageSize(options_.max_message_bytes);
   return server_->InProcessChannel(args);
+}
+
+absl::Status ReconstructionServer::ReplaceAccessTokens(std::vector<std::string> tokens) {
+  if (token_checker_ == nullptr) {
+    return absl::FailedPreconditionError(
+        "the server was started without access tokens; tokens cannot be added to it running");
+  }
+  return token_checker_->ReplaceTokens(std::move(tokens));
 }
 
 void ReconstructionServer::Shutdown(absl::Duration grace) {

@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <grpcpp/channel.h>
 #include <grpcpp/server.h>
@@ -16,6 +17,7 @@
 #include "server/executor.h"
 #include "server/reactor_registry.h"
 #include "server/reconstruction_service.h"
+#include "server/server_credentials.h"
 #include "server/session_manager.h"
 #include "server/worker_pool.h"
 
@@ -24,6 +26,8 @@ namespace neuralmesh::server {
 struct ServerOptions {
   // host:port to listen on ("127.0.0.1:0" picks a free port); empty: in-process only.
   std::string address = "127.0.0.1:0";
+  // TLS, mutual TLS and access tokens of the listening port (none: plaintext, open to all).
+  ServerSecurity security;
   int worker_threads = 2;                            // Learning threads, shared by all sessions.
   int encoder_threads = 1;                           // Draco encoding threads.
   // Threads that ingest the batches of sessions that filter outliers, off gRPC's threads.
@@ -35,8 +39,8 @@ struct ServerOptions {
 
 class ReconstructionServer {
  public:
-  // Builds and starts the server. INVALID_ARGUMENT for bad options; UNAVAILABLE when the
-  // address cannot be bound.
+  // Builds and starts the server. INVALID_ARGUMENT for bad options (security included);
+  // UNAVAILABLE when the address cannot be bound or gRPC rejects the TLS certificate or key.
   static absl::StatusOr<std::unique_ptr<ReconstructionServer>> Start(
       const ServerOptions& options);
   ~ReconstructionServer();  // Shutdown with a 5 s grace period.
@@ -44,7 +48,8 @@ class ReconstructionServer {
   ReconstructionServer(const ReconstructionServer&) = delete;
   ReconstructionServer& operator=(const ReconstructionServer&) = delete;
 
-  // The bound port (0 when in-process only) and "host:port" to dial.
+  // The bound port (0 when in-process only) and "host:port" to dial. The in-process channel
+  // bypasses TLS and access tokens: it is for callers inside the process.
   int port() const { return port_; }
   std::string target() const;
 
@@ -59,6 +64,11 @@ class ReconstructionServer {
   // Blocks until Shutdown has completed.
   void Wait() ABSL_LOCKS_EXCLUDED(shutdown_mu_);
 
+  // Replaces the access tokens for calls that start from now on (running calls go on), for a
+  // reload without a restart. FAILED_PRECONDITION when the server was started without tokens,
+  // INVALID_ARGUMENT (the old tokens kept) for an empty list or an invalid token.
+  absl::Status ReplaceAccessTokens(std::vector<std::string> tokens);
+
   SessionManager& sessions() { return *manager_; }
   ReactorRegistry& reactors() { return *reactors_; }
 
@@ -72,6 +82,7 @@ class ReconstructionServer {
   std::unique_ptr<ReactorRegistry> reactors_;
   std::unique_ptr<SessionManager> manager_;
   std::unique_ptr<ReconstructionService> service_;
+  std::shared_ptr<AccessTokenChecker> token_checker_;  // Null without access tokens.
   std::unique_ptr<grpc::Server> server_;  // Destroyed first.
   int port_ = 0;
 

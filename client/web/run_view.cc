@@ -46,10 +46,11 @@ absl::Status RunView(const ViewOptions& options, std::ostream& out) {
   const std::string web_root = options.web_root.empty() ? DefaultWebRoot() : options.web_root;
   NM_RETURN_IF_ERROR(CheckWebRoot(web_root));
   NM_ASSIGN_OR_RETURN(const HostPort listen, ParseListenAddress(options.listen));
-  ClientOptions client_options;
-  client_options.connect_timeout = options.connect_timeout;
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
-                      ReconstructionClient::Connect(options.server, client_options));
+                      ReconstructionClient::Connect(options.server, options.connection));
+  // One call before serving: a server that refuses the viewer (a missing or wrong access
+  // token) is reported now, not as a 502 on every page.
+  NM_RETURN_IF_ERROR(client->ListSessions().status());
 
   ViewerOptions viewer_options;
   viewer_options.web_root = web_root;

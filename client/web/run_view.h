@@ -7,7 +7,7 @@
 #include <string>
 
 #include "absl/status/status.h"
-#include "absl/time/time.h"
+#include "client/reconstruction_client.h"
 
 namespace neuralmesh::client::web {
 
@@ -15,7 +15,7 @@ struct ViewOptions {
   std::string server;                     // The neuralmesh-server, HOST:PORT.
   std::string listen = "127.0.0.1:8080";  // Where browsers connect, HOST:PORT (port 0: any).
   std::string web_root;                   // Empty: the source tree's client/web.
-  absl::Duration connect_timeout = absl::Seconds(5);
+  ClientOptions connection;                // Connect timeout, TLS, access token.
 };
 
 // The client/web folder of the source tree this binary was built from.
@@ -24,7 +24,8 @@ std::string DefaultWebRoot();
 // Checks the web root, connects to the server, listens, prints
 // "viewer: http://HOST:PORT/ (sessions of SERVER)" and serves until interrupted. Errors:
 // NOT_FOUND for a web root without the viewer's files, INVALID_ARGUMENT for a malformed
-// --listen, UNAVAILABLE when the server cannot be reached or the address cannot be bound.
+// --listen, UNAVAILABLE when the server cannot be reached or the address cannot be bound,
+// UNAUTHENTICATED when the server refuses the viewer's access token (or its lack of one).
 absl::Status RunView(const ViewOptions& options, std::ostream& out);
 
 }  // namespace neuralmesh::client::web

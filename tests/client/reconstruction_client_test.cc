@@ -416,6 +416,8 @@ TEST(ReconstructionClientConnectTest, NoServerGivesUnavailable) {
   ASSERT_FALSE(client.ok());
   EXPECT_TRUE(absl::IsUnavailable(client.status())) << client.status();
   EXPECT_NE(client.status().message().find(address), absl::string_view::npos) << client.status();
+  EXPECT_NE(client.status().message().find("Connection refused"), absl::string_view::npos)
+      << "gRPC's reason is passed on: " << client.status();
 }
 
 TEST(PackPointBatchTest, PacksLittleEndianFloatsOfTheRange) {

@@ -44,6 +44,7 @@ class TestServer {
   }
 
   const std::string& address() const { return address_; }
+  std::string Stdout() const { return process_.Stdout(); }
   std::string Stderr() const { return process_.Stderr(); }
   // Sends `signal` to the server process (SIGSTOP: it stops answering, connections stay open).
   void Signal(int signal) { process_.Signal(signal); }

@@ -5,9 +5,12 @@ Generates stubs with Debian's python3-grpc-tools into a temporary directory, the
 running server: checks the health service and server reflection, creates a session, uploads a
 sphere in batches (client streaming), watches it (server streaming), finishes it, fetches the
 final mesh, checks that a NaN batch is rejected with INVALID_ARGUMENT, and runs one
-Reconstruct call (bidirectional). Exits 0 on success.
+Reconstruct call (bidirectional). With --root_cert and --token it does all of it over TLS
+with the access token, after checking that calls without the token are UNAUTHENTICATED while
+the health service stays open. Exits 0 on success.
 
 Usage: python_client_test.py --target=127.0.0.1:PORT --proto_root=proto
+           [--root_cert=ca.pem --token=TOKEN]
 """
 import argparse
 import math
@@ -60,6 +63,8 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--target", required=True)
     parser.add_argument("--proto_root", required=True)
+    parser.add_argument("--root_cert", help="PEM of the CA of a TLS server")
+    parser.add_argument("--token", help="the access token of a server that asks for one")
     args = parser.parse_args()
 
     out_dir = tempfile.mkdtemp(prefix="nm_py_")
@@ -68,8 +73,27 @@ def main():
     from neuralmesh.v1 import reconstruction_pb2 as pb
     from neuralmesh.v1 import reconstruction_pb2_grpc as pb_grpc
 
-    channel = grpc.insecure_channel(args.target, options=[
-        ("grpc.max_receive_message_length", 64 << 20)])
+    options = [("grpc.max_receive_message_length", 64 << 20)]
+    if args.root_cert:
+        with open(args.root_cert, "rb") as f:
+            tls = grpc.ssl_channel_credentials(root_certificates=f.read())
+        without_token = grpc.secure_channel(args.target, tls, options=options)
+        grpc.channel_ready_future(without_token).result(timeout=10)
+        check(raw_unary(without_token, "/grpc.health.v1.Health/Check", b"") == b"\x08\x01",
+              "the health check needs no token")
+        try:
+            pb_grpc.ReconstructionServiceStub(without_token).ListSessions(
+                pb.ListSessionsRequest(), timeout=10)
+            check(False, "a call without the access token was answered")
+        except grpc.RpcError as e:
+            check(e.code() == grpc.StatusCode.UNAUTHENTICATED and
+                  "requires an access token" in e.details(),
+                  "a call without the token gave %s: %s" % (e.code(), e.details()))
+        credentials = grpc.composite_channel_credentials(
+            tls, grpc.access_token_call_credentials(args.token))
+        channel = grpc.secure_channel(args.target, credentials, options=options)
+    else:
+        channel = grpc.insecure_channel(args.target, options=options)
     grpc.channel_ready_future(channel).result(timeout=10)
 
     # grpc.health.v1.Health/Check with an empty request: status SERVING (field 1 = 1).

@@ -124,49 +124,24 @@ TEST(ServerEndToEndTest, TorusInAHundredBatchesOverLoopback) {
   // The final mesh is close to the true torus.
   absl::StatusOr<TriangleMesh> final_mesh = DecodeMesh(updates.back().draco_mesh());
   ASSERT_TRUE(final_mesh.ok());
-  GeometricErrorOptions options;
-  options.samples = 50000;
-  options.threads = 1;
-  absl::StatusOr<GeometricError> error =
-      ComputeGeometricError(*final_mesh, (*torus)->ReferenceMesh(20), options);
-  ASSERT_TRUE(error.ok()) << error.status();
-  EXPECT_LT(error->chamfer_l1, 0.02) << "the final mesh is too far from the torus (2% of the diagonal)";
+  absl::StatusOr<double> chamfer = testing::ChamferToTorus(*final_mesh);
+  ASSERT_TRUE(chamfer.ok()) << chamfer.status();
+  EXPECT_LT(*chamfer, 0.02) << "the final mesh is too far from the torus (2% of the diagonal)";
   const double bytes_per_vertex =
       static_cast<double>(updates.back().draco_mesh().size()) / updates.back().vertex_count();
   std::printf("final mesh: %llu vertices, genus %d, chamfer %.5f, %.2f bytes/vertex\n",
               static_cast<unsigned long long>(updates.back().vertex_count()),
-              updates.back().report().genus(), error->chamfer_l1, bytes_per_vertex);
+              updates.back().report().genus(), *chamfer, bytes_per_vertex);
 }
 
 TEST(ServerEndToEndTest, HealthServiceReportsServing) {
   std::unique_ptr<ReconstructionServer> server = testing::StartServer(/*listen=*/true);
   ASSERT_NE(server, nullptr);
   auto channel = grpc::CreateChannel(server->target(), grpc::InsecureChannelCredentials());
-  grpc::GenericStub generic(channel);
   for (const std::string service : {"", "neuralmesh.v1.ReconstructionService"}) {
-    // grpc.health.v1.HealthCheckRequest{service}: field 1, length-delimited.
-    std::string request_bytes;
-    if (!service.empty()) {
-      request_bytes = absl::StrCat(std::string(1, '\x0a'),
-                                   std::string(1, static_cast<char>(service.size())), service);
-    }
-    grpc::Slice slice(request_bytes);
-    grpc::ByteBuffer request(&slice, 1);
-    grpc::ByteBuffer response;
-    grpc::ClientContext context;
-    absl::Notification done;
-    grpc::Status status;
-    generic.UnaryCall(&context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &request,
-                      &response, [&](grpc::Status s) {
-                        status = s;
-                        done.Notify();
-                      });
-    done.WaitForNotification();
-    ASSERT_TRUE(status.ok()) << status.error_message();
-    std::vector<grpc::Slice> slices;
-    ASSERT_TRUE(response.Dump(&slices).ok());
     std::string bytes;
-    for (const grpc::Slice& s : slices) bytes += std::string(s.begin(), s.end());
+    const grpc::Status status = testing::CheckHealth(channel, service, &bytes);
+    ASSERT_TRUE(status.ok()) << status.error_message();
     EXPECT_EQ(bytes, std::string("\x08\x01", 2)) << "status SERVING for \"" << service << "\"";
   }
 }

@@ -3,6 +3,7 @@
 #ifndef NEURALMESH_TESTS_SERVER_SERVER_TEST_SUPPORT_H_
 #define NEURALMESH_TESTS_SERVER_SERVER_TEST_SUPPORT_H_
 
+#include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
@@ -12,6 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
+#include "absl/synchronization/notification.h"
+#include "core/analysis/geometric_error.h"
 #include "core/point_cloud.h"
 #include "core/random.h"
 #include "core/sampling/implicit_surfaces.h"
@@ -173,6 +177,52 @@ inline grpc::Status WatchAll(v1::ReconstructionService::Stub& stub, const std::s
   v1::MeshUpdate update;
   while (reader->Read(&update)) updates->push_back(update);
   return reader->Finish();
+}
+
+// grpc.health.v1.Health/Check of `service` ("": the server as a whole) through `channel`;
+// the response's bytes in `response` (08 01 is SERVING).
+inline grpc::Status CheckHealth(const std::shared_ptr<grpc::Channel>& channel,
+                                const std::string& service, std::string* response_bytes) {
+  grpc::GenericStub generic(channel);
+  // grpc.health.v1.HealthCheckRequest{service}: field 1, length-delimited.
+  std::string request_bytes;
+  if (!service.empty()) {
+    request_bytes = absl::StrCat(std::string(1, '\x0a'),
+                                 std::string(1, static_cast<char>(service.size())), service);
+  }
+  grpc::Slice slice(request_bytes);
+  grpc::ByteBuffer request(&slice, 1);
+  grpc::ByteBuffer response;
+  grpc::ClientContext context;
+  context.set_deadline(absl::ToChronoTime(absl::Now() + absl::Seconds(10)));
+  absl::Notification done;
+  grpc::Status status;
+  generic.UnaryCall(&context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &request,
+                    &response, [&](grpc::Status s) {
+                      status = s;
+                      done.Notify();
+                    });
+  done.WaitForNotification();
+  if (!status.ok()) return status;
+  std::vector<grpc::Slice> slices;
+  if (!response.Dump(&slices).ok()) return grpc::Status(grpc::StatusCode::INTERNAL, "no bytes");
+  response_bytes->clear();
+  for (const grpc::Slice& s : slices) response_bytes->append(s.begin(), s.end());
+  return status;
+}
+
+// Symmetric Chamfer-L1 from `mesh` to the torus of TorusPoints, relative to the bounding-box
+// diagonal (core/analysis/geometric_error.h, 50,000 samples, one thread).
+inline absl::StatusOr<double> ChamferToTorus(const TriangleMesh& mesh) {
+  absl::StatusOr<std::unique_ptr<ImplicitSurface>> torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4);
+  if (!torus.ok()) return torus.status();
+  GeometricErrorOptions options;
+  options.samples = 50000;
+  options.threads = 1;
+  absl::StatusOr<GeometricError> error =
+      ComputeGeometricError(mesh, (*torus)->ReferenceMesh(20), options);
+  if (!error.ok()) return error.status();
+  return error->chamfer_l1;
 }
 
 // Largest distance from the mesh's vertices to `surface`.

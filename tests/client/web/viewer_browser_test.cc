@@ -106,7 +106,9 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
     EXPECT_EQ(shown[i].faces, shown[i].server_faces);
     EXPECT_GT(shown[i].draco_bytes, 0u);
     EXPECT_LT(shown[i].delay_ms, 30000u) << "the page got each mesh while it was recent";
-    if (i > 0) EXPECT_GT(shown[i].sequence, shown[i - 1].sequence);
+    if (i > 0) {
+      EXPECT_GT(shown[i].sequence, shown[i - 1].sequence);
+    }
   }
   EXPECT_LT(shown.front().vertices, shown.back().vertices) << "coarse to fine";
   EXPECT_EQ(shown.back().kind, "final");

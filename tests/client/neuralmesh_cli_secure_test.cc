@@ -1,0 +1,212 @@
+// The command line against a secured server: neuralmesh-server with TLS and access tokens,
+// `neuralmesh reconstruct/sessions/view` connecting with --tls_ca_file and
+// --access_token_file, all run as subprocesses on 127.0.0.1 with throw-away certificates; and
+// the messages and exit codes of security flags that are wrong.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "core/io/file_contents.h"
+#include "tests/client/subprocess.h"
+#include "tests/client/test_server.h"
+#include "tests/client/web/viewer_test_support.h"
+#include "tests/testing/test_certificates.h"
+
+namespace neuralmesh::testing {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr char kToken[] = "cli-test-token-0123456789abcdef";
+
+class SecureCliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(MakeTempDir("cli_secure"));
+    absl::StatusOr<TestCertificates> made = MakeTestCertificates(*dir_ + "/tls");
+    ASSERT_TRUE(made.ok()) << made.status();
+    certificates_ = new TestCertificates(*std::move(made));
+    ASSERT_TRUE(WriteFileContents(Path("tokens"), absl::StrCat("# test\n", kToken, "\n")).ok());
+    ASSERT_TRUE(WriteFileContents(Path("token"), absl::StrCat(kToken, "\n")).ok());
+    ASSERT_TRUE(WriteFileContents(Path("wrong_token"), "wrong-token-0123456789abcdef").ok());
+    chmod(Path("token").c_str(), 0600);
+    std::string error;
+    server_ = TestServer::Start({"--tls_cert_file=" + certs().Path("server.pem"),
+                                 "--tls_key_file=" + certs().Path("server.key"),
+                                 "--access_tokens_file=" + Path("tokens")},
+                                &error)
+                  .release();
+    ASSERT_NE(server_, nullptr) << error;
+  }
+  static void TearDownTestSuite() {
+    delete server_;
+    delete certificates_;
+    std::filesystem::remove_all(*dir_);
+    delete dir_;
+  }
+
+  static std::string Path(const std::string& file) { return *dir_ + "/" + file; }
+  static const TestCertificates& certs() { return *certificates_; }
+  // The flags that reach the test server: its address, the CA and the token.
+  static std::vector<std::string> Secured(std::vector<std::string> args) {
+    args.insert(args.end(), {"--server=" + server_->address(),
+                             "--tls_ca_file=" + certs().Path("ca.pem"),
+                             "--access_token_file=" + Path("token")});
+    return args;
+  }
+
+  static std::string* dir_;
+  static TestCertificates* certificates_;
+  static TestServer* server_;
+};
+
+std::string* SecureCliTest::dir_ = nullptr;
+TestCertificates* SecureCliTest::certificates_ = nullptr;
+TestServer* SecureCliTest::server_ = nullptr;
+
+TEST_F(SecureCliTest, ReconstructAndSessionsOverTlsWithAToken) {
+  const RunResult reconstruct =
+      RunNeuralmesh(Secured({"reconstruct", "builtin:sphere", "--out-dir", Path("out"),
+                             "--vertices", "300", "--points", "3000"}));
+  ASSERT_EQ(reconstruct.exit_code, 0) << reconstruct.Describe();
+  EXPECT_TRUE(std::filesystem::exists(Path("out/sphere.drc"))) << reconstruct.out;
+  const RunResult stats = RunNeuralmesh({"stats", Path("out/sphere.drc"), "--json"});
+  ASSERT_EQ(stats.exit_code, 0) << stats.Describe();
+  EXPECT_THAT(stats.out, HasSubstr("\"vertices\": 300"));
+  EXPECT_THAT(stats.out, HasSubstr("\"genus\": 0"));
+
+  const RunResult sessions = RunNeuralmesh(Secured({"sessions"}));
+  ASSERT_EQ(sessions.exit_code, 0) << sessions.Describe();
+  EXPECT_THAT(sessions.out, HasSubstr("finished"));
+}
+
+TEST_F(SecureCliTest, AMissingWrongOrUnprotectedTokenFailsClearly) {
+  const std::string server = "--server=" + server_->address();
+  const std::string ca = "--tls_ca_file=" + certs().Path("ca.pem");
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const Case cases[] = {
+      {{"sessions", server, ca}, "requires an access token"},
+      {{"sessions", server, ca, "--access_token_file=" + Path("wrong_token")},
+       "not one this server accepts"},
+      {{"sessions", server, "--connect_timeout=1s"}, "does the server want TLS"},
+      {{"sessions", server, "--access_token_file=" + Path("token")},
+       "--access_token_file needs TLS"},
+      {{"sessions", server, "--tls_ca_file=" + Path("missing.pem")},
+       "--tls_ca_file: cannot open"},
+      {{"sessions", server, "--tls_ca_file=" + Path("token")}, "not PEM text"},
+      {{"sessions", server, "--tls", "--tls_cert_file=" + certs().Path("client.pem")},
+       "needs its private key"},
+      {{"reconstruct", "builtin:sphere", "-o", Path("local.ply"), "--vertices", "100", "--tls"},
+       "--tls needs --server"},
+  };
+  for (const Case& c : cases) {
+    const RunResult run = RunNeuralmesh(c.args);
+    EXPECT_NE(run.exit_code, 0) << run.Describe();
+    EXPECT_THAT(run.err, HasSubstr(c.message)) << run.Describe();
+  }
+}
+
+TEST_F(SecureCliTest, TheViewerReachesASecuredServer) {
+  BackgroundProcess viewer("neuralmesh", Secured({"view", "--listen=127.0.0.1:0"}));
+  const int port = WaitForViewerPort(viewer);
+  ASSERT_NE(port, 0) << viewer.Stderr();
+  const HttpReply sessions = HttpGet(port, "/api/sessions");
+  EXPECT_EQ(sessions.status, 200) << sessions.body;
+  EXPECT_THAT(sessions.body, ::testing::StartsWith("["))
+      << "listed through TLS with the token (a refused call is a 502 with an error object)";
+  EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << viewer.Stderr();
+
+  const RunResult refused = RunNeuralmesh({"view", "--server=" + server_->address(),
+                                           "--tls_ca_file=" + certs().Path("ca.pem"),
+                                           "--access_token_file=" + Path("wrong_token"),
+                                           "--listen=127.0.0.1:0"});
+  EXPECT_NE(refused.exit_code, 0) << refused.Describe();
+  EXPECT_THAT(refused.err, HasSubstr("not one this server accepts")) << "said at start";
+}
+
+TEST_F(SecureCliTest, SighupReadsTheTokensFileAgain) {
+  const std::string tokens = Path("reloaded_tokens");
+  ASSERT_TRUE(WriteFileContents(tokens, absl::StrCat(kToken, "\n")).ok());
+  std::string error;
+  std::unique_ptr<TestServer> server =
+      TestServer::Start({"--tls_cert_file=" + certs().Path("server.pem"),
+                         "--tls_key_file=" + certs().Path("server.key"),
+                         "--access_tokens_file=" + tokens},
+                        &error);
+  ASSERT_NE(server, nullptr) << error;
+  const std::vector<std::string> sessions = {"sessions", "--server=" + server->address(),
+                                             "--tls_ca_file=" + certs().Path("ca.pem")};
+  auto with_token = [&](const std::string& token_file) {
+    std::vector<std::string> args = sessions;
+    args.push_back("--access_token_file=" + token_file);
+    return RunNeuralmesh(args);
+  };
+  EXPECT_EQ(with_token(Path("token")).exit_code, 0);
+  EXPECT_NE(with_token(Path("wrong_token")).exit_code, 0);
+
+  // The file now holds the other token: after SIGHUP it is the one accepted.
+  ASSERT_TRUE(WriteFileContents(tokens, ReadWholeFile(Path("wrong_token"))).ok());
+  server->Signal(SIGHUP);
+  for (int i = 0; i < 100 && !absl::StrContains(server->Stdout(), "read again"); ++i) {
+    usleep(50 * 1000);
+  }
+  EXPECT_THAT(server->Stdout(), HasSubstr("SIGHUP received; 1 access tokens read again"));
+  EXPECT_EQ(with_token(Path("wrong_token")).exit_code, 0);
+  const RunResult old_token = with_token(Path("token"));
+  EXPECT_NE(old_token.exit_code, 0);
+  EXPECT_THAT(old_token.err, HasSubstr("not one this server accepts"));
+
+  // A file that went wrong keeps the tokens the server has.
+  ASSERT_TRUE(WriteFileContents(tokens, "short\n").ok());
+  server->Signal(SIGHUP);
+  for (int i = 0; i < 100 && !absl::StrContains(server->Stderr(), "stay"); ++i) {
+    usleep(50 * 1000);
+  }
+  EXPECT_THAT(server->Stderr(),
+              HasSubstr("the old access tokens stay: --access_tokens_file: line 1"));
+  EXPECT_EQ(with_token(Path("wrong_token")).exit_code, 0);
+}
+
+TEST_F(SecureCliTest, TheServerRefusesSecurityFlagsThatDoNotGoTogetherAndDocumentsThem) {
+  const std::string cert = "--tls_cert_file=" + certs().Path("server.pem");
+  const std::string key = "--tls_key_file=" + certs().Path("server.key");
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const Case cases[] = {
+      {{"--port=0", "--tls_cert_file=" + Path("missing.pem"), key}, "--tls_cert_file: cannot open"},
+      {{"--port=0", cert}, "without its private key"},
+      {{"--port=0", "--access_tokens_file=" + Path("tokens")}, "access tokens need TLS"},
+      {{"--port=0", cert, key, "--access_tokens_file=" + certs().Path("ca.pem")},
+       "--access_tokens_file: line 1"},
+      {{"--port=0", cert, "--tls_key_file=" + certs().Path("client.key")},
+       "rejected the TLS certificate or key"},
+  };
+  for (const Case& c : cases) {
+    const RunResult run = RunBinary("neuralmesh-server", c.args);
+    EXPECT_NE(run.exit_code, 0) << run.Describe();
+    EXPECT_THAT(run.err, HasSubstr(c.message)) << run.Describe();
+  }
+  // --help documents them, with the server's other flags.
+  const RunResult help = RunBinary("neuralmesh-server", {"--help"});
+  for (const char* flag : {"--tls_cert_file", "--tls_key_file", "--tls_client_ca_file",
+                           "--access_tokens_file", "--max_sessions", "--port"}) {
+    EXPECT_THAT(help.out, HasSubstr(flag)) << help.Describe();
+  }
+}
+
+}  // namespace
+}  // namespace neuralmesh::testing

@@ -11,8 +11,12 @@
 #      (build/bin/neuralmesh, built when missing) and decodes the final .drc with Debian's
 #      draco_decoder and `neuralmesh stats`;
 #   6. stops the container with SIGTERM (podman stop) and checks that the server shut down
-#      gracefully (exit status 0, shutdown messages in its log).
-# The container is always removed at the end. The Dockerfile itself stays standard: every
+#      gracefully (exit status 0, shutdown messages in its log);
+#   7. runs it again secured, with TLS and an access token from a read-only mount (throw-away
+#      certificates made with openssl): plaintext and token-less calls are refused, a client
+#      with the CA and the token reconstructs a torus, and after `podman kill -s HUP` with a
+#      new tokens file only the new token is accepted.
+# The containers are always removed at the end. The Dockerfile itself stays standard: every
 # podman adjustment (containers.conf, chroot isolation, the imported base image) lives here.
 #
 # Usage: scripts/container-test.sh      (as root; from anywhere, paths are relative to the repo)
@@ -189,25 +193,38 @@ step "Starting the container on 127.0.0.1"
 free_port() {
   "${PYTHON}" -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'
 }
-CONTAINER="neuralmesh-test-$$"
-PORT=""
-# The port is free when picked; should another process take it before podman binds it, pick
-# another.
-for _ in 1 2 3; do
-  PORT=$(free_port)
-  if podman run -d --name "${CONTAINER}" -p "127.0.0.1:${PORT}:${CONTAINER_PORT}" "${IMAGE}" \
-    >/dev/null 2>"${WORK_DIR}/run.err"; then
-    break
-  fi
-  podman rm -f "${CONTAINER}" >/dev/null 2>&1 || true
-  PORT=""
-done
-[[ -n "${PORT}" ]] || fail "podman run: $(cat "${WORK_DIR}/run.err")"
-ADDRESS="127.0.0.1:${PORT}"
+# start_container NAME [PODMAN_RUN_OPTION...] -- [SERVER_FLAG...]: runs the image as
+# CONTAINER=NAME with its port published on 127.0.0.1 at a free port; sets ADDRESS.
+start_container() {
+  CONTAINER=$1
+  shift
+  local options=()
+  while [[ $# -gt 0 && "$1" != "--" ]]; do
+    options+=("$1")
+    shift
+  done
+  [[ $# -gt 0 ]] && shift
+  local port=""
+  # The port is free when picked; should another process take it before podman binds it,
+  # pick another.
+  for _ in 1 2 3; do
+    port=$(free_port)
+    if podman run -d --name "${CONTAINER}" -p "127.0.0.1:${port}:${CONTAINER_PORT}" \
+      "${options[@]}" "${IMAGE}" "$@" >/dev/null 2>"${WORK_DIR}/run.err"; then
+      break
+    fi
+    podman rm -f "${CONTAINER}" >/dev/null 2>&1 || true
+    port=""
+  done
+  [[ -n "${port}" ]] || fail "podman run: $(cat "${WORK_DIR}/run.err")"
+  ADDRESS="127.0.0.1:${port}"
+}
+start_container "neuralmesh-test-$$" --
 
 step "Waiting for grpc.health.v1 to report SERVING on ${ADDRESS}"
 # grpc.health.v1.Health/Check with raw bytes, so no stubs are needed: a request naming a
 # service is field 1 (string); the answer SERVING is field 1 (enum) = 1, i.e. bytes 08 01.
+# A third argument, a CA's PEM file, makes it a TLS call (no token: health checks need none).
 cat >"${WORK_DIR}/health.py" <<'EOF'
 import sys
 
@@ -215,7 +232,12 @@ import grpc
 
 target, service = sys.argv[1], sys.argv[2].encode()
 request = b"\x0a" + bytes([len(service)]) + service if service else b""
-with grpc.insecure_channel(target) as channel:
+if len(sys.argv) > 3:
+    with open(sys.argv[3], "rb") as ca:
+        channel = grpc.secure_channel(target, grpc.ssl_channel_credentials(ca.read()))
+else:
+    channel = grpc.insecure_channel(target)
+with channel:
     check = channel.unary_unary("/grpc.health.v1.Health/Check",
                                 request_serializer=lambda b: b, response_deserializer=lambda b: b)
     try:
@@ -227,20 +249,24 @@ with grpc.insecure_channel(target) as channel:
         print("health check: not SERVING (answer %r)" % answer, file=sys.stderr)
         sys.exit(1)
 EOF
-healthy=0
-for _ in $(seq 1 60); do
-  running=$(podman inspect --format '{{.State.Running}}' "${CONTAINER}" 2>/dev/null || echo false)
-  [[ "${running}" == true ]] || fail "the container exited at start"
-  if "${PYTHON}" "${WORK_DIR}/health.py" "${ADDRESS}" "" 2>"${WORK_DIR}/health.err" \
-    && "${PYTHON}" "${WORK_DIR}/health.py" "${ADDRESS}" neuralmesh.v1.ReconstructionService \
-      2>"${WORK_DIR}/health.err"; then
-    healthy=1
-    break
-  fi
-  sleep 1
-done
-[[ ${healthy} -eq 1 ]] || fail "not SERVING within 60 s: $(cat "${WORK_DIR}/health.err")"
-say "SERVING on ${ADDRESS}: the server and neuralmesh.v1.ReconstructionService"
+# wait_serving [CA_FILE]: waits up to 60 s for CONTAINER's server to report SERVING.
+wait_serving() {
+  local healthy=0
+  for _ in $(seq 1 60); do
+    running=$(podman inspect --format '{{.State.Running}}' "${CONTAINER}" 2>/dev/null || echo false)
+    [[ "${running}" == true ]] || fail "the container exited at start"
+    if "${PYTHON}" "${WORK_DIR}/health.py" "${ADDRESS}" "" "$@" 2>"${WORK_DIR}/health.err" \
+      && "${PYTHON}" "${WORK_DIR}/health.py" "${ADDRESS}" neuralmesh.v1.ReconstructionService \
+        "$@" 2>"${WORK_DIR}/health.err"; then
+      healthy=1
+      break
+    fi
+    sleep 1
+  done
+  [[ ${healthy} -eq 1 ]] || fail "not SERVING within 60 s: $(cat "${WORK_DIR}/health.err")"
+  say "SERVING on ${ADDRESS}: the server and neuralmesh.v1.ReconstructionService"
+}
+wait_serving
 
 # --- 6. Reconstruction ---------------------------------------------------------------------
 step "Reconstructing builtin:torus to ${VERTICES} vertices through the container"
@@ -276,6 +302,80 @@ grep -q 'SIGTERM received, shutting down' "${OUT_DIR}/server.log" \
 grep -q 'neuralmesh-server: stopped' "${OUT_DIR}/server.log" \
   || fail "no 'neuralmesh-server: stopped' in the server's log"
 say "The server shut down gracefully (exit status 0)"
+podman rm "${CONTAINER}" >/dev/null
+CONTAINER=""
+
+# --- 8. Secured run ------------------------------------------------------------------------
+step "Making throw-away TLS certificates and tokens for a secured run"
+SECRETS="${WORK_DIR}/secrets"
+mkdir -p "${SECRETS}"
+(
+  cd "${SECRETS}"
+  openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 1 \
+    -subj /CN=neuralmesh-container-test-ca -keyout ca.key -out ca.pem
+  openssl req -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes \
+    -subj /CN=neuralmesh-container-test -keyout server.key -out server.csr
+  printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\n' >server.ext
+  openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial -days 1 \
+    -extfile server.ext -out server.pem
+) >"${OUT_DIR}/openssl.log" 2>&1 || fail "openssl (see ${OUT_DIR}/openssl.log)"
+"${PYTHON}" -c 'import secrets; print(secrets.token_hex(24))' >"${WORK_DIR}/token"
+"${PYTHON}" -c 'import secrets; print(secrets.token_hex(24))' >"${WORK_DIR}/new_token"
+cp "${WORK_DIR}/token" "${SECRETS}/tokens.txt"
+# The server runs as an unprivileged user of the image: it must be able to read the mount.
+chmod 755 "${SECRETS}"
+chmod 644 "${SECRETS}"/*
+
+step "Starting the container with TLS and an access token"
+start_container "neuralmesh-test-secured-$$" -v "${SECRETS}:/secrets:ro" -- \
+  --host=0.0.0.0 --port="${CONTAINER_PORT}" --tls_cert_file=/secrets/server.pem \
+  --tls_key_file=/secrets/server.key --access_tokens_file=/secrets/tokens.txt
+wait_serving "${SECRETS}/ca.pem"
+grep -q 'TLS, 1 access tokens' <(podman logs "${CONTAINER}" 2>&1) \
+  || fail "the server's first line does not say 'TLS, 1 access tokens'"
+
+step "Checking that plaintext and token-less calls are refused"
+secured=(--server "${ADDRESS}" --tls_ca_file "${SECRETS}/ca.pem")
+# expect_refused MESSAGE NEURALMESH_ARG...: the command fails and its stderr says MESSAGE.
+expect_refused() {
+  local message=$1
+  shift
+  if "${CLI}" "$@" >"${WORK_DIR}/refused.out" 2>"${WORK_DIR}/refused.err"; then
+    fail "'neuralmesh $*' succeeded"
+  fi
+  grep -q "${message}" "${WORK_DIR}/refused.err" \
+    || fail "'neuralmesh $*' did not say '${message}': $(cat "${WORK_DIR}/refused.err")"
+}
+expect_refused "does the server want TLS" sessions --server "${ADDRESS}" --connect_timeout 2s
+expect_refused "requires an access token" sessions "${secured[@]}"
+
+step "Reconstructing builtin:torus over TLS with the access token"
+status=0
+timeout 600 "${CLI}" reconstruct builtin:torus "${secured[@]}" --access_token_file \
+  "${WORK_DIR}/token" --out-dir "${MESH_DIR}/secured" --vertices "${VERTICES}" \
+  >"${OUT_DIR}/reconstruct-secured.out" 2>"${OUT_DIR}/reconstruct-secured.err" || status=$?
+[[ ${status} -eq 0 ]] \
+  || fail "the client exited with ${status}: $(tail -n 5 "${OUT_DIR}/reconstruct-secured.err")"
+[[ -s "${MESH_DIR}/secured/torus.drc" ]] || fail "no final mesh over TLS"
+say "Final mesh over TLS: $(tail -n 1 "${OUT_DIR}/reconstruct-secured.out")"
+
+step "Replacing the token and sending SIGHUP"
+cp "${WORK_DIR}/new_token" "${SECRETS}/tokens.txt"
+podman kill -s HUP "${CONTAINER}" >/dev/null || fail "podman kill -s HUP"
+for _ in $(seq 1 50); do
+  podman logs "${CONTAINER}" 2>&1 | grep -q 'access tokens read again' && break
+  sleep 0.2
+done
+podman logs "${CONTAINER}" 2>&1 | grep -q '1 access tokens read again' \
+  || fail "the server did not say it read the tokens again"
+expect_refused "not one this server accepts" sessions "${secured[@]}" --access_token_file \
+  "${WORK_DIR}/token"
+"${CLI}" sessions "${secured[@]}" --access_token_file "${WORK_DIR}/new_token" \
+  >"${OUT_DIR}/sessions-secured.out" 2>&1 || fail "the new token: $(cat "${OUT_DIR}/sessions-secured.out")"
+grep -q finished "${OUT_DIR}/sessions-secured.out" || fail "the secured session is not listed"
+say "The old token is refused and the new one accepted after SIGHUP"
+podman stop --time 30 "${CONTAINER}" >/dev/null || fail "podman stop"
+podman logs "${CONTAINER}" >"${OUT_DIR}/server-secured.log" 2>&1
 podman rm "${CONTAINER}" >/dev/null
 CONTAINER=""
 STEP="done"

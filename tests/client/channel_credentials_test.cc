@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -16,6 +15,7 @@
 #include "core/io/draco_codec.h"
 #include "server/server.h"
 #include "tests/server/server_test_support.h"
+#include "tests/testing/temp_dir.h"
 #include "tests/testing/test_certificates.h"
 
 namespace neuralmesh::client {
@@ -65,12 +65,11 @@ class SecureConnectionTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     absl::StatusOr<testing::TestCertificates> made = testing::MakeTestCertificates(
-        absl::StrCat(::testing::TempDir(), "/neuralmesh_channel_credentials_test_", getpid()));
+        testing::MakeTempDir("tls"));
     ASSERT_TRUE(made.ok()) << made.status();
     certificates_ = new testing::TestCertificates(*std::move(made));
   }
   static void TearDownTestSuite() {
-    if (certificates_ != nullptr) std::filesystem::remove_all(certificates_->dir);
     delete certificates_;
     certificates_ = nullptr;
   }

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/testing/temp_dir.h"
+
 namespace neuralmesh::testing {
 
 // The directory of the built binaries.
@@ -30,16 +32,6 @@ inline std::string ReadWholeFile(const std::string& path) {
   std::stringstream buffer;
   buffer << in.rdbuf();
   return buffer.str();
-}
-
-// A fresh empty directory under the test's temporary directory.
-inline std::string MakeTempDir(const std::string& name) {
-  const char* base = std::getenv("TEST_TMPDIR");
-  std::filesystem::path dir = std::filesystem::path(base != nullptr ? base : "/tmp") /
-                              ("neuralmesh_" + name + "_" + std::to_string(getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
 }
 
 struct RunResult {
@@ -122,7 +114,9 @@ inline int PickFreePort() {
 class BackgroundProcess {
  public:
   BackgroundProcess(const std::string& name, const std::vector<std::string>& args) {
-    const std::string base = MakeTempDir(name);
+    // A directory of its own: two processes of one name must not share their output files.
+    static int counter = 0;
+    const std::string base = MakeTempDir(name + "_" + std::to_string(counter++));
     out_path_ = base + "/stdout";
     err_path_ = base + "/stderr";
     pid_ = internal::Spawn(BinDir() + "/" + name, args, out_path_, err_path_);

@@ -5,11 +5,11 @@
 #include <unistd.h>
 
 #include <cstdlib>
-#include <filesystem>
 #include <string>
 
 #include "absl/strings/str_cat.h"
 #include "tests/server/server_test_support.h"
+#include "tests/testing/temp_dir.h"
 #include "tests/testing/test_certificates.h"
 
 namespace neuralmesh::server {
@@ -37,7 +37,7 @@ TEST(PythonClientTest, CompletesASessionAgainstTheProtoOnly) {
 TEST(PythonClientTest, CompletesASessionOverTlsWithAnAccessToken) {
   absl::StatusOr<neuralmesh::testing::TestCertificates> certificates =
       neuralmesh::testing::MakeTestCertificates(
-          absl::StrCat(::testing::TempDir(), "/neuralmesh_python_client_test_", getpid()));
+          neuralmesh::testing::MakeTempDir("tls"));
   ASSERT_TRUE(certificates.ok()) << certificates.status();
   constexpr char kToken[] = "python-token-0123456789";
   ServerOptions options;
@@ -48,7 +48,6 @@ TEST(PythonClientTest, CompletesASessionOverTlsWithAnAccessToken) {
   ASSERT_NE(server, nullptr);
   RunPythonClient(*server, absl::StrCat(" --root_cert=", certificates->Path("ca.pem"),
                                         " --token=", kToken));
-  std::filesystem::remove_all(certificates->dir);
 }
 
 }  // namespace

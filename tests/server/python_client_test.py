@@ -13,9 +13,11 @@ Usage: python_client_test.py --target=127.0.0.1:PORT --proto_root=proto
            [--root_cert=ca.pem --token=TOKEN]
 """
 import argparse
+import atexit
 import math
 import os
 import random
+import shutil
 import struct
 import subprocess
 import sys
@@ -68,6 +70,7 @@ def main():
     args = parser.parse_args()
 
     out_dir = tempfile.mkdtemp(prefix="nm_py_")
+    atexit.register(shutil.rmtree, out_dir, ignore_errors=True)
     generate_stubs(args.proto_root, out_dir)
     import grpc
     from neuralmesh.v1 import reconstruction_pb2 as pb

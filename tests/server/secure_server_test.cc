@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <thread>
@@ -19,6 +18,7 @@
 #include "server/server.h"
 #include "server/server_credentials.h"
 #include "tests/server/server_test_support.h"
+#include "tests/testing/temp_dir.h"
 #include "tests/testing/test_certificates.h"
 
 namespace neuralmesh::server {
@@ -30,15 +30,12 @@ constexpr char kSecondToken[] = "second-token-0123456789abcdef";
 class SecureServerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    const std::string dir = absl::StrCat(
-        ::testing::TempDir(), "/neuralmesh_secure_server_test_", getpid());
     absl::StatusOr<neuralmesh::testing::TestCertificates> made =
-        neuralmesh::testing::MakeTestCertificates(dir);
+        neuralmesh::testing::MakeTestCertificates(neuralmesh::testing::MakeTempDir("tls"));
     ASSERT_TRUE(made.ok()) << made.status();
     certificates_ = new neuralmesh::testing::TestCertificates(*std::move(made));
   }
   static void TearDownTestSuite() {
-    if (certificates_ != nullptr) std::filesystem::remove_all(certificates_->dir);
     delete certificates_;
     certificates_ = nullptr;
   }

@@ -24,6 +24,7 @@
 #include "core/analysis/geometric_error.h"
 #include "core/io/draco_codec.h"
 #include "tests/server/server_test_support.h"
+#include "tests/testing/temp_dir.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -107,8 +108,7 @@ TEST(ServerEndToEndTest, TorusInAHundredBatchesOverLoopback) {
                                << u.draco_mesh().size() << " bytes";
   }
 
-  const fs::path dir = fs::temp_directory_path() / absl::StrCat("nm_e2e_", getpid());
-  fs::create_directories(dir);
+  const fs::path dir = neuralmesh::testing::MakeTempDir("decoded");
   for (size_t i = 0; i < updates.size(); ++i) {
     const v1::MeshUpdate& u = updates[i];
     absl::StatusOr<TriangleMesh> mesh = DecodeMesh(u.draco_mesh());
@@ -119,7 +119,6 @@ TEST(ServerEndToEndTest, TorusInAHundredBatchesOverLoopback) {
         << "draco_decoder cannot decode update " << u.sequence();
     EXPECT_EQ(u.quantization_epoch(), 0u);
   }
-  fs::remove_all(dir);
 
   // The final mesh is close to the true torus.
   absl::StatusOr<TriangleMesh> final_mesh = DecodeMesh(updates.back().draco_mesh());

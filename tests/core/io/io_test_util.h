@@ -17,6 +17,7 @@
 #include "core/random.h"
 #include "core/triangle_mesh.h"
 #include "gtest/gtest.h"
+#include "tests/testing/temp_dir.h"
 
 namespace neuralmesh::io_test {
 
@@ -31,12 +32,11 @@ void Put(T value, bool big_endian, std::string* out) {
 }
 
 
-// A path under the temporary directory, prefixed with the running test's name so that tests
-// run in parallel (ctest -j) never share a file.
+// A path in this test process's temporary directory (tests/testing/temp_dir.h), prefixed with
+// the running test's name.
 inline std::string TempPath(const std::string& name) {
-  std::string dir = ::testing::TempDir();
-  if (dir.empty() || dir.back() != '/') dir += '/';
-  std::string prefix = "neuralmesh_io_";
+  const std::string dir = neuralmesh::testing::ProcessTempDir() + "/";
+  std::string prefix;
   if (const auto* test = ::testing::UnitTest::GetInstance()->current_test_info()) {
     prefix += std::string(test->test_suite_name()) + "." + test->name() + "_";
   }

@@ -10,8 +10,8 @@
 
 #include "absl/flags/flag.h"
 #include "absl/status/status.h"
-#include "absl/strings/str_cat.h"
 #include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
 #include "client/command_line.h"
 #include "client/inputs.h"
@@ -21,8 +21,8 @@
 #include "client/remote_commands.h"
 #include "client/web/run_view.h"
 #include "core/analysis/statistical_outliers.h"
-#include "core/io/file_contents.h"
 #include "core/io/draco_codec.h"
+#include "core/io/file_contents.h"
 #include "core/learning/learner_options.h"
 #include "core/status_macros.h"
 

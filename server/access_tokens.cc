@@ -53,8 +53,12 @@ absl::StatusOr<std::vector<std::string>> ParseAccessTokens(absl::string_view tex
   return tokens;
 }
 
-AccessTokenChecker::AccessTokenChecker(std::vector<std::string> tokens)
-    : tokens_(std::move(tokens)) {}
+absl::StatusOr<std::shared_ptr<AccessTokenChecker>> AccessTokenChecker::Create(
+    std::vector<std::string> tokens) {
+  std::shared_ptr<AccessTokenChecker> checker(new AccessTokenChecker());
+  if (absl::Status s = checker->ReplaceTokens(std::move(tokens)); !s.ok()) return s;
+  return checker;
+}
 
 absl::Status AccessTokenChecker::ReplaceTokens(std::vector<std::string> tokens) {
   if (tokens.empty()) return absl::InvalidArgumentError("no access token given");

@@ -12,11 +12,12 @@
 
 #include <grpcpp/security/auth_metadata_processor.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "absl/status/status.h"
 #include "absl/base/thread_annotations.h"
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "absl/synchronization/mutex.h"
@@ -39,8 +40,9 @@ absl::StatusOr<std::vector<std::string>> ParseAccessTokens(absl::string_view tex
 // comparisons). The accepted token is consumed, so handlers never see it. Thread-safe.
 class AccessTokenChecker : public grpc::AuthMetadataProcessor {
  public:
-  // `tokens` must be valid (ValidateAccessToken) and not empty.
-  explicit AccessTokenChecker(std::vector<std::string> tokens);
+  // A checker accepting `tokens`. INVALID_ARGUMENT for an empty list or an invalid token.
+  static absl::StatusOr<std::shared_ptr<AccessTokenChecker>> Create(
+      std::vector<std::string> tokens);
 
   // Replaces the tokens for the calls that start from now on (calls already running go on).
   // INVALID_ARGUMENT, and the old tokens kept, for an empty list or an invalid token.
@@ -53,6 +55,8 @@ class AccessTokenChecker : public grpc::AuthMetadataProcessor {
 
  private:
   // Compares against every token in time independent of where the bytes differ.
+  AccessTokenChecker() = default;
+
   bool Accepts(absl::string_view token) const ABSL_LOCKS_EXCLUDED(mu_);
 
   mutable absl::Mutex mu_;

@@ -46,10 +46,10 @@ absl::StatusOr<PortCredentials> MakeServerCredentials(const ServerSecurity& secu
   }
   PortCredentials port{grpc::SslServerCredentials(options), nullptr};
   if (!security.access_tokens.empty()) {
-    for (const std::string& token : security.access_tokens) {
-      if (absl::Status s = ValidateAccessToken(token); !s.ok()) return s;
-    }
-    port.token_checker = std::make_shared<AccessTokenChecker>(security.access_tokens);
+    absl::StatusOr<std::shared_ptr<AccessTokenChecker>> checker =
+        AccessTokenChecker::Create(security.access_tokens);
+    if (!checker.ok()) return checker.status();
+    port.token_checker = *std::move(checker);
     port.credentials->SetAuthMetadataProcessor(port.token_checker);
   }
   return port;

@@ -58,10 +58,11 @@ class AccessTokenCheckerTest : public ::testing::Test {
     }
     consumed_.clear();
     grpc::AuthMetadataProcessor::OutputMetadata response;
-    return checker_.Process(metadata, nullptr, &consumed_, &response);
+    return checker_->Process(metadata, nullptr, &consumed_, &response);
   }
 
-  AccessTokenChecker checker_{{"first-token-0123456789", "second-token-0123456789"}};
+  std::shared_ptr<AccessTokenChecker> checker_ =
+      *AccessTokenChecker::Create({"first-token-0123456789", "second-token-0123456789"});
   std::vector<std::string> storage_;
   grpc::AuthMetadataProcessor::OutputMetadata consumed_;
 };
@@ -90,6 +91,12 @@ TEST_F(AccessTokenCheckerTest, RefusesMissingAndUnknownTokens) {
     EXPECT_FALSE(absl::StrContains(refused.error_message(), "0123456789")) << "not echoed";
     EXPECT_TRUE(consumed_.empty());
   }
+}
+
+TEST(AccessTokenCheckerCreateTest, RefusesAnEmptyListAndInvalidTokens) {
+  EXPECT_TRUE(absl::IsInvalidArgument(AccessTokenChecker::Create({}).status()));
+  EXPECT_TRUE(absl::IsInvalidArgument(
+      AccessTokenChecker::Create({"good-token-0123456789", "short"}).status()));
 }
 
 TEST_F(AccessTokenCheckerTest, HealthChecksAreOpen) {

@@ -301,6 +301,8 @@ grep -q 'SIGTERM received, shutting down' "${OUT_DIR}/server.log" \
   || fail "no 'SIGTERM received' in the server's log"
 grep -q 'neuralmesh-server: stopped' "${OUT_DIR}/server.log" \
   || fail "no 'neuralmesh-server: stopped' in the server's log"
+grep -q "finished: ${VERTICES} vertices" "${OUT_DIR}/server.log" \
+  || fail "no 'finished: ${VERTICES} vertices' event in the server's log"
 say "The server shut down gracefully (exit status 0)"
 podman rm "${CONTAINER}" >/dev/null
 CONTAINER=""

@@ -56,6 +56,9 @@ ABSL_FLAG(std::string, access_tokens_file, "",
           "printable characters); set: every call except health checks must carry "
           "'authorization: Bearer TOKEN' with one of them. Needs --tls_cert_file. SIGHUP "
           "reads the file again (calls already running go on).");
+ABSL_FLAG(bool, log_sessions, true,
+          "Print a line on standard output when a session is created, finishes, is cancelled, "
+          "fails or is deleted (with the time, the client's address and the figures).");
 ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(5),
           "On SIGTERM/SIGINT, how long calls may take to end before they are cancelled.");
 
@@ -171,6 +174,9 @@ int main(int argc, char** argv) {
   options.limits.max_points_per_session = static_cast<size_t>(max_points);
   options.limits.max_batch_points = static_cast<size_t>(max_batch);
   options.limits.idle_timeout = absl::GetFlag(FLAGS_idle_timeout);
+  if (absl::GetFlag(FLAGS_log_sessions)) {
+    options.event_sink = neuralmesh::server::EventLog::StandardOutput();
+  }
   absl::StatusOr<neuralmesh::server::ServerSecurity> security = SecurityFromFlags();
   if (!security.ok()) {
     std::fprintf(stderr, "neuralmesh-server: %s\n", security.status().ToString().c_str());

@@ -530,7 +530,7 @@ class ReconstructReactor final
             SessionConfigFromProto(start.create().config());
         if (!config.ok()) return config.status();
         absl::StatusOr<std::shared_ptr<Session>> created =
-            manager_->Create(*std::move(config), start.create().name());
+            manager_->Create(*std::move(config), start.create().name(), context_->peer());
         if (!created.ok()) return created.status();
         session = *std::move(created);
         break;
@@ -767,7 +767,7 @@ grpc::ServerUnaryReactor* ReconstructionService::CreateSession(
   absl::StatusOr<SessionConfig> config = SessionConfigFromProto(request->config());
   if (!config.ok()) return FinishUnary(context, config.status());
   absl::StatusOr<std::shared_ptr<Session>> session =
-      manager_->Create(*std::move(config), request->name());
+      manager_->Create(*std::move(config), request->name(), context->peer());
   if (!session.ok()) return FinishUnary(context, session.status());
   *response = (*session)->ToProto();
   return FinishUnary(context, absl::OkStatus());

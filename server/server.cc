@@ -57,8 +57,9 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   server->encoder_ = std::make_unique<Executor>(options.encoder_threads);
   server->filter_ = std::make_unique<Executor>(options.filter_threads);
   server->reactors_ = std::make_unique<ReactorRegistry>();
-  server->manager_ = std::make_unique<SessionManager>(options.limits, server->pool_.get(),
-                                                      server->encoder_.get());
+  server->manager_ = std::make_unique<SessionManager>(
+      options.limits, server->pool_.get(), server->encoder_.get(),
+      options.event_sink ? std::make_shared<EventLog>(options.event_sink) : nullptr);
   server->service_ = std::make_unique<ReconstructionService>(
       server->manager_.get(), server->reactors_.get(), server->filter_.get());
 

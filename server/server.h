@@ -14,6 +14,7 @@
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
+#include "server/event_log.h"
 #include "server/executor.h"
 #include "server/reactor_registry.h"
 #include "server/reconstruction_service.h"
@@ -35,6 +36,8 @@ struct ServerOptions {
   absl::Duration time_slice = absl::Milliseconds(20);  // Learning per session per turn.
   int max_message_bytes = 64 << 20;                  // Both directions.
   SessionLimits limits;
+  // Where each session's creation, end and deletion are recorded (event_log.h); null: nowhere.
+  EventLog::Sink event_sink;
 };
 
 class ReconstructionServer {

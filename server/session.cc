@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "core/analysis/mesh_report.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/status_macros.h"
@@ -59,13 +60,14 @@ bool IsSpatiallyBiased(absl::Span<const Vec3f> arrival_sample) {
 }
 
 Session::Session(std::string id, std::string name, SessionConfig config, size_t max_points,
-                 WorkerPool* pool, Executor* encoder)
+                 WorkerPool* pool, Executor* encoder, std::shared_ptr<EventLog> log)
     : id_(std::move(id)),
       name_(std::move(name)),
       config_(std::move(config)),
       create_time_(absl::Now()),
       pool_(pool),
       encoder_(encoder),
+      log_(std::move(log)),
       points_(max_points) {
   if (config_.outlier_removal.has_value()) {
     absl::MutexLock ingest(&ingest_mu_);
@@ -260,6 +262,7 @@ absl::Status Session::Cancel(absl::string_view reason) {
     error_ = std::string(reason);
     cancel_.store(true);
   }
+  Record(absl::StrCat("cancelled: ", reason));
   updates_.Close(absl::CancelledError(absl::StrCat("session ", id_, " was cancelled: ", reason)));
   Wake();  // Lets the pool drop the session at its next slice.
   return absl::OkStatus();
@@ -287,8 +290,13 @@ void Session::Fail(const absl::Status& status) {
     error_ = std::string(status.message());
     cancel_.store(true);
   }
+  Record(absl::StrCat("failed: ", status.message()));
   updates_.Close(absl::InternalError(
       absl::StrCat("learning failed in session ", id_, ": ", status.message())));
+}
+
+void Session::Record(absl::string_view event) const {
+  if (log_ != nullptr) log_->Record(id_, event);
 }
 
 v1::SessionState Session::state() const {
@@ -550,6 +558,13 @@ void Session::EncodeNext() {
       }
     }
     if (finished) {
+      const v1::MeshUpdate& final_mesh = **update;
+      Record(absl::StrFormat(
+          "finished: %d vertices, %d faces, genus %d, %d boundaries, %d Basic Steps in %.2f s "
+          "of learning, %d points",
+          final_mesh.vertex_count(), final_mesh.face_count(), final_mesh.report().genus(),
+          final_mesh.report().boundary_loops(), final_mesh.learning().basic_steps(),
+          final_mesh.learning().learning_seconds(), final_mesh.learning().points_received()));
       updates_.Publish(*std::move(update));
       updates_.Close(absl::OkStatus());
     }

@@ -50,6 +50,7 @@
 #include "core/sampling/growing_point_cloud.h"
 #include "core/triangle_mesh.h"
 #include "neuralmesh/v1/reconstruction.pb.h"
+#include "server/event_log.h"
 #include "server/executor.h"
 #include "server/held_outliers.h"
 #include "server/session_config.h"
@@ -69,8 +70,9 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
  public:
   // `config` must have passed ResolveSessionConfig. `pool` and `encoder` must outlive every
   // slice and encoding task of the session (the server shuts them down before it lets go).
+  // `log`, when set, records the session's end (finished, cancelled, failed).
   Session(std::string id, std::string name, SessionConfig config, size_t max_points,
-          WorkerPool* pool, Executor* encoder);
+          WorkerPool* pool, Executor* encoder, std::shared_ptr<EventLog> log = nullptr);
   ~Session() override;
 
   Session(const Session&) = delete;
@@ -160,6 +162,8 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   void EncodeNext() ABSL_LOCKS_EXCLUDED(mu_);
   absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Encode(Snapshot& snapshot) const;
   void Fail(const absl::Status& status) ABSL_LOCKS_EXCLUDED(mu_);
+  // Records `event` in the event log, if there is one.
+  void Record(absl::string_view event) const;
   void Wake();
 
   const std::string id_;
@@ -168,6 +172,7 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   const absl::Time create_time_;
   WorkerPool* const pool_;
   Executor* const encoder_;
+  const std::shared_ptr<EventLog> log_;  // May be null.
 
   GrowingPointCloud points_;
   UpdateChannel updates_;

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "absl/random/random.h"
+#include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
@@ -18,6 +19,17 @@ absl::Status UnknownSession(absl::string_view id) {
   return absl::NotFoundError(absl::StrCat("no session with id ", QuotedSessionId(id)));
 }
 
+// "created by PEER: "NAME", target N vertices" and the options that change how it learns.
+std::string CreationEvent(const SessionConfig& config, absl::string_view name,
+                          absl::string_view peer) {
+  std::string event = absl::StrCat("created", peer.empty() ? "" : " by ", peer, ": \"",
+                                   absl::CHexEscape(name), "\", target ",
+                                   config.target_vertices, " vertices");
+  if (config.learner.initial_mesh == InitialMesh::kDisc) absl::StrAppend(&event, ", disc start");
+  if (config.outlier_removal.has_value()) absl::StrAppend(&event, ", outlier removal");
+  return event;
+}
+
 }  // namespace
 
 std::string QuotedSessionId(absl::string_view id) {
@@ -25,8 +37,9 @@ std::string QuotedSessionId(absl::string_view id) {
   return absl::StrCat("\"", id.substr(0, kMaxQuotedIdBytes), "...\" (", id.size(), " bytes)");
 }
 
-SessionManager::SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder)
-    : limits_(limits), pool_(pool), encoder_(encoder) {
+SessionManager::SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder,
+                               std::shared_ptr<EventLog> log)
+    : limits_(limits), pool_(pool), encoder_(encoder), log_(std::move(log)) {
   {
     absl::MutexLock lock(&mu_);
     absl::BitGen gen;
@@ -54,24 +67,30 @@ std::string SessionManager::NewIdLocked() {
 }
 
 absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(SessionConfig config,
-                                                                std::string name) {
+                                                                std::string name,
+                                                                absl::string_view peer) {
   if (name.size() > kMaxNameBytes) {
     return absl::InvalidArgumentError(
         absl::StrCat("name has ", name.size(), " bytes; at most 256 are allowed"));
   }
   NM_RETURN_IF_ERROR(ResolveSessionConfig(limits_.max_points_per_session, config));
-  absl::MutexLock lock(&mu_);
-  if (shutdown_) return absl::UnavailableError("the server is shutting down");
-  if (sessions_.size() >= limits_.max_sessions) {
-    return absl::ResourceExhaustedError(absl::StrCat(
-        "the server holds its maximum of ", limits_.max_sessions,
-        " sessions; delete finished or cancelled ones first"));
+  const std::string event = CreationEvent(config, name, peer);
+  std::shared_ptr<Session> session;
+  {
+    absl::MutexLock lock(&mu_);
+    if (shutdown_) return absl::UnavailableError("the server is shutting down");
+    if (sessions_.size() >= limits_.max_sessions) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "the server holds its maximum of ", limits_.max_sessions,
+          " sessions; delete finished or cancelled ones first"));
+    }
+    std::string id = NewIdLocked();
+    session = std::make_shared<Session>(id, std::move(name), std::move(config),
+                                        limits_.max_points_per_session, pool_, encoder_, log_);
+    sessions_.emplace(id, session);
+    order_.emplace(created_++, id);
   }
-  std::string id = NewIdLocked();
-  auto session = std::make_shared<Session>(id, std::move(name), std::move(config),
-                                           limits_.max_points_per_session, pool_, encoder_);
-  sessions_.emplace(id, session);
-  order_.emplace(created_++, id);
+  if (log_ != nullptr) log_->Record(session->id(), event);
   return session;
 }
 
@@ -128,6 +147,12 @@ absl::Status SessionManager::DeleteUnlessActive(absl::string_view id,
         break;
       }
     }
+  }
+  if (log_ != nullptr) {
+    log_->Record(session->id(),
+                 idle_at.has_value()
+                     ? absl::StrCat("deleted: idle for ", absl::FormatDuration(limits_.idle_timeout))
+                     : std::string("deleted"));
   }
   session->Terminate(absl::NotFoundError(absl::StrCat("session ", id, " was deleted")));
   return absl::OkStatus();

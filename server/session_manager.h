@@ -18,6 +18,7 @@
 #include "absl/strings/string_view.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
+#include "server/event_log.h"
 #include "server/executor.h"
 #include "server/session.h"
 #include "server/session_config.h"
@@ -44,17 +45,21 @@ std::string QuotedSessionId(absl::string_view id);
 
 class SessionManager {
  public:
-  // `pool` and `encoder` must outlive the manager's sessions' work (see Session).
-  SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder);
+  // `pool` and `encoder` must outlive the manager's sessions' work (see Session). `log`, when
+  // set, records every session's creation, end and deletion.
+  SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder,
+                 std::shared_ptr<EventLog> log = nullptr);
   ~SessionManager();  // Calls Shutdown().
 
   SessionManager(const SessionManager&) = delete;
   SessionManager& operator=(const SessionManager&) = delete;
 
-  // Validates `config` (ResolveSessionConfig) and creates a session. INVALID_ARGUMENT for an
-  // invalid configuration or a name longer than 256 bytes; RESOURCE_EXHAUSTED at max_sessions;
-  // UNAVAILABLE after Shutdown.
-  absl::StatusOr<std::shared_ptr<Session>> Create(SessionConfig config, std::string name)
+  // Validates `config` (ResolveSessionConfig) and creates a session for the client at `peer`
+  // (gRPC's peer address, for the event log). INVALID_ARGUMENT for an invalid configuration or
+  // a name longer than 256 bytes; RESOURCE_EXHAUSTED at max_sessions; UNAVAILABLE after
+  // Shutdown.
+  absl::StatusOr<std::shared_ptr<Session>> Create(SessionConfig config, std::string name,
+                                                  absl::string_view peer = "")
       ABSL_LOCKS_EXCLUDED(mu_);
 
   // NOT_FOUND for an unknown id (INVALID_ARGUMENT for an empty one), UNAVAILABLE after
@@ -94,6 +99,7 @@ class SessionManager {
   const SessionLimits limits_;
   WorkerPool* const pool_;
   Executor* const encoder_;
+  const std::shared_ptr<EventLog> log_;  // May be null.
 
   mutable absl::Mutex mu_;
   bool shutdown_ ABSL_GUARDED_BY(mu_) = false;

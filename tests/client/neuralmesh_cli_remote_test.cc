@@ -5,6 +5,7 @@
 #include <csignal>
 #include <filesystem>
 #include <memory>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -108,6 +109,17 @@ TEST_F(RemoteCliTest, ReconstructWritesIncreasingLodsAndTheFinalMesh) {
   }
   EXPECT_TRUE(std::filesystem::exists(*dir_ + "/out/sphere.drc"));
   EXPECT_TRUE(std::filesystem::exists(*dir_ + "/out/sphere.ply"));
+}
+
+TEST_F(RemoteCliTest, TheServerPrintsTheSessionsEvents) {
+  const std::string out = server_->Stdout();
+  EXPECT_TRUE(std::regex_search(
+      out, std::regex("Z session s-[0-9a-f]{16} created by ipv4:127\\.0\\.0\\.1:[0-9]+: "
+                      "\"sphere\", target 400 vertices\n")))
+      << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex("Z session s-[0-9a-f]{16} finished: 400 "
+                                                "vertices, [0-9]+ faces, genus 0, 0 boundaries")))
+      << out;
 }
 
 TEST_F(RemoteCliTest, TheFinalMeshIsAClosedSphere) {

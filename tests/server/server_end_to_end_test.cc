@@ -133,6 +133,36 @@ TEST(ServerEndToEndTest, TorusInAHundredBatchesOverLoopback) {
               updates.back().report().genus(), *chamfer, bytes_per_vertex);
 }
 
+TEST(ServerEndToEndTest, TheEventLogNamesTheClientAndHowEachSessionEnded) {
+  testing::CapturedEvents events;
+  ServerOptions options;
+  options.event_sink = events.Sink();
+  std::unique_ptr<ReconstructionServer> server = testing::StartServer(/*listen=*/true, options);
+  ASSERT_NE(server, nullptr);
+  auto stub = testing::NetworkStub(*server);
+  const std::string finished = testing::MustCreate(*stub, testing::CreateRequest(300));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(testing::Upload(*stub, finished, testing::TorusPoints(4000, 3), 2, &response).ok());
+  ASSERT_TRUE(testing::Finish(*stub, finished).ok());
+  v1::MeshUpdate final_mesh;
+  ASSERT_TRUE(testing::WaitFinal(*stub, finished, &final_mesh).ok());
+  const std::string cancelled = testing::MustCreate(*stub, testing::CreateRequest(300));
+  ASSERT_TRUE(testing::Cancel(*stub, cancelled).ok());
+  ASSERT_TRUE(testing::Delete(*stub, finished).ok());
+
+  const std::string created = events.Await(absl::StrCat(finished, " created"));
+  EXPECT_THAT(created, ::testing::HasSubstr(absl::StrCat(
+                           "session ", finished,
+                           " created by ipv4:127.0.0.1:")));  // The client's own port follows.
+  EXPECT_THAT(created, ::testing::EndsWith(": \"test\", target 300 vertices"));
+  EXPECT_THAT(events.Await(absl::StrCat(finished, " finished")),
+              ::testing::HasSubstr("finished: 300 vertices, "));
+  EXPECT_THAT(events.Await(absl::StrCat(cancelled, " cancelled")),
+              ::testing::HasSubstr("cancelled: "));
+  EXPECT_FALSE(events.Await(absl::StrCat(finished, " deleted")).empty());
+  EXPECT_EQ(events.lines().size(), 5u);
+}
+
 TEST(ServerEndToEndTest, HealthServiceReportsServing) {
   std::unique_ptr<ReconstructionServer> server = testing::StartServer(/*listen=*/true);
   ASSERT_NE(server, nullptr);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/synchronization/mutex.h"
 #include "absl/synchronization/notification.h"
 #include "core/analysis/geometric_error.h"
 #include "core/point_cloud.h"
@@ -21,10 +22,46 @@
 #include "core/sampling/implicit_surfaces.h"
 #include "core/sampling/sample_points.h"
 #include "neuralmesh/v1/reconstruction.grpc.pb.h"
+#include "server/event_log.h"
 #include "server/proto_conversion.h"
 #include "server/server.h"
 
 namespace neuralmesh::server::testing {
+
+// The lines an EventLog wrote, for checking them.
+class CapturedEvents {
+ public:
+  EventLog::Sink Sink() {
+    return [this](const std::string& line) {
+      absl::MutexLock lock(&mu_);
+      lines_.push_back(line);
+    };
+  }
+  std::vector<std::string> lines() const {
+    absl::MutexLock lock(&mu_);
+    return lines_;
+  }
+  // Waits up to 10 s for a line that contains `text`; returns it, or "" when none came.
+  std::string Await(const std::string& text) const {
+    absl::MutexLock lock(&mu_);
+    std::string found;
+    auto has = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+      for (const std::string& line : lines_) {
+        if (line.find(text) != std::string::npos) {
+          found = line;
+          return true;
+        }
+      }
+      return false;
+    };
+    mu_.AwaitWithTimeout(absl::Condition(&has), absl::Seconds(10));
+    return found;
+  }
+
+ private:
+  mutable absl::Mutex mu_;
+  std::vector<std::string> lines_ ABSL_GUARDED_BY(mu_);
+};
 
 // A server on 127.0.0.1 with a picked port, or in-process only when `listen` is false.
 inline std::unique_ptr<ReconstructionServer> StartServer(bool listen, ServerOptions options = {}) {

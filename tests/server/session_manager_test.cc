@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "tests/server/server_test_support.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -70,6 +72,32 @@ TEST_F(SessionManagerTest, ReapIdleDeletesSessionsIdleForTheTimeout) {
   ASSERT_TRUE(a->updates().close_status().has_value()) << "a reaped session's watchers end";
   EXPECT_TRUE(absl::IsNotFound(*a->updates().close_status())) << *a->updates().close_status();
   EXPECT_THAT(a->updates().close_status()->message(), ::testing::HasSubstr("was deleted"));
+}
+
+TEST_F(SessionManagerTest, TheEventLogRecordsCreationsAndDeletions) {
+  testing::CapturedEvents events;
+  SessionManager manager(HourLimits(), &pool_, &encoder_,
+                         std::make_shared<EventLog>(events.Sink()));
+  SessionConfig disc = SmallConfig();
+  disc.learner.initial_mesh = InitialMesh::kDisc;
+  disc.outlier_removal = OutlierOptions();
+  std::shared_ptr<Session> a = manager.Create(SmallConfig(), "a", "ipv4:10.0.0.7:41234").value();
+  std::shared_ptr<Session> b = manager.Create(disc, "say \"hi\"\n").value();
+  ASSERT_TRUE(manager.Delete(a->id()).ok());
+  EXPECT_EQ(manager.ReapIdle(absl::Now() + absl::Hours(2)), 1u);
+  EXPECT_FALSE(manager.Create(SmallConfig(), std::string(300, 'x')).ok());
+  const std::vector<std::string> lines = events.lines();
+  ASSERT_EQ(lines.size(), 4u) << "a refused creation is no event";
+  EXPECT_THAT(lines[0], ::testing::EndsWith(absl::StrCat(
+                            "session ", a->id(),
+                            " created by ipv4:10.0.0.7:41234: \"a\", target 100 vertices")));
+  EXPECT_THAT(lines[1], ::testing::EndsWith(absl::StrCat(
+                            "session ", b->id(), " created: \"say \\\"hi\\\"\\n\", target 100 ",
+                            "vertices, disc start, outlier removal")))
+      << "the name is escaped";
+  EXPECT_THAT(lines[2], ::testing::EndsWith(absl::StrCat("session ", a->id(), " deleted")));
+  EXPECT_THAT(lines[3],
+              ::testing::EndsWith(absl::StrCat("session ", b->id(), " deleted: idle for 1h")));
 }
 
 TEST_F(SessionManagerTest, OpenStreamsKeepASessionFromIdlingOut) {

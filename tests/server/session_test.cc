@@ -14,6 +14,7 @@
 #include "core/io/draco_codec.h"
 #include "core/sampling/implicit_surfaces.h"
 #include "core/sampling/sample_points.h"
+#include "tests/server/server_test_support.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -73,7 +74,8 @@ class SessionTest : public ::testing::Test {
     absl::Status status = ResolveSessionConfig(max_points, config);
     EXPECT_TRUE(status.ok()) << status;
     auto session = std::make_shared<Session>("s-test", "test", std::move(config), max_points,
-                                             &pool_, &encoder_);
+                                             &pool_, &encoder_,
+                                             std::make_shared<EventLog>(events_.Sink()));
     handles_.push_back(session->updates().Subscribe(&recorder_, 0));
     return session;
   }
@@ -93,6 +95,7 @@ class SessionTest : public ::testing::Test {
   WorkerPool pool_{2, absl::Milliseconds(10)};
   Executor encoder_{1};
   Recorder recorder_;
+  testing::CapturedEvents events_;
   std::vector<uint64_t> handles_;
 };
 
@@ -194,6 +197,12 @@ TEST_F(SessionTest, BadBatchesAreRejectedAndTheSessionKeepsItsPoints) {
       << "a finished session takes no points";
   EXPECT_EQ(session->Finish().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_EQ(session->Cancel("late").code(), absl::StatusCode::kFailedPrecondition);
+  const std::vector<std::string> events = events_.lines();
+  ASSERT_EQ(events.size(), 1u) << "one end, and refused calls are no events";
+  EXPECT_THAT(events[0], ::testing::MatchesRegex(
+                             ".* session s-test finished: 50 vertices, [0-9]+ faces, genus -?[0-9]+, "
+                             "[0-9]+ boundaries, [0-9]+ Basic Steps in [0-9.]+ s of learning, 600 "
+                             "points"));
 }
 
 // With outlier removal the session keeps every point received, dropped ones too (they are
@@ -279,6 +288,8 @@ TEST_F(SessionTest, CancelStopsLearningAndEndsWatchersWithCancelled) {
   ASSERT_TRUE(session->Cancel("test").ok());
   EXPECT_EQ(recorder_.AwaitClose(absl::Seconds(5)).code(), absl::StatusCode::kCancelled);
   EXPECT_TRUE(session->Cancel("again").ok()) << "cancelling twice is a no-op";
+  ASSERT_EQ(events_.lines().size(), 1u) << "recorded once";
+  EXPECT_THAT(events_.lines()[0], ::testing::EndsWith("session s-test cancelled: test"));
   EXPECT_EQ(session->Finish().code(), absl::StatusCode::kFailedPrecondition);
   // The slice that was running stops at the learner's next poll and leaves the pool.
   const absl::Time deadline = absl::Now() + absl::Seconds(5);
@@ -373,6 +384,8 @@ TEST_F(SessionTest, AStalledLearnerFailsTheSessionInsteadOfSpinning) {
   EXPECT_THAT(std::string(status.message()), HasSubstr("stalled"));
   EXPECT_EQ(session->state(), v1::SESSION_STATE_FAILED);
   EXPECT_THAT(session->ToProto().error(), HasSubstr("stalled"));
+  ASSERT_EQ(events_.lines().size(), 1u);
+  EXPECT_THAT(events_.lines()[0], HasSubstr("session s-test failed: learning stalled"));
 }
 
 TEST(IsSpatiallyBiasedTest, RandomOrderIsNotBiasedAScanIs) {

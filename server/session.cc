@@ -285,7 +285,11 @@ void Session::Terminate(const absl::Status& status) {
 void Session::Fail(const absl::Status& status) {
   {
     absl::MutexLock lock(&mu_);
-    if (state_ == v1::SESSION_STATE_CANCELLED || state_ == v1::SESSION_STATE_FINISHED) return;
+    // Ended already (a second failure keeps the first one's reason).
+    if (state_ == v1::SESSION_STATE_CANCELLED || state_ == v1::SESSION_STATE_FINISHED ||
+        state_ == v1::SESSION_STATE_FAILED) {
+      return;
+    }
     state_ = v1::SESSION_STATE_FAILED;
     error_ = std::string(status.message());
     cancel_.store(true);

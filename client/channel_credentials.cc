@@ -25,8 +25,9 @@ absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> MakeChannelCredentials
           "clear");
     }
     if (!tls.root_certificates.empty() || !tls.certificate_chain.empty() ||
-        !tls.private_key.empty()) {
-      return absl::InvalidArgumentError("TLS certificates or keys were given without TLS");
+        !tls.private_key.empty() || !tls.server_name.empty()) {
+      return absl::InvalidArgumentError(
+          "TLS certificates, keys or a server name were given without TLS");
     }
     return grpc::InsecureChannelCredentials();
   }

@@ -21,6 +21,9 @@ struct ClientTls {
   // The client's certificate and key, for servers that ask for one (mutual TLS).
   std::string certificate_chain;
   std::string private_key;
+  // The name the server's certificate must carry, when it is not the host dialled (a tunnel
+  // or port forward to 127.0.0.1); empty: the host of the address.
+  std::string server_name;
 };
 
 struct ClientSecurity {
@@ -29,9 +32,10 @@ struct ClientSecurity {
   std::string access_token;
 };
 
-// The channel credentials. INVALID_ARGUMENT when the parts do not go together (a token or
-// PEM text without TLS, a certificate without its key or the reverse) or a PEM text is not
-// PEM.
+// The channel credentials. INVALID_ARGUMENT when the parts do not go together (a token, PEM
+// text or a server name without TLS, a certificate without its key or the reverse) or a PEM
+// text is not PEM. The server name is a channel argument: ReconstructionClient::Connect sets
+// it.
 absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> MakeChannelCredentials(
     const ClientSecurity& security);
 

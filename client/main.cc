@@ -152,6 +152,9 @@ ABSL_FLAG(std::string, tls_cert_file, "",
           "PEM file with this client's certificate, for servers that require one (mutual "
           "TLS); implies --tls and needs --tls_key_file.");
 ABSL_FLAG(std::string, tls_key_file, "", "PEM file with the private key of --tls_cert_file.");
+ABSL_FLAG(std::string, tls_server_name, "",
+          "The name the server's certificate must carry when it is not the host of --server "
+          "(through an SSH tunnel or a port forward to 127.0.0.1); implies --tls.");
 ABSL_FLAG(std::string, access_token_file, "",
           "File holding the access token the server asks for (sent as 'authorization: Bearer "
           "TOKEN' with every call); needs TLS. Keep it readable by its owner only.");
@@ -242,8 +245,8 @@ absl::StatusOr<neuralmesh::DracoOptions> DracoFromFlags() {
   return o;
 }
 
-constexpr const char* kConnectionFlags[] = {"connect_timeout", "tls", "tls_ca_file",
-                                            "tls_cert_file", "tls_key_file",
+constexpr const char* kConnectionFlags[] = {"connect_timeout", "tls",          "tls_ca_file",
+                                            "tls_cert_file",   "tls_key_file", "tls_server_name",
                                             "access_token_file"};
 
 // How to reach the server: --connect_timeout, TLS and the access token.
@@ -271,8 +274,10 @@ absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
     *file.contents = *std::move(contents);
   }
   security.access_token = std::string(absl::StripAsciiWhitespace(security.access_token));
+  security.tls.server_name = absl::GetFlag(FLAGS_tls_server_name);
   security.tls.enabled = absl::GetFlag(FLAGS_tls) || !security.tls.root_certificates.empty() ||
-                         !security.tls.certificate_chain.empty();
+                         !security.tls.certificate_chain.empty() ||
+                         !security.tls.server_name.empty();
   if (!security.access_token.empty() && !security.tls.enabled) {
     return absl::InvalidArgumentError(
         "--access_token_file needs TLS (--tls or --tls_ca_file): the token must not cross the "

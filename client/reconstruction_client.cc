@@ -104,6 +104,9 @@ absl::StatusOr<std::unique_ptr<ReconstructionClient>> ReconstructionClient::Conn
   args.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, ToMillis(options.keepalive_timeout));
   // Keep pinging while only the server sends (a Watch): gRPC stops after two pings otherwise.
   args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
+  if (!options.security.tls.server_name.empty()) {
+    args.SetSslTargetNameOverride(options.security.tls.server_name);
+  }
   absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> credentials =
       MakeChannelCredentials(options.security);
   if (!credentials.ok()) return credentials.status();

@@ -42,6 +42,8 @@ TEST(MakeChannelCredentialsTest, RefusesPartsThatDoNotGoTogether) {
   ClientSecurity ca_not_pem;
   ca_not_pem.tls.enabled = true;
   ca_not_pem.tls.root_certificates = "MIIB";
+  ClientSecurity name_without_tls;
+  name_without_tls.tls.server_name = "scans.example.test";
   ClientSecurity token_with_space;
   token_with_space.tls.enabled = true;
   token_with_space.access_token = "two words";
@@ -50,6 +52,7 @@ TEST(MakeChannelCredentialsTest, RefusesPartsThatDoNotGoTogether) {
                         Case{"certificate alone", certificate_without_key, "private key"},
                         Case{"key alone", key_without_certificate, "private key"},
                         Case{"CA not PEM", ca_not_pem, "not PEM"},
+                        Case{"server name without TLS", name_without_tls, "without TLS"},
                         Case{"token with a space", token_with_space, "printable ASCII"}}) {
     absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> credentials =
         MakeChannelCredentials(c.security);
@@ -75,11 +78,14 @@ class SecureConnectionTest : public ::testing::Test {
   }
   static const testing::TestCertificates& certs() { return *certificates_; }
 
-  // A server on 127.0.0.1 with mutual TLS when `mutual`, and the access token kToken.
-  static std::unique_ptr<server::ReconstructionServer> StartServer(bool mutual) {
+  // A server on 127.0.0.1 with mutual TLS when `mutual`, and the access token kToken; with
+  // `named`, its certificate names scans.example.test only.
+  static std::unique_ptr<server::ReconstructionServer> StartServer(bool mutual,
+                                                                   bool named = false) {
     server::ServerOptions options;
-    options.security.tls.certificate_chain = certs().server_chain;
-    options.security.tls.private_key = certs().server_key;
+    options.security.tls.certificate_chain =
+        named ? certs().named_server_chain : certs().server_chain;
+    options.security.tls.private_key = named ? certs().named_server_key : certs().server_key;
     if (mutual) options.security.tls.client_ca_certificates = certs().ca;
     options.security.access_tokens = {kToken};
     return server::testing::StartServer(/*listen=*/true, options);
@@ -131,6 +137,25 @@ TEST_F(SecureConnectionTest, AWrongTokenConnectsButEveryCallIsUnauthenticated) {
   EXPECT_TRUE(absl::IsUnauthenticated(sessions.status())) << sessions.status();
   EXPECT_TRUE(absl::StrContains(sessions.status().message(), "ListSessions"));
   EXPECT_TRUE(absl::StrContains(sessions.status().message(), "not one this server accepts"));
+}
+
+TEST_F(SecureConnectionTest, AServerNameReachesACertificateForAnotherHost) {
+  std::unique_ptr<server::ReconstructionServer> server =
+      StartServer(/*mutual=*/false, /*named=*/true);
+  ASSERT_NE(server, nullptr);
+  ClientOptions dialled = Trusting(kToken);
+  dialled.connect_timeout = absl::Milliseconds(500);
+  absl::StatusOr<std::unique_ptr<ReconstructionClient>> refused =
+      ReconstructionClient::Connect(server->target(), dialled);
+  ASSERT_FALSE(refused.ok()) << "the certificate does not name 127.0.0.1";
+  EXPECT_TRUE(absl::IsUnavailable(refused.status())) << refused.status();
+
+  ClientOptions named = Trusting(kToken);
+  named.security.tls.server_name = "scans.example.test";
+  absl::StatusOr<std::unique_ptr<ReconstructionClient>> client =
+      ReconstructionClient::Connect(server->target(), named);
+  ASSERT_TRUE(client.ok()) << client.status();
+  EXPECT_TRUE((*client)->ListSessions().ok());
 }
 
 TEST_F(SecureConnectionTest, ConnectNamesWhyTheHandshakeFailed) {

@@ -87,6 +87,14 @@ TEST_F(SecureCliTest, ReconstructAndSessionsOverTlsWithAToken) {
   const RunResult sessions = RunNeuralmesh(Secured({"sessions"}));
   ASSERT_EQ(sessions.exit_code, 0) << sessions.Describe();
   EXPECT_THAT(sessions.out, HasSubstr("finished"));
+  // As through a tunnel: the certificate's name, not the host dialled.
+  const RunResult named = RunNeuralmesh(Secured({"sessions", "--tls_server_name=localhost"}));
+  EXPECT_EQ(named.exit_code, 0) << named.Describe();
+  const RunResult wrong_name =
+      RunNeuralmesh(Secured({"sessions", "--tls_server_name=scans.example.test",
+                             "--connect_timeout=1s"}));
+  EXPECT_NE(wrong_name.exit_code, 0) << wrong_name.Describe();
+  EXPECT_THAT(wrong_name.err, HasSubstr("cannot reach")) << wrong_name.Describe();
 }
 
 TEST_F(SecureCliTest, AMissingWrongOrUnprotectedTokenFailsClearly) {

@@ -56,6 +56,7 @@ absl::StatusOr<TestCertificates> MakeTestCertificates(const std::string& dir) {
   for (const std::string& step :
        {MakeCa("ca"), MakeCa("other_ca"),
         MakeSigned("server", "ca", "IP:127.0.0.1,DNS:localhost"),
+        MakeSigned("named_server", "ca", "DNS:scans.example.test"),
         MakeSigned("client", "ca", "DNS:neuralmesh-test-client"),
         MakeSigned("other_client", "other_ca", "DNS:neuralmesh-test-client")}) {
     if (absl::Status s = Run(dir, step); !s.ok()) return s;
@@ -70,7 +71,9 @@ absl::StatusOr<TestCertificates> MakeTestCertificates(const std::string& dir) {
       {&certificates.client_key, "client.key"},
       {&certificates.other_ca, "other_ca.pem"},
       {&certificates.other_client_chain, "other_client.pem"},
-      {&certificates.other_client_key, "other_client.key"}};
+      {&certificates.other_client_key, "other_client.key"},
+      {&certificates.named_server_chain, "named_server.pem"},
+      {&certificates.named_server_key, "named_server.key"}};
   for (const auto& [text, file] : files) {
     absl::StatusOr<std::string> read = Read(certificates.Path(file));
     if (!read.ok()) return read.status();

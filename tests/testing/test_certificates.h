@@ -1,6 +1,7 @@
 // Throw-away TLS material for tests, made with the openssl command-line tool: a CA, a server
-// certificate it signs for 127.0.0.1 and localhost, a client certificate it signs, and a
-// second CA that signs nothing the server trusts. Valid for two days from now.
+// certificate it signs for 127.0.0.1 and localhost, one it signs for a name only, a client
+// certificate it signs, and a second CA that signs nothing the server trusts. Valid for two
+// days from now.
 #ifndef NEURALMESH_TESTS_TESTING_TEST_CERTIFICATES_H_
 #define NEURALMESH_TESTS_TESTING_TEST_CERTIFICATES_H_
 
@@ -18,6 +19,8 @@ struct TestCertificates {
   std::string client_chain, client_key;   // client.pem, client.key: signed by the CA.
   std::string other_ca;                   // other_ca.pem: an unrelated CA.
   std::string other_client_chain, other_client_key;  // other_client.*: signed by other_ca.
+  // named_server.pem, .key: signed by the CA for the name scans.example.test only.
+  std::string named_server_chain, named_server_key;
 
   std::string Path(const std::string& file) const { return dir + "/" + file; }
 };

@@ -7,6 +7,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/io/file_contents.h"
 
 namespace neuralmesh::testing {
 namespace {
@@ -19,14 +20,6 @@ absl::Status Run(const std::string& dir, const std::string& command) {
   std::stringstream output;
   output << in.rdbuf();
   return absl::InternalError(absl::StrCat("'", command, "' failed:\n", output.str()));
-}
-
-absl::StatusOr<std::string> Read(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::InternalError(absl::StrCat("cannot read ", path));
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 // A CA named `name` (name.pem, name.key).
@@ -75,7 +68,7 @@ absl::StatusOr<TestCertificates> MakeTestCertificates(const std::string& dir) {
       {&certificates.named_server_chain, "named_server.pem"},
       {&certificates.named_server_key, "named_server.key"}};
   for (const auto& [text, file] : files) {
-    absl::StatusOr<std::string> read = Read(certificates.Path(file));
+    absl::StatusOr<std::string> read = ReadFileContents(certificates.Path(file));
     if (!read.ok()) return read.status();
     *text = *std::move(read);
   }

@@ -140,6 +140,10 @@ ABSL_FLAG(uint64_t, batch_size, 10000, "Points per uploaded batch.");
 ABSL_FLAG(uint64_t, points, 100000,
           "Points sampled from a builtin:NAME input before it is uploaded.");
 ABSL_FLAG(bool, ply, false, "Also write each mesh received from the server as .ply.");
+ABSL_FLAG(std::string, resume, "",
+          "reconstruct --server: the id of a session whose upload lost its connection; the "
+          "upload goes on from the points the session has taken (run with the same INPUT and "
+          "input flags; the session keeps its configuration).");
 ABSL_FLAG(absl::Duration, connect_timeout, absl::Seconds(5),
           "How long to wait for the server to accept the connection.");
 ABSL_FLAG(bool, tls, false,
@@ -327,11 +331,14 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.builtin_points = absl::GetFlag(FLAGS_points);
     o.ply = absl::GetFlag(FLAGS_ply);
     o.progress = progress;
+    o.resume_session = absl::GetFlag(FLAGS_resume);
     NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
     return neuralmesh::client::RunRemoteReconstruct(o, std::cout, std::cerr);
   }
   NM_RETURN_IF_ERROR(RejectFlags(
-      args, WithConnectionFlags({"out-dir", "batch-size", "points", "ply", "outliers_on_server"}),
+      args,
+      WithConnectionFlags({"out-dir", "batch-size", "points", "ply", "outliers_on_server",
+                           "resume"}),
       "needs --server (a local reconstruct writes -o OUTPUT)"));
   if (!args.Has("vertices")) return absl::InvalidArgumentError("--vertices N is required");
   neuralmesh::client::LocalReconstructOptions o;
@@ -405,13 +412,13 @@ std::vector<Subcommand> Commands() {
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
       "remove_outliers", "outlier_neighbours", "outlier_std_ratio", "outliers_on_server",
       "sampling", "time_budget", "max_steps", "quantization_bits", "encode_speed", "progress",
-      "server", "out-dir", "batch-size", "points", "ply"};
+      "server", "out-dir", "batch-size", "points", "ply", "resume"};
   // clang-format on
   return {
       {"reconstruct",
        "reconstruct INPUT -o OUTPUT --vertices N [flags]\n"
        "       neuralmesh reconstruct INPUT --server HOST:PORT --out-dir DIR [--vertices N] "
-       "[--batch-size K] [--ply]",
+       "[--batch-size K] [--ply] [--resume SESSION]",
        "Learns a mesh of a point cloud, a mesh or a built-in surface, locally or on a server.",
        "Learns a mesh of INPUT: a point cloud (.ply .xyz .obj .off .drc), a triangle mesh with\n"
        "--sampling area|curvature, or builtin:sphere|torus|genus2. Locally it writes OUTPUT and\n"

@@ -65,6 +65,7 @@ std::string LastConnectionError(const std::shared_ptr<grpc::Channel>& channel,
 
 v1::PointBatch PackPointBatch(const PointCloud& cloud, size_t begin, size_t end) {
   v1::PointBatch batch;
+  batch.mutable_first_point()->set_value(begin);
   v1::PackedPoints* packed = batch.mutable_packed();
   packed->set_positions(PackRange(cloud.positions, begin, end));
   if (!cloud.weights.empty()) packed->set_weights(PackRange(cloud.weights, begin, end));
@@ -148,9 +149,13 @@ absl::StatusOr<v1::Session> ReconstructionClient::CreateSession(const v1::Sessio
 
 absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
     const std::string& session_id, const PointCloud& cloud, size_t batch_size,
-    const UploadProgress& progress) {
+    const UploadProgress& progress, size_t first_point) {
   if (cloud.empty()) return absl::InvalidArgumentError("UploadPoints: no points to upload");
   if (batch_size == 0) return absl::InvalidArgumentError("UploadPoints: batch size must be > 0");
+  if (first_point > cloud.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("UploadPoints: the upload cannot start at point ",
+                                                   first_point, " of ", cloud.size()));
+  }
   grpc::ClientContext context;
   const OpenCall open(*this, context);
   v1::UploadPointsResponse response;
@@ -158,7 +163,7 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
       stub_->UploadPoints(&context, &response);
   v1::UploadPointsRequest request;
   request.set_session_id(session_id);
-  for (size_t begin = 0; begin < cloud.size(); begin += batch_size) {
+  for (size_t begin = first_point; begin < cloud.size(); begin += batch_size) {
     const size_t end = std::min(cloud.size(), begin + batch_size);
     *request.mutable_batch() = PackPointBatch(cloud, begin, end);
     // A failed write means the call is over (the server rejected a batch or went away);

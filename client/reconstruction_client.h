@@ -90,12 +90,16 @@ class ReconstructionClient {
   using UploadProgress = std::function<void(uint64_t points_sent, uint64_t points_total)>;
 
   // Streams `cloud` into the session in batches of at most `batch_size` points (packed
-  // float32, with the weights and normals the cloud carries). Returns the server's
-  // acknowledgement; on failure the server's status (the batches before the bad one stay
-  // accepted). INVALID_ARGUMENT for an empty cloud or a zero batch size.
+  // float32, with the weights and normals the cloud carries), each marked with its place in
+  // the cloud (PointBatch.first_point), from point `first_point` on: to resume an upload that
+  // lost its connection, pass the session's points_taken (points it has already are skipped,
+  // so resending is harmless). Returns the server's acknowledgement; on failure the server's
+  // status (the batches before the bad one stay accepted). INVALID_ARGUMENT for an empty
+  // cloud, a zero batch size or a first point beyond the cloud.
   absl::StatusOr<v1::UploadPointsResponse> UploadPoints(const std::string& session_id,
                                                         const PointCloud& cloud, size_t batch_size,
-                                                        const UploadProgress& progress = {});
+                                                        const UploadProgress& progress = {},
+                                                        size_t first_point = 0);
 
   // Called with each published mesh; returning false ends the watch early.
   using UpdateCallback = std::function<bool(const v1::MeshUpdate&)>;

@@ -75,7 +75,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     out << "outliers removed: " << removed << " of " << points_read << " points\n";
   }
   const size_t affordable = static_cast<size_t>(std::floor(cloud.size() / kDefaultPointsPerVertex));
-  const size_t target =
+  size_t target =
       options.vertices > 0 ? options.vertices : std::min(kDefaultMaxVertices, affordable);
   NM_ASSIGN_OR_RETURN(const std::vector<size_t> milestones, LodTargets(options.lods, target));
 
@@ -102,7 +102,27 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   // From here on Ctrl-C ends the upload and the watch at once and cancels the session (see
   // `canceller` below), so that the server does not keep learning for nobody.
   InterruptScope interrupt;
-  NM_ASSIGN_OR_RETURN(const v1::Session session, client->CreateSession(config, stem));
+  size_t first_point = 0;
+  v1::Session session;
+  if (options.resume_session.empty()) {
+    NM_ASSIGN_OR_RETURN(session, client->CreateSession(config, stem));
+  } else {
+    NM_ASSIGN_OR_RETURN(session, client->GetSession(options.resume_session));
+    if (session.state() != v1::SESSION_STATE_COLLECTING &&
+        session.state() != v1::SESSION_STATE_LEARNING) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("session ", session.session_id(), " is ", SessionStateName(session.state()),
+                       "; only a session that still takes points can be resumed"));
+    }
+    if (session.points_taken() > cloud.size()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "session ", session.session_id(), " has taken ", session.points_taken(),
+          " points, more than the ", cloud.size(),
+          " of this input: resume with the input (and its flags) of the first run"));
+    }
+    first_point = static_cast<size_t>(session.points_taken());
+    target = session.config().target_vertices();
+  }
   const std::string& id = session.session_id();
   const double points_per_vertex = session.config().has_points_per_vertex()
                                        ? session.config().points_per_vertex().value()
@@ -110,7 +130,9 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   const size_t reachable =
       std::min<size_t>(target, static_cast<size_t>(std::floor(cloud.size() / points_per_vertex)));
   out << "session " << id << " on " << client->address() << ": " << cloud.size()
-      << " points, target " << target << " vertices\n";
+      << " points, target " << target << " vertices";
+  if (!options.resume_session.empty()) out << "; resuming at point " << first_point;
+  out << "\n";
   if (reachable < target) {
     err << "note: " << cloud.size() << " points allow at most " << reachable
         << " vertices at the server's " << points_per_vertex << " points per vertex\n";
@@ -158,11 +180,13 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     if (!interrupted && InterruptScope::interrupted()) on_interrupt();
   };
 
-  absl::StatusOr<v1::UploadPointsResponse> uploaded =
-      client->UploadPoints(id, cloud, options.batch_size, [&](uint64_t sent, uint64_t total) {
+  absl::StatusOr<v1::UploadPointsResponse> uploaded = client->UploadPoints(
+      id, cloud, options.batch_size,
+      [&](uint64_t sent, uint64_t total) {
         absl::MutexLock lock(&mu);
         upload_bar.Update(sent, total);
-      });
+      },
+      first_point);
   {
     absl::MutexLock lock(&mu);
     upload_bar.Finish();
@@ -179,7 +203,8 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
           << " more held back on arrival and accepted later)\n";
     }
   }
-  if (!status.ok() && !InterruptScope::interrupted()) {
+  const bool connection_lost = absl::IsUnavailable(status);
+  if (!status.ok() && !InterruptScope::interrupted() && !connection_lost) {
     // Without a finished upload no final mesh can come: stop the server's work and the watch.
     client->Cancel(id, kTidyCancelTimeout).IgnoreError();
   }
@@ -193,6 +218,12 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
                        " may go on: cancelling it failed: ", interrupt_cancel.message()));
     }
     return absl::CancelledError(absl::StrCat("interrupted; session ", id, " cancelled"));
+  }
+  if (connection_lost && !uploaded.ok()) {
+    // The session keeps what it has taken; the same command with --resume goes on from there.
+    return absl::UnavailableError(absl::StrCat(
+        status.message(), "; session ", id, " keeps the points it has taken: run this command "
+        "again with --resume ", id, " to go on from there"));
   }
   NM_RETURN_IF_ERROR(status);
   if (!write_status.ok()) {

@@ -33,13 +33,19 @@ struct RemoteReconstructOptions {
   bool ply = false;                // Also write each LOD as .ply.
   bool progress = false;           // Draw progress bars on `err`.
   ClientOptions connection;        // Connect timeout, TLS, access token.
+  // Set: no new session; the upload into this one, which still takes points, goes on from the
+  // points it has taken (Session.points_taken). The input and its flags must be those of the
+  // first run; the session keeps the configuration it was created with.
+  std::string resume_session;
 };
 
-// Creates a session, watches it while the input streams up in batches, finishes it and
-// writes every LOD milestone (<stem>_lod<N>.drc) and the final mesh (<stem>.drc) into
-// out_dir, printing each update's figures on `out`. Returns OK only when the final mesh
-// arrived; otherwise the first error (the session is cancelled when the upload fails). A
-// first SIGINT or SIGTERM cancels the session and returns CANCELLED.
+// Creates a session (or takes up `resume_session`), watches it while the input streams up in
+// batches, finishes it and writes every LOD milestone (<stem>_lod<N>.drc) and the final mesh
+// (<stem>.drc) into out_dir, printing each update's figures on `out`. Returns OK only when the
+// final mesh arrived; otherwise the first error. When the upload fails the session is
+// cancelled, except when the connection was lost (UNAVAILABLE): the session keeps its points
+// and the message says how to resume. A first SIGINT or SIGTERM cancels the session and
+// returns CANCELLED.
 absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::ostream& out,
                                   std::ostream& err);
 

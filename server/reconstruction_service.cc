@@ -49,7 +49,7 @@ absl::Status BatchError(const absl::Status& status, uint64_t batch_number, uint6
 
 // What one batch added to a session.
 struct Ingested {
-  size_t accepted = 0;   // Points of the batch accepted.
+  size_t accepted = 0;   // Points of the batch accepted (not those the session had already).
   size_t held_back = 0;  // Points of the batch held back as outliers.
   size_t total = 0;      // The session's running total of accepted points.
 };
@@ -60,10 +60,15 @@ absl::StatusOr<Ingested> Ingest(Session& session, const v1::PointBatch& batch,
   absl::StatusOr<PointCloud> cloud = PointBatchFromProto(batch, max_batch_points);
   if (!cloud.ok()) return cloud.status();
   Ingested ingested;
-  absl::StatusOr<size_t> running = session.AddPoints(*cloud, &ingested.held_back);
+  size_t skipped = 0;
+  absl::StatusOr<size_t> running = session.AddPoints(
+      *cloud, &ingested.held_back,
+      batch.has_first_point() ? std::optional<uint64_t>(batch.first_point().value())
+                              : std::nullopt,
+      &skipped);
   if (!running.ok()) return running.status();
   ingested.total = *running;
-  ingested.accepted = cloud->size() - ingested.held_back;
+  ingested.accepted = cloud->size() - skipped - ingested.held_back;
   return ingested;
 }
 

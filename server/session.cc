@@ -17,6 +17,15 @@
 namespace neuralmesh::server {
 namespace {
 
+// The points of `cloud` from `begin` on, with their weights and normals.
+PointCloud PointsFrom(const PointCloud& cloud, size_t begin) {
+  PointCloud part;
+  part.positions.assign(cloud.positions.begin() + begin, cloud.positions.end());
+  if (!cloud.weights.empty()) part.weights.assign(cloud.weights.begin() + begin, cloud.weights.end());
+  if (!cloud.normals.empty()) part.normals.assign(cloud.normals.begin() + begin, cloud.normals.end());
+  return part;
+}
+
 // How often (in Basic Steps) the learner looks at the clock and the cancel flag: about a
 // tenth of a millisecond of learning, small against the slice.
 constexpr uint64_t kPollInterval = 128;
@@ -113,15 +122,40 @@ absl::StatusOr<QuantizationBox> Session::CubeWithLocked(const BoundingBox& batch
   return GrowQuantizationCube(box, batch_bounds, bits);
 }
 
-absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* held_back) {
+absl::StatusOr<size_t> Session::AddPoints(const PointCloud& sent, size_t* held_back,
+                                          std::optional<uint64_t> first_point, size_t* skipped) {
   if (held_back != nullptr) *held_back = 0;
+  if (skipped != nullptr) *skipped = 0;
   size_t total = 0;
   {
     absl::MutexLock ingest(&ingest_mu_);
+    uint64_t taken = 0;  // Only ingestion changes it, and ingest_mu_ is held.
     {
       absl::MutexLock lock(&mu_);  // Checked again below; here to spare the filter's work.
       NM_RETURN_IF_ERROR(AcceptingPointsLocked());
+      taken = points_taken_;
     }
+    // A batch resent after a lost connection: what the session has already is skipped.
+    PointCloud unseen;
+    const PointCloud* new_points = &sent;
+    if (first_point.has_value()) {
+      if (*first_point > taken) {
+        return absl::OutOfRangeError(absl::StrCat(
+            "the batch starts at point ", *first_point, " of the upload, but the session has ",
+            "taken ", taken, " points: send from point ", taken, " (Session.points_taken)"));
+      }
+      const uint64_t already = taken - *first_point;
+      if (already >= sent.positions.size()) {
+        if (skipped != nullptr) *skipped = sent.positions.size();
+        return points_.size();
+      }
+      if (already > 0) {
+        unseen = PointsFrom(sent, static_cast<size_t>(already));
+        new_points = &unseen;
+        if (skipped != nullptr) *skipped = static_cast<size_t>(already);
+      }
+    }
+    const PointCloud& batch = *new_points;
     NM_RETURN_IF_ERROR(
         GrowingPointCloud::ValidateBatch(batch.positions, batch.weights, batch.normals));
     // The filter keeps every point received, outliers too: they count toward the limit.
@@ -189,6 +223,7 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& batch, size_t* held_
       if (grown) ++epoch_;
     }
     learning_.set_points_received(total);
+    points_taken_ += batch.positions.size();
     learning_.set_points_removed_as_outliers(learning_.points_removed_as_outliers() + dropped);
     learning_.set_outliers_accepted_later(learning_.outliers_accepted_later() + released);
     learning_.set_outliers_held(held_outliers_.size());
@@ -345,6 +380,7 @@ v1::Session Session::ToProto() const {
   absl::MutexLock lock(&mu_);
   out.set_state(state_);
   *out.mutable_learning() = learning_;
+  out.set_points_taken(points_taken_);
   if (next_milestone_ < config_.lod_milestones.size()) {
     out.set_next_milestone(config_.lod_milestones[next_milestone_]);
   }

@@ -94,7 +94,14 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // cancelled, failed); INVALID_ARGUMENT for non-finite values or mismatched weights/normals;
   // RESOURCE_EXHAUSTED when the session's point limit would be exceeded (with outlier removal,
   // by the points received, outliers included). On error nothing changes.
-  absl::StatusOr<size_t> AddPoints(const PointCloud& batch, size_t* held_back = nullptr)
+  //
+  // With `first_point` (the batch's place in the client's upload, PointBatch.first_point), the
+  // points the session has taken already are skipped, their count going to `*skipped`: a
+  // batch resent after a lost connection adds only what is new. OUT_OF_RANGE, nothing taken,
+  // when `first_point` is beyond the points taken (a gap).
+  absl::StatusOr<size_t> AddPoints(const PointCloud& batch, size_t* held_back = nullptr,
+                                   std::optional<uint64_t> first_point = std::nullopt,
+                                   size_t* skipped = nullptr)
       ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
 
   // No more points: learn to the final vertex count and publish the final mesh. The points
@@ -193,6 +200,8 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   v1::SessionState state_ ABSL_GUARDED_BY(mu_) = v1::SESSION_STATE_COLLECTING;
   std::string error_ ABSL_GUARDED_BY(mu_);
   size_t final_vertices_ ABSL_GUARDED_BY(mu_) = 0;  // Set by Finish.
+  // Points taken from uploads, outliers included (changed with ingest_mu_ held too).
+  uint64_t points_taken_ ABSL_GUARDED_BY(mu_) = 0;
   size_t next_milestone_ ABSL_GUARDED_BY(mu_) = 0;  // Index into config_.lod_milestones.
   bool has_box_ ABSL_GUARDED_BY(mu_) = false;
   QuantizationBox box_ ABSL_GUARDED_BY(mu_);

@@ -11,12 +11,17 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
+#include "client/inputs.h"
 #include "client/reconstruction_client.h"
+#include "core/learning/learner_options.h"
 #include "core/io/point_cloud_io.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
+#include "tests/client/tcp_proxy.h"
 #include "tests/client/test_server.h"
 #include "tests/testing/shapes.h"
 
@@ -109,6 +114,95 @@ TEST_F(RemoteCliTest, ReconstructWritesIncreasingLodsAndTheFinalMesh) {
   }
   EXPECT_TRUE(std::filesystem::exists(*dir_ + "/out/sphere.drc"));
   EXPECT_TRUE(std::filesystem::exists(*dir_ + "/out/sphere.ply"));
+}
+
+TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
+  // The first run: half of the input, then the connection was lost.
+  absl::StatusOr<PointCloud> cloud =
+      client::LoadPointsForUpload("builtin:sphere", 4000, LearnerOptions().seed);
+  ASSERT_TRUE(cloud.ok()) << cloud.status();
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
+      client::ReconstructionClient::Connect(server_->address());
+  ASSERT_TRUE(service.ok()) << service.status();
+  auto upload_half = [&]() {
+    v1::SessionConfig config;
+    config.set_target_vertices(400);
+    absl::StatusOr<v1::Session> created = (*service)->CreateSession(config, "sphere");
+    EXPECT_TRUE(created.ok()) << created.status();
+    PointCloud half;
+    half.positions.assign(cloud->positions.begin(), cloud->positions.begin() + 1500);
+    EXPECT_TRUE((*service)->UploadPoints(created->session_id(), half, 500).ok());
+    return created->session_id();
+  };
+  const std::string id = upload_half();
+  const std::vector<std::string> resume = {"reconstruct", "builtin:sphere", "--server",
+                                           server_->address(), "--out-dir", *dir_ + "/resumed",
+                                           "--points", "4000", "--batch-size", "500",
+                                           "--resume", id};
+  const RunResult resumed = RunNeuralmesh(resume);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.Describe();
+  EXPECT_THAT(resumed.out, ::testing::HasSubstr("resuming at point 1500"));
+  EXPECT_TRUE(std::filesystem::exists(*dir_ + "/resumed/sphere.drc"));
+  absl::StatusOr<v1::Session> session = (*service)->GetSession(id);
+  ASSERT_TRUE(session.ok()) << session.status();
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_FINISHED);
+  EXPECT_EQ(session->points_taken(), 4000u);
+  EXPECT_EQ(session->learning().points_received(), 4000u) << "every point once";
+
+  const RunResult finished = RunNeuralmesh(resume);
+  EXPECT_NE(finished.exit_code, 0);
+  EXPECT_THAT(finished.err, ::testing::HasSubstr("only a session that still takes points"));
+  const RunResult smaller = RunNeuralmesh({"reconstruct", "builtin:sphere", "--server",
+                                           server_->address(), "--out-dir", *dir_ + "/smaller",
+                                           "--points", "1000", "--resume", upload_half()});
+  EXPECT_NE(smaller.exit_code, 0);
+  EXPECT_THAT(smaller.err, ::testing::HasSubstr("more than the 1000 of this input"));
+  const RunResult local = RunNeuralmesh(
+      {"reconstruct", "builtin:sphere", "-o", *dir_ + "/local.ply", "--vertices", "100",
+       "--resume", id});
+  EXPECT_NE(local.exit_code, 0);
+  EXPECT_THAT(local.err, ::testing::HasSubstr("--resume needs --server"));
+}
+
+TEST_F(RemoteCliTest, ALostConnectionKeepsTheSessionAndResumeFinishesIt) {
+  const std::string& address = server_->address();
+  TcpProxy proxy(std::stoi(address.substr(address.rfind(':') + 1)),
+                 /*cut_after_client_bytes=*/300 * 1000);
+  std::vector<std::string> args = {
+      "reconstruct", "builtin:sphere", "--server", absl::StrCat("127.0.0.1:", proxy.port()),
+      "--out-dir", *dir_ + "/lost", "--points", "60000", "--batch-size", "1000",
+      "--vertices", "400"};
+  const RunResult lost = RunNeuralmesh(args);
+  ASSERT_TRUE(proxy.cut()) << "the upload of 720 KB passed the 300 KB mark";
+  EXPECT_NE(lost.exit_code, 0) << lost.Describe();
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(lost.err, match,
+                                std::regex("run this command again with --resume (s-[0-9a-f]+)")))
+      << lost.Describe();
+  const std::string id = match[1];
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
+      client::ReconstructionClient::Connect(address);
+  ASSERT_TRUE(service.ok()) << service.status();
+  absl::StatusOr<v1::Session> kept = (*service)->GetSession(id);
+  ASSERT_TRUE(kept.ok()) << kept.status() << ": the session was not cancelled";
+  EXPECT_TRUE(kept->state() == v1::SESSION_STATE_COLLECTING ||
+              kept->state() == v1::SESSION_STATE_LEARNING)
+      << v1::SessionState_Name(kept->state());
+  // Whole batches, as many as reached the server before the cut (none, when the proxy's
+  // buffers still held them all).
+  EXPECT_LT(kept->points_taken(), 60000u);
+  EXPECT_EQ(kept->points_taken() % 1000, 0u);
+
+  args.insert(args.end(), {"--resume", id});
+  const RunResult resumed = RunNeuralmesh(args);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.Describe();
+  EXPECT_THAT(resumed.out, ::testing::HasSubstr(
+                               absl::StrCat("resuming at point ", kept->points_taken())));
+  absl::StatusOr<v1::Session> done = (*service)->GetSession(id);
+  ASSERT_TRUE(done.ok()) << done.status();
+  EXPECT_EQ(done->state(), v1::SESSION_STATE_FINISHED);
+  EXPECT_EQ(done->learning().points_received(), 60000u) << "every point once";
+  EXPECT_TRUE(std::filesystem::exists(*dir_ + "/lost/sphere.drc"));
 }
 
 TEST_F(RemoteCliTest, TheServerPrintsTheSessionsEvents) {

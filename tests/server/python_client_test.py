@@ -147,6 +147,16 @@ def main():
           "upload acknowledged %d points in %d batches" % (ack.total_points,
                                                            ack.batches_accepted))
 
+    # A batch sent again with its place in the upload (after a lost connection) adds nothing.
+    resent = pb.PointBatch(packed=pb.PackedPoints(positions=batches[9]))
+    resent.first_point.value = 5400
+    again = stub.UploadPoints(iter([pb.UploadPointsRequest(session_id=sid, batch=resent)]),
+                              timeout=10)
+    check(again.points_accepted == 0 and again.total_points == 6000,
+          "a resent batch added %d points" % again.points_accepted)
+    check(stub.GetSession(pb.GetSessionRequest(session_id=sid), timeout=10).points_taken == 6000,
+          "points_taken is not 6000")
+
     # A NaN batch is rejected with INVALID_ARGUMENT and the session keeps its points.
     nan_batch = struct.pack("<6f", 0.0, 0.0, 0.0, float("nan"), 0.0, 0.0)
     try:

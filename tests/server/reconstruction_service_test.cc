@@ -158,6 +158,34 @@ TEST_F(ReconstructionServiceTest, InvalidOptionsAreInvalidArgumentNamingTheField
   }
 }
 
+TEST_F(ReconstructionServiceTest, BatchesSentAgainCountOnlyTheirNewPoints) {
+  const std::string id = MustCreate(*stub_, CreateRequest(50));
+  const PointCloud points = TorusPoints(3000, 8);
+  auto batch = [&](size_t begin, size_t end) {
+    v1::PointBatch b = testing::Batch(points, begin, end);
+    b.mutable_first_point()->set_value(begin);
+    return b;
+  };
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(UploadOne(Request(id, batch(0, 2000)), &response).ok());
+  EXPECT_EQ(response.points_accepted(), 2000u);
+  // The connection was lost before the client saw the answer: it sends from 1000 again.
+  ASSERT_TRUE(UploadOne(Request(id, batch(1000, 3000)), &response).ok());
+  EXPECT_EQ(response.points_accepted(), 1000u) << "only points 2000-2999 are new";
+  EXPECT_EQ(response.total_points(), 3000u);
+  const grpc::Status known = UploadOne(Request(id, batch(2500, 2600)), &response);
+  EXPECT_EQ(known.error_code(), grpc::StatusCode::OK) << "2500 < 3000: all known";
+  EXPECT_EQ(response.points_accepted(), 0u);
+  v1::PointBatch beyond = testing::Batch(points, 0, 10);
+  beyond.mutable_first_point()->set_value(3001);
+  const grpc::Status refused = UploadOne(Request(id, beyond), &response);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::OUT_OF_RANGE) << refused.error_message();
+  EXPECT_THAT(refused.error_message(), ::testing::HasSubstr("send from point 3000"));
+  const v1::Session session = testing::GetSession(*stub_, id);
+  EXPECT_EQ(session.points_taken(), 3000u);
+  EXPECT_EQ(session.learning().points_received(), 3000u);
+}
+
 TEST_F(ReconstructionServiceTest, MaxSessionsIsResourceExhausted) {
   for (int i = 0; i < 16; ++i) MustCreate(*stub_, CreateRequest(100));
   grpc::ClientContext context;

@@ -205,6 +205,57 @@ TEST_F(SessionTest, BadBatchesAreRejectedAndTheSessionKeepsItsPoints) {
                              "points"));
 }
 
+TEST_F(SessionTest, BatchesSentAgainAddOnlyWhatTheSessionLacks) {
+  SessionConfig config;
+  config.target_vertices = 50;
+  auto session = NewSession(config);
+  const PointCloud points = Torus(1000, 4);
+  size_t skipped = 0;
+  ASSERT_TRUE(session->AddPoints(Slice(points, 0, 300), nullptr, 0, &skipped).ok());
+  EXPECT_EQ(skipped, 0u);
+  // After a lost connection the client sends from 200 again: 100 points it had already.
+  absl::StatusOr<size_t> total = session->AddPoints(Slice(points, 200, 500), nullptr, 200, &skipped);
+  ASSERT_TRUE(total.ok()) << total.status();
+  EXPECT_EQ(skipped, 100u);
+  EXPECT_EQ(*total, 500u);
+  total = session->AddPoints(Slice(points, 0, 100), nullptr, 0, &skipped);
+  ASSERT_TRUE(total.ok()) << total.status();
+  EXPECT_EQ(skipped, 100u) << "all of it known: nothing added";
+  EXPECT_EQ(*total, 500u);
+  // A gap is refused and changes nothing.
+  total = session->AddPoints(Slice(points, 600, 700), nullptr, 600, &skipped);
+  EXPECT_EQ(total.status().code(), absl::StatusCode::kOutOfRange) << total.status();
+  EXPECT_THAT(std::string(total.status().message()), HasSubstr("send from point 500"));
+  EXPECT_EQ(session->ToProto().points_taken(), 500u);
+  // Without a place, every point is new.
+  ASSERT_TRUE(session->AddPoints(Slice(points, 500, 600)).ok());
+  EXPECT_EQ(session->ToProto().points_taken(), 600u);
+  EXPECT_EQ(session->points_received(), 600u);
+  // The points are those of the upload, each once, in order.
+  ASSERT_TRUE(session->Finish().ok());
+  EXPECT_TRUE(recorder_.AwaitClose().ok());
+  EXPECT_EQ(session->ToProto().learning().points_received(), 600u);
+}
+
+TEST_F(SessionTest, PointsTakenCountOutliersHeldBack) {
+  SessionConfig config;
+  config.target_vertices = 50;
+  config.outlier_removal = OutlierOptions();
+  auto session = NewSession(config);
+  PointCloud batch = Torus(2000, 6);
+  batch.positions.push_back(Vec3f(0, 0, 100));  // A stray far off the torus.
+  size_t held = 0;
+  ASSERT_TRUE(session->AddPoints(batch, &held, 0).ok());
+  EXPECT_EQ(held, 1u);
+  EXPECT_EQ(session->points_received(), 2000u);
+  EXPECT_EQ(session->ToProto().points_taken(), 2001u) << "the stray was taken, and held";
+  size_t skipped = 0;
+  ASSERT_TRUE(session->AddPoints(batch, &held, 0, &skipped).ok());
+  EXPECT_EQ(skipped, 2001u);
+  EXPECT_EQ(held, 0u) << "nothing judged twice";
+  EXPECT_EQ(session->ToProto().learning().outliers_held(), 1u);
+}
+
 // With outlier removal the session keeps every point received, dropped ones too (they are
 // the neighbours later batches are judged against), so they count toward its point limit: a
 // client sending only outliers cannot grow it without bound.

@@ -29,6 +29,7 @@ void WriteSessionJson(const neuralmesh::v1::Session& s, JsonWriter& json) {
   json.Key("name").String(s.name());
   json.Key("state").String(SessionStateName(s.state()));
   json.Key("points_received").Uint(s.learning().points_received());
+  json.Key("points_taken").Uint(s.points_taken());
   json.Key("points_removed_as_outliers").Uint(s.learning().points_removed_as_outliers());
   json.Key("outliers_held").Uint(s.learning().outliers_held());
   json.Key("outliers_accepted_later").Uint(s.learning().outliers_accepted_later());

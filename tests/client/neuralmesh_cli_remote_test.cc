@@ -268,6 +268,7 @@ TEST_F(RemoteCliTest, SessionsListsTheFinishedSession) {
   const RunResult json = RunNeuralmesh({"sessions", "--server", server_->address(), "--json"});
   ASSERT_EQ(json.exit_code, 0) << json.Describe();
   EXPECT_TRUE(absl::StrContains(json.out, "\"state\": \"finished\"")) << json.out;
+  EXPECT_TRUE(absl::StrContains(json.out, "\"points_taken\": 4000")) << json.out;
 }
 
 TEST_F(RemoteCliTest, WatchingAFinishedSessionSavesItsFinalMesh) {

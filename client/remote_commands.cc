@@ -110,9 +110,14 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     NM_ASSIGN_OR_RETURN(session, client->GetSession(options.resume_session));
     if (session.state() != v1::SESSION_STATE_COLLECTING &&
         session.state() != v1::SESSION_STATE_LEARNING) {
-      return absl::FailedPreconditionError(
-          absl::StrCat("session ", session.session_id(), " is ", SessionStateName(session.state()),
-                       "; only a session that still takes points can be resumed"));
+      const bool finishing = session.state() == v1::SESSION_STATE_FINISHING ||
+                             session.state() == v1::SESSION_STATE_FINISHED;
+      return absl::FailedPreconditionError(absl::StrCat(
+          "session ", session.session_id(), " is ", SessionStateName(session.state()),
+          "; only a session that still takes points can be resumed",
+          finishing ? absl::StrCat(" (neuralmesh watch ", session.session_id(),
+                                   " saves its meshes)")
+                    : ""));
     }
     if (session.points_taken() > cloud.size()) {
       return absl::InvalidArgumentError(absl::StrCat(
@@ -180,13 +185,17 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     if (!interrupted && InterruptScope::interrupted()) on_interrupt();
   };
 
-  absl::StatusOr<v1::UploadPointsResponse> uploaded = client->UploadPoints(
-      id, cloud, options.batch_size,
-      [&](uint64_t sent, uint64_t total) {
-        absl::MutexLock lock(&mu);
-        upload_bar.Update(sent, total);
-      },
-      first_point);
+  // A resumed session may have every point already (the connection broke at the finish).
+  absl::StatusOr<v1::UploadPointsResponse> uploaded = v1::UploadPointsResponse();
+  if (first_point < cloud.size()) {
+    uploaded = client->UploadPoints(
+        id, cloud, options.batch_size,
+        [&](uint64_t sent, uint64_t total) {
+          absl::MutexLock lock(&mu);
+          upload_bar.Update(sent, total);
+        },
+        first_point);
+  }
   {
     absl::MutexLock lock(&mu);
     upload_bar.Finish();
@@ -219,7 +228,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     }
     return absl::CancelledError(absl::StrCat("interrupted; session ", id, " cancelled"));
   }
-  if (connection_lost && !uploaded.ok()) {
+  if (connection_lost) {
     // The session keeps what it has taken; the same command with --resume goes on from there.
     return absl::UnavailableError(absl::StrCat(
         status.message(), "; session ", id, " keeps the points it has taken: run this command "

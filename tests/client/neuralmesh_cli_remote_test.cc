@@ -124,17 +124,17 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
   absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
       client::ReconstructionClient::Connect(server_->address());
   ASSERT_TRUE(service.ok()) << service.status();
-  auto upload_half = [&]() {
+  auto upload_first = [&](size_t points) {
     v1::SessionConfig config;
     config.set_target_vertices(400);
     absl::StatusOr<v1::Session> created = (*service)->CreateSession(config, "sphere");
     EXPECT_TRUE(created.ok()) << created.status();
-    PointCloud half;
-    half.positions.assign(cloud->positions.begin(), cloud->positions.begin() + 1500);
-    EXPECT_TRUE((*service)->UploadPoints(created->session_id(), half, 500).ok());
+    PointCloud part;
+    part.positions.assign(cloud->positions.begin(), cloud->positions.begin() + points);
+    EXPECT_TRUE((*service)->UploadPoints(created->session_id(), part, 500).ok());
     return created->session_id();
   };
-  const std::string id = upload_half();
+  const std::string id = upload_first(1500);
   const std::vector<std::string> resume = {"reconstruct", "builtin:sphere", "--server",
                                            server_->address(), "--out-dir", *dir_ + "/resumed",
                                            "--points", "4000", "--batch-size", "500",
@@ -152,9 +152,18 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
   const RunResult finished = RunNeuralmesh(resume);
   EXPECT_NE(finished.exit_code, 0);
   EXPECT_THAT(finished.err, ::testing::HasSubstr("only a session that still takes points"));
+  EXPECT_THAT(finished.err, ::testing::HasSubstr("neuralmesh watch " + id));
+  // Every point was taken, but the finish never reached the server.
+  const std::string whole = upload_first(4000);
+  const RunResult finish_only =
+      RunNeuralmesh({"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir",
+                     *dir_ + "/whole", "--points", "4000", "--resume", whole});
+  ASSERT_EQ(finish_only.exit_code, 0) << finish_only.Describe();
+  EXPECT_THAT(finish_only.out, ::testing::HasSubstr("resuming at point 4000"));
+  EXPECT_TRUE(std::filesystem::exists(*dir_ + "/whole/sphere.drc"));
   const RunResult smaller = RunNeuralmesh({"reconstruct", "builtin:sphere", "--server",
                                            server_->address(), "--out-dir", *dir_ + "/smaller",
-                                           "--points", "1000", "--resume", upload_half()});
+                                           "--points", "1000", "--resume", upload_first(1500)});
   EXPECT_NE(smaller.exit_code, 0);
   EXPECT_THAT(smaller.err, ::testing::HasSubstr("more than the 1000 of this input"));
   const RunResult local = RunNeuralmesh(

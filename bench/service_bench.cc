@@ -56,9 +56,7 @@ PointCloud Torus(size_t n, uint64_t seed) {
 }
 
 v1::PointBatch Batch(const PointCloud& cloud, size_t begin, size_t end) {
-  PointCloud part;
-  part.positions.assign(cloud.positions.begin() + begin, cloud.positions.begin() + end);
-  return server::PointCloudToPackedBatch(part);
+  return server::PointCloudToPackedBatch(PointRange(cloud, begin, end));
 }
 
 std::string Create(v1::ReconstructionService::Stub& stub, uint64_t target,

@@ -156,9 +156,12 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
     return absl::InvalidArgumentError(absl::StrCat("UploadPoints: the upload cannot start at point ",
                                                    first_point, " of ", cloud.size()));
   }
+  v1::UploadPointsResponse response;
+  response.set_session_id(session_id);
+  // A resumed upload whose every point the session has already: nothing to send.
+  if (first_point == cloud.size()) return response;
   grpc::ClientContext context;
   const OpenCall open(*this, context);
-  v1::UploadPointsResponse response;
   std::unique_ptr<grpc::ClientWriter<v1::UploadPointsRequest>> writer =
       stub_->UploadPoints(&context, &response);
   v1::UploadPointsRequest request;

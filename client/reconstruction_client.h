@@ -94,8 +94,9 @@ class ReconstructionClient {
   // the cloud (PointBatch.first_point), from point `first_point` on: to resume an upload that
   // lost its connection, pass the session's points_taken (points it has already are skipped,
   // so resending is harmless). Returns the server's acknowledgement; on failure the server's
-  // status (the batches before the bad one stay accepted). INVALID_ARGUMENT for an empty
-  // cloud, a zero batch size or a first point beyond the cloud.
+  // status (the batches before the bad one stay accepted); with nothing left to send, an
+  // empty acknowledgement and no call. INVALID_ARGUMENT for an empty cloud, a zero batch size
+  // or a first point beyond the cloud.
   absl::StatusOr<v1::UploadPointsResponse> UploadPoints(const std::string& session_id,
                                                         const PointCloud& cloud, size_t batch_size,
                                                         const UploadProgress& progress = {},

@@ -185,17 +185,13 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     if (!interrupted && InterruptScope::interrupted()) on_interrupt();
   };
 
-  // A resumed session may have every point already (the connection broke at the finish).
-  absl::StatusOr<v1::UploadPointsResponse> uploaded = v1::UploadPointsResponse();
-  if (first_point < cloud.size()) {
-    uploaded = client->UploadPoints(
-        id, cloud, options.batch_size,
-        [&](uint64_t sent, uint64_t total) {
-          absl::MutexLock lock(&mu);
-          upload_bar.Update(sent, total);
-        },
-        first_point);
-  }
+  absl::StatusOr<v1::UploadPointsResponse> uploaded = client->UploadPoints(
+      id, cloud, options.batch_size,
+      [&](uint64_t sent, uint64_t total) {
+        absl::MutexLock lock(&mu);
+        upload_bar.Update(sent, total);
+      },
+      first_point);
   {
     absl::MutexLock lock(&mu);
     upload_bar.Finish();

@@ -48,4 +48,16 @@ absl::Status ValidatePointCloud(const PointCloud& cloud) {
   return absl::OkStatus();
 }
 
+PointCloud PointRange(const PointCloud& cloud, size_t begin, size_t end) {
+  PointCloud part;
+  part.positions.assign(cloud.positions.begin() + begin, cloud.positions.begin() + end);
+  if (!cloud.weights.empty()) {
+    part.weights.assign(cloud.weights.begin() + begin, cloud.weights.begin() + end);
+  }
+  if (!cloud.normals.empty()) {
+    part.normals.assign(cloud.normals.begin() + begin, cloud.normals.begin() + end);
+  }
+  return part;
+}
+
 }  // namespace neuralmesh

@@ -23,6 +23,9 @@ struct PointCloud {
 // Returns INVALID_ARGUMENT with the first offending index otherwise.
 absl::Status ValidatePointCloud(const PointCloud& cloud);
 
+// Points [begin, end) of `cloud`, with their weights and normals; begin <= end <= size().
+PointCloud PointRange(const PointCloud& cloud, size_t begin, size_t end);
+
 }  // namespace neuralmesh
 
 #endif  // NEURALMESH_CORE_POINT_CLOUD_H_

@@ -17,15 +17,6 @@
 namespace neuralmesh::server {
 namespace {
 
-// The points of `cloud` from `begin` on, with their weights and normals.
-PointCloud PointsFrom(const PointCloud& cloud, size_t begin) {
-  PointCloud part;
-  part.positions.assign(cloud.positions.begin() + begin, cloud.positions.end());
-  if (!cloud.weights.empty()) part.weights.assign(cloud.weights.begin() + begin, cloud.weights.end());
-  if (!cloud.normals.empty()) part.normals.assign(cloud.normals.begin() + begin, cloud.normals.end());
-  return part;
-}
-
 // How often (in Basic Steps) the learner looks at the clock and the cancel flag: about a
 // tenth of a millisecond of learning, small against the slice.
 constexpr uint64_t kPollInterval = 128;
@@ -150,7 +141,7 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& sent, size_t* held_b
         return points_.size();
       }
       if (already > 0) {
-        unseen = PointsFrom(sent, static_cast<size_t>(already));
+        unseen = PointRange(sent, static_cast<size_t>(already), sent.positions.size());
         new_points = &unseen;
         if (skipped != nullptr) *skipped = static_cast<size_t>(already);
       }

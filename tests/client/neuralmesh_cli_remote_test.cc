@@ -129,9 +129,8 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
     config.set_target_vertices(400);
     absl::StatusOr<v1::Session> created = (*service)->CreateSession(config, "sphere");
     EXPECT_TRUE(created.ok()) << created.status();
-    PointCloud part;
-    part.positions.assign(cloud->positions.begin(), cloud->positions.begin() + points);
-    EXPECT_TRUE((*service)->UploadPoints(created->session_id(), part, 500).ok());
+    EXPECT_TRUE(
+        (*service)->UploadPoints(created->session_id(), PointRange(*cloud, 0, points), 500).ok());
     return created->session_id();
   };
   const std::string id = upload_first(1500);

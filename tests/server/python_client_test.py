@@ -110,11 +110,11 @@ def main():
     check(any(b"neuralmesh.v1.ReconstructionService" in a for a in answers),
           "reflection does not list neuralmesh.v1.ReconstructionService")
 
-    stub = pb_grpc.ReconstructionServiceStub(channel)
+    service = pb_grpc.ReconstructionServiceStub(channel)
     config = pb.SessionConfig(target_vertices=300)
     config.refresh_interval_ms.value = 50
     config.learner.alpha_w.value = 0.06
-    session = stub.CreateSession(pb.CreateSessionRequest(config=config, name="python"),
+    session = service.CreateSession(pb.CreateSessionRequest(config=config, name="python"),
                                  timeout=10)
     check(session.session_id.startswith("s-"), "unexpected session id " + session.session_id)
     check(session.config.learner.c_vs.value == 100, "defaults are not echoed")
@@ -125,7 +125,7 @@ def main():
 
     def watch():
         try:
-            for update in stub.WatchSession(pb.WatchSessionRequest(session_id=sid), timeout=120):
+            for update in service.WatchSession(pb.WatchSessionRequest(session_id=sid), timeout=120):
                 updates.append(update)
         except grpc.RpcError as e:  # Recorded and checked below.
             errors.append(e)
@@ -142,7 +142,7 @@ def main():
                 session_id=sid if index == 0 else "",
                 batch=pb.PointBatch(packed=pb.PackedPoints(positions=chunk)))
 
-    ack = stub.UploadPoints(requests(), timeout=60)
+    ack = service.UploadPoints(requests(), timeout=60)
     check(ack.total_points == 6000 and ack.batches_accepted == 10,
           "upload acknowledged %d points in %d batches" % (ack.total_points,
                                                            ack.batches_accepted))
@@ -150,28 +150,28 @@ def main():
     # A batch sent again with its place in the upload (after a lost connection) adds nothing.
     resent = pb.PointBatch(packed=pb.PackedPoints(positions=batches[9]))
     resent.first_point.value = 5400
-    again = stub.UploadPoints(iter([pb.UploadPointsRequest(session_id=sid, batch=resent)]),
+    again = service.UploadPoints(iter([pb.UploadPointsRequest(session_id=sid, batch=resent)]),
                               timeout=10)
     check(again.points_accepted == 0 and again.total_points == 6000,
           "a resent batch added %d points" % again.points_accepted)
-    check(stub.GetSession(pb.GetSessionRequest(session_id=sid), timeout=10).points_taken == 6000,
+    check(service.GetSession(pb.GetSessionRequest(session_id=sid), timeout=10).points_taken == 6000,
           "points_taken is not 6000")
 
     # A NaN batch is rejected with INVALID_ARGUMENT and the session keeps its points.
     nan_batch = struct.pack("<6f", 0.0, 0.0, 0.0, float("nan"), 0.0, 0.0)
     try:
-        stub.UploadPoints(iter([pb.UploadPointsRequest(
+        service.UploadPoints(iter([pb.UploadPointsRequest(
             session_id=sid, batch=pb.PointBatch(packed=pb.PackedPoints(positions=nan_batch)))]),
             timeout=10)
         check(False, "a NaN batch was accepted")
     except grpc.RpcError as e:
         check(e.code() == grpc.StatusCode.INVALID_ARGUMENT,
               "NaN batch gave %s: %s" % (e.code(), e.details()))
-    check(stub.GetSession(pb.GetSessionRequest(session_id=sid)).learning.points_received == 6000,
+    check(service.GetSession(pb.GetSessionRequest(session_id=sid)).learning.points_received == 6000,
           "the rejected batch changed the session")
 
-    stub.FinishSession(pb.FinishSessionRequest(session_id=sid), timeout=10)
-    final = stub.GetMesh(pb.GetMeshRequest(session_id=sid, version=pb.MESH_VERSION_FINAL,
+    service.FinishSession(pb.FinishSessionRequest(session_id=sid), timeout=10)
+    final = service.GetMesh(pb.GetMeshRequest(session_id=sid, version=pb.MESH_VERSION_FINAL,
                                            wait=True), timeout=120)
     watcher.join(timeout=120)
     check(not errors, "watch failed: %s" % errors)
@@ -208,7 +208,7 @@ def main():
             yield pb.ReconstructRequest(points=pb.PointBatch(
                 packed=pb.PackedPoints(positions=chunk)))
 
-    responses = list(stub.Reconstruct(stream(), timeout=120))
+    responses = list(service.Reconstruct(stream(), timeout=120))
     check(responses[0].WhichOneof("kind") == "session", "Reconstruct did not start with a session")
     check(responses[-1].WhichOneof("kind") == "update" and
           responses[-1].update.kind == pb.UPDATE_KIND_FINAL and
@@ -220,7 +220,7 @@ def main():
           ((acks[-1].points_accepted, acks[-1].points_held_back) if acks else (0, 0)))
     # Finished: nothing is held any more, and every point held back was accepted later or
     # removed; the stray, which nothing came near, was removed.
-    learning = stub.GetSession(pb.GetSessionRequest(
+    learning = service.GetSession(pb.GetSessionRequest(
         session_id=responses[0].session.session_id), timeout=10).learning
     check(learning.outliers_held == 0 and learning.points_removed_as_outliers >= 1 and
           learning.points_removed_as_outliers + learning.outliers_accepted_later ==
@@ -230,11 +230,11 @@ def main():
           (learning.outliers_held, learning.points_removed_as_outliers,
            learning.outliers_accepted_later))
 
-    listed = stub.ListSessions(pb.ListSessionsRequest(), timeout=10)
+    listed = service.ListSessions(pb.ListSessionsRequest(), timeout=10)
     check(len(listed.sessions) == 2, "ListSessions returned %d sessions" % len(listed.sessions))
-    stub.DeleteSession(pb.DeleteSessionRequest(session_id=sid), timeout=10)
+    service.DeleteSession(pb.DeleteSessionRequest(session_id=sid), timeout=10)
     try:
-        stub.GetSession(pb.GetSessionRequest(session_id=sid), timeout=10)
+        service.GetSession(pb.GetSessionRequest(session_id=sid), timeout=10)
         check(False, "a deleted session was found")
     except grpc.RpcError as e:
         check(e.code() == grpc.StatusCode.NOT_FOUND, "deleted session gave %s" % e.code())

@@ -23,7 +23,7 @@ namespace {
 using ::testing::HasSubstr;
 using testing::Batch;
 using testing::CreateRequest;
-using testing::InProcessStub;
+using testing::InProcessService;
 using testing::MustCreate;
 using testing::StartServer;
 using testing::TorusPoints;
@@ -36,7 +36,7 @@ class ReconstructionServiceTest : public ::testing::Test {
     options.limits.max_sessions = 16;
     server_ = StartServer(/*listen=*/false, options);
     ASSERT_NE(server_, nullptr);
-    stub_ = InProcessStub(*server_);
+    stub_ = InProcessService(*server_);
   }
   void TearDown() override { server_->Shutdown(absl::Seconds(2)); }
 
@@ -277,9 +277,8 @@ TEST_F(ReconstructionServiceTest, EveryBadInputGetsItsStatusAndTheSessionGoesOn)
 
   // Draco point clouds are accepted like packed ones.
   {
-    PointCloud part;
-    part.positions.assign(points.positions.begin() + 1500, points.positions.begin() + 4000);
-    absl::StatusOr<std::string> draco = EncodePointCloud(part, DracoOptions());
+    absl::StatusOr<std::string> draco =
+        EncodePointCloud(PointRange(points, 1500, 4000), DracoOptions());
     ASSERT_TRUE(draco.ok());
     v1::PointBatch batch;
     batch.set_draco_point_cloud(*draco);
@@ -810,7 +809,7 @@ TEST(ReconstructionServiceIdleTimeoutTest, IdleSessionsAreDeletedWatchedOnesStay
   std::unique_ptr<ReconstructionServer> server = StartServer(/*listen=*/false, options);
   ASSERT_NE(server, nullptr);
   // The generated client class of the service (gRPC calls it a stub), over an in-process channel.
-  auto client = InProcessStub(*server);
+  auto client = InProcessService(*server);
   // ListSessions is no call on a session: it keeps none alive.
   auto listed = [&] {
     grpc::ClientContext context;

@@ -66,7 +66,7 @@ class SecureServerTest : public ::testing::Test {
     return grpc::SslCredentials(options);
   }
 
-  static std::unique_ptr<v1::ReconstructionService::Stub> Stub(
+  static std::unique_ptr<v1::ReconstructionService::Stub> Service(
       const ReconstructionServer& server,
       const std::shared_ptr<grpc::ChannelCredentials>& credentials) {
     grpc::ChannelArguments args;
@@ -76,13 +76,13 @@ class SecureServerTest : public ::testing::Test {
   }
 
   // ListSessions within 5 s, with `authorization` as metadata when set.
-  static grpc::Status List(v1::ReconstructionService::Stub& stub,
+  static grpc::Status List(v1::ReconstructionService::Stub& service,
                            const std::string& authorization = "") {
     grpc::ClientContext context;
     context.set_deadline(absl::ToChronoTime(absl::Now() + absl::Seconds(5)));
     if (!authorization.empty()) context.AddMetadata("authorization", authorization);
     v1::ListSessionsResponse response;
-    return stub.ListSessions(&context, v1::ListSessionsRequest(), &response);
+    return service.ListSessions(&context, v1::ListSessionsRequest(), &response);
   }
 
  private:
@@ -94,17 +94,17 @@ neuralmesh::testing::TestCertificates* SecureServerTest::certificates_ = nullptr
 TEST_F(SecureServerTest, TlsClientReconstructsATorus) {
   std::unique_ptr<ReconstructionServer> server = Start(Tls());
   ASSERT_NE(server, nullptr);
-  auto stub = Stub(*server, TlsTrusting(certs().ca));
-  const std::string id = testing::MustCreate(*stub, testing::CreateRequest(2000));
+  auto service = Service(*server, TlsTrusting(certs().ca));
+  const std::string id = testing::MustCreate(*service, testing::CreateRequest(2000));
   ASSERT_FALSE(id.empty());
   v1::UploadPointsResponse response;
   const grpc::Status uploaded =
-      testing::Upload(*stub, id, testing::TorusPoints(40000, 5), 8, &response);
+      testing::Upload(*service, id, testing::TorusPoints(40000, 5), 8, &response);
   ASSERT_TRUE(uploaded.ok()) << uploaded.error_message();
   EXPECT_EQ(response.points_accepted(), 40000u);
-  ASSERT_TRUE(testing::Finish(*stub, id).ok());
+  ASSERT_TRUE(testing::Finish(*service, id).ok());
   v1::MeshUpdate final_mesh;
-  const grpc::Status waited = testing::WaitFinal(*stub, id, &final_mesh);
+  const grpc::Status waited = testing::WaitFinal(*service, id, &final_mesh);
   ASSERT_TRUE(waited.ok()) << waited.error_message();
   absl::StatusOr<TriangleMesh> mesh = DecodeMesh(final_mesh.draco_mesh());
   ASSERT_TRUE(mesh.ok()) << mesh.status();
@@ -117,17 +117,17 @@ TEST_F(SecureServerTest, TlsClientReconstructsATorus) {
 TEST_F(SecureServerTest, PlaintextClientsAndUntrustedCertificatesAreRefused) {
   std::unique_ptr<ReconstructionServer> server = Start(Tls());
   ASSERT_NE(server, nullptr);
-  auto plaintext = Stub(*server, grpc::InsecureChannelCredentials());
+  auto plaintext = Service(*server, grpc::InsecureChannelCredentials());
   EXPECT_EQ(List(*plaintext).error_code(), grpc::StatusCode::UNAVAILABLE);
 
   // A client that trusts another CA rejects the server's certificate.
-  auto distrustful = Stub(*server, TlsTrusting(certs().other_ca));
+  auto distrustful = Service(*server, TlsTrusting(certs().other_ca));
   const grpc::Status refused = List(*distrustful);
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::UNAVAILABLE);
   EXPECT_TRUE(absl::StrContains(refused.error_message(), "certificate verify failed"))
       << refused.error_message();
 
-  auto trusting = Stub(*server, TlsTrusting(certs().ca));
+  auto trusting = Service(*server, TlsTrusting(certs().ca));
   const grpc::Status listed = List(*trusting);
   EXPECT_TRUE(listed.ok()) << listed.error_message();
 }
@@ -138,12 +138,12 @@ TEST_F(SecureServerTest, MutualTlsNeedsAClientCertificateSignedByTheClientCa) {
   std::unique_ptr<ReconstructionServer> server = Start(security);
   ASSERT_NE(server, nullptr);
 
-  auto anonymous = Stub(*server, TlsTrusting(certs().ca));
+  auto anonymous = Service(*server, TlsTrusting(certs().ca));
   EXPECT_EQ(List(*anonymous).error_code(), grpc::StatusCode::UNAVAILABLE);
-  auto stranger = Stub(*server, TlsTrusting(certs().ca, certs().other_client_chain,
+  auto stranger = Service(*server, TlsTrusting(certs().ca, certs().other_client_chain,
                                             certs().other_client_key));
   EXPECT_EQ(List(*stranger).error_code(), grpc::StatusCode::UNAVAILABLE);
-  auto known = Stub(*server, TlsTrusting(certs().ca, certs().client_chain, certs().client_key));
+  auto known = Service(*server, TlsTrusting(certs().ca, certs().client_chain, certs().client_key));
   const grpc::Status listed = List(*known);
   EXPECT_TRUE(listed.ok()) << listed.error_message();
 }
@@ -153,9 +153,9 @@ TEST_F(SecureServerTest, CallsWithoutAKnownTokenAreUnauthenticated) {
   security.access_tokens = {kToken, kSecondToken};
   std::unique_ptr<ReconstructionServer> server = Start(security);
   ASSERT_NE(server, nullptr);
-  auto stub = Stub(*server, TlsTrusting(certs().ca));
+  auto service = Service(*server, TlsTrusting(certs().ca));
 
-  const grpc::Status missing = List(*stub);
+  const grpc::Status missing = List(*service);
   EXPECT_EQ(missing.error_code(), grpc::StatusCode::UNAUTHENTICATED);
   EXPECT_TRUE(absl::StrContains(missing.error_message(), "requires an access token"))
       << missing.error_message();
@@ -163,19 +163,19 @@ TEST_F(SecureServerTest, CallsWithoutAKnownTokenAreUnauthenticated) {
        {absl::StrCat("Bearer ", kToken, "x"), absl::StrCat("Bearer ", kToken).substr(0, 20),
         std::string("Bearer first-token-0123456789abcdeF"), absl::StrCat("Basic ", kToken),
         std::string(kToken)}) {
-    const grpc::Status refused = List(*stub, wrong);
+    const grpc::Status refused = List(*service, wrong);
     EXPECT_EQ(refused.error_code(), grpc::StatusCode::UNAUTHENTICATED) << wrong;
     EXPECT_TRUE(absl::StrContains(refused.error_message(), "not one this server accepts"))
         << refused.error_message();
   }
   for (const char* token : {kToken, kSecondToken}) {
-    const grpc::Status listed = List(*stub, absl::StrCat("Bearer ", token));
+    const grpc::Status listed = List(*service, absl::StrCat("Bearer ", token));
     EXPECT_TRUE(listed.ok()) << listed.error_message();
   }
-  EXPECT_TRUE(List(*stub, absl::StrCat("bearer ", kToken)).ok()) << "the scheme is caseless";
+  EXPECT_TRUE(List(*service, absl::StrCat("bearer ", kToken)).ok()) << "the scheme is caseless";
 
   // gRPC's own token credentials, as the neuralmesh client sends them.
-  auto with_token = Stub(*server, grpc::CompositeChannelCredentials(
+  auto with_token = Service(*server, grpc::CompositeChannelCredentials(
                                       TlsTrusting(certs().ca),
                                       grpc::AccessTokenCredentials(kSecondToken)));
   const std::string id = testing::MustCreate(*with_token, testing::CreateRequest(100));
@@ -187,7 +187,7 @@ TEST_F(SecureServerTest, CallsWithoutAKnownTokenAreUnauthenticated) {
     grpc::ClientContext context;
     context.AddMetadata("authorization", "Bearer wrong-token-0123456789");
     v1::UploadPointsResponse response;
-    auto writer = stub->UploadPoints(&context, &response);
+    auto writer = service->UploadPoints(&context, &response);
     v1::UploadPointsRequest request;
     request.set_session_id(id);
     *request.mutable_batch() = testing::Batch(testing::TorusPoints(1000, 1), 0, 1000);
@@ -200,7 +200,7 @@ TEST_F(SecureServerTest, CallsWithoutAKnownTokenAreUnauthenticated) {
     context.set_deadline(absl::ToChronoTime(absl::Now() + absl::Seconds(5)));
     v1::WatchSessionRequest request;
     request.set_session_id(id);
-    auto reader = stub->WatchSession(&context, request);
+    auto reader = service->WatchSession(&context, request);
     v1::MeshUpdate update;
     EXPECT_FALSE(reader->Read(&update));
     EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::UNAUTHENTICATED);
@@ -216,9 +216,9 @@ TEST_F(SecureServerTest, ReplacedTokensApplyToCallsThatStartLater) {
   security.access_tokens = {kToken};
   std::unique_ptr<ReconstructionServer> server = Start(security);
   ASSERT_NE(server, nullptr);
-  auto first = Stub(*server, grpc::CompositeChannelCredentials(
+  auto first = Service(*server, grpc::CompositeChannelCredentials(
                                  TlsTrusting(certs().ca), grpc::AccessTokenCredentials(kToken)));
-  auto second = Stub(*server, grpc::CompositeChannelCredentials(
+  auto second = Service(*server, grpc::CompositeChannelCredentials(
                                   TlsTrusting(certs().ca),
                                   grpc::AccessTokenCredentials(kSecondToken)));
   const std::string id = testing::MustCreate(*first, testing::CreateRequest(300));

@@ -7,7 +7,6 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <grpcpp/generic/generic_stub.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -56,7 +55,7 @@ TEST(ServerEndToEndTest, TorusInAHundredBatchesOverLoopback) {
   std::unique_ptr<ReconstructionServer> server = testing::StartServer(/*listen=*/true);
   ASSERT_NE(server, nullptr);
   ASSERT_GT(server->port(), 0);
-  auto stub = testing::NetworkStub(*server);
+  auto stub = testing::NetworkService(*server);
 
   auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4);
   ASSERT_TRUE(torus.ok());
@@ -139,16 +138,16 @@ TEST(ServerEndToEndTest, TheEventLogNamesTheClientAndHowEachSessionEnded) {
   options.event_sink = events.Sink();
   std::unique_ptr<ReconstructionServer> server = testing::StartServer(/*listen=*/true, options);
   ASSERT_NE(server, nullptr);
-  auto stub = testing::NetworkStub(*server);
-  const std::string finished = testing::MustCreate(*stub, testing::CreateRequest(300));
+  auto service = testing::NetworkService(*server);
+  const std::string finished = testing::MustCreate(*service, testing::CreateRequest(300));
   v1::UploadPointsResponse response;
-  ASSERT_TRUE(testing::Upload(*stub, finished, testing::TorusPoints(4000, 3), 2, &response).ok());
-  ASSERT_TRUE(testing::Finish(*stub, finished).ok());
+  ASSERT_TRUE(testing::Upload(*service, finished, testing::TorusPoints(4000, 3), 2, &response).ok());
+  ASSERT_TRUE(testing::Finish(*service, finished).ok());
   v1::MeshUpdate final_mesh;
-  ASSERT_TRUE(testing::WaitFinal(*stub, finished, &final_mesh).ok());
-  const std::string cancelled = testing::MustCreate(*stub, testing::CreateRequest(300));
-  ASSERT_TRUE(testing::Cancel(*stub, cancelled).ok());
-  ASSERT_TRUE(testing::Delete(*stub, finished).ok());
+  ASSERT_TRUE(testing::WaitFinal(*service, finished, &final_mesh).ok());
+  const std::string cancelled = testing::MustCreate(*service, testing::CreateRequest(300));
+  ASSERT_TRUE(testing::Cancel(*service, cancelled).ok());
+  ASSERT_TRUE(testing::Delete(*service, finished).ok());
 
   const std::string created = events.Await(absl::StrCat(finished, " created"));
   EXPECT_THAT(created, ::testing::HasSubstr(absl::StrCat(

@@ -72,12 +72,12 @@ inline std::unique_ptr<ReconstructionServer> StartServer(bool listen, ServerOpti
   return server.ok() ? *std::move(server) : nullptr;
 }
 
-inline std::unique_ptr<v1::ReconstructionService::Stub> InProcessStub(
+inline std::unique_ptr<v1::ReconstructionService::Stub> InProcessService(
     ReconstructionServer& server) {
   return v1::ReconstructionService::NewStub(server.InProcessChannel());
 }
 
-inline std::unique_ptr<v1::ReconstructionService::Stub> NetworkStub(
+inline std::unique_ptr<v1::ReconstructionService::Stub> NetworkService(
     ReconstructionServer& server) {
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(64 << 20);
@@ -99,15 +99,7 @@ inline PointCloud SpherePoints(size_t n, uint64_t seed) {
 
 // Points [begin, end) of `cloud` as a packed batch.
 inline v1::PointBatch Batch(const PointCloud& cloud, size_t begin, size_t end) {
-  PointCloud part;
-  part.positions.assign(cloud.positions.begin() + begin, cloud.positions.begin() + end);
-  if (!cloud.weights.empty()) {
-    part.weights.assign(cloud.weights.begin() + begin, cloud.weights.begin() + end);
-  }
-  if (!cloud.normals.empty()) {
-    part.normals.assign(cloud.normals.begin() + begin, cloud.normals.begin() + end);
-  }
-  return PointCloudToPackedBatch(part);
+  return PointCloudToPackedBatch(PointRange(cloud, begin, end));
 }
 
 inline v1::CreateSessionRequest CreateRequest(uint64_t target, uint32_t refresh_ms = 250) {

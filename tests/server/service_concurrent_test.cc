@@ -17,7 +17,7 @@ TEST(ServiceConcurrentTest, EightSessionsOnTwoWorkersStayIsolatedAndAllProgress)
   options.worker_threads = 2;
   std::unique_ptr<ReconstructionServer> server = testing::StartServer(false, options);
   ASSERT_NE(server, nullptr);
-  auto stub = testing::InProcessStub(*server);
+  auto stub = testing::InProcessService(*server);
 
   constexpr int kSessions = 8;
   // Each session gets its own shape: spheres and tori of different sizes at different places.
@@ -90,7 +90,7 @@ class FilteringServiceTest : public ::testing::Test {
     options.limits.max_batch_points = 400000;
     server_ = testing::StartServer(false, options);
     ASSERT_NE(server_, nullptr);
-    stub_ = testing::InProcessStub(*server_);
+    stub_ = testing::InProcessService(*server_);
   }
 
   std::string FilteredSession() {

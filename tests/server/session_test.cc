@@ -80,12 +80,6 @@ class SessionTest : public ::testing::Test {
     return session;
   }
 
-  static PointCloud Slice(const PointCloud& cloud, size_t begin, size_t end) {
-    PointCloud part;
-    part.positions.assign(cloud.positions.begin() + begin, cloud.positions.begin() + end);
-    return part;
-  }
-
   // Stops the threads before the recorder they publish to goes away.
   void TearDown() override {
     pool_.Shutdown();
@@ -110,7 +104,7 @@ TEST_F(SessionTest, PublishesMilestonesWithGrowingVertexCountsThenTheFinalMesh) 
   auto session = NewSession(config);
   const PointCloud points = Torus(6000, 1);
   for (size_t b = 0; b < 10; ++b) {
-    ASSERT_TRUE(session->AddPoints(Slice(points, b * 600, (b + 1) * 600)).ok());
+    ASSERT_TRUE(session->AddPoints(PointRange(points, b * 600, (b + 1) * 600)).ok());
   }
   ASSERT_TRUE(session->Finish().ok());
   EXPECT_TRUE(recorder_.AwaitClose().ok()) << "the session ends with OK after the final mesh";
@@ -145,7 +139,7 @@ TEST_F(SessionTest, TheMeshNeverOutgrowsThePointsReceivedAndGrowsWithMore) {
   config.refresh_interval = absl::Milliseconds(10);
   auto session = NewSession(config);
   const PointCloud points = Torus(4000, 2);
-  ASSERT_TRUE(session->AddPoints(Slice(points, 0, 400)).ok());
+  ASSERT_TRUE(session->AddPoints(PointRange(points, 0, 400)).ok());
   // 400 points at 4 per vertex allow 100 vertices: learning pauses there.
   MeshUpdatePtr at_cap =
       recorder_.AwaitUpdate([](const v1::MeshUpdate& u) { return u.vertex_count() == 100; });
@@ -156,7 +150,7 @@ TEST_F(SessionTest, TheMeshNeverOutgrowsThePointsReceivedAndGrowsWithMore) {
   }
   EXPECT_EQ(session->ToProto().learning().allowed_vertices(), 100u);
 
-  ASSERT_TRUE(session->AddPoints(Slice(points, 400, 2000)).ok());
+  ASSERT_TRUE(session->AddPoints(PointRange(points, 400, 2000)).ok());
   MeshUpdatePtr grown =
       recorder_.AwaitUpdate([](const v1::MeshUpdate& u) { return u.vertex_count() >= 500; });
   ASSERT_NE(grown, nullptr) << "more points must let the mesh grow to 500 vertices";
@@ -168,31 +162,31 @@ TEST_F(SessionTest, BadBatchesAreRejectedAndTheSessionKeepsItsPoints) {
   config.target_vertices = 50;
   auto session = NewSession(config, /*max_points=*/1000);
   const PointCloud points = Torus(1000, 3);
-  ASSERT_TRUE(session->AddPoints(Slice(points, 0, 300)).ok());
+  ASSERT_TRUE(session->AddPoints(PointRange(points, 0, 300)).ok());
 
-  PointCloud nan = Slice(points, 300, 310);
+  PointCloud nan = PointRange(points, 300, 310);
   nan.positions[4][1] = std::nanf("");
   absl::StatusOr<size_t> result = session->AddPoints(nan);
   EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument) << result.status();
   EXPECT_THAT(std::string(result.status().message()),
               HasSubstr("point 4 of the batch has a non-finite coordinate"));
 
-  PointCloud inf = Slice(points, 300, 310);
+  PointCloud inf = PointRange(points, 300, 310);
   inf.positions[0][0] = INFINITY;
   EXPECT_EQ(session->AddPoints(inf).status().code(), absl::StatusCode::kInvalidArgument);
 
-  PointCloud mismatched = Slice(points, 300, 310);
+  PointCloud mismatched = PointRange(points, 300, 310);
   mismatched.weights = {1, 2};
   EXPECT_EQ(session->AddPoints(mismatched).status().code(), absl::StatusCode::kInvalidArgument);
 
-  result = session->AddPoints(Slice(points, 0, 800));  // 300 + 800 > 1000.
+  result = session->AddPoints(PointRange(points, 0, 800));  // 300 + 800 > 1000.
   EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted) << result.status();
 
   EXPECT_EQ(session->points_received(), 300u) << "rejected batches add nothing";
-  ASSERT_TRUE(session->AddPoints(Slice(points, 300, 600)).ok()) << "the session goes on";
+  ASSERT_TRUE(session->AddPoints(PointRange(points, 300, 600)).ok()) << "the session goes on";
   ASSERT_TRUE(session->Finish().ok());
   EXPECT_TRUE(recorder_.AwaitClose().ok());
-  EXPECT_EQ(session->AddPoints(Slice(points, 0, 10)).status().code(),
+  EXPECT_EQ(session->AddPoints(PointRange(points, 0, 10)).status().code(),
             absl::StatusCode::kFailedPrecondition)
       << "a finished session takes no points";
   EXPECT_EQ(session->Finish().code(), absl::StatusCode::kFailedPrecondition);
@@ -211,24 +205,24 @@ TEST_F(SessionTest, BatchesSentAgainAddOnlyWhatTheSessionLacks) {
   auto session = NewSession(config);
   const PointCloud points = Torus(1000, 4);
   size_t skipped = 0;
-  ASSERT_TRUE(session->AddPoints(Slice(points, 0, 300), nullptr, 0, &skipped).ok());
+  ASSERT_TRUE(session->AddPoints(PointRange(points, 0, 300), nullptr, 0, &skipped).ok());
   EXPECT_EQ(skipped, 0u);
   // After a lost connection the client sends from 200 again: 100 points it had already.
-  absl::StatusOr<size_t> total = session->AddPoints(Slice(points, 200, 500), nullptr, 200, &skipped);
+  absl::StatusOr<size_t> total = session->AddPoints(PointRange(points, 200, 500), nullptr, 200, &skipped);
   ASSERT_TRUE(total.ok()) << total.status();
   EXPECT_EQ(skipped, 100u);
   EXPECT_EQ(*total, 500u);
-  total = session->AddPoints(Slice(points, 0, 100), nullptr, 0, &skipped);
+  total = session->AddPoints(PointRange(points, 0, 100), nullptr, 0, &skipped);
   ASSERT_TRUE(total.ok()) << total.status();
   EXPECT_EQ(skipped, 100u) << "all of it known: nothing added";
   EXPECT_EQ(*total, 500u);
   // A gap is refused and changes nothing.
-  total = session->AddPoints(Slice(points, 600, 700), nullptr, 600, &skipped);
+  total = session->AddPoints(PointRange(points, 600, 700), nullptr, 600, &skipped);
   EXPECT_EQ(total.status().code(), absl::StatusCode::kOutOfRange) << total.status();
   EXPECT_THAT(std::string(total.status().message()), HasSubstr("send from point 500"));
   EXPECT_EQ(session->ToProto().points_taken(), 500u);
   // Without a place, every point is new.
-  ASSERT_TRUE(session->AddPoints(Slice(points, 500, 600)).ok());
+  ASSERT_TRUE(session->AddPoints(PointRange(points, 500, 600)).ok());
   EXPECT_EQ(session->ToProto().points_taken(), 600u);
   EXPECT_EQ(session->points_received(), 600u);
   // The points are those of the upload, each once, in order.
@@ -276,7 +270,7 @@ TEST_F(SessionTest, OutliersCountTowardThePointLimit) {
     EXPECT_EQ(removed, 1u) << "stray " << i;
   }
   EXPECT_EQ(session->points_received(), accepted);
-  const absl::StatusOr<size_t> full = session->AddPoints(Slice(points, 0, 1));
+  const absl::StatusOr<size_t> full = session->AddPoints(PointRange(points, 0, 1));
   EXPECT_EQ(full.status().code(), absl::StatusCode::kResourceExhausted) << full.status();
   EXPECT_THAT(std::string(full.status().message()), HasSubstr("outliers included"));
   EXPECT_EQ(session->points_received(), accepted) << "the refused batch adds nothing";
@@ -290,17 +284,17 @@ TEST_F(SessionTest, ABatchNoQuantizationCubeCanHoldIsRefused) {
   config.target_vertices = 50;
   auto session = NewSession(config);
   const PointCloud points = Torus(1000, 3);
-  ASSERT_TRUE(session->AddPoints(Slice(points, 0, 300)).ok());
+  ASSERT_TRUE(session->AddPoints(PointRange(points, 0, 300)).ok());
   for (const float far : {3.3e38f, 1.8e38f}) {
-    PointCloud huge = Slice(points, 300, 310);
+    PointCloud huge = PointRange(points, 300, 310);
     huge.positions[2] = Vec3f(far, -far, far);
     const absl::StatusOr<size_t> result = session->AddPoints(huge);
     EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument)
         << far << ": " << result.status();
   }
   EXPECT_EQ(session->points_received(), 300u) << "refused batches add nothing";
-  ASSERT_TRUE(session->AddPoints(Slice(points, 300, 600)).ok()) << "the session goes on";
-  PointCloud large = Slice(points, 600, 610);
+  ASSERT_TRUE(session->AddPoints(PointRange(points, 300, 600)).ok()) << "the session goes on";
+  PointCloud large = PointRange(points, 600, 610);
   large.positions[2] = Vec3f(1e38f, -1e38f, 1e38f);
   EXPECT_TRUE(session->AddPoints(large).ok()) << "a cube of range 2e38 is still usable";
   EXPECT_EQ(session->points_received(), 610u);
@@ -323,7 +317,7 @@ TEST_F(SessionTest, FinishNeedsPointsForATetrahedron) {
   SessionConfig config;
   config.target_vertices = 100;
   auto session = NewSession(config);
-  ASSERT_TRUE(session->AddPoints(Slice(Torus(7, 4), 0, 7)).ok());
+  ASSERT_TRUE(session->AddPoints(PointRange(Torus(7, 4), 0, 7)).ok());
   absl::Status status = session->Finish();
   EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition) << status;
   EXPECT_THAT(std::string(status.message()), HasSubstr("at least 8"));
@@ -366,7 +360,7 @@ TEST_F(SessionTest, AllMeshesShareOneQuantizationBoxUntilDataFallsOutside) {
   auto session = NewSession(config);
   const PointCloud points = Torus(4000, 6);
   for (size_t b = 0; b < 4; ++b) {
-    ASSERT_TRUE(session->AddPoints(Slice(points, b * 1000, (b + 1) * 1000)).ok());
+    ASSERT_TRUE(session->AddPoints(PointRange(points, b * 1000, (b + 1) * 1000)).ok());
   }
   ASSERT_NE(recorder_.AwaitUpdate([](const v1::MeshUpdate& u) { return u.vertex_count() >= 100; }),
             nullptr);
@@ -468,7 +462,7 @@ TEST_F(SessionTest, ScanOrderEndsAsGoodAsRandomOrder) {
         std::make_shared<Session>("s", "", config, size_t{1} << 20, &pool_, &encoder_);
     const uint64_t handle = session->updates().Subscribe(&recorder, 0);
     for (size_t b = 0; b < 50; ++b) {
-      EXPECT_TRUE(session->AddPoints(Slice(cloud, b * 400, (b + 1) * 400)).ok());
+      EXPECT_TRUE(session->AddPoints(PointRange(cloud, b * 400, (b + 1) * 400)).ok());
       absl::SleepFor(absl::Milliseconds(2));  // Let learning follow the scan.
     }
     EXPECT_TRUE(session->Finish().ok());

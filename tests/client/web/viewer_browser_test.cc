@@ -41,7 +41,7 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
   }
   std::unique_ptr<server::ReconstructionServer> server = st::StartServer(/*listen=*/true);
   ASSERT_NE(server, nullptr);
-  auto service = st::NetworkStub(*server);
+  auto service = st::NetworkService(*server);
   v1::CreateSessionRequest request = st::CreateRequest(8000, /*refresh_ms=*/100);
   request.set_name("browser");
   const std::string id = st::MustCreate(*service, request);
@@ -67,9 +67,7 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
   EXPECT_TRUE(std::filesystem::exists(ready)) << "the page never started watching";
   const PointCloud points = st::TorusPoints(40000, 11);
   for (size_t part = 0; part < 8; ++part) {
-    PointCloud batch;
-    batch.positions.assign(points.positions.begin() + part * 5000,
-                           points.positions.begin() + (part + 1) * 5000);
+    const PointCloud batch = PointRange(points, part * 5000, (part + 1) * 5000);
     v1::UploadPointsResponse response;
     ASSERT_TRUE(st::Upload(*service, id, batch, 1, &response).ok());
     absl::SleepFor(absl::Milliseconds(250));
@@ -131,7 +129,7 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
 TEST(ViewerBrowserTest, ThePageOpensOnTheNewestSessionStillLearning) {
   std::unique_ptr<server::ReconstructionServer> server = st::StartServer(/*listen=*/true);
   ASSERT_NE(server, nullptr);
-  auto service = st::NetworkStub(*server);
+  auto service = st::NetworkService(*server);
   const std::string finished = st::MustCreate(*service, st::CreateRequest(500));
   v1::UploadPointsResponse response;
   ASSERT_TRUE(st::Upload(*service, finished, st::SpherePoints(2000, 1), 1, &response).ok());

@@ -46,7 +46,7 @@ class ViewerServiceTest : public ::testing::Test {
                    absl::Duration relay_idle_timeout = absl::Seconds(60)) {
     server_ = st::StartServer(/*listen=*/false);
     ASSERT_NE(server_, nullptr);
-    service_ = st::InProcessStub(*server_);
+    service_ = st::InProcessService(*server_);
     ViewerOptions options;
     options.web_root = DefaultWebRoot();
     options.poll_timeout = poll_timeout;
@@ -159,9 +159,7 @@ TEST_F(ViewerServiceTest, LongPollsFollowALiveSessionCoarseToFineToItsFinalMesh)
   std::thread upload([&] {
     v1::UploadPointsResponse response;
     for (size_t part = 0; part < 4; ++part) {
-      PointCloud quarter;
-      quarter.positions.assign(points.positions.begin() + part * 10000,
-                               points.positions.begin() + (part + 1) * 10000);
+      const PointCloud quarter = PointRange(points, part * 10000, (part + 1) * 10000);
       ASSERT_TRUE(st::Upload(*service_, id, quarter, 5, &response).ok());
       absl::SleepFor(absl::Milliseconds(100));
     }

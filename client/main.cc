@@ -144,6 +144,12 @@ ABSL_FLAG(std::string, resume, "",
           "reconstruct --server: the id of a session whose upload lost its connection; the "
           "upload goes on from the points the session has taken (run with the same INPUT and "
           "input flags; the session keeps its configuration).");
+ABSL_FLAG(absl::Duration, reconnect_for,
+          neuralmesh::client::ReconnectOptions().give_up_after,
+          "reconstruct --server and watch: how long to keep trying when the connection to the "
+          "server is lost, counted from the last batch taken or mesh received (the upload goes "
+          "on from the points the session has taken, the watch from its last mesh); 0: give up "
+          "at once (reconstruct then prints the --resume command).");
 ABSL_FLAG(absl::Duration, connect_timeout, absl::Seconds(5),
           "How long to wait for the server to accept the connection.");
 ABSL_FLAG(bool, tls, false,
@@ -290,6 +296,16 @@ absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
   return o;
 }
 
+absl::StatusOr<absl::Duration> ReconnectForFromFlags() {
+  const absl::Duration reconnect_for = absl::GetFlag(FLAGS_reconnect_for);
+  if (reconnect_for < absl::ZeroDuration() || reconnect_for == absl::InfiniteDuration()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--reconnect_for must be a finite duration >= 0 (e.g. 60s, 5m), not ",
+                     absl::FormatDuration(reconnect_for)));
+  }
+  return reconnect_for;
+}
+
 // The flags of a command that connects to a server, and `flags`.
 std::vector<std::string> WithConnectionFlags(std::vector<std::string> flags) {
   for (const char* f : kConnectionFlags) flags.push_back(f);
@@ -332,13 +348,14 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.ply = absl::GetFlag(FLAGS_ply);
     o.progress = progress;
     o.resume_session = absl::GetFlag(FLAGS_resume);
+    NM_ASSIGN_OR_RETURN(o.reconnect_for, ReconnectForFromFlags());
     NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
     return neuralmesh::client::RunRemoteReconstruct(o, std::cout, std::cerr);
   }
   NM_RETURN_IF_ERROR(RejectFlags(
       args,
       WithConnectionFlags({"out-dir", "batch-size", "points", "ply", "outliers_on_server",
-                           "resume"}),
+                           "resume", "reconnect_for"}),
       "needs --server (a local reconstruct writes -o OUTPUT)"));
   if (!args.Has("vertices")) return absl::InvalidArgumentError("--vertices N is required");
   neuralmesh::client::LocalReconstructOptions o;
@@ -381,8 +398,9 @@ absl::Status Watch(const ParsedArgs& args) {
   o.server = absl::GetFlag(FLAGS_server);
   o.out_dir = absl::GetFlag(FLAGS_out_dir);
   o.ply = absl::GetFlag(FLAGS_ply);
+  NM_ASSIGN_OR_RETURN(o.reconnect_for, ReconnectForFromFlags());
   NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
-  return neuralmesh::client::RunWatch(o, std::cout);
+  return neuralmesh::client::RunWatch(o, std::cout, std::cerr);
 }
 
 absl::Status Sessions(const ParsedArgs& args) {
@@ -412,13 +430,13 @@ std::vector<Subcommand> Commands() {
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
       "remove_outliers", "outlier_neighbours", "outlier_std_ratio", "outliers_on_server",
       "sampling", "time_budget", "max_steps", "quantization_bits", "encode_speed", "progress",
-      "server", "out-dir", "batch-size", "points", "ply", "resume"};
+      "server", "out-dir", "batch-size", "points", "ply", "resume", "reconnect_for"};
   // clang-format on
   return {
       {"reconstruct",
        "reconstruct INPUT -o OUTPUT --vertices N [flags]\n"
        "       neuralmesh reconstruct INPUT --server HOST:PORT --out-dir DIR [--vertices N] "
-       "[--batch-size K] [--ply] [--resume SESSION]",
+       "[--batch-size K] [--ply] [--resume SESSION] [--reconnect_for D]",
        "Learns a mesh of a point cloud, a mesh or a built-in surface, locally or on a server.",
        "Learns a mesh of INPUT: a point cloud (.ply .xyz .obj .off .drc), a triangle mesh with\n"
        "--sampling area|curvature, or builtin:sphere|torus|genus2. Locally it writes OUTPUT and\n"
@@ -440,10 +458,10 @@ std::vector<Subcommand> Commands() {
        {"reference", "json", "samples", "seed"},
        Eval},
       {"watch",
-       "watch SESSION --server HOST:PORT --out-dir DIR [--ply]",
+       "watch SESSION --server HOST:PORT --out-dir DIR [--ply] [--reconnect_for D]",
        "Watches a server session until it ends, saving every milestone and the final mesh.",
        "",
-       WithConnectionFlags({"server", "out-dir", "ply"}),
+       WithConnectionFlags({"server", "out-dir", "ply", "reconnect_for"}),
        Watch},
       {"sessions",
        "sessions --server HOST:PORT [--json]",

@@ -28,6 +28,9 @@ std::string PackRange(const std::vector<T>& values, size_t begin, size_t end) {
   return bytes;
 }
 
+// The longest pause between two attempts to connect again.
+constexpr absl::Duration kMaxReconnectBackoff = absl::Seconds(4);
+
 int ToMillis(absl::Duration d) {
   return static_cast<int>(std::clamp<int64_t>(absl::ToInt64Milliseconds(d), 1, INT32_MAX));
 }
@@ -105,6 +108,10 @@ absl::StatusOr<std::unique_ptr<ReconstructionClient>> ReconstructionClient::Conn
   args.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, ToMillis(options.keepalive_timeout));
   // Keep pinging while only the server sends (a Watch): gRPC stops after two pings otherwise.
   args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
+  // After a lost connection gRPC tries again with a growing pause, by default up to two
+  // minutes; a client that waits for its server to come back (AwaitSession) should notice
+  // within seconds.
+  args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, ToMillis(kMaxReconnectBackoff));
   if (!options.security.tls.server_name.empty()) {
     args.SetSslTargetNameOverride(options.security.tls.server_name);
   }
@@ -282,9 +289,21 @@ absl::StatusOr<ReconstructResult> ReconstructionClient::Reconstruct(
 }
 
 absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& session_id) {
+  return GetSession(session_id, options_.call_timeout, /*wait_for_ready=*/false);
+}
+
+absl::StatusOr<v1::Session> ReconstructionClient::AwaitSession(const std::string& session_id,
+                                                               absl::Duration timeout) {
+  return GetSession(session_id, timeout, /*wait_for_ready=*/true);
+}
+
+absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& session_id,
+                                                             absl::Duration timeout,
+                                                             bool wait_for_ready) {
   grpc::ClientContext context;
   const OpenCall open(*this, context);
-  SetDeadline(context, options_.call_timeout);
+  SetDeadline(context, timeout);
+  context.set_wait_for_ready(wait_for_ready);
   v1::GetSessionRequest request;
   request.set_session_id(session_id);
   v1::Session session;
@@ -356,6 +375,11 @@ absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& 
   const grpc::Status status = stub_->GetMesh(&context, request, &update);
   if (!status.ok()) return FromGrpcStatus(status, "GetMesh");
   return update;
+}
+
+bool ReconstructionClient::calls_cancelled() const {
+  absl::MutexLock lock(&calls_mu_);
+  return calls_cancelled_;
 }
 
 void ReconstructionClient::CancelCalls() {

@@ -137,6 +137,10 @@ class ReconstructionClient {
                                                 const UploadProgress& progress = {});
 
   absl::StatusOr<v1::Session> GetSession(const std::string& session_id);
+  // GetSession that first waits up to `timeout` for the channel to have a connection again
+  // (gRPC's wait-for-ready), for a client riding out a lost connection: UNAVAILABLE or
+  // DEADLINE_EXCEEDED when the server did not answer within `timeout`.
+  absl::StatusOr<v1::Session> AwaitSession(const std::string& session_id, absl::Duration timeout);
   absl::StatusOr<std::vector<v1::Session>> ListSessions();
   absl::StatusOr<v1::Session> Finish(const std::string& session_id);
   absl::StatusOr<v1::Session> Cancel(const std::string& session_id);
@@ -153,11 +157,15 @@ class ReconstructionClient {
   // every call started later except Cancel: each returns CANCELLED. The sessions go on; Cancel
   // still reaches the server, to stop one. For a client that is being interrupted.
   void CancelCalls();
+  // Whether CancelCalls was called.
+  bool calls_cancelled() const;
 
  private:
   // Registers a call's context for CancelCalls while the call is open.
   class OpenCall;
 
+  absl::StatusOr<v1::Session> GetSession(const std::string& session_id, absl::Duration timeout,
+                                         bool wait_for_ready);
   // A context whose deadline is `timeout` from now (none when infinite).
   static void SetDeadline(grpc::ClientContext& context, absl::Duration timeout);
 
@@ -165,7 +173,7 @@ class ReconstructionClient {
   ClientOptions options_;
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::ReconstructionService::Stub> stub_;
-  absl::Mutex calls_mu_;
+  mutable absl::Mutex calls_mu_;
   std::vector<grpc::ClientContext*> open_calls_ ABSL_GUARDED_BY(calls_mu_);
   bool calls_cancelled_ ABSL_GUARDED_BY(calls_mu_) = false;
 };

@@ -15,6 +15,7 @@
 #include "client/lod_plan.h"
 #include "client/mesh_update_writer.h"
 #include "client/progress_bar.h"
+#include "client/reconnecting_calls.h"
 #include "client/proto_conversion.h"
 #include "client/reconstruction_client.h"
 #include "client/session_json.h"
@@ -151,15 +152,24 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   MeshUpdateWriter writer({options.out_dir, stem, options.ply}, out);
   absl::Status write_status;
   absl::Status watch_status;
+  ReconnectOptions reconnect;
+  reconnect.give_up_after = options.reconnect_for;
+  reconnect.notify = [&](const std::string& notice) {
+    absl::MutexLock lock(&mu);
+    upload_bar.Clear();
+    learn_bar.Clear();
+    err << notice << "\n";
+  };
   std::thread watcher([&] {
-    watch_status = client->Watch(id, 0, [&](const v1::MeshUpdate& update) {
+    const auto on_update = [&](const v1::MeshUpdate& update) {
       absl::MutexLock lock(&mu);
       upload_bar.Clear();
       learn_bar.Clear();
       write_status = writer.Write(update);
       learn_bar.Update(update.vertex_count(), reachable);
       return write_status.ok();
-    });
+    };
+    watch_status = WatchReconnecting(*client, id, 0, on_update, reconnect);
   });
 
   absl::Notification done;
@@ -185,20 +195,20 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     if (!interrupted && InterruptScope::interrupted()) on_interrupt();
   };
 
-  absl::StatusOr<v1::UploadPointsResponse> uploaded = client->UploadPoints(
-      id, cloud, options.batch_size,
+  absl::StatusOr<v1::UploadPointsResponse> uploaded = UploadPointsReconnecting(
+      *client, id, cloud, options.batch_size,
       [&](uint64_t sent, uint64_t total) {
         absl::MutexLock lock(&mu);
         upload_bar.Update(sent, total);
       },
-      first_point);
+      first_point, reconnect);
   {
     absl::MutexLock lock(&mu);
     upload_bar.Finish();
   }
   absl::Status status = uploaded.status();
   if (status.ok()) {
-    absl::StatusOr<v1::Session> finished = client->Finish(id);
+    absl::StatusOr<v1::Session> finished = FinishReconnecting(*client, id, reconnect);
     status = finished.status();
     if (finished.ok() && outliers_on_server) {
       const v1::LearningState& learning = finished->learning();
@@ -209,7 +219,10 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     }
   }
   const bool connection_lost = absl::IsUnavailable(status);
-  if (!status.ok() && !InterruptScope::interrupted() && !connection_lost) {
+  if (connection_lost) {
+    // The watch needs no more of its own window to learn that the server is out of reach.
+    client->CancelCalls();
+  } else if (!status.ok() && !InterruptScope::interrupted()) {
     // Without a finished upload no final mesh can come: stop the server's work and the watch.
     client->Cancel(id, kTidyCancelTimeout).IgnoreError();
   }
@@ -247,18 +260,23 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   return absl::OkStatus();
 }
 
-absl::Status RunWatch(const WatchOptions& options, std::ostream& out) {
+absl::Status RunWatch(const WatchOptions& options, std::ostream& out, std::ostream& err) {
   if (options.session_id.empty()) return absl::InvalidArgumentError("missing SESSION id");
   if (options.out_dir.empty()) return absl::InvalidArgumentError("--out-dir DIR is required");
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ConnectTo(options.server, options.connection));
   MeshUpdateWriter writer({options.out_dir, options.session_id, options.ply}, out);
   absl::Status write_status;
-  const absl::Status watch_status =
-      client->Watch(options.session_id, 0, [&](const v1::MeshUpdate& update) {
+  ReconnectOptions reconnect;
+  reconnect.give_up_after = options.reconnect_for;
+  reconnect.notify = [&](const std::string& notice) { err << notice << "\n"; };
+  const absl::Status watch_status = WatchReconnecting(
+      *client, options.session_id, 0,
+      [&](const v1::MeshUpdate& update) {
         write_status = writer.Write(update);
         return write_status.ok();
-      });
+      },
+      reconnect);
   NM_RETURN_IF_ERROR(write_status);
   if (!writer.final_received()) return ExplainWatchEnd(watch_status, options.session_id);
   return absl::OkStatus();

@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/time/time.h"
+#include "client/reconnecting_calls.h"
 #include "client/reconstruction_client.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
@@ -33,6 +35,9 @@ struct RemoteReconstructOptions {
   bool ply = false;                // Also write each LOD as .ply.
   bool progress = false;           // Draw progress bars on `err`.
   ClientOptions connection;        // Connect timeout, TLS, access token.
+  // How long the upload, the watch and the finish keep trying after a lost connection
+  // (client/reconnecting_calls.h); zero: the first lost connection ends the command.
+  absl::Duration reconnect_for = ReconnectOptions().give_up_after;
   // Set: no new session; the upload into this one, which still takes points, goes on from the
   // points it has taken (Session.points_taken). The input and its flags must be those of the
   // first run; the session keeps the configuration it was created with.
@@ -42,10 +47,11 @@ struct RemoteReconstructOptions {
 // Creates a session (or takes up `resume_session`), watches it while the input streams up in
 // batches, finishes it and writes every LOD milestone (<stem>_lod<N>.drc) and the final mesh
 // (<stem>.drc) into out_dir, printing each update's figures on `out`. Returns OK only when the
-// final mesh arrived; otherwise the first error. When the upload fails the session is
-// cancelled, except when the connection was lost (UNAVAILABLE): the session keeps its points
-// and the message says how to resume. A first SIGINT or SIGTERM cancels the session and
-// returns CANCELLED.
+// final mesh arrived; otherwise the first error. A lost connection is ridden out for
+// `reconnect_for` (notices on `err`): the upload goes on from the points the session has
+// taken. When the upload fails the session is cancelled, except when the connection stayed
+// lost (UNAVAILABLE): the session keeps its points and the message says how to resume. A
+// first SIGINT or SIGTERM cancels the session and returns CANCELLED.
 absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::ostream& out,
                                   std::ostream& err);
 
@@ -55,11 +61,13 @@ struct WatchOptions {
   std::string out_dir;
   bool ply = false;
   ClientOptions connection;
+  absl::Duration reconnect_for = ReconnectOptions().give_up_after;  // As above.
 };
 
 // Watches a session until it ends, saving and printing updates as RunRemoteReconstruct does
-// (the file stem is the session id). OK only when the final mesh arrived.
-absl::Status RunWatch(const WatchOptions& options, std::ostream& out);
+// (the file stem is the session id), watching again after lost connections for
+// `reconnect_for` (notices on `err`). OK only when the final mesh arrived.
+absl::Status RunWatch(const WatchOptions& options, std::ostream& out, std::ostream& err);
 
 // Lists the server's sessions as a table, or as JSON.
 absl::Status RunSessions(const std::string& server, bool json, std::ostream& out,

@@ -215,6 +215,22 @@ TEST_F(CliErrorsTest, NonPositiveTimeBudget) {
   }
 }
 
+TEST_F(CliErrorsTest, ReconnectWindowThatIsNegativeOrInfinite) {
+  // Refused before any connection is tried (nothing listens on port 1).
+  for (const char* window : {"-5s", "inf"}) {
+    std::string err =
+        ExpectFailure({"reconstruct", "builtin:sphere", "--server", "127.0.0.1:1", "--out-dir",
+                       dir_, "--vertices", "100", "--reconnect_for", window});
+    EXPECT_TRUE(absl::StrContains(err, "--reconnect_for must be a finite duration >= 0")) << err;
+    err = ExpectFailure(
+        {"watch", "s-0", "--server", "127.0.0.1:1", "--out-dir", dir_, "--reconnect_for", window});
+    EXPECT_TRUE(absl::StrContains(err, "--reconnect_for must be a finite duration >= 0")) << err;
+  }
+  const std::string err = ExpectFailure({"reconstruct", "builtin:sphere", "-o", Output(),
+                                         "--vertices", "100", "--reconnect_for", "10s"});
+  EXPECT_TRUE(absl::StrContains(err, "--reconnect_for needs --server")) << err;
+}
+
 TEST_F(CliErrorsTest, EvalWithTooManySamples) {
   const std::string err = ExpectFailure(
       {"eval", "builtin:sphere", "--reference", "builtin:sphere", "--samples", "100000000000"});

@@ -172,6 +172,37 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
   EXPECT_THAT(local.err, ::testing::HasSubstr("--resume needs --server"));
 }
 
+// By default the command rides out a lost connection: the upload goes on from the points the
+// session took, and the watch from its last mesh, without a second command.
+TEST_F(RemoteCliTest, ALostConnectionIsRiddenOutAndEveryPointArrivesOnce) {
+  const std::string& address = server_->address();
+  TcpProxy proxy(std::stoi(address.substr(address.rfind(':') + 1)),
+                 /*cut_after_client_bytes=*/300 * 1000);
+  const RunResult run = RunNeuralmesh(
+      {"reconstruct", "builtin:sphere", "--server", absl::StrCat("127.0.0.1:", proxy.port()),
+       "--out-dir", *dir_ + "/ridden", "--points", "60000", "--batch-size", "1000", "--vertices",
+       "400"});
+  ASSERT_TRUE(proxy.cut()) << "the upload of 720 KB passed the 300 KB mark";
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_THAT(run.err, ::testing::HasSubstr("lost (UploadPoints")) << run.Describe();
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(
+      run.err, match,
+      std::regex("reconnected: the upload into session (s-[0-9a-f]+) goes on at point [0-9]+ "
+                 "of 60000")))
+      << run.Describe();
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
+      client::ReconstructionClient::Connect(address);
+  ASSERT_TRUE(service.ok()) << service.status();
+  absl::StatusOr<v1::Session> done = (*service)->GetSession(match[1]);
+  ASSERT_TRUE(done.ok()) << done.status();
+  EXPECT_EQ(done->state(), v1::SESSION_STATE_FINISHED);
+  EXPECT_EQ(done->learning().points_received(), 60000u) << "every point once";
+  EXPECT_LT(HausdorffToTheUnitSphere(*dir_ + "/ridden/sphere.drc"), 0.05);
+}
+
+// With --reconnect_for=0 the first lost connection ends the command; the session keeps its
+// points, and --resume goes on with them.
 TEST_F(RemoteCliTest, ALostConnectionKeepsTheSessionAndResumeFinishesIt) {
   const std::string& address = server_->address();
   TcpProxy proxy(std::stoi(address.substr(address.rfind(':') + 1)),
@@ -179,7 +210,7 @@ TEST_F(RemoteCliTest, ALostConnectionKeepsTheSessionAndResumeFinishesIt) {
   std::vector<std::string> args = {
       "reconstruct", "builtin:sphere", "--server", absl::StrCat("127.0.0.1:", proxy.port()),
       "--out-dir", *dir_ + "/lost", "--points", "60000", "--batch-size", "1000",
-      "--vertices", "400"};
+      "--vertices", "400", "--reconnect_for", "0"};
   const RunResult lost = RunNeuralmesh(args);
   ASSERT_TRUE(proxy.cut()) << "the upload of 720 KB passed the 300 KB mark";
   EXPECT_NE(lost.exit_code, 0) << lost.Describe();

@@ -1,6 +1,8 @@
 // A TCP proxy on 127.0.0.1 for tests of lost connections: it forwards each connection to a
 // port of 127.0.0.1 and, once the clients have sent a given number of bytes through it, closes
-// every connection open at that moment, once (later connections pass untouched).
+// every connection open at that moment, once (later connections pass untouched). A test can
+// also cut the connections itself (CutNow) and make the server look gone (SetRefusing: new
+// connections are closed as soon as they are accepted).
 #ifndef NEURALMESH_TESTS_CLIENT_TCP_PROXY_H_
 #define NEURALMESH_TESTS_CLIENT_TCP_PROXY_H_
 
@@ -11,6 +13,7 @@
 
 #include <atomic>
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -21,7 +24,8 @@ namespace neuralmesh::testing {
 
 class TcpProxy {
  public:
-  TcpProxy(int target_port, size_t cut_after_client_bytes)
+  explicit TcpProxy(int target_port,
+                    size_t cut_after_client_bytes = std::numeric_limits<size_t>::max())
       : target_port_(target_port), cut_after_(cut_after_client_bytes) {
     listener_ = socket(AF_INET, SOCK_STREAM, 0);
     sockaddr_in address = Loopback(0);
@@ -46,6 +50,12 @@ class TcpProxy {
 
   int port() const { return port_; }
   bool cut() const { return cut_done_; }
+  // Closes every connection open now (later ones pass, unless refused).
+  void CutNow() {
+    cut_done_ = true;
+    CloseAll();
+  }
+  void SetRefusing(bool refusing) { refusing_ = refusing; }
 
  private:
   static sockaddr_in Loopback(int port) {
@@ -60,6 +70,10 @@ class TcpProxy {
     while (!stopping_) {
       const int client = accept(listener_, nullptr, nullptr);
       if (client < 0) return;
+      if (refusing_) {
+        close(client);
+        continue;
+      }
       const int server = socket(AF_INET, SOCK_STREAM, 0);
       sockaddr_in target = Loopback(target_port_);
       if (connect(server, reinterpret_cast<sockaddr*>(&target), sizeof(target)) != 0) {
@@ -83,7 +97,7 @@ class TcpProxy {
       for (int i = 0; i < 2; ++i) {
         if ((fds[i].revents & (POLLIN | POLLHUP | POLLERR)) == 0) continue;
         const ssize_t got = read(fds[i].fd, buffer, sizeof(buffer));
-        if (got <= 0 || write(fds[1 - i].fd, buffer, got) != got) {
+        if (got <= 0 || send(fds[1 - i].fd, buffer, got, MSG_NOSIGNAL) != got) {
           ended = true;
           break;
         }
@@ -111,6 +125,7 @@ class TcpProxy {
   std::atomic<bool> stopping_{false};
   std::atomic<size_t> client_bytes_{0};
   std::atomic<bool> cut_done_{false};
+  std::atomic<bool> refusing_{false};
   std::thread acceptor_;
   absl::Mutex mu_;
   std::vector<int> open_;  // Never closed before the destructor (no fd reuse meanwhile).

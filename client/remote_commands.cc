@@ -296,13 +296,20 @@ absl::Status RunSessions(const std::string& server, bool json, std::ostream& out
     out << text << "\n";
     return absl::OkStatus();
   }
-  out << absl::StrFormat("%-20s %-16s %-10s %10s %9s %9s %9s %8s\n", "session", "name", "state",
-                         "points", "vertices", "faces", "target", "updates");
+  // The owner column only on a server whose tokens name their clients.
+  const bool owners = std::any_of(sessions.begin(), sessions.end(),
+                                  [](const v1::Session& s) { return !s.owner().empty(); });
+  const auto owner_cell = [owners](absl::string_view owner) {
+    return owners ? absl::StrFormat("%-16s ", owner.empty() ? "-" : owner) : std::string();
+  };
+  out << absl::StrFormat("%-20s %-16s %s%-10s %10s %9s %9s %9s %8s\n", "session", "name",
+                         owner_cell("owner"), "state", "points", "vertices", "faces", "target",
+                         "updates");
   for (const v1::Session& s : sessions) {
-    out << absl::StrFormat("%-20s %-16s %-10s %10d %9d %9d %9d %8d\n", s.session_id(), s.name(),
-                           SessionStateName(s.state()), s.learning().points_received(),
-                           s.vertex_count(), s.face_count(), s.config().target_vertices(),
-                           s.latest_sequence());
+    out << absl::StrFormat("%-20s %-16s %s%-10s %10d %9d %9d %9d %8d\n", s.session_id(), s.name(),
+                           owner_cell(s.owner()), SessionStateName(s.state()),
+                           s.learning().points_received(), s.vertex_count(), s.face_count(),
+                           s.config().target_vertices(), s.latest_sequence());
   }
   out << sessions.size() << (sessions.size() == 1 ? " session\n" : " sessions\n");
   return absl::OkStatus();

@@ -27,6 +27,7 @@ void WriteSessionJson(const neuralmesh::v1::Session& s, JsonWriter& json) {
   json.BeginObject();
   json.Key("session_id").String(s.session_id());
   json.Key("name").String(s.name());
+  json.Key("owner").String(s.owner());
   json.Key("state").String(SessionStateName(s.state()));
   json.Key("points_received").Uint(s.learning().points_received());
   json.Key("points_taken").Uint(s.points_taken());

@@ -1,8 +1,10 @@
 #include "server/access_tokens.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/escaping.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
@@ -34,58 +36,127 @@ absl::Status ValidateAccessToken(absl::string_view token) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<std::vector<std::string>> ParseAccessTokens(absl::string_view text) {
-  std::vector<std::string> tokens;
+absl::string_view AccessRoleName(AccessRole role) {
+  switch (role) {
+    case AccessRole::kAdmin:
+      return "admin";
+    case AccessRole::kUser:
+      return "user";
+    case AccessRole::kReader:
+      return "reader";
+  }
+  return "admin";
+}
+
+absl::Status ValidateClient(const AccessToken& token) {
+  if (token.client.empty()) {
+    if (token.role == AccessRole::kAdmin) return absl::OkStatus();
+    return absl::InvalidArgumentError(absl::StrCat("a \"", AccessRoleName(token.role),
+                                                   "\" token needs a client name"));
+  }
+  if (token.client.size() > kMaxClientNameLength) {
+    return absl::InvalidArgumentError(absl::StrCat("the client name has ", token.client.size(),
+                                                   " characters; at most ",
+                                                   kMaxClientNameLength, " are allowed"));
+  }
+  for (const char c : token.client) {
+    if (!absl::ascii_isalnum(c) && c != '.' && c != '_' && c != '@' && c != '-') {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "the client name \"", absl::CHexEscape(token.client),
+          "\" may hold letters, digits and \"._@-\" only"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::vector<AccessToken>> ParseAccessTokens(absl::string_view text) {
+  std::vector<AccessToken> tokens;
   int line_number = 0;
   for (absl::string_view line : absl::StrSplit(text, '\n')) {
     ++line_number;
     line = absl::StripAsciiWhitespace(line);
     if (line.empty() || line.front() == '#') continue;
-    if (absl::Status valid = ValidateAccessToken(line); !valid.ok()) {
-      return absl::InvalidArgumentError(absl::StrCat("line ", line_number, ": ", valid.message()));
+    std::vector<absl::string_view> fields =
+        absl::StrSplit(line, absl::ByAnyChar(" \t\r"), absl::SkipEmpty());
+    // A field starting with '#' starts a comment (no token or client name starts with one).
+    fields.erase(std::find_if(fields.begin(), fields.end(),
+                              [](absl::string_view f) { return f.front() == '#'; }),
+                 fields.end());
+    const auto bad_line = [line_number](absl::string_view why) {
+      return absl::InvalidArgumentError(absl::StrCat("line ", line_number, ": ", why));
+    };
+    if (fields.size() > 3) {
+      return bad_line(absl::StrCat("expected TOKEN [CLIENT [ROLE]], found ", fields.size(),
+                                   " fields"));
     }
-    tokens.emplace_back(line);
+    if (absl::Status valid = ValidateAccessToken(fields[0]); !valid.ok()) {
+      return bad_line(valid.message());
+    }
+    AccessToken token{std::string(fields[0])};
+    if (fields.size() >= 2) {
+      token.client = std::string(fields[1]);
+      token.role = AccessRole::kUser;
+    }
+    if (fields.size() == 3) {
+      bool known = false;
+      for (const AccessRole role : {AccessRole::kAdmin, AccessRole::kUser, AccessRole::kReader}) {
+        if (fields[2] == AccessRoleName(role)) {
+          token.role = role;
+          known = true;
+        }
+      }
+      if (!known) {
+        return bad_line(absl::StrCat("unknown role \"", absl::CHexEscape(fields[2]),
+                                     "\" (admin, user or reader)"));
+      }
+    }
+    if (absl::Status valid = ValidateClient(token); !valid.ok()) return bad_line(valid.message());
+    tokens.push_back(std::move(token));
   }
   if (tokens.empty()) {
     return absl::InvalidArgumentError(
-        "no access token in it (one per line; '#' starts a comment line)");
+        "no access token in it (one per line: TOKEN [CLIENT [ROLE]]; '#' starts a comment "
+        "line)");
   }
   return tokens;
 }
 
 absl::StatusOr<std::shared_ptr<AccessTokenChecker>> AccessTokenChecker::Create(
-    std::vector<std::string> tokens) {
+    std::vector<AccessToken> tokens) {
   std::shared_ptr<AccessTokenChecker> checker(new AccessTokenChecker());
   if (absl::Status s = checker->ReplaceTokens(std::move(tokens)); !s.ok()) return s;
   return checker;
 }
 
-absl::Status AccessTokenChecker::ReplaceTokens(std::vector<std::string> tokens) {
+absl::Status AccessTokenChecker::ReplaceTokens(std::vector<AccessToken> tokens) {
   if (tokens.empty()) return absl::InvalidArgumentError("no access token given");
-  for (const std::string& token : tokens) {
-    if (absl::Status valid = ValidateAccessToken(token); !valid.ok()) return valid;
+  for (const AccessToken& token : tokens) {
+    if (absl::Status valid = ValidateAccessToken(token.token); !valid.ok()) return valid;
+    if (absl::Status valid = ValidateClient(token); !valid.ok()) return valid;
   }
   absl::MutexLock lock(&mu_);
   tokens_ = std::move(tokens);
   return absl::OkStatus();
 }
 
-bool AccessTokenChecker::Accepts(absl::string_view token) const {
+std::optional<AccessToken> AccessTokenChecker::Find(absl::string_view token) const {
   absl::MutexLock lock(&mu_);
-  bool accepted = false;
-  for (const std::string& known : tokens_) {
+  const AccessToken* found = nullptr;
+  for (const AccessToken& known : tokens_) {
     // Every byte of equal lengths is compared: the time tells nothing of a partial match.
-    unsigned char difference = known.size() == token.size() ? 0 : 1;
+    const std::string& bytes = known.token;
+    unsigned char difference = bytes.size() == token.size() ? 0 : 1;
     for (size_t i = 0; i < token.size(); ++i) {
-      difference |= static_cast<unsigned char>(known[i % known.size()] ^ token[i]);
+      difference |= static_cast<unsigned char>(bytes[i % bytes.size()] ^ token[i]);
     }
-    accepted |= difference == 0;
+    found = difference == 0 ? &known : found;
   }
-  return accepted;
+  if (found == nullptr) return std::nullopt;
+  return AccessToken("", found->client, found->role);
 }
 
 grpc::Status AccessTokenChecker::Process(const InputMetadata& auth_metadata,
-                                         grpc::AuthContext* /*context*/,
+                                         grpc::AuthContext* context,
                                          OutputMetadata* consumed_auth_metadata,
                                          OutputMetadata* /*response_metadata*/) {
   const auto path = auth_metadata.find(":path");
@@ -105,8 +176,10 @@ grpc::Status AccessTokenChecker::Process(const InputMetadata& auth_metadata,
         !absl::EqualsIgnoreCase(value.substr(0, kBearer.size()), kBearer)) {
       continue;
     }
-    if (Accepts(value.substr(kBearer.size()))) {
+    if (std::optional<AccessToken> found = Find(value.substr(kBearer.size()))) {
       consumed_auth_metadata->emplace(std::string(kAuthorization), std::string(value));
+      context->AddProperty(kClientProperty, found->client);
+      context->AddProperty(kRoleProperty, std::string(AccessRoleName(found->role)));
       return grpc::Status::OK;
     }
   }

@@ -52,9 +52,12 @@ ABSL_FLAG(std::string, tls_client_ca_file, "",
           "PEM file with the CAs that sign client certificates; set: mutual TLS, every client "
           "must present a certificate signed by one of them. Needs --tls_cert_file.");
 ABSL_FLAG(std::string, access_tokens_file, "",
-          "File of access tokens, one per line ('#' starts a comment line; each at least 16 "
-          "printable characters); set: every call except health checks must carry "
-          "'authorization: Bearer TOKEN' with one of them. Needs --tls_cert_file. SIGHUP "
+          "File of access tokens, one per line as 'TOKEN [CLIENT [ROLE]]' ('#' starts a "
+          "comment line; a token has at least 16 printable characters); set: every call except "
+          "health checks must carry 'authorization: Bearer TOKEN' with one of them. ROLE is "
+          "user (the default for a named token: it creates sessions and sees and changes only "
+          "those CLIENT created), reader (it lists, gets and watches every session and changes "
+          "none) or admin (every session; a token alone is one). Needs --tls_cert_file. SIGHUP "
           "reads the file again (calls already running go on).");
 ABSL_FLAG(bool, log_sessions, true,
           "Print a line on standard output when a session is created, finishes, is cancelled, "
@@ -76,10 +79,11 @@ absl::StatusOr<std::string> ReadFlagFile(const char* flag, const std::string& pa
 }
 
 // The tokens of --access_tokens_file, which is set.
-absl::StatusOr<std::vector<std::string>> AccessTokensFromFlag() {
+absl::StatusOr<std::vector<neuralmesh::server::AccessToken>> AccessTokensFromFlag() {
   NM_ASSIGN_OR_RETURN(const std::string text,
                       ReadFlagFile("access_tokens_file", absl::GetFlag(FLAGS_access_tokens_file)));
-  absl::StatusOr<std::vector<std::string>> tokens = neuralmesh::server::ParseAccessTokens(text);
+  absl::StatusOr<std::vector<neuralmesh::server::AccessToken>> tokens =
+      neuralmesh::server::ParseAccessTokens(text);
   if (!tokens.ok()) {
     return absl::InvalidArgumentError(
         absl::StrCat("--access_tokens_file: ", tokens.status().message()));
@@ -115,7 +119,7 @@ void ReloadAccessTokens(neuralmesh::server::ReconstructionServer& server) {
     std::printf("neuralmesh-server: SIGHUP received; no --access_tokens_file to read again\n");
     return;
   }
-  absl::StatusOr<std::vector<std::string>> tokens = AccessTokensFromFlag();
+  absl::StatusOr<std::vector<neuralmesh::server::AccessToken>> tokens = AccessTokensFromFlag();
   absl::Status replaced = tokens.ok() ? server.ReplaceAccessTokens(*tokens) : tokens.status();
   if (replaced.ok()) {
     std::printf("neuralmesh-server: SIGHUP received; %zu access tokens read again\n",

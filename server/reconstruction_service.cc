@@ -14,6 +14,8 @@
 #include "server/latest_wins_writer.h"
 #include "server/off_thread_work.h"
 #include "server/proto_conversion.h"
+#include "core/status_macros.h"
+#include "server/session_access.h"
 #include "server/update_channel.h"
 
 namespace neuralmesh::server {
@@ -93,7 +95,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
                            public UpdateSubscriber,
                            public LiveReactor {
  public:
-  WatchReactor(SessionManager* manager, ReactorRegistry* reactors,
+  WatchReactor(SessionManager* manager, ReactorRegistry* reactors, const Caller& caller,
                const v1::WatchSessionRequest& request)
       : reactors_(reactors), writer_(request.after_sequence()) {
     registered_ = reactors_->Add(this);
@@ -101,7 +103,8 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
       EndNow(Unavailable());
       return;
     }
-    absl::StatusOr<std::shared_ptr<Session>> session = manager->Get(request.session_id());
+    absl::StatusOr<std::shared_ptr<Session>> session =
+        GetSessionFor(*manager, caller, request.session_id(), SessionUse::kSee);
     if (!session.ok()) {
       EndNow(session.status());
       return;
@@ -195,9 +198,10 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
                             public LiveReactor {
  public:
   UploadReactor(SessionManager* manager, ReactorRegistry* reactors, Executor* filter,
-                v1::UploadPointsResponse* response)
+                Caller caller, v1::UploadPointsResponse* response)
       : manager_(manager),
         reactors_(reactors),
+        caller_(std::move(caller)),
         filter_(filter),
         response_(response),
         work_([this] { CleanUpAndDelete(); }) {
@@ -306,7 +310,8 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
       if (request_.session_id().empty()) {
         return absl::InvalidArgumentError("the first message must set session_id");
       }
-      absl::StatusOr<std::shared_ptr<Session>> session = manager_->Get(request_.session_id());
+      absl::StatusOr<std::shared_ptr<Session>> session =
+          GetSessionFor(*manager_, caller_, request_.session_id(), SessionUse::kChange);
       if (!session.ok()) return session.status();
       session_ = *std::move(session);
       session_->AddStream();
@@ -374,6 +379,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
 
   SessionManager* const manager_;
   ReactorRegistry* const reactors_;
+  const Caller caller_;
   Executor* const filter_;
   v1::UploadPointsResponse* const response_;
   OffThreadWork work_;
@@ -528,20 +534,23 @@ class ReconstructReactor final
           "the first request must be a ReconstructStart (create or attach a session)");
     }
     const v1::ReconstructStart& start = request_.start();
+    const Caller caller = CallerOf(*context_);
     std::shared_ptr<Session> session;
     switch (start.target_case()) {
       case v1::ReconstructStart::kCreate: {
+        NM_RETURN_IF_ERROR(CheckMayCreate(caller));
         absl::StatusOr<SessionConfig> config =
             SessionConfigFromProto(start.create().config());
         if (!config.ok()) return config.status();
-        absl::StatusOr<std::shared_ptr<Session>> created =
-            manager_->Create(*std::move(config), start.create().name(), context_->peer());
+        absl::StatusOr<std::shared_ptr<Session>> created = manager_->Create(
+            *std::move(config), start.create().name(), context_->peer(), caller.client);
         if (!created.ok()) return created.status();
         session = *std::move(created);
         break;
       }
       case v1::ReconstructStart::kSessionId: {
-        absl::StatusOr<std::shared_ptr<Session>> found = manager_->Get(start.session_id());
+        absl::StatusOr<std::shared_ptr<Session>> found =
+            GetSessionFor(*manager_, caller, start.session_id(), SessionUse::kChange);
         if (!found.ok()) return found.status();
         session = *std::move(found);
         const v1::SessionState state = session->state();
@@ -769,10 +778,14 @@ ReconstructionService::ReconstructionService(SessionManager* manager, ReactorReg
 grpc::ServerUnaryReactor* ReconstructionService::CreateSession(
     grpc::CallbackServerContext* context, const v1::CreateSessionRequest* request,
     v1::Session* response) {
+  const Caller caller = CallerOf(*context);
+  if (absl::Status allowed = CheckMayCreate(caller); !allowed.ok()) {
+    return FinishUnary(context, allowed);
+  }
   absl::StatusOr<SessionConfig> config = SessionConfigFromProto(request->config());
   if (!config.ok()) return FinishUnary(context, config.status());
   absl::StatusOr<std::shared_ptr<Session>> session =
-      manager_->Create(*std::move(config), request->name(), context->peer());
+      manager_->Create(*std::move(config), request->name(), context->peer(), caller.client);
   if (!session.ok()) return FinishUnary(context, session.status());
   *response = (*session)->ToProto();
   return FinishUnary(context, absl::OkStatus());
@@ -780,12 +793,12 @@ grpc::ServerUnaryReactor* ReconstructionService::CreateSession(
 
 grpc::ServerReadReactor<v1::UploadPointsRequest>* ReconstructionService::UploadPoints(
     grpc::CallbackServerContext* context, v1::UploadPointsResponse* response) {
-  return new UploadReactor(manager_, reactors_, filter_, response);
+  return new UploadReactor(manager_, reactors_, filter_, CallerOf(*context), response);
 }
 
 grpc::ServerWriteReactor<v1::MeshUpdate>* ReconstructionService::WatchSession(
     grpc::CallbackServerContext* context, const v1::WatchSessionRequest* request) {
-  return new WatchReactor(manager_, reactors_, *request);
+  return new WatchReactor(manager_, reactors_, CallerOf(*context), *request);
 }
 
 grpc::ServerBidiReactor<v1::ReconstructRequest, v1::ReconstructResponse>*
@@ -796,7 +809,8 @@ ReconstructionService::Reconstruct(grpc::CallbackServerContext* context) {
 grpc::ServerUnaryReactor* ReconstructionService::GetSession(
     grpc::CallbackServerContext* context, const v1::GetSessionRequest* request,
     v1::Session* response) {
-  absl::StatusOr<std::shared_ptr<Session>> session = manager_->Get(request->session_id());
+  absl::StatusOr<std::shared_ptr<Session>> session =
+      GetSessionFor(*manager_, CallerOf(*context), request->session_id(), SessionUse::kSee);
   if (!session.ok()) return FinishUnary(context, session.status());
   *response = (*session)->ToProto();
   return FinishUnary(context, absl::OkStatus());
@@ -807,7 +821,9 @@ grpc::ServerUnaryReactor* ReconstructionService::ListSessions(
     v1::ListSessionsResponse* response) {
   absl::StatusOr<std::vector<std::shared_ptr<Session>>> sessions = manager_->List();
   if (!sessions.ok()) return FinishUnary(context, sessions.status());
+  const Caller caller = CallerOf(*context);
   for (const std::shared_ptr<Session>& session : *sessions) {
+    if (!CheckMayUse(caller, *session, SessionUse::kSee).ok()) continue;
     *response->add_sessions() = session->ToProto();
   }
   return FinishUnary(context, absl::OkStatus());
@@ -816,7 +832,8 @@ grpc::ServerUnaryReactor* ReconstructionService::ListSessions(
 grpc::ServerUnaryReactor* ReconstructionService::FinishSession(
     grpc::CallbackServerContext* context, const v1::FinishSessionRequest* request,
     v1::Session* response) {
-  absl::StatusOr<std::shared_ptr<Session>> session = manager_->Get(request->session_id());
+  absl::StatusOr<std::shared_ptr<Session>> session =
+      GetSessionFor(*manager_, CallerOf(*context), request->session_id(), SessionUse::kChange);
   if (!session.ok()) return FinishUnary(context, session.status());
   if (absl::Status status = (*session)->Finish(); !status.ok()) {
     return FinishUnary(context, status);
@@ -828,7 +845,8 @@ grpc::ServerUnaryReactor* ReconstructionService::FinishSession(
 grpc::ServerUnaryReactor* ReconstructionService::CancelSession(
     grpc::CallbackServerContext* context, const v1::CancelSessionRequest* request,
     v1::Session* response) {
-  absl::StatusOr<std::shared_ptr<Session>> session = manager_->Get(request->session_id());
+  absl::StatusOr<std::shared_ptr<Session>> session =
+      GetSessionFor(*manager_, CallerOf(*context), request->session_id(), SessionUse::kChange);
   if (!session.ok()) return FinishUnary(context, session.status());
   if (absl::Status status = (*session)->Cancel("cancelled by a CancelSession call");
       !status.ok()) {
@@ -841,13 +859,17 @@ grpc::ServerUnaryReactor* ReconstructionService::CancelSession(
 grpc::ServerUnaryReactor* ReconstructionService::DeleteSession(
     grpc::CallbackServerContext* context, const v1::DeleteSessionRequest* request,
     v1::DeleteSessionResponse* response) {
+  absl::StatusOr<std::shared_ptr<Session>> session =
+      GetSessionFor(*manager_, CallerOf(*context), request->session_id(), SessionUse::kChange);
+  if (!session.ok()) return FinishUnary(context, session.status());
   return FinishUnary(context, manager_->Delete(request->session_id()));
 }
 
 grpc::ServerUnaryReactor* ReconstructionService::GetMesh(grpc::CallbackServerContext* context,
                                                          const v1::GetMeshRequest* request,
                                                          v1::MeshUpdate* response) {
-  absl::StatusOr<std::shared_ptr<Session>> session = manager_->Get(request->session_id());
+  absl::StatusOr<std::shared_ptr<Session>> session =
+      GetSessionFor(*manager_, CallerOf(*context), request->session_id(), SessionUse::kSee);
   if (!session.ok()) return FinishUnary(context, session.status());
   const bool final = request->version() == v1::MESH_VERSION_FINAL;
   if (request->version() != v1::MESH_VERSION_LATEST && !final) {

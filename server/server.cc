@@ -119,7 +119,7 @@ std::shared_ptr<grpc::Channel> ReconstructionServer::InProcessChannel() {
   return server_->InProcessChannel(args);
 }
 
-absl::Status ReconstructionServer::ReplaceAccessTokens(std::vector<std::string> tokens) {
+absl::Status ReconstructionServer::ReplaceAccessTokens(std::vector<AccessToken> tokens) {
   if (token_checker_ == nullptr) {
     return absl::FailedPreconditionError(
         "the server was started without access tokens; tokens cannot be added to it running");

@@ -69,8 +69,8 @@ class ReconstructionServer {
 
   // Replaces the access tokens for calls that start from now on (running calls go on), for a
   // reload without a restart. FAILED_PRECONDITION when the server was started without tokens,
-  // INVALID_ARGUMENT (the old tokens kept) for an empty list or an invalid token.
-  absl::Status ReplaceAccessTokens(std::vector<std::string> tokens);
+  // INVALID_ARGUMENT (the old tokens kept) for an empty list, an invalid token or client name.
+  absl::Status ReplaceAccessTokens(std::vector<AccessToken> tokens);
 
   SessionManager& sessions() { return *manager_; }
   ReactorRegistry& reactors() { return *reactors_; }

@@ -28,7 +28,7 @@ struct ServerTls {
 struct ServerSecurity {
   ServerTls tls;
   // Set: every call but the health service's must carry one of these tokens (needs TLS).
-  std::vector<std::string> access_tokens;
+  std::vector<AccessToken> access_tokens;
 };
 
 struct PortCredentials {

@@ -60,9 +60,11 @@ bool IsSpatiallyBiased(absl::Span<const Vec3f> arrival_sample) {
 }
 
 Session::Session(std::string id, std::string name, SessionConfig config, size_t max_points,
-                 WorkerPool* pool, Executor* encoder, std::shared_ptr<EventLog> log)
+                 WorkerPool* pool, Executor* encoder, std::shared_ptr<EventLog> log,
+                 std::string owner)
     : id_(std::move(id)),
       name_(std::move(name)),
+      owner_(std::move(owner)),
       config_(std::move(config)),
       create_time_(absl::Now()),
       pool_(pool),
@@ -360,6 +362,7 @@ v1::Session Session::ToProto() const {
   v1::Session out;
   out.set_session_id(id_);
   out.set_name(name_);
+  out.set_owner(owner_);
   *out.mutable_config() = SessionConfigToProto(config_);
   out.set_create_time_us(absl::ToUnixMicros(create_time_));
   if (MeshUpdatePtr latest = updates_.latest(); latest != nullptr) {

@@ -70,9 +70,12 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
  public:
   // `config` must have passed ResolveSessionConfig. `pool` and `encoder` must outlive every
   // slice and encoding task of the session (the server shuts them down before it lets go).
-  // `log`, when set, records the session's end (finished, cancelled, failed).
+  // `log`, when set, records the session's end (finished, cancelled, failed). `owner` is the
+  // client name of the access token that created the session (session_access.h); empty
+  // without one.
   Session(std::string id, std::string name, SessionConfig config, size_t max_points,
-          WorkerPool* pool, Executor* encoder, std::shared_ptr<EventLog> log = nullptr);
+          WorkerPool* pool, Executor* encoder, std::shared_ptr<EventLog> log = nullptr,
+          std::string owner = "");
   ~Session() override;
 
   Session(const Session&) = delete;
@@ -80,6 +83,7 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
 
   const std::string& id() const { return id_; }
   const std::string& name() const { return name_; }
+  const std::string& owner() const { return owner_; }
   const SessionConfig& config() const { return config_; }
   // Whether AddPoints filters outliers (SessionConfig::outlier_removal): work proportional to
   // the batch times log^2 of the points so far, too long for a gRPC callback thread.
@@ -175,6 +179,7 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
 
   const std::string id_;
   const std::string name_;
+  const std::string owner_;
   const SessionConfig config_;
   const absl::Time create_time_;
   WorkerPool* const pool_;

@@ -19,12 +19,15 @@ absl::Status UnknownSession(absl::string_view id) {
   return absl::NotFoundError(absl::StrCat("no session with id ", QuotedSessionId(id)));
 }
 
-// "created by PEER: "NAME", target N vertices" and the options that change how it learns.
+// "created by [client OWNER at ]PEER: "NAME", target N vertices" and the options that change
+// how it learns.
 std::string CreationEvent(const SessionConfig& config, absl::string_view name,
-                          absl::string_view peer) {
-  std::string event = absl::StrCat("created", peer.empty() ? "" : " by ", peer, ": \"",
-                                   absl::CHexEscape(name), "\", target ",
-                                   config.target_vertices, " vertices");
+                          absl::string_view peer, absl::string_view owner) {
+  std::string event = "created";
+  if (!owner.empty()) absl::StrAppend(&event, " by client ", owner, peer.empty() ? "" : " at");
+  if (!peer.empty()) absl::StrAppend(&event, owner.empty() ? " by " : " ", peer);
+  absl::StrAppend(&event, ": \"", absl::CHexEscape(name), "\", target ", config.target_vertices,
+                  " vertices");
   if (config.learner.initial_mesh == InitialMesh::kDisc) absl::StrAppend(&event, ", disc start");
   if (config.outlier_removal.has_value()) absl::StrAppend(&event, ", outlier removal");
   return event;
@@ -68,13 +71,14 @@ std::string SessionManager::NewIdLocked() {
 
 absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(SessionConfig config,
                                                                 std::string name,
-                                                                absl::string_view peer) {
+                                                                absl::string_view peer,
+                                                                std::string owner) {
   if (name.size() > kMaxNameBytes) {
     return absl::InvalidArgumentError(
         absl::StrCat("name has ", name.size(), " bytes; at most 256 are allowed"));
   }
   NM_RETURN_IF_ERROR(ResolveSessionConfig(limits_.max_points_per_session, config));
-  const std::string event = CreationEvent(config, name, peer);
+  const std::string event = CreationEvent(config, name, peer, owner);
   std::shared_ptr<Session> session;
   {
     absl::MutexLock lock(&mu_);
@@ -86,7 +90,8 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(SessionConfig co
     }
     std::string id = NewIdLocked();
     session = std::make_shared<Session>(id, std::move(name), std::move(config),
-                                        limits_.max_points_per_session, pool_, encoder_, log_);
+                                        limits_.max_points_per_session, pool_, encoder_, log_,
+                                        std::move(owner));
     sessions_.emplace(id, session);
     order_.emplace(created_++, id);
   }

@@ -55,11 +55,12 @@ class SessionManager {
   SessionManager& operator=(const SessionManager&) = delete;
 
   // Validates `config` (ResolveSessionConfig) and creates a session for the client at `peer`
-  // (gRPC's peer address, for the event log). INVALID_ARGUMENT for an invalid configuration or
-  // a name longer than 256 bytes; RESOURCE_EXHAUSTED at max_sessions; UNAVAILABLE after
-  // Shutdown.
+  // (gRPC's peer address, for the event log), owned by `owner` (the client name of the call's
+  // access token, Session::owner). INVALID_ARGUMENT for an invalid configuration or a name
+  // longer than 256 bytes; RESOURCE_EXHAUSTED at max_sessions; UNAVAILABLE after Shutdown.
   absl::StatusOr<std::shared_ptr<Session>> Create(SessionConfig config, std::string name,
-                                                  absl::string_view peer = "")
+                                                  absl::string_view peer = "",
+                                                  std::string owner = "")
       ABSL_LOCKS_EXCLUDED(mu_);
 
   // NOT_FOUND for an unknown id (INVALID_ARGUMENT for an empty one), UNAVAILABLE after

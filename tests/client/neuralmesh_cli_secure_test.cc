@@ -10,6 +10,7 @@
 #include <csignal>
 #include <filesystem>
 #include <memory>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,8 @@ namespace {
 using ::testing::HasSubstr;
 
 constexpr char kToken[] = "cli-test-token-0123456789abcdef";
+constexpr char kAliceToken[] = "cli-alice-token-0123456789abcdef";
+constexpr char kWallToken[] = "cli-wall-token-0123456789abcdef";
 
 class SecureCliTest : public ::testing::Test {
  protected:
@@ -35,8 +38,13 @@ class SecureCliTest : public ::testing::Test {
     absl::StatusOr<TestCertificates> made = MakeTestCertificates(*dir_ + "/tls");
     ASSERT_TRUE(made.ok()) << made.status();
     certificates_ = new TestCertificates(*std::move(made));
-    ASSERT_TRUE(WriteFileContents(Path("tokens"), absl::StrCat("# test\n", kToken, "\n")).ok());
+    ASSERT_TRUE(WriteFileContents(Path("tokens"),
+                                  absl::StrCat("# test\n", kToken, "\n", kAliceToken, " alice\n",
+                                               kWallToken, " wall reader\n"))
+                    .ok());
     ASSERT_TRUE(WriteFileContents(Path("token"), absl::StrCat(kToken, "\n")).ok());
+    ASSERT_TRUE(WriteFileContents(Path("alice_token"), kAliceToken).ok());
+    ASSERT_TRUE(WriteFileContents(Path("wall_token"), kWallToken).ok());
     ASSERT_TRUE(WriteFileContents(Path("wrong_token"), "wrong-token-0123456789abcdef").ok());
     chmod(Path("token").c_str(), 0600);
     std::string error;
@@ -95,6 +103,43 @@ TEST_F(SecureCliTest, ReconstructAndSessionsOverTlsWithAToken) {
                              "--connect_timeout=1s"}));
   EXPECT_NE(wrong_name.exit_code, 0) << wrong_name.Describe();
   EXPECT_THAT(wrong_name.err, HasSubstr("cannot reach")) << wrong_name.Describe();
+}
+
+// Tokens that name their clients: a user sees its own sessions, a reader sees all and
+// creates none; `sessions` shows who owns what.
+TEST_F(SecureCliTest, NamedTokensOwnTheirSessionsAndAReaderOnlyLooks) {
+  const auto as = [](const std::string& token_file, std::vector<std::string> args) {
+    args.insert(args.end(), {"--server=" + server_->address(),
+                             "--tls_ca_file=" + certs().Path("ca.pem"),
+                             "--access_token_file=" + Path(token_file)});
+    return RunNeuralmesh(args);
+  };
+  const RunResult alice = as("alice_token", {"reconstruct", "builtin:torus", "--out-dir",
+                                             Path("alice"), "--vertices", "300", "--points",
+                                             "3000"});
+  ASSERT_EQ(alice.exit_code, 0) << alice.Describe();
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(alice.out, match, std::regex("session (s-[0-9a-f]+) on")))
+      << alice.out;
+  const std::string id = match[1];
+
+  const RunResult own = as("alice_token", {"sessions"});
+  ASSERT_EQ(own.exit_code, 0) << own.Describe();
+  EXPECT_THAT(own.out, HasSubstr("owner"));
+  EXPECT_TRUE(std::regex_search(own.out, std::regex(id + " +torus +alice +finished"))) << own.out;
+  EXPECT_THAT(own.out, HasSubstr("\n1 session\n")) << "only alice's own";
+
+  const RunResult all = as("wall_token", {"sessions", "--json"});
+  ASSERT_EQ(all.exit_code, 0) << all.Describe();
+  EXPECT_THAT(all.out, HasSubstr("\"owner\": \"alice\""));
+  const RunResult watched = as("wall_token", {"watch", id, "--out-dir", Path("wall")});
+  EXPECT_EQ(watched.exit_code, 0) << watched.Describe();
+  EXPECT_TRUE(std::filesystem::exists(Path("wall/" + id + ".drc")));
+
+  const RunResult refused = as("wall_token", {"reconstruct", "builtin:sphere", "--out-dir",
+                                              Path("refused"), "--vertices", "100"});
+  EXPECT_NE(refused.exit_code, 0) << refused.Describe();
+  EXPECT_THAT(refused.err, HasSubstr("the token of client wall is a reader's")) << refused.err;
 }
 
 TEST_F(SecureCliTest, AMissingWrongOrUnprotectedTokenFailsClearly) {

@@ -33,6 +33,10 @@ ABSL_FLAG(int, filter_threads, 1,
 ABSL_FLAG(absl::Duration, time_slice, absl::Milliseconds(20),
           "Learning time a session gets per turn on a worker thread.");
 ABSL_FLAG(int, max_sessions, 64, "Sessions held at once, in any state.");
+ABSL_FLAG(int, max_sessions_per_client, 0,
+          "Of --max_sessions, the most one client of --access_tokens_file may hold (a named "
+          "token's CLIENT; sessions of unnamed tokens count against --max_sessions only); 0: no "
+          "limit of its own.");
 ABSL_FLAG(int64_t, max_points_per_session, int64_t{1} << 26,
           "Points one session accepts in total.");
 ABSL_FLAG(int64_t, max_batch_points,
@@ -166,15 +170,17 @@ int main(int argc, char** argv) {
   options.time_slice = absl::GetFlag(FLAGS_time_slice);
   options.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
   const int max_sessions = absl::GetFlag(FLAGS_max_sessions);
+  const int max_per_client = absl::GetFlag(FLAGS_max_sessions_per_client);
   const int64_t max_points = absl::GetFlag(FLAGS_max_points_per_session);
   const int64_t max_batch = absl::GetFlag(FLAGS_max_batch_points);
-  if (max_sessions < 1 || max_points < 4 || max_batch < 1) {
+  if (max_sessions < 1 || max_points < 4 || max_batch < 1 || max_per_client < 0) {
     std::fprintf(stderr,
                  "neuralmesh-server: --max_sessions and --max_batch_points must be at least 1, "
-                 "--max_points_per_session at least 4\n");
+                 "--max_points_per_session at least 4, --max_sessions_per_client at least 0\n");
     return 2;
   }
   options.limits.max_sessions = static_cast<size_t>(max_sessions);
+  options.limits.max_sessions_per_client = static_cast<size_t>(max_per_client);
   options.limits.max_points_per_session = static_cast<size_t>(max_points);
   options.limits.max_batch_points = static_cast<size_t>(max_batch);
   options.limits.idle_timeout = absl::GetFlag(FLAGS_idle_timeout);

@@ -88,6 +88,16 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(SessionConfig co
           "the server holds its maximum of ", limits_.max_sessions,
           " sessions; delete finished or cancelled ones first"));
     }
+    if (!owner.empty() && limits_.max_sessions_per_client > 0) {
+      const size_t held = std::count_if(sessions_.begin(), sessions_.end(), [&](const auto& s) {
+        return s.second->owner() == owner;
+      });
+      if (held >= limits_.max_sessions_per_client) {
+        return absl::ResourceExhaustedError(absl::StrCat(
+            "client ", owner, " holds its maximum of ", limits_.max_sessions_per_client,
+            " sessions; delete finished or cancelled ones first"));
+      }
+    }
     std::string id = NewIdLocked();
     session = std::make_shared<Session>(id, std::move(name), std::move(config),
                                         limits_.max_points_per_session, pool_, encoder_, log_,

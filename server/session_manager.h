@@ -28,6 +28,9 @@ namespace neuralmesh::server {
 
 struct SessionLimits {
   size_t max_sessions = 64;                // Sessions held at once, in any state.
+  // Of those, the most one client (Session::owner, a named access token) may hold; 0: no
+  // limit of its own. Sessions without an owner count against max_sessions only.
+  size_t max_sessions_per_client = 0;
   size_t max_points_per_session = 1u << 26;  // 67M points.
   // Points per batch: 2M, so that a packed batch of as many points with weights and normals
   // (28 bytes a point) fits the default message limit of 64 MiB.
@@ -57,7 +60,8 @@ class SessionManager {
   // Validates `config` (ResolveSessionConfig) and creates a session for the client at `peer`
   // (gRPC's peer address, for the event log), owned by `owner` (the client name of the call's
   // access token, Session::owner). INVALID_ARGUMENT for an invalid configuration or a name
-  // longer than 256 bytes; RESOURCE_EXHAUSTED at max_sessions; UNAVAILABLE after Shutdown.
+  // longer than 256 bytes; RESOURCE_EXHAUSTED at max_sessions or when `owner` holds
+  // max_sessions_per_client; UNAVAILABLE after Shutdown.
   absl::StatusOr<std::shared_ptr<Session>> Create(SessionConfig config, std::string name,
                                                   absl::string_view peer = "",
                                                   std::string owner = "")

@@ -48,8 +48,12 @@ class SessionAccessTest : public ::testing::Test {
     certificates_ = nullptr;
   }
 
-  void SetUp() override {
+  void SetUp() override { StartServer(/*max_sessions_per_client=*/0); }
+
+  void StartServer(size_t max_sessions_per_client) {
+    server_.reset();
     ServerOptions options;
+    options.limits.max_sessions_per_client = max_sessions_per_client;
     options.security.tls.certificate_chain = certificates_->server_chain;
     options.security.tls.private_key = certificates_->server_key;
     options.security.access_tokens = {AccessToken(kAlice, "alice", AccessRole::kUser),
@@ -230,6 +234,24 @@ TEST_F(SessionAccessTest, AnAdminChangesEverySession) {
   EXPECT_TRUE(testing::Cancel(*ops_, a).ok());
   EXPECT_TRUE(testing::Delete(*unnamed_, b).ok());
   EXPECT_EQ(Listed(*ops_), (std::set<std::string>{a}));
+}
+
+TEST_F(SessionAccessTest, AClientHoldsAtMostItsShareOfSessions) {
+  StartServer(/*max_sessions_per_client=*/2);
+  const std::string first = MustCreate(*alice_, CreateRequest(200));
+  MustCreate(*alice_, CreateRequest(200));
+  grpc::ClientContext context;
+  v1::Session refused;
+  const grpc::Status third = alice_->CreateSession(&context, CreateRequest(200), &refused);
+  EXPECT_EQ(third.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_TRUE(absl::StrContains(third.error_message(), "client alice holds its maximum of 2"))
+      << third.error_message();
+  MustCreate(*bob_, CreateRequest(200));
+  MustCreate(*unnamed_, CreateRequest(200));
+  MustCreate(*unnamed_, CreateRequest(200));
+  MustCreate(*unnamed_, CreateRequest(200));  // Unnamed tokens have no share of their own.
+  ASSERT_TRUE(testing::Delete(*alice_, first).ok());
+  EXPECT_FALSE(MustCreate(*alice_, CreateRequest(200)).empty()) << "room again";
 }
 
 }  // namespace

@@ -50,7 +50,9 @@ ABSL_FLAG(absl::Duration, idle_timeout, absl::Minutes(30),
           "long; 'inf' never does.");
 ABSL_FLAG(std::string, tls_cert_file, "",
           "PEM file with the server's TLS certificate (then any intermediates); set: the port "
-          "speaks TLS only. Needs --tls_key_file.");
+          "speaks TLS only. Needs --tls_key_file. SIGHUP reads it, the key and the client CAs "
+          "again: a renewed certificate applies to new connections within a second, without a "
+          "restart.");
 ABSL_FLAG(std::string, tls_key_file, "", "PEM file with the private key of --tls_cert_file.");
 ABSL_FLAG(std::string, tls_client_ca_file, "",
           "PEM file with the CAs that sign client certificates; set: mutual TLS, every client "
@@ -95,43 +97,70 @@ absl::StatusOr<std::vector<neuralmesh::server::AccessToken>> AccessTokensFromFla
   return tokens;
 }
 
-absl::StatusOr<neuralmesh::server::ServerSecurity> SecurityFromFlags() {
-  neuralmesh::server::ServerSecurity security;
+// The TLS identity of --tls_cert_file, --tls_key_file and --tls_client_ca_file.
+absl::StatusOr<neuralmesh::server::ServerTls> TlsFromFlags() {
+  neuralmesh::server::ServerTls tls;
   struct PemFlag {
     const char* flag;
     std::string path;
     std::string* contents;
   };
   const PemFlag pem_flags[] = {
-      {"tls_cert_file", absl::GetFlag(FLAGS_tls_cert_file), &security.tls.certificate_chain},
-      {"tls_key_file", absl::GetFlag(FLAGS_tls_key_file), &security.tls.private_key},
+      {"tls_cert_file", absl::GetFlag(FLAGS_tls_cert_file), &tls.certificate_chain},
+      {"tls_key_file", absl::GetFlag(FLAGS_tls_key_file), &tls.private_key},
       {"tls_client_ca_file", absl::GetFlag(FLAGS_tls_client_ca_file),
-       &security.tls.client_ca_certificates}};
+       &tls.client_ca_certificates}};
   for (const PemFlag& pem : pem_flags) {
     NM_ASSIGN_OR_RETURN(*pem.contents, ReadFlagFile(pem.flag, pem.path));
   }
+  return tls;
+}
+
+absl::StatusOr<neuralmesh::server::ServerSecurity> SecurityFromFlags() {
+  neuralmesh::server::ServerSecurity security;
+  NM_ASSIGN_OR_RETURN(security.tls, TlsFromFlags());
   if (!absl::GetFlag(FLAGS_access_tokens_file).empty()) {
     NM_ASSIGN_OR_RETURN(security.access_tokens, AccessTokensFromFlag());
   }
   return security;
 }
 
-// On SIGHUP: the tokens of --access_tokens_file replace the server's, or, when the file is
-// now wrong, the old ones stay and the reason is printed.
-void ReloadAccessTokens(neuralmesh::server::ReconstructionServer& server) {
-  if (absl::GetFlag(FLAGS_access_tokens_file).empty()) {
-    std::printf("neuralmesh-server: SIGHUP received; no --access_tokens_file to read again\n");
-    return;
+// On SIGHUP: the files of --tls_cert_file, --tls_key_file and --tls_client_ca_file, and of
+// --access_tokens_file, replace what the server has; what is now wrong leaves the old in place,
+// and the reason is printed.
+void ReloadSecurity(neuralmesh::server::ReconstructionServer& server) {
+  const bool tls = !absl::GetFlag(FLAGS_tls_cert_file).empty();
+  const bool tokens_file = !absl::GetFlag(FLAGS_access_tokens_file).empty();
+  if (!tls && !tokens_file) {
+    std::printf("neuralmesh-server: SIGHUP received; no TLS or access tokens files to read "
+                "again\n");
   }
-  absl::StatusOr<std::vector<neuralmesh::server::AccessToken>> tokens = AccessTokensFromFlag();
-  absl::Status replaced = tokens.ok() ? server.ReplaceAccessTokens(*tokens) : tokens.status();
-  if (replaced.ok()) {
-    std::printf("neuralmesh-server: SIGHUP received; %zu access tokens read again\n",
-                tokens->size());
-  } else {
-    std::fprintf(stderr, "neuralmesh-server: SIGHUP received; the old access tokens stay: %s\n",
-                 std::string(replaced.message()).c_str());
+  if (tls) {
+    absl::StatusOr<neuralmesh::server::ServerTls> identity = TlsFromFlags();
+    const absl::Status replaced = identity.ok() ? server.ReplaceTls(*identity) : identity.status();
+    if (replaced.ok()) {
+      std::printf("neuralmesh-server: SIGHUP received; TLS certificate and key read again (new "
+                  "connections within a second)\n");
+    } else {
+      std::fprintf(stderr,
+                   "neuralmesh-server: SIGHUP received; the old TLS certificate stays: %s\n",
+                   std::string(replaced.message()).c_str());
+    }
   }
+  if (tokens_file) {
+    absl::StatusOr<std::vector<neuralmesh::server::AccessToken>> tokens = AccessTokensFromFlag();
+    const absl::Status replaced =
+        tokens.ok() ? server.ReplaceAccessTokens(*tokens) : tokens.status();
+    if (replaced.ok()) {
+      std::printf("neuralmesh-server: SIGHUP received; %zu access tokens read again\n",
+                  tokens->size());
+    } else {
+      std::fprintf(stderr,
+                   "neuralmesh-server: SIGHUP received; the old access tokens stay: %s\n",
+                   std::string(replaced.message()).c_str());
+    }
+  }
+  std::fflush(stdout);
 }
 
 }  // namespace
@@ -225,7 +254,7 @@ int main(int argc, char** argv) {
 
   int signal_number = 0;
   while (sigwait(&signals, &signal_number) == 0 && signal_number == SIGHUP) {
-    ReloadAccessTokens(**server);
+    ReloadSecurity(**server);
     std::fflush(stdout);
   }
   std::printf("neuralmesh-server: %s received, shutting down\n",

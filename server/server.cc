@@ -53,6 +53,7 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
 
   std::unique_ptr<ReconstructionServer> server(new ReconstructionServer(options));
   server->token_checker_ = credentials->token_checker;
+  server->tls_identity_ = credentials->tls_identity;
   server->pool_ = std::make_unique<WorkerPool>(options.worker_threads, options.time_slice);
   server->encoder_ = std::make_unique<Executor>(options.encoder_threads);
   server->filter_ = std::make_unique<Executor>(options.filter_threads);
@@ -87,12 +88,8 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   server->server_ = builder.BuildAndStart();
   if (server->server_ == nullptr || (!options.address.empty() && server->port_ == 0)) {
     server->server_.reset();
-    return absl::UnavailableError(absl::StrCat(
-        "cannot listen on \"", options.address, "\" (",
-        options.security.tls.enabled()
-            ? "in use, not local, or gRPC rejected the TLS certificate or key: are both PEM, "
-              "and is the key the certificate's?)"
-            : "in use or not local?)"));
+    return absl::UnavailableError(
+        absl::StrCat("cannot listen on \"", options.address, "\" (in use or not local?)"));
   }
   grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
   if (health != nullptr) {
@@ -125,6 +122,14 @@ absl::Status ReconstructionServer::ReplaceAccessTokens(std::vector<AccessToken> 
         "the server was started without access tokens; tokens cannot be added to it running");
   }
   return token_checker_->ReplaceTokens(std::move(tokens));
+}
+
+absl::Status ReconstructionServer::ReplaceTls(const ServerTls& tls) {
+  if (tls_identity_ == nullptr) {
+    return absl::FailedPreconditionError(
+        "the server was started without TLS; TLS cannot be turned on while it runs");
+  }
+  return tls_identity_->Replace(tls);
 }
 
 void ReconstructionServer::Shutdown(absl::Duration grace) {

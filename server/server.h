@@ -72,6 +72,13 @@ class ReconstructionServer {
   // INVALID_ARGUMENT (the old tokens kept) for an empty list, an invalid token or client name.
   absl::Status ReplaceAccessTokens(std::vector<AccessToken> tokens);
 
+  // Replaces the server's TLS certificate, key and client CAs for the connections that start
+  // about a second from now (ServerTlsIdentity::Replace); connections and calls already
+  // running go on. FAILED_PRECONDITION when the server was started without TLS,
+  // INVALID_ARGUMENT (the old identity kept) when gRPC does not take the new one or it would
+  // turn mutual TLS on or off.
+  absl::Status ReplaceTls(const ServerTls& tls);
+
   SessionManager& sessions() { return *manager_; }
   ReactorRegistry& reactors() { return *reactors_; }
 
@@ -86,6 +93,7 @@ class ReconstructionServer {
   std::unique_ptr<SessionManager> manager_;
   std::unique_ptr<ReconstructionService> service_;
   std::shared_ptr<AccessTokenChecker> token_checker_;  // Null without access tokens.
+  std::shared_ptr<ServerTlsIdentity> tls_identity_;    // Null without TLS; outlives server_.
   std::unique_ptr<grpc::Server> server_;  // Destroyed first.
   int port_ = 0;
 

@@ -11,19 +11,9 @@
 
 #include "absl/status/statusor.h"
 #include "server/access_tokens.h"
+#include "server/tls_identity.h"
 
 namespace neuralmesh::server {
-
-// PEM text (the contents of the files, not their paths). All empty: plaintext.
-struct ServerTls {
-  std::string certificate_chain;  // The server's certificate, then any intermediates.
-  std::string private_key;        // The certificate's key.
-  // Set: mutual TLS. Clients must present a certificate signed by one of these CAs, or the
-  // handshake fails.
-  std::string client_ca_certificates;
-
-  bool enabled() const { return !certificate_chain.empty(); }
-};
 
 struct ServerSecurity {
   ServerTls tls;
@@ -34,11 +24,13 @@ struct ServerSecurity {
 struct PortCredentials {
   std::shared_ptr<grpc::ServerCredentials> credentials;
   std::shared_ptr<AccessTokenChecker> token_checker;  // Null without access tokens.
+  // Null for plaintext. `credentials` must not outlive it.
+  std::shared_ptr<ServerTlsIdentity> tls_identity;
 };
 
 // The credentials of the listening port. INVALID_ARGUMENT when the parts do not go together
-// (a key without a certificate, a client CA or tokens without TLS, a bad token) or a PEM text
-// does not look like one. gRPC itself parses the certificate and key when the port is bound.
+// (a key without a certificate, a client CA or tokens without TLS, a bad token), or gRPC does
+// not take the certificate and key (CheckServerTls).
 absl::StatusOr<PortCredentials> MakeServerCredentials(const ServerSecurity& security);
 
 }  // namespace neuralmesh::server

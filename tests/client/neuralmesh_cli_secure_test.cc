@@ -189,6 +189,55 @@ TEST_F(SecureCliTest, TheViewerReachesASecuredServer) {
   EXPECT_THAT(refused.err, HasSubstr("not one this server accepts")) << "said at start";
 }
 
+// A renewed certificate written over the server's files applies after SIGHUP, without a
+// restart; files that went wrong keep the certificate the server has.
+TEST_F(SecureCliTest, SighupRenewsTheCertificate) {
+  absl::StatusOr<TestCertificates> renewed = MakeTestCertificates(Path("renewed"));
+  ASSERT_TRUE(renewed.ok()) << renewed.status();
+  const std::string cert = Path("live_server.pem");
+  const std::string key = Path("live_server.key");
+  ASSERT_TRUE(WriteFileContents(cert, certs().server_chain).ok());
+  ASSERT_TRUE(WriteFileContents(key, certs().server_key).ok());
+  std::string error;
+  std::unique_ptr<TestServer> server =
+      TestServer::Start({"--tls_cert_file=" + cert, "--tls_key_file=" + key}, &error);
+  ASSERT_NE(server, nullptr) << error;
+  auto sessions_trusting = [&](const std::string& ca) {
+    return RunNeuralmesh(
+        {"sessions", "--server=" + server->address(), "--tls_ca_file=" + ca, "--connect_timeout=2s"});
+  };
+  EXPECT_EQ(sessions_trusting(certs().Path("ca.pem")).exit_code, 0);
+
+  ASSERT_TRUE(WriteFileContents(cert, renewed->server_chain).ok());
+  ASSERT_TRUE(WriteFileContents(key, renewed->server_key).ok());
+  server->Signal(SIGHUP);
+  for (int i = 0; i < 100 && !absl::StrContains(server->Stdout(), "TLS certificate and key read"); ++i) {
+    usleep(50 * 1000);
+  }
+  EXPECT_THAT(server->Stdout(), HasSubstr("SIGHUP received; TLS certificate and key read again"));
+  RunResult renewed_sessions;
+  for (int i = 0; i < 20; ++i) {  // gRPC takes the new identity within a second.
+    renewed_sessions = sessions_trusting(renewed->Path("ca.pem"));
+    if (renewed_sessions.exit_code == 0) break;
+    usleep(250 * 1000);
+  }
+  EXPECT_EQ(renewed_sessions.exit_code, 0) << renewed_sessions.Describe();
+  const RunResult stale = sessions_trusting(certs().Path("ca.pem"));
+  EXPECT_NE(stale.exit_code, 0);
+  EXPECT_THAT(stale.err, HasSubstr("certificate verify failed")) << stale.Describe();
+
+  // The old CA's key with the renewed certificate: refused, the renewed identity stays.
+  ASSERT_TRUE(WriteFileContents(key, certs().server_key).ok());
+  server->Signal(SIGHUP);
+  for (int i = 0; i < 100 && !absl::StrContains(server->Stderr(), "stays"); ++i) {
+    usleep(50 * 1000);
+  }
+  EXPECT_THAT(server->Stderr(), HasSubstr("the old TLS certificate stays: gRPC rejected the TLS "
+                                          "certificate or key"));
+  usleep(1500 * 1000);  // Past gRPC's next read of its copies.
+  EXPECT_EQ(sessions_trusting(renewed->Path("ca.pem")).exit_code, 0);
+}
+
 TEST_F(SecureCliTest, SighupReadsTheTokensFileAgain) {
   const std::string tokens = Path("reloaded_tokens");
   ASSERT_TRUE(WriteFileContents(tokens, absl::StrCat(kToken, "\n")).ok());
@@ -212,7 +261,8 @@ TEST_F(SecureCliTest, SighupReadsTheTokensFileAgain) {
   // The file now holds the other token: after SIGHUP it is the one accepted.
   ASSERT_TRUE(WriteFileContents(tokens, ReadWholeFile(Path("wrong_token"))).ok());
   server->Signal(SIGHUP);
-  for (int i = 0; i < 100 && !absl::StrContains(server->Stdout(), "read again"); ++i) {
+  for (int i = 0; i < 100 && !absl::StrContains(server->Stdout(), "access tokens read again");
+       ++i) {
     usleep(50 * 1000);
   }
   EXPECT_THAT(server->Stdout(), HasSubstr("SIGHUP received; 1 access tokens read again"));

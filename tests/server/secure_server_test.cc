@@ -34,13 +34,21 @@ class SecureServerTest : public ::testing::Test {
         neuralmesh::testing::MakeTestCertificates(neuralmesh::testing::MakeTempDir("tls"));
     ASSERT_TRUE(made.ok()) << made.status();
     certificates_ = new neuralmesh::testing::TestCertificates(*std::move(made));
+    absl::StatusOr<neuralmesh::testing::TestCertificates> renewed =
+        neuralmesh::testing::MakeTestCertificates(neuralmesh::testing::MakeTempDir("renewed"));
+    ASSERT_TRUE(renewed.ok()) << renewed.status();
+    renewed_ = new neuralmesh::testing::TestCertificates(*std::move(renewed));
   }
   static void TearDownTestSuite() {
     delete certificates_;
     certificates_ = nullptr;
+    delete renewed_;
+    renewed_ = nullptr;
   }
 
   static const neuralmesh::testing::TestCertificates& certs() { return *certificates_; }
+  // Another CA's set, as after a renewal.
+  static const neuralmesh::testing::TestCertificates& renewed() { return *renewed_; }
 
   static ServerSecurity Tls() {
     ServerSecurity security;
@@ -85,11 +93,25 @@ class SecureServerTest : public ::testing::Test {
     return service.ListSessions(&context, v1::ListSessionsRequest(), &response);
   }
 
+  // Waits up to 10 s (gRPC reads a replaced identity within a second) for `service` to
+  // answer with `code`; returns the last status.
+  static grpc::Status AwaitList(v1::ReconstructionService::Stub& service, grpc::StatusCode code) {
+    grpc::Status status;
+    for (int i = 0; i < 50; ++i) {
+      status = List(service);
+      if (status.error_code() == code) break;
+      absl::SleepFor(absl::Milliseconds(200));
+    }
+    return status;
+  }
+
  private:
   static neuralmesh::testing::TestCertificates* certificates_;
+  static neuralmesh::testing::TestCertificates* renewed_;
 };
 
 neuralmesh::testing::TestCertificates* SecureServerTest::certificates_ = nullptr;
+neuralmesh::testing::TestCertificates* SecureServerTest::renewed_ = nullptr;
 
 TEST_F(SecureServerTest, TlsClientReconstructsATorus) {
   std::unique_ptr<ReconstructionServer> server = Start(Tls());
@@ -310,7 +332,7 @@ TEST_F(SecureServerTest, StartRejectsSecurityThatDoesNotGoTogether) {
        "without its private key"},
       {"not PEM", not_pem, absl::StatusCode::kInvalidArgument, "not PEM"},
       {"a short token", short_token, absl::StatusCode::kInvalidArgument, "at least 16"},
-      {"another certificate's key", wrong_key, absl::StatusCode::kUnavailable,
+      {"another certificate's key", wrong_key, absl::StatusCode::kInvalidArgument,
        "rejected the TLS certificate or key"},
   };
   for (const Case& c : cases) {
@@ -323,6 +345,96 @@ TEST_F(SecureServerTest, StartRejectsSecurityThatDoesNotGoTogether) {
     EXPECT_TRUE(absl::StrContains(server.status().message(), c.message))
         << c.what << ": " << server.status();
   }
+}
+
+// A renewed certificate applies to new connections while the server runs: a session opened
+// under the old one goes on to its final mesh over its open connection.
+TEST_F(SecureServerTest, ARenewedCertificateAppliesToNewConnectionsWithoutARestart) {
+  std::unique_ptr<ReconstructionServer> server = Start(Tls());
+  ASSERT_NE(server, nullptr);
+  auto before = Service(*server, TlsTrusting(certs().ca));
+  const std::string id = testing::MustCreate(*before, testing::CreateRequest(500));
+  ASSERT_FALSE(id.empty());
+  v1::UploadPointsResponse uploaded;
+  ASSERT_TRUE(testing::Upload(*before, id, testing::SpherePoints(5000, 3), 2, &uploaded).ok());
+
+  ServerTls renewal;
+  renewal.certificate_chain = renewed().server_chain;
+  renewal.private_key = renewed().server_key;
+  ASSERT_TRUE(server->ReplaceTls(renewal).ok());
+  auto after = Service(*server, TlsTrusting(renewed().ca));
+  const grpc::Status renewed_listed = AwaitList(*after, grpc::StatusCode::OK);
+  EXPECT_TRUE(renewed_listed.ok()) << renewed_listed.error_message();
+  auto stale = Service(*server, TlsTrusting(certs().ca));
+  const grpc::Status stale_listed = List(*stale);
+  EXPECT_EQ(stale_listed.error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_TRUE(absl::StrContains(stale_listed.error_message(), "certificate verify failed"))
+      << stale_listed.error_message();
+
+  // The connection made before the renewal still carries calls.
+  ASSERT_TRUE(testing::Finish(*before, id).ok());
+  v1::MeshUpdate final_mesh;
+  const grpc::Status waited = testing::WaitFinal(*before, id, &final_mesh);
+  ASSERT_TRUE(waited.ok()) << waited.error_message();
+  EXPECT_EQ(final_mesh.vertex_count(), 500u);
+}
+
+TEST_F(SecureServerTest, AReplacementThatGrpcWouldNotTakeKeepsTheOldIdentity) {
+  std::unique_ptr<ReconstructionServer> server = Start(Tls());
+  ASSERT_NE(server, nullptr);
+  ServerTls wrong_key;
+  wrong_key.certificate_chain = renewed().server_chain;
+  wrong_key.private_key = certs().server_key;
+  ServerTls not_pem = wrong_key;
+  not_pem.private_key = "MIIE...";
+  ServerTls mutual;
+  mutual.certificate_chain = renewed().server_chain;
+  mutual.private_key = renewed().server_key;
+  mutual.client_ca_certificates = renewed().ca;
+  struct Case {
+    const char* what;
+    const ServerTls& tls;
+    const char* message;
+  };
+  for (const Case& c : {Case{"another certificate's key", wrong_key, "rejected the TLS"},
+                        Case{"not PEM", not_pem, "not PEM"},
+                        Case{"mutual TLS turned on", mutual, "takes a restart"}}) {
+    const absl::Status replaced = server->ReplaceTls(c.tls);
+    EXPECT_TRUE(absl::IsInvalidArgument(replaced)) << c.what << ": " << replaced;
+    EXPECT_TRUE(absl::StrContains(replaced.message(), c.message)) << c.what << ": " << replaced;
+  }
+  absl::SleepFor(absl::Milliseconds(2500));  // Past two of gRPC's reads of the identity.
+  auto service = Service(*server, TlsTrusting(certs().ca));
+  const grpc::Status listed = List(*service);
+  EXPECT_TRUE(listed.ok()) << "the old certificate is still presented: " << listed.error_message();
+
+  std::unique_ptr<ReconstructionServer> plaintext = Start(ServerSecurity());
+  ASSERT_NE(plaintext, nullptr);
+  EXPECT_TRUE(absl::IsFailedPrecondition(plaintext->ReplaceTls(wrong_key)));
+}
+
+// Under mutual TLS the client CAs are renewed with the certificate.
+TEST_F(SecureServerTest, MutualTlsRenewsTheClientCasToo) {
+  ServerSecurity security = Tls();
+  security.tls.client_ca_certificates = certs().ca;
+  std::unique_ptr<ReconstructionServer> server = Start(security);
+  ASSERT_NE(server, nullptr);
+  ServerTls renewal;
+  renewal.certificate_chain = renewed().server_chain;
+  renewal.private_key = renewed().server_key;
+  renewal.client_ca_certificates = renewed().ca;
+  ASSERT_TRUE(server->ReplaceTls(renewal).ok());
+  auto known = Service(*server, TlsTrusting(renewed().ca, renewed().client_chain,
+                                            renewed().client_key));
+  const grpc::Status listed = AwaitList(*known, grpc::StatusCode::OK);
+  EXPECT_TRUE(listed.ok()) << listed.error_message();
+  auto former = Service(*server, TlsTrusting(renewed().ca, certs().client_chain,
+                                             certs().client_key));
+  EXPECT_EQ(List(*former).error_code(), grpc::StatusCode::UNAVAILABLE)
+      << "a client certificate of the former CA";
+  ServerTls without_client_cas = renewal;
+  without_client_cas.client_ca_certificates.clear();
+  EXPECT_TRUE(absl::IsInvalidArgument(server->ReplaceTls(without_client_cas)));
 }
 
 }  // namespace

@@ -15,7 +15,8 @@
 #   7. runs it again secured, with TLS and an access token from a read-only mount (throw-away
 #      certificates made with openssl): plaintext and token-less calls are refused, a client
 #      with the CA and the token reconstructs a torus, and after `podman kill -s HUP` with a
-#      new tokens file only the new token is accepted.
+#      new tokens file and a certificate from another CA copied over the old ones, only the new
+#      token and the new certificate are accepted.
 # The containers are always removed at the end. The Dockerfile itself stays standard: every
 # podman adjustment (containers.conf, chroot isolation, the imported base image) lives here.
 #
@@ -320,6 +321,14 @@ mkdir -p "${SECRETS}"
   printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\n' >server.ext
   openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial -days 1 \
     -extfile server.ext -out server.pem
+  # The renewal, from another CA, kept beside the mount until it is copied over.
+  mkdir -p ../renewed
+  openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 1 \
+    -subj /CN=neuralmesh-container-test-ca-2 -keyout ../renewed/ca.key -out ../renewed/ca.pem
+  openssl req -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes \
+    -subj /CN=neuralmesh-container-test -keyout ../renewed/server.key -out ../renewed/server.csr
+  openssl x509 -req -in ../renewed/server.csr -CA ../renewed/ca.pem -CAkey ../renewed/ca.key \
+    -CAcreateserial -days 1 -extfile server.ext -out ../renewed/server.pem
 ) >"${OUT_DIR}/openssl.log" 2>&1 || fail "openssl (see ${OUT_DIR}/openssl.log)"
 "${PYTHON}" -c 'import secrets; print(secrets.token_hex(24))' >"${WORK_DIR}/token"
 "${PYTHON}" -c 'import secrets; print(secrets.token_hex(24))' >"${WORK_DIR}/new_token"
@@ -361,8 +370,10 @@ timeout 600 "${CLI}" reconstruct builtin:torus "${secured[@]}" --access_token_fi
 [[ -s "${MESH_DIR}/secured/torus.drc" ]] || fail "no final mesh over TLS"
 say "Final mesh over TLS: $(tail -n 1 "${OUT_DIR}/reconstruct-secured.out")"
 
-step "Replacing the token and sending SIGHUP"
+step "Replacing the token and the certificate and sending SIGHUP"
 cp "${WORK_DIR}/new_token" "${SECRETS}/tokens.txt"
+cp "${WORK_DIR}/renewed/server.pem" "${WORK_DIR}/renewed/server.key" "${SECRETS}/"
+chmod 644 "${SECRETS}"/*
 podman kill -s HUP "${CONTAINER}" >/dev/null || fail "podman kill -s HUP"
 for _ in $(seq 1 50); do
   podman logs "${CONTAINER}" 2>&1 | grep -q 'access tokens read again' && break
@@ -370,12 +381,18 @@ for _ in $(seq 1 50); do
 done
 podman logs "${CONTAINER}" 2>&1 | grep -q '1 access tokens read again' \
   || fail "the server did not say it read the tokens again"
+podman logs "${CONTAINER}" 2>&1 | grep -q 'TLS certificate and key read again' \
+  || fail "the server did not say it read the certificate again"
+sleep 2  # gRPC takes the new certificate within a second.
+expect_refused "certificate verify failed" sessions "${secured[@]}" --access_token_file \
+  "${WORK_DIR}/new_token"
+secured=(--server "${ADDRESS}" --tls_ca_file "${WORK_DIR}/renewed/ca.pem")
 expect_refused "not one this server accepts" sessions "${secured[@]}" --access_token_file \
   "${WORK_DIR}/token"
 "${CLI}" sessions "${secured[@]}" --access_token_file "${WORK_DIR}/new_token" \
   >"${OUT_DIR}/sessions-secured.out" 2>&1 || fail "the new token: $(cat "${OUT_DIR}/sessions-secured.out")"
 grep -q finished "${OUT_DIR}/sessions-secured.out" || fail "the secured session is not listed"
-say "The old token is refused and the new one accepted after SIGHUP"
+say "The old token and certificate are refused, the new ones accepted after SIGHUP"
 podman stop --time 30 "${CONTAINER}" >/dev/null || fail "podman stop"
 podman logs "${CONTAINER}" >"${OUT_DIR}/server-secured.log" 2>&1
 podman rm "${CONTAINER}" >/dev/null

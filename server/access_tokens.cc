@@ -48,6 +48,14 @@ absl::string_view AccessRoleName(AccessRole role) {
   return "admin";
 }
 
+absl::StatusOr<AccessRole> ParseAccessRole(absl::string_view name) {
+  for (const AccessRole role : {AccessRole::kAdmin, AccessRole::kUser, AccessRole::kReader}) {
+    if (name == AccessRoleName(role)) return role;
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("unknown role \"", absl::CHexEscape(name), "\" (admin, user or reader)"));
+}
+
 absl::Status ValidateClient(const AccessToken& token) {
   if (token.client.empty()) {
     if (token.role == AccessRole::kAdmin) return absl::OkStatus();
@@ -98,17 +106,9 @@ absl::StatusOr<std::vector<AccessToken>> ParseAccessTokens(absl::string_view tex
       token.role = AccessRole::kUser;
     }
     if (fields.size() == 3) {
-      bool known = false;
-      for (const AccessRole role : {AccessRole::kAdmin, AccessRole::kUser, AccessRole::kReader}) {
-        if (fields[2] == AccessRoleName(role)) {
-          token.role = role;
-          known = true;
-        }
-      }
-      if (!known) {
-        return bad_line(absl::StrCat("unknown role \"", absl::CHexEscape(fields[2]),
-                                     "\" (admin, user or reader)"));
-      }
+      absl::StatusOr<AccessRole> role = ParseAccessRole(fields[2]);
+      if (!role.ok()) return bad_line(role.status().message());
+      token.role = *role;
     }
     if (absl::Status valid = ValidateClient(token); !valid.ok()) return bad_line(valid.message());
     tokens.push_back(std::move(token));

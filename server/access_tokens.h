@@ -47,6 +47,8 @@ enum class AccessRole {
 
 // "admin", "user", "reader".
 absl::string_view AccessRoleName(AccessRole role);
+// The role of that name; INVALID_ARGUMENT for another name.
+absl::StatusOr<AccessRole> ParseAccessRole(absl::string_view name);
 
 // The AuthContext properties of a call whose token was accepted: the token's client name
 // (empty for an unnamed token) and AccessRoleName of its role.

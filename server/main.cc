@@ -57,6 +57,11 @@ ABSL_FLAG(std::string, tls_key_file, "", "PEM file with the private key of --tls
 ABSL_FLAG(std::string, tls_client_ca_file, "",
           "PEM file with the CAs that sign client certificates; set: mutual TLS, every client "
           "must present a certificate signed by one of them. Needs --tls_cert_file.");
+ABSL_FLAG(std::string, client_certificate_role, "",
+          "With --tls_client_ca_file and without --access_tokens_file: admin, user or reader. "
+          "The common name of a client's certificate names its client, which has this role "
+          "(as a named token's, see --access_tokens_file): with user, each client sees and "
+          "changes only the sessions it created. Empty: every client may do everything.");
 ABSL_FLAG(std::string, access_tokens_file, "",
           "File of access tokens, one per line as 'TOKEN [CLIENT [ROLE]]' ('#' starts a "
           "comment line; a token has at least 16 printable characters); set: every call except "
@@ -121,6 +126,15 @@ absl::StatusOr<neuralmesh::server::ServerSecurity> SecurityFromFlags() {
   NM_ASSIGN_OR_RETURN(security.tls, TlsFromFlags());
   if (!absl::GetFlag(FLAGS_access_tokens_file).empty()) {
     NM_ASSIGN_OR_RETURN(security.access_tokens, AccessTokensFromFlag());
+  }
+  if (const std::string role = absl::GetFlag(FLAGS_client_certificate_role); !role.empty()) {
+    absl::StatusOr<neuralmesh::server::AccessRole> parsed =
+        neuralmesh::server::ParseAccessRole(role);
+    if (!parsed.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--client_certificate_role: ", parsed.status().message()));
+    }
+    security.client_certificate_role = *parsed;
   }
   return security;
 }
@@ -248,7 +262,13 @@ int main(int argc, char** argv) {
               : secured.tls.client_ca_certificates.empty()      ? "TLS"
                                                                 : "mutual TLS",
               secured.access_tokens.empty()
-                  ? ""
+                  ? (secured.client_certificate_role.has_value()
+                         ? absl::StrCat(", clients named by their certificates as ",
+                                        neuralmesh::server::AccessRoleName(
+                                            *secured.client_certificate_role),
+                                        "s")
+                         : std::string())
+                        .c_str()
                   : absl::StrCat(", ", secured.access_tokens.size(), " access tokens").c_str());
   std::fflush(stdout);
 

@@ -10,11 +10,11 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/synchronization/mutex.h"
+#include "core/status_macros.h"
 #include "server/grpc_status.h"
 #include "server/latest_wins_writer.h"
 #include "server/off_thread_work.h"
 #include "server/proto_conversion.h"
-#include "core/status_macros.h"
 #include "server/session_access.h"
 #include "server/update_channel.h"
 

@@ -5,6 +5,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "server/access_tokens.h"
+#include "server/client_certificate_identity.h"
 
 namespace neuralmesh::server {
 
@@ -21,6 +22,18 @@ absl::StatusOr<PortCredentials> MakeServerCredentials(const ServerSecurity& secu
     }
     return PortCredentials{grpc::InsecureServerCredentials(), nullptr, nullptr};
   }
+  if (security.client_certificate_role.has_value()) {
+    if (tls.client_ca_certificates.empty()) {
+      return absl::InvalidArgumentError(
+          "a client certificate role needs mutual TLS (client CAs): without it clients present "
+          "no certificate");
+    }
+    if (!security.access_tokens.empty()) {
+      return absl::InvalidArgumentError(
+          "a client certificate role and access tokens do not go together: with tokens, each "
+          "token names its client and role");
+    }
+  }
   absl::StatusOr<std::unique_ptr<ServerTlsIdentity>> identity = ServerTlsIdentity::Create(tls);
   if (!identity.ok()) return identity.status();
   PortCredentials port;
@@ -32,6 +45,9 @@ absl::StatusOr<PortCredentials> MakeServerCredentials(const ServerSecurity& secu
     if (!checker.ok()) return checker.status();
     port.token_checker = *std::move(checker);
     port.credentials->SetAuthMetadataProcessor(port.token_checker);
+  } else if (security.client_certificate_role.has_value()) {
+    port.credentials->SetAuthMetadataProcessor(
+        std::make_shared<ClientCertificateIdentity>(*security.client_certificate_role));
   }
   return port;
 }

@@ -6,6 +6,7 @@
 #include <grpcpp/security/server_credentials.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@ struct ServerSecurity {
   ServerTls tls;
   // Set: every call but the health service's must carry one of these tokens (needs TLS).
   std::vector<AccessToken> access_tokens;
+  // Set, under mutual TLS without tokens: the common name of a client's certificate names its
+  // client, with this role (client_certificate_identity.h). Unset: every client is an admin.
+  std::optional<AccessRole> client_certificate_role;
 };
 
 struct PortCredentials {

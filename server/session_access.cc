@@ -12,10 +12,8 @@ std::string Only(const grpc::AuthContext& context, const char* property) {
   return values.empty() ? "" : std::string(values.front().data(), values.front().size());
 }
 
-// Only admin tokens may be unnamed (access_tokens.h), so a refused caller has a name.
-std::string TokenOf(const Caller& caller) {
-  return absl::StrCat("the token of client ", caller.client);
-}
+// Only admins may be unnamed (access_tokens.h), so a refused caller has a name.
+std::string Named(const Caller& caller) { return absl::StrCat("client ", caller.client); }
 
 }  // namespace
 
@@ -33,8 +31,8 @@ Caller CallerOf(const grpc::ServerContextBase& context) {
 absl::Status CheckMayCreate(const Caller& caller) {
   if (caller.role != AccessRole::kReader) return absl::OkStatus();
   return absl::PermissionDeniedError(
-      absl::StrCat(TokenOf(caller),
-                   " is a reader's: it may list, get and watch sessions but not create one"));
+      absl::StrCat(Named(caller),
+                   " is a reader: it may list, get and watch sessions but not create one"));
 }
 
 absl::Status CheckMayUse(const Caller& caller, const Session& session, SessionUse use) {
@@ -44,13 +42,13 @@ absl::Status CheckMayUse(const Caller& caller, const Session& session, SessionUs
     case AccessRole::kReader:
       if (use == SessionUse::kSee) return absl::OkStatus();
       return absl::PermissionDeniedError(
-          absl::StrCat(TokenOf(caller), " is a reader's: it may not upload into, finish, "
+          absl::StrCat(Named(caller), " is a reader: it may not upload into, finish, "
                        "cancel or delete session ", session.id()));
     case AccessRole::kUser:
       if (session.owner() == caller.client) return absl::OkStatus();
       return absl::PermissionDeniedError(
-          absl::StrCat("session ", session.id(), " belongs to another client; ", TokenOf(caller),
-                       " may use only the sessions ", caller.client, " created"));
+          absl::StrCat("session ", session.id(), " belongs to another client; ", Named(caller),
+                       " may use only the sessions it created"));
   }
   return absl::OkStatus();
 }

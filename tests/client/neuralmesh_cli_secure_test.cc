@@ -139,7 +139,7 @@ TEST_F(SecureCliTest, NamedTokensOwnTheirSessionsAndAReaderOnlyLooks) {
   const RunResult refused = as("wall_token", {"reconstruct", "builtin:sphere", "--out-dir",
                                               Path("refused"), "--vertices", "100"});
   EXPECT_NE(refused.exit_code, 0) << refused.Describe();
-  EXPECT_THAT(refused.err, HasSubstr("the token of client wall is a reader's")) << refused.err;
+  EXPECT_THAT(refused.err, HasSubstr("client wall is a reader")) << refused.err;
 }
 
 TEST_F(SecureCliTest, AMissingWrongOrUnprotectedTokenFailsClearly) {

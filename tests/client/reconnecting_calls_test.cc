@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <regex>
 #include <string>
@@ -98,6 +99,17 @@ class ReconnectingCallsTest : public ::testing::Test {
         cut();
       }
     };
+  }
+
+  // Cuts the connections and refuses new ones, as a server that went away; after `delay`, on a
+  // thread of its own, runs `then`.
+  std::thread CutAndRefuse(absl::Duration delay, std::function<void()> then) {
+    proxy_->SetRefusing(true);
+    proxy_->CutNow();
+    return std::thread([delay, then = std::move(then)] {
+      absl::SleepFor(delay);
+      then();
+    });
   }
 
   std::unique_ptr<ReconstructionServer> server_;
@@ -239,14 +251,7 @@ TEST_F(ReconnectingCallsTest, AServerThatComesBackLateStillGetsTheWholeUpload) {
   absl::StatusOr<v1::UploadPointsResponse> uploaded = UploadPointsReconnecting(
       *client_, id, cloud_, kBatch,
       At(20 * kBatch,
-         [&] {
-           proxy_->SetRefusing(true);
-           proxy_->CutNow();
-           back = std::thread([&] {
-             absl::SleepFor(absl::Seconds(2));
-             proxy_->SetRefusing(false);
-           });
-         }),
+         [&] { back = CutAndRefuse(absl::Seconds(2), [&] { proxy_->SetRefusing(false); }); }),
       0, notices.Options(absl::Seconds(30)));
   back.join();
   ASSERT_TRUE(uploaded.ok()) << uploaded.status() << "\n" << notices.text();
@@ -292,12 +297,7 @@ TEST_F(ReconnectingCallsTest, CancelCallsEndsAReconnectAtOnce) {
       *client_, id, cloud_, kBatch,
       At(20 * kBatch,
          [&] {
-           proxy_->SetRefusing(true);
-           proxy_->CutNow();
-           canceller = std::thread([&] {
-             absl::SleepFor(absl::Milliseconds(500));
-             client_->CancelCalls();
-           });
+           canceller = CutAndRefuse(absl::Milliseconds(500), [&] { client_->CancelCalls(); });
          }),
       0, notices.Options(absl::Seconds(60)));
   canceller.join();
@@ -313,15 +313,11 @@ TEST_F(ReconnectingCallsTest, AFinishIsAskedAgainUnlessTheSessionIsFinishingAlre
     SCOPED_TRACE(finished_meanwhile ? "finished meanwhile" : "not finished");
     const std::string id = CreateSession(400);
     ASSERT_TRUE(direct_->UploadPoints(id, cloud_, kBatch).ok());
-    proxy_->SetRefusing(true);
-    proxy_->CutNow();
+    std::thread back =
+        CutAndRefuse(absl::Milliseconds(500), [&] { proxy_->SetRefusing(false); });
     if (finished_meanwhile) {
-      ASSERT_TRUE(direct_->Finish(id).ok());
+      EXPECT_TRUE(direct_->Finish(id).ok());  // While the proxy refuses.
     }
-    std::thread back([&] {
-      absl::SleepFor(absl::Milliseconds(500));
-      proxy_->SetRefusing(false);
-    });
     Notices notices;
     absl::StatusOr<v1::Session> finished =
         FinishReconnecting(*client_, id, notices.Options(absl::Seconds(30)));

@@ -322,6 +322,12 @@ TEST_F(SecureServerTest, StartRejectsSecurityThatDoesNotGoTogether) {
   short_token.access_tokens = {"short"};
   ServerSecurity wrong_key = Tls();
   wrong_key.tls.private_key = certs().client_key;
+  ServerSecurity role_without_mutual_tls = Tls();
+  role_without_mutual_tls.client_certificate_role = AccessRole::kUser;
+  ServerSecurity role_and_tokens = Tls();
+  role_and_tokens.tls.client_ca_certificates = certs().ca;
+  role_and_tokens.access_tokens = {kToken};
+  role_and_tokens.client_certificate_role = AccessRole::kUser;
   const Case cases[] = {
       {"tokens without TLS", tokens_without_tls, absl::StatusCode::kInvalidArgument,
        "access tokens need TLS"},
@@ -334,6 +340,10 @@ TEST_F(SecureServerTest, StartRejectsSecurityThatDoesNotGoTogether) {
       {"a short token", short_token, absl::StatusCode::kInvalidArgument, "at least 16"},
       {"another certificate's key", wrong_key, absl::StatusCode::kInvalidArgument,
        "rejected the TLS certificate or key"},
+      {"a client certificate role without mutual TLS", role_without_mutual_tls,
+       absl::StatusCode::kInvalidArgument, "needs mutual TLS"},
+      {"a client certificate role and tokens", role_and_tokens,
+       absl::StatusCode::kInvalidArgument, "do not go together"},
   };
   for (const Case& c : cases) {
     ServerOptions options;

@@ -164,9 +164,8 @@ TEST_F(SessionAccessTest, AUserCanNeitherSeeNorChangeAnotherUsersSession) {
   for (const auto& [call, status] : Refusals(*bob_, a, /*see_too=*/true)) {
     EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED) << call;
     EXPECT_TRUE(absl::StrContains(
-        status.error_message(), absl::StrCat("session ", a, " belongs to another client; the "
-                                             "token of client bob may use only the sessions "
-                                             "bob created")))
+        status.error_message(), absl::StrCat("session ", a, " belongs to another client; client "
+                                             "bob may use only the sessions it created")))
         << call << ": " << status.error_message();
   }
   grpc::Status got;
@@ -182,8 +181,8 @@ TEST_F(SessionAccessTest, AReaderWatchesEverySessionButChangesNone) {
   const grpc::Status create = wall_->CreateSession(&context, CreateRequest(200), &created);
   EXPECT_EQ(create.error_code(), grpc::StatusCode::PERMISSION_DENIED);
   EXPECT_TRUE(absl::StrContains(create.error_message(),
-                                "the token of client wall is a reader's: it may list, get and "
-                                "watch sessions but not create one"))
+                                "client wall is a reader: it may list, get and watch sessions "
+                                "but not create one"))
       << create.error_message();
   {
     grpc::ClientContext reconstruct_context;
@@ -202,7 +201,7 @@ TEST_F(SessionAccessTest, AReaderWatchesEverySessionButChangesNone) {
   const std::string a = MustCreate(*alice_, CreateRequest(300));
   for (const auto& [call, status] : Refusals(*wall_, a, /*see_too=*/false)) {
     EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED) << call;
-    EXPECT_TRUE(absl::StrContains(status.error_message(), "is a reader's: it may not upload "))
+    EXPECT_TRUE(absl::StrContains(status.error_message(), "is a reader: it may not upload "))
         << call << ": " << status.error_message();
   }
   // Alice learns her sphere while the reader watches it to the end.
@@ -252,6 +251,54 @@ TEST_F(SessionAccessTest, AClientHoldsAtMostItsShareOfSessions) {
   MustCreate(*unnamed_, CreateRequest(200));  // Unnamed tokens have no share of their own.
   ASSERT_TRUE(testing::Delete(*alice_, first).ok());
   EXPECT_FALSE(MustCreate(*alice_, CreateRequest(200)).empty()) << "room again";
+}
+
+// Under mutual TLS without tokens, --client_certificate_role names clients by their
+// certificates' common names.
+TEST_F(SessionAccessTest, ClientCertificatesNameTheirClientsUnderMutualTls) {
+  const auto start = [](AccessRole role) {
+    ServerOptions options;
+    options.security.tls.certificate_chain = certificates_->server_chain;
+    options.security.tls.private_key = certificates_->server_key;
+    options.security.tls.client_ca_certificates = certificates_->ca;
+    options.security.client_certificate_role = role;
+    return testing::StartServer(/*listen=*/true, options);
+  };
+  const auto presenting = [](const ReconstructionServer& server, const std::string& chain,
+                             const std::string& key) {
+    grpc::SslCredentialsOptions tls;
+    tls.pem_root_certs = certificates_->ca;
+    tls.pem_cert_chain = chain;
+    tls.pem_private_key = key;
+    return v1::ReconstructionService::NewStub(
+        grpc::CreateChannel(server.target(), grpc::SslCredentials(tls)));
+  };
+  std::unique_ptr<ReconstructionServer> users = start(AccessRole::kUser);
+  ASSERT_NE(users, nullptr);
+  auto first = presenting(*users, certificates_->client_chain, certificates_->client_key);
+  auto second =
+      presenting(*users, certificates_->second_client_chain, certificates_->second_client_key);
+  const std::string id = MustCreate(*first, CreateRequest(200));
+  ASSERT_FALSE(id.empty());
+  EXPECT_EQ(testing::GetSession(*first, id).owner(), "neuralmesh-test-client");
+  EXPECT_EQ(Listed(*first), (std::set<std::string>{id}));
+  EXPECT_TRUE(Listed(*second).empty());
+  grpc::Status got;
+  testing::GetSession(*second, id, &got);
+  EXPECT_EQ(got.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_TRUE(absl::StrContains(got.error_message(), "belongs to another client"))
+      << got.error_message();
+
+  std::unique_ptr<ReconstructionServer> readers = start(AccessRole::kReader);
+  ASSERT_NE(readers, nullptr);
+  auto reader = presenting(*readers, certificates_->client_chain, certificates_->client_key);
+  grpc::ClientContext context;
+  v1::Session refused;
+  const grpc::Status create = reader->CreateSession(&context, CreateRequest(200), &refused);
+  EXPECT_EQ(create.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_TRUE(absl::StrContains(create.error_message(),
+                                "client neuralmesh-test-client is a reader"))
+      << create.error_message();
 }
 
 }  // namespace

@@ -51,6 +51,7 @@ absl::StatusOr<TestCertificates> MakeTestCertificates(const std::string& dir) {
         MakeSigned("server", "ca", "IP:127.0.0.1,DNS:localhost"),
         MakeSigned("named_server", "ca", "DNS:scans.example.test"),
         MakeSigned("client", "ca", "DNS:neuralmesh-test-client"),
+        MakeSigned("second_client", "ca", "DNS:neuralmesh-test-second_client"),
         MakeSigned("other_client", "other_ca", "DNS:neuralmesh-test-client")}) {
     if (absl::Status s = Run(dir, step); !s.ok()) return s;
   }
@@ -62,6 +63,8 @@ absl::StatusOr<TestCertificates> MakeTestCertificates(const std::string& dir) {
       {&certificates.server_key, "server.key"},
       {&certificates.client_chain, "client.pem"},
       {&certificates.client_key, "client.key"},
+      {&certificates.second_client_chain, "second_client.pem"},
+      {&certificates.second_client_key, "second_client.key"},
       {&certificates.other_ca, "other_ca.pem"},
       {&certificates.other_client_chain, "other_client.pem"},
       {&certificates.other_client_key, "other_client.key"},

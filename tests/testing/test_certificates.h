@@ -16,7 +16,10 @@ struct TestCertificates {
   std::string dir;
   std::string ca;                         // ca.pem: the CA that signs the others.
   std::string server_chain, server_key;   // server.pem, server.key: for 127.0.0.1, localhost.
-  std::string client_chain, client_key;   // client.pem, client.key: signed by the CA.
+  // client.pem, client.key: signed by the CA, common name neuralmesh-test-client.
+  std::string client_chain, client_key;
+  // second_client.pem, .key: signed by the CA, common name neuralmesh-test-second_client.
+  std::string second_client_chain, second_client_key;
   std::string other_ca;                   // other_ca.pem: an unrelated CA.
   std::string other_client_chain, other_client_key;  // other_client.*: signed by other_ca.
   // named_server.pem, .key: signed by the CA for the name scans.example.test only.

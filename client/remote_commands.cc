@@ -56,6 +56,11 @@ absl::Status ExplainWatchEnd(const absl::Status& status, const std::string& sess
     return absl::AbortedError(
         absl::StrCat("learning failed in session ", session_id, ": ", status.message()));
   }
+  if (absl::IsUnavailable(status)) {
+    return absl::UnavailableError(absl::StrCat(status.message(), "; once the server is back, ",
+                                               "neuralmesh watch ", session_id,
+                                               " saves the session's meshes"));
+  }
   return status;
 }
 

@@ -366,6 +366,37 @@ TEST(RemoteCliInterruptTest, AnInterruptEndsTheCommandEvenWhenTheServerIsFrozen)
   std::filesystem::remove_all(dir);
 }
 
+// A watch whose server goes away for longer than --reconnect_for ends, saying how to go on.
+TEST(RemoteCliWatchTest, AWatchWhoseServerStaysAwaySaysHowToGoOn) {
+  std::string error;
+  std::unique_ptr<TestServer> server = TestServer::Start({}, &error);
+  ASSERT_NE(server, nullptr) << error;
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
+      client::ReconstructionClient::Connect(server->address());
+  ASSERT_TRUE(service.ok()) << service.status();
+  client::v1::SessionConfig config;
+  config.set_target_vertices(100);
+  absl::StatusOr<client::v1::Session> session = (*service)->CreateSession(config, "waiting");
+  ASSERT_TRUE(session.ok()) << session.status();
+  const std::string dir = MakeTempDir("cli_watch_away");
+  BackgroundProcess watch("neuralmesh", {"watch", session->session_id(), "--server",
+                                         server->address(), "--out-dir", dir, "--reconnect_for",
+                                         "1s"});
+  usleep(500 * 1000);  // The watch is open on a session without points.
+  server->Signal(SIGKILL);
+  const absl::Time killed = absl::Now();
+  while (watch.Running() && absl::Now() - killed < absl::Seconds(30)) usleep(50 * 1000);
+  ASSERT_FALSE(watch.Running()) << "the watch did not give up: " << watch.Stderr();
+  EXPECT_NE(watch.exit_code(), 0);
+  const std::string err = watch.Stderr();
+  EXPECT_THAT(err, ::testing::HasSubstr("lost (WatchSession")) << err;
+  EXPECT_THAT(err, ::testing::HasSubstr("did not answer again within 1s")) << err;
+  EXPECT_THAT(err, ::testing::HasSubstr(absl::StrCat("neuralmesh watch ", session->session_id(),
+                                                     " saves the session's meshes")))
+      << err;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(RemoteCliUnreachableTest, AnUnreachableServerFailsClearly) {
   const std::string address = "127.0.0.1:" + std::to_string(PickFreePort());
   const std::string dir = MakeTempDir("cli_unreachable");

@@ -15,8 +15,8 @@
 #include "client/lod_plan.h"
 #include "client/mesh_update_writer.h"
 #include "client/progress_bar.h"
-#include "client/reconnecting_calls.h"
 #include "client/proto_conversion.h"
+#include "client/reconnecting_calls.h"
 #include "client/reconstruction_client.h"
 #include "client/session_json.h"
 #include "core/analysis/json_writer.h"
@@ -301,7 +301,7 @@ absl::Status RunSessions(const std::string& server, bool json, std::ostream& out
     out << text << "\n";
     return absl::OkStatus();
   }
-  // The owner column only on a server whose tokens name their clients.
+  // The owner column only on a server that names its clients (tokens, client certificates).
   const bool owners = std::any_of(sessions.begin(), sessions.end(),
                                   [](const v1::Session& s) { return !s.owner().empty(); });
   const auto owner_cell = [owners](absl::string_view owner) {

@@ -36,7 +36,7 @@ class ReconstructionServiceTest : public ::testing::Test {
     options.limits.max_sessions = 16;
     server_ = StartServer(/*listen=*/false, options);
     ASSERT_NE(server_, nullptr);
-    stub_ = InProcessService(*server_);
+    service_ = InProcessService(*server_);
   }
   void TearDown() override { server_->Shutdown(absl::Seconds(2)); }
 
@@ -50,13 +50,13 @@ class ReconstructionServiceTest : public ::testing::Test {
   grpc::Status UploadOne(const v1::UploadPointsRequest& request,
                          v1::UploadPointsResponse* response = nullptr) {
     v1::UploadPointsResponse ignored;
-    return testing::UploadOne(*stub_, request, response != nullptr ? response : &ignored);
+    return testing::UploadOne(*service_, request, response != nullptr ? response : &ignored);
   }
 
   // A Reconstruct call that has created a session of `target` vertices and sent `batch`.
   std::unique_ptr<grpc::ClientReaderWriter<v1::ReconstructRequest, v1::ReconstructResponse>>
   StartReconstruct(grpc::ClientContext& context, uint64_t target, const v1::PointBatch& batch) {
-    auto stream = stub_->Reconstruct(&context);
+    auto stream = service_->Reconstruct(&context);
     v1::ReconstructRequest start;
     *start.mutable_start()->mutable_create() = CreateRequest(target);
     EXPECT_TRUE(stream->Write(start));
@@ -67,14 +67,14 @@ class ReconstructionServiceTest : public ::testing::Test {
   }
 
   std::unique_ptr<ReconstructionServer> server_;
-  std::unique_ptr<v1::ReconstructionService::Stub> stub_;
+  std::unique_ptr<v1::ReconstructionService::Stub> service_;
 };
 
 TEST_F(ReconstructionServiceTest, CreateGetListAndDelete) {
-  const std::string id = MustCreate(*stub_, CreateRequest(500));
+  const std::string id = MustCreate(*service_, CreateRequest(500));
   ASSERT_FALSE(id.empty());
   grpc::Status status;
-  v1::Session session = testing::GetSession(*stub_, id, &status);
+  v1::Session session = testing::GetSession(*service_, id, &status);
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_EQ(session.state(), v1::SESSION_STATE_COLLECTING);
   EXPECT_EQ(session.name(), "test");
@@ -85,14 +85,14 @@ TEST_F(ReconstructionServiceTest, CreateGetListAndDelete) {
 
   grpc::ClientContext list_context;
   v1::ListSessionsResponse list;
-  ASSERT_TRUE(stub_->ListSessions(&list_context, v1::ListSessionsRequest(), &list).ok());
+  ASSERT_TRUE(service_->ListSessions(&list_context, v1::ListSessionsRequest(), &list).ok());
   ASSERT_EQ(list.sessions_size(), 1);
   EXPECT_EQ(list.sessions(0).session_id(), id);
 
-  ASSERT_TRUE(testing::Delete(*stub_, id).ok());
-  testing::GetSession(*stub_, id, &status);
+  ASSERT_TRUE(testing::Delete(*service_, id).ok());
+  testing::GetSession(*service_, id, &status);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
-  EXPECT_EQ(testing::Delete(*stub_, id).error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(testing::Delete(*service_, id).error_code(), grpc::StatusCode::NOT_FOUND);
 }
 
 TEST_F(ReconstructionServiceTest, InvalidOptionsAreInvalidArgumentNamingTheField) {
@@ -152,14 +152,14 @@ TEST_F(ReconstructionServiceTest, InvalidOptionsAreInvalidArgumentNamingTheField
   for (const Case& c : cases) {
     grpc::ClientContext context;
     v1::Session session;
-    grpc::Status status = stub_->CreateSession(&context, c.request, &session);
+    grpc::Status status = service_->CreateSession(&context, c.request, &session);
     EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << c.what;
     EXPECT_THAT(status.error_message(), HasSubstr(c.field)) << c.what;
   }
 }
 
 TEST_F(ReconstructionServiceTest, BatchesSentAgainCountOnlyTheirNewPoints) {
-  const std::string id = MustCreate(*stub_, CreateRequest(50));
+  const std::string id = MustCreate(*service_, CreateRequest(50));
   const PointCloud points = TorusPoints(3000, 8);
   auto batch = [&](size_t begin, size_t end) {
     v1::PointBatch b = testing::Batch(points, begin, end);
@@ -181,22 +181,22 @@ TEST_F(ReconstructionServiceTest, BatchesSentAgainCountOnlyTheirNewPoints) {
   const grpc::Status refused = UploadOne(Request(id, beyond), &response);
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::OUT_OF_RANGE) << refused.error_message();
   EXPECT_THAT(refused.error_message(), ::testing::HasSubstr("send from point 3000"));
-  const v1::Session session = testing::GetSession(*stub_, id);
+  const v1::Session session = testing::GetSession(*service_, id);
   EXPECT_EQ(session.points_taken(), 3000u);
   EXPECT_EQ(session.learning().points_received(), 3000u);
 }
 
 TEST_F(ReconstructionServiceTest, MaxSessionsIsResourceExhausted) {
-  for (int i = 0; i < 16; ++i) MustCreate(*stub_, CreateRequest(100));
+  for (int i = 0; i < 16; ++i) MustCreate(*service_, CreateRequest(100));
   grpc::ClientContext context;
   v1::Session session;
-  grpc::Status status = stub_->CreateSession(&context, CreateRequest(100), &session);
+  grpc::Status status = service_->CreateSession(&context, CreateRequest(100), &session);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(status.error_message(), HasSubstr("maximum of 16 sessions"));
 }
 
 TEST_F(ReconstructionServiceTest, EveryBadInputGetsItsStatusAndTheSessionGoesOn) {
-  const std::string id = MustCreate(*stub_, CreateRequest(200));
+  const std::string id = MustCreate(*service_, CreateRequest(200));
   const PointCloud points = TorusPoints(4000, 11);
   v1::UploadPointsResponse response;
   ASSERT_TRUE(UploadOne(Request(id, Batch(points, 0, 1000)), &response).ok());
@@ -253,14 +253,14 @@ TEST_F(ReconstructionServiceTest, EveryBadInputGetsItsStatusAndTheSessionGoesOn)
     grpc::Status status = UploadOne(c.request);
     EXPECT_EQ(status.error_code(), c.code) << c.what << ": " << status.error_message();
     EXPECT_THAT(status.error_message(), HasSubstr(c.message)) << c.what;
-    EXPECT_EQ(testing::GetSession(*stub_, id).learning().points_received(), 1000u)
+    EXPECT_EQ(testing::GetSession(*service_, id).learning().points_received(), 1000u)
         << c.what << " changed the session";
   }
 
   // A stream whose later batch is bad keeps the batches before it.
   {
     grpc::ClientContext context;
-    auto writer = stub_->UploadPoints(&context, &response);
+    auto writer = service_->UploadPoints(&context, &response);
     writer->Write(Request(id, Batch(points, 1000, 1500)));
     v1::UploadPointsRequest bad = Request("", Batch(points, 1500, 1510));
     bad.mutable_batch()->mutable_packed()->mutable_positions()->resize(7);
@@ -273,7 +273,7 @@ TEST_F(ReconstructionServiceTest, EveryBadInputGetsItsStatusAndTheSessionGoesOn)
                 HasSubstr("the session keeps its 1500 points, 500 of them from the 1 batch this "
                           "call sent before"));
   }
-  EXPECT_EQ(testing::GetSession(*stub_, id).learning().points_received(), 1500u);
+  EXPECT_EQ(testing::GetSession(*service_, id).learning().points_received(), 1500u);
 
   // Draco point clouds are accepted like packed ones.
   {
@@ -286,38 +286,38 @@ TEST_F(ReconstructionServiceTest, EveryBadInputGetsItsStatusAndTheSessionGoesOn)
     EXPECT_EQ(response.total_points(), 4000u);
   }
 
-  ASSERT_TRUE(testing::Finish(*stub_, id).ok());
+  ASSERT_TRUE(testing::Finish(*service_, id).ok());
   v1::MeshUpdate final_mesh;
-  grpc::Status status = testing::WaitFinal(*stub_, id, &final_mesh);
+  grpc::Status status = testing::WaitFinal(*service_, id, &final_mesh);
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_EQ(final_mesh.vertex_count(), 200u) << "the session went on to its target";
 
   status = UploadOne(Request(id, Batch(points, 0, 10)));
   EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << "finished session";
   EXPECT_THAT(status.error_message(), HasSubstr("FINISHED"));
-  EXPECT_EQ(testing::Finish(*stub_, id).error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_EQ(testing::Finish(*service_, id).error_code(), grpc::StatusCode::FAILED_PRECONDITION);
 
-  const std::string cancelled = MustCreate(*stub_, CreateRequest(200));
+  const std::string cancelled = MustCreate(*service_, CreateRequest(200));
   v1::Session session;
-  ASSERT_TRUE(testing::Cancel(*stub_, cancelled, &session).ok());
+  ASSERT_TRUE(testing::Cancel(*service_, cancelled, &session).ok());
   EXPECT_EQ(session.state(), v1::SESSION_STATE_CANCELLED);
   status = UploadOne(Request(cancelled, Batch(points, 0, 10)));
   EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << "cancelled session";
-  EXPECT_EQ(testing::Finish(*stub_, "s-unknown").error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(testing::Finish(*service_, "s-unknown").error_code(), grpc::StatusCode::NOT_FOUND);
 }
 
 TEST_F(ReconstructionServiceTest, WatchersJoinLateLeaveEarlyAndReadSlowly) {
-  const std::string id = MustCreate(*stub_, CreateRequest(1000, /*refresh_ms=*/10));
+  const std::string id = MustCreate(*service_, CreateRequest(1000, /*refresh_ms=*/10));
   const PointCloud points = TorusPoints(20000, 13);
 
   std::vector<v1::MeshUpdate> early_updates, slow_updates;
   grpc::Status early_status, slow_status, leaver_status;
-  std::thread early([&] { early_status = testing::WatchAll(*stub_, id, &early_updates); });
+  std::thread early([&] { early_status = testing::WatchAll(*service_, id, &early_updates); });
   std::thread slow([&] {
     grpc::ClientContext context;
     v1::WatchSessionRequest request;
     request.set_session_id(id);
-    auto reader = stub_->WatchSession(&context, request);
+    auto reader = service_->WatchSession(&context, request);
     v1::MeshUpdate update;
     while (reader->Read(&update)) {
       slow_updates.push_back(update);
@@ -330,7 +330,7 @@ TEST_F(ReconstructionServiceTest, WatchersJoinLateLeaveEarlyAndReadSlowly) {
     grpc::ClientContext context;
     v1::WatchSessionRequest request;
     request.set_session_id(id);
-    auto reader = stub_->WatchSession(&context, request);
+    auto reader = service_->WatchSession(&context, request);
     v1::MeshUpdate update;
     while (reader->Read(&update)) {
       if (++leaver_reads == 2) context.TryCancel();
@@ -339,16 +339,16 @@ TEST_F(ReconstructionServiceTest, WatchersJoinLateLeaveEarlyAndReadSlowly) {
   });
 
   v1::UploadPointsResponse response;
-  ASSERT_TRUE(testing::Upload(*stub_, id, points, 20, &response).ok());
+  ASSERT_TRUE(testing::Upload(*service_, id, points, 20, &response).ok());
   EXPECT_EQ(response.total_points(), 20000u);
   EXPECT_EQ(response.batches_accepted(), 20u);
 
   // A late watcher gets the latest mesh at once.
   // Learning and encoding run concurrently with the upload: wait (bounded) for a mesh.
-  v1::Session before = testing::GetSession(*stub_, id);
+  v1::Session before = testing::GetSession(*service_, id);
   for (const absl::Time deadline = absl::Now() + absl::Seconds(20);
        before.latest_sequence() == 0 && absl::Now() < deadline;
-       before = testing::GetSession(*stub_, id)) {
+       before = testing::GetSession(*service_, id)) {
     absl::SleepFor(absl::Milliseconds(5));
   }
   ASSERT_GT(before.latest_sequence(), 0u) << "no mesh was published within 20 s of the upload";
@@ -356,7 +356,7 @@ TEST_F(ReconstructionServiceTest, WatchersJoinLateLeaveEarlyAndReadSlowly) {
     grpc::ClientContext context;
     v1::WatchSessionRequest request;
     request.set_session_id(id);
-    auto reader = stub_->WatchSession(&context, request);
+    auto reader = service_->WatchSession(&context, request);
     v1::MeshUpdate first;
     ASSERT_TRUE(reader->Read(&first));
     EXPECT_GE(first.sequence(), before.latest_sequence())
@@ -365,7 +365,7 @@ TEST_F(ReconstructionServiceTest, WatchersJoinLateLeaveEarlyAndReadSlowly) {
     reader->Finish();
   }
 
-  ASSERT_TRUE(testing::Finish(*stub_, id).ok());
+  ASSERT_TRUE(testing::Finish(*service_, id).ok());
   early.join();
   slow.join();
   leaver.join();
@@ -394,13 +394,13 @@ TEST_F(ReconstructionServiceTest, WatchersJoinLateLeaveEarlyAndReadSlowly) {
 
   EXPECT_EQ(leaver_status.error_code(), grpc::StatusCode::CANCELLED);
   EXPECT_EQ(leaver_reads, 2);
-  EXPECT_EQ(testing::GetSession(*stub_, id).watchers(), 0u) << "every watcher unsubscribed";
+  EXPECT_EQ(testing::GetSession(*service_, id).watchers(), 0u) << "every watcher unsubscribed";
 }
 
 TEST_F(ReconstructionServiceTest, ReconstructDoesEverythingInOneCall) {
   const PointCloud points = TorusPoints(4000, 14);
   grpc::ClientContext context;
-  auto stream = stub_->Reconstruct(&context);
+  auto stream = service_->Reconstruct(&context);
   v1::ReconstructRequest start;
   *start.mutable_start()->mutable_create() = CreateRequest(300);
   ASSERT_TRUE(stream->Write(start));
@@ -437,7 +437,7 @@ TEST_F(ReconstructionServiceTest, ADiscStartGivesAFlatSquareOneBorder) {
     points.positions.emplace_back(rng.NextDouble(), rng.NextDouble(), 0.f);
   }
   grpc::ClientContext context;
-  auto stream = stub_->Reconstruct(&context);
+  auto stream = service_->Reconstruct(&context);
   v1::ReconstructRequest start;
   *start.mutable_start()->mutable_create() = CreateRequest(2000);
   start.mutable_start()->mutable_create()->mutable_config()->mutable_learner()->set_initial_mesh(
@@ -490,7 +490,7 @@ TEST_F(ReconstructionServiceTest, OutlierRemovalDropsStraysBeforeTheSessionTakes
   batches[20].positions.emplace_back(0.f, 0.f, -50.f);  // A stray alone in its batch.
   auto upload = [&](const std::string& id, v1::UploadPointsResponse* response) {
     grpc::ClientContext context;
-    auto writer = stub_->UploadPoints(&context, response);
+    auto writer = service_->UploadPoints(&context, response);
     for (const PointCloud& batch : batches) {
       v1::UploadPointsRequest request;
       request.set_session_id(id);
@@ -503,14 +503,14 @@ TEST_F(ReconstructionServiceTest, OutlierRemovalDropsStraysBeforeTheSessionTakes
 
   v1::CreateSessionRequest create = CreateRequest(2000);
   create.mutable_config()->mutable_outlier_removal();  // Set, with the defaults.
-  const std::string id = MustCreate(*stub_, create);
+  const std::string id = MustCreate(*service_, create);
   v1::UploadPointsResponse response;
   const grpc::Status status = upload(id, &response);
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_EQ(response.points_accepted() + response.points_held_back(), 20002u);
   EXPECT_GE(response.points_held_back(), 2u);
   EXPECT_LE(response.points_held_back(), 2u + 100u) << "at most 0.5% of the sphere";
-  v1::Session session = testing::GetSession(*stub_, id);
+  v1::Session session = testing::GetSession(*service_, id);
   EXPECT_EQ(session.config().outlier_removal().neighbours().value(), 16) << "defaults echoed";
   EXPECT_DOUBLE_EQ(session.config().outlier_removal().std_ratio().value(), 3.0);
   const v1::LearningState& learning = session.learning();
@@ -527,18 +527,18 @@ TEST_F(ReconstructionServiceTest, OutlierRemovalDropsStraysBeforeTheSessionTakes
   nan_points.positions[5][1] = std::nanf("");
   *nan.mutable_batch() = PointCloudToPackedBatch(nan_points);
   v1::UploadPointsResponse refused;
-  EXPECT_EQ(testing::UploadOne(*stub_, nan, &refused).error_code(),
+  EXPECT_EQ(testing::UploadOne(*service_, nan, &refused).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_EQ(testing::GetSession(*stub_, id).learning().points_received(),
+  EXPECT_EQ(testing::GetSession(*service_, id).learning().points_received(),
             learning.points_received());
-  ASSERT_TRUE(testing::Finish(*stub_, id).ok());
-  const v1::LearningState finished = testing::GetSession(*stub_, id).learning();
+  ASSERT_TRUE(testing::Finish(*service_, id).ok());
+  const v1::LearningState finished = testing::GetSession(*service_, id).learning();
   EXPECT_EQ(finished.outliers_held(), 0u) << "dropped at the finish";
   EXPECT_EQ(finished.points_received(), learning.points_received());
   EXPECT_EQ(finished.points_removed_as_outliers() + finished.outliers_accepted_later(),
             response.points_held_back());
   v1::MeshUpdate final_mesh;
-  const grpc::Status waited = testing::WaitFinal(*stub_, id, &final_mesh);
+  const grpc::Status waited = testing::WaitFinal(*service_, id, &final_mesh);
   ASSERT_TRUE(waited.ok()) << waited.error_message();
   absl::StatusOr<TriangleMesh> mesh = DecodeMesh(final_mesh.draco_mesh());
   ASSERT_TRUE(mesh.ok()) << mesh.status();
@@ -547,13 +547,13 @@ TEST_F(ReconstructionServiceTest, OutlierRemovalDropsStraysBeforeTheSessionTakes
   EXPECT_LT(testing::MaxVertexDistance(*mesh, **unit_sphere), 0.05) << "no spike";
   EXPECT_EQ(ComputeMeshReport(*mesh).genus, 0);
 
-  const std::string unfiltered = MustCreate(*stub_, CreateRequest(2000));
+  const std::string unfiltered = MustCreate(*service_, CreateRequest(2000));
   v1::UploadPointsResponse taken_all;
   ASSERT_TRUE(upload(unfiltered, &taken_all).ok());
   EXPECT_EQ(taken_all.points_accepted(), 20002u);
   EXPECT_EQ(taken_all.points_held_back(), 0u);
-  EXPECT_GT(testing::GetSession(*stub_, unfiltered).quantization_box().range(), 100.f);
-  ASSERT_TRUE(testing::Delete(*stub_, unfiltered).ok());
+  EXPECT_GT(testing::GetSession(*service_, unfiltered).quantization_box().range(), 100.f);
+  ASSERT_TRUE(testing::Delete(*service_, unfiltered).ok());
 }
 
 // A sphere scanned region by region (its points sorted along x, batches of 500): the points on
@@ -569,10 +569,10 @@ TEST_F(ReconstructionServiceTest, OutlierRemovalAcceptsTheLeadingEdgesOfASweptSc
   const auto whole_count = static_cast<uint64_t>(std::count(whole->begin(), whole->end(), true));
   v1::CreateSessionRequest create = CreateRequest(2000);
   create.mutable_config()->mutable_outlier_removal();
-  const std::string id = MustCreate(*stub_, create);
+  const std::string id = MustCreate(*service_, create);
   grpc::ClientContext context;
   v1::UploadPointsResponse response;
-  auto writer = stub_->UploadPoints(&context, &response);
+  auto writer = service_->UploadPoints(&context, &response);
   for (size_t begin = 0; begin < sphere.size(); begin += 500) {
     v1::UploadPointsRequest request;
     request.set_session_id(id);
@@ -583,17 +583,17 @@ TEST_F(ReconstructionServiceTest, OutlierRemovalAcceptsTheLeadingEdgesOfASweptSc
   const grpc::Status status = writer->Finish();
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_GE(response.points_held_back(), 4 * whole_count);
-  const v1::LearningState learning = testing::GetSession(*stub_, id).learning();
+  const v1::LearningState learning = testing::GetSession(*service_, id).learning();
   EXPECT_GE(learning.outliers_accepted_later(), response.points_held_back() - whole_count);
   EXPECT_EQ(learning.points_received(),
             response.points_accepted() + learning.outliers_accepted_later());
   EXPECT_EQ(response.total_points(), learning.points_received());
-  ASSERT_TRUE(testing::Finish(*stub_, id).ok());
-  const v1::LearningState finished = testing::GetSession(*stub_, id).learning();
+  ASSERT_TRUE(testing::Finish(*service_, id).ok());
+  const v1::LearningState finished = testing::GetSession(*service_, id).learning();
   EXPECT_EQ(finished.outliers_held(), 0u);
   EXPECT_LE(finished.points_removed_as_outliers(), whole_count);
   EXPECT_EQ(finished.points_received() + finished.points_removed_as_outliers(), 20000u);
-  ASSERT_TRUE(testing::Delete(*stub_, id).ok());
+  ASSERT_TRUE(testing::Delete(*service_, id).ok());
 }
 
 // A Reconstruct call's acknowledgements count the points outlier removal held back.
@@ -601,7 +601,7 @@ TEST_F(ReconstructionServiceTest, ReconstructAcksCountHeldBackOutliers) {
   PointCloud points = testing::SpherePoints(3000, 24);
   points.positions.emplace_back(0.f, 30.f, 0.f);
   grpc::ClientContext context;
-  auto stream = stub_->Reconstruct(&context);
+  auto stream = service_->Reconstruct(&context);
   v1::ReconstructRequest start;
   *start.mutable_start()->mutable_create() = CreateRequest(500);
   start.mutable_start()->mutable_create()->mutable_config()->mutable_outlier_removal();
@@ -643,13 +643,13 @@ TEST_F(ReconstructionServiceTest, ReconstructRejectsABadBatchAndTheSessionStays)
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("batch 2 of this call rejected"));
   ASSERT_FALSE(id.empty());
-  v1::Session session = testing::GetSession(*stub_, id);
+  v1::Session session = testing::GetSession(*service_, id);
   EXPECT_EQ(session.learning().points_received(), 1000u) << "the good batch stays";
   EXPECT_NE(session.state(), v1::SESSION_STATE_FINISHING) << "an error does not finish it";
 
   // The first request must be a start.
   grpc::ClientContext context2;
-  auto stream2 = stub_->Reconstruct(&context2);
+  auto stream2 = service_->Reconstruct(&context2);
   stream2->Write(good);
   stream2->WritesDone();
   while (stream2->Read(&response)) {
@@ -675,10 +675,10 @@ TEST_F(ReconstructionServiceTest, ACancelledReconstructLeavesTheSessionOpen) {
     context.TryCancel();
     EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::CANCELLED);
     // Once the server has seen the cancel, the call no longer watches the session.
-    v1::Session session = testing::GetSession(*stub_, id);
+    v1::Session session = testing::GetSession(*service_, id);
     for (int i = 0; i < 500 && session.watchers() > 0; ++i) {
       absl::SleepFor(absl::Milliseconds(10));
-      session = testing::GetSession(*stub_, id);
+      session = testing::GetSession(*service_, id);
     }
     ASSERT_EQ(session.watchers(), 0u) << "the server did not end the cancelled call";
     EXPECT_EQ(session.learning().points_received(), 1000u);
@@ -690,68 +690,68 @@ TEST_F(ReconstructionServiceTest, ACancelledReconstructLeavesTheSessionOpen) {
 }
 
 TEST_F(ReconstructionServiceTest, GetMeshLatestFinalAndWaiting) {
-  const std::string id = MustCreate(*stub_, CreateRequest(200));
+  const std::string id = MustCreate(*service_, CreateRequest(200));
   grpc::ClientContext context;
   v1::GetMeshRequest request;
   request.set_session_id(id);
   v1::MeshUpdate mesh;
-  grpc::Status status = stub_->GetMesh(&context, request, &mesh);
+  grpc::Status status = service_->GetMesh(&context, request, &mesh);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
   EXPECT_THAT(status.error_message(), HasSubstr("no mesh yet"));
 
   // A waiting call for the final mesh returns once the session finishes.
   v1::MeshUpdate final_mesh;
   grpc::Status final_status;
-  std::thread waiter([&] { final_status = testing::WaitFinal(*stub_, id, &final_mesh); });
+  std::thread waiter([&] { final_status = testing::WaitFinal(*service_, id, &final_mesh); });
   v1::UploadPointsResponse response;
-  ASSERT_TRUE(testing::Upload(*stub_, id, TorusPoints(2000, 16), 4, &response).ok());
-  ASSERT_TRUE(testing::Finish(*stub_, id).ok());
+  ASSERT_TRUE(testing::Upload(*service_, id, TorusPoints(2000, 16), 4, &response).ok());
+  ASSERT_TRUE(testing::Finish(*service_, id).ok());
   waiter.join();
   ASSERT_TRUE(final_status.ok()) << final_status.error_message();
   EXPECT_EQ(final_mesh.kind(), v1::UPDATE_KIND_FINAL);
 
   grpc::ClientContext latest_context;
-  ASSERT_TRUE(stub_->GetMesh(&latest_context, request, &mesh).ok());
+  ASSERT_TRUE(service_->GetMesh(&latest_context, request, &mesh).ok());
   EXPECT_EQ(mesh.sequence(), final_mesh.sequence()) << "after finishing, latest is final";
 
   // Waiting for a final mesh that cannot come.
-  const std::string other = MustCreate(*stub_, CreateRequest(200));
+  const std::string other = MustCreate(*service_, CreateRequest(200));
   grpc::Status cancelled_status;
   std::thread waiter2([&] {
     v1::MeshUpdate unused;
-    cancelled_status = testing::WaitFinal(*stub_, other, &unused);
+    cancelled_status = testing::WaitFinal(*service_, other, &unused);
   });
   absl::SleepFor(absl::Milliseconds(100));
-  ASSERT_TRUE(testing::Cancel(*stub_, other).ok());
+  ASSERT_TRUE(testing::Cancel(*service_, other).ok());
   waiter2.join();
   EXPECT_EQ(cancelled_status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
 
   // A deadline ends the wait.
-  const std::string third = MustCreate(*stub_, CreateRequest(200));
+  const std::string third = MustCreate(*service_, CreateRequest(200));
   v1::MeshUpdate unused;
-  status = testing::WaitFinal(*stub_, third, &unused, absl::Milliseconds(200));
+  status = testing::WaitFinal(*service_, third, &unused, absl::Milliseconds(200));
   EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
 }
 
 TEST_F(ReconstructionServiceTest, CancelAndDeleteEndWatchers) {
-  const std::string id = MustCreate(*stub_, CreateRequest(100000));
+  const std::string id = MustCreate(*service_, CreateRequest(100000));
   v1::UploadPointsResponse response;
-  ASSERT_TRUE(testing::Upload(*stub_, id, TorusPoints(20000, 17), 4, &response).ok());
+  ASSERT_TRUE(testing::Upload(*service_, id, TorusPoints(20000, 17), 4, &response).ok());
   std::vector<v1::MeshUpdate> updates;
   grpc::Status watch_status;
-  std::thread watcher([&] { watch_status = testing::WatchAll(*stub_, id, &updates); });
+  std::thread watcher([&] { watch_status = testing::WatchAll(*service_, id, &updates); });
   absl::SleepFor(absl::Milliseconds(200));
-  ASSERT_TRUE(testing::Cancel(*stub_, id).ok());
+  ASSERT_TRUE(testing::Cancel(*service_, id).ok());
   watcher.join();
   EXPECT_EQ(watch_status.error_code(), grpc::StatusCode::CANCELLED)
       << watch_status.error_message();
-  EXPECT_TRUE(testing::Cancel(*stub_, id).ok()) << "cancel is idempotent";
+  EXPECT_TRUE(testing::Cancel(*service_, id).ok()) << "cancel is idempotent";
 
-  const std::string id2 = MustCreate(*stub_, CreateRequest(100000));
-  ASSERT_TRUE(testing::Upload(*stub_, id2, TorusPoints(20000, 18), 4, &response).ok());
-  std::thread watcher2([&] { watch_status = testing::WatchAll(*stub_, id2, &updates); });
+  const std::string id2 = MustCreate(*service_, CreateRequest(100000));
+  ASSERT_TRUE(testing::Upload(*service_, id2, TorusPoints(20000, 18), 4, &response).ok());
+  std::thread watcher2([&] { watch_status = testing::WatchAll(*service_, id2, &updates); });
   absl::SleepFor(absl::Milliseconds(200));
-  ASSERT_TRUE(testing::Delete(*stub_, id2).ok());
+  ASSERT_TRUE(testing::Delete(*service_, id2).ok());
   watcher2.join();
   EXPECT_EQ(watch_status.error_code(), grpc::StatusCode::NOT_FOUND);
   EXPECT_THAT(watch_status.error_message(), HasSubstr("deleted"));
@@ -764,18 +764,18 @@ TEST_F(ReconstructionServiceTest, AnOpenUploadEndsWhenItsSessionEnds) {
   const PointCloud points = TorusPoints(2000, 19);
   enum class End { kDelete, kCancel, kFinish };
   for (const End end : {End::kDelete, End::kCancel, End::kFinish}) {
-    const std::string id = MustCreate(*stub_, CreateRequest(200));
+    const std::string id = MustCreate(*service_, CreateRequest(200));
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
     v1::UploadPointsResponse response;
-    auto writer = stub_->UploadPoints(&context, &response);
+    auto writer = service_->UploadPoints(&context, &response);
     ASSERT_TRUE(writer->Write(Request(id, Batch(points, 0, 1000))));
-    while (testing::GetSession(*stub_, id).learning().points_received() < 1000) {
+    while (testing::GetSession(*service_, id).learning().points_received() < 1000) {
       absl::SleepFor(absl::Milliseconds(5));
     }
-    const grpc::Status ended = end == End::kDelete   ? testing::Delete(*stub_, id)
-                               : end == End::kCancel ? testing::Cancel(*stub_, id)
-                                                     : testing::Finish(*stub_, id);
+    const grpc::Status ended = end == End::kDelete   ? testing::Delete(*service_, id)
+                               : end == End::kCancel ? testing::Cancel(*service_, id)
+                                                     : testing::Finish(*service_, id);
     ASSERT_TRUE(ended.ok()) << ended.error_message();
     // No WritesDone: the server ends the call by itself.
     const grpc::Status status = writer->Finish();
@@ -795,7 +795,7 @@ TEST_F(ReconstructionServiceTest, AnUnknownIdOfAnyLengthIsNotFoundWithAShortMess
   v1::GetSessionRequest request;
   request.set_session_id(id);
   v1::Session session;
-  const grpc::Status status = stub_->GetSession(&context, request, &session);
+  const grpc::Status status = service_->GetSession(&context, request, &session);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND) << status.error_message();
   EXPECT_THAT(status.error_message(), HasSubstr("(10000 bytes)"));
   EXPECT_LT(status.error_message().size(), 200u);
@@ -808,7 +808,7 @@ TEST(ReconstructionServiceIdleTimeoutTest, IdleSessionsAreDeletedWatchedOnesStay
   options.limits.idle_timeout = absl::Seconds(1);  // The reaper looks every 250 ms.
   std::unique_ptr<ReconstructionServer> server = StartServer(/*listen=*/false, options);
   ASSERT_NE(server, nullptr);
-  // The generated client class of the service (gRPC calls it a stub), over an in-process channel.
+  // The generated client class of the service (gRPC calls it a service), over an in-process channel.
   auto client = InProcessService(*server);
   // ListSessions is no call on a session: it keeps none alive.
   auto listed = [&] {
@@ -859,17 +859,17 @@ TEST(ReconstructionServiceIdleTimeoutTest, IdleSessionsAreDeletedWatchedOnesStay
 }
 
 TEST_F(ReconstructionServiceTest, ShutdownEndsEveryOpenStream) {
-  const std::string id = MustCreate(*stub_, CreateRequest(100000));
+  const std::string id = MustCreate(*service_, CreateRequest(100000));
   v1::UploadPointsResponse response;
-  ASSERT_TRUE(testing::Upload(*stub_, id, TorusPoints(20000, 19), 5, &response).ok());
+  ASSERT_TRUE(testing::Upload(*service_, id, TorusPoints(20000, 19), 5, &response).ok());
 
   grpc::Status watch_status, upload_status, bidi_status, wait_status;
   std::vector<v1::MeshUpdate> updates;
-  std::thread watcher([&] { watch_status = testing::WatchAll(*stub_, id, &updates); });
+  std::thread watcher([&] { watch_status = testing::WatchAll(*service_, id, &updates); });
   std::thread uploader([&] {  // An upload that never half-closes.
     grpc::ClientContext context;
     v1::UploadPointsResponse r;
-    auto writer = stub_->UploadPoints(&context, &r);
+    auto writer = service_->UploadPoints(&context, &r);
     v1::UploadPointsRequest request;
     request.set_session_id(id);
     *request.mutable_batch() = Batch(TorusPoints(100, 20), 0, 100);
@@ -878,7 +878,7 @@ TEST_F(ReconstructionServiceTest, ShutdownEndsEveryOpenStream) {
   });
   std::thread bidi([&] {  // A Reconstruct call that never half-closes.
     grpc::ClientContext context;
-    auto stream = stub_->Reconstruct(&context);
+    auto stream = service_->Reconstruct(&context);
     v1::ReconstructRequest start;
     *start.mutable_start()->mutable_create() = CreateRequest(100000);
     stream->Write(start);
@@ -889,7 +889,7 @@ TEST_F(ReconstructionServiceTest, ShutdownEndsEveryOpenStream) {
   });
   std::thread waiter([&] {
     v1::MeshUpdate unused;
-    wait_status = testing::WaitFinal(*stub_, id, &unused);
+    wait_status = testing::WaitFinal(*service_, id, &unused);
   });
   absl::SleepFor(absl::Milliseconds(300));
   const absl::Time start = absl::Now();

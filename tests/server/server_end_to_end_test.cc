@@ -55,22 +55,22 @@ TEST(ServerEndToEndTest, TorusInAHundredBatchesOverLoopback) {
   std::unique_ptr<ReconstructionServer> server = testing::StartServer(/*listen=*/true);
   ASSERT_NE(server, nullptr);
   ASSERT_GT(server->port(), 0);
-  auto stub = testing::NetworkService(*server);
+  auto service = testing::NetworkService(*server);
 
   auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4);
   ASSERT_TRUE(torus.ok());
   const PointCloud points = SamplePoints(**torus, 40000, 21);
-  const std::string id = testing::MustCreate(*stub, testing::CreateRequest(2000));
+  const std::string id = testing::MustCreate(*service, testing::CreateRequest(2000));
 
   std::vector<v1::MeshUpdate> updates;
   grpc::Status watch_status;
-  std::thread watcher([&] { watch_status = testing::WatchAll(*stub, id, &updates); });
+  std::thread watcher([&] { watch_status = testing::WatchAll(*service, id, &updates); });
   v1::UploadPointsResponse response;
-  grpc::Status upload = testing::Upload(*stub, id, points, 100, &response);
+  grpc::Status upload = testing::Upload(*service, id, points, 100, &response);
   ASSERT_TRUE(upload.ok()) << upload.error_message();
   EXPECT_EQ(response.batches_accepted(), 100u);
   EXPECT_EQ(response.total_points(), 40000u);
-  ASSERT_TRUE(testing::Finish(*stub, id).ok());
+  ASSERT_TRUE(testing::Finish(*service, id).ok());
   watcher.join();
   ASSERT_TRUE(watch_status.ok()) << watch_status.error_message();
 
@@ -91,7 +91,7 @@ TEST(ServerEndToEndTest, TorusInAHundredBatchesOverLoopback) {
   // The stream's budget, 8 bytes per vertex at 11 bits, holds for every level of detail of the
   // default series and for every refresh between them (the first batch allows 200 vertices,
   // so no refresh shows a mesh below the first milestone).
-  const v1::Session session = testing::GetSession(*stub, id);
+  const v1::Session session = testing::GetSession(*service, id);
   EXPECT_THAT(session.config().lod_milestones(),
               ::testing::ElementsAre(50, 100, 200, 500, 1000, 2000))
       << "the default series";
@@ -218,23 +218,23 @@ TEST(ServerEndToEndTest, BinaryShutsDownOnSigtermDuringOpenStreams) {
   Child child = StartServerBinary();
   ASSERT_GT(child.pid, 0);
   ASSERT_GT(child.port, 0) << "the server did not print its port";
-  auto stub = v1::ReconstructionService::NewStub(grpc::CreateChannel(
+  auto service = v1::ReconstructionService::NewStub(grpc::CreateChannel(
       absl::StrCat("127.0.0.1:", child.port), grpc::InsecureChannelCredentials()));
-  const std::string id = testing::MustCreate(*stub, testing::CreateRequest(100000));
+  const std::string id = testing::MustCreate(*service, testing::CreateRequest(100000));
   v1::UploadPointsResponse response;
-  ASSERT_TRUE(testing::Upload(*stub, id, testing::TorusPoints(20000, 22), 4, &response).ok());
+  ASSERT_TRUE(testing::Upload(*service, id, testing::TorusPoints(20000, 22), 4, &response).ok());
 
   grpc::Status watch_status, upload_status;
   std::vector<v1::MeshUpdate> updates;
   absl::Time watch_end, upload_end;
   std::thread watcher([&] {
-    watch_status = testing::WatchAll(*stub, id, &updates);
+    watch_status = testing::WatchAll(*service, id, &updates);
     watch_end = absl::Now();
   });
   std::thread uploader([&] {
     grpc::ClientContext context;
     v1::UploadPointsResponse r;
-    auto writer = stub->UploadPoints(&context, &r);
+    auto writer = service->UploadPoints(&context, &r);
     v1::UploadPointsRequest request;
     request.set_session_id(id);
     *request.mutable_batch() = testing::Batch(testing::TorusPoints(100, 23), 0, 100);

@@ -17,7 +17,7 @@ TEST(ServiceConcurrentTest, EightSessionsOnTwoWorkersStayIsolatedAndAllProgress)
   options.worker_threads = 2;
   std::unique_ptr<ReconstructionServer> server = testing::StartServer(false, options);
   ASSERT_NE(server, nullptr);
-  auto stub = testing::InProcessService(*server);
+  auto service = testing::InProcessService(*server);
 
   constexpr int kSessions = 8;
   // Each session gets its own shape: spheres and tori of different sizes at different places.
@@ -32,7 +32,7 @@ TEST(ServiceConcurrentTest, EightSessionsOnTwoWorkersStayIsolatedAndAllProgress)
   std::vector<std::string> ids(kSessions);
   std::vector<size_t> counts(kSessions);
   for (int i = 0; i < kSessions; ++i) {
-    ids[i] = testing::MustCreate(*stub, testing::CreateRequest(400 + 10 * i));
+    ids[i] = testing::MustCreate(*service, testing::CreateRequest(400 + 10 * i));
     counts[i] = 3000 + 100 * i;
   }
 
@@ -42,7 +42,7 @@ TEST(ServiceConcurrentTest, EightSessionsOnTwoWorkersStayIsolatedAndAllProgress)
   for (int i = 0; i < kSessions; ++i) {
     threads.emplace_back([&, i] {
       v1::UploadPointsResponse response;
-      statuses[i] = testing::Upload(*stub, ids[i], SamplePoints(*surfaces[i], counts[i], i + 1),
+      statuses[i] = testing::Upload(*service, ids[i], SamplePoints(*surfaces[i], counts[i], i + 1),
                                     10, &response);
     });
   }
@@ -52,7 +52,7 @@ TEST(ServiceConcurrentTest, EightSessionsOnTwoWorkersStayIsolatedAndAllProgress)
 
   absl::SleepFor(absl::Milliseconds(300));
   for (int i = 0; i < kSessions; ++i) {
-    v1::Session session = testing::GetSession(*stub, ids[i]);
+    v1::Session session = testing::GetSession(*service, ids[i]);
     EXPECT_EQ(session.learning().points_received(), counts[i]) << "session " << i;
     EXPECT_GT(session.learning().basic_steps(), 0u)
         << "session " << i << " made no progress while 7 others learned";
@@ -61,14 +61,14 @@ TEST(ServiceConcurrentTest, EightSessionsOnTwoWorkersStayIsolatedAndAllProgress)
   std::vector<v1::MeshUpdate> finals(kSessions);
   for (int i = 0; i < kSessions; ++i) {
     threads.emplace_back([&, i] {
-      statuses[i] = testing::Finish(*stub, ids[i]);
-      if (statuses[i].ok()) statuses[i] = testing::WaitFinal(*stub, ids[i], &finals[i]);
+      statuses[i] = testing::Finish(*service, ids[i]);
+      if (statuses[i].ok()) statuses[i] = testing::WaitFinal(*service, ids[i], &finals[i]);
     });
   }
   for (std::thread& t : threads) t.join();
   for (int i = 0; i < kSessions; ++i) {
     ASSERT_TRUE(statuses[i].ok()) << "session " << i << ": " << statuses[i].error_message()
-                                  << "\n" << testing::GetSession(*stub, ids[i]).DebugString();
+                                  << "\n" << testing::GetSession(*service, ids[i]).DebugString();
     EXPECT_EQ(finals[i].session_id(), ids[i]);
     EXPECT_EQ(finals[i].vertex_count(), 400u + 10 * i) << "each session keeps its own target";
     EXPECT_EQ(finals[i].learning().points_received(), counts[i]);
@@ -90,18 +90,18 @@ class FilteringServiceTest : public ::testing::Test {
     options.limits.max_batch_points = 400000;
     server_ = testing::StartServer(false, options);
     ASSERT_NE(server_, nullptr);
-    stub_ = testing::InProcessService(*server_);
+    service_ = testing::InProcessService(*server_);
   }
 
   std::string FilteredSession() {
     v1::CreateSessionRequest create = testing::CreateRequest(1000);
     create.mutable_config()->mutable_points_per_vertex()->set_value(300);
     create.mutable_config()->mutable_outlier_removal();
-    return testing::MustCreate(*stub_, create);
+    return testing::MustCreate(*service_, create);
   }
 
   std::unique_ptr<ReconstructionServer> server_;
-  std::unique_ptr<v1::ReconstructionService::Stub> stub_;
+  std::unique_ptr<v1::ReconstructionService::Stub> service_;
 };
 
 // Filtering a batch for outliers takes seconds for a few hundred thousand points. gRPC runs
@@ -113,7 +113,7 @@ class FilteringServiceTest : public ::testing::Test {
 // are answered at once.
 TEST_F(FilteringServiceTest, FilteringOutliersDoesNotHoldUpOtherCalls) {
   const PointCloud points = testing::SpherePoints(300000, 31);
-  const std::string other = testing::MustCreate(*stub_, testing::CreateRequest(100));
+  const std::string other = testing::MustCreate(*service_, testing::CreateRequest(100));
 
   constexpr int kUploads = 4;
   std::vector<std::thread> uploads;
@@ -122,18 +122,18 @@ TEST_F(FilteringServiceTest, FilteringOutliersDoesNotHoldUpOtherCalls) {
   for (int i = 0; i < kUploads; ++i) {
     const std::string id = FilteredSession();
     uploads.emplace_back(
-        [&, i, id] { statuses[i] = testing::Upload(*stub_, id, points, 1, &responses[i]); });
+        [&, i, id] { statuses[i] = testing::Upload(*service_, id, points, 1, &responses[i]); });
   }
   absl::SleepFor(absl::Milliseconds(500));  // The uploads have arrived and are being filtered.
   absl::Duration slowest;
   for (int probe = 0; probe < 5; ++probe) {
     const absl::Time start = absl::Now();
     grpc::Status status;
-    testing::GetSession(*stub_, other, &status);
+    testing::GetSession(*service_, other, &status);
     ASSERT_TRUE(status.ok()) << status.error_message();
     v1::UploadPointsResponse response;
     ASSERT_TRUE(
-        testing::Upload(*stub_, other, testing::SpherePoints(500, probe), 1, &response).ok());
+        testing::Upload(*service_, other, testing::SpherePoints(500, probe), 1, &response).ok());
     slowest = std::max(slowest, absl::Now() - start);
     absl::SleepFor(absl::Milliseconds(100));
   }
@@ -156,10 +156,10 @@ TEST_F(FilteringServiceTest, CallsEndWhileTheirBatchIsFiltered) {
   grpc::Status deleted_status;
   std::thread upload([&] {
     v1::UploadPointsResponse response;
-    deleted_status = testing::Upload(*stub_, deleted, points, 1, &response);
+    deleted_status = testing::Upload(*service_, deleted, points, 1, &response);
   });
   absl::SleepFor(absl::Milliseconds(800));  // The batch is being filtered (about 2 s).
-  ASSERT_TRUE(testing::Delete(*stub_, deleted).ok());
+  ASSERT_TRUE(testing::Delete(*service_, deleted).ok());
   upload.join();
   // NOT_FOUND from the deletion; FAILED_PRECONDITION if the batch reached the session after.
   EXPECT_TRUE(deleted_status.error_code() == grpc::StatusCode::NOT_FOUND ||
@@ -170,7 +170,7 @@ TEST_F(FilteringServiceTest, CallsEndWhileTheirBatchIsFiltered) {
   grpc::Status shut_down_status;
   std::thread last_upload([&] {
     v1::UploadPointsResponse response;
-    shut_down_status = testing::Upload(*stub_, shut_down, points, 2, &response);
+    shut_down_status = testing::Upload(*service_, shut_down, points, 2, &response);
   });
   absl::SleepFor(absl::Milliseconds(800));
   server_->Shutdown(absl::Seconds(1));

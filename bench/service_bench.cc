@@ -22,6 +22,7 @@
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "bench/bench_flags.h"
@@ -43,6 +44,10 @@ ABSL_FLAG(std::vector<std::string>, lod_milestones, {},
           "Milestones of the LOD session, e.g. 10,20,50 (the target is appended); empty: the "
           "server's default series.");
 ABSL_FLAG(bool, only_lods, false, "Run the LOD and learning-rate measurements only.");
+ABSL_FLAG(std::string, state_dir, "",
+          "Run the server with this state directory (neuralmesh-server --state_dir; it should be "
+          "empty) and, after the ingest, measure a restart that restores the ingested session.");
+ABSL_FLAG(bool, state_sync, true, "With --state_dir: neuralmesh-server --state_sync.");
 
 namespace neuralmesh {
 namespace {
@@ -116,7 +121,8 @@ void Delete(v1::ReconstructionService::Stub& stub, const std::string& id) {
   stub.DeleteSession(&context, request, &response);
 }
 
-void MeasureIngest(v1::ReconstructionService::Stub& stub) {
+// Returns the session, which holds the points.
+std::string MeasureIngest(v1::ReconstructionService::Stub& stub) {
   const size_t total = static_cast<size_t>(absl::GetFlag(FLAGS_ingest_points));
   const size_t batch = static_cast<size_t>(absl::GetFlag(FLAGS_batch_points));
   const PointCloud source = Torus(std::min<size_t>(total, 1 << 20), 1);
@@ -142,7 +148,15 @@ void MeasureIngest(v1::ReconstructionService::Stub& stub) {
               points, requests.size(), seconds, points / seconds / 1e6,
               points * 12.0 / seconds / 1e6,
               static_cast<unsigned long long>(session.learning().points_received()));
-  Delete(stub, id);
+  return id;
+}
+
+std::unique_ptr<v1::ReconstructionService::Stub> Connect(const ReconstructionServer& server) {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(64 << 20);
+  args.SetMaxSendMessageSize(64 << 20);
+  return v1::ReconstructionService::NewStub(
+      grpc::CreateCustomChannel(server.target(), grpc::InsecureChannelCredentials(), args));
 }
 
 void MeasureFirstMesh(v1::ReconstructionService::Stub& stub) {
@@ -350,23 +364,45 @@ int main(int argc, char** argv) {
   options.limits.max_points_per_session =
       std::max<size_t>(static_cast<size_t>(absl::GetFlag(FLAGS_ingest_points)), 1 << 22);
   options.limits.max_batch_points = static_cast<size_t>(absl::GetFlag(FLAGS_batch_points));
+  options.state_dir = absl::GetFlag(FLAGS_state_dir);
+  options.state_sync = absl::GetFlag(FLAGS_state_sync);
   absl::StatusOr<std::unique_ptr<ReconstructionServer>> server =
       ReconstructionServer::Start(options);
   if (!server.ok()) {
     std::fprintf(stderr, "%s\n", server.status().ToString().c_str());
     return 1;
   }
-  grpc::ChannelArguments args;
-  args.SetMaxReceiveMessageSize(64 << 20);
-  args.SetMaxSendMessageSize(64 << 20);
-  auto stub = v1::ReconstructionService::NewStub(
-      grpc::CreateCustomChannel((*server)->target(), grpc::InsecureChannelCredentials(), args));
-  std::printf("neuralmesh service benchmark over %s, %d worker threads, %u hardware threads\n",
+  auto stub = Connect(**server);
+  std::printf("neuralmesh service benchmark over %s, %d worker threads, %u hardware threads%s\n",
               (*server)->target().c_str(), options.worker_threads,
-              std::thread::hardware_concurrency());
+              std::thread::hardware_concurrency(),
+              options.state_dir.empty()
+                  ? ""
+                  : absl::StrCat(", state directory ", options.state_dir,
+                                 options.state_sync ? " (synced)" : " (not synced)")
+                        .c_str());
 
   if (!absl::GetFlag(FLAGS_only_lods)) {
-    MeasureIngest(*stub);
+    const std::string ingested = MeasureIngest(*stub);
+    if (!options.state_dir.empty()) {
+      // A restart: the new server restores the ingested session before it listens.
+      (*server)->Shutdown();
+      server->reset();
+      const absl::Time start = absl::Now();
+      server = ReconstructionServer::Start(options);
+      if (!server.ok()) {
+        std::fprintf(stderr, "%s\n", server.status().ToString().c_str());
+        return 1;
+      }
+      const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
+      const server::RestoreReport& restored = (*server)->restored();
+      std::printf("restart: %zu session of %zu points restored in %.3f s (%.1f M points/s), "
+                  "the server up in %.3f s\n",
+                  restored.sessions, restored.points, absl::ToDoubleSeconds(restored.took),
+                  restored.points / absl::ToDoubleSeconds(restored.took) / 1e6, seconds);
+      stub = Connect(**server);
+    }
+    Delete(*stub, ingested);
     MeasureFirstMesh(*stub);
   }
   const PointCloud points = Torus(400000, 3);

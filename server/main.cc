@@ -70,6 +70,16 @@ ABSL_FLAG(std::string, access_tokens_file, "",
           "those CLIENT created), reader (it lists, gets and watches every session and changes "
           "none) or admin (every session; a token alone is one). Needs --tls_cert_file. SIGHUP "
           "reads the file again (calls already running go on).");
+ABSL_FLAG(std::string, state_dir, "",
+          "Directory in which every session is kept (its settings, state, points and latest "
+          "mesh) and from which a server started again restores them: uploads and watches go "
+          "on where they were, and sessions that were learning learn again from their points. "
+          "One server at a time uses a directory. Empty: sessions live in memory and a "
+          "restart loses them.");
+ABSL_FLAG(bool, state_sync, true,
+          "With --state_dir: a batch or a finish or cancel is acknowledged only once it is on "
+          "the disk (fdatasync). false: once the kernel has it, which survives a crash of the "
+          "server but perhaps not one of the machine.");
 ABSL_FLAG(bool, log_sessions, true,
           "Print a line on standard output when a session is created, finishes, is cancelled, "
           "fails or is deleted (with the time, the client's address and the figures).");
@@ -201,6 +211,9 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  // A write past a file size limit (ulimit -f) then fails with EFBIG, which refuses the batch
+  // that --state_dir could not store, instead of killing the server.
+  signal(SIGXFSZ, SIG_IGN);
 
   neuralmesh::server::ServerOptions options;
   options.address =
@@ -227,6 +240,8 @@ int main(int argc, char** argv) {
   options.limits.max_points_per_session = static_cast<size_t>(max_points);
   options.limits.max_batch_points = static_cast<size_t>(max_batch);
   options.limits.idle_timeout = absl::GetFlag(FLAGS_idle_timeout);
+  options.state_dir = absl::GetFlag(FLAGS_state_dir);
+  options.state_sync = absl::GetFlag(FLAGS_state_sync);
   if (absl::GetFlag(FLAGS_log_sessions)) {
     options.event_sink = neuralmesh::server::EventLog::StandardOutput();
   }
@@ -254,6 +269,15 @@ int main(int argc, char** argv) {
   if (!server.ok()) {
     std::fprintf(stderr, "neuralmesh-server: %s\n", server.status().ToString().c_str());
     return 1;
+  }
+  if (!options.state_dir.empty()) {
+    const neuralmesh::server::RestoreReport& restored = (*server)->restored();
+    for (const std::string& problem : restored.problems) {
+      std::fprintf(stderr, "neuralmesh-server: --state_dir: %s\n", problem.c_str());
+    }
+    std::printf("neuralmesh-server: %zu sessions (%zu points) restored from %s in %.2f s\n",
+                restored.sessions, restored.points, options.state_dir.c_str(),
+                absl::ToDoubleSeconds(restored.took));
   }
   const neuralmesh::server::ServerSecurity& secured = options.security;
   std::printf("neuralmesh-server listening on %s:%d (%d worker threads; %s%s)\n",

@@ -58,9 +58,17 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   server->encoder_ = std::make_unique<Executor>(options.encoder_threads);
   server->filter_ = std::make_unique<Executor>(options.filter_threads);
   server->reactors_ = std::make_unique<ReactorRegistry>();
+  if (!options.state_dir.empty()) {
+    absl::StatusOr<std::unique_ptr<SessionStore>> store =
+        SessionStore::Open(options.state_dir, options.state_sync);
+    if (!store.ok()) return store.status();
+    server->store_ = *std::move(store);
+  }
   server->manager_ = std::make_unique<SessionManager>(
       options.limits, server->pool_.get(), server->encoder_.get(),
-      options.event_sink ? std::make_shared<EventLog>(options.event_sink) : nullptr);
+      options.event_sink ? std::make_shared<EventLog>(options.event_sink) : nullptr,
+      server->store_.get());
+  server->restored_ = server->manager_->RestoreStored();
   server->service_ = std::make_unique<ReconstructionService>(
       server->manager_.get(), server->reactors_.get(), server->filter_.get());
 

@@ -38,12 +38,21 @@ struct ServerOptions {
   SessionLimits limits;
   // Where each session's creation, end and deletion are recorded (event_log.h); null: nowhere.
   EventLog::Sink event_sink;
+  // The state directory (session_store.h): sessions kept on disk and restored at Start, so
+  // that they outlive a restart. Empty: sessions live in memory only.
+  std::string state_dir;
+  // With state_dir: each batch and state change is on the disk (fdatasync) before it is
+  // acknowledged; false: in the kernel's hands, which survives a crash of the server but
+  // perhaps not one of the machine.
+  bool state_sync = true;
 };
 
 class ReconstructionServer {
  public:
-  // Builds and starts the server. INVALID_ARGUMENT for bad options (security included);
-  // UNAVAILABLE when the address cannot be bound or gRPC rejects the TLS certificate or key.
+  // Builds and starts the server, after restoring the sessions of options.state_dir.
+  // INVALID_ARGUMENT for bad options (security included); UNAVAILABLE when the address cannot
+  // be bound or gRPC rejects the TLS certificate or key; FAILED_PRECONDITION when another
+  // server uses the state directory, and the errno's code when it cannot be created.
   static absl::StatusOr<std::unique_ptr<ReconstructionServer>> Start(
       const ServerOptions& options);
   ~ReconstructionServer();  // Shutdown with a 5 s grace period.
@@ -80,6 +89,8 @@ class ReconstructionServer {
   absl::Status ReplaceTls(const ServerTls& tls);
 
   SessionManager& sessions() { return *manager_; }
+  // What Start restored from options.state_dir (nothing without one).
+  const RestoreReport& restored() const { return restored_; }
   ReactorRegistry& reactors() { return *reactors_; }
 
  private:
@@ -90,7 +101,9 @@ class ReconstructionServer {
   std::unique_ptr<Executor> encoder_;
   std::unique_ptr<Executor> filter_;
   std::unique_ptr<ReactorRegistry> reactors_;
+  std::unique_ptr<SessionStore> store_;  // Null without a state directory; outlives manager_.
   std::unique_ptr<SessionManager> manager_;
+  RestoreReport restored_;
   std::unique_ptr<ReconstructionService> service_;
   std::shared_ptr<AccessTokenChecker> token_checker_;  // Null without access tokens.
   std::shared_ptr<ServerTlsIdentity> tls_identity_;    // Null without TLS; outlives server_.

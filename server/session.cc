@@ -61,12 +61,12 @@ bool IsSpatiallyBiased(absl::Span<const Vec3f> arrival_sample) {
 
 Session::Session(std::string id, std::string name, SessionConfig config, size_t max_points,
                  WorkerPool* pool, Executor* encoder, std::shared_ptr<EventLog> log,
-                 std::string owner)
+                 std::string owner, absl::Time create_time)
     : id_(std::move(id)),
       name_(std::move(name)),
       owner_(std::move(owner)),
       config_(std::move(config)),
-      create_time_(absl::Now()),
+      create_time_(create_time),
       pool_(pool),
       encoder_(encoder),
       log_(std::move(log)),
@@ -76,7 +76,7 @@ Session::Session(std::string id, std::string name, SessionConfig config, size_t 
     outlier_filter_ = std::make_unique<StreamingOutlierFilter>(*config_.outlier_removal);
   }
   absl::MutexLock lock(&mu_);
-  last_activity_ = create_time_;
+  last_activity_ = absl::Now();  // Not create_time_: a restored session starts its idle time now.
   learning_.set_allowed_vertices(0);
 }
 
@@ -117,6 +117,16 @@ absl::StatusOr<QuantizationBox> Session::CubeWithLocked(const BoundingBox& batch
 
 absl::StatusOr<size_t> Session::AddPoints(const PointCloud& sent, size_t* held_back,
                                           std::optional<uint64_t> first_point, size_t* skipped) {
+  return AddPointsAndMaybeWake(sent, held_back, first_point, skipped, /*wake=*/true);
+}
+
+absl::Status Session::ReplayBatch(const PointCloud& batch) {
+  return AddPointsAndMaybeWake(batch, nullptr, std::nullopt, nullptr, /*wake=*/false).status();
+}
+
+absl::StatusOr<size_t> Session::AddPointsAndMaybeWake(const PointCloud& sent, size_t* held_back,
+                                                      std::optional<uint64_t> first_point,
+                                                      size_t* skipped, bool wake) {
   if (held_back != nullptr) *held_back = 0;
   if (skipped != nullptr) *skipped = 0;
   size_t total = 0;
@@ -193,6 +203,12 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& sent, size_t* held_b
         box = *cube;
       }
     }
+    // Stored before it is taken, as it came (outliers too, so that a restored session's filter
+    // judges as this one did): a batch is acknowledged only once a restart would keep it.
+    if (record_ != nullptr) {
+      NM_RETURN_IF_ERROR(points_.CheckAppend(*appended));
+      NM_RETURN_IF_ERROR(record_->AppendBatch(batch));
+    }
     const size_t first_index = points_.size();
     // A batch of outliers only: nothing to append.
     if (!appended->positions.empty()) NM_RETURN_IF_ERROR(points_.Append(*appended));
@@ -222,7 +238,7 @@ absl::StatusOr<size_t> Session::AddPoints(const PointCloud& sent, size_t* held_b
     learning_.set_outliers_held(held_outliers_.size());
     learning_.set_allowed_vertices(AllowedVerticesLocked());
   }
-  Wake();
+  if (wake) Wake();
   return total;
 }
 
@@ -261,6 +277,7 @@ absl::Status Session::Finish() {
           static_cast<size_t>(std::ceil(kMinTargetVertices * config_.points_per_vertex)),
           " (4 vertices at points_per_vertex ", config_.points_per_vertex, ")"));
     }
+    NM_RETURN_IF_ERROR(StoreState(v1::SESSION_STATE_FINISHING, ""));
     final_vertices_ = final_vertices;
     state_ = v1::SESSION_STATE_FINISHING;
     learning_.set_allowed_vertices(final_vertices_);
@@ -286,6 +303,7 @@ absl::Status Session::Cancel(absl::string_view reason) {
       return absl::FailedPreconditionError(absl::StrCat(
           "session ", id_, " is ", v1::SessionState_Name(state_), " and cannot be cancelled"));
     }
+    NM_RETURN_IF_ERROR(StoreState(v1::SESSION_STATE_CANCELLED, std::string(reason)));
     state_ = v1::SESSION_STATE_CANCELLED;
     error_ = std::string(reason);
     cancel_.store(true);
@@ -323,8 +341,84 @@ void Session::Fail(const absl::Status& status) {
     cancel_.store(true);
   }
   Record(absl::StrCat("failed: ", status.message()));
+  if (absl::Status stored = StoreState(v1::SESSION_STATE_FAILED, std::string(status.message()));
+      !stored.ok()) {
+    Record(absl::StrCat("could not store the failure: ", stored.message()));
+  }
   updates_.Close(absl::InternalError(
       absl::StrCat("learning failed in session ", id_, ": ", status.message())));
+}
+
+absl::Status Session::StoreState(v1::SessionState state, const std::string& error) const {
+  if (record_ == nullptr) return absl::OkStatus();
+  return record_->SetState(state, error);
+}
+
+void Session::StoreMesh(const v1::MeshUpdate& update, bool durable) {
+  if (record_ == nullptr) return;
+  const absl::Status stored = record_->WriteLatestMesh(update, durable);
+  if (!stored.ok() && !mesh_store_failed_.exchange(true)) {
+    Record(absl::StrCat("could not store mesh ", update.sequence(), " (a restart would learn it "
+                        "again; later failures are not recorded): ", stored.message()));
+  }
+}
+
+void Session::FinishRestore(v1::SessionState state, const std::string& error,
+                            std::shared_ptr<v1::MeshUpdate> latest,
+                            std::unique_ptr<SessionRecord> record) {
+  record_ = std::move(record);
+  const bool ended = state == v1::SESSION_STATE_FINISHED ||
+                     state == v1::SESSION_STATE_CANCELLED || state == v1::SESSION_STATE_FAILED;
+  if (latest != nullptr) {
+    absl::MutexLock lock(&mu_);
+    // The milestones up to the stored mesh were published before the restart. Learning again
+    // publishes nothing coarser: refreshes come only after a first publication, which is a
+    // later milestone or, paused for lack of points, a mesh of as many vertices as before.
+    const std::vector<size_t>& milestones = config_.lod_milestones;
+    next_milestone_ = static_cast<size_t>(
+        std::upper_bound(milestones.begin(), milestones.end(), latest->vertex_count()) -
+        milestones.begin());
+    if (ended) {
+      // The counters of the learning that ended; the points are the replayed ones.
+      v1::LearningState learning = latest->learning();
+      learning.set_points_received(learning_.points_received());
+      learning.set_allowed_vertices(learning_.allowed_vertices());
+      learning_ = learning;
+    }
+    updates_.Restore(std::move(latest));
+  }
+  switch (state) {
+    case v1::SESSION_STATE_FINISHED: {
+      {
+        absl::MutexLock lock(&mu_);
+        state_ = state;
+        next_milestone_ = config_.lod_milestones.size();
+      }
+      updates_.Close(absl::OkStatus());
+      return;
+    }
+    case v1::SESSION_STATE_CANCELLED:
+    case v1::SESSION_STATE_FAILED: {
+      {
+        absl::MutexLock lock(&mu_);
+        state_ = state;
+        error_ = error;
+        cancel_.store(true);
+      }
+      updates_.Close(state == v1::SESSION_STATE_CANCELLED
+                         ? absl::CancelledError(absl::StrCat("session ", id_,
+                                                             " was cancelled: ", error))
+                         : absl::InternalError(absl::StrCat("learning failed in session ", id_,
+                                                            ": ", error)));
+      return;
+    }
+    case v1::SESSION_STATE_FINISHING:
+      if (absl::Status finished = Finish(); !finished.ok()) Fail(finished);
+      return;
+    default:
+      Wake();
+      return;
+  }
 }
 
 void Session::Record(absl::string_view event) const {
@@ -592,18 +686,27 @@ void Session::EncodeNext() {
       }
     }
     if (finished) {
-      const v1::MeshUpdate& final_mesh = **update;
+      const std::shared_ptr<v1::MeshUpdate> final_mesh_ptr = *update;
+      const v1::MeshUpdate& final_mesh = *final_mesh_ptr;
       Record(absl::StrFormat(
           "finished: %d vertices, %d faces, genus %d, %d boundaries, %d Basic Steps in %.2f s "
           "of learning, %d points",
           final_mesh.vertex_count(), final_mesh.face_count(), final_mesh.report().genus(),
           final_mesh.report().boundary_loops(), final_mesh.learning().basic_steps(),
           final_mesh.learning().learning_seconds(), final_mesh.learning().points_received()));
-      updates_.Publish(*std::move(update));
+      updates_.Publish(final_mesh_ptr);
+      // Stored before the watchers hear that it is final: a client that has the final mesh
+      // finds it again after a restart.
+      StoreMesh(final_mesh, /*durable=*/true);
+      if (absl::Status stored = StoreState(v1::SESSION_STATE_FINISHED, ""); !stored.ok()) {
+        Record(absl::StrCat("could not store the finish (a restart would learn the final mesh "
+                            "again): ", stored.message()));
+      }
       updates_.Close(absl::OkStatus());
     }
   } else {
-    updates_.Publish(*std::move(update));
+    const std::shared_ptr<v1::MeshUpdate> published = *update;
+    if (updates_.Publish(published) != 0) StoreMesh(*published, /*durable=*/false);
   }
   // One snapshot per task, so that sessions take turns on the encoder threads.
   absl::MutexLock lock(&mu_);

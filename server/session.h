@@ -19,6 +19,14 @@
 // milestones it snapshots every refresh interval; when it reaches `allowed` it pauses (one more
 // refresh snapshot) until more points arrive.
 //
+// With a state directory (session_store.h) the session keeps its identity, state changes,
+// batches and latest mesh on disk through a SessionRecord, and a server that starts again
+// restores it: its batches are taken again in their order (so the points, the quantization
+// cube and the outlier filter's verdicts come out as before), the stored latest mesh is
+// published again with its sequence number, and a session that was still learning learns
+// again from scratch, publishing no mesh coarser than the stored one (the milestones up to it
+// are skipped).
+//
 // A learner whose vertex count makes no new maximum for kStallSplits * C_vs Basic Steps while
 // it should grow (Step 3 collapsing as many vertices as Step 2 splits, as happens on some thin
 // shapes at a few vertices) fails the session with a message instead of spinning forever.
@@ -54,6 +62,7 @@
 #include "server/executor.h"
 #include "server/held_outliers.h"
 #include "server/session_config.h"
+#include "server/session_store.h"
 #include "server/update_channel.h"
 #include "server/worker_pool.h"
 
@@ -75,11 +84,26 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // without one.
   Session(std::string id, std::string name, SessionConfig config, size_t max_points,
           WorkerPool* pool, Executor* encoder, std::shared_ptr<EventLog> log = nullptr,
-          std::string owner = "");
+          std::string owner = "", absl::Time create_time = absl::Now());
   ~Session() override;
 
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
+
+  // Keeps the session on disk from now on (session_store.h): every batch taken, every state
+  // change and every published mesh. Once, before the session is shared with other threads.
+  void AttachRecord(std::unique_ptr<SessionRecord> record) { record_ = std::move(record); }
+  // The session's files, or null without a state directory.
+  SessionRecord* record() const { return record_.get(); }
+
+  // Restoring a stored session, before it is shared: ReplayBatch takes each batch of its
+  // journal as AddPoints took it, without waking the learner; FinishRestore then restores the
+  // stored state and latest mesh (which must belong to the session and carry its sequence
+  // number), attaches `record`, and sets learning going again unless the session had ended.
+  absl::Status ReplayBatch(const PointCloud& batch) ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
+  void FinishRestore(v1::SessionState state, const std::string& error,
+                     std::shared_ptr<v1::MeshUpdate> latest,
+                     std::unique_ptr<SessionRecord> record) ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
 
   const std::string& id() const { return id_; }
   const std::string& name() const { return name_; }
@@ -103,6 +127,9 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // points the session has taken already are skipped, their count going to `*skipped`: a
   // batch resent after a lost connection adds only what is new. OUT_OF_RANGE, nothing taken,
   // when `first_point` is beyond the points taken (a gap).
+  //
+  // With a record, the batch is stored before it is taken; when that fails (a full disk:
+  // RESOURCE_EXHAUSTED) the batch is refused and nothing changes.
   absl::StatusOr<size_t> AddPoints(const PointCloud& batch, size_t* held_back = nullptr,
                                    std::optional<uint64_t> first_point = std::nullopt,
                                    size_t* skipped = nullptr)
@@ -111,15 +138,17 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // No more points: learn to the final vertex count and publish the final mesh. The points
   // outlier removal still holds back are dropped. FAILED_PRECONDITION when already finishing,
   // finished, cancelled or failed, or when the points received are too few for the initial
-  // tetrahedron.
+  // tetrahedron; with a record, the error of storing the new state (nothing changes then).
   absl::Status Finish() ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
 
   // Stops learning; watchers end with CANCELLED and `reason`. Cancelling a cancelled session is
-  // a no-op. FAILED_PRECONDITION when finished or failed.
+  // a no-op. FAILED_PRECONDITION when finished or failed; with a record, the error of storing
+  // the new state (nothing changes then).
   absl::Status Cancel(absl::string_view reason) ABSL_LOCKS_EXCLUDED(mu_);
 
-  // Ends the session for good (deletion, server shutdown): cancels learning if it still runs and
-  // ends every watcher with `status`.
+  // Ends the session in this process (deletion, server shutdown): cancels learning if it still
+  // runs and ends every watcher with `status`. The record, if any, is left as it is: a deleted
+  // session's caller removes it.
   void Terminate(const absl::Status& status) ABSL_LOCKS_EXCLUDED(mu_);
 
   v1::SessionState state() const ABSL_LOCKS_EXCLUDED(mu_);
@@ -153,6 +182,15 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
     absl::Time taken;
   };
 
+  absl::StatusOr<size_t> AddPointsAndMaybeWake(const PointCloud& sent, size_t* held_back,
+                                               std::optional<uint64_t> first_point,
+                                               size_t* skipped, bool wake)
+      ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
+  // Stores a new state; OK without a record.
+  absl::Status StoreState(v1::SessionState state, const std::string& error) const;
+  // Stores a published mesh; a failure is recorded in the event log (once per session), as the
+  // mesh can be learned again.
+  void StoreMesh(const v1::MeshUpdate& update, bool durable);
   bool AcceptsPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // OK, or FAILED_PRECONDITION naming the state in which the session refuses points.
   absl::Status AcceptingPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
@@ -226,6 +264,9 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   absl::Time last_publish_time_ = absl::InfinitePast();
   uint64_t last_publish_steps_ = 0;
   std::optional<GrowthWatch> growth_;  // Stall detection for the current learner.
+
+  std::unique_ptr<SessionRecord> record_;  // Null without a state directory.
+  std::atomic<bool> mesh_store_failed_{false};
 };
 
 }  // namespace neuralmesh::server

@@ -1,6 +1,8 @@
 #include "server/session_manager.h"
 
 #include <algorithm>
+#include <filesystem>
+#include <system_error>
 #include <utility>
 
 #include "absl/random/random.h"
@@ -8,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/status_macros.h"
+#include "server/proto_conversion.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -41,8 +44,8 @@ std::string QuotedSessionId(absl::string_view id) {
 }
 
 SessionManager::SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder,
-                               std::shared_ptr<EventLog> log)
-    : limits_(limits), pool_(pool), encoder_(encoder), log_(std::move(log)) {
+                               std::shared_ptr<EventLog> log, SessionStore* store)
+    : limits_(limits), pool_(pool), encoder_(encoder), log_(std::move(log)), store_(store) {
   {
     absl::MutexLock lock(&mu_);
     absl::BitGen gen;
@@ -102,6 +105,22 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(SessionConfig co
     session = std::make_shared<Session>(id, std::move(name), std::move(config),
                                         limits_.max_points_per_session, pool_, encoder_, log_,
                                         std::move(owner));
+    if (store_ != nullptr) {
+      storage::v1::StoredSession stored;
+      stored.set_session_id(id);
+      stored.set_name(session->name());
+      stored.set_owner(session->owner());
+      *stored.mutable_config() = SessionConfigToProto(session->config());
+      stored.set_create_time_us(absl::ToUnixMicros(session->create_time()));
+      stored.set_state(v1::SESSION_STATE_COLLECTING);
+      absl::StatusOr<std::unique_ptr<SessionRecord>> record = store_->Create(stored);
+      if (!record.ok()) {
+        return absl::Status(record.status().code(),
+                            absl::StrCat("the server cannot keep a new session on disk: ",
+                                         record.status().message()));
+      }
+      session->AttachRecord(*std::move(record));
+    }
     sessions_.emplace(id, session);
     order_.emplace(created_++, id);
   }
@@ -170,6 +189,7 @@ absl::Status SessionManager::DeleteUnlessActive(absl::string_view id,
                      : std::string("deleted"));
   }
   session->Terminate(absl::NotFoundError(absl::StrCat("session ", id, " was deleted")));
+  if (session->record() != nullptr) session->record()->Remove();
   return absl::OkStatus();
 }
 
@@ -200,6 +220,112 @@ void SessionManager::ReaperLoop() {
     }
     ReapIdle(absl::Now());
   }
+}
+
+RestoreReport SessionManager::RestoreStored() {
+  RestoreReport report;
+  if (store_ == nullptr) return report;
+  const absl::Time start = absl::Now();
+  for (const StoredSessionFiles& files : store_->List(&report.problems)) {
+    std::shared_ptr<Session> session = Restore(files, report);
+    if (session == nullptr) continue;
+    absl::MutexLock lock(&mu_);
+    if (shutdown_) {
+      session->Terminate(absl::UnavailableError("the server is shutting down"));
+      break;
+    }
+    sessions_.emplace(session->id(), session);
+    order_.emplace(created_++, session->id());
+    ++report.sessions;
+    report.points += session->points_received();
+  }
+  report.took = absl::Now() - start;
+  return report;
+}
+
+std::shared_ptr<Session> SessionManager::Restore(const StoredSessionFiles& files,
+                                                 RestoreReport& report) {
+  const storage::v1::StoredSession& stored = files.stored;
+  const std::string& id = stored.session_id();
+  absl::StatusOr<SessionConfig> config = SessionConfigFromProto(stored.config());
+  const absl::Status valid =
+      config.ok() ? ResolveSessionConfig(limits_.max_points_per_session, *config)
+                  : config.status();
+  if (!valid.ok()) {
+    report.problems.push_back(absl::StrCat("session ", id, " stays on disk unrestored: ",
+                                           valid.message()));
+    return nullptr;
+  }
+  auto session = std::make_shared<Session>(
+      id, stored.name(), *std::move(config), limits_.max_points_per_session, pool_, encoder_,
+      log_, stored.owner(), absl::FromUnixMicros(stored.create_time_us()));
+
+  // The batches, taken again; after one that no longer fits (lower limits), the rest are read
+  // only to find where the journal's whole records end.
+  absl::Status replayed = absl::OkStatus();
+  uint64_t batches = 0;
+  uint64_t journal_bytes = 0;
+  std::error_code exists_error;
+  if (std::filesystem::exists(files.journal_path, exists_error)) {
+    absl::StatusOr<JournalReadResult> read =
+        ReadPointsJournal(files.journal_path, [&](const PointCloud& batch) {
+          if (!replayed.ok()) return absl::OkStatus();
+          replayed = session->ReplayBatch(batch);
+          if (replayed.ok()) {
+            ++batches;
+          } else {
+            replayed = absl::Status(replayed.code(), absl::StrCat("batch ", batches + 1, " of ",
+                                                                  "its journal: ",
+                                                                  replayed.message()));
+          }
+          return absl::OkStatus();
+        });
+    if (!read.ok()) {
+      report.problems.push_back(absl::StrCat("session ", id, " stays on disk unrestored: ",
+                                             read.status().message()));
+      return nullptr;
+    }
+    journal_bytes = read->valid_bytes;
+    if (!read->damage.empty()) {
+      report.problems.push_back(absl::StrCat("session ", id, ": its journal ends in ",
+                                             read->damage, "; cut off there"));
+    }
+  }
+
+  v1::SessionState state = stored.state();
+  std::string error = stored.error();
+  std::shared_ptr<v1::MeshUpdate> latest;
+  if (files.latest.has_value() && files.latest->session_id() == id) {
+    latest = std::make_shared<v1::MeshUpdate>(*files.latest);
+  }
+  // Finished, but the final mesh did not reach the disk: it is learned again.
+  if (state == v1::SESSION_STATE_FINISHED &&
+      (latest == nullptr || latest->kind() != v1::UPDATE_KIND_FINAL)) {
+    state = v1::SESSION_STATE_FINISHING;
+  }
+  if (!replayed.ok()) {
+    state = v1::SESSION_STATE_FAILED;
+    error = absl::StrCat("restoring it after a restart failed at ", replayed.message());
+    report.problems.push_back(absl::StrCat("session ", id, " is restored as failed (its files "
+                                           "stay as they are): ", error));
+  }
+  absl::StatusOr<std::unique_ptr<SessionRecord>> record = store_->Reopen(files, journal_bytes);
+  if (!record.ok()) {
+    report.problems.push_back(absl::StrCat("session ", id, " stays on disk unrestored: ",
+                                           record.status().message()));
+    return nullptr;
+  }
+  const std::string latest_note =
+      latest == nullptr ? std::string()
+                        : absl::StrCat(", mesh ", latest->sequence(), " of ",
+                                       latest->vertex_count(), " vertices");
+  session->FinishRestore(state, error, std::move(latest), *std::move(record));
+  if (log_ != nullptr) {
+    log_->Record(id, absl::StrCat("restored after a restart: ", session->points_received(),
+                                  " points in ", batches, " batches, ",
+                                  v1::SessionState_Name(session->state()), latest_note));
+  }
+  return session;
 }
 
 void SessionManager::Shutdown(const absl::Status& status) {

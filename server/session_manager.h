@@ -22,6 +22,7 @@
 #include "server/executor.h"
 #include "server/session.h"
 #include "server/session_config.h"
+#include "server/session_store.h"
 #include "server/worker_pool.h"
 
 namespace neuralmesh::server {
@@ -40,6 +41,16 @@ struct SessionLimits {
   absl::Duration idle_timeout = absl::Minutes(30);
 };
 
+// What RestoreStored found in the state directory.
+struct RestoreReport {
+  size_t sessions = 0;  // Restored, in any state.
+  size_t points = 0;    // Their points, taken again.
+  absl::Duration took;  // Reading the directory and taking the points again.
+  // Sessions left on disk unrestored, torn journal tails cut off, sessions restored as failed:
+  // one line each, for the server's log.
+  std::vector<std::string> problems;
+};
+
 // `id`, as a client sent it, quoted for a status message: cut to its first 64 bytes, with its
 // length, when longer (ids the server makes have 18), so that an error about a bogus id never
 // outgrows the client's metadata limit (8 KB by default), which turns it into
@@ -49,9 +60,10 @@ std::string QuotedSessionId(absl::string_view id);
 class SessionManager {
  public:
   // `pool` and `encoder` must outlive the manager's sessions' work (see Session). `log`, when
-  // set, records every session's creation, end and deletion.
+  // set, records every session's creation, end and deletion. `store`, when set, keeps every
+  // session on disk (session_store.h) and must outlive the manager.
   SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder,
-                 std::shared_ptr<EventLog> log = nullptr);
+                 std::shared_ptr<EventLog> log = nullptr, SessionStore* store = nullptr);
   ~SessionManager();  // Calls Shutdown().
 
   SessionManager(const SessionManager&) = delete;
@@ -61,7 +73,8 @@ class SessionManager {
   // (gRPC's peer address, for the event log), owned by `owner` (the client name of the call's
   // access token, Session::owner). INVALID_ARGUMENT for an invalid configuration or a name
   // longer than 256 bytes; RESOURCE_EXHAUSTED at max_sessions or when `owner` holds
-  // max_sessions_per_client; UNAVAILABLE after Shutdown.
+  // max_sessions_per_client; UNAVAILABLE after Shutdown; with a store, the error of creating
+  // the session's files (RESOURCE_EXHAUSTED for a full disk, and so on).
   absl::StatusOr<std::shared_ptr<Session>> Create(SessionConfig config, std::string name,
                                                   absl::string_view peer = "",
                                                   std::string owner = "")
@@ -75,8 +88,8 @@ class SessionManager {
   // Every session, oldest first; UNAVAILABLE after Shutdown.
   absl::StatusOr<std::vector<std::shared_ptr<Session>>> List() const ABSL_LOCKS_EXCLUDED(mu_);
 
-  // Removes the session; its watchers end with NOT_FOUND. NOT_FOUND when unknown, UNAVAILABLE
-  // after Shutdown.
+  // Removes the session, and its files with a store; its watchers end with NOT_FOUND.
+  // NOT_FOUND when unknown, UNAVAILABLE after Shutdown.
   absl::Status Delete(absl::string_view id) ABSL_LOCKS_EXCLUDED(mu_);
 
   // Deletes the sessions idle at `now` (see SessionLimits::idle_timeout); returns how many.
@@ -87,6 +100,14 @@ class SessionManager {
   // FAILED_PRECONDITION when it was touched since (or has an open stream), so that a session
   // used between ReapIdle's listing and its deletion stays. Otherwise as Delete.
   absl::Status DeleteIfIdle(absl::string_view id, absl::Time idle_at) ABSL_LOCKS_EXCLUDED(mu_);
+
+  // Restores the sessions of the store (none without one), oldest first, before any other
+  // call: each takes its batches again and goes on from its stored state (session.h). Limits
+  // apply as at creation, except max_sessions, which restored sessions may exceed (creation
+  // waits until they are deleted). A session whose configuration no longer passes the
+  // limits stays on disk unrestored; one whose batches no longer fit them is restored as
+  // failed, its files unchanged.
+  RestoreReport RestoreStored() ABSL_LOCKS_EXCLUDED(mu_);
 
   // Stops the reaper and terminates every session with `status` (their streams end with it).
   // Idempotent.
@@ -100,11 +121,14 @@ class SessionManager {
   absl::Status DeleteUnlessActive(absl::string_view id, std::optional<absl::Time> idle_at)
       ABSL_LOCKS_EXCLUDED(mu_);
   std::string NewIdLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Restores one stored session; null (with a line in `report`) when it stays on disk.
+  std::shared_ptr<Session> Restore(const StoredSessionFiles& files, RestoreReport& report);
 
   const SessionLimits limits_;
   WorkerPool* const pool_;
   Executor* const encoder_;
   const std::shared_ptr<EventLog> log_;  // May be null.
+  SessionStore* const store_;             // May be null.
 
   mutable absl::Mutex mu_;
   bool shutdown_ ABSL_GUARDED_BY(mu_) = false;

@@ -13,6 +13,12 @@ uint64_t UpdateChannel::Publish(std::shared_ptr<v1::MeshUpdate> update) {
   return sequence_;
 }
 
+void UpdateChannel::Restore(MeshUpdatePtr update) {
+  absl::MutexLock lock(&mu_);
+  sequence_ = update->sequence();
+  latest_ = std::move(update);
+}
+
 void UpdateChannel::Close(const absl::Status& status) {
   absl::MutexLock lock(&mu_);
   if (closed_.has_value()) return;

@@ -46,6 +46,11 @@ class UpdateChannel {
   // subscriber. Returns the sequence number, or 0 (and drops the update) after Close.
   uint64_t Publish(std::shared_ptr<v1::MeshUpdate> update) ABSL_LOCKS_EXCLUDED(mu_);
 
+  // Makes `update`, as published before a restart of the server (session_store.h), the latest,
+  // and continues its sequence numbers, so that a watcher that resumes after it
+  // (after_sequence) is not sent it again. Only before the first Publish and Subscribe.
+  void Restore(MeshUpdatePtr update) ABSL_LOCKS_EXCLUDED(mu_);
+
   // Ends the channel with `status`; later calls are ignored.
   void Close(const absl::Status& status) ABSL_LOCKS_EXCLUDED(mu_);
 

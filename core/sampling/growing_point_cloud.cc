@@ -136,15 +136,7 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
   std::lock_guard<std::mutex> lock(append_mu_);
   // Only this thread changes size_, so a relaxed load sees the latest value.
   const size_t old_size = size_.load(std::memory_order_relaxed);
-  if (n > max_points_ - old_size) {
-    return absl::ResourceExhaustedError(absl::StrCat("appending ", n, " points to ", old_size,
-                                                     " would exceed the capacity of ", max_points_,
-                                                     " points"));
-  }
-  if (old_size == 0 && !weights.empty() && batch_max_weight == 0.0f) {
-    return absl::InvalidArgumentError(
-        "every weight of the first batch is zero: there would be nothing to sample");
-  }
+  NM_RETURN_IF_ERROR(CheckRoomFor(n, old_size, !weights.empty() && batch_max_weight == 0.0f));
 
   // Earlier points weigh 1 and have a zero normal; they get them, and the weight-1 class, before
   // the flag that lets readers look for them.
@@ -187,6 +179,29 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
   size_.store(old_size + n, std::memory_order_release);
   if (weighted && old_size != 0) PublishClasses();
   return absl::OkStatus();
+}
+
+absl::Status GrowingPointCloud::CheckRoomFor(size_t n, size_t old_size,
+                                             bool weights_all_zero) const {
+  if (n > max_points_ - old_size) {
+    return absl::ResourceExhaustedError(absl::StrCat("appending ", n, " points to ", old_size,
+                                                     " would exceed the capacity of ", max_points_,
+                                                     " points"));
+  }
+  if (old_size == 0 && weights_all_zero) {
+    return absl::InvalidArgumentError(
+        "every weight of the first batch is zero: there would be nothing to sample");
+  }
+  return absl::OkStatus();
+}
+
+absl::Status GrowingPointCloud::CheckAppend(const PointCloud& batch) const {
+  NM_RETURN_IF_ERROR(ValidateBatch(batch.positions, batch.weights, batch.normals));
+  if (batch.positions.empty()) return absl::OkStatus();
+  const bool weights_all_zero =
+      !batch.weights.empty() &&
+      std::all_of(batch.weights.begin(), batch.weights.end(), [](float w) { return w == 0.0f; });
+  return CheckRoomFor(batch.positions.size(), size(), weights_all_zero);
 }
 
 absl::Status GrowingPointCloud::Append(const PointCloud& batch) {

@@ -1,0 +1,222 @@
+#include "server/session_store.h"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <system_error>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/io/file_contents.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh::server {
+namespace {
+
+constexpr uint32_t kFormatVersion = 1;
+constexpr char kSessionsDirectory[] = "sessions";
+constexpr char kLockFile[] = "LOCK";
+
+absl::Status ErrorCodeStatus(const std::error_code& error, const std::string& what) {
+  return absl::ErrnoToStatus(error.value(), what);
+}
+
+// fsync()s the file or directory at `path`.
+absl::Status SyncPath(const std::string& path) {
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open '", path, "'"));
+  const int result = fsync(fd);
+  const int error = errno;
+  close(fd);
+  if (result != 0) return absl::ErrnoToStatus(error, absl::StrCat("cannot sync '", path, "'"));
+  return absl::OkStatus();
+}
+
+// Whether `name` can be a session id the server made (server/session_manager.cc).
+bool IsSessionId(const std::string& name) {
+  return !name.empty() && name.size() <= 64 &&
+         std::all_of(name.begin(), name.end(), [](char c) {
+           return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-';
+         });
+}
+
+absl::StatusOr<StoredSessionFiles> ReadSessionDirectory(const std::string& directory) {
+  StoredSessionFiles files;
+  files.directory = directory;
+  files.journal_path = absl::StrCat(directory, "/", kPointsJournalFile);
+  NM_ASSIGN_OR_RETURN(const std::string state,
+                      ReadFileContents(absl::StrCat(directory, "/", kStoredSessionFile)));
+  if (!files.stored.ParseFromString(state)) {
+    return absl::DataLossError(absl::StrCat("'", directory, "/", kStoredSessionFile,
+                                            "' is not a stored session"));
+  }
+  if (files.stored.format_version() != kFormatVersion) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("'", directory, "' has format version ", files.stored.format_version(),
+                     "; this server reads version ", kFormatVersion));
+  }
+  const std::string id = std::filesystem::path(directory).filename().string();
+  if (files.stored.session_id() != id) {
+    return absl::DataLossError(absl::StrCat("'", directory, "' holds session \"",
+                                            files.stored.session_id(), "\""));
+  }
+  if (absl::StatusOr<std::string> latest =
+          ReadFileContents(absl::StrCat(directory, "/", kLatestMeshFile));
+      latest.ok()) {
+    v1::MeshUpdate update;
+    if (update.ParseFromString(*latest)) files.latest = std::move(update);
+  }
+  return files;
+}
+
+}  // namespace
+
+SessionRecord::SessionRecord(std::string directory, storage::v1::StoredSession stored,
+                             std::unique_ptr<PointsJournal> journal, bool sync)
+    : directory_(std::move(directory)),
+      sync_(sync),
+      stored_(std::move(stored)),
+      journal_(std::move(journal)) {}
+
+absl::Status SessionRecord::AppendBatch(const PointCloud& batch) {
+  absl::MutexLock lock(&mu_);
+  if (removed_) return absl::OkStatus();
+  return journal_->Append(batch);
+}
+
+absl::Status SessionRecord::SetState(v1::SessionState state, const std::string& error) {
+  absl::MutexLock lock(&mu_);
+  if (removed_) return absl::OkStatus();
+  storage::v1::StoredSession changed = stored_;
+  changed.set_state(state);
+  changed.set_error(error);
+  NM_RETURN_IF_ERROR(ReplaceFile(kStoredSessionFile, changed, /*durable=*/true));
+  stored_ = std::move(changed);
+  return absl::OkStatus();
+}
+
+absl::Status SessionRecord::WriteLatestMesh(const v1::MeshUpdate& update, bool durable) {
+  absl::MutexLock lock(&mu_);
+  if (removed_) return absl::OkStatus();
+  return ReplaceFile(kLatestMeshFile, update, durable);
+}
+
+void SessionRecord::Remove() {
+  absl::MutexLock lock(&mu_);
+  if (removed_) return;
+  removed_ = true;
+  journal_.reset();
+  std::error_code error;
+  std::filesystem::remove_all(directory_, error);
+}
+
+absl::Status SessionRecord::ReplaceFile(const std::string& name,
+                                        const google::protobuf::Message& message, bool durable) {
+  const std::string path = absl::StrCat(directory_, "/", name);
+  const std::string temporary = absl::StrCat(path, ".new");
+  NM_RETURN_IF_ERROR(WriteFileContents(temporary, message.SerializeAsString()));
+  if (durable && sync_) NM_RETURN_IF_ERROR(SyncPath(temporary));
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const int error = errno;
+    std::remove(temporary.c_str());
+    return absl::ErrnoToStatus(error, absl::StrCat("cannot replace '", path, "'"));
+  }
+  if (durable && sync_) return SyncPath(directory_);
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::unique_ptr<SessionStore>> SessionStore::Open(const std::string& directory,
+                                                                 bool sync) {
+  if (directory.empty()) return absl::InvalidArgumentError("the state directory is empty");
+  std::error_code error;
+  std::filesystem::create_directories(absl::StrCat(directory, "/", kSessionsDirectory), error);
+  if (error) {
+    return ErrorCodeStatus(error, absl::StrCat("cannot create the state directory '", directory,
+                                               "'"));
+  }
+  const std::string lock_path = absl::StrCat(directory, "/", kLockFile);
+  const int fd = open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+  if (fd < 0) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open '", lock_path, "'"));
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int lock_error = errno;
+    close(fd);
+    if (lock_error == EWOULDBLOCK) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "the state directory '", directory, "' is in use by another neuralmesh-server"));
+    }
+    return absl::ErrnoToStatus(lock_error, absl::StrCat("cannot lock '", lock_path, "'"));
+  }
+  return std::unique_ptr<SessionStore>(new SessionStore(directory, fd, sync));
+}
+
+SessionStore::~SessionStore() { close(lock_fd_); }
+
+std::vector<StoredSessionFiles> SessionStore::List(std::vector<std::string>* problems) const {
+  std::vector<StoredSessionFiles> found;
+  std::error_code error;
+  const std::string sessions = absl::StrCat(directory_, "/", kSessionsDirectory);
+  for (const auto& entry : std::filesystem::directory_iterator(sessions, error)) {
+    const std::string name = entry.path().filename().string();
+    if (!entry.is_directory() || !IsSessionId(name)) {
+      problems->push_back(absl::StrCat("'", entry.path().string(), "' is not a session; left"));
+      continue;
+    }
+    absl::StatusOr<StoredSessionFiles> files = ReadSessionDirectory(entry.path().string());
+    if (!files.ok()) {
+      problems->push_back(absl::StrCat(files.status().message(), "; left as it is"));
+      continue;
+    }
+    found.push_back(*std::move(files));
+  }
+  if (error) {
+    problems->push_back(
+        absl::StrCat("cannot list '", sessions, "': ", error.message()));
+  }
+  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) {
+    if (a.stored.create_time_us() != b.stored.create_time_us()) {
+      return a.stored.create_time_us() < b.stored.create_time_us();
+    }
+    return a.stored.session_id() < b.stored.session_id();
+  });
+  return found;
+}
+
+absl::StatusOr<std::unique_ptr<SessionRecord>> SessionStore::Create(
+    const storage::v1::StoredSession& stored) {
+  const std::string directory =
+      absl::StrCat(directory_, "/", kSessionsDirectory, "/", stored.session_id());
+  std::error_code error;
+  if (!std::filesystem::create_directory(directory, error)) {
+    return error ? ErrorCodeStatus(error, absl::StrCat("cannot create '", directory, "'"))
+                 : absl::AlreadyExistsError(absl::StrCat("'", directory, "' exists already"));
+  }
+  storage::v1::StoredSession first = stored;
+  first.set_format_version(kFormatVersion);
+  const std::string state_path = absl::StrCat(directory, "/", kStoredSessionFile);
+  absl::Status written = WriteFileContents(state_path, first.SerializeAsString());
+  if (written.ok() && sync_) written = SyncPath(state_path);
+  if (written.ok() && sync_) written = SyncPath(absl::StrCat(directory_, "/", kSessionsDirectory));
+  absl::StatusOr<std::unique_ptr<PointsJournal>> journal =
+      written.ok() ? PointsJournal::Open(absl::StrCat(directory, "/", kPointsJournalFile), 0, sync_)
+                   : absl::StatusOr<std::unique_ptr<PointsJournal>>(written);
+  if (!journal.ok()) {
+    std::filesystem::remove_all(directory, error);
+    return journal.status();
+  }
+  return std::make_unique<SessionRecord>(directory, std::move(first), *std::move(journal), sync_);
+}
+
+absl::StatusOr<std::unique_ptr<SessionRecord>> SessionStore::Reopen(
+    const StoredSessionFiles& files, uint64_t journal_bytes) {
+  NM_ASSIGN_OR_RETURN(std::unique_ptr<PointsJournal> journal,
+                      PointsJournal::Open(files.journal_path, journal_bytes, sync_));
+  return std::make_unique<SessionRecord>(files.directory, files.stored, std::move(journal),
+                                         sync_);
+}
+
+}  // namespace neuralmesh::server

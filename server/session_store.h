@@ -1,0 +1,122 @@
+// The state directory of neuralmesh-server --state_dir: each session's identity, state, points
+// and latest mesh on disk, so that sessions outlive a restart of the server.
+//
+// Layout:
+//   DIR/LOCK                      flock()ed by the one server that uses DIR
+//   DIR/sessions/ID/session.binpb neuralmesh.storage.v1.StoredSession, replaced whole
+//   DIR/sessions/ID/points.journal every batch the session took, in order (points_journal.h)
+//   DIR/sessions/ID/latest.binpb  the latest published neuralmesh.v1.MeshUpdate, replaced whole
+//
+// What is durable: a batch is acknowledged only after its record is written (and, with `sync`,
+// on the disk); a state change a client asks for (finish, cancel) is written before it
+// answers. Meshes are written after they are published and are not synced: a restored session
+// that lacks one relearns it. The learner's own state is not kept: a restored session learns
+// again from its points (session.h).
+#ifndef NEURALMESH_SERVER_SESSION_STORE_H_
+#define NEURALMESH_SERVER_SESSION_STORE_H_
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
+#include "core/point_cloud.h"
+#include "neuralmesh/storage/v1/stored_session.pb.h"
+#include "neuralmesh/v1/reconstruction.pb.h"
+#include "server/points_journal.h"
+
+namespace neuralmesh::server {
+
+// The files of one session, open for writing. Thread-safe.
+class SessionRecord {
+ public:
+  SessionRecord(std::string directory, storage::v1::StoredSession stored,
+                std::unique_ptr<PointsJournal> journal, bool sync);
+
+  SessionRecord(const SessionRecord&) = delete;
+  SessionRecord& operator=(const SessionRecord&) = delete;
+
+  // Appends a batch to the journal (PointsJournal::Append). OK and nothing written once
+  // removed.
+  absl::Status AppendBatch(const PointCloud& batch) ABSL_LOCKS_EXCLUDED(mu_);
+  // Records a new state and its reason (the error of a cancelled or failed session).
+  absl::Status SetState(v1::SessionState state, const std::string& error)
+      ABSL_LOCKS_EXCLUDED(mu_);
+  // Replaces the stored latest mesh; with `durable` (the final mesh) synced like a state.
+  absl::Status WriteLatestMesh(const v1::MeshUpdate& update, bool durable)
+      ABSL_LOCKS_EXCLUDED(mu_);
+  // Deletes the session's directory; every later call does nothing.
+  void Remove() ABSL_LOCKS_EXCLUDED(mu_);
+
+  const std::string& directory() const { return directory_; }
+
+ private:
+  // Writes `message` to `name` in the directory through a temporary file and a rename.
+  absl::Status ReplaceFile(const std::string& name, const google::protobuf::Message& message,
+                           bool durable) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+
+  const std::string directory_;
+  const bool sync_;
+  absl::Mutex mu_;
+  storage::v1::StoredSession stored_ ABSL_GUARDED_BY(mu_);
+  std::unique_ptr<PointsJournal> journal_ ABSL_GUARDED_BY(mu_);
+  bool removed_ ABSL_GUARDED_BY(mu_) = false;
+};
+
+// A session found in the state directory.
+struct StoredSessionFiles {
+  std::string directory;
+  storage::v1::StoredSession stored;
+  std::string journal_path;
+  // The latest mesh, when its file was there and readable.
+  std::optional<v1::MeshUpdate> latest;
+};
+
+class SessionStore {
+ public:
+  // Opens (creating) the state directory `directory` and locks it against other servers:
+  // FAILED_PRECONDITION when another process holds it, the errno's code otherwise. `sync`:
+  // batches and state changes reach the disk before they are acknowledged (fdatasync).
+  static absl::StatusOr<std::unique_ptr<SessionStore>> Open(const std::string& directory,
+                                                            bool sync);
+  ~SessionStore();
+
+  SessionStore(const SessionStore&) = delete;
+  SessionStore& operator=(const SessionStore&) = delete;
+
+  // The sessions in the directory, oldest first. A session directory that cannot be read is
+  // left as it is and described in `problems`.
+  std::vector<StoredSessionFiles> List(std::vector<std::string>* problems) const;
+
+  // Creates the files of a new session (its state file first) and opens them for writing.
+  absl::StatusOr<std::unique_ptr<SessionRecord>> Create(const storage::v1::StoredSession& stored);
+
+  // Opens the files of a listed session for writing, its journal cut to `journal_bytes`
+  // (ReadPointsJournal's valid_bytes).
+  absl::StatusOr<std::unique_ptr<SessionRecord>> Reopen(const StoredSessionFiles& files,
+                                                        uint64_t journal_bytes);
+
+  const std::string& directory() const { return directory_; }
+  bool sync() const { return sync_; }
+
+ private:
+  SessionStore(std::string directory, int lock_fd, bool sync)
+      : directory_(std::move(directory)), lock_fd_(lock_fd), sync_(sync) {}
+
+  const std::string directory_;
+  const int lock_fd_;
+  const bool sync_;
+};
+
+// The file names inside a session's directory.
+inline constexpr char kStoredSessionFile[] = "session.binpb";
+inline constexpr char kPointsJournalFile[] = "points.journal";
+inline constexpr char kLatestMeshFile[] = "latest.binpb";
+
+}  // namespace neuralmesh::server
+
+#endif  // NEURALMESH_SERVER_SESSION_STORE_H_

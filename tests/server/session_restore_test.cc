@@ -1,0 +1,379 @@
+// neuralmesh-server --state_dir (server/session_store.h): sessions outlive a restart of the
+// server. Each test runs a server on a state directory, stops it, starts another on the same
+// directory and checks what a client sees there: the same sessions, points, states and meshes,
+// uploads and watches that go on, and what happens with damaged or full storage.
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "core/io/draco_codec.h"
+#include "core/sampling/implicit_surfaces.h"
+#include "server/server.h"
+#include "tests/server/server_test_support.h"
+#include "tests/testing/temp_dir.h"
+
+namespace neuralmesh::server {
+namespace {
+
+using ::neuralmesh::server::testing::Batch;
+using ::neuralmesh::server::testing::CreateRequest;
+using ::neuralmesh::server::testing::GetSession;
+using ::neuralmesh::server::testing::MustCreate;
+using ::neuralmesh::server::testing::SpherePoints;
+using ::neuralmesh::server::testing::TorusPoints;
+using ::neuralmesh::server::testing::Upload;
+using ::neuralmesh::server::testing::WaitFinal;
+using Service = v1::ReconstructionService::Stub;
+
+// Uploads points [begin, end) of `cloud` in `batches` batches that carry their place in the
+// upload (PointBatch.first_point).
+grpc::Status UploadFrom(Service& service, const std::string& id, const PointCloud& cloud,
+                        size_t begin, size_t end, size_t batches,
+                        v1::UploadPointsResponse* response) {
+  grpc::ClientContext context;
+  auto writer = service.UploadPoints(&context, response);
+  for (size_t b = 0; b < batches; ++b) {
+    const size_t first = begin + (end - begin) * b / batches;
+    v1::UploadPointsRequest request;
+    request.set_session_id(id);
+    *request.mutable_batch() = Batch(cloud, first, begin + (end - begin) * (b + 1) / batches);
+    request.mutable_batch()->mutable_first_point()->set_value(first);
+    if (!writer->Write(request)) break;
+  }
+  writer->WritesDone();
+  return writer->Finish();
+}
+
+grpc::Status GetLatest(Service& service, const std::string& id, v1::MeshUpdate* update) {
+  grpc::ClientContext context;
+  context.set_deadline(absl::ToChronoTime(absl::Now() + absl::Seconds(30)));
+  v1::GetMeshRequest request;
+  request.set_session_id(id);
+  request.set_wait(true);
+  return service.GetMesh(&context, request, update);
+}
+
+grpc::Status WatchAfter(Service& service, const std::string& id, uint64_t after_sequence,
+                        std::vector<v1::MeshUpdate>* updates) {
+  grpc::ClientContext context;
+  context.set_deadline(absl::ToChronoTime(absl::Now() + absl::Seconds(60)));
+  v1::WatchSessionRequest request;
+  request.set_session_id(id);
+  request.set_after_sequence(after_sequence);
+  auto reader = service.WatchSession(&context, request);
+  v1::MeshUpdate update;
+  while (reader->Read(&update)) updates->push_back(update);
+  return reader->Finish();
+}
+
+class SessionRestoreTest : public ::testing::Test {
+ protected:
+  void SetUp() override { state_dir_ = neuralmesh::testing::MakeTempDir("state"); }
+
+  // Starts a server on the state directory (stopping the one before), with `options`' limits.
+  void Restart(ServerOptions options = {}) {
+    service_.reset();
+    server_.reset();
+    options.address = "";
+    options.state_dir = state_dir_;
+    options.state_sync = false;  // The tests stop servers, not machines.
+    options.event_sink = events_.Sink();
+    absl::StatusOr<std::unique_ptr<ReconstructionServer>> server =
+        ReconstructionServer::Start(options);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = *std::move(server);
+    service_ = testing::InProcessService(*server_);
+  }
+
+  std::string SessionDirectory(const std::string& id) const {
+    return absl::StrCat(state_dir_, "/sessions/", id);
+  }
+
+  std::string state_dir_;
+  testing::CapturedEvents events_;
+  std::unique_ptr<ReconstructionServer> server_;
+  std::unique_ptr<Service> service_;
+};
+
+TEST_F(SessionRestoreTest, AnUploadGoesOnWhereItWasAndEndsOnTheSphere) {
+  Restart();
+  const PointCloud cloud = SpherePoints(40000, 11);
+  const std::string id = MustCreate(*service_, CreateRequest(2000, /*refresh_ms=*/20));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(UploadFrom(*service_, id, cloud, 0, 15000, 3, &response).ok());
+  v1::MeshUpdate mesh;
+  ASSERT_TRUE(GetLatest(*service_, id, &mesh).ok());
+  // Let learning go on a little, so that the stored mesh is a later one.
+  absl::SleepFor(absl::Milliseconds(200));
+  const v1::Session before = GetSession(*service_, id);
+  ASSERT_GT(before.latest_sequence(), 0u);
+
+  Restart();
+  EXPECT_EQ(server_->restored().sessions, 1u);
+  EXPECT_EQ(server_->restored().points, 15000u);
+  EXPECT_TRUE(server_->restored().problems.empty());
+  EXPECT_FALSE(events_.Await("restored after a restart: 15000 points in 3 batches").empty());
+  grpc::Status status;
+  const v1::Session after = GetSession(*service_, id, &status);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(after.name(), before.name());
+  EXPECT_EQ(after.create_time_us(), before.create_time_us());
+  EXPECT_EQ(after.config().SerializeAsString(), before.config().SerializeAsString());
+  EXPECT_EQ(after.points_taken(), 15000u);
+  EXPECT_EQ(after.learning().points_received(), 15000u);
+  EXPECT_EQ(after.quantization_box().SerializeAsString(),
+            before.quantization_box().SerializeAsString());
+  // The stored mesh is the latest again, under its own sequence number (or, learning having
+  // gone on since, a later one).
+  EXPECT_GE(after.latest_sequence(), before.latest_sequence());
+  v1::MeshUpdate restored_mesh;
+  ASSERT_TRUE(GetLatest(*service_, id, &restored_mesh).ok());
+  EXPECT_GE(restored_mesh.sequence(), before.latest_sequence());
+
+  // A watch resumed after the restored mesh, and the rest of the upload resent from before
+  // the points the session has (the overlap is skipped).
+  std::vector<v1::MeshUpdate> watched;
+  grpc::Status watch_status;
+  std::thread watcher([&] {
+    watch_status = WatchAfter(*service_, id, restored_mesh.sequence(), &watched);
+  });
+  ASSERT_TRUE(UploadFrom(*service_, id, cloud, 10000, 40000, 6, &response).ok());
+  EXPECT_EQ(response.total_points(), 40000u);
+  EXPECT_EQ(response.points_accepted(), 25000u);  // Its first batch was there already.
+  ASSERT_TRUE(testing::Finish(*service_, id).ok());
+  v1::MeshUpdate final_mesh;
+  ASSERT_TRUE(WaitFinal(*service_, id, &final_mesh).ok());
+  watcher.join();
+  ASSERT_TRUE(watch_status.ok()) << watch_status.error_message();
+  ASSERT_FALSE(watched.empty());
+  for (const v1::MeshUpdate& update : watched) {
+    EXPECT_GT(update.sequence(), restored_mesh.sequence());
+    // Nothing coarser than what the watchers had before the restart.
+    EXPECT_GE(update.vertex_count(), restored_mesh.vertex_count());
+  }
+  EXPECT_EQ(watched.back().kind(), v1::UPDATE_KIND_FINAL);
+
+  EXPECT_EQ(final_mesh.learning().points_received(), 40000u);
+  EXPECT_EQ(final_mesh.vertex_count(), 2000u);
+  EXPECT_EQ(final_mesh.report().genus(), 0);
+  EXPECT_EQ(final_mesh.report().boundary_loops(), 0u);
+  EXPECT_TRUE(final_mesh.report().manifold());
+  absl::StatusOr<TriangleMesh> decoded = DecodeMesh(final_mesh.draco_mesh());
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  absl::StatusOr<std::unique_ptr<ImplicitSurface>> sphere = MakeSphere(Vec3(0, 0, 0), 1.0);
+  ASSERT_TRUE(sphere.ok());
+  EXPECT_LT(testing::MaxVertexDistance(*decoded, **sphere), 0.02);
+}
+
+TEST_F(SessionRestoreTest, EndedSessionsComeBackAsTheyEndedAndDeletedOnesDoNot) {
+  Restart();
+  const PointCloud cloud = TorusPoints(20000, 3);
+  const std::string finished = MustCreate(*service_, CreateRequest(1000));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(Upload(*service_, finished, cloud, 4, &response).ok());
+  ASSERT_TRUE(testing::Finish(*service_, finished).ok());
+  v1::MeshUpdate final_before;
+  ASSERT_TRUE(WaitFinal(*service_, finished, &final_before).ok());
+  const std::string cancelled = MustCreate(*service_, CreateRequest(1000));
+  ASSERT_TRUE(Upload(*service_, cancelled, cloud, 2, &response).ok());
+  ASSERT_TRUE(testing::Cancel(*service_, cancelled).ok());
+  const std::string deleted = MustCreate(*service_, CreateRequest(1000));
+  ASSERT_TRUE(testing::Delete(*service_, deleted).ok());
+  EXPECT_FALSE(std::filesystem::exists(SessionDirectory(deleted)));
+
+  Restart();
+  EXPECT_EQ(server_->restored().sessions, 2u);
+  grpc::ClientContext context;
+  v1::ListSessionsResponse list;
+  ASSERT_TRUE(service_->ListSessions(&context, v1::ListSessionsRequest(), &list).ok());
+  ASSERT_EQ(list.sessions_size(), 2);
+  EXPECT_EQ(list.sessions(0).session_id(), finished);
+  EXPECT_EQ(list.sessions(1).session_id(), cancelled);
+
+  // The finished session: its final mesh, byte for byte, and nothing more to learn.
+  const v1::Session done = list.sessions(0);
+  EXPECT_EQ(done.state(), v1::SESSION_STATE_FINISHED);
+  EXPECT_EQ(done.learning().basic_steps(), final_before.learning().basic_steps());
+  EXPECT_EQ(done.learning().points_received(), 20000u);
+  v1::MeshUpdate final_after;
+  ASSERT_TRUE(WaitFinal(*service_, finished, &final_after).ok());
+  EXPECT_EQ(final_after.SerializeAsString(), final_before.SerializeAsString());
+  std::vector<v1::MeshUpdate> watched;
+  EXPECT_TRUE(WatchAfter(*service_, finished, 0, &watched).ok());
+  ASSERT_EQ(watched.size(), 1u);
+  EXPECT_EQ(watched[0].sequence(), final_before.sequence());
+  EXPECT_EQ(UploadFrom(*service_, finished, cloud, 20000, 20001, 1, &response).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+
+  // The cancelled one: cancelled, with who cancelled it.
+  EXPECT_EQ(list.sessions(1).state(), v1::SESSION_STATE_CANCELLED);
+  EXPECT_EQ(list.sessions(1).error(), "cancelled by a CancelSession call");
+  watched.clear();
+  EXPECT_EQ(WatchAfter(*service_, cancelled, 0, &watched).error_code(),
+            grpc::StatusCode::CANCELLED);
+  EXPECT_EQ(testing::Finish(*service_, cancelled).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+
+  grpc::Status status;
+  GetSession(*service_, deleted, &status);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  // Deleting a restored session removes its files too.
+  ASSERT_TRUE(testing::Delete(*service_, cancelled).ok());
+  EXPECT_FALSE(std::filesystem::exists(SessionDirectory(cancelled)));
+  Restart();
+  EXPECT_EQ(server_->restored().sessions, 1u);
+}
+
+TEST_F(SessionRestoreTest, OutlierVerdictsComeOutAsBefore) {
+  Restart();
+  PointCloud cloud = TorusPoints(12000, 5);
+  // Strays far from the torus, spread over the batches.
+  for (size_t i = 0; i < 60; ++i) {
+    cloud.positions[i * 200 + 7] = Vec3f(3.0f + 0.01f * i, -2.5f, 2.0f + 0.02f * i);
+  }
+  v1::CreateSessionRequest request = CreateRequest(500);
+  request.mutable_config()->mutable_outlier_removal();
+  const std::string id = MustCreate(*service_, request);
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(Upload(*service_, id, cloud, 6, &response).ok());
+  const v1::Session before = GetSession(*service_, id);
+  EXPECT_GT(before.learning().points_removed_as_outliers() + before.learning().outliers_held(),
+            0u);
+
+  Restart();
+  const v1::Session after = GetSession(*service_, id);
+  EXPECT_EQ(after.points_taken(), before.points_taken());
+  EXPECT_EQ(after.learning().points_received(), before.learning().points_received());
+  EXPECT_EQ(after.learning().points_removed_as_outliers(),
+            before.learning().points_removed_as_outliers());
+  EXPECT_EQ(after.learning().outliers_held(), before.learning().outliers_held());
+  EXPECT_EQ(after.learning().outliers_accepted_later(),
+            before.learning().outliers_accepted_later());
+  EXPECT_EQ(after.quantization_box().SerializeAsString(),
+            before.quantization_box().SerializeAsString());
+}
+
+TEST_F(SessionRestoreTest, PointsBeyondANewLimitFailTheSessionAndKeepItsFiles) {
+  Restart();
+  const PointCloud cloud = SpherePoints(10000, 7);
+  const std::string id = MustCreate(*service_, CreateRequest(1000));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(Upload(*service_, id, cloud, 4, &response).ok());
+  const uintmax_t journal_bytes =
+      std::filesystem::file_size(SessionDirectory(id) + "/points.journal");
+
+  ServerOptions smaller;
+  smaller.limits.max_points_per_session = 6000;
+  Restart(smaller);
+  const v1::Session failed = GetSession(*service_, id);
+  EXPECT_EQ(failed.state(), v1::SESSION_STATE_FAILED);
+  EXPECT_TRUE(absl::StrContains(failed.error(), "restoring it after a restart failed at batch 3"))
+      << failed.error();
+  EXPECT_EQ(failed.learning().points_received(), 5000u);
+  ASSERT_EQ(server_->restored().problems.size(), 1u);
+  EXPECT_EQ(std::filesystem::file_size(SessionDirectory(id) + "/points.journal"), journal_bytes);
+
+  // With the old limit back, the session is whole again.
+  Restart();
+  const v1::Session whole = GetSession(*service_, id);
+  EXPECT_NE(whole.state(), v1::SESSION_STATE_FAILED) << whole.error();
+  EXPECT_EQ(whole.learning().points_received(), 10000u);
+  EXPECT_TRUE(testing::Finish(*service_, id).ok());
+}
+
+TEST_F(SessionRestoreTest, ATornJournalTailIsCutOffAndTheUploadResumesBeforeIt) {
+  Restart();
+  const PointCloud cloud = SpherePoints(9000, 8);
+  const std::string id = MustCreate(*service_, CreateRequest(1000));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(UploadFrom(*service_, id, cloud, 0, 6000, 2, &response).ok());
+  service_.reset();
+  server_.reset();
+  // A crash in the middle of writing a third record.
+  std::ofstream(SessionDirectory(id) + "/points.journal", std::ios::app | std::ios::binary)
+      << std::string("NMPB\x10\x00", 6);
+
+  Restart();
+  ASSERT_EQ(server_->restored().problems.size(), 1u);
+  EXPECT_TRUE(absl::StrContains(server_->restored().problems[0], "torn record header"))
+      << server_->restored().problems[0];
+  const v1::Session after = GetSession(*service_, id);
+  EXPECT_EQ(after.points_taken(), 6000u);
+  ASSERT_TRUE(UploadFrom(*service_, id, cloud, 6000, 9000, 1, &response).ok());
+
+  Restart();
+  EXPECT_TRUE(server_->restored().problems.empty());
+  EXPECT_EQ(GetSession(*service_, id).points_taken(), 9000u);
+}
+
+TEST_F(SessionRestoreTest, ABatchThatCannotBeStoredIsRefusedAndChangesNothing) {
+  Restart();
+  const PointCloud cloud = SpherePoints(20000, 9);
+  const std::string id = MustCreate(*service_, CreateRequest(1000, /*refresh_ms=*/0));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(UploadFrom(*service_, id, cloud, 0, 5000, 1, &response).ok());
+  const uintmax_t journal_bytes =
+      std::filesystem::file_size(SessionDirectory(id) + "/points.journal");
+
+  // A file size limit that the next batch's record would pass (a full disk answers alike).
+  signal(SIGXFSZ, SIG_IGN);
+  rlimit old_limit;
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  rlimit limit = old_limit;
+  limit.rlim_cur = journal_bytes + 1000;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+  const grpc::Status refused = UploadFrom(*service_, id, cloud, 5000, 15000, 1, &response);
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_TRUE(absl::StrContains(refused.error_message(), "cannot store the batch"))
+      << refused.error_message();
+  EXPECT_EQ(GetSession(*service_, id).points_taken(), 5000u);
+  EXPECT_EQ(std::filesystem::file_size(SessionDirectory(id) + "/points.journal"), journal_bytes);
+
+  ASSERT_TRUE(UploadFrom(*service_, id, cloud, 5000, 15000, 1, &response).ok());
+  Restart();
+  EXPECT_EQ(GetSession(*service_, id).points_taken(), 15000u);
+}
+
+TEST_F(SessionRestoreTest, ARestoredSessionsIdleTimeStartsAtTheRestart) {
+  ServerOptions options;
+  options.limits.idle_timeout = absl::Milliseconds(400);
+  Restart(options);
+  const std::string id = MustCreate(*service_, CreateRequest(1000));
+  absl::SleepFor(absl::Milliseconds(250));
+  Restart(options);
+  absl::SleepFor(absl::Milliseconds(250));
+  // 500 ms after its creation, 250 ms after the restart: not idle yet.
+  grpc::Status status;
+  GetSession(*service_, id, &status);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  // And the reaper still deletes it, files too, once it is idle.
+  absl::SleepFor(absl::Milliseconds(700));
+  GetSession(*service_, id, &status);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_FALSE(std::filesystem::exists(SessionDirectory(id)));
+}
+
+TEST_F(SessionRestoreTest, OneServerAtATimeUsesAStateDirectory) {
+  Restart();
+  ServerOptions options;
+  options.address = "";
+  options.state_dir = state_dir_;
+  absl::StatusOr<std::unique_ptr<ReconstructionServer>> second =
+      ReconstructionServer::Start(options);
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_TRUE(absl::StrContains(second.status().message(), "in use by another"))
+      << second.status();
+}
+
+}  // namespace
+}  // namespace neuralmesh::server

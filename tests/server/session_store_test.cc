@@ -1,0 +1,126 @@
+// server/session_store.h: one server per state directory, sessions created, listed, changed
+// and removed, and what the directory holds that is not a session.
+#include "server/session_store.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "tests/testing/temp_dir.h"
+
+namespace neuralmesh::server {
+namespace {
+
+storage::v1::StoredSession NewSession(const std::string& id, int64_t create_time_us) {
+  storage::v1::StoredSession stored;
+  stored.set_session_id(id);
+  stored.set_name(absl::StrCat("name of ", id));
+  stored.set_owner("alice");
+  stored.mutable_config()->set_target_vertices(1234);
+  stored.set_create_time_us(create_time_us);
+  stored.set_state(v1::SESSION_STATE_COLLECTING);
+  return stored;
+}
+
+TEST(SessionStoreTest, OneServerAtATimeUsesADirectory) {
+  const std::string dir = neuralmesh::testing::MakeTempDir("locked") + "/state";
+  absl::StatusOr<std::unique_ptr<SessionStore>> first = SessionStore::Open(dir, false);
+  ASSERT_TRUE(first.ok()) << first.status();
+  EXPECT_TRUE(std::filesystem::is_directory(dir + "/sessions"));
+  absl::StatusOr<std::unique_ptr<SessionStore>> second = SessionStore::Open(dir, false);
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_TRUE(absl::StrContains(second.status().message(), "in use by another neuralmesh-server"))
+      << second.status();
+  first->reset();
+  EXPECT_TRUE(SessionStore::Open(dir, false).ok());
+}
+
+TEST(SessionStoreTest, ADirectoryThatCannotBeMadeIsAnError) {
+  const std::string file = neuralmesh::testing::MakeTempDir("notdir") + "/file";
+  std::ofstream(file) << "x";
+  absl::StatusOr<std::unique_ptr<SessionStore>> store = SessionStore::Open(file, false);
+  EXPECT_FALSE(store.ok());
+  EXPECT_TRUE(absl::StrContains(store.status().message(), file)) << store.status();
+}
+
+TEST(SessionStoreTest, SessionsAreListedOldestFirstWithTheirStateAndMesh) {
+  const std::string dir = neuralmesh::testing::MakeTempDir("listed");
+  absl::StatusOr<std::unique_ptr<SessionStore>> store = SessionStore::Open(dir, true);
+  ASSERT_TRUE(store.ok()) << store.status();
+  absl::StatusOr<std::unique_ptr<SessionRecord>> later =
+      (*store)->Create(NewSession("s-later", 2000));
+  absl::StatusOr<std::unique_ptr<SessionRecord>> earlier =
+      (*store)->Create(NewSession("s-earlier", 1000));
+  ASSERT_TRUE(later.ok() && earlier.ok());
+  EXPECT_EQ((*store)->Create(NewSession("s-later", 3000)).status().code(),
+            absl::StatusCode::kAlreadyExists);
+
+  ASSERT_TRUE((*earlier)->SetState(v1::SESSION_STATE_CANCELLED, "enough").ok());
+  v1::MeshUpdate mesh;
+  mesh.set_session_id("s-earlier");
+  mesh.set_sequence(7);
+  mesh.set_draco_mesh("bytes");
+  ASSERT_TRUE((*earlier)->WriteLatestMesh(mesh, /*durable=*/true).ok());
+  PointCloud batch;
+  batch.positions = {Vec3f(1, 2, 3)};
+  ASSERT_TRUE((*later)->AppendBatch(batch).ok());
+
+  std::vector<std::string> problems;
+  const std::vector<StoredSessionFiles> listed = (*store)->List(&problems);
+  EXPECT_TRUE(problems.empty());
+  ASSERT_EQ(listed.size(), 2u);
+  EXPECT_EQ(listed[0].stored.session_id(), "s-earlier");
+  EXPECT_EQ(listed[0].stored.state(), v1::SESSION_STATE_CANCELLED);
+  EXPECT_EQ(listed[0].stored.error(), "enough");
+  EXPECT_EQ(listed[0].stored.owner(), "alice");
+  EXPECT_EQ(listed[0].stored.config().target_vertices(), 1234u);
+  ASSERT_TRUE(listed[0].latest.has_value());
+  EXPECT_EQ(listed[0].latest->sequence(), 7u);
+  EXPECT_EQ(listed[0].latest->draco_mesh(), "bytes");
+  EXPECT_EQ(listed[1].stored.session_id(), "s-later");
+  EXPECT_FALSE(listed[1].latest.has_value());
+  EXPECT_GT(std::filesystem::file_size(listed[1].journal_path), 12u);
+
+  // Removed: gone from the disk, and the record ignores later writes.
+  (*earlier)->Remove();
+  EXPECT_FALSE(std::filesystem::exists(dir + "/sessions/s-earlier"));
+  EXPECT_TRUE((*earlier)->SetState(v1::SESSION_STATE_FAILED, "late").ok());
+  EXPECT_FALSE(std::filesystem::exists(dir + "/sessions/s-earlier"));
+  EXPECT_EQ((*store)->List(&problems).size(), 1u);
+}
+
+TEST(SessionStoreTest, WhatIsNotASessionIsReportedAndLeft) {
+  const std::string dir = neuralmesh::testing::MakeTempDir("strays");
+  absl::StatusOr<std::unique_ptr<SessionStore>> store = SessionStore::Open(dir, false);
+  ASSERT_TRUE(store.ok());
+  ASSERT_TRUE((*store)->Create(NewSession("s-good", 1)).ok());
+  std::ofstream(dir + "/sessions/README") << "a stray file";
+  std::filesystem::create_directory(dir + "/sessions/s-garbage");
+  std::ofstream(dir + "/sessions/s-garbage/session.binpb") << "not a protobuf \xff\xff\xff";
+  std::filesystem::create_directory(dir + "/sessions/s-empty");
+  // A session whose directory was renamed: its file names another id.
+  std::filesystem::create_directory(dir + "/sessions/s-renamed");
+  std::filesystem::copy_file(dir + "/sessions/s-good/session.binpb",
+                             dir + "/sessions/s-renamed/session.binpb");
+
+  std::vector<std::string> problems;
+  const std::vector<StoredSessionFiles> listed = (*store)->List(&problems);
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_EQ(listed[0].stored.session_id(), "s-good");
+  ASSERT_EQ(problems.size(), 4u);
+  std::string all;
+  for (const std::string& problem : problems) absl::StrAppend(&all, problem, "\n");
+  EXPECT_TRUE(absl::StrContains(all, "README' is not a session")) << all;
+  EXPECT_TRUE(absl::StrContains(all, "s-garbage/session.binpb' is not a stored session")) << all;
+  EXPECT_TRUE(absl::StrContains(all, "s-empty/session.binpb")) << all;
+  EXPECT_TRUE(absl::StrContains(all, "holds session \"s-good\"")) << all;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/sessions/s-garbage/session.binpb"));
+}
+
+}  // namespace
+}  // namespace neuralmesh::server

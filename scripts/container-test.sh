@@ -11,7 +11,9 @@
 #      (build/bin/neuralmesh, built when missing) and decodes the final .drc with Debian's
 #      draco_decoder and `neuralmesh stats`;
 #   6. stops the container with SIGTERM (podman stop) and checks that the server shut down
-#      gracefully (exit status 0, shutdown messages in its log);
+#      gracefully (exit status 0, shutdown messages in its log); starts it again and checks
+#      that the finished session came back from the state volume (--state_dir), its final
+#      mesh served byte for byte as before;
 #   7. runs it again secured, with TLS and an access token from a read-only mount (throw-away
 #      certificates made with openssl): plaintext and token-less calls are refused, a client
 #      with the CA and the token reconstructs a torus, and after `podman kill -s HUP` with a
@@ -65,7 +67,7 @@ cleanup() {
       say "Last lines of the container's log:"
       podman logs "${CONTAINER}" 2>&1 | tail -n 20 >&2 || true
     fi
-    podman rm -f "${CONTAINER}" >/dev/null 2>&1 || true
+    podman rm -f -v "${CONTAINER}" >/dev/null 2>&1 || true
   fi
   [[ -n "${ROOTFS}" ]] && rm -rf "${ROOTFS}"
   [[ -n "${WORK_DIR}" ]] && rm -rf "${WORK_DIR}"
@@ -214,7 +216,7 @@ start_container() {
       "${options[@]}" "${IMAGE}" "$@" >/dev/null 2>"${WORK_DIR}/run.err"; then
       break
     fi
-    podman rm -f "${CONTAINER}" >/dev/null 2>&1 || true
+    podman rm -f -v "${CONTAINER}" >/dev/null 2>&1 || true
     port=""
   done
   [[ -n "${port}" ]] || fail "podman run: $(cat "${WORK_DIR}/run.err")"
@@ -305,7 +307,28 @@ grep -q 'neuralmesh-server: stopped' "${OUT_DIR}/server.log" \
 grep -q "finished: ${VERTICES} vertices" "${OUT_DIR}/server.log" \
   || fail "no 'finished: ${VERTICES} vertices' event in the server's log"
 say "The server shut down gracefully (exit status 0)"
-podman rm "${CONTAINER}" >/dev/null
+
+# --- 7b. Restart ---------------------------------------------------------------------------
+step "Starting the container again: the finished session comes back from its state volume"
+podman start "${CONTAINER}" >/dev/null || fail "podman start"
+wait_serving
+"${CLI}" sessions --server "${ADDRESS}" >"${OUT_DIR}/sessions-after-restart.out" 2>&1 \
+  || fail "neuralmesh sessions: $(tail -n 3 "${OUT_DIR}/sessions-after-restart.out")"
+cat "${OUT_DIR}/sessions-after-restart.out" >&2
+SESSION_ID=$(awk '$1 ~ /^s-/ && $3 == "finished" {print $1}' "${OUT_DIR}/sessions-after-restart.out")
+[[ -n "${SESSION_ID}" ]] || fail "no finished session after the restart"
+WATCH_DIR="${WORK_DIR}/watched"
+timeout 120 "${CLI}" watch "${SESSION_ID}" --server "${ADDRESS}" --out-dir "${WATCH_DIR}" \
+  >"${OUT_DIR}/watch-after-restart.out" 2>&1 \
+  || fail "neuralmesh watch: $(tail -n 3 "${OUT_DIR}/watch-after-restart.out")"
+cmp -s "${WATCH_DIR}/${SESSION_ID}.drc" "${FINAL}" \
+  || fail "the final mesh served after the restart differs from ${FINAL}"
+podman stop --time 30 "${CONTAINER}" >/dev/null || fail "podman stop"
+podman logs "${CONTAINER}" >"${OUT_DIR}/server.log" 2>&1
+grep -q "${SESSION_ID} restored after a restart: .* finished" "${OUT_DIR}/server.log" \
+  || fail "no 'restored after a restart' event in the server's log"
+say "Session ${SESSION_ID} came back finished, its final mesh byte for byte"
+podman rm -v "${CONTAINER}" >/dev/null
 CONTAINER=""
 
 # --- 8. Secured run ------------------------------------------------------------------------
@@ -395,6 +418,6 @@ grep -q finished "${OUT_DIR}/sessions-secured.out" || fail "the secured session 
 say "The old token and certificate are refused, the new ones accepted after SIGHUP"
 podman stop --time 30 "${CONTAINER}" >/dev/null || fail "podman stop"
 podman logs "${CONTAINER}" >"${OUT_DIR}/server-secured.log" 2>&1
-podman rm "${CONTAINER}" >/dev/null
+podman rm -v "${CONTAINER}" >/dev/null
 CONTAINER=""
 STEP="done"

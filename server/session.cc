@@ -694,14 +694,16 @@ void Session::EncodeNext() {
           final_mesh.vertex_count(), final_mesh.face_count(), final_mesh.report().genus(),
           final_mesh.report().boundary_loops(), final_mesh.learning().basic_steps(),
           final_mesh.learning().learning_seconds(), final_mesh.learning().points_received()));
-      updates_.Publish(final_mesh_ptr);
-      // Stored before the watchers hear that it is final: a client that has the final mesh
-      // finds it again after a restart.
+      // Stored before any watcher has it, so that a client that has the final mesh finds it
+      // again after a restart. Only this task publishes, so the sequence number it will get is
+      // known.
+      final_mesh_ptr->set_sequence(updates_.next_sequence());
       StoreMesh(final_mesh, /*durable=*/true);
       if (absl::Status stored = StoreState(v1::SESSION_STATE_FINISHED, ""); !stored.ok()) {
         Record(absl::StrCat("could not store the finish (a restart would learn the final mesh "
                             "again): ", stored.message()));
       }
+      updates_.Publish(final_mesh_ptr);
       updates_.Close(absl::OkStatus());
     }
   } else {

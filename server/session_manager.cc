@@ -6,9 +6,11 @@
 #include <utility>
 
 #include "absl/random/random.h"
+#include "absl/strings/ascii.h"
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/strip.h"
 #include "core/status_macros.h"
 #include "server/proto_conversion.h"
 
@@ -323,7 +325,9 @@ std::shared_ptr<Session> SessionManager::Restore(const StoredSessionFiles& files
   if (log_ != nullptr) {
     log_->Record(id, absl::StrCat("restored after a restart: ", session->points_received(),
                                   " points in ", batches, " batches, ",
-                                  v1::SessionState_Name(session->state()), latest_note));
+                                  absl::AsciiStrToLower(absl::StripPrefix(
+                                      v1::SessionState_Name(session->state()), "SESSION_STATE_")),
+                                  latest_note));
   }
   return session;
 }

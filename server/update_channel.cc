@@ -45,6 +45,11 @@ MeshUpdatePtr UpdateChannel::latest() const {
   return latest_;
 }
 
+uint64_t UpdateChannel::next_sequence() const {
+  absl::MutexLock lock(&mu_);
+  return sequence_ + 1;
+}
+
 std::optional<absl::Status> UpdateChannel::close_status() const {
   absl::MutexLock lock(&mu_);
   return closed_;

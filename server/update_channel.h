@@ -63,6 +63,8 @@ class UpdateChannel {
   void Unsubscribe(uint64_t handle) ABSL_LOCKS_EXCLUDED(mu_);
 
   MeshUpdatePtr latest() const ABSL_LOCKS_EXCLUDED(mu_);
+  // The sequence number the next Publish assigns.
+  uint64_t next_sequence() const ABSL_LOCKS_EXCLUDED(mu_);
   std::optional<absl::Status> close_status() const ABSL_LOCKS_EXCLUDED(mu_);
   size_t subscribers() const ABSL_LOCKS_EXCLUDED(mu_);
 

@@ -55,6 +55,20 @@ TEST(UpdateChannelTest, ResumingSubscriberSkipsWhatItHasSeen) {
   EXPECT_TRUE(resumed.sequences.empty()) << "after_sequence 1 already covers update 1";
 }
 
+TEST(UpdateChannelTest, ARestoredUpdateIsTheLatestAndItsNumbersGoOn) {
+  UpdateChannel channel;
+  auto stored = Update(300);
+  stored->set_sequence(7);
+  channel.Restore(stored);
+  EXPECT_EQ(channel.latest()->vertex_count(), 300u);
+  EXPECT_EQ(channel.next_sequence(), 8u);
+  RecordingSubscriber resumed;
+  channel.Subscribe(&resumed, 7);
+  EXPECT_TRUE(resumed.sequences.empty()) << "a watcher that had update 7 is not sent it again";
+  EXPECT_EQ(channel.Publish(Update(400)), 8u);
+  EXPECT_EQ(resumed.sequences, std::vector<uint64_t>({8}));
+}
+
 TEST(UpdateChannelTest, CloseIsFinalAndReplayedToLateSubscribers) {
   UpdateChannel channel;
   RecordingSubscriber early;

@@ -3,8 +3,6 @@
 #include "server/points_journal.h"
 
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/resource.h>
 
 #include <filesystem>
 #include <fstream>
@@ -13,6 +11,7 @@
 
 #include "absl/strings/match.h"
 #include "core/random.h"
+#include "tests/testing/file_size_limit.h"
 #include "tests/testing/temp_dir.h"
 
 namespace neuralmesh::server {
@@ -124,16 +123,12 @@ TEST_F(PointsJournalTest, AFailedWriteLeavesTheJournalAsItWas) {
   absl::StatusOr<std::unique_ptr<PointsJournal>> journal =
       PointsJournal::Open(path_, size_, false);
   ASSERT_TRUE(journal.ok()) << journal.status();
-  // A file size limit just above the journal: the next batch fits only partly (EFBIG, with
-  // SIGXFSZ ignored, as neuralmesh-server does).
-  signal(SIGXFSZ, SIG_IGN);
-  rlimit old_limit;
-  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
-  rlimit limit = old_limit;
-  limit.rlim_cur = size_ + 1000;
-  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
-  const absl::Status failed = (*journal)->Append(RandomBatch(1000, 5, false, false));
-  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  // A file size limit just above the journal: the next batch fits only partly.
+  absl::Status failed;
+  {
+    neuralmesh::testing::ScopedFileSizeLimit limit(size_ + 1000);
+    failed = (*journal)->Append(RandomBatch(1000, 5, false, false));
+  }
   EXPECT_EQ(failed.code(), absl::StatusCode::kResourceExhausted) << failed;
   EXPECT_TRUE(absl::StrContains(failed.message(), path_)) << failed;
   EXPECT_EQ(std::filesystem::file_size(path_), size_);

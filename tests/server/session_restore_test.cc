@@ -4,8 +4,6 @@
 // uploads and watches that go on, and what happens with damaged or full storage.
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/resource.h>
 
 #include <filesystem>
 #include <fstream>
@@ -19,6 +17,7 @@
 #include "core/sampling/implicit_surfaces.h"
 #include "server/server.h"
 #include "tests/server/server_test_support.h"
+#include "tests/testing/file_size_limit.h"
 #include "tests/testing/temp_dir.h"
 
 namespace neuralmesh::server {
@@ -325,14 +324,11 @@ TEST_F(SessionRestoreTest, ABatchThatCannotBeStoredIsRefusedAndChangesNothing) {
       std::filesystem::file_size(SessionDirectory(id) + "/points.journal");
 
   // A file size limit that the next batch's record would pass (a full disk answers alike).
-  signal(SIGXFSZ, SIG_IGN);
-  rlimit old_limit;
-  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
-  rlimit limit = old_limit;
-  limit.rlim_cur = journal_bytes + 1000;
-  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
-  const grpc::Status refused = UploadFrom(*service_, id, cloud, 5000, 15000, 1, &response);
-  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  grpc::Status refused;
+  {
+    neuralmesh::testing::ScopedFileSizeLimit limit(journal_bytes + 1000);
+    refused = UploadFrom(*service_, id, cloud, 5000, 15000, 1, &response);
+  }
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_TRUE(absl::StrContains(refused.error_message(), "cannot store the batch"))
       << refused.error_message();

@@ -1,5 +1,5 @@
 // neuralmesh-server --state_dir under concurrency (ctest label server-concurrency): uploads
-// into several sessions at once while meshes are stored, watchers read, one session is
+// into several sessions at once while meshes are stored and a reader lists them, one session is
 // deleted and others finish; a restarted server then has exactly what was acknowledged.
 #include <gtest/gtest.h>
 

@@ -1,18 +1,15 @@
 #include "server/session_manager.h"
 
 #include <algorithm>
-#include <filesystem>
-#include <system_error>
 #include <utility>
 
 #include "absl/random/random.h"
-#include "absl/strings/ascii.h"
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "absl/strings/strip.h"
 #include "core/status_macros.h"
 #include "server/proto_conversion.h"
+#include "server/session_restore.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -229,7 +226,8 @@ RestoreReport SessionManager::RestoreStored() {
   if (store_ == nullptr) return report;
   const absl::Time start = absl::Now();
   for (const StoredSessionFiles& files : store_->List(&report.problems)) {
-    std::shared_ptr<Session> session = Restore(files, report);
+    std::shared_ptr<Session> session = RestoreSession(
+        files, *store_, limits_.max_points_per_session, pool_, encoder_, log_, report.problems);
     if (session == nullptr) continue;
     absl::MutexLock lock(&mu_);
     if (shutdown_) {
@@ -243,93 +241,6 @@ RestoreReport SessionManager::RestoreStored() {
   }
   report.took = absl::Now() - start;
   return report;
-}
-
-std::shared_ptr<Session> SessionManager::Restore(const StoredSessionFiles& files,
-                                                 RestoreReport& report) {
-  const storage::v1::StoredSession& stored = files.stored;
-  const std::string& id = stored.session_id();
-  absl::StatusOr<SessionConfig> config = SessionConfigFromProto(stored.config());
-  const absl::Status valid =
-      config.ok() ? ResolveSessionConfig(limits_.max_points_per_session, *config)
-                  : config.status();
-  if (!valid.ok()) {
-    report.problems.push_back(absl::StrCat("session ", id, " stays on disk unrestored: ",
-                                           valid.message()));
-    return nullptr;
-  }
-  auto session = std::make_shared<Session>(
-      id, stored.name(), *std::move(config), limits_.max_points_per_session, pool_, encoder_,
-      log_, stored.owner(), absl::FromUnixMicros(stored.create_time_us()));
-
-  // The batches, taken again; after one that no longer fits (lower limits), the rest are read
-  // only to find where the journal's whole records end.
-  absl::Status replayed = absl::OkStatus();
-  uint64_t batches = 0;
-  uint64_t journal_bytes = 0;
-  std::error_code exists_error;
-  if (std::filesystem::exists(files.journal_path, exists_error)) {
-    absl::StatusOr<JournalReadResult> read =
-        ReadPointsJournal(files.journal_path, [&](const PointCloud& batch) {
-          if (!replayed.ok()) return absl::OkStatus();
-          replayed = session->ReplayBatch(batch);
-          if (replayed.ok()) {
-            ++batches;
-          } else {
-            replayed = absl::Status(replayed.code(), absl::StrCat("batch ", batches + 1, " of ",
-                                                                  "its journal: ",
-                                                                  replayed.message()));
-          }
-          return absl::OkStatus();
-        });
-    if (!read.ok()) {
-      report.problems.push_back(absl::StrCat("session ", id, " stays on disk unrestored: ",
-                                             read.status().message()));
-      return nullptr;
-    }
-    journal_bytes = read->valid_bytes;
-    if (!read->damage.empty()) {
-      report.problems.push_back(absl::StrCat("session ", id, ": its journal ends in ",
-                                             read->damage, "; cut off there"));
-    }
-  }
-
-  v1::SessionState state = stored.state();
-  std::string error = stored.error();
-  std::shared_ptr<v1::MeshUpdate> latest;
-  if (files.latest.has_value() && files.latest->session_id() == id) {
-    latest = std::make_shared<v1::MeshUpdate>(*files.latest);
-  }
-  // Finished, but the final mesh did not reach the disk: it is learned again.
-  if (state == v1::SESSION_STATE_FINISHED &&
-      (latest == nullptr || latest->kind() != v1::UPDATE_KIND_FINAL)) {
-    state = v1::SESSION_STATE_FINISHING;
-  }
-  if (!replayed.ok()) {
-    state = v1::SESSION_STATE_FAILED;
-    error = absl::StrCat("restoring it after a restart failed at ", replayed.message());
-    report.problems.push_back(absl::StrCat("session ", id, " is restored as failed (its files "
-                                           "stay as they are): ", error));
-  }
-  absl::StatusOr<std::unique_ptr<SessionRecord>> record = store_->Reopen(files, journal_bytes);
-  if (!record.ok()) {
-    report.problems.push_back(absl::StrCat("session ", id, " stays on disk unrestored: ",
-                                           record.status().message()));
-    return nullptr;
-  }
-  const std::string latest_note =
-      latest == nullptr ? std::string()
-                        : absl::StrCat(", mesh ", latest->sequence(), " of ",
-                                       latest->vertex_count(), " vertices");
-  session->FinishRestore(state, error, std::move(latest), *std::move(record));
-  if (log_ != nullptr) {
-    log_->Record(id, absl::StrCat("restored after a restart: ", session->points_received(),
-                                  " points in ", batches, " batches, ",
-                                  absl::AsciiStrToLower(absl::StripPrefix(
-                                      v1::SessionState_Name(session->state()), "SESSION_STATE_")),
-                                  latest_note));
-  }
-  return session;
 }
 
 void SessionManager::Shutdown(const absl::Status& status) {

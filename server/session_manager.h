@@ -121,8 +121,6 @@ class SessionManager {
   absl::Status DeleteUnlessActive(absl::string_view id, std::optional<absl::Time> idle_at)
       ABSL_LOCKS_EXCLUDED(mu_);
   std::string NewIdLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
-  // Restores one stored session; null (with a line in `report`) when it stays on disk.
-  std::shared_ptr<Session> Restore(const StoredSessionFiles& files, RestoreReport& report);
 
   const SessionLimits limits_;
   WorkerPool* const pool_;

@@ -134,10 +134,17 @@ absl::StatusOr<std::unique_ptr<SessionStore>> SessionStore::Open(const std::stri
                                                                  bool sync) {
   if (directory.empty()) return absl::InvalidArgumentError("the state directory is empty");
   std::error_code error;
-  std::filesystem::create_directories(absl::StrCat(directory, "/", kSessionsDirectory), error);
+  const std::string sessions = absl::StrCat(directory, "/", kSessionsDirectory);
+  std::filesystem::create_directories(sessions, error);
   if (error) {
     return ErrorCodeStatus(error, absl::StrCat("cannot create the state directory '", directory,
                                                "'"));
+  }
+  // The points are the clients' data: readable by the server's user only.
+  std::filesystem::permissions(sessions, std::filesystem::perms::owner_all,
+                               std::filesystem::perm_options::replace, error);
+  if (error) {
+    return ErrorCodeStatus(error, absl::StrCat("cannot make '", sessions, "' private"));
   }
   const std::string lock_path = absl::StrCat(directory, "/", kLockFile);
   const int fd = open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);

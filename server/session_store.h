@@ -78,8 +78,9 @@ struct StoredSessionFiles {
 
 class SessionStore {
  public:
-  // Opens (creating) the state directory `directory` and locks it against other servers:
-  // FAILED_PRECONDITION when another process holds it, the errno's code otherwise. `sync`:
+  // Opens (creating) the state directory `directory`, makes its sessions directory private to
+  // the server's user (mode 0700) and locks it against other servers: FAILED_PRECONDITION when
+  // another process holds it, the errno's code otherwise. `sync`:
   // batches and state changes reach the disk before they are acknowledged (fdatasync).
   static absl::StatusOr<std::unique_ptr<SessionStore>> Open(const std::string& directory,
                                                             bool sync);

@@ -32,6 +32,9 @@ TEST(SessionStoreTest, OneServerAtATimeUsesADirectory) {
   absl::StatusOr<std::unique_ptr<SessionStore>> first = SessionStore::Open(dir, false);
   ASSERT_TRUE(first.ok()) << first.status();
   EXPECT_TRUE(std::filesystem::is_directory(dir + "/sessions"));
+  EXPECT_EQ(std::filesystem::status(dir + "/sessions").permissions(),
+            std::filesystem::perms::owner_all)
+      << "the clients' points are the server user's alone";
   absl::StatusOr<std::unique_ptr<SessionStore>> second = SessionStore::Open(dir, false);
   EXPECT_EQ(second.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_TRUE(absl::StrContains(second.status().message(), "in use by another neuralmesh-server"))

@@ -188,7 +188,12 @@ absl::Status SessionManager::DeleteUnlessActive(absl::string_view id,
                      : std::string("deleted"));
   }
   session->Terminate(absl::NotFoundError(absl::StrCat("session ", id, " was deleted")));
-  if (session->record() != nullptr) session->record()->Remove();
+  if (session->record() != nullptr) {
+    if (absl::Status removed = session->record()->Remove(); !removed.ok() && log_ != nullptr) {
+      log_->Record(session->id(), absl::StrCat("its files stay, and a restart would restore it: ",
+                                               removed.message()));
+    }
+  }
   return absl::OkStatus();
 }
 

@@ -106,13 +106,15 @@ absl::Status SessionRecord::WriteLatestMesh(const v1::MeshUpdate& update, bool d
   return ReplaceFile(kLatestMeshFile, update, durable);
 }
 
-void SessionRecord::Remove() {
+absl::Status SessionRecord::Remove() {
   absl::MutexLock lock(&mu_);
-  if (removed_) return;
+  if (removed_) return absl::OkStatus();
   removed_ = true;
   journal_.reset();
   std::error_code error;
   std::filesystem::remove_all(directory_, error);
+  if (error) return ErrorCodeStatus(error, absl::StrCat("cannot remove '", directory_, "'"));
+  return absl::OkStatus();
 }
 
 absl::Status SessionRecord::ReplaceFile(const std::string& name,

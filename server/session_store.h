@@ -49,8 +49,9 @@ class SessionRecord {
   // Replaces the stored latest mesh; with `durable` (the final mesh) synced like a state.
   absl::Status WriteLatestMesh(const v1::MeshUpdate& update, bool durable)
       ABSL_LOCKS_EXCLUDED(mu_);
-  // Deletes the session's directory; every later call does nothing.
-  void Remove() ABSL_LOCKS_EXCLUDED(mu_);
+  // Deletes the session's directory; every later call does nothing. The errno's code when the
+  // directory could not be removed (a restart would then restore the session).
+  absl::Status Remove() ABSL_LOCKS_EXCLUDED(mu_);
 
   const std::string& directory() const { return directory_; }
 

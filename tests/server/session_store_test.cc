@@ -90,7 +90,7 @@ TEST(SessionStoreTest, SessionsAreListedOldestFirstWithTheirStateAndMesh) {
   EXPECT_GT(std::filesystem::file_size(listed[1].journal_path), 12u);
 
   // Removed: gone from the disk, and the record ignores later writes.
-  (*earlier)->Remove();
+  EXPECT_TRUE((*earlier)->Remove().ok());
   EXPECT_FALSE(std::filesystem::exists(dir + "/sessions/s-earlier"));
   EXPECT_TRUE((*earlier)->SetState(v1::SESSION_STATE_FAILED, "late").ok());
   EXPECT_FALSE(std::filesystem::exists(dir + "/sessions/s-earlier"));

@@ -8,7 +8,9 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <limits>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -155,6 +157,8 @@ absl::StatusOr<JournalReadResult> ReadPointsJournal(
   if (file == nullptr) {
     return absl::NotFoundError(absl::StrCat("cannot open '", path, "': ", std::strerror(errno)));
   }
+  std::error_code size_error;
+  const uint64_t file_size = std::filesystem::file_size(path, size_error);
   JournalReadResult result;
   std::string payload;
   absl::Status status;
@@ -171,8 +175,17 @@ absl::StatusOr<JournalReadResult> ReadPointsJournal(
       result.damage = absl::StrCat("no record header at byte ", result.valid_bytes);
       break;
     }
-    payload.resize(length);
-    if (std::fread(payload.data(), 1, length, file) != length) {
+    // A length beyond the end of the file is a torn record, found without allocating for it.
+    const uint64_t read_so_far = result.valid_bytes + kHeaderBytes;
+    const uint64_t left = size_error ? std::numeric_limits<uint64_t>::max()
+                          : file_size > read_so_far ? file_size - read_so_far
+                                                    : 0;
+    bool torn = length > left;
+    if (!torn) {
+      payload.resize(length);
+      torn = std::fread(payload.data(), 1, length, file) != length;
+    }
+    if (torn) {
       result.damage = absl::StrCat("a torn record at byte ", result.valid_bytes);
       break;
     }

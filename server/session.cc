@@ -206,7 +206,8 @@ absl::StatusOr<size_t> Session::AddPointsAndMaybeWake(const PointCloud& sent, si
     // Stored before it is taken, as it came (outliers too, so that a restored session's filter
     // judges as this one did): a batch is acknowledged only once a restart would keep it.
     if (record_ != nullptr) {
-      NM_RETURN_IF_ERROR(points_.CheckAppend(*appended));
+      // `appended` holds points of batches that passed ValidateBatch.
+      NM_RETURN_IF_ERROR(points_.CheckRoomFor(*appended));
       NM_RETURN_IF_ERROR(record_->AppendBatch(batch));
     }
     const size_t first_index = points_.size();

@@ -136,7 +136,7 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
   std::lock_guard<std::mutex> lock(append_mu_);
   // Only this thread changes size_, so a relaxed load sees the latest value.
   const size_t old_size = size_.load(std::memory_order_relaxed);
-  NM_RETURN_IF_ERROR(CheckRoomFor(n, old_size, !weights.empty() && batch_max_weight == 0.0f));
+  NM_RETURN_IF_ERROR(CheckRoom(n, old_size, !weights.empty() && batch_max_weight == 0.0f));
 
   // Earlier points weigh 1 and have a zero normal; they get them, and the weight-1 class, before
   // the flag that lets readers look for them.
@@ -181,8 +181,8 @@ absl::Status GrowingPointCloud::Append(absl::Span<const Vec3f> positions,
   return absl::OkStatus();
 }
 
-absl::Status GrowingPointCloud::CheckRoomFor(size_t n, size_t old_size,
-                                             bool weights_all_zero) const {
+absl::Status GrowingPointCloud::CheckRoom(size_t n, size_t old_size,
+                                          bool weights_all_zero) const {
   if (n > max_points_ - old_size) {
     return absl::ResourceExhaustedError(absl::StrCat("appending ", n, " points to ", old_size,
                                                      " would exceed the capacity of ", max_points_,
@@ -195,13 +195,14 @@ absl::Status GrowingPointCloud::CheckRoomFor(size_t n, size_t old_size,
   return absl::OkStatus();
 }
 
-absl::Status GrowingPointCloud::CheckAppend(const PointCloud& batch) const {
-  NM_RETURN_IF_ERROR(ValidateBatch(batch.positions, batch.weights, batch.normals));
+absl::Status GrowingPointCloud::CheckRoomFor(const PointCloud& batch) const {
   if (batch.positions.empty()) return absl::OkStatus();
+  const size_t old_size = size();
+  // Only the first batch's weights matter (CheckRoom).
   const bool weights_all_zero =
-      !batch.weights.empty() &&
+      old_size == 0 && !batch.weights.empty() &&
       std::all_of(batch.weights.begin(), batch.weights.end(), [](float w) { return w == 0.0f; });
-  return CheckRoomFor(batch.positions.size(), size(), weights_all_zero);
+  return CheckRoom(batch.positions.size(), old_size, weights_all_zero);
 }
 
 absl::Status GrowingPointCloud::Append(const PointCloud& batch) {

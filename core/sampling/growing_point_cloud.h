@@ -73,10 +73,11 @@ class GrowingPointCloud : public Sampler {
                                     absl::Span<const float> weights,
                                     absl::Span<const Vec3f> normals);
 
-  // Every check of Append, without appending: OK when Append(batch) would succeed, as long as
-  // no other append comes first (for a caller that must do something, such as storing the
-  // batch, between the check and the append, and serialises its appends).
-  absl::Status CheckAppend(const PointCloud& batch) const;
+  // The checks of Append beyond ValidateBatch, without appending: with a batch that passed
+  // ValidateBatch, OK when Append(batch) would succeed, as long as no other append comes first
+  // (for a caller that must do something, such as storing the batch, between the check and
+  // the append, and serialises its appends). O(1) but on the first batch (its weights).
+  absl::Status CheckRoomFor(const PointCloud& batch) const;
 
   // The number of points visible to readers. Never decreases.
   size_t size() const { return size_.load(std::memory_order_acquire); }
@@ -110,7 +111,7 @@ class GrowingPointCloud : public Sampler {
  private:
   // Append's checks of room and weight: RESOURCE_EXHAUSTED when `n` more points would exceed
   // max_points after `old_size`; INVALID_ARGUMENT when they would be the first and weigh zero.
-  absl::Status CheckRoomFor(size_t n, size_t old_size, bool weights_all_zero) const;
+  absl::Status CheckRoom(size_t n, size_t old_size, bool weights_all_zero) const;
 
   static constexpr int kChunkBits = 16;
   static constexpr size_t kChunkSize = size_t{1} << kChunkBits;

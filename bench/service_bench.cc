@@ -54,6 +54,8 @@ namespace {
 
 using server::ReconstructionServer;
 using server::ServerOptions;
+// gRPC's generated client class of the service.
+using Service = v1::ReconstructionService::Stub;
 
 PointCloud Torus(size_t n, uint64_t seed) {
   auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4);
@@ -64,7 +66,7 @@ v1::PointBatch Batch(const PointCloud& cloud, size_t begin, size_t end) {
   return server::PointCloudToPackedBatch(PointRange(cloud, begin, end));
 }
 
-std::string Create(v1::ReconstructionService::Stub& stub, uint64_t target,
+std::string Create(Service& service, uint64_t target,
                    v1::FinalPass final_pass = v1::FINAL_PASS_AUTO, int refresh_ms = 250,
                    const std::vector<uint64_t>& milestones = {}) {
   grpc::ClientContext context;
@@ -74,7 +76,7 @@ std::string Create(v1::ReconstructionService::Stub& stub, uint64_t target,
   request.mutable_config()->mutable_refresh_interval_ms()->set_value(refresh_ms);
   request.mutable_config()->set_final_pass(final_pass);
   v1::Session session;
-  grpc::Status status = stub.CreateSession(&context, request, &session);
+  grpc::Status status = service.CreateSession(&context, request, &session);
   if (!status.ok()) {
     std::fprintf(stderr, "CreateSession: %s\n", status.error_message().c_str());
     std::exit(1);
@@ -82,11 +84,11 @@ std::string Create(v1::ReconstructionService::Stub& stub, uint64_t target,
   return session.session_id();
 }
 
-void Upload(v1::ReconstructionService::Stub& stub, const std::string& id,
+void Upload(Service& service, const std::string& id,
             const std::vector<v1::UploadPointsRequest>& requests) {
   grpc::ClientContext context;
   v1::UploadPointsResponse response;
-  auto writer = stub.UploadPoints(&context, &response);
+  auto writer = service.UploadPoints(&context, &response);
   for (size_t i = 0; i < requests.size(); ++i) {
     if (i == 0) {
       v1::UploadPointsRequest first = requests[0];
@@ -104,25 +106,25 @@ void Upload(v1::ReconstructionService::Stub& stub, const std::string& id,
   }
 }
 
-v1::Session Get(v1::ReconstructionService::Stub& stub, const std::string& id) {
+v1::Session Get(Service& service, const std::string& id) {
   grpc::ClientContext context;
   v1::GetSessionRequest request;
   request.set_session_id(id);
   v1::Session session;
-  stub.GetSession(&context, request, &session);
+  service.GetSession(&context, request, &session);
   return session;
 }
 
-void Delete(v1::ReconstructionService::Stub& stub, const std::string& id) {
+void Delete(Service& service, const std::string& id) {
   grpc::ClientContext context;
   v1::DeleteSessionRequest request;
   request.set_session_id(id);
   v1::DeleteSessionResponse response;
-  stub.DeleteSession(&context, request, &response);
+  service.DeleteSession(&context, request, &response);
 }
 
 // Returns the session, which holds the points.
-std::string MeasureIngest(v1::ReconstructionService::Stub& stub) {
+std::string MeasureIngest(Service& service) {
   const size_t total = static_cast<size_t>(absl::GetFlag(FLAGS_ingest_points));
   const size_t batch = static_cast<size_t>(absl::GetFlag(FLAGS_batch_points));
   const PointCloud source = Torus(std::min<size_t>(total, 1 << 20), 1);
@@ -138,11 +140,11 @@ std::string MeasureIngest(v1::ReconstructionService::Stub& stub) {
   size_t points = 0;
   for (const auto& r : requests) points += r.batch().packed().positions().size() / 12;
   // A small target: learning pauses quickly and leaves the cores to ingestion.
-  const std::string id = Create(stub, 1000);
+  const std::string id = Create(service, 1000);
   const absl::Time start = absl::Now();
-  Upload(stub, id, requests);
+  Upload(service, id, requests);
   const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
-  const v1::Session session = Get(stub, id);
+  const v1::Session session = Get(service, id);
   std::printf("ingest: %zu points in %zu batches over one stream: %.3f s, %.1f M points/s "
               "(%.0f MB/s); session holds %llu points   [target >= 10 M points/s]\n",
               points, requests.size(), seconds, points / seconds / 1e6,
@@ -151,7 +153,7 @@ std::string MeasureIngest(v1::ReconstructionService::Stub& stub) {
   return id;
 }
 
-std::unique_ptr<v1::ReconstructionService::Stub> Connect(const ReconstructionServer& server) {
+std::unique_ptr<Service> Connect(const ReconstructionServer& server) {
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(64 << 20);
   args.SetMaxSendMessageSize(64 << 20);
@@ -159,12 +161,12 @@ std::unique_ptr<v1::ReconstructionService::Stub> Connect(const ReconstructionSer
       grpc::CreateCustomChannel(server.target(), grpc::InsecureChannelCredentials(), args));
 }
 
-void MeasureFirstMesh(v1::ReconstructionService::Stub& stub) {
+void MeasureFirstMesh(Service& service) {
   const PointCloud points = Torus(10000, 2);
   std::vector<double> latencies;
   for (int run = 0; run < 5; ++run) {
     grpc::ClientContext context;
-    auto stream = stub.Reconstruct(&context);
+    auto stream = service.Reconstruct(&context);
     v1::ReconstructRequest start;
     start.mutable_start()->mutable_create()->mutable_config()->set_target_vertices(5000);
     stream->Write(start);
@@ -183,7 +185,7 @@ void MeasureFirstMesh(v1::ReconstructionService::Stub& stub) {
     latencies.push_back(absl::ToDoubleMilliseconds(absl::Now() - t0));
     context.TryCancel();
     stream->Finish();
-    Delete(stub, id);
+    Delete(service, id);
   }
   std::sort(latencies.begin(), latencies.end());
   std::printf("first mesh: %.1f ms after the first batch of 10000 points (median of 5; "
@@ -192,7 +194,7 @@ void MeasureFirstMesh(v1::ReconstructionService::Stub& stub) {
 }
 
 // Returns the wall time from the upload to the final mesh and the Basic Steps taken.
-std::pair<double, uint64_t> MeasureLods(v1::ReconstructionService::Stub& stub,
+std::pair<double, uint64_t> MeasureLods(Service& service,
                                         const PointCloud& points) {
   const uint64_t target = static_cast<uint64_t>(absl::GetFlag(FLAGS_lod_target));
   std::vector<uint64_t> milestones;
@@ -204,14 +206,14 @@ std::pair<double, uint64_t> MeasureLods(v1::ReconstructionService::Stub& stub,
     }
     milestones.push_back(value);
   }
-  const std::string id = Create(stub, target, v1::FINAL_PASS_CONTINUE,
+  const std::string id = Create(service, target, v1::FINAL_PASS_CONTINUE,
                                 absl::GetFlag(FLAGS_lod_refresh_ms), milestones);
   std::vector<v1::MeshUpdate> updates;
   std::thread watcher([&] {
     grpc::ClientContext context;
     v1::WatchSessionRequest request;
     request.set_session_id(id);
-    auto reader = stub.WatchSession(&context, request);
+    auto reader = service.WatchSession(&context, request);
     v1::MeshUpdate update;
     while (reader->Read(&update)) updates.push_back(update);
     reader->Finish();
@@ -223,13 +225,13 @@ std::pair<double, uint64_t> MeasureLods(v1::ReconstructionService::Stub& stub,
     requests.push_back(std::move(r));
   }
   const absl::Time start = absl::Now();
-  Upload(stub, id, requests);
+  Upload(service, id, requests);
   {
     grpc::ClientContext context;
     v1::FinishSessionRequest request;
     request.set_session_id(id);
     v1::Session session;
-    stub.FinishSession(&context, request, &session);
+    service.FinishSession(&context, request, &session);
   }
   watcher.join();
   const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
@@ -259,7 +261,7 @@ std::pair<double, uint64_t> MeasureLods(v1::ReconstructionService::Stub& stub,
                 static_cast<unsigned long long>(learning.basic_steps()),
                 learning.learning_seconds(), learning.steps_per_second(), seconds);
   }
-  Delete(stub, id);
+  Delete(service, id);
   return {seconds, steps};
 }
 
@@ -295,7 +297,7 @@ double LocalRate(const PointCloud& points, absl::Duration age, absl::Duration wi
          absl::ToDoubleSeconds(absl::Now() - start);
 }
 
-void MeasureLearning(v1::ReconstructionService::Stub& stub, const PointCloud& points,
+void MeasureLearning(Service& service, const PointCloud& points,
                      double lod_wall_seconds, uint64_t lod_steps, double local_to_target) {
   const absl::Duration window = absl::Seconds(absl::GetFlag(FLAGS_learn_seconds));
   const absl::Duration warmup = absl::Milliseconds(500);
@@ -319,23 +321,23 @@ void MeasureLearning(v1::ReconstructionService::Stub& stub, const PointCloud& po
   for (int sessions : {1, 2, 8}) {
     std::vector<std::string> ids;
     // Targets high enough that no session finishes inside the window.
-    for (int i = 0; i < sessions; ++i) ids.push_back(Create(stub, points.size() / 2));
+    for (int i = 0; i < sessions; ++i) ids.push_back(Create(service, points.size() / 2));
     const absl::Time upload_start = absl::Now();
-    for (const std::string& id : ids) Upload(stub, id, requests);
+    for (const std::string& id : ids) Upload(service, id, requests);
     absl::SleepFor(warmup);
     std::vector<uint64_t> before;
-    for (const std::string& id : ids) before.push_back(Get(stub, id).learning().basic_steps());
+    for (const std::string& id : ids) before.push_back(Get(service, id).learning().basic_steps());
     const absl::Time start = absl::Now();
     absl::SleepFor(window);
     double total = 0, least = 1e300, most = 0;
     for (size_t i = 0; i < ids.size(); ++i) {
-      const uint64_t after = Get(stub, ids[i]).learning().basic_steps();
+      const uint64_t after = Get(service, ids[i]).learning().basic_steps();
       const double rate = (after - before[i]) / absl::ToDoubleSeconds(absl::Now() - start);
       total += rate;
       least = std::min(least, rate);
       most = std::max(most, rate);
     }
-    for (const std::string& id : ids) Delete(stub, id);
+    for (const std::string& id : ids) Delete(service, id);
     if (sessions == 1) {
       local_rate = LocalRate(points, start - upload_start, window);
       std::printf("learning, local learner of the same age (%.2f s): %.0f Basic Steps/s\n",
@@ -372,7 +374,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", server.status().ToString().c_str());
     return 1;
   }
-  auto stub = Connect(**server);
+  auto service = Connect(**server);
   std::printf("neuralmesh service benchmark over %s, %d worker threads, %u hardware threads%s\n",
               (*server)->target().c_str(), options.worker_threads,
               std::thread::hardware_concurrency(),
@@ -383,7 +385,7 @@ int main(int argc, char** argv) {
                         .c_str());
 
   if (!absl::GetFlag(FLAGS_only_lods)) {
-    const std::string ingested = MeasureIngest(*stub);
+    const std::string ingested = MeasureIngest(*service);
     if (!options.state_dir.empty()) {
       // A restart: the new server restores the ingested session before it listens.
       (*server)->Shutdown();
@@ -394,24 +396,26 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", server.status().ToString().c_str());
         return 1;
       }
-      const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
+      const double up_seconds = absl::ToDoubleSeconds(absl::Now() - start);
       const server::RestoreReport& restored = (*server)->restored();
+      const double restore_seconds = absl::ToDoubleSeconds(restored.took);
       std::printf("restart: %zu session of %zu points restored in %.3f s (%.1f M points/s), "
                   "the server up in %.3f s\n",
-                  restored.sessions, restored.points, absl::ToDoubleSeconds(restored.took),
-                  restored.points / absl::ToDoubleSeconds(restored.took) / 1e6, seconds);
-      stub = Connect(**server);
+                  restored.sessions, restored.points, restore_seconds,
+                  restore_seconds > 0 ? restored.points / restore_seconds / 1e6 : 0.0,
+                  up_seconds);
+      service = Connect(**server);
     }
-    Delete(*stub, ingested);
-    MeasureFirstMesh(*stub);
+    Delete(*service, ingested);
+    MeasureFirstMesh(*service);
   }
   const PointCloud points = Torus(400000, 3);
   // Local runs right before and after the server's, so that load from other processes on
   // the machine weighs on both sides alike.
   const double local_before = LocalToTarget(points);
-  const auto [lod_seconds, lod_steps] = MeasureLods(*stub, points);
+  const auto [lod_seconds, lod_steps] = MeasureLods(*service, points);
   const double local_after = LocalToTarget(points);
-  MeasureLearning(*stub, points, lod_seconds, lod_steps, (local_before + local_after) / 2);
+  MeasureLearning(*service, points, lod_seconds, lod_steps, (local_before + local_after) / 2);
   (*server)->Shutdown();
   return 0;
 }

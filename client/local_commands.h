@@ -25,6 +25,8 @@ struct LocalReconstructOptions {
   size_t vertices = 0;       // Final vertex count, > 4.
   std::vector<size_t> lods;  // Milestones below `vertices`, each written beside `output`.
   LearnerOptions learner;
+  // A mesh file to learn on from (Learner::CreateFrom); empty: learner.initial_mesh.
+  std::string start_mesh;
   SamplingMode sampling = SamplingMode::kUniform;
   std::optional<OutlierOptions> outliers;  // Set: remove a point cloud's outliers first.
   absl::Duration time_budget = absl::InfiniteDuration();  // For the whole run.
@@ -39,8 +41,9 @@ struct LocalReconstructOptions {
 // learned so far is written as OUTPUT and the summary says which budget stopped it.
 // A first SIGINT or SIGTERM stops learning at a consistent state; the mesh so far is written
 // as OUTPUT and CANCELLED returned.
-// Returns INVALID_ARGUMENT for invalid options, an unknown output extension or a bad input;
-// NOT_FOUND for a missing input; the writer's error when a file cannot be written.
+// Returns INVALID_ARGUMENT for invalid options, an unknown output extension, a bad input or
+// a start mesh learning cannot go on from; NOT_FOUND for a missing input or start mesh; the
+// writer's error when a file cannot be written.
 absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::ostream& out,
                                  std::ostream& err);
 

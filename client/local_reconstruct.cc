@@ -1,6 +1,7 @@
 // RunLocalReconstruct (declared in client/local_commands.h).
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <system_error>
 
 #include "absl/strings/str_cat.h"
@@ -68,14 +69,36 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
                                                    absl::FormatDuration(options.time_budget)));
   }
   NM_RETURN_IF_ERROR(CheckOutputPath(options.output));
+  std::optional<TriangleMesh> start_mesh;
+  if (!options.start_mesh.empty()) {
+    absl::StatusOr<TriangleMesh> read = ReadMesh(options.start_mesh);
+    if (!read.ok()) {
+      return absl::Status(read.status().code(),
+                          absl::StrCat("--start_mesh: ", read.status().message()));
+    }
+    start_mesh = *std::move(read);
+  }
   NM_ASSIGN_OR_RETURN(const std::vector<size_t> targets,
-                      LodTargets(options.lods, options.vertices));
+                      LodTargets(options.lods, options.vertices,
+                                 start_mesh.has_value() ? start_mesh->positions.size() : 0));
   NM_ASSIGN_OR_RETURN(const TargetSpace target,
                       LoadTargetSpace(options.input, options.sampling, options.outliers));
-  NM_ASSIGN_OR_RETURN(std::unique_ptr<Learner> learner,
-                      Learner::Create(options.learner, target.sampler.get()));
-  out << "learning " << target.description << " to " << options.vertices << " vertices (seed "
-      << options.learner.seed << ")\n";
+  absl::StatusOr<std::unique_ptr<Learner>> created =
+      start_mesh.has_value()
+          ? Learner::CreateFrom(options.learner, target.sampler.get(), *start_mesh)
+          : Learner::Create(options.learner, target.sampler.get());
+  if (start_mesh.has_value() && absl::IsInvalidArgument(created.status())) {
+    return absl::Status(created.status().code(),
+                        absl::StrCat("--start_mesh '", options.start_mesh,
+                                     "': ", created.status().message()));
+  }
+  NM_RETURN_IF_ERROR(created.status());
+  std::unique_ptr<Learner> learner = *std::move(created);
+  out << "learning " << target.description << " to " << options.vertices << " vertices";
+  if (start_mesh.has_value()) {
+    out << " from " << options.start_mesh << " (" << start_mesh->positions.size() << " vertices)";
+  }
+  out << " (seed " << options.learner.seed << ")\n";
 
   // Ctrl-C stops learning at a consistent state; the mesh so far is still written.
   InterruptScope interrupt;

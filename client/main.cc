@@ -99,6 +99,13 @@ ABSL_FLAG(std::string, initial_mesh,
           "border is never refilled: open, nearly flat sheets such as one range scan, a "
           "terrain or a facade).");
 
+ABSL_FLAG(std::string, start_mesh, "",
+          "Local reconstruct: learn on from this mesh (.ply .obj .off .stl .drc, for example an "
+          "earlier OUTPUT) instead of --initial_mesh, refining it with INPUT's points to "
+          "--vertices, which must exceed its vertex count. It must be an orientable manifold "
+          "triangle mesh, with or without borders, every vertex on a face and no face of zero "
+          "area. --initial_mesh disc still keeps its longest border open.");
+
 // Input clean-up.
 ABSL_FLAG(bool, remove_outliers, false,
           "Remove a point cloud's statistical outliers before learning or upload: points whose "
@@ -330,6 +337,9 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     NM_RETURN_IF_ERROR(RejectFlags(
         args, {"output", "sampling", "time_budget", "max_steps"},
         "applies to a local reconstruct only (the server picks its own budget; use --out-dir)"));
+    NM_RETURN_IF_ERROR(RejectFlags(
+        args, {"start_mesh"},
+        "applies to a local reconstruct only (a server session starts from --initial_mesh)"));
     neuralmesh::client::RemoteReconstructOptions o;
     o.input = args.positional[0];
     o.server = absl::GetFlag(FLAGS_server);
@@ -367,6 +377,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
   NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
   NM_ASSIGN_OR_RETURN(o.sampling,
                       neuralmesh::client::ParseSamplingMode(absl::GetFlag(FLAGS_sampling)));
+  o.start_mesh = absl::GetFlag(FLAGS_start_mesh);
   o.time_budget = absl::GetFlag(FLAGS_time_budget);
   o.max_steps = absl::GetFlag(FLAGS_max_steps);
   NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
@@ -428,7 +439,7 @@ std::vector<Subcommand> Commands() {
       "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
-      "remove_outliers", "outlier_neighbours", "outlier_std_ratio", "outliers_on_server",
+      "start_mesh", "remove_outliers", "outlier_neighbours", "outlier_std_ratio", "outliers_on_server",
       "sampling", "time_budget", "max_steps", "quantization_bits", "encode_speed", "progress",
       "server", "out-dir", "batch-size", "points", "ply", "resume", "reconnect_for"};
   // clang-format on

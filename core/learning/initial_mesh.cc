@@ -3,6 +3,10 @@
 #include <array>
 #include <cmath>
 
+#include "absl/strings/str_cat.h"
+#include "core/mesh_validation.h"
+#include "core/status_macros.h"
+
 namespace neuralmesh {
 
 Mesh MakeInitialTetrahedron(const BoundingBox& box) {
@@ -34,6 +38,36 @@ Mesh MakeInitialDisc(const BestFitPlane& plane) {
                                                           std::sin(angle) * plane.v));
   }
   for (int i = 0; i < 6; ++i) mesh.add_face(center, corners[i], corners[(i + 1) % 6]);
+  return mesh;
+}
+
+absl::StatusOr<Mesh> MakeStartMesh(const TriangleMesh& start) {
+  if (start.positions.size() < 4) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the start mesh has ", start.positions.size(), " vertices; learning needs at least 4"));
+  }
+  for (size_t i = 0; i < start.positions.size(); ++i) {
+    const Vec3f& p = start.positions[i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("vertex ", i, " of the start mesh has a coordinate that is not finite"));
+    }
+  }
+  NM_ASSIGN_OR_RETURN(Mesh mesh, ToMesh(start));
+  for (auto f : mesh.faces()) {
+    auto corner = mesh.fv_begin(f);
+    const Vec3 a = mesh.point(*corner);
+    const Vec3 b = mesh.point(*++corner);
+    const Vec3 c = mesh.point(*++corner);
+    if (OpenMesh::cross(b - a, c - a).sqrnorm() == 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("face ", f.idx(), " of the start mesh has zero area"));
+    }
+  }
+  if (absl::Status valid = ValidateMesh(mesh); !valid.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("learning cannot go on from the start mesh: ", valid.message()));
+  }
   return mesh;
 }
 

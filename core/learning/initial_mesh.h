@@ -1,12 +1,14 @@
 // The initial neural mesh: a regular tetrahedron around the data (Section 1.2), or, for data
 // that form an open sheet, a flat disc in their best-fit plane (not in the paper; see
-// LearnerOptions::initial_mesh).
+// LearnerOptions::initial_mesh), or a mesh learned before, to go on from (MakeStartMesh).
 #ifndef NEURALMESH_CORE_LEARNING_INITIAL_MESH_H_
 #define NEURALMESH_CORE_LEARNING_INITIAL_MESH_H_
 
+#include "absl/status/statusor.h"
 #include "core/bounding_box.h"
 #include "core/learning/best_fit_plane.h"
 #include "core/mesh.h"
+#include "core/triangle_mesh.h"
 
 namespace neuralmesh {
 
@@ -29,6 +31,14 @@ Mesh MakeInitialTetrahedron(const BoundingBox& box);
 // seeds 1-30, 58 of 60 on seeds 31-60 (this disc: 57 and 59). All of these were measured
 // before Step 5 closed crack tips (hole_closing.h), which most of the failures were.
 Mesh MakeInitialDisc(const BestFitPlane& plane);
+
+// A mesh to go on learning from (Learner::CreateFrom), such as one a learner snapshotted
+// earlier: `start` as a half-edge mesh whose every vertex meets the learner's invariants
+// (mesh_validation.h). Returns INVALID_ARGUMENT saying what is wrong when it has fewer than 4
+// vertices, a coordinate that is not finite, a face index out of range or repeated, faces
+// that do not form an orientable 2-manifold (with or without boundary), a vertex no face uses
+// or of too low a valence, or a face of zero area.
+absl::StatusOr<Mesh> MakeStartMesh(const TriangleMesh& start);
 
 }  // namespace neuralmesh
 

@@ -68,11 +68,13 @@ Mesh MakeInitialMesh(const LearnerOptions& options, const Sampler& target) {
 
 class Learner::Impl {
  public:
-  Impl(const LearnerOptions& options, const Sampler* target)
+  // Learns from `initial`: the initial mesh of the options, or a start mesh (then call
+  // PrepareStartMesh).
+  Impl(const LearnerOptions& options, const Sampler* target, Mesh initial)
       : options_(options),
         target_(target),
         rng_(options.seed),
-        mesh_(MakeInitialMesh(options, *target)),
+        mesh_(std::move(initial)),
         octree_(target->Bounds(), MeshPoints(mesh_), kOctreeBucketSize),
         counters_(options.alpha_sc) {
     mesh_.add_property(active_);
@@ -86,6 +88,9 @@ class Learner::Impl {
     live_vertices_ = mesh_.n_vertices();
     next_connectivity_step_ = ConnectivityInterval();
   }
+  // A start mesh comes in any vertex order: renumbered as after every Step 3.
+  void PrepareStartMesh() { CompactAndRefillRings(); }
+
   // The octree indexes mesh_'s own positions: a copy would index the original's.
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
@@ -323,6 +328,12 @@ class Learner::Impl {
     std::fill(active.begin(), active.end(), false);
     next_connectivity_step_ = step_ + std::max<uint64_t>(1, ConnectivityInterval());
     t0 = Clock::now();
+    CompactAndRefillRings();
+    if (lookahead_) lookahead_->ForgetWinners();  // And vertex indices.
+    timings_.compaction += Since(t0);
+  }
+
+  void CompactAndRefillRings() {
     Compact();
     rings_.InvalidateAll();  // Collapses, removals, merges and compaction changed rings.
     // Refilled at once, in vertex order: with the edges in vertex order too, the walks read the
@@ -331,8 +342,6 @@ class Learner::Impl {
     for (auto v : mesh_.vertices()) {
       if (!mesh_.is_isolated(v)) rings_.Ring(mesh_, v.idx());
     }
-    if (lookahead_) lookahead_->ForgetWinners();  // And vertex indices.
-    timings_.compaction += Since(t0);
   }
 
   void CollapseInactive() {
@@ -412,14 +421,34 @@ class Learner::Impl {
   LearnerTimings timings_;
 };
 
-absl::StatusOr<std::unique_ptr<Learner>> Learner::Create(const LearnerOptions& options,
-                                                         const Sampler* target) {
+namespace {
+
+absl::Status CheckCreateArguments(const LearnerOptions& options, const Sampler* target) {
   NM_RETURN_IF_ERROR(options.Validate());
   if (target == nullptr) return absl::InvalidArgumentError("no target sampler given");
   if (target->empty()) {
     return absl::FailedPreconditionError("the target space is empty: there is nothing to learn");
   }
-  return std::unique_ptr<Learner>(new Learner(std::make_unique<Impl>(options, target)));
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<Learner>> Learner::Create(const LearnerOptions& options,
+                                                         const Sampler* target) {
+  NM_RETURN_IF_ERROR(CheckCreateArguments(options, target));
+  return std::unique_ptr<Learner>(
+      new Learner(std::make_unique<Impl>(options, target, MakeInitialMesh(options, *target))));
+}
+
+absl::StatusOr<std::unique_ptr<Learner>> Learner::CreateFrom(const LearnerOptions& options,
+                                                             const Sampler* target,
+                                                             const TriangleMesh& start) {
+  NM_RETURN_IF_ERROR(CheckCreateArguments(options, target));
+  NM_ASSIGN_OR_RETURN(Mesh mesh, MakeStartMesh(start));
+  auto impl = std::make_unique<Impl>(options, target, std::move(mesh));
+  impl->PrepareStartMesh();
+  return std::unique_ptr<Learner>(new Learner(std::move(impl)));
 }
 
 Learner::Learner(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

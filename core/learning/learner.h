@@ -88,6 +88,16 @@ class Learner {
   // empty. `target` must outlive the learner.
   static absl::StatusOr<std::unique_ptr<Learner>> Create(const LearnerOptions& options,
                                                          const Sampler* target);
+  // Learns on from `start` (a Snapshot of a learner, a mesh read from a file) instead of
+  // options.initial_mesh's mesh, as the paper's learner goes on from any mesh: the vertices
+  // are renumbered (Morton order), every signal counter starts at 1 as on the initial mesh,
+  // no vertex counts as a winner yet, and the first Step 3 comes after C_ec v Basic Steps.
+  // options.initial_mesh still says whether the longest border is the sheet's own (kDisc).
+  // Returns what Create returns, and INVALID_ARGUMENT when `start` is not a mesh learning can
+  // go on from (MakeStartMesh, initial_mesh.h). O(v log v).
+  static absl::StatusOr<std::unique_ptr<Learner>> CreateFrom(const LearnerOptions& options,
+                                                             const Sampler* target,
+                                                             const TriangleMesh& start);
   ~Learner();
 
   // Learns until one of `stop`'s criteria holds (at least one must be set).

@@ -1,6 +1,7 @@
 // Tests of client/lod_plan.h.
 #include "client/lod_plan.h"
 
+#include <string>
 #include <vector>
 
 #include "gtest/gtest.h"
@@ -39,6 +40,17 @@ TEST(LodTargetsTest, RejectsLodsAtOrAboveTheFinalCountAndTinyTargets) {
   EXPECT_TRUE(absl::IsInvalidArgument(LodTargets({4}, 500).status()))
       << "4 vertices is the initial tetrahedron";
   EXPECT_TRUE(absl::IsInvalidArgument(LodTargets({}, 4).status()));
+}
+
+TEST(LodTargetsTest, EveryTargetExceedsTheStartMesh) {
+  absl::StatusOr<std::vector<size_t>> targets = LodTargets({300, 400}, 500, 250);
+  ASSERT_TRUE(targets.ok()) << targets.status();
+  EXPECT_EQ(*targets, (std::vector<size_t>{300, 400, 500}));
+  const absl::Status low = LodTargets({200}, 500, 250).status();
+  EXPECT_TRUE(absl::IsInvalidArgument(low));
+  EXPECT_NE(low.message().find("more than 250 vertices (those of --start_mesh)"), std::string::npos)
+      << low;
+  EXPECT_TRUE(absl::IsInvalidArgument(LodTargets({}, 250, 250).status()));
 }
 
 TEST(LodPathTest, InsertsTheVertexCountBeforeTheExtension) {

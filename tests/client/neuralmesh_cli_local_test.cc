@@ -1,6 +1,7 @@
 // End-to-end tests of the local subcommands of build/bin/neuralmesh (client/main.cc), run as
 // a subprocess: reconstruct, stats and eval on the built-in shapes.
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <utility>
 
@@ -100,6 +101,53 @@ TEST_F(LocalCliTest, StatsReportsTheGenusOfTorusAndGenusTwoReconstructions) {
     EXPECT_EQ(JsonValue(stats.out, "boundary_loops"), "0") << shape << ":\n" << stats.out;
     EXPECT_EQ(JsonValue(stats.out, "components"), "1") << shape << ":\n" << stats.out;
   }
+}
+
+// An earlier OUTPUT refined with --start_mesh: the run starts at its 500 vertices (the LOD
+// row counts the Basic Steps from there), keeps the genus and lands on the sphere; a start
+// mesh that is not a manifold, or not below --vertices, is refused before any learning.
+TEST_F(LocalCliTest, AStartMeshIsRefinedToTheTarget) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  const std::string refined = *dir_ + "/refined.ply";
+  const RunResult run =
+      RunNeuralmesh({"reconstruct", "builtin:sphere", "-o", refined, "--vertices", "1500",
+                     "--start_mesh", *output_, "--seed", "4"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "from " + *output_ + " (500 vertices)")) << run.out;
+  // From 500 to 1,500 vertices takes about C_vs = 100 steps per new vertex; from the
+  // tetrahedron about 150,000.
+  const size_t at = run.out.find("target reached: 1500 vertices");
+  ASSERT_NE(at, std::string::npos) << run.out;
+  uint64_t steps = 0;
+  const std::string after_faces = run.out.substr(run.out.find("faces, ", at) + 7);
+  ASSERT_TRUE(absl::SimpleAtoi(after_faces.substr(0, after_faces.find(' ')), &steps)) << run.out;
+  EXPECT_LT(steps, 130000u) << run.out;
+  const RunResult stats = RunNeuralmesh({"stats", refined, "--json"});
+  ASSERT_EQ(stats.exit_code, 0) << stats.Describe();
+  EXPECT_EQ(JsonValue(stats.out, "vertices"), "1500") << stats.out;
+  EXPECT_EQ(JsonValue(stats.out, "genus"), "0") << stats.out;
+  EXPECT_EQ(JsonValue(stats.out, "boundary_loops"), "0") << stats.out;
+  const RunResult eval = RunNeuralmesh(
+      {"eval", refined, "--reference", "builtin:sphere", "--json", "--samples", "20000"});
+  ASSERT_EQ(eval.exit_code, 0) << eval.Describe();
+  double hausdorff = -1;
+  ASSERT_TRUE(absl::SimpleAtod(JsonValue(eval.out, "hausdorff"), &hausdorff)) << eval.out;
+  EXPECT_LT(hausdorff, 0.01) << eval.out;
+
+  const RunResult small = RunNeuralmesh({"reconstruct", "builtin:sphere", "-o", refined,
+                                         "--vertices", "400", "--start_mesh", *output_});
+  EXPECT_EQ(small.exit_code, 1) << small.Describe();
+  EXPECT_TRUE(absl::StrContains(small.err, "more than 500 vertices (those of --start_mesh)"))
+      << small.err;
+
+  const std::string fin = *dir_ + "/fin.obj";  // Three faces on the edge 1-2.
+  std::ofstream(fin) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 1\nv 1 1 -1\n"
+                        "f 1 2 3\nf 2 4 3\nf 2 3 5\n";
+  const RunResult bad = RunNeuralmesh({"reconstruct", "builtin:sphere", "-o", refined,
+                                       "--vertices", "1000", "--start_mesh", fin});
+  EXPECT_EQ(bad.exit_code, 1) << bad.Describe();
+  EXPECT_TRUE(absl::StrContains(bad.err, "--start_mesh '" + fin + "': face 2"))
+      << bad.err;
 }
 
 TEST_F(LocalCliTest, StatsPrintsTextByDefault) {
@@ -229,6 +277,7 @@ TEST(LocalCliHelpTest, HelpDocumentsEveryReconstructFlag) {
                            "--splits_per_step",
                            "--sampling",
                            "--initial_mesh",
+                           "--start_mesh",
                            "--remove_outliers",
                            "--outlier_neighbours",
                            "--outlier_std_ratio",

@@ -1,5 +1,6 @@
 #include "core/learning/learner.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -392,6 +393,79 @@ TEST(LearnerTest, HemisphereGrowsPastItsFirstVertices) {
   EXPECT_EQ(*reason, StopReason::kTargetReached) << "stuck at " << learner->num_vertices();
   const MeshReport report = ComputeMeshReport(learner->Snapshot());
   EXPECT_EQ(report.boundary_loops, 1u) << "Step 4 has cut the disc away";
+}
+
+// The positions of `mesh`, sorted: equal for two meshes that differ in their numbering only.
+std::vector<Vec3f> SortedPositions(const TriangleMesh& mesh) {
+  std::vector<Vec3f> sorted = mesh.positions;
+  std::sort(sorted.begin(), sorted.end(), [](const Vec3f& a, const Vec3f& b) {
+    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  });
+  return sorted;
+}
+
+TEST(LearnerTest, LearningGoesOnFromASnapshotWithItsTopology) {
+  // A torus learned to 1,000 vertices, snapshotted, and learned on to 3,000 by a second
+  // learner: it starts with the snapshot (renumbered), keeps the genus, and needs far fewer
+  // Basic Steps than a learner from the tetrahedron.
+  auto torus = MakeTorus(Vec3(0, 0, 0), 1.0, 0.4).value();
+  const TriangleMesh coarse = LearnTo(*torus, 1000, 5)->Snapshot();
+  ASSERT_EQ(ComputeMeshReport(coarse).genus, 1);
+
+  LearnerOptions options;
+  options.seed = 6;
+  absl::StatusOr<std::unique_ptr<Learner>> resumed = Learner::CreateFrom(options, torus.get(), coarse);
+  ASSERT_TRUE(resumed.ok()) << resumed.status();
+  Learner& learner = **resumed;
+  ASSERT_TRUE(ValidateMesh(learner.mesh()).ok()) << ValidateMesh(learner.mesh());
+  const TriangleMesh start = learner.Snapshot();
+  EXPECT_EQ(start.faces.size(), coarse.faces.size());
+  EXPECT_EQ(SortedPositions(start), SortedPositions(coarse)) << "the start mesh's vertices";
+  EXPECT_EQ(learner.progress().basic_steps, 0u);
+
+  StopCriteria stop;
+  stop.target_vertices = 3000;
+  ASSERT_TRUE(learner.Run(stop).ok());
+  ASSERT_TRUE(ValidateMesh(learner.mesh()).ok()) << ValidateMesh(learner.mesh());
+  const MeshReport report = ComputeMeshReport(learner.Snapshot());
+  EXPECT_EQ(report.vertices, 3000u);
+  EXPECT_EQ(report.genus, 1);
+  EXPECT_TRUE(report.closed);
+  EXPECT_EQ(report.components, 1u);
+  double worst = 0;
+  for (auto v : learner.mesh().vertices()) {
+    const Vec3 p = learner.mesh().point(v);
+    const double ring = std::hypot(p[0], p[1]) - 1.0;
+    worst = std::max(worst, std::abs(std::hypot(ring, p[2]) - 0.4));
+  }
+  EXPECT_LT(worst, 0.01) << "every vertex within 0.01 of the torus";
+
+  const uint64_t fresh_steps = LearnTo(*torus, 3000, 6)->progress().basic_steps;
+  EXPECT_LT(learner.progress().basic_steps, 0.8 * fresh_steps)
+      << "from 1,000 vertices on, against " << fresh_steps << " Basic Steps from the start";
+}
+
+TEST(LearnerTest, CreateFromRejectsABadStartMeshAndWhatCreateRejects) {
+  auto sphere = UnitSphere();
+  TriangleMesh open_fan;  // A vertex with two fans: not a manifold.
+  open_fan.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0),
+                        Vec3f(-1, 0, 0), Vec3f(0, -1, 0)};
+  open_fan.faces = {{0, 1, 2}, {0, 3, 4}};
+  absl::StatusOr<std::unique_ptr<Learner>> learner =
+      Learner::CreateFrom(LearnerOptions{}, sphere.get(), open_fan);
+  ASSERT_FALSE(learner.ok());
+  EXPECT_EQ(learner.status().code(), absl::StatusCode::kInvalidArgument) << learner.status();
+  EXPECT_NE(learner.status().message().find("start mesh"), std::string::npos) << learner.status();
+
+  // The checks of Create come first.
+  const TriangleMesh coarse = LearnTo(*sphere, 100)->Snapshot();
+  LearnerOptions invalid;
+  invalid.alpha_w = 0;
+  learner = Learner::CreateFrom(invalid, sphere.get(), coarse);
+  ASSERT_FALSE(learner.ok());
+  EXPECT_NE(learner.status().message().find("alpha_w"), std::string::npos) << learner.status();
+  EXPECT_EQ(Learner::CreateFrom(LearnerOptions{}, nullptr, coarse).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 }  // namespace

@@ -364,12 +364,37 @@ void Session::StoreMesh(const v1::MeshUpdate& update, bool durable) {
   }
 }
 
+void Session::StoreCheckpoint(const Snapshot& snapshot) {
+  if (record_ == nullptr) return;
+  const absl::Status stored = record_->WriteCheckpoint(snapshot.mesh, snapshot.learning);
+  if (!stored.ok() && !checkpoint_store_failed_.exchange(true)) {
+    Record(absl::StrCat("could not store the learner's mesh of ", snapshot.mesh.positions.size(),
+                        " vertices (a restart would learn on from an older one or from the "
+                        "initial mesh; later failures are not recorded): ", stored.message()));
+  }
+}
+
 void Session::FinishRestore(v1::SessionState state, const std::string& error,
                             std::shared_ptr<v1::MeshUpdate> latest,
+                            std::optional<LearnerCheckpoint> checkpoint,
                             std::unique_ptr<SessionRecord> record) {
   record_ = std::move(record);
   const bool ended = state == v1::SESSION_STATE_FINISHED ||
                      state == v1::SESSION_STATE_CANCELLED || state == v1::SESSION_STATE_FAILED;
+  if (checkpoint.has_value() && !ended) {
+    // Learning goes on from the checkpoint's mesh, and its counts from the checkpoint's.
+    const v1::LearningState& before = checkpoint->learning;
+    start_mesh_ = std::move(checkpoint->mesh);
+    earlier_learning_.basic_steps = before.basic_steps();
+    earlier_learning_.splits = before.splits();
+    earlier_learning_.collapses = before.collapses();
+    learning_time_ = absl::Seconds(before.learning_seconds());
+    absl::MutexLock lock(&mu_);
+    learning_.set_basic_steps(before.basic_steps());
+    learning_.set_splits(before.splits());
+    learning_.set_collapses(before.collapses());
+    learning_.set_learning_seconds(before.learning_seconds());
+  }
   if (latest != nullptr) {
     absl::MutexLock lock(&mu_);
     // The milestones up to the stored mesh were published before the restart. Learning again
@@ -485,10 +510,10 @@ void Session::Wake() {
 void Session::UpdateLearningState() {
   const LearnerProgress progress = learner_->progress();
   absl::MutexLock lock(&mu_);
-  const uint64_t steps = discarded_.basic_steps + progress.basic_steps;
+  const uint64_t steps = earlier_learning_.basic_steps + progress.basic_steps;
   learning_.set_basic_steps(steps);
-  learning_.set_splits(discarded_.splits + progress.splits);
-  learning_.set_collapses(discarded_.collapses + progress.collapses);
+  learning_.set_splits(earlier_learning_.splits + progress.splits);
+  learning_.set_collapses(earlier_learning_.collapses + progress.collapses);
   learning_.set_learning_seconds(absl::ToDoubleSeconds(learning_time_));
   learning_.set_steps_per_second(learning_time_ > absl::ZeroDuration()
                                      ? steps / absl::ToDoubleSeconds(learning_time_)
@@ -517,7 +542,7 @@ SliceResult Session::RunSlice(absl::Time deadline) {
     if (finishing && !final_pass_decided_) {
       final_pass_decided_ = true;
       bool relearn = false;
-      if (learner_ != nullptr) {
+      if (learner_ != nullptr || start_mesh_.has_value()) {
         if (config_.final_pass == FinalPass::kRelearn) {
           relearn = true;
         } else if (config_.final_pass == FinalPass::kAuto) {
@@ -526,18 +551,21 @@ SliceResult Session::RunSlice(absl::Time deadline) {
         }
       }
       if (relearn) {
-        const LearnerProgress progress = learner_->progress();
-        discarded_.basic_steps += progress.basic_steps;
-        discarded_.splits += progress.splits;
-        discarded_.collapses += progress.collapses;
-        learner_.reset();
+        if (learner_ != nullptr) {
+          const LearnerProgress progress = learner_->progress();
+          earlier_learning_.basic_steps += progress.basic_steps;
+          earlier_learning_.splits += progress.splits;
+          earlier_learning_.collapses += progress.collapses;
+          learner_.reset();
+        }
+        start_mesh_.reset();
         relearning_ = true;
       }
     }
 
     if (learner_ == nullptr) {
       if (allowed < kMinTargetVertices) return {SliceResult::kIdle};
-      absl::StatusOr<std::unique_ptr<Learner>> learner = Learner::Create(config_.learner, &points_);
+      absl::StatusOr<std::unique_ptr<Learner>> learner = CreateLearner(allowed);
       if (!learner.ok()) {
         Fail(learner.status());
         return {SliceResult::kDone};
@@ -631,6 +659,29 @@ SliceResult Session::RunSlice(absl::Time deadline) {
   }
 }
 
+absl::StatusOr<std::unique_ptr<Learner>> Session::CreateLearner(size_t allowed) {
+  if (!start_mesh_.has_value()) return Learner::Create(config_.learner, &points_);
+  const TriangleMesh start = *std::move(start_mesh_);
+  start_mesh_.reset();
+  const size_t vertices = start.positions.size();
+  absl::Status taken = absl::OkStatus();
+  if (vertices > allowed) {
+    taken = absl::FailedPreconditionError(
+        absl::StrCat("it has ", vertices, " vertices, more than the ", allowed, " allowed now"));
+  } else {
+    absl::StatusOr<std::unique_ptr<Learner>> learner =
+        Learner::CreateFrom(config_.learner, &points_, start);
+    if (learner.ok()) {
+      Record(absl::StrCat("learning goes on from the stored mesh of ", vertices, " vertices"));
+      return learner;
+    }
+    taken = learner.status();
+  }
+  Record(absl::StrCat("cannot learn on from the stored mesh (", taken.message(),
+                      "); learning again from the initial mesh"));
+  return Learner::Create(config_.learner, &points_);
+}
+
 void Session::TakeSnapshot(v1::UpdateKind kind, size_t milestone, uint32_t lod_index) {
   Snapshot snapshot;
   snapshot.mesh = learner_->Snapshot();
@@ -709,7 +760,10 @@ void Session::EncodeNext() {
     }
   } else {
     const std::shared_ptr<v1::MeshUpdate> published = *update;
-    if (updates_.Publish(published) != 0) StoreMesh(*published, /*durable=*/false);
+    if (updates_.Publish(published) != 0) {
+      StoreMesh(*published, /*durable=*/false);
+      if (snapshot.kind == v1::UPDATE_KIND_MILESTONE) StoreCheckpoint(snapshot);
+    }
   }
   // One snapshot per task, so that sessions take turns on the encoder threads.
   absl::MutexLock lock(&mu_);
@@ -720,7 +774,7 @@ void Session::EncodeNext() {
   }
 }
 
-absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Session::Encode(Snapshot& snapshot) const {
+absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Session::Encode(const Snapshot& snapshot) const {
   auto update = std::make_shared<v1::MeshUpdate>();
   update->set_session_id(id_);
   update->set_kind(snapshot.kind);
@@ -736,15 +790,30 @@ absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Session::Encode(Snapshot& snapsh
   update->set_snapshot_time_us(absl::ToUnixMicros(snapshot.taken));
 
   // Early coarse meshes (the initial tetrahedron encloses the data) may reach outside the
-  // cube; clamping them keeps one grid for the whole session.
+  // cube; clamping a copy of them keeps one grid for the whole session (the snapshot stays as
+  // the learner had it, for the checkpoint).
   const QuantizationBox& box = snapshot.box;
-  for (Vec3f& p : snapshot.mesh.positions) {
-    for (int c = 0; c < 3; ++c) p[c] = std::clamp(p[c], box.origin[c], box.origin[c] + box.range);
+  auto inside = [&box](const Vec3f& p) {
+    for (int c = 0; c < 3; ++c) {
+      if (!(p[c] >= box.origin[c] && p[c] <= box.origin[c] + box.range)) return false;
+    }
+    return true;
+  };
+  const TriangleMesh* mesh = &snapshot.mesh;
+  TriangleMesh clamped;
+  if (!std::all_of(mesh->positions.begin(), mesh->positions.end(), inside)) {
+    clamped = snapshot.mesh;
+    for (Vec3f& p : clamped.positions) {
+      for (int c = 0; c < 3; ++c) {
+        p[c] = std::clamp(p[c], box.origin[c], box.origin[c] + box.range);
+      }
+    }
+    mesh = &clamped;
   }
   DracoOptions options = config_.draco;
   options.quantization_box = box;
   const absl::Time start = absl::Now();
-  absl::StatusOr<std::string> bytes = EncodeMesh(snapshot.mesh, options);
+  absl::StatusOr<std::string> bytes = EncodeMesh(*mesh, options);
   if (!bytes.ok()) return bytes.status();
   update->set_encode_time_us(absl::ToInt64Microseconds(absl::Now() - start));
   update->set_draco_mesh(*std::move(bytes));

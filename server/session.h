@@ -23,9 +23,11 @@
 // batches and latest mesh on disk through a SessionRecord, and a server that starts again
 // restores it: its batches are taken again in their order (so the points, the quantization
 // cube and the outlier filter's verdicts come out as before), the stored latest mesh is
-// published again with its sequence number, and a session that was still learning learns
-// again from scratch, publishing no mesh coarser than the stored one (the milestones up to it
-// are skipped).
+// published again with its sequence number, and a session that was still learning learns on
+// from the learner's mesh at its latest milestone (the stored checkpoint; without one, again
+// from the initial mesh), publishing no mesh coarser than the stored one (the milestones up to
+// it are skipped). Its counters (Basic Steps, splits, collapses, learning time) go on from
+// those of the checkpoint.
 //
 // A learner whose vertex count makes no new maximum for kStallSplits * C_vs Basic Steps while
 // it should grow (Step 3 collapsing as many vertices as Step 2 splits, as happens on some thin
@@ -99,10 +101,14 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // Restoring a stored session, before it is shared: ReplayBatch takes each batch of its
   // journal as AddPoints took it, without waking the learner; FinishRestore then restores the
   // stored state and latest mesh (which must belong to the session and carry its sequence
-  // number), attaches `record`, and sets learning going again unless the session had ended.
+  // number), attaches `record`, and sets learning going again unless the session had ended:
+  // from `checkpoint`'s mesh when there is one (unless the final pass relearns, see
+  // SessionConfig::final_pass), and from the initial mesh when there is none or the learner
+  // cannot take it (the event log says why).
   absl::Status ReplayBatch(const PointCloud& batch) ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
   void FinishRestore(v1::SessionState state, const std::string& error,
                      std::shared_ptr<v1::MeshUpdate> latest,
+                     std::optional<LearnerCheckpoint> checkpoint,
                      std::unique_ptr<SessionRecord> record) ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
 
   const std::string& id() const { return id_; }
@@ -191,6 +197,13 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // Stores a published mesh; a failure is recorded in the event log (once per session), as the
   // mesh can be learned again.
   void StoreMesh(const v1::MeshUpdate& update, bool durable);
+  // Stores the learner's mesh of a published milestone as the checkpoint; a failure is
+  // recorded like StoreMesh's.
+  void StoreCheckpoint(const Snapshot& snapshot);
+  // A learner for the points so far: from the restored checkpoint's mesh when there is one
+  // that fits in `allowed` vertices and that the learner takes, else from the initial mesh
+  // (learning thread).
+  absl::StatusOr<std::unique_ptr<Learner>> CreateLearner(size_t allowed);
   bool AcceptsPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // OK, or FAILED_PRECONDITION naming the state in which the session refuses points.
   absl::Status AcceptingPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
@@ -209,7 +222,7 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
       ABSL_LOCKS_EXCLUDED(mu_);
   void ScheduleEncodeLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void EncodeNext() ABSL_LOCKS_EXCLUDED(mu_);
-  absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Encode(Snapshot& snapshot) const;
+  absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Encode(const Snapshot& snapshot) const;
   void Fail(const absl::Status& status) ABSL_LOCKS_EXCLUDED(mu_);
   // Records `event` in the event log, if there is one.
   void Record(absl::string_view event) const;
@@ -259,14 +272,19 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   std::unique_ptr<Learner> learner_;
   bool final_pass_decided_ = false;
   bool relearning_ = false;
-  LearnerProgress discarded_;  // Counters of learners discarded for a relearn.
+  // The counters of learning that learner_ does not count: learners discarded for a relearn,
+  // and the learning before a restart (the checkpoint's counters).
+  LearnerProgress earlier_learning_;
   absl::Duration learning_time_;
+  // The restored checkpoint's mesh, until the learner is created.
+  std::optional<TriangleMesh> start_mesh_;
   absl::Time last_publish_time_ = absl::InfinitePast();
   uint64_t last_publish_steps_ = 0;
   std::optional<GrowthWatch> growth_;  // Stall detection for the current learner.
 
   std::unique_ptr<SessionRecord> record_;  // Null without a state directory.
   std::atomic<bool> mesh_store_failed_{false};
+  std::atomic<bool> checkpoint_store_failed_{false};
 };
 
 }  // namespace neuralmesh::server

@@ -1,6 +1,7 @@
 #include "server/session_restore.h"
 
 #include <filesystem>
+#include <optional>
 #include <system_error>
 #include <utility>
 
@@ -97,11 +98,23 @@ std::shared_ptr<Session> RestoreSession(const StoredSessionFiles& files, Session
   absl::StatusOr<std::unique_ptr<SessionRecord>> record =
       store.Reopen(files, replay->journal_bytes);
   if (!record.ok()) return unrestored(record.status());
-  const std::string latest_note =
+  std::string latest_note =
       latest == nullptr ? std::string()
                         : absl::StrCat(", mesh ", latest->sequence(), " of ",
                                        latest->vertex_count(), " vertices");
-  session->FinishRestore(state, error, std::move(latest), *std::move(record));
+  if (!files.checkpoint_damage.empty()) {
+    problems.push_back(absl::StrCat("session ", id, ": its learner checkpoint cannot be used (",
+                                    files.checkpoint_damage,
+                                    "); it learns again from the initial mesh"));
+  }
+  std::optional<LearnerCheckpoint> checkpoint = files.checkpoint;
+  if (checkpoint.has_value() && (state == v1::SESSION_STATE_COLLECTING ||
+                                 state == v1::SESSION_STATE_FINISHING)) {
+    absl::StrAppend(&latest_note, ", learner checkpoint of ",
+                    checkpoint->mesh.positions.size(), " vertices");
+  }
+  session->FinishRestore(state, error, std::move(latest), std::move(checkpoint),
+                         *std::move(record));
   if (log != nullptr) {
     log->Record(id, absl::StrCat("restored after a restart: ", session->points_received(),
                                  " points in ", replay->batches, " batches, ",

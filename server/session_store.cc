@@ -5,15 +5,18 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <system_error>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/file_contents.h"
 #include "core/status_macros.h"
+#include "neuralmesh/storage/v1/learner_checkpoint.pb.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -45,6 +48,51 @@ bool IsSessionId(const std::string& name) {
          });
 }
 
+// The bytes of `elements` as they lie in memory (this server runs on little-endian machines
+// only, as the journal does).
+template <typename T>
+std::string RawBytes(const std::vector<T>& elements) {
+  return std::string(reinterpret_cast<const char*>(elements.data()), elements.size() * sizeof(T));
+}
+
+// The elements `bytes` holds (RawBytes), or nothing when its size is not a multiple of theirs.
+template <typename T>
+std::optional<std::vector<T>> FromRawBytes(const std::string& bytes) {
+  if (bytes.size() % sizeof(T) != 0) return std::nullopt;
+  std::vector<T> elements(bytes.size() / sizeof(T));
+  std::memcpy(elements.data(), bytes.data(), bytes.size());
+  return elements;
+}
+
+// The checkpoint in `contents`, or what is wrong with it. The mesh itself is checked when
+// learning goes on from it (Learner::CreateFrom).
+absl::StatusOr<LearnerCheckpoint> ParseCheckpoint(const std::string& contents,
+                                                  const std::string& id) {
+  storage::v1::LearnerCheckpoint stored;
+  if (!stored.ParseFromString(contents)) {
+    return absl::DataLossError("it is not a learner checkpoint");
+  }
+  if (stored.format_version() != kFormatVersion) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "it has format version ", stored.format_version(), "; this server reads version ",
+        kFormatVersion));
+  }
+  if (stored.session_id() != id) {
+    return absl::DataLossError(absl::StrCat("it is of session \"", stored.session_id(), "\""));
+  }
+  std::optional<std::vector<Vec3f>> positions = FromRawBytes<Vec3f>(stored.positions());
+  std::optional<std::vector<std::array<uint32_t, 3>>> faces =
+      FromRawBytes<std::array<uint32_t, 3>>(stored.faces());
+  if (!positions.has_value() || !faces.has_value()) {
+    return absl::DataLossError("its positions or faces are cut short");
+  }
+  LearnerCheckpoint checkpoint;
+  checkpoint.mesh.positions = *std::move(positions);
+  checkpoint.mesh.faces = *std::move(faces);
+  checkpoint.learning = stored.learning();
+  return checkpoint;
+}
+
 absl::StatusOr<StoredSessionFiles> ReadSessionDirectory(const std::string& directory) {
   StoredSessionFiles files;
   files.directory = directory;
@@ -70,6 +118,17 @@ absl::StatusOr<StoredSessionFiles> ReadSessionDirectory(const std::string& direc
       latest.ok()) {
     v1::MeshUpdate update;
     if (update.ParseFromString(*latest)) files.latest = std::move(update);
+  }
+  const std::string checkpoint_path = absl::StrCat(directory, "/", kCheckpointFile);
+  if (std::error_code missing; std::filesystem::exists(checkpoint_path, missing)) {
+    absl::StatusOr<std::string> contents = ReadFileContents(checkpoint_path);
+    absl::StatusOr<LearnerCheckpoint> checkpoint =
+        contents.ok() ? ParseCheckpoint(*contents, id) : contents.status();
+    if (checkpoint.ok()) {
+      files.checkpoint = *std::move(checkpoint);
+    } else {
+      files.checkpoint_damage = std::string(checkpoint.status().message());
+    }
   }
   return files;
 }
@@ -104,6 +163,19 @@ absl::Status SessionRecord::WriteLatestMesh(const v1::MeshUpdate& update, bool d
   absl::MutexLock lock(&mu_);
   if (removed_) return absl::OkStatus();
   return ReplaceFile(kLatestMeshFile, update, durable);
+}
+
+absl::Status SessionRecord::WriteCheckpoint(const TriangleMesh& mesh,
+                                            const v1::LearningState& learning) {
+  storage::v1::LearnerCheckpoint checkpoint;
+  checkpoint.set_format_version(kFormatVersion);
+  checkpoint.set_positions(RawBytes(mesh.positions));
+  checkpoint.set_faces(RawBytes(mesh.faces));
+  *checkpoint.mutable_learning() = learning;
+  absl::MutexLock lock(&mu_);
+  if (removed_) return absl::OkStatus();
+  checkpoint.set_session_id(stored_.session_id());
+  return ReplaceFile(kCheckpointFile, checkpoint, /*durable=*/false);
 }
 
 absl::Status SessionRecord::Remove() {

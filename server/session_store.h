@@ -6,12 +6,15 @@
 //   DIR/sessions/ID/session.binpb neuralmesh.storage.v1.StoredSession, replaced whole
 //   DIR/sessions/ID/points.journal every batch the session took, in order (points_journal.h)
 //   DIR/sessions/ID/latest.binpb  the latest published neuralmesh.v1.MeshUpdate, replaced whole
+//   DIR/sessions/ID/checkpoint.binpb  the learner's mesh at the latest milestone, exactly
+//                                 (neuralmesh.storage.v1.LearnerCheckpoint), replaced whole
 //
 // What is durable: a batch is acknowledged only after its record is written (and, with `sync`,
 // on the disk); a state change a client asks for (finish, cancel) is written before it
 // answers. Meshes are written after they are published and are not synced: a restored session
-// that lacks one relearns it. The learner's own state is not kept: a restored session learns
-// again from its points (session.h).
+// that lacks one relearns it. Of the learner's state only the mesh of the checkpoint is kept
+// (not its signal counters or octree): a restored session learns on from that mesh, or, without
+// one, again from the initial mesh (session.h).
 #ifndef NEURALMESH_SERVER_SESSION_STORE_H_
 #define NEURALMESH_SERVER_SESSION_STORE_H_
 
@@ -25,6 +28,7 @@
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "core/point_cloud.h"
+#include "core/triangle_mesh.h"
 #include "neuralmesh/storage/v1/stored_session.pb.h"
 #include "neuralmesh/v1/reconstruction.pb.h"
 #include "server/points_journal.h"
@@ -49,6 +53,10 @@ class SessionRecord {
   // Replaces the stored latest mesh; with `durable` (the final mesh) synced like a state.
   absl::Status WriteLatestMesh(const v1::MeshUpdate& update, bool durable)
       ABSL_LOCKS_EXCLUDED(mu_);
+  // Replaces the stored learner checkpoint: `mesh` as the learner had it, and the session's
+  // learning counters then. Not synced.
+  absl::Status WriteCheckpoint(const TriangleMesh& mesh, const v1::LearningState& learning)
+      ABSL_LOCKS_EXCLUDED(mu_);
   // Deletes the session's directory; every later call does nothing. The errno's code when the
   // directory could not be removed (a restart would then restore the session).
   absl::Status Remove() ABSL_LOCKS_EXCLUDED(mu_);
@@ -68,6 +76,12 @@ class SessionRecord {
   bool removed_ ABSL_GUARDED_BY(mu_) = false;
 };
 
+// The learner's mesh at a session's latest milestone, and the session's counters then.
+struct LearnerCheckpoint {
+  TriangleMesh mesh;
+  v1::LearningState learning;
+};
+
 // A session found in the state directory.
 struct StoredSessionFiles {
   std::string directory;
@@ -75,6 +89,10 @@ struct StoredSessionFiles {
   std::string journal_path;
   // The latest mesh, when its file was there and readable.
   std::optional<v1::MeshUpdate> latest;
+  // The learner checkpoint, when its file was there and readable; else, when it was there,
+  // what was wrong with it.
+  std::optional<LearnerCheckpoint> checkpoint;
+  std::string checkpoint_damage;
 };
 
 class SessionStore {
@@ -118,6 +136,7 @@ class SessionStore {
 inline constexpr char kStoredSessionFile[] = "session.binpb";
 inline constexpr char kPointsJournalFile[] = "points.journal";
 inline constexpr char kLatestMeshFile[] = "latest.binpb";
+inline constexpr char kCheckpointFile[] = "checkpoint.binpb";
 
 }  // namespace neuralmesh::server
 

@@ -15,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/draco_codec.h"
 #include "core/sampling/implicit_surfaces.h"
+#include "neuralmesh/storage/v1/learner_checkpoint.pb.h"
 #include "server/server.h"
 #include "tests/server/server_test_support.h"
 #include "tests/testing/file_size_limit.h"
@@ -171,6 +172,117 @@ TEST_F(SessionRestoreTest, AnUploadGoesOnWhereItWasAndEndsOnTheSphere) {
   absl::StatusOr<std::unique_ptr<ImplicitSurface>> sphere = MakeSphere(Vec3(0, 0, 0), 1.0);
   ASSERT_TRUE(sphere.ok());
   EXPECT_LT(testing::MaxVertexDistance(*decoded, **sphere), 0.02);
+}
+
+// The learner checkpoint in `directory` once it holds a mesh of `vertices` vertices (the
+// encoder writes it right after it publishes the milestone); fails the test after 30 s.
+storage::v1::LearnerCheckpoint AwaitCheckpoint(const std::string& directory, size_t vertices) {
+  storage::v1::LearnerCheckpoint checkpoint;
+  const absl::Time deadline = absl::Now() + absl::Seconds(30);
+  while (absl::Now() < deadline) {
+    std::ifstream file(directory + "/checkpoint.binpb", std::ios::binary);
+    if (file && checkpoint.ParseFromIstream(&file) &&
+        checkpoint.positions().size() == vertices * 12) {
+      return checkpoint;
+    }
+    absl::SleepFor(absl::Milliseconds(5));
+  }
+  ADD_FAILURE() << "no checkpoint of " << vertices << " vertices in " << directory;
+  return checkpoint;
+}
+
+// A sphere session uploaded whole, learned past its 2,000-vertex milestone to its 4,000
+// allowed vertices, restarted and finished. The 2,000-vertex mesh of the checkpoint is where
+// learning goes on from: the counters go on from it, and the final mesh takes about 100 Basic
+// Steps per vertex added since, where learning from the tetrahedron takes that per vertex of
+// all 4,000.
+TEST_F(SessionRestoreTest, LearningGoesOnFromTheLatestMilestonesMesh) {
+  Restart();
+  const PointCloud cloud = SpherePoints(40000, 11);
+  v1::CreateSessionRequest request = CreateRequest(4000, /*refresh_ms=*/20);
+  request.mutable_config()->add_lod_milestones(1000);
+  request.mutable_config()->add_lod_milestones(2000);
+  const std::string id = MustCreate(*service_, request);
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(Upload(*service_, id, cloud, 4, &response).ok());
+  const storage::v1::LearnerCheckpoint checkpoint = AwaitCheckpoint(SessionDirectory(id), 2000);
+  const uint64_t steps_at_checkpoint = checkpoint.learning().basic_steps();
+  ASSERT_GT(steps_at_checkpoint, 100000u);
+  ASSERT_EQ(checkpoint.faces().size(), 3996u * 12) << "a closed mesh of 2,000 vertices";
+
+  Restart();
+  EXPECT_TRUE(server_->restored().problems.empty());
+  EXPECT_FALSE(events_.Await("learner checkpoint of 2000 vertices").empty());
+  const v1::Session restored = GetSession(*service_, id);
+  EXPECT_GE(restored.learning().basic_steps(), steps_at_checkpoint)
+      << "the counters go on from the checkpoint's";
+  EXPECT_GE(restored.learning().learning_seconds(), checkpoint.learning().learning_seconds());
+  EXPECT_FALSE(events_.Await("learning goes on from the stored mesh of 2000 vertices").empty());
+
+  ASSERT_TRUE(testing::Finish(*service_, id).ok());
+  v1::MeshUpdate final_mesh;
+  ASSERT_TRUE(WaitFinal(*service_, id, &final_mesh).ok());
+  EXPECT_EQ(final_mesh.vertex_count(), 4000u);
+  EXPECT_EQ(final_mesh.report().genus(), 0);
+  EXPECT_EQ(final_mesh.report().boundary_loops(), 0u);
+  EXPECT_TRUE(final_mesh.report().manifold());
+  const uint64_t steps_since = final_mesh.learning().basic_steps() - steps_at_checkpoint;
+  EXPECT_LT(steps_since, 300000u) << "from the 2,000-vertex mesh to 4,000 vertices";
+  absl::StatusOr<TriangleMesh> decoded = DecodeMesh(final_mesh.draco_mesh());
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  absl::StatusOr<std::unique_ptr<ImplicitSurface>> sphere = MakeSphere(Vec3(0, 0, 0), 1.0);
+  ASSERT_TRUE(sphere.ok());
+  EXPECT_LT(testing::MaxVertexDistance(*decoded, **sphere), 0.02);
+}
+
+// A checkpoint that cannot be read, and one whose mesh the learner cannot take (three faces
+// on an edge): each session says so and learns again from the initial mesh to a good sphere.
+TEST_F(SessionRestoreTest, ACheckpointThatCannotBeUsedMeansLearningFromTheInitialMesh) {
+  Restart();
+  const PointCloud cloud = SpherePoints(20000, 12);
+  std::vector<std::string> ids;
+  for (int i = 0; i < 2; ++i) {
+    v1::CreateSessionRequest request = CreateRequest(2000);
+    request.mutable_config()->add_lod_milestones(500);
+    ids.push_back(MustCreate(*service_, request));
+    v1::UploadPointsResponse response;
+    ASSERT_TRUE(Upload(*service_, ids.back(), cloud, 2, &response).ok());
+    AwaitCheckpoint(SessionDirectory(ids.back()), 500);
+  }
+  service_.reset();
+  server_.reset();
+  std::ofstream(SessionDirectory(ids[0]) + "/checkpoint.binpb", std::ios::binary) << "garbage";
+  storage::v1::LearnerCheckpoint fin;
+  fin.set_format_version(1);
+  fin.set_session_id(ids[1]);
+  const std::vector<Vec3f> positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0),
+                                        Vec3f(1, 1, 1), Vec3f(1, 1, -1)};
+  const std::vector<uint32_t> faces = {0, 1, 2, 1, 3, 2, 1, 2, 4};
+  fin.set_positions(std::string(reinterpret_cast<const char*>(positions.data()), 5 * 12));
+  fin.set_faces(std::string(reinterpret_cast<const char*>(faces.data()), 9 * 4));
+  std::ofstream(SessionDirectory(ids[1]) + "/checkpoint.binpb", std::ios::binary)
+      << fin.SerializeAsString();
+
+  Restart();
+  ASSERT_EQ(server_->restored().problems.size(), 1u);
+  EXPECT_TRUE(absl::StrContains(server_->restored().problems[0],
+                                absl::StrCat("session ", ids[0], ": its learner checkpoint "
+                                             "cannot be used (it is not a learner checkpoint)")))
+      << server_->restored().problems[0];
+  EXPECT_FALSE(events_.Await("cannot learn on from the stored mesh (face 2").empty());
+  for (const std::string& id : ids) {
+    ASSERT_TRUE(testing::Finish(*service_, id).ok());
+    v1::MeshUpdate final_mesh;
+    ASSERT_TRUE(WaitFinal(*service_, id, &final_mesh).ok());
+    EXPECT_EQ(final_mesh.vertex_count(), 2000u);
+    EXPECT_EQ(final_mesh.report().genus(), 0) << id;
+    EXPECT_EQ(final_mesh.report().boundary_loops(), 0u) << id;
+    absl::StatusOr<TriangleMesh> decoded = DecodeMesh(final_mesh.draco_mesh());
+    ASSERT_TRUE(decoded.ok()) << decoded.status();
+    absl::StatusOr<std::unique_ptr<ImplicitSurface>> sphere = MakeSphere(Vec3(0, 0, 0), 1.0);
+    ASSERT_TRUE(sphere.ok());
+    EXPECT_LT(testing::MaxVertexDistance(*decoded, **sphere), 0.02) << id;
+  }
 }
 
 TEST_F(SessionRestoreTest, EndedSessionsComeBackAsTheyEndedAndDeletedOnesDoNot) {

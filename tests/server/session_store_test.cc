@@ -11,6 +11,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "neuralmesh/storage/v1/learner_checkpoint.pb.h"
 #include "tests/testing/temp_dir.h"
 
 namespace neuralmesh::server {
@@ -123,6 +124,60 @@ TEST(SessionStoreTest, WhatIsNotASessionIsReportedAndLeft) {
   EXPECT_TRUE(absl::StrContains(all, "s-empty/session.binpb")) << all;
   EXPECT_TRUE(absl::StrContains(all, "holds session \"s-good\"")) << all;
   EXPECT_TRUE(std::filesystem::exists(dir + "/sessions/s-garbage/session.binpb"));
+}
+
+TEST(SessionStoreTest, ALearnerCheckpointComesBackExactlyOrSaysWhatIsWrong) {
+  const std::string dir = neuralmesh::testing::MakeTempDir("checkpoint");
+  absl::StatusOr<std::unique_ptr<SessionStore>> store = SessionStore::Open(dir, false);
+  ASSERT_TRUE(store.ok()) << store.status();
+  absl::StatusOr<std::unique_ptr<SessionRecord>> record = (*store)->Create(NewSession("s-1", 1));
+  ASSERT_TRUE(record.ok()) << record.status();
+  TriangleMesh mesh;
+  mesh.positions = {Vec3f(0.1f, -2.5f, 1e-7f), Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, 0, 1)};
+  mesh.faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  v1::LearningState learning;
+  learning.set_basic_steps(123456);
+  learning.set_learning_seconds(0.75);
+  ASSERT_TRUE((*record)->WriteCheckpoint(mesh, learning).ok());
+
+  std::vector<std::string> problems;
+  std::vector<StoredSessionFiles> listed = (*store)->List(&problems);
+  ASSERT_EQ(listed.size(), 1u);
+  ASSERT_TRUE(listed[0].checkpoint.has_value()) << listed[0].checkpoint_damage;
+  EXPECT_EQ(listed[0].checkpoint->mesh.positions, mesh.positions);
+  EXPECT_EQ(listed[0].checkpoint->mesh.faces, mesh.faces);
+  EXPECT_EQ(listed[0].checkpoint->learning.SerializeAsString(), learning.SerializeAsString());
+  EXPECT_TRUE(listed[0].checkpoint_damage.empty());
+
+  // Its faces cut short by a byte.
+  const std::string path = dir + "/sessions/s-1/checkpoint.binpb";
+  storage::v1::LearnerCheckpoint stored;
+  {
+    std::ifstream file(path, std::ios::binary);
+    ASSERT_TRUE(stored.ParseFromIstream(&file));
+  }
+  stored.mutable_faces()->pop_back();
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << stored.SerializeAsString();
+  listed = (*store)->List(&problems);
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_FALSE(listed[0].checkpoint.has_value());
+  EXPECT_EQ(listed[0].checkpoint_damage, "its positions or faces are cut short");
+
+  // Another session's.
+  stored.set_session_id("s-2");
+  stored.mutable_faces()->push_back('\0');
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << stored.SerializeAsString();
+  listed = (*store)->List(&problems);
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_EQ(listed[0].checkpoint_damage, "it is of session \"s-2\"");
+  EXPECT_TRUE(problems.empty()) << "the session itself is fine";
+
+  // None at all: nothing wrong.
+  std::filesystem::remove(path);
+  listed = (*store)->List(&problems);
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_FALSE(listed[0].checkpoint.has_value());
+  EXPECT_TRUE(listed[0].checkpoint_damage.empty());
 }
 
 }  // namespace

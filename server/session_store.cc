@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <optional>
@@ -46,6 +47,11 @@ bool IsSessionId(const std::string& name) {
          std::all_of(name.begin(), name.end(), [](char c) {
            return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-';
          });
+}
+
+bool Ended(v1::SessionState state) {
+  return state == v1::SESSION_STATE_FINISHED || state == v1::SESSION_STATE_CANCELLED ||
+         state == v1::SESSION_STATE_FAILED;
 }
 
 // The bytes of `elements` as they lie in memory (this server runs on little-endian machines
@@ -156,6 +162,8 @@ absl::Status SessionRecord::SetState(v1::SessionState state, const std::string& 
   changed.set_error(error);
   NM_RETURN_IF_ERROR(ReplaceFile(kStoredSessionFile, changed, /*durable=*/true));
   stored_ = std::move(changed);
+  // An ended session learns no more; a checkpoint left behind (the removal failing) is unused.
+  if (Ended(state)) std::remove(absl::StrCat(directory_, "/", kCheckpointFile).c_str());
   return absl::OkStatus();
 }
 
@@ -173,7 +181,7 @@ absl::Status SessionRecord::WriteCheckpoint(const TriangleMesh& mesh,
   checkpoint.set_faces(RawBytes(mesh.faces));
   *checkpoint.mutable_learning() = learning;
   absl::MutexLock lock(&mu_);
-  if (removed_) return absl::OkStatus();
+  if (removed_ || Ended(stored_.state())) return absl::OkStatus();
   checkpoint.set_session_id(stored_.session_id());
   return ReplaceFile(kCheckpointFile, checkpoint, /*durable=*/false);
 }

@@ -47,14 +47,15 @@ class SessionRecord {
   // Appends a batch to the journal (PointsJournal::Append). OK and nothing written once
   // removed.
   absl::Status AppendBatch(const PointCloud& batch) ABSL_LOCKS_EXCLUDED(mu_);
-  // Records a new state and its reason (the error of a cancelled or failed session).
+  // Records a new state and its reason (the error of a cancelled or failed session). An ended
+  // state (finished, cancelled, failed) removes the learner checkpoint.
   absl::Status SetState(v1::SessionState state, const std::string& error)
       ABSL_LOCKS_EXCLUDED(mu_);
   // Replaces the stored latest mesh; with `durable` (the final mesh) synced like a state.
   absl::Status WriteLatestMesh(const v1::MeshUpdate& update, bool durable)
       ABSL_LOCKS_EXCLUDED(mu_);
   // Replaces the stored learner checkpoint: `mesh` as the learner had it, and the session's
-  // learning counters then. Not synced.
+  // learning counters then. Not synced. OK and nothing written once the state is an ended one.
   absl::Status WriteCheckpoint(const TriangleMesh& mesh, const v1::LearningState& learning)
       ABSL_LOCKS_EXCLUDED(mu_);
   // Deletes the session's directory; every later call does nothing. The errno's code when the

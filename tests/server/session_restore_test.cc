@@ -285,6 +285,45 @@ TEST_F(SessionRestoreTest, ACheckpointThatCannotBeUsedMeansLearningFromTheInitia
   }
 }
 
+// A session stopped while finishing, whose final pass relearns (SessionConfig.final_pass):
+// the final mesh is learned again from the initial mesh, as it would have been without the
+// restart, and the checkpoint is not used.
+TEST_F(SessionRestoreTest, AFinalPassThatRelearnsLeavesTheCheckpointUnused) {
+  Restart();
+  v1::CreateSessionRequest request = CreateRequest(2000);
+  request.mutable_config()->add_lod_milestones(500);
+  request.mutable_config()->set_final_pass(v1::FINAL_PASS_RELEARN);
+  const std::string id = MustCreate(*service_, request);
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(Upload(*service_, id, SpherePoints(20000, 13), 2, &response).ok());
+  AwaitCheckpoint(SessionDirectory(id), 500);
+  service_.reset();
+  server_.reset();
+  // As if the server had stopped right after taking the finish.
+  const std::string state_path = SessionDirectory(id) + "/session.binpb";
+  storage::v1::StoredSession stored;
+  {
+    std::ifstream file(state_path, std::ios::binary);
+    ASSERT_TRUE(stored.ParseFromIstream(&file));
+  }
+  stored.set_state(v1::SESSION_STATE_FINISHING);
+  std::ofstream(state_path, std::ios::binary | std::ios::trunc) << stored.SerializeAsString();
+
+  Restart();
+  EXPECT_FALSE(events_.Await("finishing, mesh").empty());
+  v1::MeshUpdate final_mesh;
+  ASSERT_TRUE(WaitFinal(*service_, id, &final_mesh).ok());
+  EXPECT_TRUE(final_mesh.learning().relearning());
+  EXPECT_EQ(final_mesh.vertex_count(), 2000u);
+  EXPECT_EQ(final_mesh.report().genus(), 0);
+  EXPECT_FALSE(events_.Await("finished: 2000 vertices").empty());
+  for (const std::string& line : events_.lines()) {
+    EXPECT_FALSE(absl::StrContains(line, "learning goes on")) << line;
+  }
+  EXPECT_FALSE(std::filesystem::exists(SessionDirectory(id) + "/checkpoint.binpb"))
+      << "a finished session keeps no checkpoint";
+}
+
 TEST_F(SessionRestoreTest, EndedSessionsComeBackAsTheyEndedAndDeletedOnesDoNot) {
   Restart();
   const PointCloud cloud = TorusPoints(20000, 3);

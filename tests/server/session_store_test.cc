@@ -178,6 +178,14 @@ TEST(SessionStoreTest, ALearnerCheckpointComesBackExactlyOrSaysWhatIsWrong) {
   ASSERT_EQ(listed.size(), 1u);
   EXPECT_FALSE(listed[0].checkpoint.has_value());
   EXPECT_TRUE(listed[0].checkpoint_damage.empty());
+
+  // An ended session keeps none, and takes none.
+  ASSERT_TRUE((*record)->WriteCheckpoint(mesh, learning).ok());
+  EXPECT_TRUE(std::filesystem::exists(path));
+  ASSERT_TRUE((*record)->SetState(v1::SESSION_STATE_FINISHED, "").ok());
+  EXPECT_FALSE(std::filesystem::exists(path));
+  ASSERT_TRUE((*record)->WriteCheckpoint(mesh, learning).ok());
+  EXPECT_FALSE(std::filesystem::exists(path));
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "bench/bench_flags.h"
+#include "bench/first_touch.h"
 #include "core/learning/learner.h"
 #include "core/sampling/growing_point_cloud.h"
 #include "core/sampling/implicit_surfaces.h"
@@ -139,6 +140,11 @@ std::string MeasureIngest(Service& service) {
   }
   size_t points = 0;
   for (const auto& r : requests) points += r.batch().packed().positions().size() / 12;
+  const double first_touch = bench::FirstTouchBytesPerSecond(points * 12);
+  std::printf("memory first touch: %.0f MB/s; the session's %.0f MB of fresh memory for the "
+              "points take %.2f s of the ingest\n",
+              first_touch / 1e6, points * 12.0 / 1e6,
+              first_touch > 0 ? points * 12.0 / first_touch : 0.0);
   // A small target: learning pauses quickly and leaves the cores to ingestion.
   const std::string id = Create(service, 1000);
   const absl::Time start = absl::Now();

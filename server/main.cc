@@ -71,9 +71,10 @@ ABSL_FLAG(std::string, access_tokens_file, "",
           "none) or admin (every session; a token alone is one). Needs --tls_cert_file. SIGHUP "
           "reads the file again (calls already running go on).");
 ABSL_FLAG(std::string, state_dir, "",
-          "Directory in which every session is kept (its settings, state, points and latest "
-          "mesh) and from which a server started again restores them: uploads and watches go "
-          "on where they were, and sessions that were learning learn again from their points. "
+          "Directory in which every session is kept (its settings, state, points, latest "
+          "mesh and the learner's mesh at its latest milestone) and from which a server "
+          "started again restores them: uploads and watches go on where they were, and "
+          "sessions that were learning learn on from that milestone's mesh. "
           "One server at a time uses a directory. Empty: sessions live in memory and a "
           "restart loses them.");
 ABSL_FLAG(bool, state_sync, true,

@@ -152,6 +152,15 @@ absl::StatusOr<TriangleMesh> LoadMesh(const std::string& input, absl::string_vie
   return mesh;
 }
 
+absl::StatusOr<TriangleMesh> ReadStartMesh(const std::string& path) {
+  absl::StatusOr<TriangleMesh> mesh = ReadMesh(path);
+  if (!mesh.ok()) {
+    return absl::Status(mesh.status().code(),
+                        absl::StrCat("--start_mesh: ", mesh.status().message()));
+  }
+  return mesh;
+}
+
 std::string InputStem(const std::string& input) {
   if (IsBuiltin(input)) return input.substr(kBuiltinPrefix.size());
   return std::filesystem::path(input).stem().string();

@@ -65,6 +65,11 @@ absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t 
 // implicit surface. Errors as LoadTargetSpace; `role` names the argument in messages.
 absl::StatusOr<TriangleMesh> LoadMesh(const std::string& input, absl::string_view role);
 
+// The mesh of --start_mesh (a mesh file): NOT_FOUND or INVALID_ARGUMENT as ReadMesh, the
+// message prefixed "--start_mesh: ". Whether learning can go on from it is judged by the
+// learner (Learner::CreateFrom) or the server.
+absl::StatusOr<TriangleMesh> ReadStartMesh(const std::string& path);
+
 // A short name for output files: the file name without directory and extension, or NAME for
 // builtin:NAME.
 std::string InputStem(const std::string& input);

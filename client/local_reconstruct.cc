@@ -71,12 +71,7 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
   NM_RETURN_IF_ERROR(CheckOutputPath(options.output));
   std::optional<TriangleMesh> start_mesh;
   if (!options.start_mesh.empty()) {
-    absl::StatusOr<TriangleMesh> read = ReadMesh(options.start_mesh);
-    if (!read.ok()) {
-      return absl::Status(read.status().code(),
-                          absl::StrCat("--start_mesh: ", read.status().message()));
-    }
-    start_mesh = *std::move(read);
+    NM_ASSIGN_OR_RETURN(start_mesh, ReadStartMesh(options.start_mesh));
   }
   NM_ASSIGN_OR_RETURN(const std::vector<size_t> targets,
                       LodTargets(options.lods, options.vertices,

@@ -100,11 +100,12 @@ ABSL_FLAG(std::string, initial_mesh,
           "terrain or a facade).");
 
 ABSL_FLAG(std::string, start_mesh, "",
-          "Local reconstruct: learn on from this mesh (.ply .obj .off .stl .drc, for example an "
-          "earlier OUTPUT) instead of --initial_mesh, refining it with INPUT's points to "
+          "Learn on from this mesh (.ply .obj .off .stl .drc, for example an earlier OUTPUT or "
+          "final mesh) instead of --initial_mesh, refining it with INPUT's points to "
           "--vertices, which must exceed its vertex count. It must be an orientable manifold "
           "triangle mesh, with or without borders, every vertex on a face and no face of zero "
-          "area. --initial_mesh disc still keeps its longest border open.");
+          "area. --initial_mesh disc still keeps its longest border open. With --server the "
+          "mesh is sent exactly (CreateSessionRequest.start_mesh); not with --resume.");
 
 // Input clean-up.
 ABSL_FLAG(bool, remove_outliers, false,
@@ -337,9 +338,6 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     NM_RETURN_IF_ERROR(RejectFlags(
         args, {"output", "sampling", "time_budget", "max_steps"},
         "applies to a local reconstruct only (the server picks its own budget; use --out-dir)"));
-    NM_RETURN_IF_ERROR(RejectFlags(
-        args, {"start_mesh"},
-        "applies to a local reconstruct only (a server session starts from --initial_mesh)"));
     neuralmesh::client::RemoteReconstructOptions o;
     o.input = args.positional[0];
     o.server = absl::GetFlag(FLAGS_server);
@@ -358,6 +356,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.ply = absl::GetFlag(FLAGS_ply);
     o.progress = progress;
     o.resume_session = absl::GetFlag(FLAGS_resume);
+    o.start_mesh = absl::GetFlag(FLAGS_start_mesh);
     NM_ASSIGN_OR_RETURN(o.reconnect_for, ReconnectForFromFlags());
     NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
     return neuralmesh::client::RunRemoteReconstruct(o, std::cout, std::cerr);

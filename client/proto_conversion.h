@@ -5,6 +5,7 @@
 #include "core/bounding_box.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
+#include "core/triangle_mesh.h"
 #include "neuralmesh/v1/reconstruction.pb.h"
 
 namespace neuralmesh::client {
@@ -15,6 +16,8 @@ v1::LearnerOptions ToProto(const LearnerOptions& options);
 v1::DracoOptions ToProto(const DracoOptions& options);
 // A non-empty box.
 v1::Box ToProto(const BoundingBox& box);
+// A start mesh, packed exactly (CreateSessionRequest.start_mesh).
+v1::StartMesh ToProto(const TriangleMesh& mesh);
 
 }  // namespace neuralmesh::client
 

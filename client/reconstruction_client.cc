@@ -12,6 +12,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "client/grpc_status.h"
+#include "client/proto_conversion.h"
 
 namespace neuralmesh::client {
 namespace {
@@ -141,13 +142,15 @@ void ReconstructionClient::SetDeadline(grpc::ClientContext& context, absl::Durat
 }
 
 absl::StatusOr<v1::Session> ReconstructionClient::CreateSession(const v1::SessionConfig& config,
-                                                                const std::string& name) {
+                                                                const std::string& name,
+                                                                const TriangleMesh* start_mesh) {
   grpc::ClientContext context;
   const OpenCall open(*this, context);
   SetDeadline(context, options_.call_timeout);
   v1::CreateSessionRequest request;
   *request.mutable_config() = config;
   request.set_name(name);
+  if (start_mesh != nullptr) *request.mutable_start_mesh() = ToProto(*start_mesh);
   v1::Session session;
   const grpc::Status status = stub_->CreateSession(&context, request, &session);
   if (!status.ok()) return FromGrpcStatus(status, "CreateSession");

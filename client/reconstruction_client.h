@@ -34,6 +34,7 @@
 #include "absl/time/time.h"
 #include "client/channel_credentials.h"
 #include "core/point_cloud.h"
+#include "core/triangle_mesh.h"
 #include "neuralmesh/v1/reconstruction.grpc.pb.h"
 
 namespace neuralmesh::client {
@@ -81,10 +82,12 @@ class ReconstructionClient {
   const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
   const ClientOptions& options() const { return options_; }
 
-  // CreateSession. INVALID_ARGUMENT for an invalid config, RESOURCE_EXHAUSTED when the server
-  // is full.
+  // CreateSession, learning from `start_mesh` when it is not null
+  // (CreateSessionRequest.start_mesh). INVALID_ARGUMENT for an invalid config or start mesh,
+  // RESOURCE_EXHAUSTED when the server is full.
   absl::StatusOr<v1::Session> CreateSession(const v1::SessionConfig& config,
-                                            const std::string& name);
+                                            const std::string& name,
+                                            const TriangleMesh* start_mesh = nullptr);
 
   // Called after each batch is written, with the points written so far and the total.
   using UploadProgress = std::function<void(uint64_t points_sent, uint64_t points_total)>;

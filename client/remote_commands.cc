@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "absl/strings/str_cat.h"
@@ -80,10 +81,20 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     NM_ASSIGN_OR_RETURN(const size_t removed, RemoveOutliers(cloud, *options.outliers));
     out << "outliers removed: " << removed << " of " << points_read << " points\n";
   }
+  std::optional<TriangleMesh> start_mesh;
+  if (!options.start_mesh.empty()) {
+    if (!options.resume_session.empty()) {
+      return absl::InvalidArgumentError(
+          "--start_mesh applies to a new session; --resume goes on with the session's own");
+    }
+    NM_ASSIGN_OR_RETURN(start_mesh, ReadStartMesh(options.start_mesh));
+  }
   const size_t affordable = static_cast<size_t>(std::floor(cloud.size() / kDefaultPointsPerVertex));
   size_t target =
       options.vertices > 0 ? options.vertices : std::min(kDefaultMaxVertices, affordable);
-  NM_ASSIGN_OR_RETURN(const std::vector<size_t> milestones, LodTargets(options.lods, target));
+  NM_ASSIGN_OR_RETURN(
+      const std::vector<size_t> milestones,
+      LodTargets(options.lods, target, start_mesh.has_value() ? start_mesh->positions.size() : 0));
 
   v1::SessionConfig config;
   *config.mutable_learner() = ToProto(options.learner);
@@ -111,7 +122,8 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   size_t first_point = 0;
   v1::Session session;
   if (options.resume_session.empty()) {
-    NM_ASSIGN_OR_RETURN(session, client->CreateSession(config, stem));
+    NM_ASSIGN_OR_RETURN(session, client->CreateSession(
+                                     config, stem, start_mesh ? &*start_mesh : nullptr));
   } else {
     NM_ASSIGN_OR_RETURN(session, client->GetSession(options.resume_session));
     if (session.state() != v1::SESSION_STATE_COLLECTING &&

@@ -42,6 +42,9 @@ struct RemoteReconstructOptions {
   // points it has taken (Session.points_taken). The input and its flags must be those of the
   // first run; the session keeps the configuration it was created with.
   std::string resume_session;
+  // A mesh file for a new session to learn on from (CreateSessionRequest.start_mesh); empty:
+  // learner.initial_mesh.
+  std::string start_mesh;
 };
 
 // Creates a session (or takes up `resume_session`), watches it while the input streams up in

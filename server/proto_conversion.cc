@@ -285,4 +285,51 @@ v1::PointBatch PointCloudToPackedBatch(const PointCloud& cloud) {
   return batch;
 }
 
+v1::PackedMesh TriangleMeshToPacked(const TriangleMesh& mesh) {
+  v1::PackedMesh packed;
+  packed.set_positions(reinterpret_cast<const char*>(mesh.positions.data()),
+                       mesh.positions.size() * sizeof(Vec3f));
+  packed.set_faces(reinterpret_cast<const char*>(mesh.faces.data()),
+                   mesh.faces.size() * sizeof(mesh.faces[0]));
+  return packed;
+}
+
+absl::StatusOr<TriangleMesh> TriangleMeshFromPacked(const v1::PackedMesh& packed,
+                                                    absl::string_view field) {
+  TriangleMesh mesh;
+  const std::string& positions = packed.positions();
+  const std::string& faces = packed.faces();
+  if (positions.empty()) return absl::InvalidArgumentError(absl::StrCat(field, " has no vertices"));
+  if (positions.size() % sizeof(Vec3f) != 0 || faces.size() % sizeof(mesh.faces[0]) != 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, " has ", positions.size(), " bytes of positions and ", faces.size(),
+        " of faces; each must be a multiple of 12 (x, y, z as little-endian float32; three "
+        "little-endian uint32 vertex indices)"));
+  }
+  mesh.positions.resize(positions.size() / sizeof(Vec3f));
+  std::memcpy(mesh.positions.data(), positions.data(), positions.size());
+  mesh.faces.resize(faces.size() / sizeof(mesh.faces[0]));
+  if (!faces.empty()) std::memcpy(mesh.faces.data(), faces.data(), faces.size());
+  return mesh;
+}
+
+absl::StatusOr<TriangleMesh> StartMeshFromProto(const v1::StartMesh& start) {
+  switch (start.data_case()) {
+    case v1::StartMesh::kPacked:
+      return TriangleMeshFromPacked(start.packed(), "start_mesh.packed");
+    case v1::StartMesh::kDracoMesh: {
+      absl::StatusOr<TriangleMesh> decoded = DecodeMesh(start.draco_mesh());
+      if (!decoded.ok()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("start_mesh.draco_mesh: ", decoded.status().message()));
+      }
+      return decoded;
+    }
+    case v1::StartMesh::DATA_NOT_SET:
+      break;
+  }
+  return absl::InvalidArgumentError(
+      "start_mesh holds no mesh: set StartMesh.packed or StartMesh.draco_mesh");
+}
+
 }  // namespace neuralmesh::server

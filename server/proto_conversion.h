@@ -6,9 +6,11 @@
 #include <cstddef>
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "core/analysis/mesh_report.h"
 #include "core/io/draco_codec.h"
 #include "core/point_cloud.h"
+#include "core/triangle_mesh.h"
 #include "neuralmesh/v1/reconstruction.pb.h"
 #include "server/session_config.h"
 
@@ -34,6 +36,18 @@ absl::StatusOr<PointCloud> PointBatchFromProto(const v1::PointBatch& batch,
 
 // Packs `cloud` into a PointBatch (the inverse of PointBatchFromProto for packed batches).
 v1::PointBatch PointCloudToPackedBatch(const PointCloud& cloud);
+
+// A mesh packed as PackedMesh says (little-endian float32 positions, uint32 faces), and back.
+// The unpacking checks only the sizes: INVALID_ARGUMENT, naming `field`, when positions or
+// faces are not whole elements or there are no positions; what the mesh is made of is checked
+// where it is used (MakeStartMesh).
+v1::PackedMesh TriangleMeshToPacked(const TriangleMesh& mesh);
+absl::StatusOr<TriangleMesh> TriangleMeshFromPacked(const v1::PackedMesh& packed,
+                                                    absl::string_view field);
+
+// The mesh of CreateSessionRequest.start_mesh: unpacked or Draco-decoded. INVALID_ARGUMENT,
+// prefixed "start_mesh", when it holds no mesh or one that cannot be read.
+absl::StatusOr<TriangleMesh> StartMeshFromProto(const v1::StartMesh& start);
 
 }  // namespace neuralmesh::server
 

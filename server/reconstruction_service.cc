@@ -49,6 +49,20 @@ absl::Status BatchError(const absl::Status& status, uint64_t batch_number, uint6
                    " this call sent before"));
 }
 
+// Creates the session `request` asks for, on behalf of `caller` (allowed to create).
+absl::StatusOr<std::shared_ptr<Session>> CreateFromRequest(SessionManager& manager,
+                                                           const v1::CreateSessionRequest& request,
+                                                           absl::string_view peer,
+                                                           const Caller& caller) {
+  NM_ASSIGN_OR_RETURN(SessionConfig config, SessionConfigFromProto(request.config()));
+  std::optional<TriangleMesh> start_mesh;
+  if (request.has_start_mesh()) {
+    NM_ASSIGN_OR_RETURN(start_mesh, StartMeshFromProto(request.start_mesh()));
+  }
+  return manager.Create(std::move(config), request.name(), peer, caller.client,
+                        std::move(start_mesh));
+}
+
 // What one batch added to a session.
 struct Ingested {
   size_t accepted = 0;   // Points of the batch accepted (not those the session had already).
@@ -539,11 +553,8 @@ class ReconstructReactor final
     switch (start.target_case()) {
       case v1::ReconstructStart::kCreate: {
         NM_RETURN_IF_ERROR(CheckMayCreate(caller));
-        absl::StatusOr<SessionConfig> config =
-            SessionConfigFromProto(start.create().config());
-        if (!config.ok()) return config.status();
-        absl::StatusOr<std::shared_ptr<Session>> created = manager_->Create(
-            *std::move(config), start.create().name(), context_->peer(), caller.client);
+        absl::StatusOr<std::shared_ptr<Session>> created =
+            CreateFromRequest(*manager_, start.create(), context_->peer(), caller);
         if (!created.ok()) return created.status();
         session = *std::move(created);
         break;
@@ -782,10 +793,8 @@ grpc::ServerUnaryReactor* ReconstructionService::CreateSession(
   if (absl::Status allowed = CheckMayCreate(caller); !allowed.ok()) {
     return FinishUnary(context, allowed);
   }
-  absl::StatusOr<SessionConfig> config = SessionConfigFromProto(request->config());
-  if (!config.ok()) return FinishUnary(context, config.status());
   absl::StatusOr<std::shared_ptr<Session>> session =
-      manager_->Create(*std::move(config), request->name(), context->peer(), caller.client);
+      CreateFromRequest(*manager_, *request, context->peer(), caller);
   if (!session.ok()) return FinishUnary(context, session.status());
   *response = (*session)->ToProto();
   return FinishUnary(context, absl::OkStatus());

@@ -272,11 +272,15 @@ absl::Status Session::Finish() {
           "session ", id_, " is ", v1::SessionState_Name(state_), " and cannot finish"));
     }
     const size_t final_vertices = AllowedVerticesLocked();
-    if (final_vertices < kMinTargetVertices) {
+    if (final_vertices < std::max(kMinTargetVertices, start_vertices_)) {
       return absl::FailedPreconditionError(absl::StrCat(
           "session ", id_, " has ", points_.size(), " points; finishing needs at least ",
-          static_cast<size_t>(std::ceil(kMinTargetVertices * config_.points_per_vertex)),
-          " (4 vertices at points_per_vertex ", config_.points_per_vertex, ")"));
+          static_cast<size_t>(
+              std::ceil(std::max(kMinTargetVertices, start_vertices_) * config_.points_per_vertex)),
+          start_vertices_ > kMinTargetVertices
+              ? absl::StrCat(" (the start mesh's ", start_vertices_, " vertices")
+              : std::string(" (4 vertices"),
+          " at points_per_vertex ", config_.points_per_vertex, ")"));
     }
     NM_RETURN_IF_ERROR(StoreState(v1::SESSION_STATE_FINISHING, ""));
     final_vertices_ = final_vertices;
@@ -385,6 +389,8 @@ void Session::FinishRestore(v1::SessionState state, const std::string& error,
     // Learning goes on from the checkpoint's mesh, and its counts from the checkpoint's.
     const v1::LearningState& before = checkpoint->learning;
     start_mesh_ = std::move(checkpoint->mesh);
+    start_mesh_name_ = "the stored mesh";
+    start_vertices_ = start_mesh_->positions.size();
     earlier_learning_.basic_steps = before.basic_steps();
     earlier_learning_.splits = before.splits();
     earlier_learning_.collapses = before.collapses();
@@ -564,16 +570,35 @@ SliceResult Session::RunSlice(absl::Time deadline) {
     }
 
     if (learner_ == nullptr) {
-      if (allowed < kMinTargetVertices) return {SliceResult::kIdle};
-      absl::StatusOr<std::unique_ptr<Learner>> learner = CreateLearner(allowed);
+      // A start mesh waits for points enough for its vertices.
+      if (allowed < std::max(kMinTargetVertices, start_vertices_)) return {SliceResult::kIdle};
+      absl::StatusOr<std::unique_ptr<Learner>> learner = CreateLearner();
       if (!learner.ok()) {
         Fail(learner.status());
         return {SliceResult::kDone};
       }
       learner_ = *std::move(learner);
       growth_.emplace(config_.learner.c_vs, learner_->num_vertices(), 0);
-      absl::MutexLock lock(&mu_);
-      if (state_ == v1::SESSION_STATE_COLLECTING) state_ = v1::SESSION_STATE_LEARNING;
+      {
+        absl::MutexLock lock(&mu_);
+        if (state_ == v1::SESSION_STATE_COLLECTING) state_ = v1::SESSION_STATE_LEARNING;
+        // Milestones the start mesh has reached already are not published.
+        const std::vector<size_t>& milestones = config_.lod_milestones;
+        const size_t reached = static_cast<size_t>(
+            std::upper_bound(milestones.begin(), milestones.end(), learner_->num_vertices()) -
+            milestones.begin());
+        next_milestone_ = std::max(next_milestone_, reached);
+        milestone_index = next_milestone_;
+      }
+      // A start mesh is shown at once (a restored session shows its stored mesh instead).
+      if (updates_.latest() == nullptr && learner_->num_vertices() == start_vertices_ &&
+          !relearning_ && !(finishing && learner_->num_vertices() >= allowed)) {
+        const std::vector<size_t>& milestones = config_.lod_milestones;
+        TakeSnapshot(v1::UPDATE_KIND_REFRESH,
+                     milestone_index < milestones.size() ? milestones[milestone_index]
+                                                         : config_.target_vertices,
+                     static_cast<uint32_t>(milestone_index));
+      }
     }
 
     const std::vector<size_t>& milestones = config_.lod_milestones;
@@ -659,26 +684,19 @@ SliceResult Session::RunSlice(absl::Time deadline) {
   }
 }
 
-absl::StatusOr<std::unique_ptr<Learner>> Session::CreateLearner(size_t allowed) {
+absl::StatusOr<std::unique_ptr<Learner>> Session::CreateLearner() {
   if (!start_mesh_.has_value()) return Learner::Create(config_.learner, &points_);
   const TriangleMesh start = *std::move(start_mesh_);
   start_mesh_.reset();
-  const size_t vertices = start.positions.size();
-  absl::Status taken = absl::OkStatus();
-  if (vertices > allowed) {
-    taken = absl::FailedPreconditionError(
-        absl::StrCat("it has ", vertices, " vertices, more than the ", allowed, " allowed now"));
-  } else {
-    absl::StatusOr<std::unique_ptr<Learner>> learner =
-        Learner::CreateFrom(config_.learner, &points_, start);
-    if (learner.ok()) {
-      Record(absl::StrCat("learning goes on from the stored mesh of ", vertices, " vertices"));
-      return learner;
-    }
-    taken = learner.status();
+  absl::StatusOr<std::unique_ptr<Learner>> learner =
+      Learner::CreateFrom(config_.learner, &points_, start);
+  if (learner.ok()) {
+    Record(absl::StrCat("learning goes on from ", start_mesh_name_, " of ",
+                        start.positions.size(), " vertices"));
+    return learner;
   }
-  Record(absl::StrCat("cannot learn on from the stored mesh (", taken.message(),
-                      "); learning again from the initial mesh"));
+  Record(absl::StrCat("cannot learn on from ", start_mesh_name_, " (",
+                      learner.status().message(), "); learning again from the initial mesh"));
   return Learner::Create(config_.learner, &points_);
 }
 

@@ -14,7 +14,9 @@
 // Learning follows the data: the mesh may have at most
 //   allowed = min(target, floor(points_received / points_per_vertex))
 // vertices (after Finish: the final count, the same bound frozen). The learner is created once
-// allowed >= 4, with its initial tetrahedron around the points received so far. A slice runs
+// allowed >= 4, with its initial tetrahedron around the points received so far; with a start
+// mesh (CreateSessionRequest.start_mesh), once allowed reaches its vertex count, and the start
+// mesh is published first. A slice runs
 // the learner toward min(next milestone, allowed); at a milestone it snapshots; between
 // milestones it snapshots every refresh interval; when it reaches `allowed` it pauses (one more
 // refresh snapshot) until more points arrive.
@@ -97,6 +99,13 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   void AttachRecord(std::unique_ptr<SessionRecord> record) { record_ = std::move(record); }
   // The session's files, or null without a state directory.
   SessionRecord* record() const { return record_.get(); }
+  // Learning starts from `mesh` (CreateSessionRequest.start_mesh, checked by CheckStartMesh)
+  // once the points allow its vertex count, and publishes it first. Once, before the session
+  // is shared with other threads.
+  void SetStartMesh(TriangleMesh mesh) {
+    start_vertices_ = mesh.positions.size();
+    start_mesh_ = std::move(mesh);
+  }
 
   // Restoring a stored session, before it is shared: ReplayBatch takes each batch of its
   // journal as AddPoints took it, without waking the learner; FinishRestore then restores the
@@ -200,10 +209,9 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // Stores the learner's mesh of a published milestone as the checkpoint; a failure is
   // recorded like StoreMesh's.
   void StoreCheckpoint(const Snapshot& snapshot);
-  // A learner for the points so far: from the restored checkpoint's mesh when there is one
-  // that fits in `allowed` vertices and that the learner takes, else from the initial mesh
-  // (learning thread).
-  absl::StatusOr<std::unique_ptr<Learner>> CreateLearner(size_t allowed);
+  // A learner for the points so far: from start_mesh_ when there is one that the learner
+  // takes, else from the initial mesh (learning thread).
+  absl::StatusOr<std::unique_ptr<Learner>> CreateLearner();
   bool AcceptsPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // OK, or FAILED_PRECONDITION naming the state in which the session refuses points.
   absl::Status AcceptingPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
@@ -233,6 +241,9 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   const std::string owner_;
   const SessionConfig config_;
   const absl::Time create_time_;
+  // The vertices of the start mesh or restored checkpoint (0: none). Set before the session is
+  // shared and not changed after: learning and Finish wait for points enough for them.
+  size_t start_vertices_ = 0;
   WorkerPool* const pool_;
   Executor* const encoder_;
   const std::shared_ptr<EventLog> log_;  // May be null.
@@ -276,8 +287,10 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // and the learning before a restart (the checkpoint's counters).
   LearnerProgress earlier_learning_;
   absl::Duration learning_time_;
-  // The restored checkpoint's mesh, until the learner is created.
+  // The start mesh or the restored checkpoint's mesh, until the learner is created, and what
+  // the event log calls it.
   std::optional<TriangleMesh> start_mesh_;
+  const char* start_mesh_name_ = "the start mesh";
   absl::Time last_publish_time_ = absl::InfinitePast();
   uint64_t last_publish_steps_ = 0;
   std::optional<GrowthWatch> growth_;  // Stall detection for the current learner.

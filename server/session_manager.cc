@@ -7,6 +7,7 @@
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/learning/initial_mesh.h"
 #include "core/status_macros.h"
 #include "server/proto_conversion.h"
 #include "server/session_restore.h"
@@ -24,18 +25,36 @@ absl::Status UnknownSession(absl::string_view id) {
 // "created by [client OWNER at ]PEER: "NAME", target N vertices" and the options that change
 // how it learns.
 std::string CreationEvent(const SessionConfig& config, absl::string_view name,
-                          absl::string_view peer, absl::string_view owner) {
+                          absl::string_view peer, absl::string_view owner,
+                          const std::optional<TriangleMesh>& start_mesh) {
   std::string event = "created";
   if (!owner.empty()) absl::StrAppend(&event, " by client ", owner, peer.empty() ? "" : " at");
   if (!peer.empty()) absl::StrAppend(&event, owner.empty() ? " by " : " ", peer);
   absl::StrAppend(&event, ": \"", absl::CHexEscape(name), "\", target ", config.target_vertices,
                   " vertices");
-  if (config.learner.initial_mesh == InitialMesh::kDisc) absl::StrAppend(&event, ", disc start");
+  if (start_mesh.has_value()) {
+    absl::StrAppend(&event, ", from a start mesh of ", start_mesh->positions.size(), " vertices");
+  } else if (config.learner.initial_mesh == InitialMesh::kDisc) {
+    absl::StrAppend(&event, ", disc start");
+  }
   if (config.outlier_removal.has_value()) absl::StrAppend(&event, ", outlier removal");
   return event;
 }
 
 }  // namespace
+
+absl::Status CheckStartMesh(const TriangleMesh& start_mesh, const SessionConfig& config) {
+  if (start_mesh.positions.size() >= config.target_vertices) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "start_mesh has ", start_mesh.positions.size(), " vertices; it must have fewer than "
+        "target_vertices (", config.target_vertices, ")"));
+  }
+  absl::StatusOr<Mesh> mesh = MakeStartMesh(start_mesh);
+  if (!mesh.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("start_mesh: ", mesh.status().message()));
+  }
+  return absl::OkStatus();
+}
 
 std::string QuotedSessionId(absl::string_view id) {
   if (id.size() <= kMaxQuotedIdBytes) return absl::StrCat("\"", id, "\"");
@@ -71,16 +90,16 @@ std::string SessionManager::NewIdLocked() {
   }
 }
 
-absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(SessionConfig config,
-                                                                std::string name,
-                                                                absl::string_view peer,
-                                                                std::string owner) {
+absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(
+    SessionConfig config, std::string name, absl::string_view peer, std::string owner,
+    std::optional<TriangleMesh> start_mesh) {
   if (name.size() > kMaxNameBytes) {
     return absl::InvalidArgumentError(
         absl::StrCat("name has ", name.size(), " bytes; at most 256 are allowed"));
   }
   NM_RETURN_IF_ERROR(ResolveSessionConfig(limits_.max_points_per_session, config));
-  const std::string event = CreationEvent(config, name, peer, owner);
+  if (start_mesh.has_value()) NM_RETURN_IF_ERROR(CheckStartMesh(*start_mesh, config));
+  const std::string event = CreationEvent(config, name, peer, owner, start_mesh);
   std::shared_ptr<Session> session;
   {
     absl::MutexLock lock(&mu_);
@@ -113,6 +132,14 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(SessionConfig co
       stored.set_create_time_us(absl::ToUnixMicros(session->create_time()));
       stored.set_state(v1::SESSION_STATE_COLLECTING);
       absl::StatusOr<std::unique_ptr<SessionRecord>> record = store_->Create(stored);
+      // A start mesh is the session's first checkpoint: a restart learns on from it.
+      if (record.ok() && start_mesh.has_value()) {
+        if (absl::Status written = (*record)->WriteCheckpoint(*start_mesh, v1::LearningState());
+            !written.ok()) {
+          (*record)->Remove().IgnoreError();  // A session it could not keep is no session.
+          record = written;
+        }
+      }
       if (!record.ok()) {
         return absl::Status(record.status().code(),
                             absl::StrCat("the server cannot keep a new session on disk: ",
@@ -120,6 +147,7 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(SessionConfig co
       }
       session->AttachRecord(*std::move(record));
     }
+    if (start_mesh.has_value()) session->SetStartMesh(*std::move(start_mesh));
     sessions_.emplace(id, session);
     order_.emplace(created_++, id);
   }

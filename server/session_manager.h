@@ -18,6 +18,7 @@
 #include "absl/strings/string_view.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
+#include "core/triangle_mesh.h"
 #include "server/event_log.h"
 #include "server/executor.h"
 #include "server/session.h"
@@ -57,6 +58,10 @@ struct RestoreReport {
 // RESOURCE_EXHAUSTED.
 std::string QuotedSessionId(absl::string_view id);
 
+// OK when a session of `config` can learn from `start_mesh`: fewer vertices than its target,
+// and a mesh the learner can go on from (MakeStartMesh); INVALID_ARGUMENT saying why not.
+absl::Status CheckStartMesh(const TriangleMesh& start_mesh, const SessionConfig& config);
+
 class SessionManager {
  public:
   // `pool` and `encoder` must outlive the manager's sessions' work (see Session). `log`, when
@@ -71,13 +76,15 @@ class SessionManager {
 
   // Validates `config` (ResolveSessionConfig) and creates a session for the client at `peer`
   // (gRPC's peer address, for the event log), owned by `owner` (the client name of the call's
-  // access token, Session::owner). INVALID_ARGUMENT for an invalid configuration or a name
-  // longer than 256 bytes; RESOURCE_EXHAUSTED at max_sessions or when `owner` holds
+  // access token, Session::owner), that learns from `start_mesh` when set
+  // (CreateSessionRequest.start_mesh; with a store it is the session's first checkpoint).
+  // INVALID_ARGUMENT for an invalid configuration, a name longer than 256 bytes or a start mesh
+  // CheckStartMesh refuses; RESOURCE_EXHAUSTED at max_sessions or when `owner` holds
   // max_sessions_per_client; UNAVAILABLE after Shutdown; with a store, the error of creating
   // the session's files (RESOURCE_EXHAUSTED for a full disk, and so on).
-  absl::StatusOr<std::shared_ptr<Session>> Create(SessionConfig config, std::string name,
-                                                  absl::string_view peer = "",
-                                                  std::string owner = "")
+  absl::StatusOr<std::shared_ptr<Session>> Create(
+      SessionConfig config, std::string name, absl::string_view peer = "",
+      std::string owner = "", std::optional<TriangleMesh> start_mesh = std::nullopt)
       ABSL_LOCKS_EXCLUDED(mu_);
 
   // NOT_FOUND for an unknown id (INVALID_ARGUMENT for an empty one), UNAVAILABLE after

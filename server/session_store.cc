@@ -5,12 +5,10 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <optional>
 #include <system_error>
 #include <utility>
 
@@ -18,6 +16,7 @@
 #include "core/io/file_contents.h"
 #include "core/status_macros.h"
 #include "neuralmesh/storage/v1/learner_checkpoint.pb.h"
+#include "server/proto_conversion.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -54,22 +53,6 @@ bool Ended(v1::SessionState state) {
          state == v1::SESSION_STATE_FAILED;
 }
 
-// The bytes of `elements` as they lie in memory (this server runs on little-endian machines
-// only, as the journal does).
-template <typename T>
-std::string RawBytes(const std::vector<T>& elements) {
-  return std::string(reinterpret_cast<const char*>(elements.data()), elements.size() * sizeof(T));
-}
-
-// The elements `bytes` holds (RawBytes), or nothing when its size is not a multiple of theirs.
-template <typename T>
-std::optional<std::vector<T>> FromRawBytes(const std::string& bytes) {
-  if (bytes.size() % sizeof(T) != 0) return std::nullopt;
-  std::vector<T> elements(bytes.size() / sizeof(T));
-  std::memcpy(elements.data(), bytes.data(), bytes.size());
-  return elements;
-}
-
 // The checkpoint in `contents`, or what is wrong with it. The mesh itself is checked when
 // learning goes on from it (Learner::CreateFrom).
 absl::StatusOr<LearnerCheckpoint> ParseCheckpoint(const std::string& contents,
@@ -86,15 +69,10 @@ absl::StatusOr<LearnerCheckpoint> ParseCheckpoint(const std::string& contents,
   if (stored.session_id() != id) {
     return absl::DataLossError(absl::StrCat("it is of session \"", stored.session_id(), "\""));
   }
-  std::optional<std::vector<Vec3f>> positions = FromRawBytes<Vec3f>(stored.positions());
-  std::optional<std::vector<std::array<uint32_t, 3>>> faces =
-      FromRawBytes<std::array<uint32_t, 3>>(stored.faces());
-  if (!positions.has_value() || !faces.has_value()) {
-    return absl::DataLossError("its positions or faces are cut short");
-  }
+  absl::StatusOr<TriangleMesh> mesh = TriangleMeshFromPacked(stored.mesh(), "its mesh");
+  if (!mesh.ok()) return absl::DataLossError(mesh.status().message());
   LearnerCheckpoint checkpoint;
-  checkpoint.mesh.positions = *std::move(positions);
-  checkpoint.mesh.faces = *std::move(faces);
+  checkpoint.mesh = *std::move(mesh);
   checkpoint.learning = stored.learning();
   return checkpoint;
 }
@@ -177,8 +155,7 @@ absl::Status SessionRecord::WriteCheckpoint(const TriangleMesh& mesh,
                                             const v1::LearningState& learning) {
   storage::v1::LearnerCheckpoint checkpoint;
   checkpoint.set_format_version(kFormatVersion);
-  checkpoint.set_positions(RawBytes(mesh.positions));
-  checkpoint.set_faces(RawBytes(mesh.faces));
+  *checkpoint.mutable_mesh() = TriangleMeshToPacked(mesh);
   *checkpoint.mutable_learning() = learning;
   absl::MutexLock lock(&mu_);
   if (removed_ || Ended(stored_.state())) return absl::OkStatus();

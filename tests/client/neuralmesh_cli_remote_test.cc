@@ -172,6 +172,33 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
   EXPECT_THAT(local.err, ::testing::HasSubstr("--resume needs --server"));
 }
 
+// The final 400-vertex sphere sent back as the start of a finer session: the table's first
+// row is the start mesh, the final mesh has the new target and lies on the sphere, and
+// --start_mesh with --resume is refused.
+TEST_F(RemoteCliTest, AStartMeshIsRefinedOnTheServer) {
+  ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
+  const std::string out = *dir_ + "/refined";
+  const RunResult run = RunNeuralmesh(
+      {"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir", out,
+       "--vertices", "1500", "--points", "6000", "--lod", "1000", "--start_mesh",
+       *dir_ + "/out/sphere.ply"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_EQ(RowVertices(run.out, "refresh").front(), 400u) << run.out;
+  EXPECT_EQ(RowVertices(run.out, "lod"), std::vector<uint64_t>{1000}) << run.out;
+  EXPECT_EQ(RowVertices(run.out, "final"), std::vector<uint64_t>{1500}) << run.out;
+  // About 110,000 Basic Steps from 400 vertices; about 150,000 from the tetrahedron.
+  const double basic_steps = NumberAfter(run.out, "valence 6, ");
+  EXPECT_GT(basic_steps, 0) << run.out;
+  EXPECT_LT(basic_steps, 130000) << run.out;
+  EXPECT_LT(HausdorffToTheUnitSphere(out + "/sphere.drc"), 0.02);
+
+  const RunResult resumed = RunNeuralmesh(
+      {"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir", out,
+       "--resume", "s-0", "--start_mesh", *dir_ + "/out/sphere.ply"});
+  EXPECT_EQ(resumed.exit_code, 1) << resumed.Describe();
+  EXPECT_THAT(resumed.err, ::testing::HasSubstr("--start_mesh applies to a new session"));
+}
+
 // By default the command rides out a lost connection: the upload goes on from the points the
 // session took, and the watch from its last mesh, without a second command.
 TEST_F(RemoteCliTest, ALostConnectionIsRiddenOutAndEveryPointArrivesOnce) {

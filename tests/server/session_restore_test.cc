@@ -182,7 +182,7 @@ storage::v1::LearnerCheckpoint AwaitCheckpoint(const std::string& directory, siz
   while (absl::Now() < deadline) {
     std::ifstream file(directory + "/checkpoint.binpb", std::ios::binary);
     if (file && checkpoint.ParseFromIstream(&file) &&
-        checkpoint.positions().size() == vertices * 12) {
+        checkpoint.mesh().positions().size() == vertices * 12) {
       return checkpoint;
     }
     absl::SleepFor(absl::Milliseconds(5));
@@ -208,7 +208,7 @@ TEST_F(SessionRestoreTest, LearningGoesOnFromTheLatestMilestonesMesh) {
   const storage::v1::LearnerCheckpoint checkpoint = AwaitCheckpoint(SessionDirectory(id), 2000);
   const uint64_t steps_at_checkpoint = checkpoint.learning().basic_steps();
   ASSERT_GT(steps_at_checkpoint, 100000u);
-  ASSERT_EQ(checkpoint.faces().size(), 3996u * 12) << "a closed mesh of 2,000 vertices";
+  ASSERT_EQ(checkpoint.mesh().faces().size(), 3996u * 12) << "a closed mesh of 2,000 vertices";
 
   Restart();
   EXPECT_TRUE(server_->restored().problems.empty());
@@ -258,8 +258,8 @@ TEST_F(SessionRestoreTest, ACheckpointThatCannotBeUsedMeansLearningFromTheInitia
   const std::vector<Vec3f> positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0),
                                         Vec3f(1, 1, 1), Vec3f(1, 1, -1)};
   const std::vector<uint32_t> faces = {0, 1, 2, 1, 3, 2, 1, 2, 4};
-  fin.set_positions(std::string(reinterpret_cast<const char*>(positions.data()), 5 * 12));
-  fin.set_faces(std::string(reinterpret_cast<const char*>(faces.data()), 9 * 4));
+  fin.mutable_mesh()->set_positions(std::string(reinterpret_cast<const char*>(positions.data()), 5 * 12));
+  fin.mutable_mesh()->set_faces(std::string(reinterpret_cast<const char*>(faces.data()), 9 * 4));
   std::ofstream(SessionDirectory(ids[1]) + "/checkpoint.binpb", std::ios::binary)
       << fin.SerializeAsString();
 

@@ -156,16 +156,18 @@ TEST(SessionStoreTest, ALearnerCheckpointComesBackExactlyOrSaysWhatIsWrong) {
     std::ifstream file(path, std::ios::binary);
     ASSERT_TRUE(stored.ParseFromIstream(&file));
   }
-  stored.mutable_faces()->pop_back();
+  stored.mutable_mesh()->mutable_faces()->pop_back();
   std::ofstream(path, std::ios::binary | std::ios::trunc) << stored.SerializeAsString();
   listed = (*store)->List(&problems);
   ASSERT_EQ(listed.size(), 1u);
   EXPECT_FALSE(listed[0].checkpoint.has_value());
-  EXPECT_EQ(listed[0].checkpoint_damage, "its positions or faces are cut short");
+  EXPECT_TRUE(absl::StrContains(listed[0].checkpoint_damage,
+                                "its mesh has 48 bytes of positions and 47 of faces"))
+      << listed[0].checkpoint_damage;
 
   // Another session's.
   stored.set_session_id("s-2");
-  stored.mutable_faces()->push_back('\0');
+  stored.mutable_mesh()->mutable_faces()->push_back('\0');
   std::ofstream(path, std::ios::binary | std::ios::trunc) << stored.SerializeAsString();
   listed = (*store)->List(&problems);
   ASSERT_EQ(listed.size(), 1u);

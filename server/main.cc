@@ -72,15 +72,19 @@ ABSL_FLAG(std::string, access_tokens_file, "",
           "reads the file again (calls already running go on).");
 ABSL_FLAG(std::string, state_dir, "",
           "Directory in which every session is kept (its settings, state, points, latest "
-          "mesh and the learner's mesh at its latest milestone) and from which a server "
-          "started again restores them: uploads and watches go on where they were, and "
-          "sessions that were learning learn on from that milestone's mesh. "
+          "mesh and the learner's mesh at its latest milestone or checkpoint_interval) and from "
+          "which a server started again restores them: uploads and watches go on where they "
+          "were, and sessions that were learning learn on from that mesh. "
           "One server at a time uses a directory. Empty: sessions live in memory and a "
           "restart loses them.");
 ABSL_FLAG(bool, state_sync, true,
           "With --state_dir: a batch or a finish or cancel is acknowledged only once it is on "
           "the disk (fdatasync). false: once the kernel has it, which survives a crash of the "
           "server but perhaps not one of the machine.");
+ABSL_FLAG(absl::Duration, checkpoint_interval, neuralmesh::server::kDefaultCheckpointInterval,
+          "With --state_dir: besides the learner's mesh at every milestone, keep a refresh of a "
+          "learning session as its checkpoint when this long has passed since the last one, so "
+          "that a restart costs at most about this much learning. 0: milestones only.");
 ABSL_FLAG(bool, log_sessions, true,
           "Print a line on standard output when a session is created, finishes, is cancelled, "
           "fails or is deleted (with the time, the client's address and the figures).");
@@ -243,6 +247,15 @@ int main(int argc, char** argv) {
   options.limits.idle_timeout = absl::GetFlag(FLAGS_idle_timeout);
   options.state_dir = absl::GetFlag(FLAGS_state_dir);
   options.state_sync = absl::GetFlag(FLAGS_state_sync);
+  options.checkpoint_interval = absl::GetFlag(FLAGS_checkpoint_interval);
+  if (options.checkpoint_interval < absl::ZeroDuration() ||
+      options.checkpoint_interval == absl::InfiniteDuration()) {
+    std::fprintf(stderr,
+                 "neuralmesh-server: --checkpoint_interval must be a finite duration >= 0 (e.g. "
+                 "30s, 5m), not %s\n",
+                 absl::FormatDuration(options.checkpoint_interval).c_str());
+    return 2;
+  }
   if (absl::GetFlag(FLAGS_log_sessions)) {
     options.event_sink = neuralmesh::server::EventLog::StandardOutput();
   }

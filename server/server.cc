@@ -60,7 +60,7 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   server->reactors_ = std::make_unique<ReactorRegistry>();
   if (!options.state_dir.empty()) {
     absl::StatusOr<std::unique_ptr<SessionStore>> store =
-        SessionStore::Open(options.state_dir, options.state_sync);
+        SessionStore::Open(options.state_dir, options.state_sync, options.checkpoint_interval);
     if (!store.ok()) return store.status();
     server->store_ = *std::move(store);
   }

@@ -20,6 +20,7 @@
 #include "server/reconstruction_service.h"
 #include "server/server_credentials.h"
 #include "server/session_manager.h"
+#include "server/session_store.h"
 #include "server/worker_pool.h"
 
 namespace neuralmesh::server {
@@ -45,6 +46,10 @@ struct ServerOptions {
   // acknowledged; false: in the kernel's hands, which survives a crash of the server but
   // perhaps not one of the machine.
   bool state_sync = true;
+  // With state_dir: a refresh of a learning session is kept as its learner checkpoint when at
+  // least this long has passed since its last one (every milestone is kept), so that a restart
+  // costs at most about this much learning. Zero: milestones only.
+  absl::Duration checkpoint_interval = kDefaultCheckpointInterval;
 };
 
 class ReconstructionServer {

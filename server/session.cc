@@ -370,7 +370,10 @@ void Session::StoreMesh(const v1::MeshUpdate& update, bool durable) {
 
 void Session::StoreCheckpoint(const Snapshot& snapshot) {
   if (record_ == nullptr) return;
-  const absl::Status stored = record_->WriteCheckpoint(snapshot.mesh, snapshot.learning);
+  const absl::Status stored = record_->WriteCheckpoint(
+      snapshot.mesh, snapshot.learning,
+      snapshot.kind == v1::UPDATE_KIND_MILESTONE ? CheckpointKind::kMilestone
+                                                 : CheckpointKind::kRefresh);
   if (!stored.ok() && !checkpoint_store_failed_.exchange(true)) {
     Record(absl::StrCat("could not store the learner's mesh of ", snapshot.mesh.positions.size(),
                         " vertices (a restart would learn on from an older one or from the "
@@ -780,7 +783,7 @@ void Session::EncodeNext() {
     const std::shared_ptr<v1::MeshUpdate> published = *update;
     if (updates_.Publish(published) != 0) {
       StoreMesh(*published, /*durable=*/false);
-      if (snapshot.kind == v1::UPDATE_KIND_MILESTONE) StoreCheckpoint(snapshot);
+      StoreCheckpoint(snapshot);
     }
   }
   // One snapshot per task, so that sessions take turns on the encoder threads.

@@ -26,8 +26,8 @@
 // restores it: its batches are taken again in their order (so the points, the quantization
 // cube and the outlier filter's verdicts come out as before), the stored latest mesh is
 // published again with its sequence number, and a session that was still learning learns on
-// from the learner's mesh at its latest milestone (the stored checkpoint; without one, again
-// from the initial mesh), publishing no mesh coarser than the stored one (the milestones up to
+// from the learner's mesh at its latest checkpoint (a milestone, or a refresh every
+// checkpoint interval: session_store.h; without one, again from the initial mesh), publishing no mesh coarser than the stored one (the milestones up to
 // it are skipped). Its counters (Basic Steps, splits, collapses, learning time) go on from
 // those of the checkpoint.
 //
@@ -206,7 +206,8 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // Stores a published mesh; a failure is recorded in the event log (once per session), as the
   // mesh can be learned again.
   void StoreMesh(const v1::MeshUpdate& update, bool durable);
-  // Stores the learner's mesh of a published milestone as the checkpoint; a failure is
+  // Stores the learner's mesh of a published milestone or refresh as the checkpoint, as the
+  // record's checkpoint interval allows (SessionRecord::WriteCheckpoint); a failure is
   // recorded like StoreMesh's.
   void StoreCheckpoint(const Snapshot& snapshot);
   // A learner for the points so far: from start_mesh_ when there is one that the learner

@@ -120,9 +120,11 @@ absl::StatusOr<StoredSessionFiles> ReadSessionDirectory(const std::string& direc
 }  // namespace
 
 SessionRecord::SessionRecord(std::string directory, storage::v1::StoredSession stored,
-                             std::unique_ptr<PointsJournal> journal, bool sync)
+                             std::unique_ptr<PointsJournal> journal, bool sync,
+                             absl::Duration checkpoint_interval)
     : directory_(std::move(directory)),
       sync_(sync),
+      checkpoint_interval_(checkpoint_interval),
       stored_(std::move(stored)),
       journal_(std::move(journal)) {}
 
@@ -151,16 +153,31 @@ absl::Status SessionRecord::WriteLatestMesh(const v1::MeshUpdate& update, bool d
   return ReplaceFile(kLatestMeshFile, update, durable);
 }
 
+bool SessionRecord::CheckpointDueLocked(CheckpointKind kind) const {
+  if (removed_ || Ended(stored_.state())) return false;
+  if (kind == CheckpointKind::kMilestone) return true;
+  return checkpoint_interval_ > absl::ZeroDuration() &&
+         absl::Now() - last_checkpoint_ >= checkpoint_interval_;
+}
+
 absl::Status SessionRecord::WriteCheckpoint(const TriangleMesh& mesh,
-                                            const v1::LearningState& learning) {
+                                            const v1::LearningState& learning,
+                                            CheckpointKind kind) {
+  {
+    absl::MutexLock lock(&mu_);
+    if (!CheckpointDueLocked(kind)) return absl::OkStatus();
+  }
+  // Packed outside the lock, which batches take.
   storage::v1::LearnerCheckpoint checkpoint;
   checkpoint.set_format_version(kFormatVersion);
   *checkpoint.mutable_mesh() = TriangleMeshToPacked(mesh);
   *checkpoint.mutable_learning() = learning;
   absl::MutexLock lock(&mu_);
-  if (removed_ || Ended(stored_.state())) return absl::OkStatus();
+  if (!CheckpointDueLocked(kind)) return absl::OkStatus();
   checkpoint.set_session_id(stored_.session_id());
-  return ReplaceFile(kCheckpointFile, checkpoint, /*durable=*/false);
+  NM_RETURN_IF_ERROR(ReplaceFile(kCheckpointFile, checkpoint, /*durable=*/false));
+  last_checkpoint_ = absl::Now();
+  return absl::OkStatus();
 }
 
 absl::Status SessionRecord::Remove() {
@@ -189,8 +206,8 @@ absl::Status SessionRecord::ReplaceFile(const std::string& name,
   return absl::OkStatus();
 }
 
-absl::StatusOr<std::unique_ptr<SessionStore>> SessionStore::Open(const std::string& directory,
-                                                                 bool sync) {
+absl::StatusOr<std::unique_ptr<SessionStore>> SessionStore::Open(
+    const std::string& directory, bool sync, absl::Duration checkpoint_interval) {
   if (directory.empty()) return absl::InvalidArgumentError("the state directory is empty");
   std::error_code error;
   const std::string sessions = absl::StrCat(directory, "/", kSessionsDirectory);
@@ -217,7 +234,8 @@ absl::StatusOr<std::unique_ptr<SessionStore>> SessionStore::Open(const std::stri
     }
     return absl::ErrnoToStatus(lock_error, absl::StrCat("cannot lock '", lock_path, "'"));
   }
-  return std::unique_ptr<SessionStore>(new SessionStore(directory, fd, sync));
+  return std::unique_ptr<SessionStore>(
+      new SessionStore(directory, fd, sync, checkpoint_interval));
 }
 
 SessionStore::~SessionStore() { close(lock_fd_); }
@@ -274,7 +292,8 @@ absl::StatusOr<std::unique_ptr<SessionRecord>> SessionStore::Create(
     std::filesystem::remove_all(directory, error);
     return journal.status();
   }
-  return std::make_unique<SessionRecord>(directory, std::move(first), *std::move(journal), sync_);
+  return std::make_unique<SessionRecord>(directory, std::move(first), *std::move(journal), sync_,
+                                         checkpoint_interval_);
 }
 
 absl::StatusOr<std::unique_ptr<SessionRecord>> SessionStore::Reopen(
@@ -282,7 +301,7 @@ absl::StatusOr<std::unique_ptr<SessionRecord>> SessionStore::Reopen(
   NM_ASSIGN_OR_RETURN(std::unique_ptr<PointsJournal> journal,
                       PointsJournal::Open(files.journal_path, journal_bytes, sync_));
   return std::make_unique<SessionRecord>(files.directory, files.stored, std::move(journal),
-                                         sync_);
+                                         sync_, checkpoint_interval_);
 }
 
 }  // namespace neuralmesh::server

@@ -6,7 +6,8 @@
 //   DIR/sessions/ID/session.binpb neuralmesh.storage.v1.StoredSession, replaced whole
 //   DIR/sessions/ID/points.journal every batch the session took, in order (points_journal.h)
 //   DIR/sessions/ID/latest.binpb  the latest published neuralmesh.v1.MeshUpdate, replaced whole
-//   DIR/sessions/ID/checkpoint.binpb  the learner's mesh at the latest milestone, exactly
+//   DIR/sessions/ID/checkpoint.binpb  the learner's mesh at the latest milestone, or at a later
+//                                 refresh (every checkpoint_interval), exactly
 //                                 (neuralmesh.storage.v1.LearnerCheckpoint), replaced whole
 //
 // What is durable: a batch is acknowledged only after its record is written (and, with `sync`,
@@ -14,7 +15,8 @@
 // answers. Meshes are written after they are published and are not synced: a restored session
 // that lacks one relearns it. Of the learner's state only the mesh of the checkpoint is kept
 // (not its signal counters or octree): a restored session learns on from that mesh, or, without
-// one, again from the initial mesh (session.h).
+// one, again from the initial mesh (session.h). So a restart costs the learning since the
+// latest milestone, or at most about checkpoint_interval of it.
 #ifndef NEURALMESH_SERVER_SESSION_STORE_H_
 #define NEURALMESH_SERVER_SESSION_STORE_H_
 
@@ -27,6 +29,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
 #include "core/point_cloud.h"
 #include "core/triangle_mesh.h"
 #include "neuralmesh/storage/v1/stored_session.pb.h"
@@ -35,11 +38,19 @@
 
 namespace neuralmesh::server {
 
+// How often a refresh of a learning session is kept as its checkpoint, at most.
+inline constexpr absl::Duration kDefaultCheckpointInterval = absl::Seconds(30);
+
+// What a checkpoint is taken from: every milestone is kept, a refresh only when
+// checkpoint_interval has passed since the last checkpoint.
+enum class CheckpointKind { kMilestone, kRefresh };
+
 // The files of one session, open for writing. Thread-safe.
 class SessionRecord {
  public:
   SessionRecord(std::string directory, storage::v1::StoredSession stored,
-                std::unique_ptr<PointsJournal> journal, bool sync);
+                std::unique_ptr<PointsJournal> journal, bool sync,
+                absl::Duration checkpoint_interval = kDefaultCheckpointInterval);
 
   SessionRecord(const SessionRecord&) = delete;
   SessionRecord& operator=(const SessionRecord&) = delete;
@@ -55,8 +66,11 @@ class SessionRecord {
   absl::Status WriteLatestMesh(const v1::MeshUpdate& update, bool durable)
       ABSL_LOCKS_EXCLUDED(mu_);
   // Replaces the stored learner checkpoint: `mesh` as the learner had it, and the session's
-  // learning counters then. Not synced. OK and nothing written once the state is an ended one.
-  absl::Status WriteCheckpoint(const TriangleMesh& mesh, const v1::LearningState& learning)
+  // learning counters then. Not synced. OK and nothing written once the state is an ended
+  // one, and for a refresh that comes before checkpoint_interval has passed since the last
+  // checkpoint (or at all, with an interval of zero).
+  absl::Status WriteCheckpoint(const TriangleMesh& mesh, const v1::LearningState& learning,
+                               CheckpointKind kind = CheckpointKind::kMilestone)
       ABSL_LOCKS_EXCLUDED(mu_);
   // Deletes the session's directory; every later call does nothing. The errno's code when the
   // directory could not be removed (a restart would then restore the session).
@@ -69,15 +83,20 @@ class SessionRecord {
   absl::Status ReplaceFile(const std::string& name, const google::protobuf::Message& message,
                            bool durable) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 
+  // Whether a checkpoint of `kind` is to be written now.
+  bool CheckpointDueLocked(CheckpointKind kind) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+
   const std::string directory_;
   const bool sync_;
+  const absl::Duration checkpoint_interval_;
   absl::Mutex mu_;
   storage::v1::StoredSession stored_ ABSL_GUARDED_BY(mu_);
+  absl::Time last_checkpoint_ ABSL_GUARDED_BY(mu_) = absl::InfinitePast();
   std::unique_ptr<PointsJournal> journal_ ABSL_GUARDED_BY(mu_);
   bool removed_ ABSL_GUARDED_BY(mu_) = false;
 };
 
-// The learner's mesh at a session's latest milestone, and the session's counters then.
+// The learner's mesh at a session's latest checkpoint, and the session's counters then.
 struct LearnerCheckpoint {
   TriangleMesh mesh;
   v1::LearningState learning;
@@ -102,8 +121,10 @@ class SessionStore {
   // the server's user (mode 0700) and locks it against other servers: FAILED_PRECONDITION when
   // another process holds it, the errno's code otherwise. `sync`:
   // batches and state changes reach the disk before they are acknowledged (fdatasync).
-  static absl::StatusOr<std::unique_ptr<SessionStore>> Open(const std::string& directory,
-                                                            bool sync);
+  // `checkpoint_interval`: the records' (SessionRecord::WriteCheckpoint).
+  static absl::StatusOr<std::unique_ptr<SessionStore>> Open(
+      const std::string& directory, bool sync,
+      absl::Duration checkpoint_interval = kDefaultCheckpointInterval);
   ~SessionStore();
 
   SessionStore(const SessionStore&) = delete;
@@ -125,12 +146,16 @@ class SessionStore {
   bool sync() const { return sync_; }
 
  private:
-  SessionStore(std::string directory, int lock_fd, bool sync)
-      : directory_(std::move(directory)), lock_fd_(lock_fd), sync_(sync) {}
+  SessionStore(std::string directory, int lock_fd, bool sync, absl::Duration checkpoint_interval)
+      : directory_(std::move(directory)),
+        lock_fd_(lock_fd),
+        sync_(sync),
+        checkpoint_interval_(checkpoint_interval) {}
 
   const std::string directory_;
   const int lock_fd_;
   const bool sync_;
+  const absl::Duration checkpoint_interval_;
 };
 
 // The file names inside a session's directory.

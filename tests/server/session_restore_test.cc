@@ -235,6 +235,44 @@ TEST_F(SessionRestoreTest, LearningGoesOnFromTheLatestMilestonesMesh) {
   EXPECT_LT(testing::MaxVertexDistance(*decoded, **sphere), 0.02);
 }
 
+// A session with no milestone below its target, restarted while paused for lack of points:
+// its first refresh was kept as the checkpoint, and learning goes on from it. With a
+// checkpoint interval of zero there is none.
+TEST_F(SessionRestoreTest, ARefreshIsTheCheckpointOfASessionWithoutMilestones) {
+  for (const absl::Duration interval : {kDefaultCheckpointInterval, absl::ZeroDuration()}) {
+    ServerOptions options;
+    options.checkpoint_interval = interval;
+    Restart(options);
+    v1::CreateSessionRequest request = CreateRequest(5000, /*refresh_ms=*/20);
+    request.mutable_config()->add_lod_milestones(5000);  // The target only.
+    const std::string id = MustCreate(*service_, request);
+    v1::UploadPointsResponse response;
+    // 6,000 points allow 3,000 vertices: learning pauses there and publishes a refresh.
+    ASSERT_TRUE(Upload(*service_, id, SpherePoints(6000, 14), 2, &response).ok());
+    v1::MeshUpdate latest;
+    ASSERT_TRUE(GetLatest(*service_, id, &latest).ok());
+    EXPECT_EQ(latest.kind(), v1::UPDATE_KIND_REFRESH);
+    EXPECT_EQ(latest.vertex_count(), 3000u);
+    if (interval > absl::ZeroDuration()) {
+      AwaitCheckpoint(SessionDirectory(id), 3000);
+    } else {
+      absl::SleepFor(absl::Milliseconds(100));  // Time for a checkpoint that should not come.
+      EXPECT_FALSE(std::filesystem::exists(SessionDirectory(id) + "/checkpoint.binpb"));
+    }
+    Restart(options);
+    if (interval > absl::ZeroDuration()) {
+      EXPECT_FALSE(events_.Await(absl::StrCat("session ", id,
+                                              " learning goes on from the stored mesh of 3000"))
+                       .empty());
+    }
+    ASSERT_TRUE(testing::Finish(*service_, id).ok());
+    v1::MeshUpdate final_mesh;
+    ASSERT_TRUE(WaitFinal(*service_, id, &final_mesh).ok());
+    EXPECT_EQ(final_mesh.vertex_count(), 3000u);
+    EXPECT_EQ(final_mesh.report().genus(), 0);
+  }
+}
+
 // A checkpoint that cannot be read, and one whose mesh the learner cannot take (three faces
 // on an edge): each session says so and learns again from the initial mesh to a good sphere.
 TEST_F(SessionRestoreTest, ACheckpointThatCannotBeUsedMeansLearningFromTheInitialMesh) {

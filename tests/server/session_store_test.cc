@@ -190,5 +190,42 @@ TEST(SessionStoreTest, ALearnerCheckpointComesBackExactlyOrSaysWhatIsWrong) {
   EXPECT_FALSE(std::filesystem::exists(path));
 }
 
+TEST(SessionStoreTest, ARefreshIsACheckpointOnlyOnceTheIntervalHasPassed) {
+  TriangleMesh mesh;
+  mesh.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0), Vec3f(0, 0, 1)};
+  mesh.faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  // The basic steps of the stored checkpoint (0: none).
+  auto stored_steps = [](const std::string& path) -> uint64_t {
+    std::ifstream file(path, std::ios::binary);
+    storage::v1::LearnerCheckpoint checkpoint;
+    return file && checkpoint.ParseFromIstream(&file) ? checkpoint.learning().basic_steps() : 0;
+  };
+  auto learning = [](uint64_t steps) {
+    v1::LearningState state;
+    state.set_basic_steps(steps);
+    return state;
+  };
+  for (const absl::Duration interval : {absl::ZeroDuration(), absl::Milliseconds(200)}) {
+    const std::string dir = neuralmesh::testing::MakeTempDir("interval");
+    absl::StatusOr<std::unique_ptr<SessionStore>> store = SessionStore::Open(dir, false, interval);
+    ASSERT_TRUE(store.ok()) << store.status();
+    absl::StatusOr<std::unique_ptr<SessionRecord>> record =
+        (*store)->Create(NewSession("s-1", 1));
+    ASSERT_TRUE(record.ok()) << record.status();
+    const std::string path = dir + "/sessions/s-1/checkpoint.binpb";
+    const bool refreshes = interval > absl::ZeroDuration();
+    // The first refresh comes after no checkpoint at all.
+    ASSERT_TRUE((*record)->WriteCheckpoint(mesh, learning(1), CheckpointKind::kRefresh).ok());
+    EXPECT_EQ(stored_steps(path), refreshes ? 1u : 0u) << interval;
+    ASSERT_TRUE((*record)->WriteCheckpoint(mesh, learning(2), CheckpointKind::kMilestone).ok());
+    EXPECT_EQ(stored_steps(path), 2u) << "every milestone";
+    ASSERT_TRUE((*record)->WriteCheckpoint(mesh, learning(3), CheckpointKind::kRefresh).ok());
+    EXPECT_EQ(stored_steps(path), 2u) << "a refresh right after a checkpoint";
+    absl::SleepFor(absl::Milliseconds(250));
+    ASSERT_TRUE((*record)->WriteCheckpoint(mesh, learning(4), CheckpointKind::kRefresh).ok());
+    EXPECT_EQ(stored_steps(path), refreshes ? 4u : 2u) << interval;
+  }
+}
+
 }  // namespace
 }  // namespace neuralmesh::server

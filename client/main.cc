@@ -20,6 +20,7 @@
 #include "client/progress_bar.h"
 #include "client/remote_commands.h"
 #include "client/web/run_view.h"
+#include "client/web/viewer_key.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/io/file_contents.h"
@@ -184,6 +185,12 @@ ABSL_FLAG(std::string, listen, neuralmesh::client::web::ViewOptions().listen,
 ABSL_FLAG(std::string, web_root, "",
           "view: the folder with the viewer's static/ and node_modules/three; empty: the "
           "client/web folder of the source tree it was built from.");
+ABSL_FLAG(std::string, view_key_file, "",
+          "view: a file holding a key (16 or more letters, digits or -._~) that every browser "
+          "must bring: it opens http://HOST:PORT/?key=KEY once (printed at start) and keeps "
+          "the key in a cookie; other clients send 'Authorization: Bearer KEY'. Plain HTTP: "
+          "it keeps out who does not know the URL, not who can read the traffic. Empty: "
+          "anyone who reaches --listen is let in.");
 
 // Reports.
 ABSL_FLAG(bool, json, false, "Print JSON instead of text.");
@@ -427,7 +434,16 @@ absl::Status View(const ParsedArgs& args) {
   o.listen = absl::GetFlag(FLAGS_listen);
   o.web_root = absl::GetFlag(FLAGS_web_root);
   NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
-  return neuralmesh::client::web::RunView(o, std::cout);
+  if (const std::string key_file = absl::GetFlag(FLAGS_view_key_file); !key_file.empty()) {
+    absl::StatusOr<std::string> contents = neuralmesh::ReadFileContents(key_file);
+    if (contents.ok()) contents = neuralmesh::client::web::ParseViewerKey(*contents);
+    if (!contents.ok()) {
+      return absl::Status(contents.status().code(),
+                          absl::StrCat("--view_key_file: ", contents.status().message()));
+    }
+    o.key = *std::move(contents);
+  }
+  return neuralmesh::client::web::RunView(o, std::cout, std::cerr);
 }
 
 std::vector<Subcommand> Commands() {
@@ -438,8 +454,8 @@ std::vector<Subcommand> Commands() {
       "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
-      "start_mesh", "remove_outliers", "outlier_neighbours", "outlier_std_ratio", "outliers_on_server",
-      "sampling", "time_budget", "max_steps", "quantization_bits", "encode_speed", "progress",
+      "start_mesh", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
+      "outliers_on_server", "sampling", "time_budget", "max_steps", "quantization_bits", "encode_speed", "progress",
       "server", "out-dir", "batch-size", "points", "ply", "resume", "reconnect_for"};
   // clang-format on
   return {
@@ -480,14 +496,14 @@ std::vector<Subcommand> Commands() {
        WithConnectionFlags({"server", "json"}),
        Sessions},
       {"view",
-       "view --server HOST:PORT [--listen HOST:PORT]",
+       "view --server HOST:PORT [--listen HOST:PORT] [--view_key_file FILE]",
        "Serves a live 3D viewer of the server's sessions to web browsers.",
        "Serves a web page (http://HOST:PORT/ of --listen) that lists the sessions of the\n"
        "server and shows the chosen one's mesh as it learns: each published mesh is fetched\n"
        "Draco-encoded, decoded in the browser and drawn with three.js, coarse to fine, until\n"
        "the final mesh. It opens on the newest session still learning;\n"
        "http://HOST:PORT/?session=ID goes straight to a session. Runs until Ctrl-C.",
-       WithConnectionFlags({"server", "listen", "web_root"}),
+       WithConnectionFlags({"server", "listen", "web_root", "view_key_file"}),
        View},
   };
 }

@@ -3,6 +3,7 @@
 #include <memory>
 #include <utility>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
@@ -37,11 +38,16 @@ absl::StatusOr<HostPort> ParseListenAddress(const std::string& address) {
   return parsed;
 }
 
+// Whether `host` (as --listen names it) is a loopback address: localhost, 127.0.0.0/8, ::1.
+bool IsLoopback(absl::string_view host) {
+  return host == "localhost" || host == "::1" || absl::StartsWith(host, "127.");
+}
+
 }  // namespace
 
 std::string DefaultWebRoot() { return NEURALMESH_WEB_ROOT; }
 
-absl::Status RunView(const ViewOptions& options, std::ostream& out) {
+absl::Status RunView(const ViewOptions& options, std::ostream& out, std::ostream& err) {
   if (options.server.empty()) return absl::InvalidArgumentError("--server HOST:PORT is required");
   const std::string web_root = options.web_root.empty() ? DefaultWebRoot() : options.web_root;
   NM_RETURN_IF_ERROR(CheckWebRoot(web_root));
@@ -54,14 +60,23 @@ absl::Status RunView(const ViewOptions& options, std::ostream& out) {
 
   ViewerOptions viewer_options;
   viewer_options.web_root = web_root;
+  viewer_options.key = options.key;
   ViewerService viewer(std::move(client), viewer_options);
   NM_ASSIGN_OR_RETURN(
       std::unique_ptr<HttpServer> http,
       HttpServer::Start(listen.host, listen.port,
                         [&viewer](const HttpRequest& request) { return viewer.Handle(request); }));
   const bool ipv6 = listen.host.find(':') != std::string::npos;
-  out << "viewer: http://" << (ipv6 ? "[" : "") << listen.host << (ipv6 ? "]" : "") << ":"
-      << http->port() << "/ (sessions of " << options.server << "); Ctrl-C stops it" << std::endl;
+  const std::string url = absl::StrCat("http://", ipv6 ? "[" : "", listen.host, ipv6 ? "]" : "",
+                                       ":", http->port(), "/");
+  out << "viewer: " << url << " (sessions of " << options.server << "); Ctrl-C stops it";
+  if (!options.key.empty()) out << "; browsers open " << url << "?key=" << options.key;
+  out << std::endl;
+  if (options.key.empty() && !IsLoopback(listen.host)) {
+    err << "neuralmesh view: warning: anyone who reaches " << listen.host
+        << " sees every session of " << options.server
+        << "; --view_key_file lets in only those given the key" << std::endl;
+  }
 
   InterruptScope interrupt;
   for (int tick = 1; !InterruptScope::interrupted(); ++tick) {

@@ -16,6 +16,7 @@ struct ViewOptions {
   std::string listen = "127.0.0.1:8080";  // Where browsers connect, HOST:PORT (port 0: any).
   std::string web_root;                   // Empty: the source tree's client/web.
   ClientOptions connection;                // Connect timeout, TLS, access token.
+  std::string key;  // Empty: every browser is let in; else the key it must bring (viewer_key.h).
 };
 
 // The client/web folder of the source tree this binary was built from.
@@ -26,7 +27,8 @@ std::string DefaultWebRoot();
 // NOT_FOUND for a web root without the viewer's files, INVALID_ARGUMENT for a malformed
 // --listen, UNAVAILABLE when the server cannot be reached or the address cannot be bound,
 // UNAUTHENTICATED when the server refuses the viewer's access token (or its lack of one).
-absl::Status RunView(const ViewOptions& options, std::ostream& out);
+// Without a key, a --listen address that is not a loopback one gets a warning on `err`.
+absl::Status RunView(const ViewOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace neuralmesh::client::web
 

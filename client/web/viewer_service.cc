@@ -14,6 +14,7 @@
 #include "absl/time/clock.h"
 #include "client/session_json.h"
 #include "core/analysis/json_writer.h"
+#include "client/web/viewer_key.h"
 #include "core/io/file_contents.h"
 
 namespace neuralmesh::client::web {
@@ -134,6 +135,18 @@ void ViewerService::Stop() {
 }
 
 HttpResponse ViewerService::Handle(const HttpRequest& request) {
+  if (!options_.key.empty()) {
+    switch (CheckViewerKey(request, options_.key)) {
+      case ViewerKeyCheck::kGranted:
+        break;
+      case ViewerKeyCheck::kGrantedFromUrl:
+        return ViewerKeyRedirect(request, options_.key);
+      case ViewerKeyCheck::kRefused:
+        return ErrorResponse(401,
+                             "this viewer needs its key: open the URL with ?key= that "
+                             "neuralmesh view printed");
+    }
+  }
   absl::string_view path = request.path;
   if (path == "/" || path == "/index.html") return ServeFile("static/index.html");
   if (absl::ConsumePrefix(&path, "/static/")) {

@@ -43,6 +43,10 @@ struct ViewerOptions {
   absl::Duration poll_timeout = absl::Seconds(20);
   // A session's watch is dropped when no browser has asked for its meshes for this long.
   absl::Duration relay_idle_timeout = absl::Seconds(60);
+  // Empty: every request is answered. Else every request must bring this key (viewer_key.h):
+  // one with the key in its query is sent on without it, keeping the key in a cookie, and one
+  // without the key gets 401.
+  std::string key;
 };
 
 // OK when `web_root` holds the viewer's page and three.js; otherwise NOT_FOUND naming the

@@ -29,6 +29,10 @@ TEST(NeuralmeshViewTest, BadArgumentsGetAMessageAndAFailingExit) {
        "/nonexistent/static/index.html is missing: run scripts/install-deps.sh"},
       {{"view", "--server=127.0.0.1:1", "--connect_timeout=200ms"},
        "cannot reach a neuralmesh-server at 127.0.0.1:1"},
+      {{"view", "--server=127.0.0.1:1", "--view_key_file=/nonexistent/key"},
+       "--view_key_file: cannot open '/nonexistent/key'"},
+      {{"view", "--server=127.0.0.1:1", "--view_key_file=/dev/null"},
+       "--view_key_file: '/dev/null' is empty"},
   };
   for (const Case& c : cases) {
     const RunResult run = RunNeuralmesh(c.args);

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -153,6 +154,30 @@ TEST(ViewerBrowserTest, ThePageOpensOnTheNewestSessionStillLearning) {
   ASSERT_EQ(std::system(command.c_str()), 0) << testing::ReadWholeFile(dir + "/err");
   EXPECT_EQ(testing::ReadWholeFile(dir + "/out"), absl::StrCat("watching ", newest, "\n"))
       << "not the older live one (" << older << "), nor the finished or cancelled ones";
+}
+
+// neuralmesh view --view_key_file: the browser opens the URL with the key once, the viewer
+// keeps the key in a cookie and sends the browser on to the page, whose requests (scripts,
+// three.js, the API) all bring the cookie: the page shows the learning session.
+TEST(ViewerBrowserTest, AKeyedViewerShowsTheSessionsToTheBrowserGivenTheKey) {
+  std::unique_ptr<server::ReconstructionServer> server = st::StartServer(/*listen=*/true);
+  ASSERT_NE(server, nullptr);
+  auto service = st::NetworkService(*server);
+  const std::string live = st::MustCreate(*service, st::CreateRequest(500));
+  const std::string dir = testing::MakeTempDir("browser_key");
+  const std::string key = "browser-key-0123456789";
+  std::ofstream(dir + "/key") << key << "\n";
+
+  BackgroundProcess viewer("neuralmesh", {"view", "--server=" + server->target(),
+                                          "--listen=127.0.0.1:0", "--view_key_file=" + dir + "/key"});
+  const int port = WaitForViewerPort(viewer);
+  ASSERT_NE(port, 0) << "neuralmesh view did not start: " << viewer.Stderr();
+  const std::string command = absl::StrCat(
+      "/usr/bin/python3 tests/client/web/viewer_browser_driver.py --timeout=60 "
+      "--stop_when_watching --url=http://127.0.0.1:",
+      port, "/?key=", key, " --ready_file=", dir, "/ready > ", dir, "/out 2> ", dir, "/err");
+  ASSERT_EQ(std::system(command.c_str()), 0) << testing::ReadWholeFile(dir + "/err");
+  EXPECT_EQ(testing::ReadWholeFile(dir + "/out"), absl::StrCat("watching ", live, "\n"));
 }
 
 }  // namespace

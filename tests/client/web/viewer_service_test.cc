@@ -43,7 +43,8 @@ class ViewerServiceTest : public ::testing::Test {
   void TearDown() override { StopViewer(); }
 
   void StartViewer(absl::Duration poll_timeout,
-                   absl::Duration relay_idle_timeout = absl::Seconds(60)) {
+                   absl::Duration relay_idle_timeout = absl::Seconds(60),
+                   const std::string& key = "") {
     server_ = st::StartServer(/*listen=*/false);
     ASSERT_NE(server_, nullptr);
     service_ = st::InProcessService(*server_);
@@ -51,6 +52,7 @@ class ViewerServiceTest : public ::testing::Test {
     options.web_root = DefaultWebRoot();
     options.poll_timeout = poll_timeout;
     options.relay_idle_timeout = relay_idle_timeout;
+    options.key = key;
     viewer_ = std::make_unique<ViewerService>(
         std::make_unique<ReconstructionClient>(server_->InProcessChannel(), ClientOptions{}),
         options);
@@ -104,6 +106,37 @@ TEST_F(ViewerServiceTest, ServesThePageAndItsScriptsOnly) {
     EXPECT_EQ(reply.Header("content-type"), "application/json") << target;
     EXPECT_THAT(reply.body, HasSubstr("\"error\":\"no such ")) << target;
   }
+}
+
+// --view_key_file: nothing without the key; the page opened with ?key= once sends the browser
+// on with a cookie, and the cookie or a bearer header lets every later request in.
+TEST_F(ViewerServiceTest, AKeyedViewerAnswersOnlyRequestsThatBringTheKey) {
+  StopViewer();
+  const std::string key = "0123456789-abcdef";
+  StartViewer(absl::Milliseconds(300), absl::Seconds(60), key);
+  const std::string id = st::MustCreate(*service_, st::CreateRequest(500));
+  for (const std::string& target : std::vector<std::string>{
+           "/", "/static/viewer.js", "/api/sessions", "/api/sessions/" + id + "/mesh?after=0",
+           "/?key=0123456789-abcdeF"}) {
+    const HttpReply refused = HttpGet(port_, target);
+    EXPECT_EQ(refused.status, 401) << target;
+    EXPECT_THAT(refused.body, HasSubstr("this viewer needs its key")) << target;
+  }
+  const HttpReply opened = HttpGet(port_, "/?key=" + key + "&session=" + id);
+  EXPECT_EQ(opened.status, 303);
+  EXPECT_EQ(opened.Header("location"), "/?session=" + id);
+  const std::string cookie = opened.Header("set-cookie");
+  EXPECT_THAT(cookie, HasSubstr("neuralmesh_view_key=" + key + ";"));
+  const std::string with_cookie =
+      absl::StrCat("GET /api/sessions HTTP/1.1\r\nHost: 127.0.0.1\r\nCookie: ",
+                   cookie.substr(0, cookie.find(';')), "\r\n\r\n");
+  const HttpReply listed = SendRawHttp(port_, with_cookie);
+  EXPECT_EQ(listed.status, 200);
+  EXPECT_THAT(listed.body, HasSubstr(id));
+  const HttpReply page = SendRawHttp(
+      port_, "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " + key + "\r\n\r\n");
+  EXPECT_EQ(page.status, 200);
+  EXPECT_THAT(page.body, HasSubstr("/static/viewer.js"));
 }
 
 TEST_F(ViewerServiceTest, AnswersMalformedRequestsWithTheirStatus) {

@@ -1,0 +1,107 @@
+#include "client/web/viewer_key.h"
+
+#include <cstddef>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+
+namespace neuralmesh::client::web {
+namespace {
+
+constexpr size_t kMinKeyLength = 16;
+
+bool IsKeyCharacter(char c) {
+  return absl::ascii_isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' ||
+         c == '_' || c == '~';
+}
+
+// Equal, in time that does not depend on where `a` and `b` first differ.
+bool SameKey(absl::string_view a, absl::string_view b) {
+  if (a.size() != b.size()) return false;
+  unsigned char difference = 0;
+  for (size_t i = 0; i < a.size(); ++i) difference |= static_cast<unsigned char>(a[i] ^ b[i]);
+  return difference == 0;
+}
+
+// The value of cookie `name` in a Cookie header, or nothing.
+absl::string_view CookieValue(absl::string_view header, absl::string_view name) {
+  for (absl::string_view pair : absl::StrSplit(header, ';')) {
+    pair = absl::StripAsciiWhitespace(pair);
+    if (absl::ConsumePrefix(&pair, name) && absl::ConsumePrefix(&pair, "=")) return pair;
+  }
+  return {};
+}
+
+// `text` percent-encoded for a URL path segment or query (letters, digits and "-._~" as they
+// are).
+std::string PercentEncoded(absl::string_view text) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  std::string encoded;
+  for (const char c : text) {
+    if (IsKeyCharacter(c)) {
+      encoded.push_back(c);
+    } else {
+      const unsigned char byte = static_cast<unsigned char>(c);
+      encoded += {'%', kHex[byte >> 4], kHex[byte & 15]};
+    }
+  }
+  return encoded;
+}
+
+}  // namespace
+
+absl::StatusOr<std::string> ParseViewerKey(absl::string_view contents) {
+  const absl::string_view key = absl::StripAsciiWhitespace(contents);
+  if (key.size() < kMinKeyLength) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the viewer key has ", key.size(), " characters; it needs at least ", kMinKeyLength));
+  }
+  for (const char c : key) {
+    if (!IsKeyCharacter(c)) {
+      return absl::InvalidArgumentError(
+          "the viewer key may hold letters, digits and \"-._~\" only (one line)");
+    }
+  }
+  return std::string(key);
+}
+
+ViewerKeyCheck CheckViewerKey(const HttpRequest& request, absl::string_view key) {
+  if (auto it = request.query.find("key"); it != request.query.end()) {
+    return SameKey(it->second, key) ? ViewerKeyCheck::kGrantedFromUrl : ViewerKeyCheck::kRefused;
+  }
+  if (auto it = request.headers.find("cookie"); it != request.headers.end()) {
+    if (SameKey(CookieValue(it->second, kViewerKeyCookie), key)) return ViewerKeyCheck::kGranted;
+  }
+  if (auto it = request.headers.find("authorization"); it != request.headers.end()) {
+    absl::string_view value = it->second;
+    if (absl::ConsumePrefix(&value, "Bearer ") && SameKey(value, key)) {
+      return ViewerKeyCheck::kGranted;
+    }
+  }
+  return ViewerKeyCheck::kRefused;
+}
+
+HttpResponse ViewerKeyRedirect(const HttpRequest& request, absl::string_view key) {
+  std::string location;  // The path starts with '/': its first segment is empty.
+  bool first = true;
+  for (absl::string_view segment : absl::StrSplit(request.path, '/')) {
+    if (!first) location.push_back('/');
+    first = false;
+    location += PercentEncoded(segment);
+  }
+  const char* separator = "?";
+  for (const auto& [name, value] : request.query) {
+    if (name == "key") continue;
+    absl::StrAppend(&location, separator, PercentEncoded(name), "=", PercentEncoded(value));
+    separator = "&";
+  }
+  HttpResponse response = TextResponse(303, "the key is kept in a cookie: on to the page");
+  response.headers.emplace_back("Location", location);
+  response.headers.emplace_back(
+      "Set-Cookie", absl::StrCat(kViewerKeyCookie, "=", key, "; HttpOnly; SameSite=Strict; Path=/"));
+  return response;
+}
+
+}  // namespace neuralmesh::client::web

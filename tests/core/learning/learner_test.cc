@@ -445,6 +445,23 @@ TEST(LearnerTest, LearningGoesOnFromASnapshotWithItsTopology) {
       << "from 1,000 vertices on, against " << fresh_steps << " Basic Steps from the start";
 }
 
+TEST(LearnerTest, TheSameSeedAndStartMeshReproduceTheMeshExactly) {
+  auto sphere = UnitSphere();
+  const TriangleMesh start = LearnTo(*sphere, 300, 2)->Snapshot();
+  LearnerOptions options;
+  options.seed = 9;
+  TriangleMesh meshes[2];
+  for (TriangleMesh& mesh : meshes) {
+    std::unique_ptr<Learner> learner = Learner::CreateFrom(options, sphere.get(), start).value();
+    StopCriteria stop;
+    stop.target_vertices = 900;
+    ASSERT_TRUE(learner->Run(stop).ok());
+    mesh = learner->Snapshot();
+  }
+  EXPECT_EQ(meshes[0].positions, meshes[1].positions);
+  EXPECT_EQ(meshes[0].faces, meshes[1].faces);
+}
+
 TEST(LearnerTest, CreateFromRejectsABadStartMeshAndWhatCreateRejects) {
   auto sphere = UnitSphere();
   TriangleMesh open_fan;  // A vertex with two fans: not a manifold.

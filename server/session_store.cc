@@ -163,19 +163,24 @@ bool SessionRecord::CheckpointDueLocked(CheckpointKind kind) const {
 absl::Status SessionRecord::WriteCheckpoint(const TriangleMesh& mesh,
                                             const v1::LearningState& learning,
                                             CheckpointKind kind) {
+  storage::v1::LearnerCheckpoint checkpoint;
   {
     absl::MutexLock lock(&mu_);
     if (!CheckpointDueLocked(kind)) return absl::OkStatus();
+    checkpoint.set_session_id(stored_.session_id());
   }
-  // Packed outside the lock, which batches take.
-  storage::v1::LearnerCheckpoint checkpoint;
+  // Packed and written outside the lock, which batches take (36 MB at a million vertices).
   checkpoint.set_format_version(kFormatVersion);
   *checkpoint.mutable_mesh() = TriangleMeshToPacked(mesh);
   *checkpoint.mutable_learning() = learning;
+  const absl::Status written = WriteTemporary(kCheckpointFile, checkpoint, /*durable=*/false);
   absl::MutexLock lock(&mu_);
-  if (!CheckpointDueLocked(kind)) return absl::OkStatus();
-  checkpoint.set_session_id(stored_.session_id());
-  NM_RETURN_IF_ERROR(ReplaceFile(kCheckpointFile, checkpoint, /*durable=*/false));
+  if (!CheckpointDueLocked(kind)) {  // Removed or ended meanwhile.
+    std::remove(absl::StrCat(directory_, "/", kCheckpointFile, ".new").c_str());
+    return absl::OkStatus();
+  }
+  NM_RETURN_IF_ERROR(written);
+  NM_RETURN_IF_ERROR(MoveTemporaryIntoPlace(kCheckpointFile, /*durable=*/false));
   last_checkpoint_ = absl::Now();
   return absl::OkStatus();
 }
@@ -193,10 +198,22 @@ absl::Status SessionRecord::Remove() {
 
 absl::Status SessionRecord::ReplaceFile(const std::string& name,
                                         const google::protobuf::Message& message, bool durable) {
+  NM_RETURN_IF_ERROR(WriteTemporary(name, message, durable));
+  return MoveTemporaryIntoPlace(name, durable);
+}
+
+absl::Status SessionRecord::WriteTemporary(const std::string& name,
+                                           const google::protobuf::Message& message,
+                                           bool durable) const {
+  const std::string temporary = absl::StrCat(directory_, "/", name, ".new");
+  NM_RETURN_IF_ERROR(WriteFileContents(temporary, message.SerializeAsString()));
+  if (durable && sync_) return SyncPath(temporary);
+  return absl::OkStatus();
+}
+
+absl::Status SessionRecord::MoveTemporaryIntoPlace(const std::string& name, bool durable) {
   const std::string path = absl::StrCat(directory_, "/", name);
   const std::string temporary = absl::StrCat(path, ".new");
-  NM_RETURN_IF_ERROR(WriteFileContents(temporary, message.SerializeAsString()));
-  if (durable && sync_) NM_RETURN_IF_ERROR(SyncPath(temporary));
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
     const int error = errno;
     std::remove(temporary.c_str());

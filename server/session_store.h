@@ -68,7 +68,8 @@ class SessionRecord {
   // Replaces the stored learner checkpoint: `mesh` as the learner had it, and the session's
   // learning counters then. Not synced. OK and nothing written once the state is an ended
   // one, and for a refresh that comes before checkpoint_interval has passed since the last
-  // checkpoint (or at all, with an interval of zero).
+  // checkpoint (or at all, with an interval of zero). The file is written without holding the
+  // lock that AppendBatch takes; one thread at a time may call it.
   absl::Status WriteCheckpoint(const TriangleMesh& mesh, const v1::LearningState& learning,
                                CheckpointKind kind = CheckpointKind::kMilestone)
       ABSL_LOCKS_EXCLUDED(mu_);
@@ -82,6 +83,12 @@ class SessionRecord {
   // Writes `message` to `name` in the directory through a temporary file and a rename.
   absl::Status ReplaceFile(const std::string& name, const google::protobuf::Message& message,
                            bool durable) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // The two halves of ReplaceFile: the temporary file of `name` written (which needs no lock
+  // when one thread at a time writes `name`), and renamed over `name`.
+  absl::Status WriteTemporary(const std::string& name, const google::protobuf::Message& message,
+                              bool durable) const;
+  absl::Status MoveTemporaryIntoPlace(const std::string& name, bool durable)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 
   // Whether a checkpoint of `kind` is to be written now.
   bool CheckpointDueLocked(CheckpointKind kind) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);

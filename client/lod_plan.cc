@@ -34,9 +34,9 @@ absl::StatusOr<std::vector<size_t>> ParseLodList(absl::string_view text) {
 absl::StatusOr<std::vector<size_t>> LodTargets(const std::vector<size_t>& lods,
                                                size_t final_vertices, size_t start_vertices) {
   const size_t start = start_vertices == 0 ? kInitialVertices : start_vertices;
-  const std::string what = start_vertices == 0
-                               ? absl::StrCat(kInitialVertices, " vertices (the initial tetrahedron)")
-                               : absl::StrCat(start, " vertices (those of --start_mesh)");
+  const std::string what =
+      start_vertices == 0 ? absl::StrCat(kInitialVertices, " vertices (the initial tetrahedron)")
+                          : absl::StrCat(start, " vertices (those of --start_mesh)");
   if (final_vertices <= start) {
     return absl::InvalidArgumentError(
         absl::StrCat("--vertices must be more than ", what, ", got ", final_vertices));

@@ -455,8 +455,9 @@ std::vector<Subcommand> Commands() {
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
       "start_mesh", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
-      "outliers_on_server", "sampling", "time_budget", "max_steps", "quantization_bits", "encode_speed", "progress",
-      "server", "out-dir", "batch-size", "points", "ply", "resume", "reconnect_for"};
+      "outliers_on_server", "sampling", "time_budget", "max_steps", "quantization_bits",
+      "encode_speed", "progress", "server", "out-dir", "batch-size", "points", "ply", "resume",
+      "reconnect_for"};
   // clang-format on
   return {
       {"reconstruct",

@@ -16,20 +16,19 @@
 // vertices (after Finish: the final count, the same bound frozen). The learner is created once
 // allowed >= 4, with its initial tetrahedron around the points received so far; with a start
 // mesh (CreateSessionRequest.start_mesh), once allowed reaches its vertex count, and the start
-// mesh is published first. A slice runs
-// the learner toward min(next milestone, allowed); at a milestone it snapshots; between
-// milestones it snapshots every refresh interval; when it reaches `allowed` it pauses (one more
-// refresh snapshot) until more points arrive.
+// mesh is published first. A slice runs the learner toward min(next milestone, allowed); at a
+// milestone it snapshots; between milestones it snapshots every refresh interval; when it
+// reaches `allowed` it pauses (one more refresh snapshot) until more points arrive.
 //
 // With a state directory (session_store.h) the session keeps its identity, state changes,
-// batches and latest mesh on disk through a SessionRecord, and a server that starts again
-// restores it: its batches are taken again in their order (so the points, the quantization
-// cube and the outlier filter's verdicts come out as before), the stored latest mesh is
-// published again with its sequence number, and a session that was still learning learns on
-// from the learner's mesh at its latest checkpoint (a milestone, or a refresh every
-// checkpoint interval: session_store.h; without one, again from the initial mesh), publishing no mesh coarser than the stored one (the milestones up to
-// it are skipped). Its counters (Basic Steps, splits, collapses, learning time) go on from
-// those of the checkpoint.
+// batches, latest mesh and learner checkpoint on disk through a SessionRecord, and a server
+// that starts again restores it: its batches are taken again in their order (so the points,
+// the quantization cube and the outlier filter's verdicts come out as before), the stored
+// latest mesh is published again with its sequence number, and a session that was still
+// learning learns on from the learner's mesh at its latest checkpoint (a milestone, or a
+// refresh every checkpoint interval; without one, again from the initial mesh), publishing no
+// mesh coarser than the stored one (the milestones up to it are skipped). Its counters (Basic
+// Steps, splits, collapses, learning time) go on from those of the checkpoint.
 //
 // A learner whose vertex count makes no new maximum for kStallSplits * C_vs Basic Steps while
 // it should grow (Step 3 collapsing as many vertices as Step 2 splits, as happens on some thin

@@ -100,7 +100,8 @@ HttpResponse ViewerKeyRedirect(const HttpRequest& request, absl::string_view key
   HttpResponse response = TextResponse(303, "the key is kept in a cookie: on to the page");
   response.headers.emplace_back("Location", location);
   response.headers.emplace_back(
-      "Set-Cookie", absl::StrCat(kViewerKeyCookie, "=", key, "; HttpOnly; SameSite=Strict; Path=/"));
+      "Set-Cookie",
+      absl::StrCat(kViewerKeyCookie, "=", key, "; HttpOnly; SameSite=Strict; Path=/"));
   return response;
 }
 

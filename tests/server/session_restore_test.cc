@@ -296,7 +296,8 @@ TEST_F(SessionRestoreTest, ACheckpointThatCannotBeUsedMeansLearningFromTheInitia
   const std::vector<Vec3f> positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0),
                                         Vec3f(1, 1, 1), Vec3f(1, 1, -1)};
   const std::vector<uint32_t> faces = {0, 1, 2, 1, 3, 2, 1, 2, 4};
-  fin.mutable_mesh()->set_positions(std::string(reinterpret_cast<const char*>(positions.data()), 5 * 12));
+  fin.mutable_mesh()->set_positions(
+      std::string(reinterpret_cast<const char*>(positions.data()), 5 * 12));
   fin.mutable_mesh()->set_faces(std::string(reinterpret_cast<const char*>(faces.data()), 9 * 4));
   std::ofstream(SessionDirectory(ids[1]) + "/checkpoint.binpb", std::ios::binary)
       << fin.SerializeAsString();

@@ -168,8 +168,9 @@ TEST(ViewerBrowserTest, AKeyedViewerShowsTheSessionsToTheBrowserGivenTheKey) {
   const std::string key = "browser-key-0123456789";
   std::ofstream(dir + "/key") << key << "\n";
 
-  BackgroundProcess viewer("neuralmesh", {"view", "--server=" + server->target(),
-                                          "--listen=127.0.0.1:0", "--view_key_file=" + dir + "/key"});
+  BackgroundProcess viewer("neuralmesh",
+                           {"view", "--server=" + server->target(), "--listen=127.0.0.1:0",
+                            "--view_key_file=" + dir + "/key"});
   const int port = WaitForViewerPort(viewer);
   ASSERT_NE(port, 0) << "neuralmesh view did not start: " << viewer.Stderr();
   const std::string command = absl::StrCat(

@@ -414,7 +414,8 @@ TEST(LearnerTest, LearningGoesOnFromASnapshotWithItsTopology) {
 
   LearnerOptions options;
   options.seed = 6;
-  absl::StatusOr<std::unique_ptr<Learner>> resumed = Learner::CreateFrom(options, torus.get(), coarse);
+  absl::StatusOr<std::unique_ptr<Learner>> resumed =
+      Learner::CreateFrom(options, torus.get(), coarse);
   ASSERT_TRUE(resumed.ok()) << resumed.status();
   Learner& learner = **resumed;
   ASSERT_TRUE(ValidateMesh(learner.mesh()).ok()) << ValidateMesh(learner.mesh());

@@ -368,6 +368,13 @@ void Session::StoreMesh(const v1::MeshUpdate& update, bool durable) {
   }
 }
 
+void Session::SkipMilestonesUpToLocked(size_t vertices) {
+  const std::vector<size_t>& milestones = config_.lod_milestones;
+  const size_t past = static_cast<size_t>(
+      std::upper_bound(milestones.begin(), milestones.end(), vertices) - milestones.begin());
+  next_milestone_ = std::max(next_milestone_, past);
+}
+
 void Session::StoreCheckpoint(const Snapshot& snapshot) {
   if (record_ == nullptr) return;
   const absl::Status stored = record_->WriteCheckpoint(
@@ -409,10 +416,7 @@ void Session::FinishRestore(v1::SessionState state, const std::string& error,
     // The milestones up to the stored mesh were published before the restart. Learning again
     // publishes nothing coarser: refreshes come only after a first publication, which is a
     // later milestone or, paused for lack of points, a mesh of as many vertices as before.
-    const std::vector<size_t>& milestones = config_.lod_milestones;
-    next_milestone_ = static_cast<size_t>(
-        std::upper_bound(milestones.begin(), milestones.end(), latest->vertex_count()) -
-        milestones.begin());
+    SkipMilestonesUpToLocked(latest->vertex_count());
     if (ended) {
       // The counters of the learning that ended; the points are the replayed ones.
       v1::LearningState learning = latest->learning();
@@ -586,11 +590,7 @@ SliceResult Session::RunSlice(absl::Time deadline) {
         absl::MutexLock lock(&mu_);
         if (state_ == v1::SESSION_STATE_COLLECTING) state_ = v1::SESSION_STATE_LEARNING;
         // Milestones the start mesh has reached already are not published.
-        const std::vector<size_t>& milestones = config_.lod_milestones;
-        const size_t reached = static_cast<size_t>(
-            std::upper_bound(milestones.begin(), milestones.end(), learner_->num_vertices()) -
-            milestones.begin());
-        next_milestone_ = std::max(next_milestone_, reached);
+        SkipMilestonesUpToLocked(learner_->num_vertices());
         milestone_index = next_milestone_;
       }
       // A start mesh is shown at once (a restored session shows its stored mesh instead).

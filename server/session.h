@@ -216,6 +216,8 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // OK, or FAILED_PRECONDITION naming the state in which the session refuses points.
   absl::Status AcceptingPointsLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   size_t AllowedVerticesLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Moves the next milestone past every one of at most `vertices` vertices (never back).
+  void SkipMilestonesUpToLocked(size_t vertices) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // The quantization cube once a batch with `batch_bounds` is in, and in `grown` whether the
   // present (or the first) cube had to grow for it; INVALID_ARGUMENT when no cube Draco can
   // use holds the batch.

@@ -26,6 +26,8 @@ using testing::SpherePoints;
 using testing::Upload;
 using testing::WaitFinal;
 using testing::WatchAll;
+// gRPC's generated client class of the service.
+using Service = v1::ReconstructionService::Stub;
 
 // A unit sphere learned to `vertices` vertices by a local learner.
 TriangleMesh LearnedSphere(size_t vertices) {
@@ -63,7 +65,7 @@ class StartMeshTest : public ::testing::Test {
   void TearDown() override { server_->Shutdown(absl::Seconds(2)); }
 
   std::unique_ptr<ReconstructionServer> server_;
-  std::unique_ptr<v1::ReconstructionService::Stub> service_;
+  std::unique_ptr<Service> service_;
 };
 
 // A 500-vertex sphere refined to 2,000 vertices: learning waits until the points allow 500
@@ -201,7 +203,7 @@ TEST(StartMeshRestartTest, ARestartBeforeAnyMilestoneLearnsOnFromTheStartMesh) {
   options.state_sync = false;
   options.event_sink = events.Sink();
   std::unique_ptr<ReconstructionServer> server = ReconstructionServer::Start(options).value();
-  std::unique_ptr<v1::ReconstructionService::Stub> service = testing::InProcessService(*server);
+  std::unique_ptr<Service> service = testing::InProcessService(*server);
   const TriangleMesh start = LearnedSphere(500);
   const std::string id = MustCreate(*service, RequestFrom(start, 2000));
   service.reset();

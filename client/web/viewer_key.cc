@@ -1,6 +1,7 @@
 #include "client/web/viewer_key.h"
 
 #include <cstddef>
+#include <cstdint>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
@@ -52,6 +53,14 @@ std::string PercentEncoded(absl::string_view text) {
 
 }  // namespace
 
+std::string ViewerKeyCookieName(absl::string_view key) {
+  uint64_t hash = 0xcbf29ce484222325ull;  // 64-bit FNV-1a: the same name in every run.
+  for (const char c : key) {
+    hash = (hash ^ static_cast<unsigned char>(c)) * 0x100000001b3ull;
+  }
+  return absl::StrCat("neuralmesh_view_key_", absl::Hex(hash, absl::kZeroPad16));
+}
+
 absl::StatusOr<std::string> ParseViewerKey(absl::string_view contents) {
   const absl::string_view key = absl::StripAsciiWhitespace(contents);
   if (key.size() < kMinKeyLength) {
@@ -72,7 +81,7 @@ ViewerKeyCheck CheckViewerKey(const HttpRequest& request, absl::string_view key)
     return SameKey(it->second, key) ? ViewerKeyCheck::kGrantedFromUrl : ViewerKeyCheck::kRefused;
   }
   if (auto it = request.headers.find("cookie"); it != request.headers.end()) {
-    if (SameKey(CookieValue(it->second, kViewerKeyCookie), key)) return ViewerKeyCheck::kGranted;
+    if (SameKey(CookieValue(it->second, ViewerKeyCookieName(key)), key)) return ViewerKeyCheck::kGranted;
   }
   if (auto it = request.headers.find("authorization"); it != request.headers.end()) {
     absl::string_view value = it->second;
@@ -101,7 +110,7 @@ HttpResponse ViewerKeyRedirect(const HttpRequest& request, absl::string_view key
   response.headers.emplace_back("Location", location);
   response.headers.emplace_back(
       "Set-Cookie",
-      absl::StrCat(kViewerKeyCookie, "=", key, "; HttpOnly; SameSite=Strict; Path=/"));
+      absl::StrCat(ViewerKeyCookieName(key), "=", key, "; HttpOnly; SameSite=Strict; Path=/"));
   return response;
 }
 

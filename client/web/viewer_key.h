@@ -16,8 +16,10 @@
 
 namespace neuralmesh::client::web {
 
-// The cookie that carries the key.
-inline constexpr char kViewerKeyCookie[] = "neuralmesh_view_key";
+// The name of the cookie that carries `key`: "neuralmesh_view_key_" and 16 hex digits of a
+// hash of the key. Browsers keep cookies by host, not by port, so viewers with other keys on
+// the same host (other ports, or the same port behind other mappings) each keep their own.
+std::string ViewerKeyCookieName(absl::string_view key);
 
 // The key in `contents` (a key file): its text without surrounding whitespace, at least 16
 // characters, each a letter, a digit or one of "-._~" (so that it stands in a URL as it is).

@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 
 namespace neuralmesh::client::web {
@@ -31,11 +32,11 @@ TEST(ViewerKeyTest, TheKeyComesInTheQueryACookieOrABearerHeader) {
   HttpRequest request;
   request.path = "/api/sessions";
   EXPECT_EQ(CheckViewerKey(request, kKey), ViewerKeyCheck::kRefused);
-  request.headers["cookie"] = absl::StrCat("theme=dark; ", kViewerKeyCookie, "=", kKey);
+  request.headers["cookie"] = absl::StrCat("theme=dark; ", ViewerKeyCookieName(kKey), "=", kKey);
   EXPECT_EQ(CheckViewerKey(request, kKey), ViewerKeyCheck::kGranted);
-  request.headers["cookie"] = absl::StrCat(kViewerKeyCookie, "=", kKey, "x");
+  request.headers["cookie"] = absl::StrCat(ViewerKeyCookieName(kKey), "=", kKey, "x");
   EXPECT_EQ(CheckViewerKey(request, kKey), ViewerKeyCheck::kRefused);
-  request.headers["cookie"] = absl::StrCat("x", kViewerKeyCookie, "=", kKey);
+  request.headers["cookie"] = absl::StrCat("x", ViewerKeyCookieName(kKey), "=", kKey);
   EXPECT_EQ(CheckViewerKey(request, kKey), ViewerKeyCheck::kRefused) << "another cookie's name";
   request.headers.erase("cookie");
   request.headers["authorization"] = absl::StrCat("Bearer ", kKey);
@@ -49,6 +50,30 @@ TEST(ViewerKeyTest, TheKeyComesInTheQueryACookieOrABearerHeader) {
   EXPECT_EQ(CheckViewerKey(request, kKey), ViewerKeyCheck::kRefused) << "a wrong key in the URL";
 }
 
+// Browsers keep cookies by host: two viewers on one host (say ports 8080 and 8081, each with
+// its key) must not overwrite each other's cookie, or a browser open on both is let into one.
+TEST(ViewerKeyTest, ViewersWithOtherKeysOnOneHostKeepCookiesOfTheirOwn) {
+  constexpr char kOtherKey[] = "another-viewer-key-2";
+  const std::string name = ViewerKeyCookieName(kKey);
+  EXPECT_EQ(name, ViewerKeyCookieName(kKey)) << "the same name in every run";
+  EXPECT_NE(name, ViewerKeyCookieName(kOtherKey));
+  EXPECT_NE(name, ViewerKeyCookieName("k3y-Of_The.Viewer~2")) << "keys one character apart";
+  EXPECT_TRUE(absl::StartsWith(name, "neuralmesh_view_key_")) << name;
+  EXPECT_EQ(name.size(), std::string("neuralmesh_view_key_").size() + 16) << name;
+
+  HttpRequest request;
+  request.path = "/api/sessions";
+  request.headers["cookie"] =
+      absl::StrCat(ViewerKeyCookieName(kOtherKey), "=", kOtherKey, "; ", name, "=", kKey);
+  EXPECT_EQ(CheckViewerKey(request, kKey), ViewerKeyCheck::kGranted);
+  EXPECT_EQ(CheckViewerKey(request, kOtherKey), ViewerKeyCheck::kGranted);
+  request.headers["cookie"] = absl::StrCat(ViewerKeyCookieName(kOtherKey), "=", kOtherKey);
+  EXPECT_EQ(CheckViewerKey(request, kKey), ViewerKeyCheck::kRefused);
+  request.headers["cookie"] = absl::StrCat(ViewerKeyCookieName(kOtherKey), "=", kKey);
+  EXPECT_EQ(CheckViewerKey(request, kKey), ViewerKeyCheck::kRefused)
+      << "the key under another viewer's name";
+}
+
 TEST(ViewerKeyTest, AKeyInTheUrlBecomesACookieAndTheUrlLosesIt) {
   HttpRequest request;
   request.path = "/";
@@ -60,7 +85,7 @@ TEST(ViewerKeyTest, AKeyInTheUrlBecomesACookieAndTheUrlLosesIt) {
   EXPECT_EQ(response.headers[0].second, "/?note=a%20b%26c&session=s-1a2b");
   EXPECT_EQ(response.headers[1].first, "Set-Cookie");
   EXPECT_EQ(response.headers[1].second,
-            absl::StrCat(kViewerKeyCookie, "=", kKey, "; HttpOnly; SameSite=Strict; Path=/"));
+            absl::StrCat(ViewerKeyCookieName(kKey), "=", kKey, "; HttpOnly; SameSite=Strict; Path=/"));
   request.path = "/api/sessions/s 1";
   request.query = {{"key", kKey}};
   EXPECT_EQ(ViewerKeyRedirect(request, kKey).headers[0].second, "/api/sessions/s%201");

@@ -15,6 +15,7 @@
 #include "absl/time/clock.h"
 #include "client/web/http_server.h"
 #include "client/web/run_view.h"
+#include "client/web/viewer_key.h"
 #include "core/io/draco_codec.h"
 #include "core/sampling/implicit_surfaces.h"
 #include "tests/client/web/viewer_test_support.h"
@@ -126,7 +127,7 @@ TEST_F(ViewerServiceTest, AKeyedViewerAnswersOnlyRequestsThatBringTheKey) {
   EXPECT_EQ(opened.status, 303);
   EXPECT_EQ(opened.Header("location"), "/?session=" + id);
   const std::string cookie = opened.Header("set-cookie");
-  EXPECT_THAT(cookie, HasSubstr("neuralmesh_view_key=" + key + ";"));
+  EXPECT_THAT(cookie, HasSubstr(ViewerKeyCookieName(key) + "=" + key + ";"));
   const std::string with_cookie =
       absl::StrCat("GET /api/sessions HTTP/1.1\r\nHost: 127.0.0.1\r\nCookie: ",
                    cookie.substr(0, cookie.find(';')), "\r\n\r\n");

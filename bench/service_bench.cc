@@ -393,7 +393,7 @@ int main(int argc, char** argv) {
   if (!absl::GetFlag(FLAGS_only_lods)) {
     const std::string ingested = MeasureIngest(*service);
     if (!options.state_dir.empty()) {
-      // A restart: the new server restores the ingested session before it listens.
+      // A restart: the new server listens at once and restores the ingested session meanwhile.
       (*server)->Shutdown();
       server->reset();
       const absl::Time start = absl::Now();
@@ -403,13 +403,12 @@ int main(int argc, char** argv) {
         return 1;
       }
       const double up_seconds = absl::ToDoubleSeconds(absl::Now() - start);
-      const server::RestoreReport& restored = (*server)->restored();
+      const server::RestoreReport restored = (*server)->WaitForRestore();
       const double restore_seconds = absl::ToDoubleSeconds(restored.took);
-      std::printf("restart: %zu session of %zu points restored in %.3f s (%.1f M points/s), "
-                  "the server up in %.3f s\n",
-                  restored.sessions, restored.points, restore_seconds,
-                  restore_seconds > 0 ? restored.points / restore_seconds / 1e6 : 0.0,
-                  up_seconds);
+      std::printf("restart: the server up in %.3f s; %zu session of %zu points restored in "
+                  "%.3f s (%.1f M points/s) while it answered\n",
+                  up_seconds, restored.sessions, restored.points, restore_seconds,
+                  restore_seconds > 0 ? restored.points / restore_seconds / 1e6 : 0.0);
       service = Connect(**server);
     }
     Delete(*service, ingested);

@@ -156,4 +156,13 @@ absl::StatusOr<v1::Session> FinishReconnecting(ReconstructionClient& client,
   }
 }
 
+absl::StatusOr<v1::Session> GetSessionReconnecting(ReconstructionClient& client,
+                                                  const std::string& session_id,
+                                                  const ReconnectOptions& options) {
+  absl::StatusOr<v1::Session> session = client.GetSession(session_id);
+  if (session.ok()) return session;
+  Reconnection reconnection(client, session_id, options);
+  return reconnection.Recover(session.status());
+}
+
 }  // namespace neuralmesh::client

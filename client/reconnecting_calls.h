@@ -8,6 +8,8 @@
 // - a watch after the last update it delivered (latest wins: updates published and superseded
 //   meanwhile are skipped, as for any slow watcher; the final mesh is never skipped);
 // - a finish, unless the session is finishing or finished already (the answer was lost).
+// A server that restarted on its state directory answers UNAVAILABLE for a session it is
+// still restoring: these wait for that too.
 //
 // They give up when `give_up_after` passes without the call getting any further, with the last
 // UNAVAILABLE and a message that says so. Any other status ends them at once, as CancelCalls
@@ -60,6 +62,12 @@ absl::Status WatchReconnecting(ReconstructionClient& client, const std::string& 
 absl::StatusOr<v1::Session> FinishReconnecting(ReconstructionClient& client,
                                                const std::string& session_id,
                                                const ReconnectOptions& options);
+
+// GetSession that asks again while the server is out of reach, or answers that it is still
+// restoring the session after a restart (UNAVAILABLE as well).
+absl::StatusOr<v1::Session> GetSessionReconnecting(ReconstructionClient& client,
+                                                  const std::string& session_id,
+                                                  const ReconnectOptions& options);
 
 }  // namespace neuralmesh::client
 

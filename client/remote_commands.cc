@@ -125,7 +125,12 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     NM_ASSIGN_OR_RETURN(session, client->CreateSession(
                                      config, stem, start_mesh ? &*start_mesh : nullptr));
   } else {
-    NM_ASSIGN_OR_RETURN(session, client->GetSession(options.resume_session));
+    // Right after a restart the server may still be restoring the session.
+    ReconnectOptions reconnect;
+    reconnect.give_up_after = options.reconnect_for;
+    reconnect.notify = [&err](const std::string& notice) { err << notice << "\n"; };
+    NM_ASSIGN_OR_RETURN(session,
+                        GetSessionReconnecting(*client, options.resume_session, reconnect));
     if (session.state() != v1::SESSION_STATE_COLLECTING &&
         session.state() != v1::SESSION_STATE_LEARNING) {
       const bool finishing = session.state() == v1::SESSION_STATE_FINISHING ||

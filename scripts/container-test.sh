@@ -312,7 +312,15 @@ say "The server shut down gracefully (exit status 0)"
 step "Starting the container again: the finished session comes back from its state volume"
 podman start "${CONTAINER}" >/dev/null || fail "podman start"
 wait_serving
-"${CLI}" sessions --server "${ADDRESS}" >"${OUT_DIR}/sessions-after-restart.out" 2>&1 \
+# The server answers while it restores its sessions; until then a listing is UNAVAILABLE.
+for _ in $(seq 1 30); do
+  if "${CLI}" sessions --server "${ADDRESS}" >"${OUT_DIR}/sessions-after-restart.out" 2>&1; then
+    break
+  fi
+  grep -q "restoring its sessions" "${OUT_DIR}/sessions-after-restart.out" || break
+  sleep 1
+done
+grep -q "^session " "${OUT_DIR}/sessions-after-restart.out" \
   || fail "neuralmesh sessions: $(tail -n 3 "${OUT_DIR}/sessions-after-restart.out")"
 cat "${OUT_DIR}/sessions-after-restart.out" >&2
 SESSION_ID=$(awk '$1 ~ /^s-/ && $3 == "finished" {print $1}' "${OUT_DIR}/sessions-after-restart.out")

@@ -73,7 +73,8 @@ ABSL_FLAG(std::string, access_tokens_file, "",
 ABSL_FLAG(std::string, state_dir, "",
           "Directory in which every session is kept (its settings, state, points, latest "
           "mesh and the learner's mesh at its latest milestone or checkpoint_interval) and from "
-          "which a server started again restores them: uploads and watches go on where they "
+          "which a server started again restores them while it answers (calls on a session "
+          "get UNAVAILABLE until it is back): uploads and watches go on where they "
           "were, and sessions that were learning learn on from that mesh. "
           "One server at a time uses a directory. Empty: sessions live in memory and a "
           "restart loses them.");
@@ -284,15 +285,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "neuralmesh-server: %s\n", server.status().ToString().c_str());
     return 1;
   }
-  if (!options.state_dir.empty()) {
-    const neuralmesh::server::RestoreReport& restored = (*server)->restored();
-    for (const std::string& problem : restored.problems) {
-      std::fprintf(stderr, "neuralmesh-server: --state_dir: %s\n", problem.c_str());
-    }
-    std::printf("neuralmesh-server: %zu sessions (%zu points) restored from %s in %.2f s\n",
-                restored.sessions, restored.points, options.state_dir.c_str(),
-                absl::ToDoubleSeconds(restored.took));
-  }
   const neuralmesh::server::ServerSecurity& secured = options.security;
   std::printf("neuralmesh-server listening on %s:%d (%d worker threads; %s%s)\n",
               absl::GetFlag(FLAGS_host).c_str(), (*server)->port(), options.worker_threads,
@@ -309,6 +301,20 @@ int main(int argc, char** argv) {
                         .c_str()
                   : absl::StrCat(", ", secured.access_tokens.size(), " access tokens").c_str());
   std::fflush(stdout);
+  // The stored sessions are restored while the server answers; the report comes when it is done.
+  std::thread restore_reporter;
+  if (!options.state_dir.empty()) {
+    restore_reporter = std::thread([&server, &options] {
+      const neuralmesh::server::RestoreReport restored = (*server)->WaitForRestore();
+      for (const std::string& problem : restored.problems) {
+        std::fprintf(stderr, "neuralmesh-server: --state_dir: %s\n", problem.c_str());
+      }
+      std::printf("neuralmesh-server: %zu sessions (%zu points) restored from %s in %.2f s\n",
+                  restored.sessions, restored.points, options.state_dir.c_str(),
+                  absl::ToDoubleSeconds(restored.took));
+      std::fflush(stdout);
+    });
+  }
 
   int signal_number = 0;
   while (sigwait(&signals, &signal_number) == 0 && signal_number == SIGHUP) {
@@ -319,6 +325,7 @@ int main(int argc, char** argv) {
               signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
   std::fflush(stdout);
   (*server)->Shutdown(absl::GetFlag(FLAGS_shutdown_grace));
+  if (restore_reporter.joinable()) restore_reporter.join();  // Shutdown ends the restore.
   server->reset();
   std::printf("neuralmesh-server: stopped\n");
   return 0;

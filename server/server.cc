@@ -68,7 +68,9 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
       options.limits, server->pool_.get(), server->encoder_.get(),
       options.event_sink ? std::make_shared<EventLog>(options.event_sink) : nullptr,
       server->store_.get());
-  server->restored_ = server->manager_->RestoreStored();
+  // Stored sessions are restored while the server takes calls (calls on them get UNAVAILABLE
+  // until then): a large state directory does not hold up the start.
+  server->manager_->StartRestore();
   server->service_ = std::make_unique<ReconstructionService>(
       server->manager_.get(), server->reactors_.get(), server->filter_.get());
 

@@ -94,8 +94,10 @@ class ReconstructionServer {
   absl::Status ReplaceTls(const ServerTls& tls);
 
   SessionManager& sessions() { return *manager_; }
-  // What Start restored from options.state_dir (nothing without one).
-  const RestoreReport& restored() const { return restored_; }
+  // Blocks until the sessions of options.state_dir are restored (at once without one), and
+  // returns what restoring found. Start returns before, and the server answers meanwhile
+  // (SessionManager::StartRestore).
+  RestoreReport WaitForRestore() const { return manager_->WaitForRestore(); }
   ReactorRegistry& reactors() { return *reactors_; }
 
  private:
@@ -108,7 +110,6 @@ class ReconstructionServer {
   std::unique_ptr<ReactorRegistry> reactors_;
   std::unique_ptr<SessionStore> store_;  // Null without a state directory; outlives manager_.
   std::unique_ptr<SessionManager> manager_;
-  RestoreReport restored_;
   std::unique_ptr<ReconstructionService> service_;
   std::shared_ptr<AccessTokenChecker> token_checker_;  // Null without access tokens.
   std::shared_ptr<ServerTlsIdentity> tls_identity_;    // Null without TLS; outlives server_.

@@ -86,7 +86,7 @@ std::string SessionManager::NewIdLocked() {
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
     z ^= z >> 31;
     std::string id = absl::StrFormat("s-%016x", z);
-    if (sessions_.count(id) == 0) return id;
+    if (sessions_.count(id) == 0 && unrestored_.count(id) == 0) return id;
   }
 }
 
@@ -104,16 +104,13 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(
   {
     absl::MutexLock lock(&mu_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
-    if (sessions_.size() >= limits_.max_sessions) {
+    if (HeldLocked("") >= limits_.max_sessions) {
       return absl::ResourceExhaustedError(absl::StrCat(
           "the server holds its maximum of ", limits_.max_sessions,
           " sessions; delete finished or cancelled ones first"));
     }
     if (!owner.empty() && limits_.max_sessions_per_client > 0) {
-      const size_t held = std::count_if(sessions_.begin(), sessions_.end(), [&](const auto& s) {
-        return s.second->owner() == owner;
-      });
-      if (held >= limits_.max_sessions_per_client) {
+      if (HeldLocked(owner) >= limits_.max_sessions_per_client) {
         return absl::ResourceExhaustedError(absl::StrCat(
             "client ", owner, " holds its maximum of ", limits_.max_sessions_per_client,
             " sessions; delete finished or cancelled ones first"));
@@ -161,6 +158,7 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Get(absl::string_view i
   if (shutdown_) return absl::UnavailableError("the server is shutting down");
   auto it = sessions_.find(std::string(id));
   if (it == sessions_.end()) {
+    if (unrestored_.count(std::string(id)) > 0) return StillRestoring(id);
     return UnknownSession(id);
   }
   // Touched under the lock, so that the reaper, which checks idleness again under it before it
@@ -172,6 +170,12 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Get(absl::string_view i
 absl::StatusOr<std::vector<std::shared_ptr<Session>>> SessionManager::List() const {
   absl::MutexLock lock(&mu_);
   if (shutdown_) return absl::UnavailableError("the server is shutting down");
+  if (!unrestored_.empty()) {
+    return absl::UnavailableError(absl::StrCat(
+        "the server is restoring its sessions after a restart (",
+        stored_sessions_ - unrestored_.size(), " of ", stored_sessions_,
+        " done); try again in a moment"));
+  }
   std::vector<std::shared_ptr<Session>> out;
   out.reserve(order_.size());
   for (const auto& [index, id] : order_) out.push_back(sessions_.at(id));
@@ -195,6 +199,7 @@ absl::Status SessionManager::DeleteUnlessActive(absl::string_view id,
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
     auto it = sessions_.find(std::string(id));
     if (it == sessions_.end()) {
+      if (unrestored_.count(std::string(id)) > 0) return StillRestoring(id);
       return UnknownSession(id);
     }
     if (idle_at.has_value() && !it->second->IdleSince(*idle_at, limits_.idle_timeout)) {
@@ -254,26 +259,85 @@ void SessionManager::ReaperLoop() {
   }
 }
 
-RestoreReport SessionManager::RestoreStored() {
-  RestoreReport report;
-  if (store_ == nullptr) return report;
+size_t SessionManager::HeldLocked(absl::string_view owner) const {
+  if (owner.empty()) return sessions_.size() + unrestored_.size();
+  size_t held = 0;
+  for (const auto& [id, session] : sessions_) held += session->owner() == owner;
+  for (const auto& [id, stored] : unrestored_) held += stored.owner == owner;
+  return held;
+}
+
+absl::Status SessionManager::StillRestoring(absl::string_view id) const {
+  return absl::UnavailableError(absl::StrCat(
+      "session ", QuotedSessionId(id), " is being restored after a restart of the server (",
+      stored_sessions_ - unrestored_.size(), " of ", stored_sessions_,
+      " sessions done); try again in a moment"));
+}
+
+void SessionManager::StartRestore(std::function<void(const std::string& id)> before_each) {
+  if (store_ == nullptr) return;
   const absl::Time start = absl::Now();
-  for (const StoredSessionFiles& files : store_->List(&report.problems)) {
-    std::shared_ptr<Session> session = RestoreSession(
-        files, *store_, limits_.max_points_per_session, pool_, encoder_, log_, report.problems);
-    if (session == nullptr) continue;
+  std::vector<std::string> problems;
+  std::vector<StoredSessionFiles> stored = store_->List(&problems);
+  absl::MutexLock lock(&mu_);
+  if (shutdown_ || restoring_ || restorer_.joinable()) return;
+  restore_report_.problems = std::move(problems);
+  restore_report_.took = absl::Now() - start;
+  for (const StoredSessionFiles& files : stored) {
+    unrestored_[files.stored.session_id()] = {files.stored.owner(), created_++};
+  }
+  stored_sessions_ = unrestored_.size();
+  restoring_ = true;
+  restorer_ = std::thread([this, stored = std::move(stored),
+                           before_each = std::move(before_each)]() mutable {
+    RestoreLoop(std::move(stored), std::move(before_each));
+  });
+}
+
+void SessionManager::RestoreLoop(std::vector<StoredSessionFiles> stored,
+                                 std::function<void(const std::string& id)> before_each) {
+  const absl::Time start = absl::Now();
+  for (const StoredSessionFiles& files : stored) {
+    const std::string& id = files.stored.session_id();
+    if (before_each) before_each(id);
+    std::vector<std::string> problems;
+    std::shared_ptr<Session> session =
+        stop_restoring_.load() ? nullptr
+                               : RestoreSession(files, *store_, limits_.max_points_per_session,
+                                                pool_, encoder_, log_, problems, &stop_restoring_);
     absl::MutexLock lock(&mu_);
     if (shutdown_) {
-      session->Terminate(absl::UnavailableError("the server is shutting down"));
+      // What Shutdown stopped stays on disk as it was, for the next start.
+      if (session != nullptr) {
+        session->Terminate(absl::UnavailableError("the server is shutting down"));
+      }
       break;
     }
-    sessions_.emplace(session->id(), session);
-    order_.emplace(created_++, session->id());
-    ++report.sessions;
-    report.points += session->points_received();
+    uint64_t order = 0;
+    if (const auto unrestored = unrestored_.find(id); unrestored != unrestored_.end()) {
+      order = unrestored->second.order;
+      unrestored_.erase(unrestored);
+    } else {  // Not listed twice by the store; kept safe all the same.
+      order = created_++;
+    }
+    for (std::string& problem : problems) restore_report_.problems.push_back(std::move(problem));
+    if (session == nullptr) continue;
+    sessions_.emplace(id, session);
+    order_.emplace(order, id);
+    ++restore_report_.sessions;
+    restore_report_.points += session->points_received();
   }
-  report.took = absl::Now() - start;
-  return report;
+  absl::MutexLock lock(&mu_);
+  restore_report_.took += absl::Now() - start;
+  unrestored_.clear();
+  restoring_ = false;
+}
+
+RestoreReport SessionManager::WaitForRestore() const {
+  absl::MutexLock lock(&mu_);
+  auto done = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return !restoring_; };
+  mu_.Await(absl::Condition(&done));
+  return restore_report_;
 }
 
 void SessionManager::Shutdown(const absl::Status& status) {
@@ -285,6 +349,8 @@ void SessionManager::Shutdown(const absl::Status& status) {
     sessions.swap(sessions_);
     order_.clear();
   }
+  stop_restoring_ = true;
+  if (restorer_.joinable()) restorer_.join();
   if (reaper_.joinable()) reaper_.join();
   for (auto& [id, session] : sessions) session->Terminate(status);
 }

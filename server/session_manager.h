@@ -3,8 +3,10 @@
 #ifndef NEURALMESH_SERVER_SESSION_MANAGER_H_
 #define NEURALMESH_SERVER_SESSION_MANAGER_H_
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -42,7 +44,7 @@ struct SessionLimits {
   absl::Duration idle_timeout = absl::Minutes(30);
 };
 
-// What RestoreStored found in the state directory.
+// What restoring the sessions of the state directory found (SessionManager::StartRestore).
 struct RestoreReport {
   size_t sessions = 0;  // Restored, in any state.
   size_t points = 0;    // Their points, taken again.
@@ -108,13 +110,23 @@ class SessionManager {
   // used between ReapIdle's listing and its deletion stays. Otherwise as Delete.
   absl::Status DeleteIfIdle(absl::string_view id, absl::Time idle_at) ABSL_LOCKS_EXCLUDED(mu_);
 
-  // Restores the sessions of the store (none without one), oldest first, before any other
-  // call: each takes its batches again and goes on from its stored state (session.h). Limits
-  // apply as at creation, except max_sessions, which restored sessions may exceed (creation
-  // waits until they are deleted). A session whose configuration no longer passes the
-  // limits stays on disk unrestored; one whose batches no longer fit them is restored as
-  // failed, its files unchanged.
-  RestoreReport RestoreStored() ABSL_LOCKS_EXCLUDED(mu_);
+  // Starts restoring the sessions of the store (none without one) on a thread of its own,
+  // oldest first, and returns once it knows their ids; call it once, before the server takes
+  // calls. Each session takes its batches again and goes on from its stored state (session.h).
+  // Until a session is restored, calls on it (Get, Delete) get UNAVAILABLE saying so, and List
+  // gets UNAVAILABLE until every one is: a client tries again, as after a lost connection.
+  // Sessions can be created meanwhile; stored sessions keep their places before them in List
+  // and count toward the limits as restored ones do. Limits apply as at creation, except
+  // max_sessions, which restored sessions may exceed (creation waits until they are deleted).
+  // A session whose configuration no longer passes the limits stays on disk unrestored; one
+  // whose batches no longer fit them is restored as failed, its files unchanged.
+  // `before_each`, when set, runs on the restoring thread before each session, with its id.
+  void StartRestore(std::function<void(const std::string& id)> before_each = nullptr)
+      ABSL_LOCKS_EXCLUDED(mu_);
+
+  // Blocks until the restore StartRestore began has ended (at once when none was begun, or
+  // after Shutdown stopped it), and returns what it found.
+  RestoreReport WaitForRestore() const ABSL_LOCKS_EXCLUDED(mu_);
 
   // Stops the reaper and terminates every session with `status` (their streams end with it).
   // Idempotent.
@@ -128,6 +140,13 @@ class SessionManager {
   absl::Status DeleteUnlessActive(absl::string_view id, std::optional<absl::Time> idle_at)
       ABSL_LOCKS_EXCLUDED(mu_);
   std::string NewIdLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void RestoreLoop(std::vector<StoredSessionFiles> stored,
+                   std::function<void(const std::string& id)> before_each)
+      ABSL_LOCKS_EXCLUDED(mu_);
+  // UNAVAILABLE saying that session `id` is still being restored.
+  absl::Status StillRestoring(absl::string_view id) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Sessions held now and still to be restored, of `owner` alone when not empty.
+  size_t HeldLocked(absl::string_view owner) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 
   const SessionLimits limits_;
   WorkerPool* const pool_;
@@ -143,6 +162,18 @@ class SessionManager {
   std::map<std::string, std::shared_ptr<Session>> sessions_ ABSL_GUARDED_BY(mu_);
   std::map<uint64_t, std::string> order_ ABSL_GUARDED_BY(mu_);
   std::thread reaper_;
+
+  // Stored sessions not restored yet, by id: their owners and their places in order_.
+  struct Unrestored {
+    std::string owner;
+    uint64_t order = 0;
+  };
+  std::map<std::string, Unrestored> unrestored_ ABSL_GUARDED_BY(mu_);
+  size_t stored_sessions_ ABSL_GUARDED_BY(mu_) = 0;  // Found by StartRestore.
+  bool restoring_ ABSL_GUARDED_BY(mu_) = false;
+  RestoreReport restore_report_ ABSL_GUARDED_BY(mu_);
+  std::atomic<bool> stop_restoring_{false};  // Set by Shutdown: a journal stops being read.
+  std::thread restorer_;
 };
 
 }  // namespace neuralmesh::server

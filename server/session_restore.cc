@@ -24,11 +24,15 @@ struct Replay {
 // point limit), the rest are only read, to find where the whole records end. A missing journal
 // is an empty one (a crash right after the session was created).
 absl::StatusOr<Replay> ReplayJournal(const std::string& path, Session& session,
-                                     std::vector<std::string>& problems) {
+                                     std::vector<std::string>& problems,
+                                     const std::atomic<bool>* stop) {
   Replay replay;
   std::error_code error;
   if (!std::filesystem::exists(path, error)) return replay;
   absl::StatusOr<JournalReadResult> read = ReadPointsJournal(path, [&](const PointCloud& batch) {
+    if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
+      return absl::CancelledError("the server is shutting down");
+    }
     if (!replay.status.ok()) return absl::OkStatus();
     if (absl::Status taken = session.ReplayBatch(batch); !taken.ok()) {
       replay.status = absl::Status(taken.code(), absl::StrCat("batch ", replay.batches + 1,
@@ -57,7 +61,8 @@ std::string StateName(v1::SessionState state) {
 std::shared_ptr<Session> RestoreSession(const StoredSessionFiles& files, SessionStore& store,
                                         size_t max_points_per_session, WorkerPool* pool,
                                         Executor* encoder, std::shared_ptr<EventLog> log,
-                                        std::vector<std::string>& problems) {
+                                        std::vector<std::string>& problems,
+                                        const std::atomic<bool>* stop) {
   const storage::v1::StoredSession& stored = files.stored;
   const std::string& id = stored.session_id();
   auto unrestored = [&](const absl::Status& status) {
@@ -74,7 +79,7 @@ std::shared_ptr<Session> RestoreSession(const StoredSessionFiles& files, Session
                                            max_points_per_session, pool, encoder, log,
                                            stored.owner(),
                                            absl::FromUnixMicros(stored.create_time_us()));
-  absl::StatusOr<Replay> replay = ReplayJournal(files.journal_path, *session, problems);
+  absl::StatusOr<Replay> replay = ReplayJournal(files.journal_path, *session, problems, stop);
   if (!replay.ok()) return unrestored(replay.status());
 
   v1::SessionState state = stored.state();

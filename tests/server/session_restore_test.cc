@@ -91,6 +91,9 @@ class SessionRestoreTest : public ::testing::Test {
         ReconstructionServer::Start(options);
     ASSERT_TRUE(server.ok()) << server.status();
     server_ = *std::move(server);
+    // Calls on a session get UNAVAILABLE until it is restored (SessionManager::StartRestore,
+    // session_manager_restore_test.cc): these tests look at what comes after.
+    server_->WaitForRestore();
     service_ = testing::InProcessService(*server_);
   }
 
@@ -118,9 +121,9 @@ TEST_F(SessionRestoreTest, AnUploadGoesOnWhereItWasAndEndsOnTheSphere) {
   ASSERT_GT(before.latest_sequence(), 0u);
 
   Restart();
-  EXPECT_EQ(server_->restored().sessions, 1u);
-  EXPECT_EQ(server_->restored().points, 15000u);
-  EXPECT_TRUE(server_->restored().problems.empty());
+  EXPECT_EQ(server_->WaitForRestore().sessions, 1u);
+  EXPECT_EQ(server_->WaitForRestore().points, 15000u);
+  EXPECT_TRUE(server_->WaitForRestore().problems.empty());
   EXPECT_FALSE(events_.Await("restored after a restart: 15000 points in 3 batches").empty());
   grpc::Status status;
   const v1::Session after = GetSession(*service_, id, &status);
@@ -211,7 +214,7 @@ TEST_F(SessionRestoreTest, LearningGoesOnFromTheLatestMilestonesMesh) {
   ASSERT_EQ(checkpoint.mesh().faces().size(), 3996u * 12) << "a closed mesh of 2,000 vertices";
 
   Restart();
-  EXPECT_TRUE(server_->restored().problems.empty());
+  EXPECT_TRUE(server_->WaitForRestore().problems.empty());
   EXPECT_FALSE(events_.Await("learner checkpoint of 2000 vertices").empty());
   const v1::Session restored = GetSession(*service_, id);
   EXPECT_GE(restored.learning().basic_steps(), steps_at_checkpoint)
@@ -303,11 +306,11 @@ TEST_F(SessionRestoreTest, ACheckpointThatCannotBeUsedMeansLearningFromTheInitia
       << fin.SerializeAsString();
 
   Restart();
-  ASSERT_EQ(server_->restored().problems.size(), 1u);
-  EXPECT_TRUE(absl::StrContains(server_->restored().problems[0],
+  ASSERT_EQ(server_->WaitForRestore().problems.size(), 1u);
+  EXPECT_TRUE(absl::StrContains(server_->WaitForRestore().problems[0],
                                 absl::StrCat("session ", ids[0], ": its learner checkpoint "
                                              "cannot be used (it is not a learner checkpoint)")))
-      << server_->restored().problems[0];
+      << server_->WaitForRestore().problems[0];
   EXPECT_FALSE(events_.Await("cannot learn on from the stored mesh (face 2").empty());
   for (const std::string& id : ids) {
     ASSERT_TRUE(testing::Finish(*service_, id).ok());
@@ -380,7 +383,7 @@ TEST_F(SessionRestoreTest, EndedSessionsComeBackAsTheyEndedAndDeletedOnesDoNot) 
   EXPECT_FALSE(std::filesystem::exists(SessionDirectory(deleted)));
 
   Restart();
-  EXPECT_EQ(server_->restored().sessions, 2u);
+  EXPECT_EQ(server_->WaitForRestore().sessions, 2u);
   grpc::ClientContext context;
   v1::ListSessionsResponse list;
   ASSERT_TRUE(service_->ListSessions(&context, v1::ListSessionsRequest(), &list).ok());
@@ -419,7 +422,7 @@ TEST_F(SessionRestoreTest, EndedSessionsComeBackAsTheyEndedAndDeletedOnesDoNot) 
   ASSERT_TRUE(testing::Delete(*service_, cancelled).ok());
   EXPECT_FALSE(std::filesystem::exists(SessionDirectory(cancelled)));
   Restart();
-  EXPECT_EQ(server_->restored().sessions, 1u);
+  EXPECT_EQ(server_->WaitForRestore().sessions, 1u);
 }
 
 TEST_F(SessionRestoreTest, OutlierVerdictsComeOutAsBefore) {
@@ -468,7 +471,7 @@ TEST_F(SessionRestoreTest, PointsBeyondANewLimitFailTheSessionAndKeepItsFiles) {
   EXPECT_TRUE(absl::StrContains(failed.error(), "restoring it after a restart failed at batch 3"))
       << failed.error();
   EXPECT_EQ(failed.learning().points_received(), 5000u);
-  ASSERT_EQ(server_->restored().problems.size(), 1u);
+  ASSERT_EQ(server_->WaitForRestore().problems.size(), 1u);
   EXPECT_EQ(std::filesystem::file_size(SessionDirectory(id) + "/points.journal"), journal_bytes);
 
   // With the old limit back, the session is whole again.
@@ -492,15 +495,15 @@ TEST_F(SessionRestoreTest, ATornJournalTailIsCutOffAndTheUploadResumesBeforeIt) 
       << std::string("NMPB\x10\x00", 6);
 
   Restart();
-  ASSERT_EQ(server_->restored().problems.size(), 1u);
-  EXPECT_TRUE(absl::StrContains(server_->restored().problems[0], "torn record header"))
-      << server_->restored().problems[0];
+  ASSERT_EQ(server_->WaitForRestore().problems.size(), 1u);
+  EXPECT_TRUE(absl::StrContains(server_->WaitForRestore().problems[0], "torn record header"))
+      << server_->WaitForRestore().problems[0];
   const v1::Session after = GetSession(*service_, id);
   EXPECT_EQ(after.points_taken(), 6000u);
   ASSERT_TRUE(UploadFrom(*service_, id, cloud, 6000, 9000, 1, &response).ok());
 
   Restart();
-  EXPECT_TRUE(server_->restored().problems.empty());
+  EXPECT_TRUE(server_->WaitForRestore().problems.empty());
   EXPECT_EQ(GetSession(*service_, id).points_taken(), 9000u);
 }
 

@@ -25,7 +25,9 @@ std::unique_ptr<ReconstructionServer> StartOn(const std::string& state_dir) {
   absl::StatusOr<std::unique_ptr<ReconstructionServer>> server =
       ReconstructionServer::Start(options);
   EXPECT_TRUE(server.ok()) << server.status();
-  return server.ok() ? *std::move(server) : nullptr;
+  if (!server.ok()) return nullptr;
+  (*server)->WaitForRestore();
+  return *std::move(server);
 }
 
 TEST(SessionStoreConcurrentTest, ConcurrentUploadsDeletesAndFinishesComeBackAsAcknowledged) {
@@ -78,8 +80,8 @@ TEST(SessionStoreConcurrentTest, ConcurrentUploadsDeletesAndFinishesComeBackAsAc
 
   server = StartOn(state_dir);
   ASSERT_NE(server, nullptr);
-  EXPECT_TRUE(server->restored().problems.empty());
-  EXPECT_EQ(server->restored().sessions, 3u);
+  EXPECT_TRUE(server->WaitForRestore().problems.empty());
+  EXPECT_EQ(server->WaitForRestore().sessions, 3u);
   service = testing::InProcessService(*server);
   for (int i = 0; i < 3; ++i) {
     const v1::Session session = testing::GetSession(*service, ids[i]);

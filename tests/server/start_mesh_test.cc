@@ -210,6 +210,7 @@ TEST(StartMeshRestartTest, ARestartBeforeAnyMilestoneLearnsOnFromTheStartMesh) {
   server.reset();
 
   server = ReconstructionServer::Start(options).value();
+  server->WaitForRestore();
   service = testing::InProcessService(*server);
   EXPECT_FALSE(events.Await("learner checkpoint of 500 vertices").empty());
   v1::UploadPointsResponse response;

@@ -19,6 +19,7 @@
 #include "client/lod_plan.h"
 #include "client/progress_bar.h"
 #include "client/remote_commands.h"
+#include "client/session_commands.h"
 #include "client/web/run_view.h"
 #include "client/web/viewer_key.h"
 #include "core/analysis/statistical_outliers.h"
@@ -35,7 +36,8 @@ const neuralmesh::DracoOptions kDracoDefaults;
 // Output and size.
 ABSL_FLAG(std::string, output, "",
           "Local reconstruct: the mesh to write; the extension picks the format (.ply .obj .off "
-          ".stl .drc). LOD files go beside it as <stem>_lod<N><ext>.");
+          ".stl .drc). LOD files go beside it as <stem>_lod<N><ext>. get: where the session's "
+          "mesh goes.");
 ABSL_FLAG(uint64_t, vertices, 0,
           "Vertex count of the final mesh (met exactly). Required for a local reconstruct; with "
           "--server, 0 means one vertex per 2 points, at most 10000.");
@@ -159,6 +161,11 @@ ABSL_FLAG(absl::Duration, reconnect_for,
           "server is lost, counted from the last batch taken or mesh received (the upload goes "
           "on from the points the session has taken, the watch from its last mesh); 0: give up "
           "at once (reconstruct then prints the --resume command).");
+ABSL_FLAG(bool, final, false,
+          "get: the final mesh of a finished session instead of the latest mesh.");
+ABSL_FLAG(absl::Duration, wait, absl::ZeroDuration(),
+          "get: wait up to this long for the mesh to exist (a first mesh, or with --final the "
+          "final one); 0: it must exist now.");
 ABSL_FLAG(absl::Duration, connect_timeout, absl::Seconds(5),
           "How long to wait for the server to accept the connection.");
 ABSL_FLAG(bool, tls, false,
@@ -311,14 +318,18 @@ absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
   return o;
 }
 
-absl::StatusOr<absl::Duration> ReconnectForFromFlags() {
-  const absl::Duration reconnect_for = absl::GetFlag(FLAGS_reconnect_for);
-  if (reconnect_for < absl::ZeroDuration() || reconnect_for == absl::InfiniteDuration()) {
+// `value` of the duration flag --`name` when finite and not negative.
+absl::StatusOr<absl::Duration> FiniteDurationFlag(const char* name, absl::Duration value) {
+  if (value < absl::ZeroDuration() || value == absl::InfiniteDuration()) {
     return absl::InvalidArgumentError(
-        absl::StrCat("--reconnect_for must be a finite duration >= 0 (e.g. 60s, 5m), not ",
-                     absl::FormatDuration(reconnect_for)));
+        absl::StrCat("--", name, " must be a finite duration >= 0 (e.g. 60s, 5m), not ",
+                     absl::FormatDuration(value)));
   }
-  return reconnect_for;
+  return value;
+}
+
+absl::StatusOr<absl::Duration> ReconnectForFromFlags() {
+  return FiniteDurationFlag("reconnect_for", absl::GetFlag(FLAGS_reconnect_for));
 }
 
 // The flags of a command that connects to a server, and `flags`.
@@ -427,6 +438,27 @@ absl::Status Sessions(const ParsedArgs& args) {
                                          std::cout, connection);
 }
 
+absl::Status OnSession(neuralmesh::client::SessionAction action, const ParsedArgs& args) {
+  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "SESSION"));
+  neuralmesh::client::SessionActionOptions o;
+  o.session_id = args.positional[0];
+  o.server = absl::GetFlag(FLAGS_server);
+  NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
+  return neuralmesh::client::RunSessionAction(action, o, std::cout);
+}
+
+absl::Status Get(const ParsedArgs& args) {
+  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "SESSION"));
+  neuralmesh::client::GetMeshOptions o;
+  o.session_id = args.positional[0];
+  o.server = absl::GetFlag(FLAGS_server);
+  o.output = absl::GetFlag(FLAGS_output);
+  o.final = absl::GetFlag(FLAGS_final);
+  NM_ASSIGN_OR_RETURN(o.wait, FiniteDurationFlag("wait", absl::GetFlag(FLAGS_wait)));
+  NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
+  return neuralmesh::client::RunGetMesh(o, std::cout);
+}
+
 absl::Status View(const ParsedArgs& args) {
   NM_RETURN_IF_ERROR(ExpectPositional(args, 0, "no arguments"));
   neuralmesh::client::web::ViewOptions o;
@@ -496,6 +528,39 @@ std::vector<Subcommand> Commands() {
        "",
        WithConnectionFlags({"server", "json"}),
        Sessions},
+      {"get",
+       "get SESSION --server HOST:PORT -o OUTPUT [--final] [--wait D]",
+       "Saves a session's latest or final mesh.",
+       "Saves the latest mesh of a server session (with --final its final mesh) to OUTPUT:\n"
+       ".drc keeps the server's Draco bytes as they are; .ply .obj .off .stl are decoded.\n"
+       "Prints its figures.",
+       WithConnectionFlags({"server", "output", "final", "wait"}),
+       Get},
+      {"finish",
+       "finish SESSION --server HOST:PORT",
+       "Tells a server session that all its points have arrived.",
+       "The session learns on to its target vertex count and publishes the final mesh\n"
+       "(`watch` or `get --final --wait D` fetch it).",
+       WithConnectionFlags({"server"}),
+       [](const ParsedArgs& args) {
+         return OnSession(neuralmesh::client::SessionAction::kFinish, args);
+       }},
+      {"cancel",
+       "cancel SESSION --server HOST:PORT",
+       "Stops a server session's learning; its latest mesh stays.",
+       "",
+       WithConnectionFlags({"server"}),
+       [](const ParsedArgs& args) {
+         return OnSession(neuralmesh::client::SessionAction::kCancel, args);
+       }},
+      {"delete",
+       "delete SESSION --server HOST:PORT",
+       "Removes a server session, its meshes and its files.",
+       "",
+       WithConnectionFlags({"server"}),
+       [](const ParsedArgs& args) {
+         return OnSession(neuralmesh::client::SessionAction::kDelete, args);
+       }},
       {"view",
        "view --server HOST:PORT [--listen HOST:PORT] [--view_key_file FILE]",
        "Serves a live 3D viewer of the server's sessions to web browsers.",

@@ -32,12 +32,6 @@ constexpr size_t kDefaultMaxVertices = 10000;
 constexpr absl::Duration kTidyCancelTimeout = absl::Seconds(5);
 constexpr double kDefaultPointsPerVertex = 2;  // SessionConfig.points_per_vertex's default.
 
-absl::StatusOr<std::unique_ptr<ReconstructionClient>> ConnectTo(const std::string& server,
-                                                                const ClientOptions& options) {
-  if (server.empty()) return absl::InvalidArgumentError("--server HOST:PORT is required");
-  return ReconstructionClient::Connect(server, options);
-}
-
 BoundingBox BoundsOf(const PointCloud& cloud) {
   BoundingBox box;
   for (const Vec3f& p : cloud.positions) box.Extend(Vec3(p[0], p[1], p[2]));
@@ -66,6 +60,12 @@ absl::Status ExplainWatchEnd(const absl::Status& status, const std::string& sess
 }
 
 }  // namespace
+
+absl::StatusOr<std::unique_ptr<ReconstructionClient>> ConnectTo(const std::string& server,
+                                                                const ClientOptions& options) {
+  if (server.empty()) return absl::InvalidArgumentError("--server HOST:PORT is required");
+  return ReconstructionClient::Connect(server, options);
+}
 
 absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::ostream& out,
                                   std::ostream& err) {

@@ -1,16 +1,18 @@
 // The subcommands that talk to a neuralmesh-server: `reconstruct --server`, `watch` and
-// `sessions`.
+// `sessions` (those on one session are in session_commands.h).
 #ifndef NEURALMESH_CLIENT_REMOTE_COMMANDS_H_
 #define NEURALMESH_CLIENT_REMOTE_COMMANDS_H_
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "client/reconnecting_calls.h"
 #include "client/reconstruction_client.h"
@@ -19,6 +21,10 @@
 #include "core/learning/learner_options.h"
 
 namespace neuralmesh::client {
+
+// A client of `server` (host:port, --server); INVALID_ARGUMENT when it is empty.
+absl::StatusOr<std::unique_ptr<ReconstructionClient>> ConnectTo(const std::string& server,
+                                                                const ClientOptions& options);
 
 struct RemoteReconstructOptions {
   std::string input;         // A point cloud file or builtin:NAME.

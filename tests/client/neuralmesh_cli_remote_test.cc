@@ -17,6 +17,7 @@
 #include "client/inputs.h"
 #include "client/reconstruction_client.h"
 #include "core/learning/learner_options.h"
+#include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -347,6 +348,82 @@ TEST_F(RemoteCliTest, WatchingAFinishedSessionSavesItsFinalMesh) {
       RunNeuralmesh({"watch", id, "--server", server_->address(), "--out-dir", *dir_ + "/w"});
   ASSERT_EQ(watch.exit_code, 0) << watch.Describe();
   EXPECT_TRUE(std::filesystem::exists(*dir_ + "/w/" + id + ".drc")) << watch.Describe();
+}
+
+// get, finish, cancel and delete on sessions made through the client library: the latest
+// mesh while points arrive, the final one once `finish` has told the session that all have,
+// a cancelled session, and a deleted one that is gone.
+TEST_F(RemoteCliTest, SessionCommandsGetFinishCancelAndDelete) {
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
+      client::ReconstructionClient::Connect(server_->address());
+  ASSERT_TRUE(service.ok()) << service.status();
+  v1::SessionConfig config;
+  config.set_target_vertices(400);
+  const std::string id = (*service)->CreateSession(config, "managed").value().session_id();
+  const std::string address = server_->address();
+  const std::string out = *dir_ + "/managed";
+  std::filesystem::create_directories(out);
+
+  const RunResult too_early =
+      RunNeuralmesh({"get", id, "--server", address, "-o", out + "/early.ply"});
+  EXPECT_EQ(too_early.exit_code, 1) << too_early.Describe();
+  EXPECT_THAT(too_early.err, ::testing::HasSubstr("has published no mesh yet"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/early.ply"));
+
+  absl::StatusOr<PointCloud> cloud = client::LoadPointsForUpload("builtin:sphere", 4000, 5);
+  ASSERT_TRUE(cloud.ok()) << cloud.status();
+  ASSERT_TRUE((*service)->UploadPoints(id, *cloud, 1000).ok());
+  const RunResult latest = RunNeuralmesh(
+      {"get", id, "--server", address, "-o", out + "/latest.ply", "--wait", "30s"});
+  ASSERT_EQ(latest.exit_code, 0) << latest.Describe();
+  absl::StatusOr<TriangleMesh> latest_mesh = ReadMesh(out + "/latest.ply");
+  ASSERT_TRUE(latest_mesh.ok()) << latest_mesh.status();
+  EXPECT_GE(latest_mesh->positions.size(), 4u);
+  EXPECT_THAT(latest.out, ::testing::HasSubstr(out + "/latest.ply"));
+  const RunResult no_final =
+      RunNeuralmesh({"get", id, "--server", address, "--final", "-o", out + "/final.drc"});
+  EXPECT_EQ(no_final.exit_code, 1) << no_final.Describe();
+  EXPECT_THAT(no_final.err, ::testing::HasSubstr("has no final mesh"));
+
+  const RunResult finish = RunNeuralmesh({"finish", id, "--server", address});
+  ASSERT_EQ(finish.exit_code, 0) << finish.Describe();
+  EXPECT_THAT(finish.out, ::testing::HasSubstr("session " + id + ": finish"));
+  EXPECT_THAT(finish.out, ::testing::HasSubstr("4000 points"));
+  const RunResult final_mesh = RunNeuralmesh(
+      {"get", id, "--server", address, "--final", "--wait", "60s", "-o", out + "/final.drc"});
+  ASSERT_EQ(final_mesh.exit_code, 0) << final_mesh.Describe();
+  EXPECT_EQ(RowVertices(final_mesh.out, "final"), std::vector<uint64_t>{400}) << final_mesh.out;
+  EXPECT_LT(HausdorffToTheUnitSphere(out + "/final.drc"), 0.05);
+  const RunResult late_cancel = RunNeuralmesh({"cancel", id, "--server", address});
+  EXPECT_EQ(late_cancel.exit_code, 1) << late_cancel.Describe();
+  EXPECT_THAT(late_cancel.err, ::testing::HasSubstr("cannot be cancelled"));
+
+  const std::string other = (*service)->CreateSession(config, "dropped").value().session_id();
+  const RunResult cancel = RunNeuralmesh({"cancel", other, "--server", address});
+  ASSERT_EQ(cancel.exit_code, 0) << cancel.Describe();
+  EXPECT_THAT(cancel.out, ::testing::HasSubstr("session " + other + ": cancelled, 0 points"));
+  for (const std::string& gone : {id, other}) {
+    const RunResult deleted = RunNeuralmesh({"delete", gone, "--server", address});
+    ASSERT_EQ(deleted.exit_code, 0) << deleted.Describe();
+    EXPECT_EQ(deleted.out, "session " + gone + " deleted\n");
+    const RunResult after = RunNeuralmesh({"get", gone, "--server", address, "-o", out + "/x.drc"});
+    EXPECT_EQ(after.exit_code, 1) << after.Describe();
+    EXPECT_THAT(after.err, ::testing::HasSubstr("no session with id"));
+  }
+
+  const RunResult bad_format =
+      RunNeuralmesh({"get", id, "--server", address, "-o", out + "/mesh.txt"});
+  EXPECT_EQ(bad_format.exit_code, 1) << bad_format.Describe();
+  EXPECT_THAT(bad_format.err, ::testing::HasSubstr("use .drc, .ply, .obj, .off or .stl"));
+  const RunResult bad_wait =
+      RunNeuralmesh({"get", id, "--server", address, "-o", out + "/m.ply", "--wait", "-1s"});
+  EXPECT_EQ(bad_wait.exit_code, 1) << bad_wait.Describe();
+  EXPECT_THAT(bad_wait.err, ::testing::HasSubstr("--wait must be a finite duration >= 0"));
+  const RunResult no_session = RunNeuralmesh({"finish", "--server", address});
+  EXPECT_NE(no_session.exit_code, 0) << no_session.Describe();
+  const RunResult no_server = RunNeuralmesh({"delete", id});
+  EXPECT_EQ(no_server.exit_code, 1) << no_server.Describe();
+  EXPECT_THAT(no_server.err, ::testing::HasSubstr("--server HOST:PORT is required"));
 }
 
 TEST_F(RemoteCliTest, WatchingAnUnknownSessionFails) {

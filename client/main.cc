@@ -6,6 +6,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/flags/flag.h"
@@ -447,6 +448,18 @@ absl::Status OnSession(neuralmesh::client::SessionAction action, const ParsedArg
   return neuralmesh::client::RunSessionAction(action, o, std::cout);
 }
 
+// `neuralmesh NAME SESSION --server HOST:PORT`, which asks the server for `action`.
+Subcommand SessionActionCommand(const std::string& name, std::string summary,
+                                std::string description,
+                                neuralmesh::client::SessionAction action) {
+  return {name,
+          absl::StrCat(name, " SESSION --server HOST:PORT"),
+          std::move(summary),
+          std::move(description),
+          WithConnectionFlags({"server"}),
+          [action](const ParsedArgs& args) { return OnSession(action, args); }};
+}
+
 absl::Status Get(const ParsedArgs& args) {
   NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "SESSION"));
   neuralmesh::client::GetMeshOptions o;
@@ -536,31 +549,15 @@ std::vector<Subcommand> Commands() {
        "Prints its figures.",
        WithConnectionFlags({"server", "output", "final", "wait"}),
        Get},
-      {"finish",
-       "finish SESSION --server HOST:PORT",
-       "Tells a server session that all its points have arrived.",
-       "The session learns on to its target vertex count and publishes the final mesh\n"
-       "(`watch` or `get --final --wait D` fetch it).",
-       WithConnectionFlags({"server"}),
-       [](const ParsedArgs& args) {
-         return OnSession(neuralmesh::client::SessionAction::kFinish, args);
-       }},
-      {"cancel",
-       "cancel SESSION --server HOST:PORT",
-       "Stops a server session's learning; its latest mesh stays.",
-       "",
-       WithConnectionFlags({"server"}),
-       [](const ParsedArgs& args) {
-         return OnSession(neuralmesh::client::SessionAction::kCancel, args);
-       }},
-      {"delete",
-       "delete SESSION --server HOST:PORT",
-       "Removes a server session, its meshes and its files.",
-       "",
-       WithConnectionFlags({"server"}),
-       [](const ParsedArgs& args) {
-         return OnSession(neuralmesh::client::SessionAction::kDelete, args);
-       }},
+      SessionActionCommand(
+          "finish", "Tells a server session that all its points have arrived.",
+          "The session learns on to its target vertex count and publishes the final mesh\n"
+          "(`watch` or `get --final --wait D` fetch it).",
+          neuralmesh::client::SessionAction::kFinish),
+      SessionActionCommand("cancel", "Stops a server session's learning; its latest mesh stays.",
+                           "", neuralmesh::client::SessionAction::kCancel),
+      SessionActionCommand("delete", "Removes a server session, its meshes and its files.", "",
+                           neuralmesh::client::SessionAction::kDelete),
       {"view",
        "view --server HOST:PORT [--listen HOST:PORT] [--view_key_file FILE]",
        "Serves a live 3D viewer of the server's sessions to web browsers.",

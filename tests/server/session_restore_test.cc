@@ -92,7 +92,7 @@ class SessionRestoreTest : public ::testing::Test {
     ASSERT_TRUE(server.ok()) << server.status();
     server_ = *std::move(server);
     // Calls on a session get UNAVAILABLE until it is restored (SessionManager::StartRestore,
-    // session_manager_restore_test.cc): these tests look at what comes after.
+    // SessionManagerRestoreTest): these tests look at what comes after.
     server_->WaitForRestore();
     service_ = testing::InProcessService(*server_);
   }

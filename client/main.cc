@@ -169,6 +169,9 @@ ABSL_FLAG(absl::Duration, wait, absl::ZeroDuration(),
           "final one); 0: it must exist now.");
 ABSL_FLAG(absl::Duration, connect_timeout, absl::Seconds(5),
           "How long to wait for the server to accept the connection.");
+ABSL_FLAG(int, max_message_bytes, neuralmesh::client::ClientOptions().max_message_bytes,
+          "The largest message taken from the server (a mesh of about 2 bytes a vertex): as "
+          "neuralmesh-server's --max_message_bytes.");
 ABSL_FLAG(bool, tls, false,
           "Connect over TLS, checking the server's certificate against the system's CAs (or "
           "--tls_ca_file's).");
@@ -278,14 +281,19 @@ absl::StatusOr<neuralmesh::DracoOptions> DracoFromFlags() {
   return o;
 }
 
-constexpr const char* kConnectionFlags[] = {"connect_timeout", "tls",          "tls_ca_file",
-                                            "tls_cert_file",   "tls_key_file", "tls_server_name",
-                                            "access_token_file"};
+constexpr const char* kConnectionFlags[] = {
+    "connect_timeout", "tls",          "tls_ca_file",       "tls_cert_file",
+    "tls_key_file",    "tls_server_name", "access_token_file", "max_message_bytes"};
 
 // How to reach the server: --connect_timeout, TLS and the access token.
 absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
   neuralmesh::client::ClientOptions o;
   o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
+  o.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
+  if (o.max_message_bytes < 1) {
+    return absl::InvalidArgumentError(absl::StrCat("--max_message_bytes must be at least 1, not ",
+                                                   o.max_message_bytes));
+  }
   neuralmesh::client::ClientSecurity& security = o.security;
   struct FileFlag {
     const char* flag;

@@ -113,6 +113,7 @@ absl::StatusOr<std::unique_ptr<ReconstructionClient>> ReconstructionClient::Conn
   // minutes; a client that waits for its server to come back (AwaitSession) should notice
   // within seconds.
   args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, ToMillis(kMaxReconnectBackoff));
+  args.SetMaxReceiveMessageSize(options.max_message_bytes);
   if (!options.security.tls.server_name.empty()) {
     args.SetSslTargetNameOverride(options.security.tls.server_name);
   }

@@ -60,6 +60,10 @@ struct ClientOptions {
   // leaving them waiting forever. neuralmesh-server accepts pings up to once a second.
   absl::Duration keepalive_time = absl::Seconds(20);
   absl::Duration keepalive_timeout = absl::Seconds(10);
+  // The largest message the client takes, as neuralmesh-server's --max_message_bytes (whose
+  // default it shares). gRPC's own default, 4 MiB, would refuse the meshes of sessions past
+  // about two million vertices (Draco takes about 2 bytes a vertex).
+  int max_message_bytes = 64 << 20;
   // TLS and the access token of the channel that Connect opens (none: plaintext).
   ClientSecurity security;
 };

@@ -2,6 +2,8 @@
 // (started as a subprocess, port 0), and of the Reconstruct call on an in-process server.
 #include "client/reconstruction_client.h"
 
+#include <grpcpp/grpcpp.h>
+
 #include <cmath>
 #include <csignal>
 #include <cstring>
@@ -11,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "absl/synchronization/notification.h"
 #include "absl/time/clock.h"
 #include "core/io/draco_codec.h"
@@ -418,6 +421,54 @@ TEST(ReconstructionClientConnectTest, NoServerGivesUnavailable) {
   EXPECT_NE(client.status().message().find(address), absl::string_view::npos) << client.status();
   EXPECT_NE(client.status().message().find("Connection refused"), absl::string_view::npos)
       << "gRPC's reason is passed on: " << client.status();
+}
+
+// A server that answers GetMesh with `bytes` of Draco data, as one of a session of millions
+// of vertices would.
+class LargeMeshService final : public v1::ReconstructionService::Service {
+ public:
+  explicit LargeMeshService(size_t bytes) : bytes_(bytes) {}
+  grpc::Status GetMesh(grpc::ServerContext*, const v1::GetMeshRequest* request,
+                       v1::MeshUpdate* update) override {
+    update->set_session_id(request->session_id());
+    update->set_draco_mesh(std::string(bytes_, 'd'));
+    return grpc::Status::OK;
+  }
+
+ private:
+  const size_t bytes_;
+};
+
+// gRPC takes messages of at most 4 MiB by default; the client takes the server's 64 MiB, and
+// a lower limit of its own gives RESOURCE_EXHAUSTED.
+TEST(ReconstructionClientMessageSizeTest, MeshesLargerThanGrpcsDefaultLimitArrive) {
+  LargeMeshService service(6 << 20);
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+  builder.SetMaxSendMessageSize(64 << 20);
+  builder.RegisterService(&service);
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  ASSERT_NE(server, nullptr);
+  const std::string address = absl::StrCat("127.0.0.1:", port);
+
+  absl::StatusOr<std::unique_ptr<ReconstructionClient>> client =
+      ReconstructionClient::Connect(address);
+  ASSERT_TRUE(client.ok()) << client.status();
+  absl::StatusOr<v1::MeshUpdate> mesh =
+      (*client)->GetMesh("s-1", v1::MESH_VERSION_LATEST, false, absl::Seconds(30));
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->draco_mesh().size(), size_t{6} << 20);
+
+  ClientOptions small;
+  small.max_message_bytes = 1 << 20;
+  absl::StatusOr<std::unique_ptr<ReconstructionClient>> limited =
+      ReconstructionClient::Connect(address, small);
+  ASSERT_TRUE(limited.ok()) << limited.status();
+  const absl::Status refused =
+      (*limited)->GetMesh("s-1", v1::MESH_VERSION_LATEST, false, absl::Seconds(30)).status();
+  EXPECT_TRUE(absl::IsResourceExhausted(refused)) << refused;
+  server->Shutdown();
 }
 
 TEST(PackPointBatchTest, PacksLittleEndianFloatsOfTheRange) {

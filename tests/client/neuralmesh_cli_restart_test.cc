@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
@@ -65,8 +66,13 @@ TEST(RemoteCliRestartTest, AServerStartedAgainOnItsStateDirectoryLetsTheRunFinis
   std::unique_ptr<TestServer> again =
       TestServer::Start({"--state_dir=" + state_dir, "--port=" + port}, &error);
   ASSERT_NE(again, nullptr) << error;
-  EXPECT_THAT(again->Stdout(), ::testing::HasSubstr("1 sessions ("));
+  // It listens at once and reports the restore when it ends.
   const absl::Time restarted = absl::Now();
+  while (!absl::StrContains(again->Stdout(), "restored from") &&
+         absl::Now() - restarted < absl::Seconds(60)) {
+    usleep(10 * 1000);
+  }
+  EXPECT_THAT(again->Stdout(), ::testing::HasSubstr("1 sessions ("));
   while (run.Running() && absl::Now() - restarted < absl::Seconds(120)) usleep(50 * 1000);
   ASSERT_FALSE(run.Running()) << "the run did not end: " << run.Stderr();
   ASSERT_EQ(run.exit_code(), 0) << run.Stderr();

@@ -81,7 +81,9 @@ ViewerKeyCheck CheckViewerKey(const HttpRequest& request, absl::string_view key)
     return SameKey(it->second, key) ? ViewerKeyCheck::kGrantedFromUrl : ViewerKeyCheck::kRefused;
   }
   if (auto it = request.headers.find("cookie"); it != request.headers.end()) {
-    if (SameKey(CookieValue(it->second, ViewerKeyCookieName(key)), key)) return ViewerKeyCheck::kGranted;
+    if (SameKey(CookieValue(it->second, ViewerKeyCookieName(key)), key)) {
+      return ViewerKeyCheck::kGranted;
+    }
   }
   if (auto it = request.headers.find("authorization"); it != request.headers.end()) {
     absl::string_view value = it->second;

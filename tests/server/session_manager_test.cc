@@ -219,11 +219,13 @@ TEST_F(SessionManagerRestoreTest, SessionsAnswerUnavailableUntilRestoredAndNewOn
   const absl::Status second = manager.Get(stored[1]).status();
   EXPECT_TRUE(absl::IsUnavailable(second)) << second;
   EXPECT_THAT(second.message(),
-              ::testing::HasSubstr("is being restored after a restart of the server (1 of 2 sessions done)"));
+              ::testing::HasSubstr(
+                  "is being restored after a restart of the server (1 of 2 sessions done)"));
   EXPECT_TRUE(absl::IsUnavailable(manager.Delete(stored[1])));
   const absl::Status listed = manager.List().status();
   EXPECT_TRUE(absl::IsUnavailable(listed)) << listed;
-  EXPECT_THAT(listed.message(), ::testing::HasSubstr("restoring its sessions after a restart (1 of 2 done)"));
+  EXPECT_THAT(listed.message(),
+              ::testing::HasSubstr("restoring its sessions after a restart (1 of 2 done)"));
   EXPECT_TRUE(absl::IsNotFound(manager.Get("s-0000000000000000").status()));
 
   // The session still to be restored counts toward the limits: alice holds 2 of her 2, the

@@ -85,7 +85,8 @@ TEST(ViewerKeyTest, AKeyInTheUrlBecomesACookieAndTheUrlLosesIt) {
   EXPECT_EQ(response.headers[0].second, "/?note=a%20b%26c&session=s-1a2b");
   EXPECT_EQ(response.headers[1].first, "Set-Cookie");
   EXPECT_EQ(response.headers[1].second,
-            absl::StrCat(ViewerKeyCookieName(kKey), "=", kKey, "; HttpOnly; SameSite=Strict; Path=/"));
+            absl::StrCat(ViewerKeyCookieName(kKey), "=", kKey,
+                         "; HttpOnly; SameSite=Strict; Path=/"));
   request.path = "/api/sessions/s 1";
   request.query = {{"key", kKey}};
   EXPECT_EQ(ViewerKeyRedirect(request, kKey).headers[0].second, "/api/sessions/s%201");

@@ -157,10 +157,7 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Get(absl::string_view i
   absl::MutexLock lock(&mu_);
   if (shutdown_) return absl::UnavailableError("the server is shutting down");
   auto it = sessions_.find(std::string(id));
-  if (it == sessions_.end()) {
-    if (unrestored_.count(std::string(id)) > 0) return StillRestoring(id);
-    return UnknownSession(id);
-  }
+  if (it == sessions_.end()) return NotHeldLocked(id);
   // Touched under the lock, so that the reaper, which checks idleness again under it before it
   // deletes, never deletes a session a caller has just got.
   it->second->Touch();
@@ -171,10 +168,9 @@ absl::StatusOr<std::vector<std::shared_ptr<Session>>> SessionManager::List() con
   absl::MutexLock lock(&mu_);
   if (shutdown_) return absl::UnavailableError("the server is shutting down");
   if (!unrestored_.empty()) {
-    return absl::UnavailableError(absl::StrCat(
-        "the server is restoring its sessions after a restart (",
-        stored_sessions_ - unrestored_.size(), " of ", stored_sessions_,
-        " done); try again in a moment"));
+    return absl::UnavailableError(
+        absl::StrCat("the server is restoring its sessions after a restart (",
+                     RestoredOfStoredLocked(), " done); try again in a moment"));
   }
   std::vector<std::shared_ptr<Session>> out;
   out.reserve(order_.size());
@@ -198,10 +194,7 @@ absl::Status SessionManager::DeleteUnlessActive(absl::string_view id,
     absl::MutexLock lock(&mu_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
     auto it = sessions_.find(std::string(id));
-    if (it == sessions_.end()) {
-      if (unrestored_.count(std::string(id)) > 0) return StillRestoring(id);
-      return UnknownSession(id);
-    }
+    if (it == sessions_.end()) return NotHeldLocked(id);
     if (idle_at.has_value() && !it->second->IdleSince(*idle_at, limits_.idle_timeout)) {
       return absl::FailedPreconditionError(absl::StrCat("session ", id, " is active again"));
     }
@@ -267,11 +260,15 @@ size_t SessionManager::HeldLocked(absl::string_view owner) const {
   return held;
 }
 
-absl::Status SessionManager::StillRestoring(absl::string_view id) const {
+std::string SessionManager::RestoredOfStoredLocked() const {
+  return absl::StrCat(stored_sessions_ - unrestored_.size(), " of ", stored_sessions_);
+}
+
+absl::Status SessionManager::NotHeldLocked(absl::string_view id) const {
+  if (unrestored_.count(std::string(id)) == 0) return UnknownSession(id);
   return absl::UnavailableError(absl::StrCat(
       "session ", QuotedSessionId(id), " is being restored after a restart of the server (",
-      stored_sessions_ - unrestored_.size(), " of ", stored_sessions_,
-      " sessions done); try again in a moment"));
+      RestoredOfStoredLocked(), " sessions done); try again in a moment"));
 }
 
 void SessionManager::StartRestore(std::function<void(const std::string& id)> before_each) {
@@ -280,7 +277,7 @@ void SessionManager::StartRestore(std::function<void(const std::string& id)> bef
   std::vector<std::string> problems;
   std::vector<StoredSessionFiles> stored = store_->List(&problems);
   absl::MutexLock lock(&mu_);
-  if (shutdown_ || restoring_ || restorer_.joinable()) return;
+  if (shutdown_ || restorer_.joinable()) return;  // Stopped, or started already.
   restore_report_.problems = std::move(problems);
   restore_report_.took = absl::Now() - start;
   for (const StoredSessionFiles& files : stored) {

@@ -143,8 +143,11 @@ class SessionManager {
   void RestoreLoop(std::vector<StoredSessionFiles> stored,
                    std::function<void(const std::string& id)> before_each)
       ABSL_LOCKS_EXCLUDED(mu_);
-  // UNAVAILABLE saying that session `id` is still being restored.
-  absl::Status StillRestoring(absl::string_view id) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // The answer for an `id` that sessions_ lacks: UNAVAILABLE while it is still to be
+  // restored, NOT_FOUND otherwise.
+  absl::Status NotHeldLocked(absl::string_view id) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // "N of M": the stored sessions restored so far, of all.
+  std::string RestoredOfStoredLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // Sessions held now and still to be restored, of `owner` alone when not empty.
   size_t HeldLocked(absl::string_view owner) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 

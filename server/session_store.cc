@@ -176,7 +176,7 @@ absl::Status SessionRecord::WriteCheckpoint(const TriangleMesh& mesh,
   const absl::Status written = WriteTemporary(kCheckpointFile, checkpoint, /*durable=*/false);
   absl::MutexLock lock(&mu_);
   if (!CheckpointDueLocked(kind)) {  // Removed or ended meanwhile.
-    std::remove(absl::StrCat(directory_, "/", kCheckpointFile, ".new").c_str());
+    std::remove(TemporaryPath(kCheckpointFile).c_str());
     return absl::OkStatus();
   }
   NM_RETURN_IF_ERROR(written);
@@ -205,15 +205,19 @@ absl::Status SessionRecord::ReplaceFile(const std::string& name,
 absl::Status SessionRecord::WriteTemporary(const std::string& name,
                                            const google::protobuf::Message& message,
                                            bool durable) const {
-  const std::string temporary = absl::StrCat(directory_, "/", name, ".new");
+  const std::string temporary = TemporaryPath(name);
   NM_RETURN_IF_ERROR(WriteFileContents(temporary, message.SerializeAsString()));
   if (durable && sync_) return SyncPath(temporary);
   return absl::OkStatus();
 }
 
+std::string SessionRecord::TemporaryPath(const std::string& name) const {
+  return absl::StrCat(directory_, "/", name, ".new");
+}
+
 absl::Status SessionRecord::MoveTemporaryIntoPlace(const std::string& name, bool durable) {
   const std::string path = absl::StrCat(directory_, "/", name);
-  const std::string temporary = absl::StrCat(path, ".new");
+  const std::string temporary = TemporaryPath(name);
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
     const int error = errno;
     std::remove(temporary.c_str());

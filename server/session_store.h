@@ -89,6 +89,8 @@ class SessionRecord {
                               bool durable) const;
   absl::Status MoveTemporaryIntoPlace(const std::string& name, bool durable)
       ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Where the temporary file of `name` is written.
+  std::string TemporaryPath(const std::string& name) const;
 
   // Whether a checkpoint of `kind` is to be written now.
   bool CheckpointDueLocked(CheckpointKind kind) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);

@@ -121,9 +121,10 @@ TEST_F(SessionRestoreTest, AnUploadGoesOnWhereItWasAndEndsOnTheSphere) {
   ASSERT_GT(before.latest_sequence(), 0u);
 
   Restart();
-  EXPECT_EQ(server_->WaitForRestore().sessions, 1u);
-  EXPECT_EQ(server_->WaitForRestore().points, 15000u);
-  EXPECT_TRUE(server_->WaitForRestore().problems.empty());
+  const RestoreReport restored = server_->WaitForRestore();
+  EXPECT_EQ(restored.sessions, 1u);
+  EXPECT_EQ(restored.points, 15000u);
+  EXPECT_TRUE(restored.problems.empty());
   EXPECT_FALSE(events_.Await("restored after a restart: 15000 points in 3 batches").empty());
   grpc::Status status;
   const v1::Session after = GetSession(*service_, id, &status);
@@ -306,11 +307,12 @@ TEST_F(SessionRestoreTest, ACheckpointThatCannotBeUsedMeansLearningFromTheInitia
       << fin.SerializeAsString();
 
   Restart();
-  ASSERT_EQ(server_->WaitForRestore().problems.size(), 1u);
-  EXPECT_TRUE(absl::StrContains(server_->WaitForRestore().problems[0],
+  const std::vector<std::string> problems = server_->WaitForRestore().problems;
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_TRUE(absl::StrContains(problems[0],
                                 absl::StrCat("session ", ids[0], ": its learner checkpoint "
                                              "cannot be used (it is not a learner checkpoint)")))
-      << server_->WaitForRestore().problems[0];
+      << problems[0];
   EXPECT_FALSE(events_.Await("cannot learn on from the stored mesh (face 2").empty());
   for (const std::string& id : ids) {
     ASSERT_TRUE(testing::Finish(*service_, id).ok());
@@ -495,9 +497,9 @@ TEST_F(SessionRestoreTest, ATornJournalTailIsCutOffAndTheUploadResumesBeforeIt) 
       << std::string("NMPB\x10\x00", 6);
 
   Restart();
-  ASSERT_EQ(server_->WaitForRestore().problems.size(), 1u);
-  EXPECT_TRUE(absl::StrContains(server_->WaitForRestore().problems[0], "torn record header"))
-      << server_->WaitForRestore().problems[0];
+  const std::vector<std::string> problems = server_->WaitForRestore().problems;
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_TRUE(absl::StrContains(problems[0], "torn record header")) << problems[0];
   const v1::Session after = GetSession(*service_, id);
   EXPECT_EQ(after.points_taken(), 6000u);
   ASSERT_TRUE(UploadFrom(*service_, id, cloud, 6000, 9000, 1, &response).ok());

@@ -1,5 +1,5 @@
 // The live viewer's reading of the bytes a browser (or anyone who can reach the viewer's port)
-// sends: client/web/http_message.h. Properties:
+// sends: http/http_message.h. Properties:
 //  - FindEndOfHead returns 0 or an offset just past an empty line within the input;
 //  - ParseHttpRequestHead never crashes, and either rejects the head with INVALID_ARGUMENT
 //    and a message, or returns a method of token characters, a path that starts with '/' and
@@ -11,14 +11,14 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/string_view.h"
-#include "client/web/http_message.h"
+#include "http/http_message.h"
 #include "fuzz/fuzz_check.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  using neuralmesh::client::web::FindEndOfHead;
-  using neuralmesh::client::web::HttpRequest;
-  using neuralmesh::client::web::kMaxRequestHeadBytes;
-  using neuralmesh::client::web::ParseHttpRequestHead;
+  using neuralmesh::http::FindEndOfHead;
+  using neuralmesh::http::HttpRequest;
+  using neuralmesh::http::kMaxRequestHeadBytes;
+  using neuralmesh::http::ParseHttpRequestHead;
   const absl::string_view bytes(reinterpret_cast<const char*>(data), size);
 
   const size_t end = FindEndOfHead(bytes);

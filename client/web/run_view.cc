@@ -9,11 +9,15 @@
 #include "absl/time/clock.h"
 #include "client/interrupt.h"
 #include "client/reconstruction_client.h"
-#include "client/web/http_server.h"
+#include "http/http_server.h"
 #include "client/web/viewer_service.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::client::web {
+
+using ::neuralmesh::http::HttpRequest;
+using ::neuralmesh::http::HttpServer;
+
 namespace {
 
 struct HostPort {

@@ -9,6 +9,11 @@
 #include "absl/strings/strip.h"
 
 namespace neuralmesh::client::web {
+
+using ::neuralmesh::http::HttpRequest;
+using ::neuralmesh::http::HttpResponse;
+using ::neuralmesh::http::TextResponse;
+
 namespace {
 
 constexpr size_t kMinKeyLength = 16;

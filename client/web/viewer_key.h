@@ -12,7 +12,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
-#include "client/web/http_message.h"
+#include "http/http_message.h"
 
 namespace neuralmesh::client::web {
 
@@ -33,11 +33,11 @@ enum class ViewerKeyCheck {
 };
 
 // What `request` brings of `key` (compared in time independent of where they differ).
-ViewerKeyCheck CheckViewerKey(const HttpRequest& request, absl::string_view key);
+ViewerKeyCheck CheckViewerKey(const http::HttpRequest& request, absl::string_view key);
 
 // The answer to a request with the key in its query: 303 to the same path and query without
 // `key`, setting the cookie (HttpOnly, SameSite=Strict, Path=/).
-HttpResponse ViewerKeyRedirect(const HttpRequest& request, absl::string_view key);
+http::HttpResponse ViewerKeyRedirect(const http::HttpRequest& request, absl::string_view key);
 
 }  // namespace neuralmesh::client::web
 

@@ -18,6 +18,11 @@
 #include "core/io/file_contents.h"
 
 namespace neuralmesh::client::web {
+
+using ::neuralmesh::http::HttpRequest;
+using ::neuralmesh::http::HttpResponse;
+using ::neuralmesh::http::JsonResponse;
+
 namespace {
 
 // At most this many sessions are watched at once for browsers.

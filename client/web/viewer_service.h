@@ -31,7 +31,7 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "client/reconstruction_client.h"
-#include "client/web/http_message.h"
+#include "http/http_message.h"
 #include "client/web/mesh_relay.h"
 
 namespace neuralmesh::client::web {
@@ -61,7 +61,7 @@ class ViewerService {
   ~ViewerService();
 
   // Answers one request; thread-safe, and mesh requests block up to the poll timeout.
-  HttpResponse Handle(const HttpRequest& request);
+  http::HttpResponse Handle(const http::HttpRequest& request);
 
   // Ends the watches no browser has asked about for relay_idle_timeout (each holds a stream on
   // the server). The owner calls it now and then (RunView: every 5 s).
@@ -71,10 +71,10 @@ class ViewerService {
   void Stop();
 
  private:
-  HttpResponse ServeFile(const std::string& file) const;
-  HttpResponse ListSessions();
-  HttpResponse GetSession(const std::string& session_id);
-  HttpResponse GetMesh(const std::string& session_id, const HttpRequest& request);
+  http::HttpResponse ServeFile(const std::string& file) const;
+  http::HttpResponse ListSessions();
+  http::HttpResponse GetSession(const std::string& session_id);
+  http::HttpResponse GetMesh(const std::string& session_id, const http::HttpRequest& request);
   // The relay of `session_id`, made when missing or when its watch lost the connection.
   std::shared_ptr<MeshRelay> RelayFor(const std::string& session_id);
 

@@ -10,6 +10,10 @@
 #include "absl/strings/str_cat.h"
 
 namespace neuralmesh::client::web {
+
+using ::neuralmesh::http::HttpRequest;
+using ::neuralmesh::http::HttpResponse;
+
 namespace {
 
 constexpr char kKey[] = "k3y-Of_The.Viewer~1";

@@ -13,7 +13,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
-#include "client/web/http_server.h"
+#include "http/http_server.h"
 #include "client/web/run_view.h"
 #include "client/web/viewer_key.h"
 #include "core/io/draco_codec.h"
@@ -22,6 +22,12 @@
 #include "tests/server/server_test_support.h"
 
 namespace neuralmesh::client::web {
+
+using ::neuralmesh::http::HttpRequest;
+using ::neuralmesh::http::HttpResponse;
+using ::neuralmesh::http::HttpServer;
+using ::neuralmesh::http::kMaxRequestHeadBytes;
+
 namespace {
 
 using ::neuralmesh::testing::HttpGet;

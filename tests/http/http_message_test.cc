@@ -1,11 +1,11 @@
-#include "client/web/http_message.h"
+#include "http/http_message.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <string>
 
-namespace neuralmesh::client::web {
+namespace neuralmesh::http {
 namespace {
 
 using ::testing::HasSubstr;
@@ -91,4 +91,4 @@ TEST(HttpMessageTest, WritesTheResponseHeadWithTheBodyLength) {
 }
 
 }  // namespace
-}  // namespace neuralmesh::client::web
+}  // namespace neuralmesh::http

@@ -1,4 +1,4 @@
-#include "client/web/http_server.h"
+#include "http/http_server.h"
 
 #include <netdb.h>
 #include <netinet/in.h>
@@ -16,7 +16,7 @@
 
 #include "absl/strings/str_cat.h"
 
-namespace neuralmesh::client::web {
+namespace neuralmesh::http {
 namespace {
 
 void SetTimeout(int fd, int option, absl::Duration timeout) {
@@ -221,4 +221,4 @@ void HttpServer::Serve(int fd) {
   close(fd);
 }
 
-}  // namespace neuralmesh::client::web
+}  // namespace neuralmesh::http

@@ -1,6 +1,7 @@
-// A small HTTP/1.1 server for the live viewer: one thread accepts, one thread per connection
-// reads a request head, calls the handler and writes its response, then closes the connection
-// (browsers open a new one per request, which on a viewer's few requests costs nothing).
+// A small HTTP/1.1 server for the live viewer and the server's metrics: one thread accepts, one
+// thread per connection reads a request head, calls the handler and writes its response, then
+// closes the connection (browsers and scrapers open a new one per request, which on their few
+// requests costs nothing).
 //
 //   NM_ASSIGN_OR_RETURN(std::unique_ptr<HttpServer> server,
 //                       HttpServer::Start("127.0.0.1", 8080, handler));
@@ -12,8 +13,8 @@
 // `read_timeout` is dropped. The handler runs on the connection's thread and may block (a long
 // poll), so it must return once its owner is shut down: Shutdown() closes the sockets but
 // waits for handlers in flight.
-#ifndef NEURALMESH_CLIENT_WEB_HTTP_SERVER_H_
-#define NEURALMESH_CLIENT_WEB_HTTP_SERVER_H_
+#ifndef NEURALMESH_HTTP_HTTP_SERVER_H_
+#define NEURALMESH_HTTP_HTTP_SERVER_H_
 
 #include <functional>
 #include <memory>
@@ -25,9 +26,9 @@
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
-#include "client/web/http_message.h"
+#include "http/http_message.h"
 
-namespace neuralmesh::client::web {
+namespace neuralmesh::http {
 
 struct HttpServerOptions {
   // Connections served at once; one more is answered 503 and closed.
@@ -76,6 +77,6 @@ class HttpServer {
   bool shut_down_ ABSL_GUARDED_BY(mu_) = false;
 };
 
-}  // namespace neuralmesh::client::web
+}  // namespace neuralmesh::http
 
-#endif  // NEURALMESH_CLIENT_WEB_HTTP_SERVER_H_
+#endif  // NEURALMESH_HTTP_HTTP_SERVER_H_

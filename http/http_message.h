@@ -1,8 +1,9 @@
-// The HTTP/1.1 messages of the live viewer (`neuralmesh view`): a request head parsed from the
-// bytes a browser sends, and a response written back. Only what a viewer needs: GET and HEAD
-// requests without a body, responses with a fixed Content-Length and "Connection: close".
-#ifndef NEURALMESH_CLIENT_WEB_HTTP_MESSAGE_H_
-#define NEURALMESH_CLIENT_WEB_HTTP_MESSAGE_H_
+// The HTTP/1.1 messages of the live viewer (`neuralmesh view`) and of the server's metrics
+// endpoint: a request head parsed from the bytes a browser or a scraper sends, and a response
+// written back. Only what they need: GET and HEAD requests without a body, responses with a
+// fixed Content-Length and "Connection: close".
+#ifndef NEURALMESH_HTTP_HTTP_MESSAGE_H_
+#define NEURALMESH_HTTP_HTTP_MESSAGE_H_
 
 #include <map>
 #include <string>
@@ -12,7 +13,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 
-namespace neuralmesh::client::web {
+namespace neuralmesh::http {
 
 // A request head is at most this long (request line and headers); a longer one is refused.
 inline constexpr size_t kMaxRequestHeadBytes = 16 * 1024;
@@ -57,6 +58,6 @@ absl::string_view HttpReasonPhrase(int status);
 // line. The body follows it unless the request was a HEAD.
 std::string SerializeHttpResponseHead(const HttpResponse& response);
 
-}  // namespace neuralmesh::client::web
+}  // namespace neuralmesh::http
 
-#endif  // NEURALMESH_CLIENT_WEB_HTTP_MESSAGE_H_
+#endif  // NEURALMESH_HTTP_HTTP_MESSAGE_H_

@@ -1,4 +1,4 @@
-#include "client/web/http_message.h"
+#include "http/http_message.h"
 
 #include <cctype>
 
@@ -8,7 +8,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 
-namespace neuralmesh::client::web {
+namespace neuralmesh::http {
 namespace {
 
 int HexValue(char c) {
@@ -204,4 +204,4 @@ std::string SerializeHttpResponseHead(const HttpResponse& response) {
   return head;
 }
 
-}  // namespace neuralmesh::client::web
+}  // namespace neuralmesh::http

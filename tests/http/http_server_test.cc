@@ -1,4 +1,4 @@
-#include "client/web/http_server.h"
+#include "http/http_server.h"
 
 #include <arpa/inet.h>
 #include <gmock/gmock.h>
@@ -14,9 +14,9 @@
 
 #include "absl/synchronization/notification.h"
 #include "absl/time/clock.h"
-#include "tests/client/web/viewer_test_support.h"
+#include "tests/testing/http_client.h"
 
-namespace neuralmesh::client::web {
+namespace neuralmesh::http {
 namespace {
 
 using ::neuralmesh::testing::HttpGet;
@@ -124,4 +124,4 @@ TEST(HttpServerTest, ShutdownWaitsForTheHandlersInFlightAndClosesIdleConnections
 }
 
 }  // namespace
-}  // namespace neuralmesh::client::web
+}  // namespace neuralmesh::http

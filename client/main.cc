@@ -161,7 +161,8 @@ ABSL_FLAG(absl::Duration, reconnect_for,
           "reconstruct --server and watch: how long to keep trying when the connection to the "
           "server is lost, counted from the last batch taken or mesh received (the upload goes "
           "on from the points the session has taken, the watch from its last mesh); 0: give up "
-          "at once (reconstruct then prints the --resume command).");
+          "at once (reconstruct then prints the --resume command). sessions: how long to wait "
+          "for a server that is out of reach or still restoring its sessions after a restart.");
 ABSL_FLAG(bool, final, false,
           "get: the final mesh of a finished session instead of the latest mesh.");
 ABSL_FLAG(absl::Duration, wait, absl::ZeroDuration(),
@@ -442,9 +443,12 @@ absl::Status Watch(const ParsedArgs& args) {
 
 absl::Status Sessions(const ParsedArgs& args) {
   NM_RETURN_IF_ERROR(ExpectPositional(args, 0, "no arguments"));
-  NM_ASSIGN_OR_RETURN(const neuralmesh::client::ClientOptions connection, ConnectionFromFlags());
-  return neuralmesh::client::RunSessions(absl::GetFlag(FLAGS_server), absl::GetFlag(FLAGS_json),
-                                         std::cout, connection);
+  neuralmesh::client::SessionsOptions o;
+  o.server = absl::GetFlag(FLAGS_server);
+  o.json = absl::GetFlag(FLAGS_json);
+  NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
+  NM_ASSIGN_OR_RETURN(o.reconnect_for, ReconnectForFromFlags());
+  return neuralmesh::client::RunSessions(o, std::cout, std::cerr);
 }
 
 absl::Status OnSession(neuralmesh::client::SessionAction action, const ParsedArgs& args) {
@@ -544,10 +548,11 @@ std::vector<Subcommand> Commands() {
        WithConnectionFlags({"server", "out-dir", "ply", "reconnect_for"}),
        Watch},
       {"sessions",
-       "sessions --server HOST:PORT [--json]",
+       "sessions --server HOST:PORT [--json] [--reconnect_for D]",
        "Lists the sessions of a server.",
-       "",
-       WithConnectionFlags({"server", "json"}),
+       "Lists the sessions of a server; a server restoring its sessions after a restart is\n"
+       "asked again until it is done (at most --reconnect_for).",
+       WithConnectionFlags({"server", "json", "reconnect_for"}),
        Sessions},
       {"get",
        "get SESSION --server HOST:PORT -o OUTPUT [--final] [--wait D]",

@@ -1,6 +1,8 @@
 #include "client/reconnecting_calls.h"
 
 #include <algorithm>
+#include <functional>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
@@ -39,6 +41,22 @@ class Reconnection {
   // when the window ends first; NOT_FOUND when the server no longer has the session;
   // CANCELLED when the client's calls are cancelled meanwhile.
   absl::StatusOr<v1::Session> Recover(const absl::Status& status) {
+    return AskAgain<v1::Session>(status, [this](absl::Duration left) {
+      absl::StatusOr<v1::Session> session = client_.AwaitSession(session_id_, left);
+      if (absl::IsNotFound(session.status())) {
+        return absl::StatusOr<v1::Session>(absl::NotFoundError(absl::StrCat(
+            "session ", session_id_, " is no longer on ", Server(),
+            " after the connection was lost (a restarted server keeps no sessions)")));
+      }
+      return session;
+    });
+  }
+
+  // After a call ended with `status`: `ask(time left)` until it answers with anything but
+  // UNAVAILABLE or DEADLINE_EXCEEDED, pausing between attempts; as Recover otherwise.
+  template <typename T>
+  absl::StatusOr<T> AskAgain(const absl::Status& status,
+                             const std::function<absl::StatusOr<T>(absl::Duration)>& ask) {
     if (!absl::IsUnavailable(status) || options_.give_up_after <= absl::ZeroDuration()) {
       return status;
     }
@@ -50,17 +68,10 @@ class Reconnection {
     while (true) {
       if (!Pause()) break;
       pause_ = pause_ == absl::ZeroDuration() ? kFirstPause : std::min(2 * pause_, kLongestPause);
-      absl::StatusOr<v1::Session> session =
-          client_.AwaitSession(session_id_, window_end_ - absl::Now());
-      if (session.ok()) return session;
-      if (absl::IsNotFound(session.status())) {
-        return absl::NotFoundError(absl::StrCat(
-            "session ", session_id_, " is no longer on ", Server(),
-            " after the connection was lost (a restarted server keeps no sessions)"));
-      }
-      if (!absl::IsUnavailable(session.status()) &&
-          !absl::IsDeadlineExceeded(session.status())) {
-        return session.status();
+      absl::StatusOr<T> answer = ask(window_end_ - absl::Now());
+      if (answer.ok()) return answer;
+      if (!absl::IsUnavailable(answer.status()) && !absl::IsDeadlineExceeded(answer.status())) {
+        return answer.status();
       }
     }
     if (client_.calls_cancelled()) {
@@ -163,6 +174,16 @@ absl::StatusOr<v1::Session> GetSessionReconnecting(ReconstructionClient& client,
   if (session.ok()) return session;
   Reconnection reconnection(client, session_id, options);
   return reconnection.Recover(session.status());
+}
+
+absl::StatusOr<std::vector<v1::Session>> ListSessionsReconnecting(
+    ReconstructionClient& client, const ReconnectOptions& options) {
+  absl::StatusOr<std::vector<v1::Session>> sessions = client.ListSessions();
+  if (sessions.ok()) return sessions;
+  const std::string no_session;
+  Reconnection reconnection(client, no_session, options);
+  return reconnection.AskAgain<std::vector<v1::Session>>(
+      sessions.status(), [&client](absl::Duration left) { return client.AwaitSessions(left); });
 }
 
 }  // namespace neuralmesh::client

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -68,6 +69,11 @@ absl::StatusOr<v1::Session> FinishReconnecting(ReconstructionClient& client,
 absl::StatusOr<v1::Session> GetSessionReconnecting(ReconstructionClient& client,
                                                   const std::string& session_id,
                                                   const ReconnectOptions& options);
+
+// ListSessions that asks again while the server is out of reach, or answers that it is still
+// restoring its sessions after a restart (a listing is never partial: UNAVAILABLE until then).
+absl::StatusOr<std::vector<v1::Session>> ListSessionsReconnecting(
+    ReconstructionClient& client, const ReconnectOptions& options);
 
 }  // namespace neuralmesh::client
 

@@ -317,9 +317,20 @@ absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& 
 }
 
 absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions() {
+  return ListSessions(options_.call_timeout, /*wait_for_ready=*/false);
+}
+
+absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::AwaitSessions(
+    absl::Duration timeout) {
+  return ListSessions(timeout, /*wait_for_ready=*/true);
+}
+
+absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions(
+    absl::Duration timeout, bool wait_for_ready) {
   grpc::ClientContext context;
   const OpenCall open(*this, context);
-  SetDeadline(context, options_.call_timeout);
+  SetDeadline(context, timeout);
+  context.set_wait_for_ready(wait_for_ready);
   v1::ListSessionsResponse response;
   const grpc::Status status = stub_->ListSessions(&context, v1::ListSessionsRequest(), &response);
   if (!status.ok()) return FromGrpcStatus(status, "ListSessions");

@@ -149,6 +149,8 @@ class ReconstructionClient {
   // DEADLINE_EXCEEDED when the server did not answer within `timeout`.
   absl::StatusOr<v1::Session> AwaitSession(const std::string& session_id, absl::Duration timeout);
   absl::StatusOr<std::vector<v1::Session>> ListSessions();
+  // ListSessions that first waits up to `timeout` for a connection, as AwaitSession does.
+  absl::StatusOr<std::vector<v1::Session>> AwaitSessions(absl::Duration timeout);
   absl::StatusOr<v1::Session> Finish(const std::string& session_id);
   absl::StatusOr<v1::Session> Cancel(const std::string& session_id);
   // The same with its own deadline (for a best-effort cancel that must not wait long).
@@ -173,6 +175,8 @@ class ReconstructionClient {
 
   absl::StatusOr<v1::Session> GetSession(const std::string& session_id, absl::Duration timeout,
                                          bool wait_for_ready);
+  absl::StatusOr<std::vector<v1::Session>> ListSessions(absl::Duration timeout,
+                                                        bool wait_for_ready);
   // A context whose deadline is `timeout` from now (none when infinite).
   static void SetDeadline(grpc::ClientContext& context, absl::Duration timeout);
 

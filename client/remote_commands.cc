@@ -304,12 +304,15 @@ absl::Status RunWatch(const WatchOptions& options, std::ostream& out, std::ostre
   return absl::OkStatus();
 }
 
-absl::Status RunSessions(const std::string& server, bool json, std::ostream& out,
-                         const ClientOptions& connection) {
+absl::Status RunSessions(const SessionsOptions& options, std::ostream& out, std::ostream& err) {
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
-                      ConnectTo(server, connection));
-  NM_ASSIGN_OR_RETURN(const std::vector<v1::Session> sessions, client->ListSessions());
-  if (json) {
+                      ConnectTo(options.server, options.connection));
+  ReconnectOptions reconnect;
+  reconnect.give_up_after = options.reconnect_for;
+  reconnect.notify = [&err](const std::string& notice) { err << notice << "\n"; };
+  NM_ASSIGN_OR_RETURN(const std::vector<v1::Session> sessions,
+                      ListSessionsReconnecting(*client, reconnect));
+  if (options.json) {
     JsonWriter writer(2);
     writer.BeginArray();
     for (const v1::Session& s : sessions) WriteSessionJson(s, writer);

@@ -78,9 +78,17 @@ struct WatchOptions {
 // `reconnect_for` (notices on `err`). OK only when the final mesh arrived.
 absl::Status RunWatch(const WatchOptions& options, std::ostream& out, std::ostream& err);
 
+struct SessionsOptions {
+  std::string server;
+  bool json = false;  // A JSON array instead of a table.
+  ClientOptions connection;
+  // How long to ask again while the server is out of reach or still restoring its sessions
+  // after a restart (a listing is UNAVAILABLE until it is done); notices go to `err`.
+  absl::Duration reconnect_for = ReconnectOptions().give_up_after;
+};
+
 // Lists the server's sessions as a table, or as JSON.
-absl::Status RunSessions(const std::string& server, bool json, std::ostream& out,
-                         const ClientOptions& connection = {});
+absl::Status RunSessions(const SessionsOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace neuralmesh::client
 

@@ -9,7 +9,8 @@
 #      standard gRPC health service (grpc.health.v1) to report SERVING;
 #   5. reconstructs builtin:torus through the container with the host's client
 #      (build/bin/neuralmesh, built when missing) and decodes the final .drc with Debian's
-#      draco_decoder and `neuralmesh stats`;
+#      draco_decoder and `neuralmesh stats`; reads the metrics page (--metrics_port, published
+#      on 127.0.0.1 too): the session finished, its points accepted, the calls counted;
 #   6. stops the container with SIGTERM (podman stop) and checks that the server shut down
 #      gracefully (exit status 0, shutdown messages in its log); starts it again and checks
 #      that the finished session came back from the state volume (--state_dir), its final
@@ -37,6 +38,7 @@ VERTICES=${VERTICES:-2000}
 OUT_DIR=${OUT_DIR:-out/container-test}
 BASE_IMAGE=docker.io/library/debian:bookworm-slim
 CONTAINER_PORT=50051  # the port the image's ENTRYPOINT listens on
+CONTAINER_METRICS_PORT=9464  # and its metrics page
 # Debian's interpreter, where python3-grpcio lives; an earlier python3 on PATH may lack it.
 PYTHON=/usr/bin/python3
 CLI="${BUILD_DIR}/bin/neuralmesh"
@@ -197,7 +199,8 @@ free_port() {
   "${PYTHON}" -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'
 }
 # start_container NAME [PODMAN_RUN_OPTION...] -- [SERVER_FLAG...]: runs the image as
-# CONTAINER=NAME with its port published on 127.0.0.1 at a free port; sets ADDRESS.
+# CONTAINER=NAME with its ports published on 127.0.0.1 at free ports; sets ADDRESS and
+# METRICS_ADDRESS.
 start_container() {
   CONTAINER=$1
   shift
@@ -207,12 +210,15 @@ start_container() {
     shift
   done
   [[ $# -gt 0 ]] && shift
-  local port=""
-  # The port is free when picked; should another process take it before podman binds it,
-  # pick another.
+  local port="" metrics_port=""
+  # The ports are free when picked; should another process take one before podman binds it,
+  # pick others.
   for _ in 1 2 3; do
     port=$(free_port)
+    metrics_port=$(free_port)
+    [[ "${metrics_port}" != "${port}" ]] || continue
     if podman run -d --name "${CONTAINER}" -p "127.0.0.1:${port}:${CONTAINER_PORT}" \
+      -p "127.0.0.1:${metrics_port}:${CONTAINER_METRICS_PORT}" \
       "${options[@]}" "${IMAGE}" "$@" >/dev/null 2>"${WORK_DIR}/run.err"; then
       break
     fi
@@ -221,6 +227,7 @@ start_container() {
   done
   [[ -n "${port}" ]] || fail "podman run: $(cat "${WORK_DIR}/run.err")"
   ADDRESS="127.0.0.1:${port}"
+  METRICS_ADDRESS="127.0.0.1:${metrics_port}"
 }
 start_container "neuralmesh-test-$$" --
 
@@ -294,6 +301,23 @@ decoded_faces=$(grep -c '^f ' "${WORK_DIR}/final.obj" || true)
   || fail "neuralmesh stats: $(tail -n 3 "${OUT_DIR}/stats.out")"
 say "Final mesh: ${decoded_vertices} vertices, ${decoded_faces} faces (draco_decoder)"
 
+step "Reading the metrics page on ${METRICS_ADDRESS}"
+# urllib without the environment's proxies: the page is on 127.0.0.1.
+"${PYTHON}" - "http://${METRICS_ADDRESS}/metrics" >"${OUT_DIR}/metrics.txt" \
+  2>"${WORK_DIR}/metrics.err" <<'EOF' || fail "GET /metrics: $(tail -n 3 "${WORK_DIR}/metrics.err")"
+import sys
+import urllib.request
+
+opener = urllib.request.build_opener(urllib.request.ProxyHandler({}))
+sys.stdout.write(opener.open(sys.argv[1], timeout=10).read().decode())
+EOF
+for sample in 'neuralmesh_sessions_ended_total{state="finished"} 1' \
+  'neuralmesh_points_accepted_total 100000' \
+  'grpc_server_handled_total{grpc_service="neuralmesh.v1.ReconstructionService",grpc_method="CreateSession",grpc_type="unary",grpc_code="OK"} 1'; do
+  grep -qxF "${sample}" "${OUT_DIR}/metrics.txt" || fail "/metrics lacks the line: ${sample}"
+done
+say "/metrics: the finished session, its 100000 points and its calls are counted"
+
 # --- 7. Graceful stop ----------------------------------------------------------------------
 step "Stopping the container with SIGTERM"
 podman stop --time 30 "${CONTAINER}" >/dev/null || fail "podman stop"
@@ -312,16 +336,13 @@ say "The server shut down gracefully (exit status 0)"
 step "Starting the container again: the finished session comes back from its state volume"
 podman start "${CONTAINER}" >/dev/null || fail "podman start"
 wait_serving
-# The server answers while it restores its sessions; until then a listing is UNAVAILABLE.
-for _ in $(seq 1 30); do
-  if "${CLI}" sessions --server "${ADDRESS}" >"${OUT_DIR}/sessions-after-restart.out" 2>&1; then
-    break
-  fi
-  grep -q "restoring its sessions" "${OUT_DIR}/sessions-after-restart.out" || break
-  sleep 1
-done
+# The server answers while it restores its sessions; until then a listing is UNAVAILABLE, and
+# `neuralmesh sessions` asks again (--reconnect_for).
+"${CLI}" sessions --server "${ADDRESS}" --reconnect_for 30s \
+  >"${OUT_DIR}/sessions-after-restart.out" 2>"${OUT_DIR}/sessions-after-restart.err" \
+  || fail "neuralmesh sessions: $(tail -n 3 "${OUT_DIR}/sessions-after-restart.err")"
 grep -q "^session " "${OUT_DIR}/sessions-after-restart.out" \
-  || fail "neuralmesh sessions: $(tail -n 3 "${OUT_DIR}/sessions-after-restart.out")"
+  || fail "neuralmesh sessions printed no table: $(tail -n 3 "${OUT_DIR}/sessions-after-restart.out")"
 cat "${OUT_DIR}/sessions-after-restart.out" >&2
 SESSION_ID=$(awk '$1 ~ /^s-/ && $3 == "finished" {print $1}' "${OUT_DIR}/sessions-after-restart.out")
 [[ -n "${SESSION_ID}" ]] || fail "no finished session after the restart"

@@ -89,6 +89,13 @@ ABSL_FLAG(absl::Duration, checkpoint_interval, neuralmesh::server::kDefaultCheck
 ABSL_FLAG(bool, log_sessions, true,
           "Print a line on standard output when a session is created, finishes, is cancelled, "
           "fails or is deleted (with the time, the client's address and the figures).");
+ABSL_FLAG(int, metrics_port, -1,
+          "Port of the metrics page, on plain HTTP: /metrics (the Prometheus text format: "
+          "sessions by state, points, Basic Steps, meshes published, gRPC calls by method and "
+          "status; totals only, no session ids or names) and /healthz (200 while serving, 503 "
+          "while shutting down). 0 picks a free one (printed at start); -1: none.");
+ABSL_FLAG(std::string, metrics_host, "",
+          "Address the metrics page listens on; empty: --host's.");
 ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(5),
           "On SIGTERM/SIGINT, how long calls may take to end before they are cancelled.");
 
@@ -249,6 +256,8 @@ int main(int argc, char** argv) {
   options.state_dir = absl::GetFlag(FLAGS_state_dir);
   options.state_sync = absl::GetFlag(FLAGS_state_sync);
   options.checkpoint_interval = absl::GetFlag(FLAGS_checkpoint_interval);
+  options.metrics_port = absl::GetFlag(FLAGS_metrics_port);
+  options.metrics_host = absl::GetFlag(FLAGS_metrics_host);
   if (options.checkpoint_interval < absl::ZeroDuration() ||
       options.checkpoint_interval == absl::InfiniteDuration()) {
     std::fprintf(stderr,
@@ -300,6 +309,12 @@ int main(int argc, char** argv) {
                          : std::string())
                         .c_str()
                   : absl::StrCat(", ", secured.access_tokens.size(), " access tokens").c_str());
+  if ((*server)->metrics_port() >= 0) {
+    const std::string metrics_host = options.metrics_host.empty() ? absl::GetFlag(FLAGS_host)
+                                                                   : options.metrics_host;
+    std::printf("neuralmesh-server: metrics on http://%s:%d/metrics\n", metrics_host.c_str(),
+                (*server)->metrics_port());
+  }
   std::fflush(stdout);
   // The stored sessions are restored while the server answers; the report comes when it is done.
   std::thread restore_reporter;

@@ -11,6 +11,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "server/metrics_http.h"
+#include "server/rpc_metrics_interceptor.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -18,6 +20,16 @@ namespace {
 constexpr char kServiceName[] = "neuralmesh.v1.ReconstructionService";
 // How long unary calls may take to finish once the streams are gone.
 constexpr absl::Duration kUnaryGrace = absl::Milliseconds(200);
+
+// The host of "host:port" ("[::]:50051" gives "::").
+std::string HostOf(absl::string_view address) {
+  const size_t colon = address.rfind(':');
+  absl::string_view host = colon == absl::string_view::npos ? address : address.substr(0, colon);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
+    host = host.substr(1, host.size() - 2);
+  }
+  return std::string(host);
+}
 
 }  // namespace
 
@@ -47,6 +59,10 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   if (options.limits.idle_timeout <= absl::ZeroDuration()) {
     return absl::InvalidArgumentError("idle_timeout must be positive");
   }
+  if (options.metrics_port < -1 || options.metrics_port > 65535) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "metrics_port is ", options.metrics_port, "; it must be in [0, 65535], or -1 for none"));
+  }
 
   absl::StatusOr<PortCredentials> credentials = MakeServerCredentials(options.security);
   if (!credentials.ok()) return credentials.status();
@@ -67,7 +83,7 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   server->manager_ = std::make_unique<SessionManager>(
       options.limits, server->pool_.get(), server->encoder_.get(),
       options.event_sink ? std::make_shared<EventLog>(options.event_sink) : nullptr,
-      server->store_.get());
+      server->store_.get(), &server->metrics_);
   // Stored sessions are restored while the server takes calls (calls on them get UNAVAILABLE
   // until then): a large state directory does not hold up the start.
   server->manager_->StartRestore();
@@ -95,6 +111,7 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, 20 * 1000);
   builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
   builder.RegisterService(server->service_.get());
+  builder.experimental().SetInterceptorCreators(RpcMetricsInterceptors(&server->metrics_));
   server->server_ = builder.BuildAndStart();
   if (server->server_ == nullptr || (!options.address.empty() && server->port_ == 0)) {
     server->server_.reset();
@@ -106,16 +123,39 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
     health->SetServingStatus(true);
     health->SetServingStatus(kServiceName, true);
   }
+  if (options.metrics_port >= 0) {
+    MetricsSources sources;
+    sources.metrics = &server->metrics_;
+    sources.sessions = server->manager_.get();
+    sources.worker_threads = options.worker_threads;
+    sources.start_time = absl::Now();
+    ReconstructionServer* self = server.get();
+    sources.serving = [self] {
+      absl::MutexLock lock(&self->shutdown_mu_);
+      return !self->shutting_down_;
+    };
+    std::string host = options.metrics_host.empty() ? HostOf(options.address) : options.metrics_host;
+    if (host.empty()) host = "127.0.0.1";  // In-process only: no network the server listens on.
+    absl::StatusOr<std::unique_ptr<http::HttpServer>> http = http::HttpServer::Start(
+        host, options.metrics_port,
+        [sources](const http::HttpRequest& request) {
+          return AnswerMetricsRequest(request, sources);
+        });
+    if (!http.ok()) {
+      server->Shutdown(absl::ZeroDuration());
+      return absl::Status(http.status().code(),
+                          absl::StrCat("metrics page: ", http.status().message()));
+    }
+    server->metrics_http_ = *std::move(http);
+  }
   return server;
 }
 
 ReconstructionServer::~ReconstructionServer() { Shutdown(); }
 
 std::string ReconstructionServer::target() const {
-  absl::string_view address = options_.address;
-  const size_t colon = address.rfind(':');
-  absl::string_view host = colon == absl::string_view::npos ? address : address.substr(0, colon);
-  if (host.empty() || host == "0.0.0.0" || host == "[::]") host = "127.0.0.1";
+  std::string host = HostOf(options_.address);
+  if (host.empty() || host == "0.0.0.0" || host == "::") host = "127.0.0.1";
   return absl::StrCat(host, ":", port_);
 }
 
@@ -167,6 +207,8 @@ void ReconstructionServer::Shutdown(absl::Duration grace) {
     server_->Shutdown(absl::ToChronoTime(absl::Now() + std::min(grace, kUnaryGrace)));
     server_->Wait();
   }
+  // The metrics page answers until the end (/healthz: 503 meanwhile).
+  if (metrics_http_ != nullptr) metrics_http_->Shutdown();
   // Batches still waiting to be filtered belong to calls that have ended: dropped.
   if (filter_ != nullptr) filter_->Shutdown();
   if (pool_ != nullptr) pool_->Shutdown();

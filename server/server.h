@@ -14,12 +14,14 @@
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
+#include "http/http_server.h"
 #include "server/event_log.h"
 #include "server/executor.h"
 #include "server/reactor_registry.h"
 #include "server/reconstruction_service.h"
 #include "server/server_credentials.h"
 #include "server/session_manager.h"
+#include "server/server_metrics.h"
 #include "server/session_store.h"
 #include "server/worker_pool.h"
 
@@ -50,6 +52,10 @@ struct ServerOptions {
   // least this long has passed since its last one (every milestone is kept), so that a restart
   // costs at most about this much learning. Zero: milestones only.
   absl::Duration checkpoint_interval = kDefaultCheckpointInterval;
+  // The metrics page (metrics_http.h) on plain HTTP at metrics_host (empty: the host of
+  // `address`) and this port; 0 picks a free one, -1: none.
+  int metrics_port = -1;
+  std::string metrics_host;
 };
 
 class ReconstructionServer {
@@ -69,6 +75,8 @@ class ReconstructionServer {
   // bypasses TLS and access tokens: it is for callers inside the process.
   int port() const { return port_; }
   std::string target() const;
+  // The port of the metrics page; -1 without one.
+  int metrics_port() const { return metrics_http_ != nullptr ? metrics_http_->port() : -1; }
 
   // A channel into the server without a socket (tests of the logic, in-process callers).
   std::shared_ptr<grpc::Channel> InProcessChannel();
@@ -104,6 +112,7 @@ class ReconstructionServer {
   explicit ReconstructionServer(const ServerOptions& options);
 
   const ServerOptions options_;
+  ServerMetrics metrics_;  // Outlives the sessions and the servers, which count with it.
   std::unique_ptr<WorkerPool> pool_;
   std::unique_ptr<Executor> encoder_;
   std::unique_ptr<Executor> filter_;
@@ -113,6 +122,7 @@ class ReconstructionServer {
   std::unique_ptr<ReconstructionService> service_;
   std::shared_ptr<AccessTokenChecker> token_checker_;  // Null without access tokens.
   std::shared_ptr<ServerTlsIdentity> tls_identity_;    // Null without TLS; outlives server_.
+  std::unique_ptr<http::HttpServer> metrics_http_;  // Null without a metrics port.
   std::unique_ptr<grpc::Server> server_;  // Destroyed first.
   int port_ = 0;
 

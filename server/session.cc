@@ -234,6 +234,7 @@ absl::StatusOr<size_t> Session::AddPointsAndMaybeWake(const PointCloud& sent, si
     }
     learning_.set_points_received(total);
     points_taken_ += batch.positions.size();
+    if (metrics_ != nullptr) metrics_->AddPointsAccepted(batch.positions.size());
     learning_.set_points_removed_as_outliers(learning_.points_removed_as_outliers() + dropped);
     learning_.set_outliers_accepted_later(learning_.outliers_accepted_later() + released);
     learning_.set_outliers_held(held_outliers_.size());
@@ -313,6 +314,7 @@ absl::Status Session::Cancel(absl::string_view reason) {
     error_ = std::string(reason);
     cancel_.store(true);
   }
+  if (metrics_ != nullptr) metrics_->CountSessionEnded(v1::SESSION_STATE_CANCELLED);
   Record(absl::StrCat("cancelled: ", reason));
   updates_.Close(absl::CancelledError(absl::StrCat("session ", id_, " was cancelled: ", reason)));
   Wake();  // Lets the pool drop the session at its next slice.
@@ -345,6 +347,7 @@ void Session::Fail(const absl::Status& status) {
     error_ = std::string(status.message());
     cancel_.store(true);
   }
+  if (metrics_ != nullptr) metrics_->CountSessionEnded(v1::SESSION_STATE_FAILED);
   Record(absl::StrCat("failed: ", status.message()));
   if (absl::Status stored = StoreState(v1::SESSION_STATE_FAILED, std::string(status.message()));
       !stored.ok()) {
@@ -671,8 +674,13 @@ SliceResult Session::RunSlice(absl::Time deadline) {
     stop.cancel = &cancel_;
     stop.poll_interval = kPollInterval;
     const absl::Time run_start = absl::Now();
+    const uint64_t steps_before = learner_->progress().basic_steps;
     absl::StatusOr<StopReason> reason = learner_->Run(stop);
-    learning_time_ += absl::Now() - run_start;
+    const absl::Duration ran = absl::Now() - run_start;
+    learning_time_ += ran;
+    if (metrics_ != nullptr) {
+      metrics_->AddLearning(learner_->progress().basic_steps - steps_before, ran);
+    }
     if (!reason.ok()) {
       Fail(reason.status());
       return {SliceResult::kDone};
@@ -761,6 +769,7 @@ void Session::EncodeNext() {
     if (finished) {
       const std::shared_ptr<v1::MeshUpdate> final_mesh_ptr = *update;
       const v1::MeshUpdate& final_mesh = *final_mesh_ptr;
+      if (metrics_ != nullptr) metrics_->CountSessionEnded(v1::SESSION_STATE_FINISHED);
       Record(absl::StrFormat(
           "finished: %d vertices, %d faces, genus %d, %d boundaries, %d Basic Steps in %.2f s "
           "of learning, %d points",
@@ -776,12 +785,15 @@ void Session::EncodeNext() {
         Record(absl::StrCat("could not store the finish (a restart would learn the final mesh "
                             "again): ", stored.message()));
       }
-      updates_.Publish(final_mesh_ptr);
+      if (updates_.Publish(final_mesh_ptr) != 0 && metrics_ != nullptr) {
+        metrics_->AddMeshPublished(final_mesh.draco_mesh().size());
+      }
       updates_.Close(absl::OkStatus());
     }
   } else {
     const std::shared_ptr<v1::MeshUpdate> published = *update;
     if (updates_.Publish(published) != 0) {
+      if (metrics_ != nullptr) metrics_->AddMeshPublished(published->draco_mesh().size());
       StoreMesh(*published, /*durable=*/false);
       StoreCheckpoint(snapshot);
     }

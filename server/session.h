@@ -65,6 +65,7 @@
 #include "server/executor.h"
 #include "server/held_outliers.h"
 #include "server/session_config.h"
+#include "server/server_metrics.h"
 #include "server/session_store.h"
 #include "server/update_channel.h"
 #include "server/worker_pool.h"
@@ -98,6 +99,10 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   void AttachRecord(std::unique_ptr<SessionRecord> record) { record_ = std::move(record); }
   // The session's files, or null without a state directory.
   SessionRecord* record() const { return record_.get(); }
+  // Adds the session's work from now on to `metrics` (server_metrics.h): points accepted,
+  // learning, meshes published, its end. Once, before the session is shared with other threads
+  // (for a restored one: after its batches are taken again, which are not new work).
+  void AttachMetrics(ServerMetrics* metrics) { metrics_ = metrics; }
   // Learning starts from `mesh` (CreateSessionRequest.start_mesh, checked by CheckStartMesh)
   // once the points allow its vertex count, and publishes it first. Once, before the session
   // is shared with other threads.
@@ -298,6 +303,7 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   std::optional<GrowthWatch> growth_;  // Stall detection for the current learner.
 
   std::unique_ptr<SessionRecord> record_;  // Null without a state directory.
+  ServerMetrics* metrics_ = nullptr;  // May be null.
   std::atomic<bool> mesh_store_failed_{false};
   std::atomic<bool> checkpoint_store_failed_{false};
 };

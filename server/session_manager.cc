@@ -62,8 +62,14 @@ std::string QuotedSessionId(absl::string_view id) {
 }
 
 SessionManager::SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder,
-                               std::shared_ptr<EventLog> log, SessionStore* store)
-    : limits_(limits), pool_(pool), encoder_(encoder), log_(std::move(log)), store_(store) {
+                               std::shared_ptr<EventLog> log, SessionStore* store,
+                               ServerMetrics* metrics)
+    : limits_(limits),
+      pool_(pool),
+      encoder_(encoder),
+      log_(std::move(log)),
+      store_(store),
+      metrics_(metrics) {
   {
     absl::MutexLock lock(&mu_);
     absl::BitGen gen;
@@ -145,9 +151,11 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(
       session->AttachRecord(*std::move(record));
     }
     if (start_mesh.has_value()) session->SetStartMesh(*std::move(start_mesh));
+    session->AttachMetrics(metrics_);
     sessions_.emplace(id, session);
     order_.emplace(created_++, id);
   }
+  if (metrics_ != nullptr) metrics_->CountSessionCreated();
   if (log_ != nullptr) log_->Record(session->id(), event);
   return session;
 }
@@ -176,6 +184,17 @@ absl::StatusOr<std::vector<std::shared_ptr<Session>>> SessionManager::List() con
   out.reserve(order_.size());
   for (const auto& [index, id] : order_) out.push_back(sessions_.at(id));
   return out;
+}
+
+SessionManager::Census SessionManager::TakeCensus() const {
+  Census census;
+  absl::MutexLock lock(&mu_);
+  census.sessions.reserve(order_.size());
+  for (const auto& [index, id] : order_) {
+    if (auto it = sessions_.find(id); it != sessions_.end()) census.sessions.push_back(it->second);
+  }
+  census.to_restore = unrestored_.size();
+  return census;
 }
 
 absl::Status SessionManager::Delete(absl::string_view id) {
@@ -207,6 +226,7 @@ absl::Status SessionManager::DeleteUnlessActive(absl::string_view id,
       }
     }
   }
+  if (metrics_ != nullptr) metrics_->CountSessionDeleted(/*idle=*/idle_at.has_value());
   if (log_ != nullptr) {
     log_->Record(session->id(),
                  idle_at.has_value()
@@ -301,7 +321,8 @@ void SessionManager::RestoreLoop(std::vector<StoredSessionFiles> stored,
     std::shared_ptr<Session> session =
         stop_restoring_.load() ? nullptr
                                : RestoreSession(files, *store_, limits_.max_points_per_session,
-                                                pool_, encoder_, log_, problems, &stop_restoring_);
+                                                pool_, encoder_, log_, metrics_, problems,
+                                                &stop_restoring_);
     absl::MutexLock lock(&mu_);
     if (shutdown_) {
       // What Shutdown stopped stays on disk as it was, for the next start.

@@ -23,6 +23,7 @@
 #include "core/triangle_mesh.h"
 #include "server/event_log.h"
 #include "server/executor.h"
+#include "server/server_metrics.h"
 #include "server/session.h"
 #include "server/session_config.h"
 #include "server/session_store.h"
@@ -68,9 +69,11 @@ class SessionManager {
  public:
   // `pool` and `encoder` must outlive the manager's sessions' work (see Session). `log`, when
   // set, records every session's creation, end and deletion. `store`, when set, keeps every
-  // session on disk (session_store.h) and must outlive the manager.
+  // session on disk (session_store.h) and must outlive the manager. `metrics`, when set, counts
+  // the sessions' creation, work, end and deletion (server_metrics.h) and must outlive them.
   SessionManager(const SessionLimits& limits, WorkerPool* pool, Executor* encoder,
-                 std::shared_ptr<EventLog> log = nullptr, SessionStore* store = nullptr);
+                 std::shared_ptr<EventLog> log = nullptr, SessionStore* store = nullptr,
+                 ServerMetrics* metrics = nullptr);
   ~SessionManager();  // Calls Shutdown().
 
   SessionManager(const SessionManager&) = delete;
@@ -132,6 +135,15 @@ class SessionManager {
   // Idempotent.
   void Shutdown(const absl::Status& status) ABSL_LOCKS_EXCLUDED(mu_);
 
+  // The sessions held now (restored or created, oldest first) and the stored sessions still to
+  // be restored, for the metrics: not activity, and an answer during a restore and after
+  // Shutdown too.
+  struct Census {
+    std::vector<std::shared_ptr<Session>> sessions;
+    size_t to_restore = 0;
+  };
+  Census TakeCensus() const ABSL_LOCKS_EXCLUDED(mu_);
+
   const SessionLimits& limits() const { return limits_; }
 
  private:
@@ -156,6 +168,7 @@ class SessionManager {
   Executor* const encoder_;
   const std::shared_ptr<EventLog> log_;  // May be null.
   SessionStore* const store_;             // May be null.
+  ServerMetrics* const metrics_;          // May be null.
 
   mutable absl::Mutex mu_;
   bool shutdown_ ABSL_GUARDED_BY(mu_) = false;

@@ -61,7 +61,7 @@ std::string StateName(v1::SessionState state) {
 std::shared_ptr<Session> RestoreSession(const StoredSessionFiles& files, SessionStore& store,
                                         size_t max_points_per_session, WorkerPool* pool,
                                         Executor* encoder, std::shared_ptr<EventLog> log,
-                                        std::vector<std::string>& problems,
+                                        ServerMetrics* metrics, std::vector<std::string>& problems,
                                         const std::atomic<bool>* stop) {
   const storage::v1::StoredSession& stored = files.stored;
   const std::string& id = stored.session_id();
@@ -118,6 +118,7 @@ std::shared_ptr<Session> RestoreSession(const StoredSessionFiles& files, Session
     absl::StrAppend(&latest_note, ", learner checkpoint of ",
                     checkpoint->mesh.positions.size(), " vertices");
   }
+  session->AttachMetrics(metrics);  // After the replay: its batches are not new work.
   session->FinishRestore(state, error, std::move(latest), std::move(checkpoint),
                          *std::move(record));
   if (log != nullptr) {

@@ -22,12 +22,13 @@ namespace neuralmesh::server {
 // disk untouched (its settings no longer pass `max_points_per_session`, its journal or files
 // cannot be opened). What went wrong or was mended goes to `problems`, one line each: a torn
 // journal tail (cut off), a batch that no longer fits (the session is then restored as
-// failed, its files whole). `log`, when set, records the restoration. Once `stop` is set (when
-// given), the journal is read no further and the session stays on disk untouched.
+// failed, its files whole). `log`, when set, records the restoration; `metrics`, when set,
+// counts the session's work after it (Session::AttachMetrics). Once `stop` is set (when given),
+// the journal is read no further and the session stays on disk untouched.
 std::shared_ptr<Session> RestoreSession(const StoredSessionFiles& files, SessionStore& store,
                                         size_t max_points_per_session, WorkerPool* pool,
                                         Executor* encoder, std::shared_ptr<EventLog> log,
-                                        std::vector<std::string>& problems,
+                                        ServerMetrics* metrics, std::vector<std::string>& problems,
                                         const std::atomic<bool>* stop = nullptr);
 
 }  // namespace neuralmesh::server

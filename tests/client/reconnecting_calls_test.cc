@@ -1,9 +1,11 @@
 // client/reconnecting_calls.h: uploads, watches and finishes that ride out lost connections,
 // through a TCP proxy (tests/client/tcp_proxy.h) in front of a server on 127.0.0.1 that cuts
-// the connections, refuses new ones, or lets them through again.
+// the connections, refuses new ones, or lets them through again; and a listing that waits out
+// a server restoring its sessions (a fake server).
 #include "client/reconnecting_calls.h"
 
 #include <gmock/gmock.h>
+#include <grpcpp/server_builder.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -329,6 +331,87 @@ TEST_F(ReconnectingCallsTest, AFinishIsAskedAgainUnlessTheSessionIsFinishingAlre
     EXPECT_EQ(absl::StrContains(notices.text(), "is finishing"), finished_meanwhile)
         << notices.text();
   }
+}
+
+// A server restoring its sessions after a restart: ListSessions answers UNAVAILABLE, as
+// server/session_manager.h does, for the first `restoring` calls, then the list.
+class RestoringService final : public v1::ReconstructionService::Service {
+ public:
+  explicit RestoringService(int restoring) : restoring_(restoring) {}
+  grpc::Status ListSessions(grpc::ServerContext*, const v1::ListSessionsRequest*,
+                            v1::ListSessionsResponse* response) override {
+    absl::MutexLock lock(&mu_);
+    if (++calls_ <= restoring_) {
+      return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                          absl::StrCat("the server is restoring its sessions after a restart (",
+                                       calls_ - 1, " of 2 done); try again in a moment"));
+    }
+    response->add_sessions()->set_session_id("s-restored");
+    return grpc::Status::OK;
+  }
+  int calls() const {
+    absl::MutexLock lock(&mu_);
+    return calls_;
+  }
+
+ private:
+  const int restoring_;
+  mutable absl::Mutex mu_;
+  int calls_ ABSL_GUARDED_BY(mu_) = 0;
+};
+
+// The client of a fake server (RestoringService).
+struct FakeServer {
+  explicit FakeServer(grpc::Service* service) {
+    grpc::ServerBuilder builder;
+    builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+    builder.RegisterService(service);
+    server = builder.BuildAndStart();
+  }
+  ~FakeServer() { server->Shutdown(); }
+  std::unique_ptr<ReconstructionClient> Client() const {
+    absl::StatusOr<std::unique_ptr<ReconstructionClient>> client =
+        ReconstructionClient::Connect(absl::StrCat("127.0.0.1:", port));
+    EXPECT_TRUE(client.ok()) << client.status();
+    return client.ok() ? *std::move(client) : nullptr;
+  }
+  int port = 0;
+  std::unique_ptr<grpc::Server> server;
+};
+
+TEST(ListSessionsReconnectingTest, AListingWaitsUntilTheServerHasRestoredItsSessions) {
+  RestoringService service(/*restoring=*/2);
+  FakeServer fake(&service);
+  std::unique_ptr<ReconstructionClient> client = fake.Client();
+  ASSERT_NE(client, nullptr);
+  Notices notices;
+  absl::StatusOr<std::vector<v1::Session>> sessions =
+      ListSessionsReconnecting(*client, notices.Options(absl::Seconds(30)));
+  ASSERT_TRUE(sessions.ok()) << sessions.status();
+  ASSERT_EQ(sessions->size(), 1u);
+  EXPECT_EQ((*sessions)[0].session_id(), "s-restored");
+  EXPECT_EQ(service.calls(), 3);
+  EXPECT_THAT(notices.text(), HasSubstr("restoring its sessions after a restart (0 of 2 done)"));
+}
+
+TEST(ListSessionsReconnectingTest, GivesUpWhenTheRestoreOutlastsTheWindowOrAtOnceWithoutOne) {
+  RestoringService service(/*restoring=*/1000000);
+  FakeServer fake(&service);
+  std::unique_ptr<ReconstructionClient> client = fake.Client();
+  ASSERT_NE(client, nullptr);
+  Notices notices;
+  const absl::Status late =
+      ListSessionsReconnecting(*client, notices.Options(absl::Seconds(1))).status();
+  EXPECT_TRUE(absl::IsUnavailable(late)) << late;
+  EXPECT_THAT(late.message(), HasSubstr("did not answer again within 1s"));
+  EXPECT_GT(service.calls(), 1);
+
+  const int before = service.calls();
+  const absl::Status at_once =
+      ListSessionsReconnecting(*client, notices.Options(absl::ZeroDuration())).status();
+  EXPECT_TRUE(absl::IsUnavailable(at_once)) << at_once;
+  EXPECT_THAT(at_once.message(), HasSubstr("restoring its sessions"));
+  EXPECT_EQ(service.calls(), before + 1);
 }
 
 }  // namespace

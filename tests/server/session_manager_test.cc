@@ -227,6 +227,11 @@ TEST_F(SessionManagerRestoreTest, SessionsAnswerUnavailableUntilRestoredAndNewOn
   EXPECT_THAT(listed.message(),
               ::testing::HasSubstr("restoring its sessions after a restart (1 of 2 done)"));
   EXPECT_TRUE(absl::IsNotFound(manager.Get("s-0000000000000000").status()));
+  // The metrics see what List does not yet: the session back, and one still to come.
+  const SessionManager::Census census = manager.TakeCensus();
+  ASSERT_EQ(census.sessions.size(), 1u);
+  EXPECT_EQ(census.sessions[0]->id(), stored[0]);
+  EXPECT_EQ(census.to_restore, 1u);
 
   // The session still to be restored counts toward the limits: alice holds 2 of her 2, the
   // server 2 of its 3.

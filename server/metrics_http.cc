@@ -1,0 +1,100 @@
+#include "server/metrics_http.h"
+
+#include <cstdint>
+#include <map>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
+#include "server/prometheus_text.h"
+
+#ifndef NEURALMESH_VERSION
+#define NEURALMESH_VERSION "unknown"
+#endif
+
+namespace neuralmesh::server {
+namespace {
+
+// "learning" for SESSION_STATE_LEARNING.
+std::string StateLabel(v1::SessionState state) {
+  return absl::AsciiStrToLower(
+      absl::StripPrefix(v1::SessionState_Name(state), "SESSION_STATE_"));
+}
+
+}  // namespace
+
+std::string RenderMetrics(const MetricsSources& sources) {
+  const SessionManager::Census census = sources.sessions->TakeCensus();
+  std::map<v1::SessionState, uint64_t> by_state;
+  for (int s = v1::SessionState_MIN; s <= v1::SessionState_MAX; ++s) {
+    if (v1::SessionState_IsValid(s) && s != v1::SESSION_STATE_UNSPECIFIED) {
+      by_state[static_cast<v1::SessionState>(s)] = 0;
+    }
+  }
+  uint64_t points = 0, vertices = 0, watchers = 0, outliers_held = 0;
+  for (const std::shared_ptr<Session>& session : census.sessions) {
+    const v1::Session info = session->ToProto();
+    ++by_state[info.state()];
+    points += info.learning().points_received();
+    vertices += info.vertex_count();
+    watchers += info.watchers();
+    outliers_held += info.learning().outliers_held();
+  }
+
+  PrometheusText out;
+  out.Family("neuralmesh_build_info", "gauge", "The server's version, as a label; always 1.");
+  out.Sample("neuralmesh_build_info", {{"version", NEURALMESH_VERSION}}, uint64_t{1});
+  out.Family("neuralmesh_start_time_seconds", "gauge",
+             "When the server started, in seconds since the Unix epoch.");
+  out.Sample("neuralmesh_start_time_seconds", {}, absl::ToDoubleSeconds(
+                                                      sources.start_time - absl::UnixEpoch()));
+  out.Family("neuralmesh_worker_threads", "gauge",
+             "Learning threads, shared by all sessions in time slices (--worker_threads).");
+  out.Sample("neuralmesh_worker_threads", {}, static_cast<uint64_t>(sources.worker_threads));
+  out.Family("neuralmesh_sessions", "gauge", "Sessions held, by state.");
+  for (const auto& [state, count] : by_state) {
+    out.Sample("neuralmesh_sessions", {{"state", StateLabel(state)}}, count);
+  }
+  out.Family("neuralmesh_sessions_limit", "gauge",
+             "Sessions the server holds at most (--max_sessions).");
+  out.Sample("neuralmesh_sessions_limit",
+             {}, static_cast<uint64_t>(sources.sessions->limits().max_sessions));
+  out.Family("neuralmesh_sessions_to_restore", "gauge",
+             "Stored sessions still to be restored after a restart (--state_dir).");
+  out.Sample("neuralmesh_sessions_to_restore", {}, static_cast<uint64_t>(census.to_restore));
+  out.Family("neuralmesh_points", "gauge", "Points the sessions held have received.");
+  out.Sample("neuralmesh_points", {}, points);
+  out.Family("neuralmesh_outliers_held", "gauge",
+             "Points the sessions hold back as possible outliers, to judge again.");
+  out.Sample("neuralmesh_outliers_held", {}, outliers_held);
+  out.Family("neuralmesh_mesh_vertices", "gauge",
+             "Vertices of the sessions' latest published meshes, summed.");
+  out.Sample("neuralmesh_mesh_vertices", {}, vertices);
+  out.Family("neuralmesh_watchers", "gauge",
+             "Calls following the sessions' meshes (watch streams, waiting GetMesh calls).");
+  out.Sample("neuralmesh_watchers", {}, watchers);
+  sources.metrics->AppendTo(out);
+  return out.str();
+}
+
+http::HttpResponse AnswerMetricsRequest(const http::HttpRequest& request,
+                                        const MetricsSources& sources) {
+  if (request.path == "/metrics") {
+    http::HttpResponse response = http::TextResponse(200, "");
+    response.content_type = kPrometheusTextContentType;
+    response.body = RenderMetrics(sources);
+    return response;
+  }
+  if (request.path == "/healthz") {
+    return sources.serving() ? http::TextResponse(200, "serving")
+                             : http::TextResponse(503, "shutting down");
+  }
+  if (request.path == "/") {
+    return http::TextResponse(
+        200, "neuralmesh-server: /metrics (Prometheus text format), /healthz");
+  }
+  return http::TextResponse(404, absl::StrCat("no page ", request.path,
+                                              "; this server has /metrics and /healthz"));
+}
+
+}  // namespace neuralmesh::server

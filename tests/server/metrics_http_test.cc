@@ -1,0 +1,229 @@
+// neuralmesh-server --metrics_port (server/metrics_http.h): what a scraper reads after real
+// calls over 127.0.0.1, sessions learning, ending, deleted, reaped and restored.
+#include "server/metrics_http.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/time/clock.h"
+#include "http/http_server.h"
+#include "tests/server/server_test_support.h"
+#include "tests/testing/http_client.h"
+#include "tests/testing/temp_dir.h"
+
+namespace neuralmesh::server {
+namespace {
+
+using ::neuralmesh::testing::HttpGet;
+using ::neuralmesh::testing::HttpReply;
+using ::testing::HasSubstr;
+
+constexpr char kService[] = "grpc_service=\"neuralmesh.v1.ReconstructionService\"";
+
+// The samples of a /metrics page, by "name{labels}" as written.
+std::map<std::string, double> Scrape(const ReconstructionServer& server) {
+  const HttpReply reply = HttpGet(server.metrics_port(), "/metrics");
+  EXPECT_EQ(reply.status, 200);
+  EXPECT_EQ(reply.Header("content-type"), "text/plain; version=0.0.4; charset=utf-8");
+  std::map<std::string, double> samples;
+  for (absl::string_view line : absl::StrSplit(reply.body, '\n', absl::SkipEmpty())) {
+    if (line.front() == '#') continue;
+    const size_t space = line.rfind(' ');
+    double value = 0;
+    EXPECT_TRUE(absl::SimpleAtod(line.substr(space + 1), &value)) << line;
+    samples[std::string(line.substr(0, space))] = value;
+  }
+  return samples;
+}
+
+std::string Handled(absl::string_view method, absl::string_view type, absl::string_view code) {
+  return absl::StrCat("grpc_server_handled_total{", kService, ",grpc_method=\"", method,
+                      "\",grpc_type=\"", type, "\",grpc_code=\"", code, "\"}");
+}
+
+std::unique_ptr<ReconstructionServer> StartWithMetrics(ServerOptions options = {}) {
+  options.metrics_port = 0;
+  std::unique_ptr<ReconstructionServer> server = testing::StartServer(/*listen=*/true, options);
+  if (server != nullptr) {
+    EXPECT_GT(server->metrics_port(), 0);
+  }
+  return server;
+}
+
+TEST(MetricsHttpTest, CountsASessionsWorkAndTheCallsByStatus) {
+  std::unique_ptr<ReconstructionServer> server = StartWithMetrics();
+  ASSERT_NE(server, nullptr);
+  auto stub = testing::NetworkService(*server);
+
+  std::map<std::string, double> before = Scrape(*server);
+  EXPECT_EQ(before["neuralmesh_sessions_created_total"], 0);
+  EXPECT_EQ(before["neuralmesh_sessions{state=\"learning\"}"], 0);
+  EXPECT_EQ(before["neuralmesh_build_info{version=\"0.1.0\"}"], 1);
+
+  const std::string id = testing::MustCreate(*stub, testing::CreateRequest(300));
+  v1::UploadPointsResponse uploaded;
+  ASSERT_TRUE(testing::Upload(*stub, id, testing::SpherePoints(3000, 1), 3, &uploaded).ok());
+  grpc::Status missing;
+  testing::GetSession(*stub, "s-nosuchsession", &missing);
+  ASSERT_EQ(missing.error_code(), grpc::StatusCode::NOT_FOUND);
+  ASSERT_TRUE(testing::Finish(*stub, id).ok());
+  v1::MeshUpdate final_mesh;
+  ASSERT_TRUE(testing::WaitFinal(*stub, id, &final_mesh).ok());
+  const v1::Session finished = testing::GetSession(*stub, id);
+
+  std::map<std::string, double> after = Scrape(*server);
+  EXPECT_EQ(after["neuralmesh_sessions_created_total"], 1);
+  EXPECT_EQ(after["neuralmesh_points_accepted_total"], 3000);
+  EXPECT_EQ(after["neuralmesh_points"], 3000);
+  EXPECT_EQ(after["neuralmesh_sessions{state=\"finished\"}"], 1);
+  EXPECT_EQ(after["neuralmesh_sessions{state=\"learning\"}"], 0);
+  EXPECT_EQ(after["neuralmesh_sessions_ended_total{state=\"finished\"}"], 1);
+  EXPECT_EQ(after["neuralmesh_mesh_vertices"], 300);
+  // Every Basic Step of the session, as the session itself counts them.
+  EXPECT_EQ(after["neuralmesh_basic_steps_total"], finished.learning().basic_steps());
+  EXPECT_GT(after["neuralmesh_learning_seconds_total"], 0);
+  EXPECT_GE(after["neuralmesh_meshes_published_total"], 1);
+  EXPECT_GE(after["neuralmesh_mesh_bytes_published_total"], final_mesh.draco_mesh().size());
+  EXPECT_EQ(after[Handled("CreateSession", "unary", "OK")], 1);
+  EXPECT_EQ(after[Handled("UploadPoints", "client_stream", "OK")], 1);
+  EXPECT_EQ(after[Handled("GetSession", "unary", "NotFound")], 1);
+  EXPECT_EQ(after[Handled("GetSession", "unary", "OK")], 1);
+  EXPECT_EQ(after[Handled("GetMesh", "unary", "OK")], 1);
+  EXPECT_EQ(after[absl::StrCat("grpc_server_started_total{", kService,
+                               ",grpc_method=\"GetSession\",grpc_type=\"unary\"}")],
+            2);
+  EXPECT_EQ(after[absl::StrCat("grpc_server_handling_seconds_count{", kService,
+                               ",grpc_method=\"GetSession\",grpc_type=\"unary\"}")],
+            2);
+  EXPECT_EQ(after[absl::StrCat("grpc_server_handling_seconds_bucket{", kService,
+                               ",grpc_method=\"GetSession\",grpc_type=\"unary\",le=\"+Inf\"}")],
+            2);
+
+  ASSERT_TRUE(testing::Delete(*stub, id).ok());
+  std::map<std::string, double> deleted = Scrape(*server);
+  EXPECT_EQ(deleted["neuralmesh_sessions_deleted_total{reason=\"call\"}"], 1);
+  EXPECT_EQ(deleted["neuralmesh_sessions{state=\"finished\"}"], 0);
+  EXPECT_EQ(deleted["neuralmesh_points"], 0);
+  // Counters never go back.
+  EXPECT_EQ(deleted["neuralmesh_points_accepted_total"], 3000);
+  EXPECT_EQ(deleted["neuralmesh_sessions_ended_total{state=\"finished\"}"], 1);
+}
+
+TEST(MetricsHttpTest, CountsCancelledFailedAndIdleSessions) {
+  ServerOptions options;
+  options.limits.idle_timeout = absl::Milliseconds(300);
+  std::unique_ptr<ReconstructionServer> server = StartWithMetrics(options);
+  ASSERT_NE(server, nullptr);
+  auto stub = testing::NetworkService(*server);
+
+  const std::string cancelled = testing::MustCreate(*stub, testing::CreateRequest(300));
+  ASSERT_TRUE(testing::Cancel(*stub, cancelled).ok());
+  // Step 3 after every Basic Step: collapses win over splits, learning stalls and the session
+  // fails (session.h).
+  v1::CreateSessionRequest stalling = testing::CreateRequest(100);
+  stalling.mutable_config()->mutable_learner()->mutable_c_ec()->set_value(0.01);
+  stalling.mutable_config()->mutable_learner()->mutable_c_vs()->set_value(10);
+  const std::string failed = testing::MustCreate(*stub, stalling);
+  v1::UploadPointsResponse uploaded;
+  ASSERT_TRUE(testing::Upload(*stub, failed, testing::TorusPoints(2000, 9), 1, &uploaded).ok());
+  ASSERT_TRUE(testing::Finish(*stub, failed).ok());
+
+  std::map<std::string, double> samples;
+  const absl::Time deadline = absl::Now() + absl::Seconds(60);
+  while (absl::Now() < deadline) {
+    samples = Scrape(*server);
+    if (samples["neuralmesh_sessions_deleted_total{reason=\"idle\"}"] == 2) break;
+    absl::SleepFor(absl::Milliseconds(100));
+  }
+  EXPECT_EQ(samples["neuralmesh_sessions_ended_total{state=\"cancelled\"}"], 1);
+  EXPECT_EQ(samples["neuralmesh_sessions_ended_total{state=\"failed\"}"], 1);
+  EXPECT_EQ(samples["neuralmesh_sessions_deleted_total{reason=\"idle\"}"], 2);
+  EXPECT_EQ(samples["neuralmesh_sessions_deleted_total{reason=\"call\"}"], 0);
+  EXPECT_EQ(samples["neuralmesh_sessions{state=\"cancelled\"}"], 0);
+  EXPECT_EQ(samples[Handled("CancelSession", "unary", "OK")], 1);
+}
+
+TEST(MetricsHttpTest, ARestoredSessionsPointsAreHeldButNotAcceptedAgain) {
+  const std::string state_dir = neuralmesh::testing::MakeTempDir("metrics_state");
+  ServerOptions options;
+  options.state_dir = state_dir;
+  options.state_sync = false;
+  {
+    std::unique_ptr<ReconstructionServer> server = StartWithMetrics(options);
+    ASSERT_NE(server, nullptr);
+    auto stub = testing::NetworkService(*server);
+    const std::string id = testing::MustCreate(*stub, testing::CreateRequest(5000));
+    v1::UploadPointsResponse uploaded;
+    ASSERT_TRUE(testing::Upload(*stub, id, testing::SpherePoints(2000, 2), 2, &uploaded).ok());
+    EXPECT_EQ(Scrape(*server)["neuralmesh_points_accepted_total"], 2000);
+  }
+  std::unique_ptr<ReconstructionServer> server = StartWithMetrics(options);
+  ASSERT_NE(server, nullptr);
+  EXPECT_EQ(server->WaitForRestore().sessions, 1u);
+  std::map<std::string, double> samples = Scrape(*server);
+  EXPECT_EQ(samples["neuralmesh_sessions_to_restore"], 0);
+  EXPECT_EQ(samples["neuralmesh_points"], 2000);
+  EXPECT_EQ(samples["neuralmesh_points_accepted_total"], 0);
+  EXPECT_EQ(samples["neuralmesh_sessions_created_total"], 0);
+  EXPECT_EQ(samples["neuralmesh_sessions{state=\"collecting\"}"] +
+                samples["neuralmesh_sessions{state=\"learning\"}"],
+            1);
+}
+
+TEST(MetricsHttpTest, HealthAndOtherPages) {
+  std::unique_ptr<ReconstructionServer> server = StartWithMetrics();
+  ASSERT_NE(server, nullptr);
+  const HttpReply health = HttpGet(server->metrics_port(), "/healthz");
+  EXPECT_EQ(health.status, 200);
+  EXPECT_EQ(health.body, "serving\n");
+  const HttpReply index = HttpGet(server->metrics_port(), "/");
+  EXPECT_EQ(index.status, 200);
+  EXPECT_THAT(index.body, HasSubstr("/metrics"));
+  const HttpReply missing = HttpGet(server->metrics_port(), "/metric");
+  EXPECT_EQ(missing.status, 404);
+  EXPECT_THAT(missing.body, HasSubstr("no page /metric; this server has /metrics and /healthz"));
+
+  MetricsSources stopping;
+  stopping.serving = [] { return false; };
+  http::HttpRequest request;
+  request.method = "GET";
+  request.path = "/healthz";
+  const http::HttpResponse answer = AnswerMetricsRequest(request, stopping);
+  EXPECT_EQ(answer.status, 503);
+  EXPECT_EQ(answer.body, "shutting down\n");
+}
+
+TEST(MetricsHttpTest, NoPageWithoutAPortAndClearErrorsForBadOnes) {
+  std::unique_ptr<ReconstructionServer> plain = testing::StartServer(/*listen=*/true);
+  ASSERT_NE(plain, nullptr);
+  EXPECT_EQ(plain->metrics_port(), -1);
+
+  ServerOptions options;
+  options.address = "127.0.0.1:0";
+  options.metrics_port = 65536;
+  absl::StatusOr<std::unique_ptr<ReconstructionServer>> out_of_range =
+      ReconstructionServer::Start(options);
+  ASSERT_FALSE(out_of_range.ok());
+  EXPECT_EQ(out_of_range.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(out_of_range.status().message(), HasSubstr("metrics_port is 65536"));
+
+  absl::StatusOr<std::unique_ptr<http::HttpServer>> taken = http::HttpServer::Start(
+      "127.0.0.1", 0, [](const http::HttpRequest&) { return http::TextResponse(200, ""); });
+  ASSERT_TRUE(taken.ok());
+  options.metrics_port = (*taken)->port();
+  absl::StatusOr<std::unique_ptr<ReconstructionServer>> in_use =
+      ReconstructionServer::Start(options);
+  ASSERT_FALSE(in_use.ok());
+  EXPECT_EQ(in_use.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_THAT(in_use.status().message(), HasSubstr("metrics page: cannot listen on 127.0.0.1:"));
+}
+
+}  // namespace
+}  // namespace neuralmesh::server

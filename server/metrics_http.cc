@@ -17,8 +17,7 @@ namespace {
 
 // "learning" for SESSION_STATE_LEARNING.
 std::string StateLabel(v1::SessionState state) {
-  return absl::AsciiStrToLower(
-      absl::StripPrefix(v1::SessionState_Name(state), "SESSION_STATE_"));
+  return absl::AsciiStrToLower(absl::StripPrefix(v1::SessionState_Name(state), "SESSION_STATE_"));
 }
 
 }  // namespace
@@ -46,8 +45,8 @@ std::string RenderMetrics(const MetricsSources& sources) {
   out.Sample("neuralmesh_build_info", {{"version", NEURALMESH_VERSION}}, uint64_t{1});
   out.Family("neuralmesh_start_time_seconds", "gauge",
              "When the server started, in seconds since the Unix epoch.");
-  out.Sample("neuralmesh_start_time_seconds", {}, absl::ToDoubleSeconds(
-                                                      sources.start_time - absl::UnixEpoch()));
+  out.Sample("neuralmesh_start_time_seconds", {},
+             absl::ToDoubleSeconds(sources.start_time - absl::UnixEpoch()));
   out.Family("neuralmesh_worker_threads", "gauge",
              "Learning threads, shared by all sessions in time slices (--worker_threads).");
   out.Sample("neuralmesh_worker_threads", {}, static_cast<uint64_t>(sources.worker_threads));
@@ -57,8 +56,8 @@ std::string RenderMetrics(const MetricsSources& sources) {
   }
   out.Family("neuralmesh_sessions_limit", "gauge",
              "Sessions the server holds at most (--max_sessions).");
-  out.Sample("neuralmesh_sessions_limit",
-             {}, static_cast<uint64_t>(sources.sessions->limits().max_sessions));
+  out.Sample("neuralmesh_sessions_limit", {},
+             static_cast<uint64_t>(sources.sessions->limits().max_sessions));
   out.Family("neuralmesh_sessions_to_restore", "gauge",
              "Stored sessions still to be restored after a restart (--state_dir).");
   out.Sample("neuralmesh_sessions_to_restore", {}, static_cast<uint64_t>(census.to_restore));
@@ -90,11 +89,11 @@ http::HttpResponse AnswerMetricsRequest(const http::HttpRequest& request,
                              : http::TextResponse(503, "shutting down");
   }
   if (request.path == "/") {
-    return http::TextResponse(
-        200, "neuralmesh-server: /metrics (Prometheus text format), /healthz");
+    return http::TextResponse(200,
+                              "neuralmesh-server: /metrics (Prometheus text format), /healthz");
   }
-  return http::TextResponse(404, absl::StrCat("no page ", request.path,
-                                              "; this server has /metrics and /healthz"));
+  return http::TextResponse(
+      404, absl::StrCat("no page ", request.path, "; this server has /metrics and /healthz"));
 }
 
 }  // namespace neuralmesh::server

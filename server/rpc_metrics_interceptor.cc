@@ -63,8 +63,7 @@ class RpcMetricsInterceptor : public grpc::experimental::Interceptor {
   bool handled_ = false;
 };
 
-class RpcMetricsInterceptorFactory
-    : public grpc::experimental::ServerInterceptorFactoryInterface {
+class RpcMetricsInterceptorFactory : public grpc::experimental::ServerInterceptorFactoryInterface {
  public:
   explicit RpcMetricsInterceptorFactory(ServerMetrics* metrics) : metrics_(metrics) {}
 

@@ -134,7 +134,8 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
       absl::MutexLock lock(&self->shutdown_mu_);
       return !self->shutting_down_;
     };
-    std::string host = options.metrics_host.empty() ? HostOf(options.address) : options.metrics_host;
+    std::string host =
+        options.metrics_host.empty() ? HostOf(options.address) : options.metrics_host;
     if (host.empty()) host = "127.0.0.1";  // In-process only: no network the server listens on.
     absl::StatusOr<std::unique_ptr<http::HttpServer>> http = http::HttpServer::Start(
         host, options.metrics_port,

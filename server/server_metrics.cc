@@ -24,11 +24,10 @@ absl::string_view RpcTypeName(RpcType type) {
 // gRPC's names of its status codes, as the metrics of other gRPC servers label them.
 absl::string_view StatusCodeName(int code) {
   static constexpr absl::string_view kNames[] = {
-      "OK",           "Canceled",          "Unknown",          "InvalidArgument",
-      "DeadlineExceeded", "NotFound",      "AlreadyExists",    "PermissionDenied",
-      "ResourceExhausted", "FailedPrecondition", "Aborted",    "OutOfRange",
-      "Unimplemented", "Internal",         "Unavailable",      "DataLoss",
-      "Unauthenticated"};
+      "OK",       "Canceled",       "Unknown",          "InvalidArgument",   "DeadlineExceeded",
+      "NotFound", "AlreadyExists",  "PermissionDenied", "ResourceExhausted", "FailedPrecondition",
+      "Aborted",  "OutOfRange",     "Unimplemented",    "Internal",          "Unavailable",
+      "DataLoss", "Unauthenticated"};
   return code >= 0 && code < static_cast<int>(std::size(kNames)) ? kNames[code] : "Unknown";
 }
 
@@ -47,9 +46,8 @@ MetricLabels MethodLabels(absl::string_view full_method, RpcType type) {
 }  // namespace
 
 const std::vector<double>& ServerMetrics::HandlingSecondsBounds() {
-  static const std::vector<double> bounds = {0.001, 0.0025, 0.005, 0.01, 0.025, 0.05,
-                                             0.1,   0.25,   0.5,   1,    2.5,   5,
-                                             10,    30,     60,    300};
+  static const std::vector<double> bounds = {0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25,
+                                             0.5,   1,      2.5,   5,    10,    30,   60,  300};
   return bounds;
 }
 
@@ -99,8 +97,8 @@ void ServerMetrics::CountRpcHandled(absl::string_view full_method, RpcType type,
   const std::vector<double>& bounds = HandlingSecondsBounds();
   const double seconds = absl::ToDoubleSeconds(took);
   if (counts.seconds_buckets.empty()) counts.seconds_buckets.assign(bounds.size() + 1, 0);
-  ++counts.seconds_buckets[std::lower_bound(bounds.begin(), bounds.end(), seconds) -
-                           bounds.begin()];
+  const size_t bucket = std::lower_bound(bounds.begin(), bounds.end(), seconds) - bounds.begin();
+  ++counts.seconds_buckets[bucket];
   counts.seconds_sum += seconds;
 }
 

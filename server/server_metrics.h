@@ -41,13 +41,15 @@ class ServerMetrics {
   void CountSessionCreated() { sessions_created_.fetch_add(1); }
   // `state`: FINISHED, CANCELLED or FAILED (others are ignored).
   void CountSessionEnded(v1::SessionState state);
-  void CountSessionDeleted(bool idle) { (idle ? sessions_reaped_ : sessions_deleted_).fetch_add(1); }
+  void CountSessionDeleted(bool idle) {
+    (idle ? sessions_reaped_ : sessions_deleted_).fetch_add(1);
+  }
 
   // A call of `full_method` ("/package.Service/Method") began; it ended with `code` (a
   // grpc::StatusCode) after `took`.
   void CountRpcStarted(absl::string_view full_method, RpcType type) ABSL_LOCKS_EXCLUDED(mu_);
-  void CountRpcHandled(absl::string_view full_method, RpcType type, int code,
-                       absl::Duration took) ABSL_LOCKS_EXCLUDED(mu_);
+  void CountRpcHandled(absl::string_view full_method, RpcType type, int code, absl::Duration took)
+      ABSL_LOCKS_EXCLUDED(mu_);
 
   // Writes every counter's family and samples.
   void AppendTo(PrometheusText& out) const ABSL_LOCKS_EXCLUDED(mu_);
@@ -56,7 +58,7 @@ class ServerMetrics {
   struct MethodCounts {
     RpcType type = RpcType::kUnary;
     uint64_t started = 0;
-    std::map<int, uint64_t> handled;  // By status code.
+    std::map<int, uint64_t> handled;        // By status code.
     std::vector<uint64_t> seconds_buckets;  // Unary calls: HandlingSecondsBounds() + 1 buckets.
     double seconds_sum = 0;
   };

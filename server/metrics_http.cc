@@ -43,35 +43,30 @@ std::string RenderMetrics(const MetricsSources& sources) {
   PrometheusText out;
   out.Family("neuralmesh_build_info", "gauge", "The server's version, as a label; always 1.");
   out.Sample("neuralmesh_build_info", {{"version", NEURALMESH_VERSION}}, uint64_t{1});
-  out.Family("neuralmesh_start_time_seconds", "gauge",
-             "When the server started, in seconds since the Unix epoch.");
-  out.Sample("neuralmesh_start_time_seconds", {},
+  out.Single("neuralmesh_start_time_seconds", "gauge",
+             "When the server started, in seconds since the Unix epoch.",
              absl::ToDoubleSeconds(sources.start_time - absl::UnixEpoch()));
-  out.Family("neuralmesh_worker_threads", "gauge",
-             "Learning threads, shared by all sessions in time slices (--worker_threads).");
-  out.Sample("neuralmesh_worker_threads", {}, static_cast<uint64_t>(sources.worker_threads));
+  out.Single("neuralmesh_worker_threads", "gauge",
+             "Learning threads, shared by all sessions in time slices (--worker_threads).",
+             static_cast<uint64_t>(sources.worker_threads));
   out.Family("neuralmesh_sessions", "gauge", "Sessions held, by state.");
   for (const auto& [state, count] : by_state) {
     out.Sample("neuralmesh_sessions", {{"state", StateLabel(state)}}, count);
   }
-  out.Family("neuralmesh_sessions_limit", "gauge",
-             "Sessions the server holds at most (--max_sessions).");
-  out.Sample("neuralmesh_sessions_limit", {},
+  out.Single("neuralmesh_sessions_limit", "gauge",
+             "Sessions the server holds at most (--max_sessions).",
              static_cast<uint64_t>(sources.sessions->limits().max_sessions));
-  out.Family("neuralmesh_sessions_to_restore", "gauge",
-             "Stored sessions still to be restored after a restart (--state_dir).");
-  out.Sample("neuralmesh_sessions_to_restore", {}, static_cast<uint64_t>(census.to_restore));
-  out.Family("neuralmesh_points", "gauge", "Points the sessions held have received.");
-  out.Sample("neuralmesh_points", {}, points);
-  out.Family("neuralmesh_outliers_held", "gauge",
-             "Points the sessions hold back as possible outliers, to judge again.");
-  out.Sample("neuralmesh_outliers_held", {}, outliers_held);
-  out.Family("neuralmesh_mesh_vertices", "gauge",
-             "Vertices of the sessions' latest published meshes, summed.");
-  out.Sample("neuralmesh_mesh_vertices", {}, vertices);
-  out.Family("neuralmesh_watchers", "gauge",
-             "Calls following the sessions' meshes (watch streams, waiting GetMesh calls).");
-  out.Sample("neuralmesh_watchers", {}, watchers);
+  out.Single("neuralmesh_sessions_to_restore", "gauge",
+             "Stored sessions still to be restored after a restart (--state_dir).",
+             static_cast<uint64_t>(census.to_restore));
+  out.Single("neuralmesh_points", "gauge", "Points the sessions held have received.", points);
+  out.Single("neuralmesh_outliers_held", "gauge",
+             "Points the sessions hold back as possible outliers, to judge again.", outliers_held);
+  out.Single("neuralmesh_mesh_vertices", "gauge",
+             "Vertices of the sessions' latest published meshes, summed.", vertices);
+  out.Single("neuralmesh_watchers", "gauge",
+             "Calls following the sessions' meshes (watch streams, waiting GetMesh calls).",
+             watchers);
   sources.metrics->AppendTo(out);
   return out.str();
 }

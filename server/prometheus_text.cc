@@ -9,30 +9,18 @@
 namespace neuralmesh::server {
 namespace {
 
-std::string EscapeLabelValue(absl::string_view value) {
+// Backslashes and line feeds escaped, and with `quotes` double quotes (label values; HELP
+// text keeps its quotes).
+std::string Escape(absl::string_view text, bool quotes) {
   std::string out;
-  out.reserve(value.size());
-  for (char c : value) {
+  out.reserve(text.size());
+  for (char c : text) {
     if (c == '\\') {
       out += "\\\\";
-    } else if (c == '"') {
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (c == '"' && quotes) {
       out += "\\\"";
-    } else if (c == '\n') {
-      out += "\\n";
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
-std::string EscapeHelp(absl::string_view help) {
-  std::string out;
-  for (char c : help) {
-    if (c == '\\') {
-      out += "\\\\";
-    } else if (c == '\n') {
-      out += "\\n";
     } else {
       out += c;
     }
@@ -56,8 +44,8 @@ std::string FormatDouble(double value) {
 
 void PrometheusText::Family(absl::string_view name, absl::string_view type,
                             absl::string_view help) {
-  absl::StrAppend(&text_, "# HELP ", name, " ", EscapeHelp(help), "\n# TYPE ", name, " ", type,
-                  "\n");
+  absl::StrAppend(&text_, "# HELP ", name, " ", Escape(help, /*quotes=*/false), "\n# TYPE ", name,
+                  " ", type, "\n");
 }
 
 void PrometheusText::Sample(absl::string_view name, const MetricLabels& labels, uint64_t value) {
@@ -66,6 +54,18 @@ void PrometheusText::Sample(absl::string_view name, const MetricLabels& labels, 
 
 void PrometheusText::Sample(absl::string_view name, const MetricLabels& labels, double value) {
   SampleText(name, labels, FormatDouble(value));
+}
+
+void PrometheusText::Single(absl::string_view name, absl::string_view type, absl::string_view help,
+                            uint64_t value) {
+  Family(name, type, help);
+  Sample(name, {}, value);
+}
+
+void PrometheusText::Single(absl::string_view name, absl::string_view type, absl::string_view help,
+                            double value) {
+  Family(name, type, help);
+  Sample(name, {}, value);
 }
 
 void PrometheusText::Histogram(absl::string_view name, const MetricLabels& labels,
@@ -90,7 +90,7 @@ void PrometheusText::SampleText(absl::string_view name, const MetricLabels& labe
     text_ += '{';
     for (size_t i = 0; i < labels.size(); ++i) {
       absl::StrAppend(&text_, i > 0 ? "," : "", labels[i].first, "=\"",
-                      EscapeLabelValue(labels[i].second), "\"");
+                      Escape(labels[i].second, /*quotes=*/true), "\"");
     }
     text_ += '}';
   }

@@ -39,6 +39,11 @@ class PrometheusText {
   void Sample(absl::string_view name, const MetricLabels& labels, uint64_t value);
   void Sample(absl::string_view name, const MetricLabels& labels, double value);
 
+  // A family of one sample without labels.
+  void Single(absl::string_view name, absl::string_view type, absl::string_view help,
+              uint64_t value);
+  void Single(absl::string_view name, absl::string_view type, absl::string_view help, double value);
+
   // A histogram's samples: for each upper bound in `bounds` (ascending) the count of
   // observations at most that (`counts[i]` observations fell in (bounds[i-1], bounds[i]],
   // counts[bounds.size()] above the last), then le="+Inf", _sum and _count.

@@ -77,20 +77,23 @@ void ServerMetrics::CountSessionEnded(v1::SessionState state) {
   }
 }
 
-void ServerMetrics::CountRpcStarted(absl::string_view full_method, RpcType type) {
-  absl::MutexLock lock(&mu_);
+ServerMetrics::MethodCounts& ServerMetrics::MethodLocked(absl::string_view full_method) {
   auto it = methods_.find(full_method);
   if (it == methods_.end()) it = methods_.emplace(std::string(full_method), MethodCounts()).first;
-  it->second.type = type;
-  ++it->second.started;
+  return it->second;
+}
+
+void ServerMetrics::CountRpcStarted(absl::string_view full_method, RpcType type) {
+  absl::MutexLock lock(&mu_);
+  MethodCounts& counts = MethodLocked(full_method);
+  counts.type = type;
+  ++counts.started;
 }
 
 void ServerMetrics::CountRpcHandled(absl::string_view full_method, RpcType type, int code,
                                     absl::Duration took) {
   absl::MutexLock lock(&mu_);
-  auto it = methods_.find(full_method);
-  if (it == methods_.end()) it = methods_.emplace(std::string(full_method), MethodCounts()).first;
-  MethodCounts& counts = it->second;
+  MethodCounts& counts = MethodLocked(full_method);
   counts.type = type;
   ++counts.handled[code];
   if (type != RpcType::kUnary) return;
@@ -103,24 +106,23 @@ void ServerMetrics::CountRpcHandled(absl::string_view full_method, RpcType type,
 }
 
 void ServerMetrics::AppendTo(PrometheusText& out) const {
-  out.Family("neuralmesh_points_accepted_total", "counter",
-             "Points the sessions took from uploads (outliers held back included).");
-  out.Sample("neuralmesh_points_accepted_total", {}, points_accepted_.load());
-  out.Family("neuralmesh_basic_steps_total", "counter",
-             "Basic Steps (Section 2.1 of the paper) the sessions' learners ran.");
-  out.Sample("neuralmesh_basic_steps_total", {}, basic_steps_.load());
-  out.Family("neuralmesh_learning_seconds_total", "counter",
-             "Time the worker threads spent learning, summed over the threads.");
-  out.Sample("neuralmesh_learning_seconds_total", {},
+  out.Single("neuralmesh_points_accepted_total", "counter",
+             "Points the sessions took from uploads (outliers held back included).",
+             points_accepted_.load());
+  out.Single("neuralmesh_basic_steps_total", "counter",
+             "Basic Steps (Section 2.1 of the paper) the sessions' learners ran.",
+             basic_steps_.load());
+  out.Single("neuralmesh_learning_seconds_total", "counter",
+             "Time the worker threads spent learning, summed over the threads.",
              static_cast<double>(learning_nanoseconds_.load()) * 1e-9);
-  out.Family("neuralmesh_meshes_published_total", "counter",
-             "Meshes published to the sessions' watchers (milestones, refreshes, final meshes).");
-  out.Sample("neuralmesh_meshes_published_total", {}, meshes_published_.load());
-  out.Family("neuralmesh_mesh_bytes_published_total", "counter",
-             "Draco bytes of the meshes published (once per mesh, whatever the watchers).");
-  out.Sample("neuralmesh_mesh_bytes_published_total", {}, mesh_bytes_published_.load());
-  out.Family("neuralmesh_sessions_created_total", "counter", "Sessions created by clients.");
-  out.Sample("neuralmesh_sessions_created_total", {}, sessions_created_.load());
+  out.Single("neuralmesh_meshes_published_total", "counter",
+             "Meshes published to the sessions' watchers (milestones, refreshes, final meshes).",
+             meshes_published_.load());
+  out.Single("neuralmesh_mesh_bytes_published_total", "counter",
+             "Draco bytes of the meshes published (once per mesh, whatever the watchers).",
+             mesh_bytes_published_.load());
+  out.Single("neuralmesh_sessions_created_total", "counter", "Sessions created by clients.",
+             sessions_created_.load());
   out.Family("neuralmesh_sessions_ended_total", "counter",
              "Sessions that reached an end, by how it ended.");
   out.Sample("neuralmesh_sessions_ended_total", {{"state", "finished"}}, sessions_finished_.load());

@@ -62,6 +62,8 @@ class ServerMetrics {
     std::vector<uint64_t> seconds_buckets;  // Unary calls: HandlingSecondsBounds() + 1 buckets.
     double seconds_sum = 0;
   };
+  // The counts of `full_method`, new ones when it had none.
+  MethodCounts& MethodLocked(absl::string_view full_method) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 
   std::atomic<uint64_t> points_accepted_{0};
   std::atomic<uint64_t> basic_steps_{0};

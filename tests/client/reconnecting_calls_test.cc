@@ -360,58 +360,60 @@ class RestoringService final : public v1::ReconstructionService::Service {
   int calls_ ABSL_GUARDED_BY(mu_) = 0;
 };
 
-// The client of a fake server (RestoringService).
-struct FakeServer {
-  explicit FakeServer(grpc::Service* service) {
+// RestoringService on 127.0.0.1, and a client of it.
+class RestoringServer {
+ public:
+  explicit RestoringServer(int restoring) : service_(restoring) {
     grpc::ServerBuilder builder;
+    int port = 0;
     builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
-    builder.RegisterService(service);
-    server = builder.BuildAndStart();
-  }
-  ~FakeServer() { server->Shutdown(); }
-  std::unique_ptr<ReconstructionClient> Client() const {
+    builder.RegisterService(&service_);
+    server_ = builder.BuildAndStart();
     absl::StatusOr<std::unique_ptr<ReconstructionClient>> client =
         ReconstructionClient::Connect(absl::StrCat("127.0.0.1:", port));
     EXPECT_TRUE(client.ok()) << client.status();
-    return client.ok() ? *std::move(client) : nullptr;
+    if (client.ok()) client_ = *std::move(client);
   }
-  int port = 0;
-  std::unique_ptr<grpc::Server> server;
+  ~RestoringServer() { server_->Shutdown(); }
+  // Null when it could not connect.
+  ReconstructionClient* client() const { return client_.get(); }
+  int calls() const { return service_.calls(); }
+
+ private:
+  RestoringService service_;
+  std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<ReconstructionClient> client_;
 };
 
 TEST(ListSessionsReconnectingTest, AListingWaitsUntilTheServerHasRestoredItsSessions) {
-  RestoringService service(/*restoring=*/2);
-  FakeServer fake(&service);
-  std::unique_ptr<ReconstructionClient> client = fake.Client();
-  ASSERT_NE(client, nullptr);
+  RestoringServer server(/*restoring=*/2);
+  ASSERT_NE(server.client(), nullptr);
   Notices notices;
   absl::StatusOr<std::vector<v1::Session>> sessions =
-      ListSessionsReconnecting(*client, notices.Options(absl::Seconds(30)));
+      ListSessionsReconnecting(*server.client(), notices.Options(absl::Seconds(30)));
   ASSERT_TRUE(sessions.ok()) << sessions.status();
   ASSERT_EQ(sessions->size(), 1u);
   EXPECT_EQ((*sessions)[0].session_id(), "s-restored");
-  EXPECT_EQ(service.calls(), 3);
+  EXPECT_EQ(server.calls(), 3);
   EXPECT_THAT(notices.text(), HasSubstr("restoring its sessions after a restart (0 of 2 done)"));
 }
 
 TEST(ListSessionsReconnectingTest, GivesUpWhenTheRestoreOutlastsTheWindowOrAtOnceWithoutOne) {
-  RestoringService service(/*restoring=*/1000000);
-  FakeServer fake(&service);
-  std::unique_ptr<ReconstructionClient> client = fake.Client();
-  ASSERT_NE(client, nullptr);
+  RestoringServer server(/*restoring=*/1000000);
+  ASSERT_NE(server.client(), nullptr);
   Notices notices;
   const absl::Status late =
-      ListSessionsReconnecting(*client, notices.Options(absl::Seconds(1))).status();
+      ListSessionsReconnecting(*server.client(), notices.Options(absl::Seconds(1))).status();
   EXPECT_TRUE(absl::IsUnavailable(late)) << late;
   EXPECT_THAT(late.message(), HasSubstr("did not answer again within 1s"));
-  EXPECT_GT(service.calls(), 1);
+  EXPECT_GT(server.calls(), 1);
 
-  const int before = service.calls();
+  const int before = server.calls();
   const absl::Status at_once =
-      ListSessionsReconnecting(*client, notices.Options(absl::ZeroDuration())).status();
+      ListSessionsReconnecting(*server.client(), notices.Options(absl::ZeroDuration())).status();
   EXPECT_TRUE(absl::IsUnavailable(at_once)) << at_once;
   EXPECT_THAT(at_once.message(), HasSubstr("restoring its sessions"));
-  EXPECT_EQ(service.calls(), before + 1);
+  EXPECT_EQ(server.calls(), before + 1);
 }
 
 }  // namespace

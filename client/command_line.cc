@@ -157,15 +157,21 @@ void PrintCommandList(const std::vector<Subcommand>& commands, std::ostream& out
   for (const Subcommand& c : commands) {
     out << "  " << c.name << std::string(width + 2 - c.name.size(), ' ') << c.summary << "\n";
   }
-  out << "\nRun `neuralmesh COMMAND --help` for the flags of one command.\n";
+  out << "\nRun `neuralmesh COMMAND --help` for the flags of one command, `neuralmesh --version`\n"
+         "for the version.\n";
 }
 
 int RunCommandLine(int argc, char** argv, const std::vector<Subcommand>& commands,
+                   absl::string_view version,
                    std::ostream& out, std::ostream& err) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
     PrintCommandList(commands, err);
     return 2;
+  }
+  if (args[0] == "--version" || args[0] == "version") {
+    out << version << "\n";
+    return 0;
   }
   if (IsHelp(args[0]) || args[0] == "help") {
     if (args.size() > 1) {

@@ -16,6 +16,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 
 namespace neuralmesh::client {
 
@@ -51,10 +52,12 @@ void PrintSubcommandHelp(const Subcommand& command, std::ostream& out);
 // Writes the list of subcommands.
 void PrintCommandList(const std::vector<Subcommand>& commands, std::ostream& out);
 
-// The whole command line: finds the subcommand in argv[1], handles --help / -h / `help CMD`,
-// parses the flags and runs the subcommand. Errors go to `err` as "neuralmesh CMD: message".
-// Returns the process exit code: 0 on success, 1 on a failed command, 2 on a usage error.
+// The whole command line: finds the subcommand in argv[1], handles --help / -h / `help CMD`
+// and --version / `version` (writes `version` and a line break), parses the flags and runs the
+// subcommand. Errors go to `err` as "neuralmesh CMD: message". Returns the process exit code:
+// 0 on success, 1 on a failed command, 2 on a usage error.
 int RunCommandLine(int argc, char** argv, const std::vector<Subcommand>& commands,
+                   absl::string_view version,
                    std::ostream& out, std::ostream& err);
 
 }  // namespace neuralmesh::client

@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include <grpcpp/grpcpp.h>
+
 #include "absl/flags/flag.h"
 #include "absl/status/status.h"
 #include "absl/strings/ascii.h"
@@ -28,6 +30,7 @@
 #include "core/io/file_contents.h"
 #include "core/learning/learner_options.h"
 #include "core/status_macros.h"
+#include "core/version.h"
 
 namespace {
 const neuralmesh::LearnerOptions kLearnerDefaults;
@@ -587,5 +590,9 @@ std::vector<Subcommand> Commands() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return neuralmesh::client::RunCommandLine(argc, argv, Commands(), std::cout, std::cerr);
+  const std::string version =
+      absl::StrCat("neuralmesh ", neuralmesh::NeuralmeshVersion(), " (",
+                   neuralmesh::GeometryLibraryVersions(), ", gRPC ", grpc::Version(), ")");
+  return neuralmesh::client::RunCommandLine(argc, argv, Commands(), version, std::cout,
+                                            std::cerr);
 }

@@ -9,6 +9,8 @@
 #include <string>
 #include <thread>
 
+#include <grpcpp/grpcpp.h>
+
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
@@ -18,6 +20,7 @@
 #include "absl/time/time.h"
 #include "core/io/file_contents.h"
 #include "core/status_macros.h"
+#include "core/version.h"
 #include "server/access_tokens.h"
 #include "server/server.h"
 
@@ -210,6 +213,10 @@ int main(int argc, char** argv) {
     return absl::EndsWith(file, "server/main.cc");
   };
   usage.contains_helpshort_flags = usage.contains_help_flags;
+  usage.version_string = [] {
+    return absl::StrCat("neuralmesh-server ", neuralmesh::NeuralmeshVersion(), " (",
+                        neuralmesh::GeometryLibraryVersions(), ", gRPC ", grpc::Version(), ")\n");
+  };
   absl::SetFlagsUsageConfig(usage);
   absl::SetProgramUsageMessage(
       "Serves Neural Meshes surface reconstruction over gRPC (neuralmesh.v1).\n"

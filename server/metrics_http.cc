@@ -6,11 +6,8 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/strip.h"
+#include "core/version.h"
 #include "server/prometheus_text.h"
-
-#ifndef NEURALMESH_VERSION
-#define NEURALMESH_VERSION "unknown"
-#endif
 
 namespace neuralmesh::server {
 namespace {
@@ -42,7 +39,7 @@ std::string RenderMetrics(const MetricsSources& sources) {
 
   PrometheusText out;
   out.Family("neuralmesh_build_info", "gauge", "The server's version, as a label; always 1.");
-  out.Sample("neuralmesh_build_info", {{"version", NEURALMESH_VERSION}}, uint64_t{1});
+  out.Sample("neuralmesh_build_info", {{"version", NeuralmeshVersion()}}, uint64_t{1});
   out.Single("neuralmesh_start_time_seconds", "gauge",
              "When the server started, in seconds since the Unix epoch.",
              absl::ToDoubleSeconds(sources.start_time - absl::UnixEpoch()));

@@ -2,6 +2,7 @@
 // a subprocess: reconstruct, stats and eval on the built-in shapes.
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <string>
 #include <utility>
 
@@ -303,6 +304,24 @@ TEST(LocalCliHelpTest, NoArgumentsListsTheCommandsAndFails) {
   for (const char* command : {"reconstruct", "stats", "eval", "watch", "sessions"}) {
     EXPECT_TRUE(absl::StrContains(run.err, command)) << command << " not listed:\n" << run.err;
   }
+}
+
+// "NAME 0.1.0 (Draco 1.5.5, OpenMesh 9.0.0, gRPC 1.51.1)", a line of its own.
+bool IsVersionLine(const std::string& name, const std::string& text) {
+  return std::regex_match(text, std::regex(name + " [0-9]+\\.[0-9]+\\.[0-9]+ \\(Draco [0-9.]+, "
+                                                  "OpenMesh [0-9]+\\.[0-9]+\\.[0-9]+, gRPC "
+                                                  "[0-9]+\\.[0-9]+\\.[0-9]+\\)\n"));
+}
+
+TEST(VersionTest, BothProgramsNameTheirVersionAndTheirLibraries) {
+  for (const char* flag : {"--version", "version"}) {
+    const RunResult cli = RunNeuralmesh({flag});
+    EXPECT_EQ(cli.exit_code, 0) << cli.Describe();
+    EXPECT_TRUE(IsVersionLine("neuralmesh", cli.out)) << cli.Describe();
+  }
+  const RunResult server = RunBinary("neuralmesh-server", {"--version"});
+  EXPECT_EQ(server.exit_code, 0) << server.Describe();
+  EXPECT_TRUE(IsVersionLine("neuralmesh-server", server.out)) << server.Describe();
 }
 
 }  // namespace

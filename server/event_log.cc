@@ -17,12 +17,15 @@ EventLog::Sink EventLog::StandardOutput() {
 }
 
 void EventLog::Record(absl::string_view session_id, absl::string_view event) {
+  RecordLine(absl::StrCat("session ", session_id, " ", event));
+}
+
+void EventLog::RecordLine(absl::string_view line) {
   if (!sink_) return;
-  const std::string line =
-      absl::StrCat(absl::FormatTime("%Y-%m-%dT%H:%M:%E3SZ", absl::Now(), absl::UTCTimeZone()),
-                   " session ", session_id, " ", event);
+  const std::string stamped = absl::StrCat(
+      absl::FormatTime("%Y-%m-%dT%H:%M:%E3SZ", absl::Now(), absl::UTCTimeZone()), " ", line);
   absl::MutexLock lock(&mu_);
-  sink_(line);
+  sink_(stamped);
 }
 
 }  // namespace neuralmesh::server

@@ -7,6 +7,9 @@
 // Events: created (by whom, name, target, options that change learning), finished (the final
 // mesh's figures), cancelled (why), failed (why), deleted (by a call, or idle for how long).
 // Point batches and meshes in between are not events: `neuralmesh sessions` shows progress.
+// With --log_calls, the gRPC calls too (call_log_interceptor.h):
+//
+//   2026-12-05T01:30:13.002Z call GetSession from ipv4:10.0.0.7:41240: NOT_FOUND (...) in 0.2 ms
 #ifndef NEURALMESH_SERVER_EVENT_LOG_H_
 #define NEURALMESH_SERVER_EVENT_LOG_H_
 
@@ -32,6 +35,8 @@ class EventLog {
 
   // "<UTC time> session <id> <event>". Thread-safe.
   void Record(absl::string_view session_id, absl::string_view event) ABSL_LOCKS_EXCLUDED(mu_);
+  // "<UTC time> <line>". Thread-safe.
+  void RecordLine(absl::string_view line) ABSL_LOCKS_EXCLUDED(mu_);
 
  private:
   absl::Mutex mu_;

@@ -92,6 +92,10 @@ ABSL_FLAG(absl::Duration, checkpoint_interval, neuralmesh::server::kDefaultCheck
 ABSL_FLAG(bool, log_sessions, true,
           "Print a line on standard output when a session is created, finishes, is cancelled, "
           "fails or is deleted (with the time, the client's address and the figures).");
+ABSL_FLAG(std::string, log_calls, "none",
+          "With --log_sessions, also print a line for gRPC calls: none, errors (every call that "
+          "ends with a status other than OK) or all; each with the method, the client's address "
+          "and token name, the status and message, and how long the call took.");
 ABSL_FLAG(int, metrics_port, -1,
           "Port of the metrics page, on plain HTTP: /metrics (the Prometheus text format: "
           "sessions by state, points, Basic Steps, meshes published, gRPC calls by method and "
@@ -276,6 +280,14 @@ int main(int argc, char** argv) {
   if (absl::GetFlag(FLAGS_log_sessions)) {
     options.event_sink = neuralmesh::server::EventLog::StandardOutput();
   }
+  absl::StatusOr<neuralmesh::server::CallLogLevel> log_calls =
+      neuralmesh::server::ParseCallLogLevel(absl::GetFlag(FLAGS_log_calls));
+  if (!log_calls.ok()) {
+    std::fprintf(stderr, "neuralmesh-server: --log_calls: %s\n",
+                 std::string(log_calls.status().message()).c_str());
+    return 2;
+  }
+  options.log_calls = *log_calls;
   absl::StatusOr<neuralmesh::server::ServerSecurity> security = SecurityFromFlags();
   if (!security.ok()) {
     std::fprintf(stderr, "neuralmesh-server: %s\n", security.status().ToString().c_str());

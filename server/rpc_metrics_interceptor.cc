@@ -63,9 +63,9 @@ class RpcMetricsInterceptor : public grpc::experimental::Interceptor {
   bool handled_ = false;
 };
 
-class RpcMetricsInterceptorFactory : public grpc::experimental::ServerInterceptorFactoryInterface {
+class RpcMetricsFactory : public grpc::experimental::ServerInterceptorFactoryInterface {
  public:
-  explicit RpcMetricsInterceptorFactory(ServerMetrics* metrics) : metrics_(metrics) {}
+  explicit RpcMetricsFactory(ServerMetrics* metrics) : metrics_(metrics) {}
 
   grpc::experimental::Interceptor* CreateServerInterceptor(ServerRpcInfo* info) override {
     return new RpcMetricsInterceptor(info, metrics_);
@@ -77,11 +77,9 @@ class RpcMetricsInterceptorFactory : public grpc::experimental::ServerIntercepto
 
 }  // namespace
 
-std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>>
-RpcMetricsInterceptors(ServerMetrics* metrics) {
-  std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> creators;
-  creators.push_back(std::make_unique<RpcMetricsInterceptorFactory>(metrics));
-  return creators;
+std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>
+RpcMetricsInterceptorFactory(ServerMetrics* metrics) {
+  return std::make_unique<RpcMetricsFactory>(metrics);
 }
 
 }  // namespace neuralmesh::server

@@ -2,7 +2,8 @@
 // begins, handled with the status the server sends (CANCELLED when the call ends without one,
 // as when its client goes away), and the handling time of unary calls.
 //
-//   builder.experimental().SetInterceptorCreators(RpcMetricsInterceptors(metrics));
+//   creators.push_back(RpcMetricsInterceptorFactory(metrics));
+//   builder.experimental().SetInterceptorCreators(std::move(creators));
 //
 // Calls refused before they reach the services (an access token or client certificate the
 // server does not take) are not counted: gRPC answers them before any interceptor runs.
@@ -10,7 +11,6 @@
 #define NEURALMESH_SERVER_RPC_METRICS_INTERCEPTOR_H_
 
 #include <memory>
-#include <vector>
 
 #include <grpcpp/support/server_interceptor.h>
 
@@ -18,9 +18,9 @@
 
 namespace neuralmesh::server {
 
-// The interceptor creators to give a grpc::ServerBuilder; `metrics` must outlive the server.
-std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>>
-RpcMetricsInterceptors(ServerMetrics* metrics);
+// The interceptor creator to give a grpc::ServerBuilder; `metrics` must outlive the server.
+std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>
+RpcMetricsInterceptorFactory(ServerMetrics* metrics);
 
 }  // namespace neuralmesh::server
 

@@ -80,10 +80,11 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
     if (!store.ok()) return store.status();
     server->store_ = *std::move(store);
   }
-  server->manager_ = std::make_unique<SessionManager>(
-      options.limits, server->pool_.get(), server->encoder_.get(),
-      options.event_sink ? std::make_shared<EventLog>(options.event_sink) : nullptr,
-      server->store_.get(), &server->metrics_);
+  const std::shared_ptr<EventLog> log =
+      options.event_sink ? std::make_shared<EventLog>(options.event_sink) : nullptr;
+  server->manager_ =
+      std::make_unique<SessionManager>(options.limits, server->pool_.get(), server->encoder_.get(),
+                                       log, server->store_.get(), &server->metrics_);
   // Stored sessions are restored while the server takes calls (calls on them get UNAVAILABLE
   // until then): a large state directory does not hold up the start.
   server->manager_->StartRestore();
@@ -111,7 +112,12 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, 20 * 1000);
   builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
   builder.RegisterService(server->service_.get());
-  builder.experimental().SetInterceptorCreators(RpcMetricsInterceptors(&server->metrics_));
+  std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> creators;
+  creators.push_back(RpcMetricsInterceptorFactory(&server->metrics_));
+  if (log != nullptr && options.log_calls != CallLogLevel::kNone) {
+    creators.push_back(CallLogInterceptorFactory(log, options.log_calls));
+  }
+  builder.experimental().SetInterceptorCreators(std::move(creators));
   server->server_ = builder.BuildAndStart();
   if (server->server_ == nullptr || (!options.address.empty() && server->port_ == 0)) {
     server->server_.reset();

@@ -15,6 +15,7 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "http/http_server.h"
+#include "server/call_log_interceptor.h"
 #include "server/event_log.h"
 #include "server/executor.h"
 #include "server/reactor_registry.h"
@@ -41,6 +42,8 @@ struct ServerOptions {
   SessionLimits limits;
   // Where each session's creation, end and deletion are recorded (event_log.h); null: nowhere.
   EventLog::Sink event_sink;
+  // Which gRPC calls are recorded there too (call_log_interceptor.h).
+  CallLogLevel log_calls = CallLogLevel::kNone;
   // The state directory (session_store.h): sessions kept on disk and restored at Start, so
   // that they outlive a restart. Empty: sessions live in memory only.
   std::string state_dir;

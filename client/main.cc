@@ -591,8 +591,7 @@ std::vector<Subcommand> Commands() {
 
 int main(int argc, char** argv) {
   const std::string version =
-      absl::StrCat("neuralmesh ", neuralmesh::NeuralmeshVersion(), " (",
-                   neuralmesh::GeometryLibraryVersions(), ", gRPC ", grpc::Version(), ")");
+      neuralmesh::VersionLine("neuralmesh", absl::StrCat("gRPC ", grpc::Version()));
   return neuralmesh::client::RunCommandLine(argc, argv, Commands(), version, std::cout,
                                             std::cerr);
 }

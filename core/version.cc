@@ -13,9 +13,10 @@ namespace neuralmesh {
 
 const char* NeuralmeshVersion() { return NEURALMESH_VERSION; }
 
-std::string GeometryLibraryVersions() {
-  return absl::StrCat("Draco ", draco::kDracoVersion, ", OpenMesh ", OM_GET_VER, ".", OM_GET_MAJ,
-                      ".", OM_GET_MIN);
+std::string VersionLine(absl::string_view program, absl::string_view more) {
+  return absl::StrCat(program, " ", NeuralmeshVersion(), " (Draco ", draco::kDracoVersion,
+                      ", OpenMesh ", OM_GET_VER, ".", OM_GET_MAJ, ".", OM_GET_MIN,
+                      more.empty() ? "" : ", ", more, ")");
 }
 
 }  // namespace neuralmesh

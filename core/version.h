@@ -5,13 +5,17 @@
 
 #include <string>
 
+#include "absl/strings/string_view.h"
+
 namespace neuralmesh {
 
 // "0.1.0".
 const char* NeuralmeshVersion();
 
-// "Draco 1.5.5, OpenMesh 9.0.0": the versions of the headers this build was compiled against.
-std::string GeometryLibraryVersions();
+// "neuralmesh 0.1.0 (Draco 1.5.5, OpenMesh 9.0.0, gRPC 1.51.1)" for `program` "neuralmesh" and
+// `more` "gRPC 1.51.1": the versions of the headers this build was compiled against, then
+// `more` (the libraries core does not know).
+std::string VersionLine(absl::string_view program, absl::string_view more);
 
 }  // namespace neuralmesh
 

@@ -218,8 +218,8 @@ int main(int argc, char** argv) {
   };
   usage.contains_helpshort_flags = usage.contains_help_flags;
   usage.version_string = [] {
-    return absl::StrCat("neuralmesh-server ", neuralmesh::NeuralmeshVersion(), " (",
-                        neuralmesh::GeometryLibraryVersions(), ", gRPC ", grpc::Version(), ")\n");
+    return neuralmesh::VersionLine("neuralmesh-server", absl::StrCat("gRPC ", grpc::Version())) +
+           "\n";
   };
   absl::SetFlagsUsageConfig(usage);
   absl::SetProgramUsageMessage(

@@ -81,6 +81,14 @@ TEST(CallLogTest, AllCallsWithTheClientNameOfTheirToken) {
   const std::vector<std::string> lines = CallLines(events, "CreateSession");
   ASSERT_EQ(lines.size(), 1u);
   EXPECT_THAT(lines[0], HasSubstr(" (client alice): OK in "));
+
+  // A token the server does not take is refused before the call reaches the interceptor.
+  auto stranger = v1::ReconstructionService::NewStub(grpc::CreateChannel(
+      server->target(),
+      grpc::CompositeChannelCredentials(grpc::SslCredentials(tls),
+                                        grpc::AccessTokenCredentials("not-a-token-0123456789"))));
+  EXPECT_EQ(testing::Delete(*stranger, "s-1").error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_THAT(CallLines(events, "DeleteSession"), IsEmpty());
 }
 
 TEST(CallLogTest, LevelsByName) {

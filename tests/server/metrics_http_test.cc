@@ -13,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
+#include "core/version.h"
 #include "http/http_server.h"
 #include "tests/server/server_test_support.h"
 #include "tests/testing/http_client.h"
@@ -65,7 +66,8 @@ TEST(MetricsHttpTest, CountsASessionsWorkAndTheCallsByStatus) {
   std::map<std::string, double> before = Scrape(*server);
   EXPECT_EQ(before["neuralmesh_sessions_created_total"], 0);
   EXPECT_EQ(before["neuralmesh_sessions{state=\"learning\"}"], 0);
-  EXPECT_EQ(before["neuralmesh_build_info{version=\"0.1.0\"}"], 1);
+  EXPECT_EQ(before[absl::StrCat("neuralmesh_build_info{version=\"", NeuralmeshVersion(), "\"}")],
+            1);
 
   const std::string id = testing::MustCreate(*stub, testing::CreateRequest(300));
   v1::UploadPointsResponse uploaded;

@@ -21,8 +21,8 @@
 #include "server/reactor_registry.h"
 #include "server/reconstruction_service.h"
 #include "server/server_credentials.h"
-#include "server/session_manager.h"
 #include "server/server_metrics.h"
+#include "server/session_manager.h"
 #include "server/session_store.h"
 #include "server/worker_pool.h"
 

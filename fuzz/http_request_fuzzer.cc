@@ -11,8 +11,8 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/string_view.h"
-#include "http/http_message.h"
 #include "fuzz/fuzz_check.h"
+#include "http/http_message.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using neuralmesh::http::FindEndOfHead;

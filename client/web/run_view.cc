@@ -9,9 +9,9 @@
 #include "absl/time/clock.h"
 #include "client/interrupt.h"
 #include "client/reconstruction_client.h"
-#include "http/http_server.h"
 #include "client/web/viewer_service.h"
 #include "core/status_macros.h"
+#include "http/http_server.h"
 
 namespace neuralmesh::client::web {
 

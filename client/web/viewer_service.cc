@@ -178,6 +178,16 @@ HttpResponse ViewerService::Handle(const HttpRequest& request) {
   return ErrorResponse(404, absl::StrCat("no such page: ", request.path));
 }
 
+HttpResponse ViewerService::ServerErrorResponse(const absl::Status& status) const {
+  const bool server_answered =
+      absl::IsUnavailable(status) &&
+      client_->channel()->GetState(/*try_to_connect=*/false) == GRPC_CHANNEL_READY;
+  if (!server_answered) return ErrorResponse(HttpStatusOf(status), status.message());
+  HttpResponse response = ErrorResponse(503, status.message());
+  response.headers.emplace_back("Retry-After", "1");
+  return response;
+}
+
 HttpResponse ViewerService::ServeFile(const std::string& file) const {
   absl::StatusOr<std::string> contents =
       ReadFileContents((std::filesystem::path(options_.web_root) / file).string());
@@ -191,7 +201,7 @@ HttpResponse ViewerService::ServeFile(const std::string& file) const {
 HttpResponse ViewerService::ListSessions() {
   absl::StatusOr<std::vector<v1::Session>> sessions = client_->ListSessions();
   if (!sessions.ok()) {
-    return ErrorResponse(HttpStatusOf(sessions.status()), sessions.status().message());
+    return ServerErrorResponse(sessions.status());
   }
   JsonWriter json;
   json.BeginArray();
@@ -203,7 +213,7 @@ HttpResponse ViewerService::ListSessions() {
 HttpResponse ViewerService::GetSession(const std::string& session_id) {
   absl::StatusOr<v1::Session> session = client_->GetSession(session_id);
   if (!session.ok()) {
-    return ErrorResponse(HttpStatusOf(session.status()), session.status().message());
+    return ServerErrorResponse(session.status());
   }
   JsonWriter json;
   WriteSessionJson(*session, json);
@@ -273,7 +283,7 @@ HttpResponse ViewerService::GetMesh(const std::string& session_id, const HttpReq
     // Only sessions that exist get a watch: an unknown id costs one call, not a stream.
     absl::StatusOr<v1::Session> session = client_->GetSession(session_id);
     if (!session.ok()) {
-      return ErrorResponse(HttpStatusOf(session.status()), session.status().message());
+      return ServerErrorResponse(session.status());
     }
   }
   std::shared_ptr<MeshRelay> relay = RelayFor(session_id);
@@ -300,7 +310,7 @@ HttpResponse ViewerService::GetMesh(const std::string& session_id, const HttpReq
         410, absl::StrCat("session ", session_id, " has ended: its last mesh was sequence ",
                           state.latest == nullptr ? 0 : state.latest->sequence()));
   }
-  return ErrorResponse(HttpStatusOf(state.end_status), state.end_status.message());
+  return ServerErrorResponse(state.end_status);
 }
 
 }  // namespace neuralmesh::client::web

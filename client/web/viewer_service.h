@@ -31,8 +31,8 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "client/reconstruction_client.h"
-#include "http/http_message.h"
 #include "client/web/mesh_relay.h"
+#include "http/http_message.h"
 
 namespace neuralmesh::client::web {
 
@@ -71,6 +71,11 @@ class ViewerService {
   void Stop();
 
  private:
+  // The answer to a browser whose request failed at the server with `status`, as an HTTP status
+  // that says what it means: UNAVAILABLE from a server that answered it (the channel is
+  // connected: the server is restoring its sessions after a restart, or shutting down) is 503
+  // with Retry-After; UNAVAILABLE from a server out of reach is 502 (Bad Gateway).
+  http::HttpResponse ServerErrorResponse(const absl::Status& status) const;
   http::HttpResponse ServeFile(const std::string& file) const;
   http::HttpResponse ListSessions();
   http::HttpResponse GetSession(const std::string& session_id);

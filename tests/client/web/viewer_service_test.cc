@@ -3,6 +3,7 @@
 #include "client/web/viewer_service.h"
 
 #include <gmock/gmock.h>
+#include <grpcpp/server_builder.h>
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -13,11 +14,11 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
-#include "http/http_server.h"
 #include "client/web/run_view.h"
 #include "client/web/viewer_key.h"
 #include "core/io/draco_codec.h"
 #include "core/sampling/implicit_surfaces.h"
+#include "http/http_server.h"
 #include "tests/client/web/viewer_test_support.h"
 #include "tests/server/server_test_support.h"
 
@@ -348,6 +349,56 @@ TEST(ViewerServiceWithoutServerTest, AnUnreachableServerIsABadGateway) {
   EXPECT_THAT(response.body, HasSubstr("ListSessions"));
   request.path = "/api/sessions/s-1/mesh";
   EXPECT_EQ(viewer.Handle(request).status, 502);
+}
+
+// A server that is up but answers every session call with UNAVAILABLE, as one restoring its
+// sessions after a restart does (server/session_manager.h).
+class RestoringService final : public v1::ReconstructionService::Service {
+ public:
+  grpc::Status ListSessions(grpc::ServerContext*, const v1::ListSessionsRequest*,
+                            v1::ListSessionsResponse*) override {
+    return Restoring();
+  }
+  grpc::Status GetSession(grpc::ServerContext*, const v1::GetSessionRequest*,
+                          v1::Session*) override {
+    return Restoring();
+  }
+
+ private:
+  static grpc::Status Restoring() {
+    return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                        "the server is restoring its sessions after a restart (1 of 3 done)");
+  }
+};
+
+TEST(ViewerServiceWithoutServerTest, AServerThatIsRestoringIsUnavailableForAMoment) {
+  RestoringService service;
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+  builder.RegisterService(&service);
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  ASSERT_NE(server, nullptr);
+  absl::StatusOr<std::unique_ptr<ReconstructionClient>> client =
+      ReconstructionClient::Connect(absl::StrCat("127.0.0.1:", port));
+  ASSERT_TRUE(client.ok()) << client.status();
+  ViewerOptions viewer_options;
+  viewer_options.web_root = DefaultWebRoot();
+  ViewerService viewer(*std::move(client), viewer_options);
+
+  HttpRequest request;
+  request.method = "GET";
+  for (const char* path : {"/api/sessions", "/api/sessions/s-1", "/api/sessions/s-1/mesh"}) {
+    request.path = path;
+    const HttpResponse response = viewer.Handle(request);
+    EXPECT_EQ(response.status, 503) << path;
+    EXPECT_THAT(response.body, HasSubstr("restoring its sessions after a restart (1 of 3 done)"))
+        << path;
+    EXPECT_THAT(response.headers,
+                ::testing::Contains(std::make_pair(std::string("Retry-After"), std::string("1"))))
+        << path;
+  }
+  server->Shutdown();
 }
 
 }  // namespace

@@ -64,7 +64,15 @@ ABSL_FLAG(std::string, client_certificate_role, "",
           "With --tls_client_ca_file and without --access_tokens_file: admin, user or reader. "
           "The common name of a client's certificate names its client, which has this role "
           "(as a named token's, see --access_tokens_file): with user, each client sees and "
-          "changes only the sessions it created. Empty: every client may do everything.");
+          "changes only the sessions it created. With --client_roles_file, the role of the "
+          "common names it does not list. Empty: every client may do everything (with "
+          "--client_roles_file: only those it lists may call).");
+ABSL_FLAG(std::string, client_roles_file, "",
+          "With --tls_client_ca_file and without --access_tokens_file: a file of client roles, "
+          "one per line as 'COMMON_NAME ROLE' (the role last: admin, user or reader, as for "
+          "--access_tokens_file; '#' starts a comment line). A client whose certificate's common "
+          "name is listed has that role; others get --client_certificate_role, or are refused "
+          "(PERMISSION_DENIED). SIGHUP reads the file again (calls already running go on).");
 ABSL_FLAG(std::string, access_tokens_file, "",
           "File of access tokens, one per line as 'TOKEN [CLIENT [ROLE]]' ('#' starts a "
           "comment line; a token has at least 16 printable characters); set: every call except "
@@ -132,6 +140,19 @@ absl::StatusOr<std::vector<neuralmesh::server::AccessToken>> AccessTokensFromFla
   return tokens;
 }
 
+// The roles of --client_roles_file, which is set.
+absl::StatusOr<neuralmesh::server::ClientRoles> ClientRolesFromFlag() {
+  NM_ASSIGN_OR_RETURN(const std::string text,
+                      ReadFlagFile("client_roles_file", absl::GetFlag(FLAGS_client_roles_file)));
+  absl::StatusOr<neuralmesh::server::ClientRoles> roles =
+      neuralmesh::server::ParseClientRoles(text);
+  if (!roles.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--client_roles_file: ", roles.status().message()));
+  }
+  return roles;
+}
+
 // The TLS identity of --tls_cert_file, --tls_key_file and --tls_client_ca_file.
 absl::StatusOr<neuralmesh::server::ServerTls> TlsFromFlags() {
   neuralmesh::server::ServerTls tls;
@@ -157,6 +178,9 @@ absl::StatusOr<neuralmesh::server::ServerSecurity> SecurityFromFlags() {
   if (!absl::GetFlag(FLAGS_access_tokens_file).empty()) {
     NM_ASSIGN_OR_RETURN(security.access_tokens, AccessTokensFromFlag());
   }
+  if (!absl::GetFlag(FLAGS_client_roles_file).empty()) {
+    NM_ASSIGN_OR_RETURN(security.client_roles, ClientRolesFromFlag());
+  }
   if (const std::string role = absl::GetFlag(FLAGS_client_certificate_role); !role.empty()) {
     absl::StatusOr<neuralmesh::server::AccessRole> parsed =
         neuralmesh::server::ParseAccessRole(role);
@@ -169,12 +193,13 @@ absl::StatusOr<neuralmesh::server::ServerSecurity> SecurityFromFlags() {
   return security;
 }
 
-// On SIGHUP: the files of --tls_cert_file, --tls_key_file and --tls_client_ca_file, and of
-// --access_tokens_file, replace what the server has; what is now wrong leaves the old in place,
-// and the reason is printed.
+// On SIGHUP: the files of --tls_cert_file, --tls_key_file and --tls_client_ca_file, of
+// --access_tokens_file and of --client_roles_file replace what the server has; what is now
+// wrong leaves the old in place, and the reason is printed.
 void ReloadSecurity(neuralmesh::server::ReconstructionServer& server) {
   const bool tls = !absl::GetFlag(FLAGS_tls_cert_file).empty();
   const bool tokens_file = !absl::GetFlag(FLAGS_access_tokens_file).empty();
+  const bool roles_file = !absl::GetFlag(FLAGS_client_roles_file).empty();
   if (!tls && !tokens_file) {
     std::printf("neuralmesh-server: SIGHUP received; no TLS or access tokens files to read "
                 "again\n");
@@ -201,6 +226,18 @@ void ReloadSecurity(neuralmesh::server::ReconstructionServer& server) {
     } else {
       std::fprintf(stderr,
                    "neuralmesh-server: SIGHUP received; the old access tokens stay: %s\n",
+                   std::string(replaced.message()).c_str());
+    }
+  }
+  if (roles_file) {
+    absl::StatusOr<neuralmesh::server::ClientRoles> roles = ClientRolesFromFlag();
+    const size_t count = roles.ok() ? roles->size() : 0;
+    const absl::Status replaced =
+        roles.ok() ? server.ReplaceClientRoles(*std::move(roles)) : roles.status();
+    if (replaced.ok()) {
+      std::printf("neuralmesh-server: SIGHUP received; %zu client roles read again\n", count);
+    } else {
+      std::fprintf(stderr, "neuralmesh-server: SIGHUP received; the old client roles stay: %s\n",
                    std::string(replaced.message()).c_str());
     }
   }
@@ -314,20 +351,27 @@ int main(int argc, char** argv) {
     return 1;
   }
   const neuralmesh::server::ServerSecurity& secured = options.security;
+  std::string clients;
+  if (!secured.access_tokens.empty()) {
+    clients = absl::StrCat(", ", secured.access_tokens.size(), " access tokens");
+  } else if (secured.names_clients_by_certificate()) {
+    clients = ", clients named by their certificates";
+    if (!secured.client_roles.empty()) {
+      absl::StrAppend(&clients, ", ", secured.client_roles.size(), " with roles of their own");
+    }
+    if (secured.client_certificate_role.has_value()) {
+      absl::StrAppend(&clients, secured.client_roles.empty() ? " as " : ", others as ",
+                      neuralmesh::server::AccessRoleName(*secured.client_certificate_role), "s");
+    } else {
+      absl::StrAppend(&clients, ", others refused");
+    }
+  }
   std::printf("neuralmesh-server listening on %s:%d (%d worker threads; %s%s)\n",
               absl::GetFlag(FLAGS_host).c_str(), (*server)->port(), options.worker_threads,
-              !secured.tls.enabled()                            ? "plaintext"
-              : secured.tls.client_ca_certificates.empty()      ? "TLS"
-                                                                : "mutual TLS",
-              secured.access_tokens.empty()
-                  ? (secured.client_certificate_role.has_value()
-                         ? absl::StrCat(", clients named by their certificates as ",
-                                        neuralmesh::server::AccessRoleName(
-                                            *secured.client_certificate_role),
-                                        "s")
-                         : std::string())
-                        .c_str()
-                  : absl::StrCat(", ", secured.access_tokens.size(), " access tokens").c_str());
+              !secured.tls.enabled()                       ? "plaintext"
+              : secured.tls.client_ca_certificates.empty() ? "TLS"
+                                                           : "mutual TLS",
+              clients.c_str());
   if ((*server)->metrics_port() >= 0) {
     const std::string metrics_host = options.metrics_host.empty() ? absl::GetFlag(FLAGS_host)
                                                                    : options.metrics_host;

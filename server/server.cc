@@ -69,6 +69,9 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
 
   std::unique_ptr<ReconstructionServer> server(new ReconstructionServer(options));
   server->token_checker_ = credentials->token_checker;
+  if (!options.security.client_roles.empty()) {
+    server->certificate_identity_ = credentials->certificate_identity;
+  }
   server->tls_identity_ = credentials->tls_identity;
   server->pool_ = std::make_unique<WorkerPool>(options.worker_threads, options.time_slice);
   server->encoder_ = std::make_unique<Executor>(options.encoder_threads);
@@ -179,6 +182,16 @@ absl::Status ReconstructionServer::ReplaceAccessTokens(std::vector<AccessToken> 
         "the server was started without access tokens; tokens cannot be added to it running");
   }
   return token_checker_->ReplaceTokens(std::move(tokens));
+}
+
+absl::Status ReconstructionServer::ReplaceClientRoles(ClientRoles roles) {
+  if (certificate_identity_ == nullptr) {
+    return absl::FailedPreconditionError(
+        "the server was started without client roles; they cannot be added to it running");
+  }
+  if (roles.empty()) return absl::InvalidArgumentError("no client roles");
+  certificate_identity_->ReplaceRoles(std::move(roles));
+  return absl::OkStatus();
 }
 
 absl::Status ReconstructionServer::ReplaceTls(const ServerTls& tls) {

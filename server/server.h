@@ -104,6 +104,11 @@ class ReconstructionServer {
   // turn mutual TLS on or off.
   absl::Status ReplaceTls(const ServerTls& tls);
 
+  // Replaces the roles of clients named by their certificates (ServerSecurity::client_roles)
+  // for calls that start from now on. FAILED_PRECONDITION when the server was started without
+  // client roles; INVALID_ARGUMENT (the old roles kept) for an empty map.
+  absl::Status ReplaceClientRoles(ClientRoles roles);
+
   SessionManager& sessions() { return *manager_; }
   // Blocks until the sessions of options.state_dir are restored (at once without one), and
   // returns what restoring found. Start returns before, and the server answers meanwhile
@@ -124,6 +129,8 @@ class ReconstructionServer {
   std::unique_ptr<SessionManager> manager_;
   std::unique_ptr<ReconstructionService> service_;
   std::shared_ptr<AccessTokenChecker> token_checker_;  // Null without access tokens.
+  // Null unless started with client roles.
+  std::shared_ptr<ClientCertificateIdentity> certificate_identity_;
   std::shared_ptr<ServerTlsIdentity> tls_identity_;    // Null without TLS; outlives server_.
   std::unique_ptr<http::HttpServer> metrics_http_;  // Null without a metrics port.
   std::unique_ptr<grpc::Server> server_;  // Destroyed first.

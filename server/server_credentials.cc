@@ -20,17 +20,19 @@ absl::StatusOr<PortCredentials> MakeServerCredentials(const ServerSecurity& secu
       return absl::InvalidArgumentError(
           "access tokens need TLS: without it they would cross the network in the clear");
     }
-    return PortCredentials{grpc::InsecureServerCredentials(), nullptr, nullptr};
+    PortCredentials plaintext;
+    plaintext.credentials = grpc::InsecureServerCredentials();
+    return plaintext;
   }
-  if (security.client_certificate_role.has_value()) {
+  if (security.names_clients_by_certificate()) {
     if (tls.client_ca_certificates.empty()) {
       return absl::InvalidArgumentError(
-          "a client certificate role needs mutual TLS (client CAs): without it clients present "
+          "client certificate roles need mutual TLS (client CAs): without it clients present "
           "no certificate");
     }
     if (!security.access_tokens.empty()) {
       return absl::InvalidArgumentError(
-          "a client certificate role and access tokens do not go together: with tokens, each "
+          "client certificate roles and access tokens do not go together: with tokens, each "
           "token names its client and role");
     }
   }
@@ -45,9 +47,10 @@ absl::StatusOr<PortCredentials> MakeServerCredentials(const ServerSecurity& secu
     if (!checker.ok()) return checker.status();
     port.token_checker = *std::move(checker);
     port.credentials->SetAuthMetadataProcessor(port.token_checker);
-  } else if (security.client_certificate_role.has_value()) {
-    port.credentials->SetAuthMetadataProcessor(
-        std::make_shared<ClientCertificateIdentity>(*security.client_certificate_role));
+  } else if (security.names_clients_by_certificate()) {
+    port.certificate_identity = std::make_shared<ClientCertificateIdentity>(
+        security.client_roles, security.client_certificate_role);
+    port.credentials->SetAuthMetadataProcessor(port.certificate_identity);
   }
   return port;
 }

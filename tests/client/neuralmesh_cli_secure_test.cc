@@ -282,6 +282,54 @@ TEST_F(SecureCliTest, SighupReadsTheTokensFileAgain) {
   EXPECT_EQ(with_token(Path("wrong_token")).exit_code, 0);
 }
 
+// Under mutual TLS, --client_roles_file gives each certificate's common name its role; SIGHUP
+// reads the file again.
+TEST_F(SecureCliTest, SighupReadsTheClientRolesFileAgain) {
+  const std::string roles = Path("client_roles");
+  ASSERT_TRUE(WriteFileContents(roles, "neuralmesh-test-client user\n").ok());
+  std::string error;
+  std::unique_ptr<TestServer> server =
+      TestServer::Start({"--tls_cert_file=" + certs().Path("server.pem"),
+                         "--tls_key_file=" + certs().Path("server.key"),
+                         "--tls_client_ca_file=" + certs().Path("ca.pem"),
+                         "--client_roles_file=" + roles},
+                        &error);
+  ASSERT_NE(server, nullptr) << error;
+  EXPECT_THAT(server->Stdout(), HasSubstr("mutual TLS, clients named by their certificates, 1 "
+                                          "with roles of their own, others refused"));
+  auto as = [&](const std::string& certificate) {
+    return RunNeuralmesh({"sessions", "--server=" + server->address(),
+                          "--tls_ca_file=" + certs().Path("ca.pem"),
+                          "--tls_cert_file=" + certs().Path(certificate + ".pem"),
+                          "--tls_key_file=" + certs().Path(certificate + ".key")});
+  };
+  EXPECT_EQ(as("client").exit_code, 0);
+  const RunResult unlisted = as("second_client");
+  EXPECT_NE(unlisted.exit_code, 0);
+  EXPECT_THAT(unlisted.err, HasSubstr("\"neuralmesh-test-second_client\" has no role"));
+
+  ASSERT_TRUE(WriteFileContents(roles, "neuralmesh-test-client user\n"
+                                       "neuralmesh-test-second_client reader\n")
+                  .ok());
+  server->Signal(SIGHUP);
+  for (int i = 0; i < 100 && !absl::StrContains(server->Stdout(), "client roles read again");
+       ++i) {
+    usleep(50 * 1000);
+  }
+  EXPECT_THAT(server->Stdout(), HasSubstr("SIGHUP received; 2 client roles read again"));
+  EXPECT_EQ(as("second_client").exit_code, 0) << as("second_client").Describe();
+
+  // A file that went wrong keeps the roles the server has.
+  ASSERT_TRUE(WriteFileContents(roles, "neuralmesh-test-client owner\n").ok());
+  server->Signal(SIGHUP);
+  for (int i = 0; i < 100 && !absl::StrContains(server->Stderr(), "stay"); ++i) {
+    usleep(50 * 1000);
+  }
+  EXPECT_THAT(server->Stderr(),
+              HasSubstr("the old client roles stay: --client_roles_file: line 1: unknown role"));
+  EXPECT_EQ(as("second_client").exit_code, 0);
+}
+
 TEST_F(SecureCliTest, TheServerRefusesSecurityFlagsThatDoNotGoTogetherAndDocumentsThem) {
   const std::string cert = "--tls_cert_file=" + certs().Path("server.pem");
   const std::string key = "--tls_key_file=" + certs().Path("server.key");

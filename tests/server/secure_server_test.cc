@@ -328,6 +328,8 @@ TEST_F(SecureServerTest, StartRejectsSecurityThatDoesNotGoTogether) {
   role_and_tokens.tls.client_ca_certificates = certs().ca;
   role_and_tokens.access_tokens = {kToken};
   role_and_tokens.client_certificate_role = AccessRole::kUser;
+  ServerSecurity roles_without_mutual_tls = Tls();
+  roles_without_mutual_tls.client_roles = {{"neuralmesh-test-client", AccessRole::kUser}};
   const Case cases[] = {
       {"tokens without TLS", tokens_without_tls, absl::StatusCode::kInvalidArgument,
        "access tokens need TLS"},
@@ -341,7 +343,9 @@ TEST_F(SecureServerTest, StartRejectsSecurityThatDoesNotGoTogether) {
       {"another certificate's key", wrong_key, absl::StatusCode::kInvalidArgument,
        "rejected the TLS certificate or key"},
       {"a client certificate role without mutual TLS", role_without_mutual_tls,
-       absl::StatusCode::kInvalidArgument, "needs mutual TLS"},
+       absl::StatusCode::kInvalidArgument, "need mutual TLS"},
+      {"client roles without mutual TLS", roles_without_mutual_tls,
+       absl::StatusCode::kInvalidArgument, "need mutual TLS"},
       {"a client certificate role and tokens", role_and_tokens,
        absl::StatusCode::kInvalidArgument, "do not go together"},
   };

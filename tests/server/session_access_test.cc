@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
@@ -17,6 +18,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/draco_codec.h"
 #include "core/sampling/implicit_surfaces.h"
+#include "server/client_certificate_identity.h"
 #include "server/server.h"
 #include "tests/server/server_test_support.h"
 #include "tests/testing/temp_dir.h"
@@ -299,6 +301,98 @@ TEST_F(SessionAccessTest, ClientCertificatesNameTheirClientsUnderMutualTls) {
   EXPECT_TRUE(absl::StrContains(create.error_message(),
                                 "client neuralmesh-test-client is a reader"))
       << create.error_message();
+}
+
+// --client_roles_file gives each common name a role of its own; common names it does not
+// list get --client_certificate_role, or are refused without one; SIGHUP replaces the roles.
+TEST_F(SessionAccessTest, ClientRolesByCommonName) {
+  const auto start = [](ClientRoles roles, std::optional<AccessRole> others) {
+    ServerOptions options;
+    options.security.tls.certificate_chain = certificates_->server_chain;
+    options.security.tls.private_key = certificates_->server_key;
+    options.security.tls.client_ca_certificates = certificates_->ca;
+    options.security.client_roles = std::move(roles);
+    options.security.client_certificate_role = others;
+    return testing::StartServer(/*listen=*/true, options);
+  };
+  const auto presenting = [](const ReconstructionServer& server, const std::string& chain,
+                             const std::string& key) {
+    grpc::SslCredentialsOptions tls;
+    tls.pem_root_certs = certificates_->ca;
+    tls.pem_cert_chain = chain;
+    tls.pem_private_key = key;
+    return v1::ReconstructionService::NewStub(
+        grpc::CreateChannel(server.target(), grpc::SslCredentials(tls)));
+  };
+  const auto create = [](v1::ReconstructionService::Stub& stub) {
+    grpc::ClientContext context;
+    v1::Session session;
+    return stub.CreateSession(&context, CreateRequest(200), &session);
+  };
+
+  std::unique_ptr<ReconstructionServer> server =
+      start({{"neuralmesh-test-client", AccessRole::kUser}}, std::nullopt);
+  ASSERT_NE(server, nullptr);
+  auto listed = presenting(*server, certificates_->client_chain, certificates_->client_key);
+  auto unlisted =
+      presenting(*server, certificates_->second_client_chain, certificates_->second_client_key);
+  EXPECT_TRUE(create(*listed).ok());
+  const grpc::Status refused = create(*unlisted);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_TRUE(absl::StrContains(refused.error_message(),
+                                "common name \"neuralmesh-test-second_client\" has no role"))
+      << refused.error_message();
+
+  // The second client listed as a reader: it sees, and still creates nothing.
+  ASSERT_TRUE(server
+                  ->ReplaceClientRoles({{"neuralmesh-test-client", AccessRole::kUser},
+                                        {"neuralmesh-test-second_client", AccessRole::kReader}})
+                  .ok());
+  EXPECT_EQ(Listed(*unlisted).size(), 1u);
+  const grpc::Status reader = create(*unlisted);
+  EXPECT_EQ(reader.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_TRUE(absl::StrContains(reader.error_message(), "is a reader")) << reader.error_message();
+  EXPECT_TRUE(absl::IsInvalidArgument(server->ReplaceClientRoles({})));
+
+  // Others as users: the unlisted client creates sessions of its own.
+  std::unique_ptr<ReconstructionServer> others_users =
+      start({{"neuralmesh-test-client", AccessRole::kReader}}, AccessRole::kUser);
+  ASSERT_NE(others_users, nullptr);
+  auto reader_now =
+      presenting(*others_users, certificates_->client_chain, certificates_->client_key);
+  auto user_now = presenting(*others_users, certificates_->second_client_chain,
+                             certificates_->second_client_key);
+  EXPECT_EQ(create(*reader_now).error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_TRUE(create(*user_now).ok());
+
+  // A server that names no clients by certificate has no roles to replace.
+  std::unique_ptr<ReconstructionServer> plain = testing::StartServer(/*listen=*/true);
+  ASSERT_NE(plain, nullptr);
+  EXPECT_TRUE(absl::IsFailedPrecondition(
+      plain->ReplaceClientRoles({{"neuralmesh-test-client", AccessRole::kUser}})));
+}
+
+TEST(ParseClientRolesTest, CommonNamesMayHoldSpacesAndTheRoleComesLast) {
+  absl::StatusOr<ClientRoles> roles = ParseClientRoles(
+      "# scanners\nscanner-01 user\n  Jane Doe\treader  \n\nops admin\n");
+  ASSERT_TRUE(roles.ok()) << roles.status();
+  EXPECT_EQ(*roles, (ClientRoles{{"scanner-01", AccessRole::kUser},
+                                 {"Jane Doe", AccessRole::kReader},
+                                 {"ops", AccessRole::kAdmin}}));
+  const struct {
+    const char* text;
+    const char* message;
+  } bad[] = {
+      {"scanner-01\n", "line 1: expected COMMON_NAME ROLE"},
+      {"a user\nb owner\n", "line 2: unknown role"},
+      {"a user\na reader\n", "line 2: the common name \"a\" is listed twice"},
+      {"# nobody\n\n", "no client in it"},
+  };
+  for (const auto& b : bad) {
+    const absl::Status status = ParseClientRoles(b.text).status();
+    EXPECT_TRUE(absl::IsInvalidArgument(status)) << b.text;
+    EXPECT_TRUE(absl::StrContains(status.message(), b.message)) << status;
+  }
 }
 
 }  // namespace

@@ -68,8 +68,8 @@ class CallLogInterceptor : public grpc::experimental::Interceptor {
     if (!status.error_message().empty()) {
       absl::StrAppend(&line, " (", OneLine(status.error_message()), ")");
     }
-    absl::StrAppend(&line, absl::StrFormat(" in %.1f ms",
-                                           absl::ToDoubleMilliseconds(absl::Now() - start_)));
+    absl::StrAppend(
+        &line, absl::StrFormat(" in %.1f ms", absl::ToDoubleMilliseconds(absl::Now() - start_)));
     log_->RecordLine(line);
   }
 

@@ -3,14 +3,13 @@
 #include "server/call_log_interceptor.h"
 
 #include <gmock/gmock.h>
+#include <grpcpp/security/credentials.h>
 #include <gtest/gtest.h>
 
 #include <memory>
 #include <regex>
 #include <string>
 #include <vector>
-
-#include <grpcpp/security/credentials.h>
 
 #include "absl/strings/match.h"
 #include "tests/server/server_test_support.h"
@@ -51,8 +50,9 @@ TEST(CallLogTest, ErrorsOnlyEachOnOneLineWithWhoWhatAndHowLong) {
   const std::vector<std::string> lines = CallLines(events, "GetSession");
   ASSERT_EQ(lines.size(), 1u);
   EXPECT_TRUE(std::regex_match(
-      lines[0], std::regex("[0-9-]+T[0-9:.]+Z call GetSession from ipv4:127\\.0\\.0\\.1:[0-9]+: "
-                           "NOT_FOUND \\(no session with id \"s-no such\"\\) in [0-9]+\\.[0-9] ms")))
+      lines[0],
+      std::regex("[0-9-]+T[0-9:.]+Z call GetSession from ipv4:127\\.0\\.0\\.1:[0-9]+: "
+                 "NOT_FOUND \\(no session with id \"s-no such\"\\) in [0-9]+\\.[0-9] ms")))
       << lines[0];
 }
 

@@ -72,6 +72,17 @@ class SessionAccessTest : public ::testing::Test {
     unnamed_ = As(kUnnamed);
   }
 
+  // A client of `server` (under mutual TLS) that presents the certificate `chain` with `key`.
+  static std::unique_ptr<Service> Presenting(const ReconstructionServer& server,
+                                             const std::string& chain, const std::string& key) {
+    grpc::SslCredentialsOptions tls;
+    tls.pem_root_certs = certificates_->ca;
+    tls.pem_cert_chain = chain;
+    tls.pem_private_key = key;
+    return v1::ReconstructionService::NewStub(
+        grpc::CreateChannel(server.target(), grpc::SslCredentials(tls)));
+  }
+
   // A client of the server whose every call carries `token`.
   std::unique_ptr<Service> As(const char* token) {
     grpc::SslCredentialsOptions tls;
@@ -266,20 +277,11 @@ TEST_F(SessionAccessTest, ClientCertificatesNameTheirClientsUnderMutualTls) {
     options.security.client_certificate_role = role;
     return testing::StartServer(/*listen=*/true, options);
   };
-  const auto presenting = [](const ReconstructionServer& server, const std::string& chain,
-                             const std::string& key) {
-    grpc::SslCredentialsOptions tls;
-    tls.pem_root_certs = certificates_->ca;
-    tls.pem_cert_chain = chain;
-    tls.pem_private_key = key;
-    return v1::ReconstructionService::NewStub(
-        grpc::CreateChannel(server.target(), grpc::SslCredentials(tls)));
-  };
   std::unique_ptr<ReconstructionServer> users = start(AccessRole::kUser);
   ASSERT_NE(users, nullptr);
-  auto first = presenting(*users, certificates_->client_chain, certificates_->client_key);
+  auto first = Presenting(*users, certificates_->client_chain, certificates_->client_key);
   auto second =
-      presenting(*users, certificates_->second_client_chain, certificates_->second_client_key);
+      Presenting(*users, certificates_->second_client_chain, certificates_->second_client_key);
   const std::string id = MustCreate(*first, CreateRequest(200));
   ASSERT_FALSE(id.empty());
   EXPECT_EQ(testing::GetSession(*first, id).owner(), "neuralmesh-test-client");
@@ -293,7 +295,7 @@ TEST_F(SessionAccessTest, ClientCertificatesNameTheirClientsUnderMutualTls) {
 
   std::unique_ptr<ReconstructionServer> readers = start(AccessRole::kReader);
   ASSERT_NE(readers, nullptr);
-  auto reader = presenting(*readers, certificates_->client_chain, certificates_->client_key);
+  auto reader = Presenting(*readers, certificates_->client_chain, certificates_->client_key);
   grpc::ClientContext context;
   v1::Session refused;
   const grpc::Status create = reader->CreateSession(&context, CreateRequest(200), &refused);
@@ -315,15 +317,6 @@ TEST_F(SessionAccessTest, ClientRolesByCommonName) {
     options.security.client_certificate_role = others;
     return testing::StartServer(/*listen=*/true, options);
   };
-  const auto presenting = [](const ReconstructionServer& server, const std::string& chain,
-                             const std::string& key) {
-    grpc::SslCredentialsOptions tls;
-    tls.pem_root_certs = certificates_->ca;
-    tls.pem_cert_chain = chain;
-    tls.pem_private_key = key;
-    return v1::ReconstructionService::NewStub(
-        grpc::CreateChannel(server.target(), grpc::SslCredentials(tls)));
-  };
   const auto create = [](v1::ReconstructionService::Stub& stub) {
     grpc::ClientContext context;
     v1::Session session;
@@ -333,9 +326,9 @@ TEST_F(SessionAccessTest, ClientRolesByCommonName) {
   std::unique_ptr<ReconstructionServer> server =
       start({{"neuralmesh-test-client", AccessRole::kUser}}, std::nullopt);
   ASSERT_NE(server, nullptr);
-  auto listed = presenting(*server, certificates_->client_chain, certificates_->client_key);
+  auto listed = Presenting(*server, certificates_->client_chain, certificates_->client_key);
   auto unlisted =
-      presenting(*server, certificates_->second_client_chain, certificates_->second_client_key);
+      Presenting(*server, certificates_->second_client_chain, certificates_->second_client_key);
   EXPECT_TRUE(create(*listed).ok());
   const grpc::Status refused = create(*unlisted);
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::PERMISSION_DENIED);
@@ -359,8 +352,8 @@ TEST_F(SessionAccessTest, ClientRolesByCommonName) {
       start({{"neuralmesh-test-client", AccessRole::kReader}}, AccessRole::kUser);
   ASSERT_NE(others_users, nullptr);
   auto reader_now =
-      presenting(*others_users, certificates_->client_chain, certificates_->client_key);
-  auto user_now = presenting(*others_users, certificates_->second_client_chain,
+      Presenting(*others_users, certificates_->client_chain, certificates_->client_key);
+  auto user_now = Presenting(*others_users, certificates_->second_client_chain,
                              certificates_->second_client_key);
   EXPECT_EQ(create(*reader_now).error_code(), grpc::StatusCode::PERMISSION_DENIED);
   EXPECT_TRUE(create(*user_now).ok());

@@ -211,9 +211,7 @@ TEST_F(SecureCliTest, SighupRenewsTheCertificate) {
   ASSERT_TRUE(WriteFileContents(cert, renewed->server_chain).ok());
   ASSERT_TRUE(WriteFileContents(key, renewed->server_key).ok());
   server->Signal(SIGHUP);
-  for (int i = 0; i < 100 && !absl::StrContains(server->Stdout(), "TLS certificate and key read"); ++i) {
-    usleep(50 * 1000);
-  }
+  server->AwaitStdout("TLS certificate and key read");
   EXPECT_THAT(server->Stdout(), HasSubstr("SIGHUP received; TLS certificate and key read again"));
   RunResult renewed_sessions;
   for (int i = 0; i < 20; ++i) {  // gRPC takes the new identity within a second.
@@ -229,9 +227,7 @@ TEST_F(SecureCliTest, SighupRenewsTheCertificate) {
   // The old CA's key with the renewed certificate: refused, the renewed identity stays.
   ASSERT_TRUE(WriteFileContents(key, certs().server_key).ok());
   server->Signal(SIGHUP);
-  for (int i = 0; i < 100 && !absl::StrContains(server->Stderr(), "stays"); ++i) {
-    usleep(50 * 1000);
-  }
+  server->AwaitStderr("stays");
   EXPECT_THAT(server->Stderr(), HasSubstr("the old TLS certificate stays: gRPC rejected the TLS "
                                           "certificate or key"));
   usleep(1500 * 1000);  // Past gRPC's next read of its copies.
@@ -261,10 +257,7 @@ TEST_F(SecureCliTest, SighupReadsTheTokensFileAgain) {
   // The file now holds the other token: after SIGHUP it is the one accepted.
   ASSERT_TRUE(WriteFileContents(tokens, ReadWholeFile(Path("wrong_token"))).ok());
   server->Signal(SIGHUP);
-  for (int i = 0; i < 100 && !absl::StrContains(server->Stdout(), "access tokens read again");
-       ++i) {
-    usleep(50 * 1000);
-  }
+  server->AwaitStdout("access tokens read again");
   EXPECT_THAT(server->Stdout(), HasSubstr("SIGHUP received; 1 access tokens read again"));
   EXPECT_EQ(with_token(Path("wrong_token")).exit_code, 0);
   const RunResult old_token = with_token(Path("token"));
@@ -274,9 +267,7 @@ TEST_F(SecureCliTest, SighupReadsTheTokensFileAgain) {
   // A file that went wrong keeps the tokens the server has.
   ASSERT_TRUE(WriteFileContents(tokens, "short\n").ok());
   server->Signal(SIGHUP);
-  for (int i = 0; i < 100 && !absl::StrContains(server->Stderr(), "stay"); ++i) {
-    usleep(50 * 1000);
-  }
+  server->AwaitStderr("stay");
   EXPECT_THAT(server->Stderr(),
               HasSubstr("the old access tokens stay: --access_tokens_file: line 1"));
   EXPECT_EQ(with_token(Path("wrong_token")).exit_code, 0);
@@ -312,19 +303,14 @@ TEST_F(SecureCliTest, SighupReadsTheClientRolesFileAgain) {
                                        "neuralmesh-test-second_client reader\n")
                   .ok());
   server->Signal(SIGHUP);
-  for (int i = 0; i < 100 && !absl::StrContains(server->Stdout(), "client roles read again");
-       ++i) {
-    usleep(50 * 1000);
-  }
+  server->AwaitStdout("client roles read again");
   EXPECT_THAT(server->Stdout(), HasSubstr("SIGHUP received; 2 client roles read again"));
   EXPECT_EQ(as("second_client").exit_code, 0) << as("second_client").Describe();
 
   // A file that went wrong keeps the roles the server has.
   ASSERT_TRUE(WriteFileContents(roles, "neuralmesh-test-client owner\n").ok());
   server->Signal(SIGHUP);
-  for (int i = 0; i < 100 && !absl::StrContains(server->Stderr(), "stay"); ++i) {
-    usleep(50 * 1000);
-  }
+  server->AwaitStderr("stay");
   EXPECT_THAT(server->Stderr(),
               HasSubstr("the old client roles stay: --client_roles_file: line 1: unknown role"));
   EXPECT_EQ(as("second_client").exit_code, 0);

@@ -203,9 +203,15 @@ ABSL_FLAG(std::string, web_root, "",
 ABSL_FLAG(std::string, view_key_file, "",
           "view: a file holding a key (16 or more letters, digits or -._~) that every browser "
           "must bring: it opens http://HOST:PORT/?key=KEY once (printed at start) and keeps "
-          "the key in a cookie; other clients send 'Authorization: Bearer KEY'. Plain HTTP: "
-          "it keeps out who does not know the URL, not who can read the traffic. Empty: "
-          "anyone who reaches --listen is let in.");
+          "the key in a cookie; other clients send 'Authorization: Bearer KEY'. Over plain "
+          "HTTP it keeps out who does not know the URL, not who can read the traffic (see "
+          "--view_tls_cert_file). Empty: anyone who reaches --listen is let in.");
+ABSL_FLAG(std::string, view_tls_cert_file, "",
+          "view: PEM file with the viewer's certificate (then any intermediates): browsers "
+          "connect over HTTPS (https://HOST:PORT/), and the key's cookie is sent over HTTPS "
+          "only. Needs --view_tls_key_file. Read once, at start.");
+ABSL_FLAG(std::string, view_tls_key_file, "",
+          "view: PEM file with the private key of --view_tls_cert_file.");
 
 // Reports.
 ABSL_FLAG(bool, json, false, "Print JSON instead of text.");
@@ -290,6 +296,18 @@ constexpr const char* kConnectionFlags[] = {
     "tls_key_file",    "tls_server_name", "access_token_file", "max_message_bytes"};
 
 // How to reach the server: --connect_timeout, TLS and the access token.
+// The contents of the file that flag --`flag` names; empty when it names none. The error
+// names the flag.
+absl::StatusOr<std::string> FlagFileContents(const char* flag, const std::string& path) {
+  if (path.empty()) return std::string();
+  absl::StatusOr<std::string> contents = neuralmesh::ReadFileContents(path);
+  if (!contents.ok()) {
+    return absl::Status(contents.status().code(),
+                        absl::StrCat("--", flag, ": ", contents.status().message()));
+  }
+  return contents;
+}
+
 absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
   neuralmesh::client::ClientOptions o;
   o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
@@ -310,13 +328,7 @@ absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
       {"tls_key_file", absl::GetFlag(FLAGS_tls_key_file), &security.tls.private_key},
       {"access_token_file", absl::GetFlag(FLAGS_access_token_file), &security.access_token}};
   for (const FileFlag& file : files) {
-    if (file.path.empty()) continue;
-    absl::StatusOr<std::string> contents = neuralmesh::ReadFileContents(file.path);
-    if (!contents.ok()) {
-      return absl::Status(contents.status().code(),
-                          absl::StrCat("--", file.flag, ": ", contents.status().message()));
-    }
-    *file.contents = *std::move(contents);
+    NM_ASSIGN_OR_RETURN(*file.contents, FlagFileContents(file.flag, file.path));
   }
   security.access_token = std::string(absl::StripAsciiWhitespace(security.access_token));
   security.tls.server_name = absl::GetFlag(FLAGS_tls_server_name);
@@ -495,7 +507,7 @@ absl::Status View(const ParsedArgs& args) {
   o.web_root = absl::GetFlag(FLAGS_web_root);
   NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
   if (const std::string key_file = absl::GetFlag(FLAGS_view_key_file); !key_file.empty()) {
-    absl::StatusOr<std::string> contents = neuralmesh::ReadFileContents(key_file);
+    absl::StatusOr<std::string> contents = FlagFileContents("view_key_file", key_file);
     if (contents.ok()) contents = neuralmesh::client::web::ParseViewerKey(*contents);
     if (!contents.ok()) {
       return absl::Status(contents.status().code(),
@@ -503,6 +515,11 @@ absl::Status View(const ParsedArgs& args) {
     }
     o.key = *std::move(contents);
   }
+  NM_ASSIGN_OR_RETURN(o.tls_certificate_chain,
+                      FlagFileContents("view_tls_cert_file",
+                                       absl::GetFlag(FLAGS_view_tls_cert_file)));
+  NM_ASSIGN_OR_RETURN(o.tls_private_key, FlagFileContents("view_tls_key_file",
+                                                          absl::GetFlag(FLAGS_view_tls_key_file)));
   return neuralmesh::client::web::RunView(o, std::cout, std::cerr);
 }
 
@@ -575,14 +592,16 @@ std::vector<Subcommand> Commands() {
       SessionActionCommand("delete", "Removes a server session, its meshes and its files.", "",
                            neuralmesh::client::SessionAction::kDelete),
       {"view",
-       "view --server HOST:PORT [--listen HOST:PORT] [--view_key_file FILE]",
+       "view --server HOST:PORT [--listen HOST:PORT] [--view_key_file FILE]\n"
+       "     [--view_tls_cert_file FILE --view_tls_key_file FILE]",
        "Serves a live 3D viewer of the server's sessions to web browsers.",
        "Serves a web page (http://HOST:PORT/ of --listen) that lists the sessions of the\n"
        "server and shows the chosen one's mesh as it learns: each published mesh is fetched\n"
        "Draco-encoded, decoded in the browser and drawn with three.js, coarse to fine, until\n"
        "the final mesh. It opens on the newest session still learning;\n"
        "http://HOST:PORT/?session=ID goes straight to a session. Runs until Ctrl-C.",
-       WithConnectionFlags({"server", "listen", "web_root", "view_key_file"}),
+       WithConnectionFlags({"server", "listen", "web_root", "view_key_file", "view_tls_cert_file",
+                            "view_tls_key_file"}),
        View},
   };
 }

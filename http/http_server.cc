@@ -1,6 +1,8 @@
 #include "http/http_server.h"
 
 #include <netdb.h>
+#include <pthread.h>
+#include <signal.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/eventfd.h>
@@ -15,6 +17,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "http/server_connection.h"
 
 namespace neuralmesh::http {
 namespace {
@@ -24,31 +27,21 @@ void SetTimeout(int fd, int option, absl::Duration timeout) {
   setsockopt(fd, SOL_SOCKET, option, &tv, sizeof(tv));
 }
 
-// Writes all of `data`; false when the peer went away or stopped reading.
-bool SendAll(int fd, absl::string_view data) {
-  while (!data.empty()) {
-    const ssize_t sent = send(fd, data.data(), data.size(), MSG_NOSIGNAL);
-    if (sent < 0 && errno == EINTR) continue;
-    if (sent <= 0) return false;
-    data.remove_prefix(static_cast<size_t>(sent));
+void Respond(ServerConnection& connection, const HttpResponse& response, bool with_body) {
+  if (connection.SendAll(SerializeHttpResponseHead(response)) && with_body) {
+    connection.SendAll(response.body);
   }
-  return true;
-}
-
-void Respond(int fd, const HttpResponse& response, bool with_body) {
-  if (SendAll(fd, SerializeHttpResponseHead(response)) && with_body) SendAll(fd, response.body);
 }
 
 // Reads until the end of the request head. NOT_FOUND when the peer closed or timed out before
 // sending one, RESOURCE_EXHAUSTED when the head is too long.
-absl::StatusOr<std::string> ReadRequestHead(int fd) {
+absl::StatusOr<std::string> ReadRequestHead(ServerConnection& connection) {
   std::string bytes;
   char buffer[4096];
   while (true) {
-    const ssize_t got = recv(fd, buffer, sizeof(buffer), 0);
-    if (got < 0 && errno == EINTR) continue;
-    if (got <= 0) return absl::NotFoundError("no request");
-    bytes.append(buffer, static_cast<size_t>(got));
+    const size_t got = connection.Receive(buffer, sizeof(buffer));
+    if (got == 0) return absl::NotFoundError("no request");
+    bytes.append(buffer, got);
     const size_t end = FindEndOfHead(bytes);
     if (end != 0 && end <= kMaxRequestHeadBytes) {
       bytes.resize(end);
@@ -59,6 +52,15 @@ absl::StatusOr<std::string> ReadRequestHead(int fd) {
           absl::StrCat("the request head is longer than ", kMaxRequestHeadBytes, " bytes"));
     }
   }
+}
+
+// SSL_write writes with write(2), which raises SIGPIPE when the client has gone; in this
+// connection's thread the signal stays pending instead, and is dropped when the thread ends.
+void BlockSigpipeInThisThread() {
+  sigset_t pipe;
+  sigemptyset(&pipe);
+  sigaddset(&pipe, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipe, nullptr);
 }
 
 }  // namespace
@@ -115,6 +117,10 @@ absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const std::string&
   }
   auto server = std::unique_ptr<HttpServer>(
       new HttpServer(fd, wake, bound_port, std::move(handler), options));
+  {
+    absl::MutexLock lock(&server->mu_);
+    server->tls_ = options.tls;
+  }
   server->accept_thread_ = std::thread([s = server.get()] { s->AcceptLoop(); });
   return server;
 }
@@ -124,12 +130,23 @@ HttpServer::HttpServer(int listen_fd, int wake_fd, int port, HttpHandler handler
     : listen_fd_(listen_fd),
       wake_fd_(wake_fd),
       port_(port),
+      speaks_tls_(options.tls != nullptr),
       handler_(std::move(handler)),
       options_(options) {}
 
 HttpServer::~HttpServer() {
   Shutdown();
   close(wake_fd_);
+}
+
+absl::Status HttpServer::ReplaceTls(std::shared_ptr<const TlsServerContext> tls) {
+  if (!speaks_tls_) {
+    return absl::FailedPreconditionError("this HTTP server was started without TLS");
+  }
+  if (tls == nullptr) return absl::InvalidArgumentError("no TLS context to replace with");
+  absl::MutexLock lock(&mu_);
+  tls_ = std::move(tls);
+  return absl::OkStatus();
 }
 
 void HttpServer::Shutdown() {
@@ -167,11 +184,14 @@ void HttpServer::AcceptLoop() {
         return;
       }
       if (static_cast<int>(open_fds_.size()) >= options_.max_connections) {
-        Respond(
-            fd,
-            TextResponse(503, absl::StrCat("the viewer serves at most ", options_.max_connections,
-                                           " connections at once: try again")),
-            true);
+        if (!speaks_tls_) {  // A TLS client could not read the answer before a handshake.
+          ServerConnection connection(fd);
+          Respond(connection,
+                  TextResponse(503, absl::StrCat("this server serves at most ",
+                                                 options_.max_connections,
+                                                 " connections at once: try again")),
+                  true);
+        }
         close(fd);
         continue;
       }
@@ -180,7 +200,11 @@ void HttpServer::AcceptLoop() {
     try {
       std::thread([this, fd] { Serve(fd); }).detach();
     } catch (const std::system_error&) {  // No thread to be had: refuse this one.
-      Respond(fd, TextResponse(503, "the viewer cannot start a thread: try again"), true);
+      if (!speaks_tls_) {
+        ServerConnection connection(fd);
+        Respond(connection, TextResponse(503, "this server cannot start a thread: try again"),
+                true);
+      }
       absl::MutexLock lock(&mu_);
       open_fds_.erase(fd);
       close(fd);
@@ -189,26 +213,41 @@ void HttpServer::AcceptLoop() {
 }
 
 void HttpServer::Serve(int fd) {
-  absl::StatusOr<std::string> head = ReadRequestHead(fd);
-  if (head.ok()) {
-    absl::StatusOr<HttpRequest> request = ParseHttpRequestHead(*head);
-    if (!request.ok()) {
-      Respond(fd, TextResponse(400, request.status().message()), true);
-    } else if (request->method != "GET" && request->method != "HEAD") {
-      HttpResponse response = TextResponse(
-          405, absl::StrCat("method ", request->method, " is not allowed: use GET or HEAD"));
-      response.headers.emplace_back("Allow", "GET, HEAD");
-      Respond(fd, response, true);
-    } else {
-      Respond(fd, handler_(*request), request->method == "GET");
+  BlockSigpipeInThisThread();
+  std::shared_ptr<const TlsServerContext> tls;
+  {
+    absl::MutexLock lock(&mu_);
+    tls = tls_;
+  }
+  ServerConnection connection(fd);
+  // Under TLS a request in plain HTTP is still read and answered, in plain HTTP, so that a
+  // browser or scraper pointed at http:// learns why.
+  const bool plain_on_tls = tls != nullptr && !connection.StartsWithTlsHandshake();
+  if (tls == nullptr || plain_on_tls || connection.AcceptTls(*tls).ok()) {
+    absl::StatusOr<std::string> head = ReadRequestHead(connection);
+    if (head.ok() && plain_on_tls) {
+      Respond(connection,
+              TextResponse(400, "this port speaks HTTPS only: use an https:// address"), true);
+    } else if (head.ok()) {
+      absl::StatusOr<HttpRequest> request = ParseHttpRequestHead(*head);
+      if (!request.ok()) {
+        Respond(connection, TextResponse(400, request.status().message()), true);
+      } else if (request->method != "GET" && request->method != "HEAD") {
+        HttpResponse response = TextResponse(
+            405, absl::StrCat("method ", request->method, " is not allowed: use GET or HEAD"));
+        response.headers.emplace_back("Allow", "GET, HEAD");
+        Respond(connection, response, true);
+      } else {
+        Respond(connection, handler_(*request), request->method == "GET");
+      }
+    } else if (absl::IsResourceExhausted(head.status())) {
+      Respond(connection, TextResponse(431, head.status().message()), true);
     }
-  } else if (absl::IsResourceExhausted(head.status())) {
-    Respond(fd, TextResponse(431, head.status().message()), true);
+    connection.EndSending();
   }
   // A lingering close: closing with unread bytes (the rest of a refused request) would reset
   // the connection, and the client could lose the answer. Read what the client still sends
-  // until it closes its side, for at most a second.
-  shutdown(fd, SHUT_WR);
+  // until it closes its side, for at most a second (under TLS, its records unread).
   SetTimeout(fd, SO_RCVTIMEO, absl::Seconds(1));
   char discard[4096];
   for (size_t drained = 0; drained < (size_t{1} << 20);) {

@@ -15,8 +15,9 @@ packages=(
   # Libraries fixed by the design card.
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libabsl-dev libdraco-dev libopenmesh-dev libgtest-dev libgmock-dev
-  # zlib: the CRC-32 of the server's points journal (gRPC needs it too).
-  zlib1g-dev
+  # zlib: the CRC-32 of the server's points journal; OpenSSL: HTTPS for the viewer and the
+  # metrics page (gRPC needs both too).
+  zlib1g-dev libssl-dev
   # Benchmarks.
   libbenchmark-dev
   # Tests and tools: the reference Draco binaries, an independent Python gRPC client, and

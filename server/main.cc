@@ -21,6 +21,7 @@
 #include "core/io/file_contents.h"
 #include "core/status_macros.h"
 #include "core/version.h"
+#include "http/bearer_token.h"
 #include "server/access_tokens.h"
 #include "server/server.h"
 
@@ -105,12 +106,23 @@ ABSL_FLAG(std::string, log_calls, "none",
           "ends with a status other than OK) or all; each with the method, the client's address "
           "and token name, the status and message, and how long the call took.");
 ABSL_FLAG(int, metrics_port, -1,
-          "Port of the metrics page, on plain HTTP: /metrics (the Prometheus text format: "
+          "Port of the metrics page, on plain HTTP (or HTTPS: --metrics_tls): /metrics (the "
+          "Prometheus text format: "
           "sessions by state, points, Basic Steps, meshes published, gRPC calls by method and "
           "status; totals only, no session ids or names) and /healthz (200 while serving, 503 "
           "while shutting down). 0 picks a free one (printed at start); -1: none.");
 ABSL_FLAG(std::string, metrics_host, "",
           "Address the metrics page listens on; empty: --host's.");
+ABSL_FLAG(bool, metrics_tls, false,
+          "Serve the metrics page over HTTPS with the certificate and key of --tls_cert_file "
+          "and --tls_key_file (SIGHUP renews it with them); no client certificate is asked "
+          "for. Needs --metrics_port and --tls_cert_file.");
+ABSL_FLAG(std::string, metrics_token_file, "",
+          "File holding a token (16 or more letters, digits or -._~) that /metrics asks for "
+          "as 'Authorization: Bearer TOKEN' (401 otherwise; Prometheus: authorization."
+          "credentials_file); /healthz stays open to probes. SIGHUP reads it again. Needs "
+          "--metrics_port; use it with --metrics_tls, or the token crosses the network in the "
+          "clear.");
 ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(5),
           "On SIGTERM/SIGINT, how long calls may take to end before they are cancelled.");
 
@@ -193,16 +205,30 @@ absl::StatusOr<neuralmesh::server::ServerSecurity> SecurityFromFlags() {
   return security;
 }
 
+// The token of --metrics_token_file ("" without the flag).
+absl::StatusOr<std::string> MetricsTokenFromFlag() {
+  const std::string path = absl::GetFlag(FLAGS_metrics_token_file);
+  if (path.empty()) return std::string();
+  NM_ASSIGN_OR_RETURN(const std::string contents, ReadFlagFile("metrics_token_file", path));
+  absl::StatusOr<std::string> token = neuralmesh::http::ParseSecret(contents, "the metrics token");
+  if (!token.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--metrics_token_file: ", token.status().message()));
+  }
+  return token;
+}
+
 // On SIGHUP: the files of --tls_cert_file, --tls_key_file and --tls_client_ca_file, of
-// --access_tokens_file and of --client_roles_file replace what the server has; what is now
-// wrong leaves the old in place, and the reason is printed.
+// --access_tokens_file, of --client_roles_file and of --metrics_token_file replace what the
+// server has; what is now wrong leaves the old in place, and the reason is printed.
 void ReloadSecurity(neuralmesh::server::ReconstructionServer& server) {
   const bool tls = !absl::GetFlag(FLAGS_tls_cert_file).empty();
   const bool tokens_file = !absl::GetFlag(FLAGS_access_tokens_file).empty();
   const bool roles_file = !absl::GetFlag(FLAGS_client_roles_file).empty();
-  if (!tls && !tokens_file) {
-    std::printf("neuralmesh-server: SIGHUP received; no TLS or access tokens files to read "
-                "again\n");
+  const bool metrics_token_file = !absl::GetFlag(FLAGS_metrics_token_file).empty();
+  if (!tls && !tokens_file && !metrics_token_file) {
+    std::printf("neuralmesh-server: SIGHUP received; no TLS, access tokens or metrics token "
+                "files to read again\n");
   }
   if (tls) {
     absl::StatusOr<neuralmesh::server::ServerTls> identity = TlsFromFlags();
@@ -238,6 +264,17 @@ void ReloadSecurity(neuralmesh::server::ReconstructionServer& server) {
       std::printf("neuralmesh-server: SIGHUP received; %zu client roles read again\n", count);
     } else {
       std::fprintf(stderr, "neuralmesh-server: SIGHUP received; the old client roles stay: %s\n",
+                   std::string(replaced.message()).c_str());
+    }
+  }
+  if (metrics_token_file) {
+    absl::StatusOr<std::string> token = MetricsTokenFromFlag();
+    const absl::Status replaced =
+        token.ok() ? server.ReplaceMetricsToken(*token) : token.status();
+    if (replaced.ok()) {
+      std::printf("neuralmesh-server: SIGHUP received; metrics token read again\n");
+    } else {
+      std::fprintf(stderr, "neuralmesh-server: SIGHUP received; the old metrics token stays: %s\n",
                    std::string(replaced.message()).c_str());
     }
   }
@@ -306,6 +343,7 @@ int main(int argc, char** argv) {
   options.checkpoint_interval = absl::GetFlag(FLAGS_checkpoint_interval);
   options.metrics_port = absl::GetFlag(FLAGS_metrics_port);
   options.metrics_host = absl::GetFlag(FLAGS_metrics_host);
+  options.metrics_tls = absl::GetFlag(FLAGS_metrics_tls);
   if (options.checkpoint_interval < absl::ZeroDuration() ||
       options.checkpoint_interval == absl::InfiniteDuration()) {
     std::fprintf(stderr,
@@ -331,6 +369,12 @@ int main(int argc, char** argv) {
     return 2;
   }
   options.security = *std::move(security);
+  absl::StatusOr<std::string> metrics_token = MetricsTokenFromFlag();
+  if (!metrics_token.ok()) {
+    std::fprintf(stderr, "neuralmesh-server: %s\n", metrics_token.status().ToString().c_str());
+    return 2;
+  }
+  options.metrics_token = *std::move(metrics_token);
   // PackedPoints: 12 bytes a point for the position, 4 for a weight, 12 for a normal.
   constexpr int64_t kLargestPackedPointBytes = 28;
   if (max_batch > options.max_message_bytes / kLargestPackedPointBytes) {
@@ -372,11 +416,14 @@ int main(int argc, char** argv) {
               : secured.tls.client_ca_certificates.empty() ? "TLS"
                                                            : "mutual TLS",
               clients.c_str());
-  if ((*server)->metrics_port() >= 0) {
-    const std::string metrics_host = options.metrics_host.empty() ? absl::GetFlag(FLAGS_host)
-                                                                   : options.metrics_host;
-    std::printf("neuralmesh-server: metrics on http://%s:%d/metrics\n", metrics_host.c_str(),
-                (*server)->metrics_port());
+  if (const std::string url = (*server)->metrics_url(); !url.empty()) {
+    std::printf("neuralmesh-server: metrics on %s%s\n", url.c_str(),
+                options.metrics_token.empty() ? "" : " (with the token of --metrics_token_file)");
+    if (!options.metrics_token.empty() && !options.metrics_tls) {
+      std::fprintf(stderr,
+                   "neuralmesh-server: warning: the metrics token crosses the network in the "
+                   "clear; --metrics_tls serves the page over HTTPS\n");
+    }
   }
   std::fflush(stdout);
   // The stored sessions are restored while the server answers; the report comes when it is done.

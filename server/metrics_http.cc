@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/strip.h"
 #include "core/version.h"
+#include "http/bearer_token.h"
 #include "server/prometheus_text.h"
 
 namespace neuralmesh::server {
@@ -18,6 +19,18 @@ std::string StateLabel(v1::SessionState state) {
 }
 
 }  // namespace
+
+bool MetricsAccess::Admits(const http::HttpRequest& request) const {
+  absl::MutexLock lock(&mu_);
+  return token_.empty() || http::SameSecret(http::BearerTokenOf(request), token_);
+}
+
+absl::Status MetricsAccess::Replace(std::string token) {
+  if (token.empty()) return absl::InvalidArgumentError("an empty metrics token");
+  absl::MutexLock lock(&mu_);
+  token_ = std::move(token);
+  return absl::OkStatus();
+}
 
 std::string RenderMetrics(const MetricsSources& sources) {
   const SessionManager::Census census = sources.sessions->TakeCensus();
@@ -71,6 +84,14 @@ std::string RenderMetrics(const MetricsSources& sources) {
 http::HttpResponse AnswerMetricsRequest(const http::HttpRequest& request,
                                         const MetricsSources& sources) {
   if (request.path == "/metrics") {
+    if (sources.access != nullptr && !sources.access->Admits(request)) {
+      return http::BearerChallenge(
+          "neuralmesh metrics",
+          http::BearerTokenOf(request).empty()
+              ? "/metrics needs the token of --metrics_token_file: send 'Authorization: Bearer "
+                "TOKEN'"
+              : "/metrics refused the token: it is not the one of --metrics_token_file");
+    }
     http::HttpResponse response = http::TextResponse(200, "");
     response.content_type = kPrometheusTextContentType;
     response.body = RenderMetrics(sources);

@@ -11,6 +11,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "core/status_macros.h"
+#include "http/bearer_token.h"
+#include "http/tls_server_context.h"
 #include "server/metrics_http.h"
 #include "server/rpc_metrics_interceptor.h"
 
@@ -62,6 +65,34 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   if (options.metrics_port < -1 || options.metrics_port > 65535) {
     return absl::InvalidArgumentError(absl::StrCat(
         "metrics_port is ", options.metrics_port, "; it must be in [0, 65535], or -1 for none"));
+  }
+  if ((options.metrics_tls || !options.metrics_token.empty()) && options.metrics_port < 0) {
+    return absl::InvalidArgumentError(
+        "metrics_tls and metrics_token are for the metrics page, and there is none "
+        "(metrics_port)");
+  }
+  if (options.metrics_tls && !options.security.tls.enabled()) {
+    return absl::InvalidArgumentError(
+        "metrics_tls serves the metrics page with the server's TLS certificate, and there is "
+        "none (tls_cert_file)");
+  }
+  if (!options.metrics_token.empty()) {
+    absl::StatusOr<std::string> token = http::ParseSecret(options.metrics_token, "the metrics token");
+    if (!token.ok()) return token.status();
+    if (*token != options.metrics_token) {
+      return absl::InvalidArgumentError("the metrics token has whitespace around it");
+    }
+  }
+  std::shared_ptr<const http::TlsServerContext> metrics_tls;
+  if (options.metrics_tls) {
+    absl::StatusOr<std::shared_ptr<const http::TlsServerContext>> context =
+        http::TlsServerContext::Create(options.security.tls.certificate_chain,
+                                       options.security.tls.private_key);
+    if (!context.ok()) {
+      return absl::Status(context.status().code(),
+                          absl::StrCat("metrics page: ", context.status().message()));
+    }
+    metrics_tls = *std::move(context);
   }
 
   absl::StatusOr<PortCredentials> credentials = MakeServerCredentials(options.security);
@@ -143,14 +174,22 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
       absl::MutexLock lock(&self->shutdown_mu_);
       return !self->shutting_down_;
     };
+    if (!options.metrics_token.empty()) {
+      server->metrics_access_ = std::make_shared<MetricsAccess>(options.metrics_token);
+      sources.access = server->metrics_access_;
+    }
     std::string host =
         options.metrics_host.empty() ? HostOf(options.address) : options.metrics_host;
     if (host.empty()) host = "127.0.0.1";  // In-process only: no network the server listens on.
+    server->metrics_host_ = host;
+    http::HttpServerOptions http_options;
+    http_options.tls = std::move(metrics_tls);
     absl::StatusOr<std::unique_ptr<http::HttpServer>> http = http::HttpServer::Start(
         host, options.metrics_port,
         [sources](const http::HttpRequest& request) {
           return AnswerMetricsRequest(request, sources);
-        });
+        },
+        http_options);
     if (!http.ok()) {
       server->Shutdown(absl::ZeroDuration());
       return absl::Status(http.status().code(),
@@ -199,7 +238,32 @@ absl::Status ReconstructionServer::ReplaceTls(const ServerTls& tls) {
     return absl::FailedPreconditionError(
         "the server was started without TLS; TLS cannot be turned on while it runs");
   }
-  return tls_identity_->Replace(tls);
+  std::shared_ptr<const http::TlsServerContext> metrics_tls;
+  if (options_.metrics_tls && metrics_http_ != nullptr) {
+    absl::StatusOr<std::shared_ptr<const http::TlsServerContext>> context =
+        http::TlsServerContext::Create(tls.certificate_chain, tls.private_key);
+    if (!context.ok()) return context.status();
+    metrics_tls = *std::move(context);
+  }
+  NM_RETURN_IF_ERROR(tls_identity_->Replace(tls));
+  return metrics_tls != nullptr ? metrics_http_->ReplaceTls(std::move(metrics_tls))
+                                : absl::OkStatus();
+}
+
+absl::Status ReconstructionServer::ReplaceMetricsToken(const std::string& token) {
+  if (metrics_access_ == nullptr) {
+    return absl::FailedPreconditionError(
+        "the metrics page was started without a token; one cannot be added while it runs");
+  }
+  NM_ASSIGN_OR_RETURN(std::string parsed, http::ParseSecret(token, "the metrics token"));
+  return metrics_access_->Replace(std::move(parsed));
+}
+
+std::string ReconstructionServer::metrics_url() const {
+  if (metrics_http_ == nullptr) return "";
+  const bool ipv6 = metrics_host_.find(':') != std::string::npos;
+  return absl::StrCat(metrics_http_->scheme(), "://", ipv6 ? "[" : "", metrics_host_,
+                      ipv6 ? "]" : "", ":", metrics_http_->port(), "/metrics");
 }
 
 void ReconstructionServer::Shutdown(absl::Duration grace) {

@@ -18,6 +18,7 @@
 #include "server/call_log_interceptor.h"
 #include "server/event_log.h"
 #include "server/executor.h"
+#include "server/metrics_http.h"
 #include "server/reactor_registry.h"
 #include "server/reconstruction_service.h"
 #include "server/server_credentials.h"
@@ -55,10 +56,16 @@ struct ServerOptions {
   // least this long has passed since its last one (every milestone is kept), so that a restart
   // costs at most about this much learning. Zero: milestones only.
   absl::Duration checkpoint_interval = kDefaultCheckpointInterval;
-  // The metrics page (metrics_http.h) on plain HTTP at metrics_host (empty: the host of
-  // `address`) and this port; 0 picks a free one, -1: none.
+  // The metrics page (metrics_http.h) at metrics_host (empty: the host of `address`) and this
+  // port; 0 picks a free one, -1: none.
   int metrics_port = -1;
   std::string metrics_host;
+  // The metrics page speaks HTTPS with the certificate and key of security.tls (needs TLS),
+  // and ReplaceTls renews it with them; false: plain HTTP.
+  bool metrics_tls = false;
+  // Set: /metrics asks for this token (http::ParseSecret's rules) as "Authorization: Bearer";
+  // empty: anyone who reaches the page reads it.
+  std::string metrics_token;
 };
 
 class ReconstructionServer {
@@ -80,6 +87,9 @@ class ReconstructionServer {
   std::string target() const;
   // The port of the metrics page; -1 without one.
   int metrics_port() const { return metrics_http_ != nullptr ? metrics_http_->port() : -1; }
+  // The address of the metrics page, "http://HOST:PORT/metrics" (https:// with metrics_tls);
+  // empty without one.
+  std::string metrics_url() const;
 
   // A channel into the server without a socket (tests of the logic, in-process callers).
   std::shared_ptr<grpc::Channel> InProcessChannel();
@@ -98,11 +108,17 @@ class ReconstructionServer {
   absl::Status ReplaceAccessTokens(std::vector<AccessToken> tokens);
 
   // Replaces the server's TLS certificate, key and client CAs for the connections that start
-  // about a second from now (ServerTlsIdentity::Replace); connections and calls already
-  // running go on. FAILED_PRECONDITION when the server was started without TLS,
-  // INVALID_ARGUMENT (the old identity kept) when gRPC does not take the new one or it would
-  // turn mutual TLS on or off.
+  // about a second from now (ServerTlsIdentity::Replace), and with metrics_tls the metrics
+  // page's certificate and key at once; connections and calls already running go on.
+  // FAILED_PRECONDITION when the server was started without TLS, INVALID_ARGUMENT (the old
+  // identity kept) when gRPC or OpenSSL does not take the new one or it would turn mutual TLS
+  // on or off.
   absl::Status ReplaceTls(const ServerTls& tls);
+
+  // Replaces the token that /metrics asks for, for requests from now on. FAILED_PRECONDITION
+  // when the server was started without one, INVALID_ARGUMENT (the old one kept) for a token
+  // that http::ParseSecret refuses.
+  absl::Status ReplaceMetricsToken(const std::string& token);
 
   // Replaces the roles of clients named by their certificates (ServerSecurity::client_roles)
   // for calls that start from now on. FAILED_PRECONDITION when the server was started without
@@ -133,6 +149,8 @@ class ReconstructionServer {
   std::shared_ptr<ClientCertificateIdentity> certificate_identity_;
   std::shared_ptr<ServerTlsIdentity> tls_identity_;    // Null without TLS; outlives server_.
   std::unique_ptr<http::HttpServer> metrics_http_;  // Null without a metrics port.
+  std::string metrics_host_;                        // Where metrics_http_ listens.
+  std::shared_ptr<MetricsAccess> metrics_access_;   // Null without a metrics token.
   std::unique_ptr<grpc::Server> server_;  // Destroyed first.
   int port_ = 0;
 

@@ -17,6 +17,8 @@ namespace neuralmesh::client::web {
 
 using ::neuralmesh::http::HttpRequest;
 using ::neuralmesh::http::HttpServer;
+using ::neuralmesh::http::HttpServerOptions;
+using ::neuralmesh::http::TlsServerContext;
 
 namespace {
 
@@ -56,6 +58,17 @@ absl::Status RunView(const ViewOptions& options, std::ostream& out, std::ostream
   const std::string web_root = options.web_root.empty() ? DefaultWebRoot() : options.web_root;
   NM_RETURN_IF_ERROR(CheckWebRoot(web_root));
   NM_ASSIGN_OR_RETURN(const HostPort listen, ParseListenAddress(options.listen));
+  HttpServerOptions http_options;
+  if (!options.tls_certificate_chain.empty() || !options.tls_private_key.empty()) {
+    if (options.tls_certificate_chain.empty() || options.tls_private_key.empty()) {
+      return absl::InvalidArgumentError(
+          "HTTPS needs both a certificate (--view_tls_cert_file) and its key "
+          "(--view_tls_key_file)");
+    }
+    NM_ASSIGN_OR_RETURN(
+        http_options.tls,
+        TlsServerContext::Create(options.tls_certificate_chain, options.tls_private_key));
+  }
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ReconstructionClient::Connect(options.server, options.connection));
   // One call before serving: a server that refuses the viewer (a missing or wrong access
@@ -65,14 +78,16 @@ absl::Status RunView(const ViewOptions& options, std::ostream& out, std::ostream
   ViewerOptions viewer_options;
   viewer_options.web_root = web_root;
   viewer_options.key = options.key;
+  viewer_options.https = http_options.tls != nullptr;
   ViewerService viewer(std::move(client), viewer_options);
   NM_ASSIGN_OR_RETURN(
       std::unique_ptr<HttpServer> http,
       HttpServer::Start(listen.host, listen.port,
-                        [&viewer](const HttpRequest& request) { return viewer.Handle(request); }));
+                        [&viewer](const HttpRequest& request) { return viewer.Handle(request); },
+                        http_options));
   const bool ipv6 = listen.host.find(':') != std::string::npos;
-  const std::string url = absl::StrCat("http://", ipv6 ? "[" : "", listen.host, ipv6 ? "]" : "",
-                                       ":", http->port(), "/");
+  const std::string url = absl::StrCat(http->scheme(), "://", ipv6 ? "[" : "", listen.host,
+                                       ipv6 ? "]" : "", ":", http->port(), "/");
   out << "viewer: " << url << " (sessions of " << options.server << "); Ctrl-C stops it";
   if (!options.key.empty()) out << "; browsers open " << url << "?key=" << options.key;
   out << std::endl;
@@ -80,6 +95,10 @@ absl::Status RunView(const ViewOptions& options, std::ostream& out, std::ostream
     err << "neuralmesh view: warning: anyone who reaches " << listen.host
         << " sees every session of " << options.server
         << "; --view_key_file lets in only those given the key" << std::endl;
+  } else if (!viewer_options.https && !IsLoopback(listen.host)) {
+    err << "neuralmesh view: warning: the key crosses the network in the clear; "
+           "--view_tls_cert_file and --view_tls_key_file serve HTTPS"
+        << std::endl;
   }
 
   InterruptScope interrupt;

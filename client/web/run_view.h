@@ -1,5 +1,5 @@
-// `neuralmesh view`: serves the live viewer of one neuralmesh-server's sessions over HTTP
-// (client/web/viewer_service.h) until SIGINT or SIGTERM.
+// `neuralmesh view`: serves the live viewer of one neuralmesh-server's sessions over HTTP or
+// HTTPS (client/web/viewer_service.h) until SIGINT or SIGTERM.
 #ifndef NEURALMESH_CLIENT_WEB_RUN_VIEW_H_
 #define NEURALMESH_CLIENT_WEB_RUN_VIEW_H_
 
@@ -17,17 +17,24 @@ struct ViewOptions {
   std::string web_root;                   // Empty: the source tree's client/web.
   ClientOptions connection;                // Connect timeout, TLS, access token.
   std::string key;  // Empty: every browser is let in; else the key it must bring (viewer_key.h).
+  // PEM text. Set: browsers connect over HTTPS with this certificate (and intermediates) and
+  // its key. Empty: plain HTTP.
+  std::string tls_certificate_chain;
+  std::string tls_private_key;
 };
 
 // The client/web folder of the source tree this binary was built from.
 std::string DefaultWebRoot();
 
 // Checks the web root, connects to the server, listens, prints
-// "viewer: http://HOST:PORT/ (sessions of SERVER)" and serves until interrupted. Errors:
-// NOT_FOUND for a web root without the viewer's files, INVALID_ARGUMENT for a malformed
-// --listen, UNAVAILABLE when the server cannot be reached or the address cannot be bound,
-// UNAUTHENTICATED when the server refuses the viewer's access token (or its lack of one).
-// Without a key, a --listen address that is not a loopback one gets a warning on `err`.
+// "viewer: http://HOST:PORT/ (sessions of SERVER)" (https:// with a certificate) and serves
+// until interrupted. Errors: NOT_FOUND for a web root without the viewer's files,
+// INVALID_ARGUMENT for a malformed --listen or a certificate and key that do not make a TLS
+// identity (one without the other included), UNAVAILABLE when the server cannot be reached or
+// the address cannot be bound, UNAUTHENTICATED when the server refuses the viewer's access
+// token (or its lack of one). A --listen address that is not a loopback one gets a warning on
+// `err` without a key (anyone gets in), and with a key over plain HTTP (it crosses the network
+// in the clear).
 absl::Status RunView(const ViewOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace neuralmesh::client::web

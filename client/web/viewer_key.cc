@@ -3,33 +3,21 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
+#include "http/bearer_token.h"
 
 namespace neuralmesh::client::web {
 
+using ::neuralmesh::http::BearerTokenOf;
 using ::neuralmesh::http::HttpRequest;
 using ::neuralmesh::http::HttpResponse;
+using ::neuralmesh::http::IsSecretCharacter;
+using ::neuralmesh::http::SameSecret;
 using ::neuralmesh::http::TextResponse;
 
 namespace {
-
-constexpr size_t kMinKeyLength = 16;
-
-bool IsKeyCharacter(char c) {
-  return absl::ascii_isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' ||
-         c == '_' || c == '~';
-}
-
-// Equal, in time that does not depend on where `a` and `b` first differ.
-bool SameKey(absl::string_view a, absl::string_view b) {
-  if (a.size() != b.size()) return false;
-  unsigned char difference = 0;
-  for (size_t i = 0; i < a.size(); ++i) difference |= static_cast<unsigned char>(a[i] ^ b[i]);
-  return difference == 0;
-}
 
 // The value of cookie `name` in a Cookie header, or nothing.
 absl::string_view CookieValue(absl::string_view header, absl::string_view name) {
@@ -46,7 +34,7 @@ std::string PercentEncoded(absl::string_view text) {
   static constexpr char kHex[] = "0123456789ABCDEF";
   std::string encoded;
   for (const char c : text) {
-    if (IsKeyCharacter(c)) {
+    if (IsSecretCharacter(c)) {
       encoded.push_back(c);
     } else {
       const unsigned char byte = static_cast<unsigned char>(c);
@@ -67,39 +55,23 @@ std::string ViewerKeyCookieName(absl::string_view key) {
 }
 
 absl::StatusOr<std::string> ParseViewerKey(absl::string_view contents) {
-  const absl::string_view key = absl::StripAsciiWhitespace(contents);
-  if (key.size() < kMinKeyLength) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "the viewer key has ", key.size(), " characters; it needs at least ", kMinKeyLength));
-  }
-  for (const char c : key) {
-    if (!IsKeyCharacter(c)) {
-      return absl::InvalidArgumentError(
-          "the viewer key may hold letters, digits and \"-._~\" only (one line)");
-    }
-  }
-  return std::string(key);
+  return http::ParseSecret(contents, "the viewer key");
 }
 
 ViewerKeyCheck CheckViewerKey(const HttpRequest& request, absl::string_view key) {
   if (auto it = request.query.find("key"); it != request.query.end()) {
-    return SameKey(it->second, key) ? ViewerKeyCheck::kGrantedFromUrl : ViewerKeyCheck::kRefused;
+    return SameSecret(it->second, key) ? ViewerKeyCheck::kGrantedFromUrl : ViewerKeyCheck::kRefused;
   }
   if (auto it = request.headers.find("cookie"); it != request.headers.end()) {
-    if (SameKey(CookieValue(it->second, ViewerKeyCookieName(key)), key)) {
+    if (SameSecret(CookieValue(it->second, ViewerKeyCookieName(key)), key)) {
       return ViewerKeyCheck::kGranted;
     }
   }
-  if (auto it = request.headers.find("authorization"); it != request.headers.end()) {
-    absl::string_view value = it->second;
-    if (absl::ConsumePrefix(&value, "Bearer ") && SameKey(value, key)) {
-      return ViewerKeyCheck::kGranted;
-    }
-  }
-  return ViewerKeyCheck::kRefused;
+  return SameSecret(BearerTokenOf(request), key) ? ViewerKeyCheck::kGranted
+                                                 : ViewerKeyCheck::kRefused;
 }
 
-HttpResponse ViewerKeyRedirect(const HttpRequest& request, absl::string_view key) {
+HttpResponse ViewerKeyRedirect(const HttpRequest& request, absl::string_view key, bool https) {
   std::string location;  // The path starts with '/': its first segment is empty.
   bool first = true;
   for (absl::string_view segment : absl::StrSplit(request.path, '/')) {
@@ -117,7 +89,8 @@ HttpResponse ViewerKeyRedirect(const HttpRequest& request, absl::string_view key
   response.headers.emplace_back("Location", location);
   response.headers.emplace_back(
       "Set-Cookie",
-      absl::StrCat(ViewerKeyCookieName(key), "=", key, "; HttpOnly; SameSite=Strict; Path=/"));
+      absl::StrCat(ViewerKeyCookieName(key), "=", key, "; HttpOnly; SameSite=Strict; Path=/",
+                   https ? "; Secure" : ""));
   return response;
 }
 

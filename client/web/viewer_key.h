@@ -3,8 +3,9 @@
 // opens the URL with the key once (http://HOST:PORT/?key=KEY); the viewer answers with a
 // cookie that carries the key and sends the browser on to the same page without it, and every
 // later request (the page, its scripts, the API) brings the cookie. Other clients of the API
-// may send "Authorization: Bearer KEY" instead. Plain HTTP: the key crosses the network in the
-// clear, so it keeps out those who do not know the URL, not those who can read the traffic.
+// may send "Authorization: Bearer KEY" instead. Over plain HTTP the key crosses the network in
+// the clear, so it keeps out those who do not know the URL, not those who can read the
+// traffic; over HTTPS (--view_tls_cert_file) it keeps out both.
 #ifndef NEURALMESH_CLIENT_WEB_VIEWER_KEY_H_
 #define NEURALMESH_CLIENT_WEB_VIEWER_KEY_H_
 
@@ -36,8 +37,10 @@ enum class ViewerKeyCheck {
 ViewerKeyCheck CheckViewerKey(const http::HttpRequest& request, absl::string_view key);
 
 // The answer to a request with the key in its query: 303 to the same path and query without
-// `key`, setting the cookie (HttpOnly, SameSite=Strict, Path=/).
-http::HttpResponse ViewerKeyRedirect(const http::HttpRequest& request, absl::string_view key);
+// `key`, setting the cookie (HttpOnly, SameSite=Strict, Path=/; with `https`, Secure too, so
+// that the browser never sends it in the clear).
+http::HttpResponse ViewerKeyRedirect(const http::HttpRequest& request, absl::string_view key,
+                                     bool https = false);
 
 }  // namespace neuralmesh::client::web
 

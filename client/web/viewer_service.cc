@@ -145,7 +145,7 @@ HttpResponse ViewerService::Handle(const HttpRequest& request) {
       case ViewerKeyCheck::kGranted:
         break;
       case ViewerKeyCheck::kGrantedFromUrl:
-        return ViewerKeyRedirect(request, options_.key);
+        return ViewerKeyRedirect(request, options_.key, options_.https);
       case ViewerKeyCheck::kRefused:
         return ErrorResponse(401,
                              "this viewer needs its key: open the URL with ?key= that "

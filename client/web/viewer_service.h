@@ -47,6 +47,8 @@ struct ViewerOptions {
   // one with the key in its query is sent on without it, keeping the key in a cookie, and one
   // without the key gets 401.
   std::string key;
+  // Whether browsers reach the viewer over HTTPS: the key's cookie is then Secure.
+  bool https = false;
 };
 
 // OK when `web_root` holds the viewer's page and three.js; otherwise NOT_FOUND naming the

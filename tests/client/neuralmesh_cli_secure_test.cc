@@ -20,6 +20,7 @@
 #include "tests/client/subprocess.h"
 #include "tests/client/test_server.h"
 #include "tests/client/web/viewer_test_support.h"
+#include "tests/testing/https_client.h"
 #include "tests/testing/test_certificates.h"
 
 namespace neuralmesh::testing {
@@ -316,6 +317,48 @@ TEST_F(SecureCliTest, SighupReadsTheClientRolesFileAgain) {
   EXPECT_EQ(as("second_client").exit_code, 0);
 }
 
+TEST_F(SecureCliTest, TheMetricsPageOverHttpsAsksForItsTokenAndSighupReadsItAgain) {
+  const std::string token_file = Path("metrics_token");
+  ASSERT_TRUE(WriteFileContents(token_file, "metrics-token-0123456789\n").ok());
+  std::string error;
+  std::unique_ptr<TestServer> server =
+      TestServer::Start({"--tls_cert_file=" + certs().Path("server.pem"),
+                         "--tls_key_file=" + certs().Path("server.key"), "--metrics_port=0",
+                         "--metrics_tls", "--metrics_token_file=" + token_file},
+                        &error);
+  ASSERT_NE(server, nullptr) << error;
+  server->AwaitStdout("/metrics (with the token");
+  std::smatch match;
+  const std::string out = server->Stdout();
+  ASSERT_TRUE(std::regex_search(
+      out, match,
+      std::regex("metrics on https://127\\.0\\.0\\.1:([0-9]+)/metrics \\(with the token of "
+                 "--metrics_token_file\\)")))
+      << out;
+  HttpsTarget target;
+  target.port = std::stoi(match[1].str());
+  target.ca = certs().ca;
+  const HttpReply scraped = HttpsGet(target, "/metrics", "metrics-token-0123456789", &error);
+  EXPECT_EQ(scraped.status, 200) << error;
+  EXPECT_THAT(scraped.body, HasSubstr("neuralmesh_sessions_limit "));
+  EXPECT_EQ(HttpsGet(target, "/metrics").status, 401);
+
+  ASSERT_TRUE(WriteFileContents(token_file, "metrics-token-renewed-42\n").ok());
+  server->Signal(SIGHUP);
+  server->AwaitStdout("metrics token read again");
+  EXPECT_EQ(HttpsGet(target, "/metrics", "metrics-token-0123456789").status, 401);
+  EXPECT_EQ(HttpsGet(target, "/metrics", "metrics-token-renewed-42").status, 200);
+
+  // A file that went wrong keeps the token the page has.
+  ASSERT_TRUE(WriteFileContents(token_file, "short\n").ok());
+  server->Signal(SIGHUP);
+  server->AwaitStderr("stays");
+  EXPECT_THAT(server->Stderr(),
+              HasSubstr("the old metrics token stays: --metrics_token_file: the metrics token "
+                        "has 5 characters"));
+  EXPECT_EQ(HttpsGet(target, "/metrics", "metrics-token-renewed-42").status, 200);
+}
+
 TEST_F(SecureCliTest, TheServerRefusesSecurityFlagsThatDoNotGoTogetherAndDocumentsThem) {
   const std::string cert = "--tls_cert_file=" + certs().Path("server.pem");
   const std::string key = "--tls_key_file=" + certs().Path("server.key");
@@ -331,6 +374,15 @@ TEST_F(SecureCliTest, TheServerRefusesSecurityFlagsThatDoNotGoTogetherAndDocumen
        "--access_tokens_file: line 1"},
       {{"--port=0", cert, "--tls_key_file=" + certs().Path("client.key")},
        "rejected the TLS certificate or key"},
+      {{"--port=0", "--metrics_port=0", "--metrics_tls"},
+       "metrics_tls serves the metrics page with the server's TLS certificate, and there is "
+       "none (tls_cert_file)"},
+      {{"--port=0", "--metrics_token_file=" + Path("token")},
+       "there is none (metrics_port)"},
+      {{"--port=0", "--metrics_port=0", "--metrics_token_file=" + certs().Path("ca.pem")},
+       "--metrics_token_file: the metrics token may hold letters"},
+      {{"--port=0", "--metrics_port=0", "--metrics_token_file=" + Path("missing")},
+       "--metrics_token_file: cannot open"},
   };
   for (const Case& c : cases) {
     const RunResult run = RunBinary("neuralmesh-server", c.args);
@@ -340,7 +392,8 @@ TEST_F(SecureCliTest, TheServerRefusesSecurityFlagsThatDoNotGoTogetherAndDocumen
   // --help documents them, with the server's other flags.
   const RunResult help = RunBinary("neuralmesh-server", {"--help"});
   for (const char* flag : {"--tls_cert_file", "--tls_key_file", "--tls_client_ca_file",
-                           "--access_tokens_file", "--max_sessions", "--port"}) {
+                           "--access_tokens_file", "--max_sessions", "--port", "--metrics_tls",
+                           "--metrics_token_file"}) {
     EXPECT_THAT(help.out, HasSubstr(flag)) << help.Describe();
   }
 }

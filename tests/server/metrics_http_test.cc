@@ -17,14 +17,20 @@
 #include "http/http_server.h"
 #include "tests/server/server_test_support.h"
 #include "tests/testing/http_client.h"
+#include "tests/testing/https_client.h"
 #include "tests/testing/temp_dir.h"
+#include "tests/testing/test_certificates.h"
 
 namespace neuralmesh::server {
 namespace {
 
 using ::neuralmesh::testing::HttpGet;
 using ::neuralmesh::testing::HttpReply;
+using ::neuralmesh::testing::HttpsGet;
+using ::neuralmesh::testing::HttpsTarget;
 using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::StartsWith;
 
 constexpr char kService[] = "grpc_service=\"neuralmesh.v1.ReconstructionService\"";
 
@@ -225,6 +231,103 @@ TEST(MetricsHttpTest, NoPageWithoutAPortAndClearErrorsForBadOnes) {
   ASSERT_FALSE(in_use.ok());
   EXPECT_EQ(in_use.status().code(), absl::StatusCode::kUnavailable);
   EXPECT_THAT(in_use.status().message(), HasSubstr("metrics page: cannot listen on 127.0.0.1:"));
+}
+
+constexpr char kMetricsToken[] = "metrics-token-0123456789";
+
+TEST(MetricsHttpTest, OverTlsWithATokenOnlyTheTokensHolderReadsTheMetrics) {
+  absl::StatusOr<neuralmesh::testing::TestCertificates> certificates =
+      neuralmesh::testing::MakeTestCertificates(neuralmesh::testing::MakeTempDir("metrics_tls"));
+  ASSERT_TRUE(certificates.ok()) << certificates.status();
+  ServerOptions options;
+  options.security.tls.certificate_chain = certificates->named_server_chain;
+  options.security.tls.private_key = certificates->named_server_key;
+  options.metrics_tls = true;
+  options.metrics_token = kMetricsToken;
+  std::unique_ptr<ReconstructionServer> server = StartWithMetrics(options);
+  ASSERT_NE(server, nullptr);
+  EXPECT_EQ(server->metrics_url(),
+            absl::StrCat("https://127.0.0.1:", server->metrics_port(), "/metrics"));
+  HttpsTarget target;
+  target.port = server->metrics_port();
+  target.ca = certificates->ca;
+  target.host = "scans.example.test";
+
+  std::string error;
+  const HttpReply granted = HttpsGet(target, "/metrics", kMetricsToken, &error);
+  EXPECT_EQ(granted.status, 200) << error;
+  EXPECT_THAT(granted.body, HasSubstr("neuralmesh_sessions{state=\"learning\"} 0"));
+  const HttpReply bare = HttpsGet(target, "/metrics");
+  EXPECT_EQ(bare.status, 401);
+  EXPECT_EQ(bare.Header("www-authenticate"), "Bearer realm=\"neuralmesh metrics\"");
+  EXPECT_THAT(bare.body, HasSubstr("/metrics needs the token of --metrics_token_file"));
+  EXPECT_THAT(bare.body, Not(HasSubstr("neuralmesh_")));
+  const HttpReply wrong = HttpsGet(target, "/metrics", "metrics-token-9876543210");
+  EXPECT_EQ(wrong.status, 401);
+  EXPECT_THAT(wrong.body, HasSubstr("refused the token"));
+  // Probes need no token.
+  EXPECT_EQ(HttpsGet(target, "/healthz").status, 200);
+  // Plain HTTP is not served.
+  const HttpReply plain = HttpGet(server->metrics_port(), "/metrics");
+  EXPECT_EQ(plain.status, 400);
+  EXPECT_THAT(plain.body, HasSubstr("speaks HTTPS only"));
+
+  // A new token takes over from the next request; a bad one leaves the old in place.
+  EXPECT_EQ(server->ReplaceMetricsToken("short").code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(HttpsGet(target, "/metrics", kMetricsToken).status, 200);
+  ASSERT_TRUE(server->ReplaceMetricsToken("another-metrics-token").ok());
+  EXPECT_EQ(HttpsGet(target, "/metrics", kMetricsToken).status, 401);
+  EXPECT_EQ(HttpsGet(target, "/metrics", "another-metrics-token").status, 200);
+
+  // A renewed certificate (here for 127.0.0.1) serves the metrics page too.
+  EXPECT_EQ(HttpsGet(HttpsTarget{target.port, certificates->ca, "127.0.0.1"}, "/healthz").status,
+            0);
+  ServerTls renewed;
+  renewed.certificate_chain = certificates->server_chain;
+  renewed.private_key = certificates->server_key;
+  ASSERT_TRUE(server->ReplaceTls(renewed).ok());
+  EXPECT_EQ(HttpsGet(HttpsTarget{target.port, certificates->ca, "127.0.0.1"}, "/healthz", "",
+                     &error)
+                .status,
+            200)
+      << error;
+  // A key of another certificate is refused, and the page keeps the renewed one.
+  renewed.private_key = certificates->client_key;
+  EXPECT_EQ(server->ReplaceTls(renewed).code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(HttpsGet(HttpsTarget{target.port, certificates->ca, "127.0.0.1"}, "/healthz").status,
+            200);
+
+  // Without a token from the start, none can be added.
+  std::unique_ptr<ReconstructionServer> open = StartWithMetrics();
+  ASSERT_NE(open, nullptr);
+  EXPECT_EQ(open->metrics_url(), absl::StrCat("http://127.0.0.1:", open->metrics_port(), "/metrics"));
+  EXPECT_EQ(open->ReplaceMetricsToken(kMetricsToken).code(),
+            absl::StatusCode::kFailedPrecondition);
+}
+
+TEST(MetricsHttpTest, TlsAndATokenNeedAMetricsPageAndTlsNeedsACertificate) {
+  ServerOptions options;
+  options.address = "127.0.0.1:0";
+  options.metrics_tls = true;
+  absl::Status status = ReconstructionServer::Start(options).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("there is none (metrics_port)"));
+  options.metrics_port = 0;
+  status = ReconstructionServer::Start(options).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("the server's TLS certificate, and there is none"));
+  options.metrics_tls = false;
+  options.metrics_token = "short";
+  status = ReconstructionServer::Start(options).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), StartsWith("the metrics token has 5 characters"));
+  options.metrics_port = -1;
+  options.metrics_token = kMetricsToken;
+  status = ReconstructionServer::Start(options).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  std::unique_ptr<ReconstructionServer> without = testing::StartServer(/*listen=*/true);
+  ASSERT_NE(without, nullptr);
+  EXPECT_EQ(without->metrics_url(), "");
 }
 
 }  // namespace

@@ -33,9 +33,8 @@ struct HttpReply {
   }
 };
 
-// Sends `request` as is and reads until the server closes the connection.
-inline HttpReply SendRawHttp(int port, const std::string& request) {
-  HttpReply reply;
+// A socket connected to 127.0.0.1:PORT; -1 when the connection fails.
+inline int ConnectToLoopback(int port) {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in address{};
   address.sin_family = AF_INET;
@@ -43,14 +42,14 @@ inline HttpReply SendRawHttp(int port, const std::string& request) {
   address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   if (connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
     close(fd);
-    return reply;
+    return -1;
   }
-  send(fd, request.data(), request.size(), MSG_NOSIGNAL);
-  std::string bytes;
-  char buffer[65536];
-  ssize_t got;
-  while ((got = recv(fd, buffer, sizeof(buffer), 0)) > 0) bytes.append(buffer, got);
-  close(fd);
+  return fd;
+}
+
+// The response in `bytes`, all a server sent before it closed.
+inline HttpReply ParseHttpReply(const std::string& bytes) {
+  HttpReply reply;
   const size_t end = bytes.find("\r\n\r\n");
   if (end == std::string::npos) return reply;
   reply.body = bytes.substr(end + 4);
@@ -68,6 +67,19 @@ inline HttpReply SendRawHttp(int port, const std::string& request) {
         std::string(absl::StripAsciiWhitespace(line.substr(colon + 1)));
   }
   return reply;
+}
+
+// Sends `request` as is and reads until the server closes the connection.
+inline HttpReply SendRawHttp(int port, const std::string& request) {
+  const int fd = ConnectToLoopback(port);
+  if (fd < 0) return HttpReply();
+  send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+  std::string bytes;
+  char buffer[65536];
+  ssize_t got;
+  while ((got = recv(fd, buffer, sizeof(buffer), 0)) > 0) bytes.append(buffer, got);
+  close(fd);
+  return ParseHttpReply(bytes);
 }
 
 inline HttpReply HttpGet(int port, const std::string& target) {

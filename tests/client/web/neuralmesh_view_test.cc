@@ -6,9 +6,13 @@
 #include <csignal>
 #include <string>
 
+#include "core/io/file_contents.h"
 #include "tests/client/subprocess.h"
 #include "tests/client/test_server.h"
 #include "tests/client/web/viewer_test_support.h"
+#include "tests/testing/https_client.h"
+#include "tests/testing/temp_dir.h"
+#include "tests/testing/test_certificates.h"
 
 namespace neuralmesh::testing {
 namespace {
@@ -58,6 +62,53 @@ TEST(NeuralmeshViewTest, ServesTheSessionsOfTheServerUntilSigterm) {
   EXPECT_EQ(sessions.status, 200);
   EXPECT_EQ(sessions.body, "[]");
   EXPECT_EQ(HttpGet(port, "/").status, 200);
+  EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << viewer.Stderr();
+}
+
+TEST(NeuralmeshViewTest, ServesHttpsWithItsCertificateAndKeepsTheKeyOffPlainHttp) {
+  absl::StatusOr<TestCertificates> certificates =
+      MakeTestCertificates(MakeTempDir("view_tls"));
+  ASSERT_TRUE(certificates.ok()) << certificates.status();
+  const std::string cert = "--view_tls_cert_file=" + certificates->Path("server.pem");
+  const std::string key = "--view_tls_key_file=" + certificates->Path("server.key");
+
+  // A certificate without its key, or with another's, is refused before anything is served.
+  RunResult run = RunNeuralmesh({"view", "--server=127.0.0.1:1", cert});
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.err, HasSubstr("HTTPS needs both a certificate (--view_tls_cert_file) and its "
+                                 "key (--view_tls_key_file)"));
+  run = RunNeuralmesh({"view", "--server=127.0.0.1:1", cert,
+                       "--view_tls_key_file=" + certificates->Path("client.key")});
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.err, HasSubstr("the TLS private key does not belong to the certificate"));
+  run = RunNeuralmesh({"view", "--server=127.0.0.1:1", cert, "--view_tls_key_file=/nonexistent"});
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.err, HasSubstr("--view_tls_key_file: cannot open '/nonexistent'"));
+
+  std::string error;
+  std::unique_ptr<TestServer> server = TestServer::Start({}, &error);
+  ASSERT_NE(server, nullptr) << error;
+  const std::string key_file = MakeTempDir("view_tls_key") + "/key";
+  ASSERT_TRUE(WriteFileContents(key_file, "view-key-0123456789abcdef\n").ok());
+  BackgroundProcess viewer("neuralmesh", {"view", "--server=" + server->address(),
+                                          "--listen=127.0.0.1:0", cert, key,
+                                          "--view_key_file=" + key_file});
+  const int port = WaitForViewerPort(viewer, "https");
+  ASSERT_NE(port, 0) << viewer.Stdout() << viewer.Stderr();
+  HttpsTarget target;
+  target.port = port;
+  target.ca = certificates->ca;
+
+  const HttpReply sessions =
+      HttpsGet(target, "/api/sessions", "view-key-0123456789abcdef", &error);
+  EXPECT_EQ(sessions.status, 200) << error;
+  EXPECT_EQ(sessions.body, "[]");
+  // The key in the URL becomes a cookie that browsers send over HTTPS only.
+  const HttpReply redirect = HttpsGet(target, "/?key=view-key-0123456789abcdef");
+  EXPECT_EQ(redirect.status, 303);
+  EXPECT_THAT(redirect.Header("set-cookie"), HasSubstr("; Secure"));
+  EXPECT_EQ(HttpsGet(target, "/api/sessions").status, 401);
+  EXPECT_EQ(HttpGet(port, "/api/sessions").status, 400) << "plain HTTP on the HTTPS port";
   EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << viewer.Stderr();
 }
 

@@ -12,10 +12,10 @@
 
 namespace neuralmesh::testing {
 
-// The port of `viewer` (neuralmesh view --listen=127.0.0.1:0) once it prints its URL, or 0
-// when it exits or says nothing within 10 s.
-inline int WaitForViewerPort(BackgroundProcess& viewer) {
-  const std::regex line("viewer: http://127\\.0\\.0\\.1:([0-9]+)/ \\(sessions of ");
+// The port of `viewer` (neuralmesh view --listen=127.0.0.1:0) once it prints its URL with
+// `scheme`, or 0 when it exits or says nothing within 10 s.
+inline int WaitForViewerPort(BackgroundProcess& viewer, const std::string& scheme = "http") {
+  const std::regex line("viewer: " + scheme + "://127\\.0\\.0\\.1:([0-9]+)/ \\(sessions of ");
   for (int i = 0; i < 200; ++i) {
     std::smatch match;
     const std::string out = viewer.Stdout();

@@ -296,18 +296,6 @@ constexpr const char* kConnectionFlags[] = {
     "tls_key_file",    "tls_server_name", "access_token_file", "max_message_bytes"};
 
 // How to reach the server: --connect_timeout, TLS and the access token.
-// The contents of the file that flag --`flag` names; empty when it names none. The error
-// names the flag.
-absl::StatusOr<std::string> FlagFileContents(const char* flag, const std::string& path) {
-  if (path.empty()) return std::string();
-  absl::StatusOr<std::string> contents = neuralmesh::ReadFileContents(path);
-  if (!contents.ok()) {
-    return absl::Status(contents.status().code(),
-                        absl::StrCat("--", flag, ": ", contents.status().message()));
-  }
-  return contents;
-}
-
 absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
   neuralmesh::client::ClientOptions o;
   o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
@@ -328,7 +316,7 @@ absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
       {"tls_key_file", absl::GetFlag(FLAGS_tls_key_file), &security.tls.private_key},
       {"access_token_file", absl::GetFlag(FLAGS_access_token_file), &security.access_token}};
   for (const FileFlag& file : files) {
-    NM_ASSIGN_OR_RETURN(*file.contents, FlagFileContents(file.flag, file.path));
+    NM_ASSIGN_OR_RETURN(*file.contents, neuralmesh::ReadFileNamedByFlag(file.flag, file.path));
   }
   security.access_token = std::string(absl::StripAsciiWhitespace(security.access_token));
   security.tls.server_name = absl::GetFlag(FLAGS_tls_server_name);
@@ -507,7 +495,8 @@ absl::Status View(const ParsedArgs& args) {
   o.web_root = absl::GetFlag(FLAGS_web_root);
   NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
   if (const std::string key_file = absl::GetFlag(FLAGS_view_key_file); !key_file.empty()) {
-    absl::StatusOr<std::string> contents = FlagFileContents("view_key_file", key_file);
+    absl::StatusOr<std::string> contents =
+        neuralmesh::ReadFileNamedByFlag("view_key_file", key_file);
     if (contents.ok()) contents = neuralmesh::client::web::ParseViewerKey(*contents);
     if (!contents.ok()) {
       return absl::Status(contents.status().code(),
@@ -516,10 +505,11 @@ absl::Status View(const ParsedArgs& args) {
     o.key = *std::move(contents);
   }
   NM_ASSIGN_OR_RETURN(o.tls_certificate_chain,
-                      FlagFileContents("view_tls_cert_file",
-                                       absl::GetFlag(FLAGS_view_tls_cert_file)));
-  NM_ASSIGN_OR_RETURN(o.tls_private_key, FlagFileContents("view_tls_key_file",
-                                                          absl::GetFlag(FLAGS_view_tls_key_file)));
+                      neuralmesh::ReadFileNamedByFlag("view_tls_cert_file",
+                                                      absl::GetFlag(FLAGS_view_tls_cert_file)));
+  NM_ASSIGN_OR_RETURN(
+      o.tls_private_key,
+      neuralmesh::ReadFileNamedByFlag("view_tls_key_file", absl::GetFlag(FLAGS_view_tls_key_file)));
   return neuralmesh::client::web::RunView(o, std::cout, std::cerr);
 }
 

@@ -7,7 +7,6 @@
 #include <poll.h>
 #include <sys/eventfd.h>
 #include <sys/socket.h>
-#include <sys/time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -22,10 +21,8 @@
 namespace neuralmesh::http {
 namespace {
 
-void SetTimeout(int fd, int option, absl::Duration timeout) {
-  timeval tv = absl::ToTimeval(timeout);
-  setsockopt(fd, SOL_SOCKET, option, &tv, sizeof(tv));
-}
+// How long a write may wait for the client to take more of a response.
+constexpr absl::Duration kWriteTimeout = absl::Seconds(30);
 
 void Respond(ServerConnection& connection, const HttpResponse& response, bool with_body) {
   if (connection.SendAll(SerializeHttpResponseHead(response)) && with_body) {
@@ -175,8 +172,7 @@ void HttpServer::AcceptLoop() {
     if (fds[1].revents != 0) return;
     const int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
     if (fd < 0) continue;  // The peer gave up, or descriptors ran out: the next one may work.
-    SetTimeout(fd, SO_RCVTIMEO, options_.read_timeout);
-    SetTimeout(fd, SO_SNDTIMEO, absl::Seconds(30));
+    const absl::Time read_deadline = absl::Now() + options_.read_timeout;
     {
       absl::MutexLock lock(&mu_);
       if (shut_down_) {
@@ -185,7 +181,7 @@ void HttpServer::AcceptLoop() {
       }
       if (static_cast<int>(open_fds_.size()) >= options_.max_connections) {
         if (!speaks_tls_) {  // A TLS client could not read the answer before a handshake.
-          ServerConnection connection(fd);
+          ServerConnection connection(fd, read_deadline, kWriteTimeout);
           Respond(connection,
                   TextResponse(503, absl::StrCat("this server serves at most ",
                                                  options_.max_connections,
@@ -198,10 +194,10 @@ void HttpServer::AcceptLoop() {
       open_fds_.insert(fd);
     }
     try {
-      std::thread([this, fd] { Serve(fd); }).detach();
+      std::thread([this, fd, read_deadline] { Serve(fd, read_deadline); }).detach();
     } catch (const std::system_error&) {  // No thread to be had: refuse this one.
       if (!speaks_tls_) {
-        ServerConnection connection(fd);
+        ServerConnection connection(fd, read_deadline, kWriteTimeout);
         Respond(connection, TextResponse(503, "this server cannot start a thread: try again"),
                 true);
       }
@@ -212,14 +208,14 @@ void HttpServer::AcceptLoop() {
   }
 }
 
-void HttpServer::Serve(int fd) {
+void HttpServer::Serve(int fd, absl::Time read_deadline) {
   BlockSigpipeInThisThread();
   std::shared_ptr<const TlsServerContext> tls;
   {
     absl::MutexLock lock(&mu_);
     tls = tls_;
   }
-  ServerConnection connection(fd);
+  ServerConnection connection(fd, read_deadline, kWriteTimeout);
   // Under TLS a request in plain HTTP is still read and answered, in plain HTTP, so that a
   // browser or scraper pointed at http:// learns why.
   const bool plain_on_tls = tls != nullptr && !connection.StartsWithTlsHandshake();
@@ -243,17 +239,7 @@ void HttpServer::Serve(int fd) {
     } else if (absl::IsResourceExhausted(head.status())) {
       Respond(connection, TextResponse(431, head.status().message()), true);
     }
-    connection.EndSending();
-  }
-  // A lingering close: closing with unread bytes (the rest of a refused request) would reset
-  // the connection, and the client could lose the answer. Read what the client still sends
-  // until it closes its side, for at most a second (under TLS, its records unread).
-  SetTimeout(fd, SO_RCVTIMEO, absl::Seconds(1));
-  char discard[4096];
-  for (size_t drained = 0; drained < (size_t{1} << 20);) {
-    const ssize_t got = recv(fd, discard, sizeof(discard), 0);
-    if (got <= 0) break;
-    drained += static_cast<size_t>(got);
+    connection.EndSending(absl::Seconds(1));
   }
   absl::MutexLock lock(&mu_);
   open_fds_.erase(fd);

@@ -10,7 +10,8 @@
 //
 // Bad requests get 400 with a message, oversized heads 431, methods other than GET and HEAD
 // 405, and connections beyond `max_connections` 503 (closed without an answer under TLS); a
-// client that sends nothing for `read_timeout` is dropped. Under TLS, a client that speaks plain
+// client that has not sent its whole request head `read_timeout` after connecting is dropped,
+// however it trickles its bytes. Under TLS, a client that speaks plain
 // HTTP gets 400 in plain HTTP saying that the port speaks HTTPS, and a failed handshake closes
 // the connection. The handler runs on the connection's thread and may block (a long
 // poll), so it must return once its owner is shut down: Shutdown() closes the sockets but
@@ -36,7 +37,8 @@ namespace neuralmesh::http {
 struct HttpServerOptions {
   // Connections served at once; one more is answered 503 and closed.
   int max_connections = 64;
-  // How long a connection may take to send its request head.
+  // How long a connection may take, from its accept, to send its whole request head (the TLS
+  // handshake included).
   absl::Duration read_timeout = absl::Seconds(10);
   // Set: HTTPS with this certificate and key (HttpServer::ReplaceTls changes them). Null: HTTP.
   std::shared_ptr<const TlsServerContext> tls;
@@ -76,7 +78,7 @@ class HttpServer {
              const HttpServerOptions& options);
 
   void AcceptLoop();
-  void Serve(int fd);
+  void Serve(int fd, absl::Time read_deadline);
 
   const int listen_fd_;  // Closed by Shutdown.
   const int wake_fd_;    // An eventfd that wakes the accept loop for Shutdown.

@@ -1,27 +1,65 @@
 #include "http/server_connection.h"
 
+#include <fcntl.h>
 #include <openssl/err.h>
 #include <openssl/ssl.h>
+#include <poll.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 
 namespace neuralmesh::http {
+
+ServerConnection::ServerConnection(int fd, absl::Time read_deadline,
+                                   absl::Duration write_timeout)
+    : fd_(fd), read_deadline_(read_deadline), write_timeout_(write_timeout) {
+  const int flags = fcntl(fd_, F_GETFL);
+  if (flags >= 0) fcntl(fd_, F_SETFL, flags | O_NONBLOCK);
+}
 
 ServerConnection::~ServerConnection() {
   if (tls_ != nullptr) SSL_free(tls_);
 }
 
+bool ServerConnection::Await(short events, absl::Time until) const {
+  while (true) {
+    const absl::Duration left = until - absl::Now();
+    if (left <= absl::ZeroDuration()) return false;
+    pollfd ready{fd_, events, 0};
+    const int64_t ms = std::min<int64_t>(absl::ToInt64Milliseconds(left) + 1, INT_MAX);
+    const int polled = poll(&ready, 1, static_cast<int>(ms));
+    if (polled > 0) return true;  // Ready, or an error or hang-up that the next call reports.
+    if (polled < 0 && errno != EINTR) return false;
+  }
+}
+
+bool ServerConnection::AwaitTls(int result, absl::Time read_until) {
+  switch (SSL_get_error(tls_, result)) {
+    case SSL_ERROR_WANT_READ:
+      return Await(POLLIN, read_until);
+    case SSL_ERROR_WANT_WRITE:
+      return Await(POLLOUT, absl::Now() + write_timeout_);
+    default:
+      return false;
+  }
+}
+
 bool ServerConnection::StartsWithTlsHandshake() const {
   unsigned char first = 0;
-  ssize_t got;
-  do {
-    got = recv(fd_, &first, 1, MSG_PEEK);
-  } while (got < 0 && errno == EINTR);
-  return got == 1 && first == 0x16;
+  while (true) {
+    const ssize_t got = recv(fd_, &first, 1, MSG_PEEK);
+    if (got == 1) return first == 0x16;
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0 && (errno == EAGAIN || errno == EWOULDBLOCK) && Await(POLLIN, read_deadline_)) {
+      continue;
+    }
+    return false;
+  }
 }
 
 absl::Status ServerConnection::AcceptTls(const TlsServerContext& context) {
@@ -30,55 +68,80 @@ absl::Status ServerConnection::AcceptTls(const TlsServerContext& context) {
   if (tls_ == nullptr || SSL_set_fd(tls_, fd_) != 1) {
     return absl::UnavailableError(TakeOpenSslError("cannot start TLS on the connection"));
   }
-  const int accepted = SSL_accept(tls_);
-  if (accepted != 1) {
-    const int error = SSL_get_error(tls_, accepted);
-    std::string reason = TakeOpenSslError(
-        error == SSL_ERROR_SYSCALL ? "the client closed or stopped answering" : "failed");
-    SSL_free(tls_);
-    tls_ = nullptr;  // Nothing more goes through it, not even a close_notify.
-    return absl::UnavailableError(absl::StrCat("TLS handshake: ", reason));
+  while (true) {
+    const int accepted = SSL_accept(tls_);
+    if (accepted == 1) return absl::OkStatus();
+    if (!AwaitTls(accepted, read_deadline_)) break;
   }
-  return absl::OkStatus();
+  std::string reason = TakeOpenSslError("the client closed, stopped answering or took too long");
+  SSL_free(tls_);
+  tls_ = nullptr;  // Nothing more goes through it, not even a close_notify.
+  return absl::UnavailableError(absl::StrCat("TLS handshake: ", reason));
 }
 
 size_t ServerConnection::Receive(char* buffer, size_t size) {
-  if (tls_ != nullptr) {
-    ERR_clear_error();
-    const int got = SSL_read(tls_, buffer, static_cast<int>(size < INT_MAX ? size : INT_MAX));
-    return got > 0 ? static_cast<size_t>(got) : 0;
-  }
+  const int chunk = static_cast<int>(std::min<size_t>(size, INT_MAX));
   while (true) {
-    const ssize_t got = recv(fd_, buffer, size, 0);
-    if (got < 0 && errno == EINTR) continue;
-    return got > 0 ? static_cast<size_t>(got) : 0;
+    if (tls_ != nullptr) {
+      ERR_clear_error();
+      const int got = SSL_read(tls_, buffer, chunk);
+      if (got > 0) return static_cast<size_t>(got);
+      if (!AwaitTls(got, read_deadline_)) return 0;
+      continue;
+    }
+    const ssize_t got = recv(fd_, buffer, static_cast<size_t>(chunk), 0);
+    if (got > 0) return static_cast<size_t>(got);
+    if (got == 0) return 0;
+    if (errno == EINTR) continue;
+    if ((errno != EAGAIN && errno != EWOULDBLOCK) || !Await(POLLIN, read_deadline_)) return 0;
   }
 }
 
 bool ServerConnection::SendAll(absl::string_view data) {
   while (!data.empty()) {
-    const size_t chunk = data.size() < INT_MAX ? data.size() : INT_MAX;
+    const int chunk = static_cast<int>(std::min<size_t>(data.size(), INT_MAX));
     if (tls_ != nullptr) {
       ERR_clear_error();
-      // Without SSL_MODE_ENABLE_PARTIAL_WRITE a write sends all of its chunk or fails.
-      if (SSL_write(tls_, data.data(), static_cast<int>(chunk)) <= 0) return false;
-      data.remove_prefix(chunk);
+      // Without SSL_MODE_ENABLE_PARTIAL_WRITE a write sends all of its chunk or none; one that
+      // must wait is called again with the same arguments.
+      const int sent = SSL_write(tls_, data.data(), chunk);
+      if (sent > 0) {
+        data.remove_prefix(static_cast<size_t>(sent));
+      } else if (!AwaitTls(sent, absl::Now() + write_timeout_)) {
+        return false;
+      }
       continue;
     }
-    const ssize_t sent = send(fd_, data.data(), chunk, MSG_NOSIGNAL);
-    if (sent < 0 && errno == EINTR) continue;
-    if (sent <= 0) return false;
-    data.remove_prefix(static_cast<size_t>(sent));
+    const ssize_t sent = send(fd_, data.data(), static_cast<size_t>(chunk), MSG_NOSIGNAL);
+    if (sent > 0) {
+      data.remove_prefix(static_cast<size_t>(sent));
+    } else if (sent < 0 && errno == EINTR) {
+      continue;
+    } else if (sent == 0 || (errno != EAGAIN && errno != EWOULDBLOCK) ||
+               !Await(POLLOUT, absl::Now() + write_timeout_)) {
+      return false;
+    }
   }
   return true;
 }
 
-void ServerConnection::EndSending() {
+void ServerConnection::EndSending(absl::Duration linger) {
   if (tls_ != nullptr) {
     ERR_clear_error();
-    SSL_shutdown(tls_);  // Our close_notify; the client's is not waited for.
+    SSL_shutdown(tls_);  // Our close_notify (unsent if the socket is full); not the client's.
   }
   shutdown(fd_, SHUT_WR);
+  const absl::Time until = absl::Now() + linger;
+  char discard[4096];
+  for (size_t drained = 0; drained < (size_t{1} << 20);) {
+    const ssize_t got = recv(fd_, discard, sizeof(discard), 0);
+    if (got > 0) {
+      drained += static_cast<size_t>(got);
+    } else if (got == 0 || (errno != EINTR && errno != EAGAIN && errno != EWOULDBLOCK) ||
+               !Await(POLLIN, until)) {
+      break;
+    }
+  }
 }
 
 }  // namespace neuralmesh::http

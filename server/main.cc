@@ -128,21 +128,11 @@ ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(5),
 
 namespace {
 
-// The contents of the file a flag names ("" when the flag is empty); the message names the flag.
-absl::StatusOr<std::string> ReadFlagFile(const char* flag, const std::string& path) {
-  if (path.empty()) return std::string();
-  absl::StatusOr<std::string> contents = neuralmesh::ReadFileContents(path);
-  if (!contents.ok()) {
-    return absl::Status(contents.status().code(),
-                        absl::StrCat("--", flag, ": ", contents.status().message()));
-  }
-  return contents;
-}
-
 // The tokens of --access_tokens_file, which is set.
 absl::StatusOr<std::vector<neuralmesh::server::AccessToken>> AccessTokensFromFlag() {
   NM_ASSIGN_OR_RETURN(const std::string text,
-                      ReadFlagFile("access_tokens_file", absl::GetFlag(FLAGS_access_tokens_file)));
+                      neuralmesh::ReadFileNamedByFlag("access_tokens_file",
+                                                      absl::GetFlag(FLAGS_access_tokens_file)));
   absl::StatusOr<std::vector<neuralmesh::server::AccessToken>> tokens =
       neuralmesh::server::ParseAccessTokens(text);
   if (!tokens.ok()) {
@@ -154,8 +144,9 @@ absl::StatusOr<std::vector<neuralmesh::server::AccessToken>> AccessTokensFromFla
 
 // The roles of --client_roles_file, which is set.
 absl::StatusOr<neuralmesh::server::ClientRoles> ClientRolesFromFlag() {
-  NM_ASSIGN_OR_RETURN(const std::string text,
-                      ReadFlagFile("client_roles_file", absl::GetFlag(FLAGS_client_roles_file)));
+  NM_ASSIGN_OR_RETURN(
+      const std::string text,
+      neuralmesh::ReadFileNamedByFlag("client_roles_file", absl::GetFlag(FLAGS_client_roles_file)));
   absl::StatusOr<neuralmesh::server::ClientRoles> roles =
       neuralmesh::server::ParseClientRoles(text);
   if (!roles.ok()) {
@@ -176,10 +167,9 @@ absl::StatusOr<neuralmesh::server::ServerTls> TlsFromFlags() {
   const PemFlag pem_flags[] = {
       {"tls_cert_file", absl::GetFlag(FLAGS_tls_cert_file), &tls.certificate_chain},
       {"tls_key_file", absl::GetFlag(FLAGS_tls_key_file), &tls.private_key},
-      {"tls_client_ca_file", absl::GetFlag(FLAGS_tls_client_ca_file),
-       &tls.client_ca_certificates}};
+      {"tls_client_ca_file", absl::GetFlag(FLAGS_tls_client_ca_file), &tls.client_ca_certificates}};
   for (const PemFlag& pem : pem_flags) {
-    NM_ASSIGN_OR_RETURN(*pem.contents, ReadFlagFile(pem.flag, pem.path));
+    NM_ASSIGN_OR_RETURN(*pem.contents, neuralmesh::ReadFileNamedByFlag(pem.flag, pem.path));
   }
   return tls;
 }
@@ -209,7 +199,8 @@ absl::StatusOr<neuralmesh::server::ServerSecurity> SecurityFromFlags() {
 absl::StatusOr<std::string> MetricsTokenFromFlag() {
   const std::string path = absl::GetFlag(FLAGS_metrics_token_file);
   if (path.empty()) return std::string();
-  NM_ASSIGN_OR_RETURN(const std::string contents, ReadFlagFile("metrics_token_file", path));
+  NM_ASSIGN_OR_RETURN(const std::string contents,
+                      neuralmesh::ReadFileNamedByFlag("metrics_token_file", path));
   absl::StatusOr<std::string> token = neuralmesh::http::ParseSecret(contents, "the metrics token");
   if (!token.ok()) {
     return absl::InvalidArgumentError(

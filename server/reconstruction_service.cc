@@ -16,6 +16,7 @@
 #include "server/off_thread_work.h"
 #include "server/proto_conversion.h"
 #include "server/session_access.h"
+#include "server/session_stream_hold.h"
 #include "server/update_channel.h"
 
 namespace neuralmesh::server {
@@ -111,9 +112,8 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
  public:
   WatchReactor(SessionManager* manager, ReactorRegistry* reactors, const Caller& caller,
                const v1::WatchSessionRequest& request)
-      : reactors_(reactors), writer_(request.after_sequence()) {
-    registered_ = reactors_->Add(this);
-    if (!registered_) {
+      : hold_(reactors), writer_(request.after_sequence()) {
+    if (!hold_.Register(this)) {
       EndNow(Unavailable());
       return;
     }
@@ -123,10 +123,9 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
       EndNow(session.status());
       return;
     }
-    session_ = *std::move(session);
-    session_->AddStream();
+    hold_.Attach(*std::move(session));
     // May call OnUpdate/OnClose right away (the latest mesh, a closed session).
-    handle_ = session_->updates().Subscribe(this, request.after_sequence());
+    hold_.Subscribe(this, request.after_sequence());
   }
 
   void OnUpdate(const MeshUpdatePtr& update) override {
@@ -158,11 +157,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
   void OnCancel() override { EndNow(absl::CancelledError("the watcher cancelled the call")); }
 
   void OnDone() override {
-    if (session_ != nullptr) {
-      session_->updates().Unsubscribe(handle_);
-      session_->RemoveStream();
-    }
-    if (registered_) reactors_->Remove(this);
+    hold_.Release();
     delete this;
   }
 
@@ -181,10 +176,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::MeshUpdate>,
     }
   }
 
-  ReactorRegistry* const reactors_;
-  bool registered_ = false;
-  std::shared_ptr<Session> session_;  // Set in the constructor, read in OnDone.
-  uint64_t handle_ = 0;
+  SessionStreamHold hold_;  // Set up in the constructor, released in OnDone.
 
   absl::Mutex mu_;
   LatestWinsWriter writer_ ABSL_GUARDED_BY(mu_);
@@ -214,13 +206,12 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
   UploadReactor(SessionManager* manager, ReactorRegistry* reactors, Executor* filter,
                 Caller caller, v1::UploadPointsResponse* response)
       : manager_(manager),
-        reactors_(reactors),
+        hold_(reactors),
         caller_(std::move(caller)),
         filter_(filter),
         response_(response),
         work_([this] { CleanUpAndDelete(); }) {
-    registered_ = reactors_->Add(this);
-    if (!registered_) {
+    if (!hold_.Register(this)) {
       FinishOnce(Unavailable());
       return;
     }
@@ -233,7 +224,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
       if (finished_) return;
     }
     if (!ok) {
-      if (session_ == nullptr) {
+      if (session() == nullptr) {
         FinishOnce(absl::InvalidArgumentError(
             "the upload carried no message; the first one must name a session"));
         return;
@@ -241,7 +232,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
       {
         absl::MutexLock lock(&mu_);
         if (finished_) return;
-        response_->set_session_id(session_->id());
+        response_->set_session_id(session()->id());
         response_->set_points_accepted(points_);
         response_->set_points_held_back(held_back_);
         response_->set_batches_accepted(batches_);
@@ -251,7 +242,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
       return;
     }
     absl::Status status = ResolveSession();
-    if (status.ok() && session_->filters_outliers()) {
+    if (status.ok() && session()->filters_outliers()) {
       if (work_.Run(*filter_, [this] { ContinueAfter(IngestBatchUnlessFinished()); })) return;
       status = Unavailable();
     }
@@ -263,10 +254,10 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
 
   // The session accepts no more points: the call ends now rather than at its next batch.
   // Deletion and shutdown keep their codes; a session that finished, was cancelled or failed
-  // is FAILED_PRECONDITION, as a batch sent to it would be. (session_ was set before the
-  // subscription that leads here.)
+  // is FAILED_PRECONDITION, as a batch sent to it would be. (the session was attached before
+  // the subscription that leads here.)
   void OnClose(const absl::Status& status) override {
-    const std::string why = status.ok() ? absl::StrCat("session ", session_->id(), " is finished")
+    const std::string why = status.ok() ? absl::StrCat("session ", session()->id(), " is finished")
                                         : std::string(status.message());
     const absl::StatusCode code = status.code() == absl::StatusCode::kNotFound ||
                                           status.code() == absl::StatusCode::kUnavailable
@@ -288,14 +279,13 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
   }
 
  private:
+  // The session the call streams into; null until it is named.
+  Session* session() const { return hold_.session().get(); }
+
   // After OnDone and the last batch ingested off gRPC's threads (OffThreadWork), which may
   // still subscribe to the session's channel after the call has ended.
   void CleanUpAndDelete() {
-    if (session_ != nullptr) {
-      if (subscribed_) session_->updates().Unsubscribe(handle_);
-      session_->RemoveStream();
-    }
-    if (registered_) reactors_->Remove(this);
+    hold_.Release();
     delete this;
   }
 
@@ -320,20 +310,19 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
       batches = batches_;
     }
     const uint64_t batch_number = batches + 1;
-    if (session_ == nullptr) {
+    if (session() == nullptr) {
       if (request_.session_id().empty()) {
         return absl::InvalidArgumentError("the first message must set session_id");
       }
       absl::StatusOr<std::shared_ptr<Session>> session =
           GetSessionFor(*manager_, caller_, request_.session_id(), SessionUse::kChange);
       if (!session.ok()) return session.status();
-      session_ = *std::move(session);
-      session_->AddStream();
-    } else if (!request_.session_id().empty() && request_.session_id() != session_->id()) {
+      hold_.Attach(*std::move(session));
+    } else if (!request_.session_id().empty() && request_.session_id() != session()->id()) {
       return absl::InvalidArgumentError(
           absl::StrCat("batch ", batch_number, " of this call names session ",
                        QuotedSessionId(request_.session_id()), " but this call uploads into \"",
-                       session_->id(), "\""));
+                       session()->id(), "\""));
     }
     return absl::OkStatus();
   }
@@ -348,7 +337,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
     return IngestBatch();
   }
 
-  // Ingests request_'s batch into session_ (resolved).
+  // Ingests request_'s batch into the session (resolved).
   absl::Status IngestBatch() {
     uint64_t points = 0, batches = 0;
     {
@@ -358,10 +347,10 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
     }
     const uint64_t batch_number = batches + 1;
     absl::StatusOr<Ingested> ingested =
-        Ingest(*session_, request_.batch(), manager_->limits().max_batch_points);
+        Ingest(*session(), request_.batch(), manager_->limits().max_batch_points);
     if (!ingested.ok()) {
       return BatchError(ingested.status(), batch_number, batches, points,
-                        session_->points_received());
+                        session()->points_received());
     }
     {
       absl::MutexLock lock(&mu_);
@@ -370,12 +359,11 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
       ++batches_;
       total_ = ingested->total;
     }
-    if (!subscribed_) {
+    if (!hold_.subscribed()) {
       // After the first batch, so that a session that had ended already refuses it in its own
       // words. No update is wanted (the sequence filter passes none), only OnClose, which
       // comes at once if the session ended since.
-      handle_ = session_->updates().Subscribe(this, std::numeric_limits<uint64_t>::max());
-      subscribed_ = true;
+      hold_.Subscribe(this, std::numeric_limits<uint64_t>::max());
     }
     return absl::OkStatus();
   }
@@ -392,18 +380,16 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadPointsReque
   }
 
   SessionManager* const manager_;
-  ReactorRegistry* const reactors_;
+  // Set up by the constructor and OnReadDone, which gRPC serialises, released after every other
+  // reaction.
+  SessionStreamHold hold_;
   const Caller caller_;
   Executor* const filter_;
   v1::UploadPointsResponse* const response_;
   OffThreadWork work_;
-  bool registered_ = false;
   // Read-side state: touched only by the constructor and OnReadDone, which gRPC serialises,
   // and by OnDone after every other reaction.
   v1::UploadPointsRequest request_;
-  std::shared_ptr<Session> session_;
-  uint64_t handle_ = 0;
-  bool subscribed_ = false;
 
   absl::Mutex mu_;
   bool finished_ ABSL_GUARDED_BY(mu_) = false;
@@ -448,11 +434,10 @@ class ReconstructReactor final
                      ReactorRegistry* reactors, Executor* filter)
       : context_(context),
         manager_(manager),
-        reactors_(reactors),
+        hold_(reactors),
         filter_(filter),
         work_([this] { CleanUpAndDelete(); }) {
-    registered_ = reactors_->Add(this);
-    if (!registered_) {
+    if (!hold_.Register(this)) {
       End(Unavailable());
       return;
     }
@@ -472,12 +457,12 @@ class ReconstructReactor final
       }
       return;
     }
-    if (session_ != nullptr && session_->filters_outliers()) {
+    if (session() != nullptr && session()->filters_outliers()) {
       if (work_.Run(*filter_, [this] { ContinueAfter(PointsUnlessEnded()); })) return;
       ContinueAfter(Unavailable());
       return;
     }
-    ContinueAfter(session_ == nullptr ? Start() : Points());
+    ContinueAfter(session() == nullptr ? Start() : Points());
   }
 
   void OnUpdate(const MeshUpdatePtr& update) override {
@@ -509,13 +494,12 @@ class ReconstructReactor final
   }
 
  private:
+  // The session the call streams into; null until it is named.
+  Session* session() const { return hold_.session().get(); }
+
   // After OnDone and the last batch ingested off gRPC's threads (OffThreadWork).
   void CleanUpAndDelete() {
-    if (session_ != nullptr) {
-      if (subscribed_) session_->updates().Unsubscribe(handle_);
-      session_->RemoveStream();
-    }
-    if (registered_) reactors_->Remove(this);
+    hold_.Release();
     delete this;
   }
 
@@ -549,25 +533,25 @@ class ReconstructReactor final
     }
     const v1::ReconstructStart& start = request_.start();
     const Caller caller = CallerOf(*context_);
-    std::shared_ptr<Session> session;
+    std::shared_ptr<Session> chosen;
     switch (start.target_case()) {
       case v1::ReconstructStart::kCreate: {
         NM_RETURN_IF_ERROR(CheckMayCreate(caller));
         absl::StatusOr<std::shared_ptr<Session>> created =
             CreateFromRequest(*manager_, start.create(), context_->peer(), caller);
         if (!created.ok()) return created.status();
-        session = *std::move(created);
+        chosen = *std::move(created);
         break;
       }
       case v1::ReconstructStart::kSessionId: {
         absl::StatusOr<std::shared_ptr<Session>> found =
             GetSessionFor(*manager_, caller, start.session_id(), SessionUse::kChange);
         if (!found.ok()) return found.status();
-        session = *std::move(found);
-        const v1::SessionState state = session->state();
+        chosen = *std::move(found);
+        const v1::SessionState state = chosen->state();
         if (state != v1::SESSION_STATE_COLLECTING && state != v1::SESSION_STATE_LEARNING) {
           return absl::FailedPreconditionError(
-              absl::StrCat("session ", session->id(), " is ", v1::SessionState_Name(state),
+              absl::StrCat("session ", chosen->id(), " is ", v1::SessionState_Name(state),
                            " and accepts no more points"));
         }
         break;
@@ -576,16 +560,14 @@ class ReconstructReactor final
         return absl::InvalidArgumentError(
             "ReconstructStart must set either create or session_id");
     }
-    session_ = std::move(session);
-    session_->AddStream();
-    v1::Session proto = session_->ToProto();  // Before mu_: ToProto takes the channel's lock.
+    hold_.Attach(std::move(chosen));
+    v1::Session proto = session()->ToProto();  // Before mu_: ToProto takes the channel's lock.
     {
       absl::MutexLock lock(&mu_);
       pending_session_ = std::move(proto);
       MaybeWriteLocked();
     }
-    handle_ = session_->updates().Subscribe(this, 0);
-    subscribed_ = true;
+    hold_.Subscribe(this, 0);
     return absl::OkStatus();
   }
 
@@ -597,10 +579,10 @@ class ReconstructReactor final
                        "the first request may be a ReconstructStart"));
     }
     absl::StatusOr<Ingested> ingested =
-        Ingest(*session_, request_.points(), manager_->limits().max_batch_points);
+        Ingest(*session(), request_.points(), manager_->limits().max_batch_points);
     if (!ingested.ok()) {
       return BatchError(ingested.status(), batch_number, batches_, points_,
-                        session_->points_received());
+                        session()->points_received());
     }
     points_ += ingested->accepted;
     held_back_ += ingested->held_back;
@@ -618,14 +600,14 @@ class ReconstructReactor final
 
   // No more points from this client: finish the session and wait for its final mesh.
   void HalfClosed() {
-    if (session_ == nullptr) {
+    if (session() == nullptr) {
       End(absl::InvalidArgumentError("the request stream ended before its ReconstructStart"));
       return;
     }
-    absl::Status status = session_->Finish();
+    absl::Status status = session()->Finish();
     if (!status.ok()) {
       // Finished by someone else meanwhile: the final mesh comes all the same.
-      const v1::SessionState state = session_->state();
+      const v1::SessionState state = session()->state();
       if (state != v1::SESSION_STATE_FINISHING && state != v1::SESSION_STATE_FINISHED) {
         End(status);
       }
@@ -672,16 +654,14 @@ class ReconstructReactor final
 
   grpc::CallbackServerContext* const context_;
   SessionManager* const manager_;
-  ReactorRegistry* const reactors_;
+  // Set up by the constructor and OnReadDone (serialised by gRPC), released after every other
+  // reaction.
+  SessionStreamHold hold_;
   Executor* const filter_;
   OffThreadWork work_;
-  bool registered_ = false;
   // Read-side state: touched by the constructor and OnReadDone (serialised by gRPC), and by
   // OnDone after every other reaction.
   v1::ReconstructRequest request_;
-  std::shared_ptr<Session> session_;
-  uint64_t handle_ = 0;
-  bool subscribed_ = false;
   uint64_t points_ = 0;
   uint64_t held_back_ = 0;
   uint64_t batches_ = 0;
@@ -708,18 +688,13 @@ class GetMeshReactor final : public grpc::ServerUnaryReactor,
  public:
   GetMeshReactor(std::shared_ptr<Session> session, ReactorRegistry* reactors,
                  v1::MeshVersion version, v1::MeshUpdate* response)
-      : session_(std::move(session)),
-        reactors_(reactors),
-        version_(version),
-        response_(response) {
-    registered_ = reactors_->Add(this);
-    if (!registered_) {
+      : hold_(reactors), version_(version), response_(response) {
+    if (!hold_.Register(this)) {
       FinishOnce(Unavailable());
       return;
     }
-    session_->AddStream();
-    streaming_ = true;
-    handle_ = session_->updates().Subscribe(this, 0);
+    hold_.Attach(std::move(session));
+    hold_.Subscribe(this, 0);
   }
 
   void OnUpdate(const MeshUpdatePtr& update) override {
@@ -749,11 +724,7 @@ class GetMeshReactor final : public grpc::ServerUnaryReactor,
   }
 
   void OnDone() override {
-    if (streaming_) {
-      session_->updates().Unsubscribe(handle_);
-      session_->RemoveStream();
-    }
-    if (registered_) reactors_->Remove(this);
+    hold_.Release();
     delete this;
   }
 
@@ -768,13 +739,9 @@ class GetMeshReactor final : public grpc::ServerUnaryReactor,
     Finish(ToGrpcStatus(status));
   }
 
-  const std::shared_ptr<Session> session_;
-  ReactorRegistry* const reactors_;
+  SessionStreamHold hold_;  // Set up in the constructor, released in OnDone.
   const v1::MeshVersion version_;
   v1::MeshUpdate* const response_;
-  bool registered_ = false;
-  bool streaming_ = false;
-  uint64_t handle_ = 0;
 
   absl::Mutex mu_;
   bool finished_ ABSL_GUARDED_BY(mu_) = false;

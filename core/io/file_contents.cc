@@ -30,6 +30,16 @@ absl::StatusOr<std::string> ReadFileContents(const std::string& path) {
   return contents;
 }
 
+absl::StatusOr<std::string> ReadFileNamedByFlag(absl::string_view flag, const std::string& path) {
+  if (path.empty()) return std::string();
+  absl::StatusOr<std::string> contents = ReadFileContents(path);
+  if (!contents.ok()) {
+    return absl::Status(contents.status().code(),
+                        absl::StrCat("--", flag, ": ", contents.status().message()));
+  }
+  return contents;
+}
+
 absl::Status WriteFileContents(const std::string& path, absl::string_view contents) {
   std::FILE* file = std::fopen(path.c_str(), "wb");
   if (file == nullptr) {

@@ -17,6 +17,10 @@ namespace neuralmesh {
 // INVALID_ARGUMENT when it is empty.
 absl::StatusOr<std::string> ReadFileContents(const std::string& path);
 
+// For the programs' flags that name a file (--tls_cert_file=PATH): its contents, or "" when
+// `path` is empty. ReadFileContents's errors, their message prefixed with "--FLAG: ".
+absl::StatusOr<std::string> ReadFileNamedByFlag(absl::string_view flag, const std::string& path);
+
 // Replaces the file at `path` with `contents`; removes a partly written file on failure.
 // Returns the errno-derived status ("cannot write 'path': reason") when opening, writing or
 // closing fails: NOT_FOUND for a missing directory, PERMISSION_DENIED, RESOURCE_EXHAUSTED for a

@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -91,6 +92,32 @@ TEST(HttpServerTest, DropsAClientThatSendsNothingWithinTheReadTimeout) {
   EXPECT_EQ(recv(idle, &byte, 1, 0), 0) << "closed without an answer";
   EXPECT_LT(absl::Now() - start, absl::Seconds(5));
   close(idle);
+}
+
+TEST(HttpServerTest, DropsAClientThatTricklesItsRequestPastTheReadTimeout) {
+  HttpServerOptions options;
+  options.read_timeout = absl::Milliseconds(500);
+  absl::StatusOr<std::unique_ptr<HttpServer>> server =
+      HttpServer::Start("127.0.0.1", 0, Echo, options);
+  ASSERT_TRUE(server.ok());
+  // A byte every 100 ms: each comes well within the timeout, the whole head never does.
+  const int slow = ConnectIdle((*server)->port());
+  const std::string request = "GET /trickled HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+  const absl::Time start = absl::Now();
+  size_t sent = 0;
+  for (; sent < request.size(); ++sent) {
+    if (send(slow, &request[sent], 1, MSG_NOSIGNAL) != 1) break;
+    absl::SleepFor(absl::Milliseconds(100));
+    pollfd closed{slow, POLLIN, 0};
+    if (poll(&closed, 1, 0) == 1) break;  // The server has given up on it.
+  }
+  char byte;
+  EXPECT_LE(recv(slow, &byte, 1, 0), 0) << "closed without an answer";
+  EXPECT_LT(sent, request.size()) << "the server waited for the whole trickled head";
+  EXPECT_LT(absl::Now() - start, absl::Seconds(3));
+  close(slow);
+  // A client that sends its request at once is answered as before.
+  EXPECT_EQ(HttpGet((*server)->port(), "/prompt").body, "/prompt\n");
 }
 
 TEST(HttpServerTest, ShutdownWaitsForTheHandlersInFlightAndClosesIdleConnections) {

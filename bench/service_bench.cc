@@ -32,6 +32,7 @@
 #include "core/sampling/implicit_surfaces.h"
 #include "core/sampling/sample_points.h"
 #include "neuralmesh/v1/reconstruction.grpc.pb.h"
+#include "proto/packing.h"
 #include "server/proto_conversion.h"
 #include "server/server.h"
 
@@ -64,7 +65,9 @@ PointCloud Torus(size_t n, uint64_t seed) {
 }
 
 v1::PointBatch Batch(const PointCloud& cloud, size_t begin, size_t end) {
-  return server::PointCloudToPackedBatch(PointRange(cloud, begin, end));
+  v1::PointBatch batch;
+  *batch.mutable_packed() = PackPoints(cloud, begin, end);
+  return batch;
 }
 
 std::string Create(Service& service, uint64_t target,

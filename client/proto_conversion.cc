@@ -1,4 +1,5 @@
 #include "client/proto_conversion.h"
+#include "proto/packing.h"
 
 namespace neuralmesh::client {
 
@@ -52,11 +53,7 @@ v1::Box ToProto(const BoundingBox& box) {
 
 v1::StartMesh ToProto(const TriangleMesh& mesh) {
   v1::StartMesh proto;
-  v1::PackedMesh& packed = *proto.mutable_packed();
-  packed.set_positions(reinterpret_cast<const char*>(mesh.positions.data()),
-                       mesh.positions.size() * sizeof(mesh.positions[0]));
-  packed.set_faces(reinterpret_cast<const char*>(mesh.faces.data()),
-                   mesh.faces.size() * sizeof(mesh.faces[0]));
+  *proto.mutable_packed() = PackMesh(mesh);
   return proto;
 }
 

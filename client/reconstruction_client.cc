@@ -13,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "client/grpc_status.h"
 #include "client/proto_conversion.h"
+#include "proto/packing.h"
 
 namespace neuralmesh::client {
 namespace {
@@ -21,13 +22,6 @@ namespace {
 // right on a little-endian host.
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "packing assumes little-endian");
 static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be three packed floats");
-
-template <typename T>
-std::string PackRange(const std::vector<T>& values, size_t begin, size_t end) {
-  std::string bytes((end - begin) * sizeof(T), '\0');
-  std::memcpy(bytes.data(), values.data() + begin, bytes.size());
-  return bytes;
-}
 
 // The longest pause between two attempts to connect again.
 constexpr absl::Duration kMaxReconnectBackoff = absl::Seconds(4);
@@ -66,16 +60,6 @@ std::string LastConnectionError(const std::shared_ptr<grpc::Channel>& channel,
 }
 
 }  // namespace
-
-v1::PointBatch PackPointBatch(const PointCloud& cloud, size_t begin, size_t end) {
-  v1::PointBatch batch;
-  batch.mutable_first_point()->set_value(begin);
-  v1::PackedPoints* packed = batch.mutable_packed();
-  packed->set_positions(PackRange(cloud.positions, begin, end));
-  if (!cloud.weights.empty()) packed->set_weights(PackRange(cloud.weights, begin, end));
-  if (!cloud.normals.empty()) packed->set_normals(PackRange(cloud.normals, begin, end));
-  return batch;
-}
 
 class ReconstructionClient::OpenCall {
  public:

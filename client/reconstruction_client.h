@@ -189,9 +189,6 @@ class ReconstructionClient {
   bool calls_cancelled_ ABSL_GUARDED_BY(calls_mu_) = false;
 };
 
-// One batch of `cloud`, points [begin, end), as packed little-endian float32.
-v1::PointBatch PackPointBatch(const PointCloud& cloud, size_t begin, size_t end);
-
 }  // namespace neuralmesh::client
 
 #endif  // NEURALMESH_CLIENT_RECONSTRUCTION_CLIENT_H_

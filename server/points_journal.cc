@@ -73,7 +73,7 @@ absl::string_view BytesOf(const std::vector<T>& values) {
 // the caller to fill, then the payload. The header and the protobuf framing live in `framing`
 // (which must outlive the pieces), the point arrays stay in place. The payload is the wire
 // format of a PointBatch whose PackedPoints hold the arrays (packed little-endian float32, as
-// PointCloudToPackedBatch makes them), written without copying the arrays: copies would cost
+// PackPoints makes them), written without copying the arrays: copies would cost
 // more than the write, in fresh pages for each batch.
 std::vector<absl::string_view> RecordPieces(const PointCloud& batch, std::string* framing) {
   // PackedPoints fields 1-3 (positions, weights, normals) and PointBatch field 1 (packed), all

@@ -269,31 +269,6 @@ absl::StatusOr<PointCloud> PointBatchFromProto(const v1::PointBatch& batch,
       "the batch has no points: set PointBatch.packed or PointBatch.draco_point_cloud");
 }
 
-v1::PointBatch PointCloudToPackedBatch(const PointCloud& cloud) {
-  v1::PointBatch batch;
-  v1::PackedPoints& packed = *batch.mutable_packed();
-  packed.set_positions(reinterpret_cast<const char*>(cloud.positions.data()),
-                       cloud.positions.size() * sizeof(Vec3f));
-  if (!cloud.weights.empty()) {
-    packed.set_weights(reinterpret_cast<const char*>(cloud.weights.data()),
-                       cloud.weights.size() * sizeof(float));
-  }
-  if (!cloud.normals.empty()) {
-    packed.set_normals(reinterpret_cast<const char*>(cloud.normals.data()),
-                       cloud.normals.size() * sizeof(Vec3f));
-  }
-  return batch;
-}
-
-v1::PackedMesh TriangleMeshToPacked(const TriangleMesh& mesh) {
-  v1::PackedMesh packed;
-  packed.set_positions(reinterpret_cast<const char*>(mesh.positions.data()),
-                       mesh.positions.size() * sizeof(Vec3f));
-  packed.set_faces(reinterpret_cast<const char*>(mesh.faces.data()),
-                   mesh.faces.size() * sizeof(mesh.faces[0]));
-  return packed;
-}
-
 absl::StatusOr<TriangleMesh> TriangleMeshFromPacked(const v1::PackedMesh& packed,
                                                     absl::string_view field) {
   TriangleMesh mesh;

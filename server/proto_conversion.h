@@ -34,14 +34,10 @@ v1::MeshReport MeshReportToProto(const MeshReport& report);
 absl::StatusOr<PointCloud> PointBatchFromProto(const v1::PointBatch& batch,
                                                size_t max_batch_points);
 
-// Packs `cloud` into a PointBatch (the inverse of PointBatchFromProto for packed batches).
-v1::PointBatch PointCloudToPackedBatch(const PointCloud& cloud);
-
-// A mesh packed as PackedMesh says (little-endian float32 positions, uint32 faces), and back.
-// The unpacking checks only the sizes: INVALID_ARGUMENT, naming `field`, when positions or
-// faces are not whole elements or there are no positions; what the mesh is made of is checked
-// where it is used (MakeStartMesh).
-v1::PackedMesh TriangleMeshToPacked(const TriangleMesh& mesh);
+// A mesh packed as PackedMesh says (little-endian float32 positions, uint32 faces; the packing is
+// proto/packing.h's PackMesh). Checks only the sizes: INVALID_ARGUMENT, naming `field`, when
+// positions or faces are not whole elements or there are no positions; what the mesh is made
+// of is checked where it is used (MakeStartMesh).
 absl::StatusOr<TriangleMesh> TriangleMeshFromPacked(const v1::PackedMesh& packed,
                                                     absl::string_view field);
 

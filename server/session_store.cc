@@ -14,6 +14,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/file_contents.h"
+#include "proto/packing.h"
 #include "core/status_macros.h"
 #include "neuralmesh/storage/v1/learner_checkpoint.pb.h"
 #include "server/proto_conversion.h"
@@ -171,7 +172,7 @@ absl::Status SessionRecord::WriteCheckpoint(const TriangleMesh& mesh,
   }
   // Packed and written outside the lock, which batches take (36 MB at a million vertices).
   checkpoint.set_format_version(kFormatVersion);
-  *checkpoint.mutable_mesh() = TriangleMeshToPacked(mesh);
+  *checkpoint.mutable_mesh() = PackMesh(mesh);
   *checkpoint.mutable_learning() = learning;
   const absl::Status written = WriteTemporary(kCheckpointFile, checkpoint, /*durable=*/false);
   absl::MutexLock lock(&mu_);

@@ -471,23 +471,5 @@ TEST(ReconstructionClientMessageSizeTest, MeshesLargerThanGrpcsDefaultLimitArriv
   server->Shutdown();
 }
 
-TEST(PackPointBatchTest, PacksLittleEndianFloatsOfTheRange) {
-  PointCloud cloud;
-  cloud.positions = {Vec3f(1, 2, 3), Vec3f(4, 5, 6), Vec3f(7, 8, 9)};
-  cloud.weights = {0.5f, 1.5f, 2.5f};
-  const v1::PointBatch batch = PackPointBatch(cloud, 1, 3);
-  ASSERT_TRUE(batch.has_packed());
-  ASSERT_EQ(batch.packed().positions().size(), 2 * 12u);
-  ASSERT_EQ(batch.packed().weights().size(), 2 * 4u);
-  EXPECT_TRUE(batch.packed().normals().empty());
-  float first[3];
-  std::memcpy(first, batch.packed().positions().data(), sizeof(first));
-  EXPECT_EQ(first[0], 4.0f);
-  EXPECT_EQ(first[2], 6.0f);
-  float weight;
-  std::memcpy(&weight, batch.packed().weights().data() + 4, sizeof(weight));
-  EXPECT_EQ(weight, 2.5f);
-}
-
 }  // namespace
 }  // namespace neuralmesh::client

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/io/draco_codec.h"
+#include "tests/server/server_test_support.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -22,7 +23,7 @@ TEST(PointBatchFromProtoTest, UnpacksPositionsWeightsAndNormals) {
   PointCloud cloud = ThreePoints();
   cloud.weights = {1, 2, 3};
   cloud.normals = {Vec3f(0, 0, 1), Vec3f(0, 0, 1), Vec3f(0, 0, 1)};
-  absl::StatusOr<PointCloud> back = PointBatchFromProto(PointCloudToPackedBatch(cloud), 100);
+  absl::StatusOr<PointCloud> back = PointBatchFromProto(testing::Batch(cloud), 100);
   ASSERT_TRUE(back.ok()) << back.status();
   EXPECT_EQ(back->positions, cloud.positions);
   EXPECT_EQ(back->weights, cloud.weights);
@@ -45,19 +46,19 @@ TEST(PointBatchFromProtoTest, RejectsMalformedBatchesSayingWhatIsWrong) {
     cases.push_back({"empty positions", b, absl::StatusCode::kInvalidArgument, "no points"});
   }
   {
-    v1::PointBatch b = PointCloudToPackedBatch(ThreePoints());
+    v1::PointBatch b = testing::Batch(ThreePoints());
     b.mutable_packed()->mutable_positions()->push_back('x');
     cases.push_back({"ragged positions", b, absl::StatusCode::kInvalidArgument,
                      "not a multiple of 12"});
   }
   {
-    v1::PointBatch b = PointCloudToPackedBatch(ThreePoints());
+    v1::PointBatch b = testing::Batch(ThreePoints());
     b.mutable_packed()->set_weights(std::string(8, '\0'));
     cases.push_back({"weights for two of three points", b, absl::StatusCode::kInvalidArgument,
                      "PackedPoints.weights has 8 bytes"});
   }
   {
-    v1::PointBatch b = PointCloudToPackedBatch(ThreePoints());
+    v1::PointBatch b = testing::Batch(ThreePoints());
     b.mutable_packed()->set_normals(std::string(24, '\0'));
     cases.push_back({"normals for two of three points", b, absl::StatusCode::kInvalidArgument,
                      "PackedPoints.normals has 24 bytes"});
@@ -76,7 +77,7 @@ TEST(PointBatchFromProtoTest, RejectsMalformedBatchesSayingWhatIsWrong) {
 }
 
 TEST(PointBatchFromProtoTest, OversizedBatchIsResourceExhausted) {
-  absl::StatusOr<PointCloud> result = PointBatchFromProto(PointCloudToPackedBatch(ThreePoints()), 2);
+  absl::StatusOr<PointCloud> result = PointBatchFromProto(testing::Batch(ThreePoints()), 2);
   EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted) << result.status();
   EXPECT_THAT(std::string(result.status().message()), HasSubstr("at most 2"));
 }

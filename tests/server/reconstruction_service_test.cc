@@ -494,7 +494,7 @@ TEST_F(ReconstructionServiceTest, OutlierRemovalDropsStraysBeforeTheSessionTakes
     for (const PointCloud& batch : batches) {
       v1::UploadPointsRequest request;
       request.set_session_id(id);
-      *request.mutable_batch() = PointCloudToPackedBatch(batch);
+      *request.mutable_batch() = testing::Batch(batch);
       EXPECT_TRUE(writer->Write(request));
     }
     writer->WritesDone();
@@ -525,7 +525,7 @@ TEST_F(ReconstructionServiceTest, OutlierRemovalDropsStraysBeforeTheSessionTakes
   nan.set_session_id(id);
   PointCloud nan_points = batches[0];
   nan_points.positions[5][1] = std::nanf("");
-  *nan.mutable_batch() = PointCloudToPackedBatch(nan_points);
+  *nan.mutable_batch() = testing::Batch(nan_points);
   v1::UploadPointsResponse refused;
   EXPECT_EQ(testing::UploadOne(*service_, nan, &refused).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);

@@ -22,6 +22,7 @@
 #include "core/sampling/implicit_surfaces.h"
 #include "core/sampling/sample_points.h"
 #include "neuralmesh/v1/reconstruction.grpc.pb.h"
+#include "proto/packing.h"
 #include "server/event_log.h"
 #include "server/proto_conversion.h"
 #include "server/server.h"
@@ -97,10 +98,16 @@ inline PointCloud SpherePoints(size_t n, uint64_t seed) {
   return SamplePoints(**sphere, n, seed);
 }
 
-// Points [begin, end) of `cloud` as a packed batch.
+// Points [begin, end) of `cloud` as a packed batch that does not say where it starts in the
+// upload (PackPointBatch's do).
 inline v1::PointBatch Batch(const PointCloud& cloud, size_t begin, size_t end) {
-  return PointCloudToPackedBatch(PointRange(cloud, begin, end));
+  v1::PointBatch batch;
+  *batch.mutable_packed() = PackPoints(cloud, begin, end);
+  return batch;
 }
+
+// All of `cloud` as such a batch.
+inline v1::PointBatch Batch(const PointCloud& cloud) { return Batch(cloud, 0, cloud.size()); }
 
 inline v1::CreateSessionRequest CreateRequest(uint64_t target, uint32_t refresh_ms = 250) {
   v1::CreateSessionRequest request;

@@ -43,7 +43,7 @@ v1::CreateSessionRequest RequestFrom(const TriangleMesh& start, uint64_t target)
   v1::CreateSessionRequest request = CreateRequest(target);
   request.mutable_config()->add_lod_milestones(200);
   request.mutable_config()->add_lod_milestones(1000);
-  *request.mutable_start_mesh()->mutable_packed() = TriangleMeshToPacked(start);
+  *request.mutable_start_mesh()->mutable_packed() = PackMesh(start);
   return request;
 }
 

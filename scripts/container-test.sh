@@ -17,9 +17,11 @@
 #      mesh served byte for byte as before;
 #   7. runs it again secured, with TLS and an access token from a read-only mount (throw-away
 #      certificates made with openssl): plaintext and token-less calls are refused, a client
-#      with the CA and the token reconstructs a torus, and after `podman kill -s HUP` with a
-#      new tokens file and a certificate from another CA copied over the old ones, only the new
-#      token and the new certificate are accepted.
+#      with the CA and the token reconstructs a torus, the metrics page answers over HTTPS
+#      with its own token (--metrics_tls, --metrics_token_file) and 401 without it, and after
+#      `podman kill -s HUP` with a new tokens file and a certificate from another CA copied
+#      over the old ones, only the new token and the new certificate are accepted (the metrics
+#      page presents the new certificate too).
 # The containers are always removed at the end. The Dockerfile itself stays standard: every
 # podman adjustment (containers.conf, chroot isolation, the imported base image) lives here.
 #
@@ -302,15 +304,33 @@ decoded_faces=$(grep -c '^f ' "${WORK_DIR}/final.obj" || true)
 say "Final mesh: ${decoded_vertices} vertices, ${decoded_faces} faces (draco_decoder)"
 
 step "Reading the metrics page on ${METRICS_ADDRESS}"
-# urllib without the environment's proxies: the page is on 127.0.0.1.
-"${PYTHON}" - "http://${METRICS_ADDRESS}/metrics" >"${OUT_DIR}/metrics.txt" \
-  2>"${WORK_DIR}/metrics.err" <<'EOF' || fail "GET /metrics: $(tail -n 3 "${WORK_DIR}/metrics.err")"
+# get.py URL [CA_PEM [TOKEN_FILE]]: prints the body of GET URL, or the status and body of an
+# HTTP error (exit 1); with a CA, over HTTPS checking the certificate against it; with a token
+# file, as "Authorization: Bearer". urllib without the environment's proxies: the pages are on
+# 127.0.0.1.
+cat >"${WORK_DIR}/get.py" <<'EOF'
+import ssl
 import sys
+import urllib.error
 import urllib.request
 
-opener = urllib.request.build_opener(urllib.request.ProxyHandler({}))
-sys.stdout.write(opener.open(sys.argv[1], timeout=10).read().decode())
+handlers = [urllib.request.ProxyHandler({})]
+if len(sys.argv) > 2:
+    context = ssl.create_default_context(cafile=sys.argv[2])
+    handlers.append(urllib.request.HTTPSHandler(context=context))
+request = urllib.request.Request(sys.argv[1])
+if len(sys.argv) > 3:
+    with open(sys.argv[3]) as token:
+        request.add_header("Authorization", "Bearer " + token.read().strip())
+try:
+    reply = urllib.request.build_opener(*handlers).open(request, timeout=10)
+    sys.stdout.write(reply.read().decode())
+except urllib.error.HTTPError as error:
+    sys.stdout.write(f"HTTP {error.code}: {error.read().decode()}")
+    sys.exit(1)
 EOF
+"${PYTHON}" "${WORK_DIR}/get.py" "http://${METRICS_ADDRESS}/metrics" >"${OUT_DIR}/metrics.txt" \
+  2>"${WORK_DIR}/metrics.err" || fail "GET /metrics: $(tail -n 3 "${WORK_DIR}/metrics.err")"
 for sample in 'neuralmesh_sessions_ended_total{state="finished"} 1' \
   'neuralmesh_points_accepted_total 100000' \
   'grpc_server_handled_total{grpc_service="neuralmesh.v1.ReconstructionService",grpc_method="CreateSession",grpc_type="unary",grpc_code="OK"} 1'; do
@@ -385,14 +405,16 @@ mkdir -p "${SECRETS}"
 "${PYTHON}" -c 'import secrets; print(secrets.token_hex(24))' >"${WORK_DIR}/token"
 "${PYTHON}" -c 'import secrets; print(secrets.token_hex(24))' >"${WORK_DIR}/new_token"
 cp "${WORK_DIR}/token" "${SECRETS}/tokens.txt"
+"${PYTHON}" -c 'import secrets; print(secrets.token_hex(24))' >"${SECRETS}/metrics_token"
 # The server runs as an unprivileged user of the image: it must be able to read the mount.
 chmod 755 "${SECRETS}"
 chmod 644 "${SECRETS}"/*
 
-step "Starting the container with TLS and an access token"
+step "Starting the container with TLS and an access token, its metrics page over HTTPS"
 start_container "neuralmesh-test-secured-$$" -v "${SECRETS}:/secrets:ro" -- \
   --host=0.0.0.0 --port="${CONTAINER_PORT}" --tls_cert_file=/secrets/server.pem \
-  --tls_key_file=/secrets/server.key --access_tokens_file=/secrets/tokens.txt
+  --tls_key_file=/secrets/server.key --access_tokens_file=/secrets/tokens.txt \
+  --metrics_tls --metrics_token_file=/secrets/metrics_token
 wait_serving "${SECRETS}/ca.pem"
 grep -q 'TLS, 1 access tokens' <(podman logs "${CONTAINER}" 2>&1) \
   || fail "the server's first line does not say 'TLS, 1 access tokens'"
@@ -422,6 +444,20 @@ timeout 600 "${CLI}" reconstruct builtin:torus "${secured[@]}" --access_token_fi
 [[ -s "${MESH_DIR}/secured/torus.drc" ]] || fail "no final mesh over TLS"
 say "Final mesh over TLS: $(tail -n 1 "${OUT_DIR}/reconstruct-secured.out")"
 
+step "Reading the metrics page over HTTPS with its token"
+"${PYTHON}" "${WORK_DIR}/get.py" "https://${METRICS_ADDRESS}/metrics" "${SECRETS}/ca.pem" \
+  "${SECRETS}/metrics_token" >"${OUT_DIR}/metrics-secured.txt" 2>&1 \
+  || fail "GET https://.../metrics: $(tail -n 3 "${OUT_DIR}/metrics-secured.txt")"
+grep -qxF 'neuralmesh_sessions{state="finished"} 1' "${OUT_DIR}/metrics-secured.txt" \
+  || fail "/metrics over HTTPS lacks the finished session"
+if "${PYTHON}" "${WORK_DIR}/get.py" "https://${METRICS_ADDRESS}/metrics" "${SECRETS}/ca.pem" \
+  >"${WORK_DIR}/no-token.out" 2>&1; then
+  fail "/metrics answered without the token"
+fi
+grep -q "^HTTP 401" "${WORK_DIR}/no-token.out" \
+  || fail "/metrics without the token: $(cat "${WORK_DIR}/no-token.out")"
+say "/metrics over HTTPS: 200 with the token, 401 without"
+
 step "Replacing the token and the certificate and sending SIGHUP"
 cp "${WORK_DIR}/new_token" "${SECRETS}/tokens.txt"
 cp "${WORK_DIR}/renewed/server.pem" "${WORK_DIR}/renewed/server.key" "${SECRETS}/"
@@ -444,7 +480,10 @@ expect_refused "not one this server accepts" sessions "${secured[@]}" --access_t
 "${CLI}" sessions "${secured[@]}" --access_token_file "${WORK_DIR}/new_token" \
   >"${OUT_DIR}/sessions-secured.out" 2>&1 || fail "the new token: $(cat "${OUT_DIR}/sessions-secured.out")"
 grep -q finished "${OUT_DIR}/sessions-secured.out" || fail "the secured session is not listed"
-say "The old token and certificate are refused, the new ones accepted after SIGHUP"
+"${PYTHON}" "${WORK_DIR}/get.py" "https://${METRICS_ADDRESS}/healthz" \
+  "${WORK_DIR}/renewed/ca.pem" >"${WORK_DIR}/healthz.out" 2>&1 \
+  || fail "the metrics page kept the old certificate: $(tail -n 3 "${WORK_DIR}/healthz.out")"
+say "The old token and certificate are refused, the new ones accepted after SIGHUP (and on /metrics)"
 podman stop --time 30 "${CONTAINER}" >/dev/null || fail "podman stop"
 podman logs "${CONTAINER}" >"${OUT_DIR}/server-secured.log" 2>&1
 podman rm -v "${CONTAINER}" >/dev/null

@@ -77,7 +77,8 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
         "none (tls_cert_file)");
   }
   if (!options.metrics_token.empty()) {
-    absl::StatusOr<std::string> token = http::ParseSecret(options.metrics_token, "the metrics token");
+    absl::StatusOr<std::string> token =
+        http::ParseSecret(options.metrics_token, "the metrics token");
     if (!token.ok()) return token.status();
     if (*token != options.metrics_token) {
       return absl::InvalidArgumentError("the metrics token has whitespace around it");

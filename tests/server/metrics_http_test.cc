@@ -300,7 +300,8 @@ TEST(MetricsHttpTest, OverTlsWithATokenOnlyTheTokensHolderReadsTheMetrics) {
   // Without a token from the start, none can be added.
   std::unique_ptr<ReconstructionServer> open = StartWithMetrics();
   ASSERT_NE(open, nullptr);
-  EXPECT_EQ(open->metrics_url(), absl::StrCat("http://127.0.0.1:", open->metrics_port(), "/metrics"));
+  EXPECT_EQ(open->metrics_url(),
+            absl::StrCat("http://127.0.0.1:", open->metrics_port(), "/metrics"));
   EXPECT_EQ(open->ReplaceMetricsToken(kMetricsToken).code(),
             absl::StatusCode::kFailedPrecondition);
 }

@@ -589,7 +589,8 @@ std::vector<Subcommand> Commands() {
        "server and shows the chosen one's mesh as it learns: each published mesh is fetched\n"
        "Draco-encoded, decoded in the browser and drawn with three.js, coarse to fine, until\n"
        "the final mesh. It opens on the newest session still learning;\n"
-       "http://HOST:PORT/?session=ID goes straight to a session. Runs until Ctrl-C.",
+       "http://HOST:PORT/?session=ID goes straight to a session. With --view_tls_cert_file\n"
+       "and --view_tls_key_file it serves https:// instead. Runs until Ctrl-C.",
        WithConnectionFlags({"server", "listen", "web_root", "view_key_file", "view_tls_cert_file",
                             "view_tls_key_file"}),
        View},

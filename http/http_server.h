@@ -11,11 +11,10 @@
 // Bad requests get 400 with a message, oversized heads 431, methods other than GET and HEAD
 // 405, and connections beyond `max_connections` 503 (closed without an answer under TLS); a
 // client that has not sent its whole request head `read_timeout` after connecting is dropped,
-// however it trickles its bytes. Under TLS, a client that speaks plain
-// HTTP gets 400 in plain HTTP saying that the port speaks HTTPS, and a failed handshake closes
-// the connection. The handler runs on the connection's thread and may block (a long
-// poll), so it must return once its owner is shut down: Shutdown() closes the sockets but
-// waits for handlers in flight.
+// however it trickles its bytes. Under TLS, a client that speaks plain HTTP gets 400 in plain
+// HTTP saying that the port speaks HTTPS, and a failed handshake closes the connection. The
+// handler runs on the connection's thread and may block (a long poll), so it must return once
+// its owner is shut down: Shutdown() closes the sockets but waits for handlers in flight.
 #ifndef NEURALMESH_HTTP_HTTP_SERVER_H_
 #define NEURALMESH_HTTP_HTTP_SERVER_H_
 

@@ -15,10 +15,11 @@ that show the mesh (the surface's blue or its edges; the background is grey), an
 the page follows a session, and stops there.
 
 Usage: viewer_browser_driver.py --url=URL --ready_file=PATH [--timeout=60] [--screenshot=PATH]
-                                [--stop_when_watching]
+                                [--stop_when_watching] [--trust_certificate=PEM]
 """
 import argparse
 import base64
+import hashlib
 import json
 import os
 import re
@@ -34,7 +35,16 @@ import zlib
 import websocket  # Debian's python3-websocket.
 
 
-def start_chromium(profile):
+def spki_hash(certificate):
+    """The base64 SHA-256 of a PEM certificate's public key, as Chromium names a key it trusts."""
+    key = subprocess.run(["openssl", "x509", "-in", certificate, "-pubkey", "-noout"],
+                         check=True, capture_output=True).stdout
+    der = subprocess.run(["openssl", "pkey", "-pubin", "-outform", "der"], input=key,
+                         check=True, capture_output=True).stdout
+    return base64.b64encode(hashlib.sha256(der).digest()).decode()
+
+
+def start_chromium(profile, trusted_certificate=None):
     binary = shutil.which("chromium") or shutil.which("chromium-browser")
     if binary is None:
         sys.exit("chromium is not installed (scripts/install-deps.sh installs it)")
@@ -42,6 +52,9 @@ def start_chromium(profile):
                "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-first-run",
                "--disable-dev-shm-usage",
                "--remote-debugging-port=0", "--user-data-dir=" + profile, "about:blank"]
+    if trusted_certificate:
+        # That certificate's key only: any other certificate error still stops the page.
+        command.insert(1, "--ignore-certificate-errors-spki-list=" + spki_hash(trusted_certificate))
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                text=True)
     deadline = time.time() + 30
@@ -152,10 +165,13 @@ def main():
     parser.add_argument("--timeout", type=float, default=60)
     parser.add_argument("--screenshot")
     parser.add_argument("--stop_when_watching", action="store_true")
+    parser.add_argument("--trust_certificate",
+                        help="a PEM certificate whose key the browser trusts (an https:// URL "
+                             "served with a test certificate)")
     args = parser.parse_args()
 
     profile = tempfile.mkdtemp(prefix="neuralmesh-chromium-")
-    process, browser_url = start_chromium(profile)
+    process, browser_url = start_chromium(profile, args.trust_certificate)
     try:
         page = Page(page_socket(browser_url))
         page.call("Emulation.setDeviceMetricsOverride", width=1000, height=700,

@@ -20,6 +20,8 @@
 #include "tests/client/subprocess.h"
 #include "tests/client/web/viewer_test_support.h"
 #include "tests/server/server_test_support.h"
+#include "tests/testing/temp_dir.h"
+#include "tests/testing/test_certificates.h"
 
 namespace neuralmesh::client::web {
 namespace {
@@ -177,6 +179,40 @@ TEST(ViewerBrowserTest, AKeyedViewerShowsTheSessionsToTheBrowserGivenTheKey) {
       "/usr/bin/python3 tests/client/web/viewer_browser_driver.py --timeout=60 "
       "--stop_when_watching --url=http://127.0.0.1:",
       port, "/?key=", key, " --ready_file=", dir, "/ready > ", dir, "/out 2> ", dir, "/err");
+  ASSERT_EQ(std::system(command.c_str()), 0) << testing::ReadWholeFile(dir + "/err");
+  EXPECT_EQ(testing::ReadWholeFile(dir + "/out"), absl::StrCat("watching ", live, "\n"));
+}
+
+// The same over HTTPS (--view_tls_cert_file): the browser, trusting the test certificate's key,
+// takes the key's cookie, which is Secure, and brings it with every request of the page.
+TEST(ViewerBrowserTest, AKeyedViewerOverHttpsShowsTheSessionsToTheBrowserGivenTheKey) {
+  if (std::system("command -v chromium > /dev/null && /usr/bin/python3 -c 'import websocket'") !=
+      0) {
+    FAIL() << "chromium and Debian's python3-websocket are required (scripts/install-deps.sh)";
+  }
+  absl::StatusOr<testing::TestCertificates> certificates =
+      testing::MakeTestCertificates(testing::MakeTempDir("browser_https_certificates"));
+  ASSERT_TRUE(certificates.ok()) << certificates.status();
+  std::unique_ptr<server::ReconstructionServer> server = st::StartServer(/*listen=*/true);
+  ASSERT_NE(server, nullptr);
+  auto service = st::NetworkService(*server);
+  const std::string live = st::MustCreate(*service, st::CreateRequest(500));
+  const std::string dir = testing::MakeTempDir("browser_https");
+  const std::string key = "browser-key-0123456789";
+  std::ofstream(dir + "/key") << key << "\n";
+
+  BackgroundProcess viewer(
+      "neuralmesh", {"view", "--server=" + server->target(), "--listen=127.0.0.1:0",
+                     "--view_key_file=" + dir + "/key",
+                     "--view_tls_cert_file=" + certificates->Path("server.pem"),
+                     "--view_tls_key_file=" + certificates->Path("server.key")});
+  const int port = WaitForViewerPort(viewer, "https");
+  ASSERT_NE(port, 0) << "neuralmesh view did not start: " << viewer.Stderr();
+  const std::string command = absl::StrCat(
+      "/usr/bin/python3 tests/client/web/viewer_browser_driver.py --timeout=60 "
+      "--stop_when_watching --trust_certificate=",
+      certificates->Path("server.pem"), " --url=https://127.0.0.1:", port, "/?key=", key,
+      " --ready_file=", dir, "/ready > ", dir, "/out 2> ", dir, "/err");
   ASSERT_EQ(std::system(command.c_str()), 0) << testing::ReadWholeFile(dir + "/err");
   EXPECT_EQ(testing::ReadWholeFile(dir + "/out"), absl::StrCat("watching ", live, "\n"));
 }

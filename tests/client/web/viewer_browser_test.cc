@@ -158,29 +158,45 @@ TEST(ViewerBrowserTest, ThePageOpensOnTheNewestSessionStillLearning) {
       << "not the older live one (" << older << "), nor the finished or cancelled ones";
 }
 
-// neuralmesh view --view_key_file: the browser opens the URL with the key once, the viewer
-// keeps the key in a cookie and sends the browser on to the page, whose requests (scripts,
-// three.js, the API) all bring the cookie: the page shows the learning session.
-TEST(ViewerBrowserTest, AKeyedViewerShowsTheSessionsToTheBrowserGivenTheKey) {
+// A keyed viewer (neuralmesh view --view_key_file) of a server with one live session, over
+// HTTPS with `https`'s server certificate when given: headless Chromium, trusting that
+// certificate's key only, opens the URL with the key and must end up watching the session.
+void ExpectTheKeyedPageWatchesTheLiveSession(const std::string& dir_name,
+                                             const testing::TestCertificates* https) {
   std::unique_ptr<server::ReconstructionServer> server = st::StartServer(/*listen=*/true);
   ASSERT_NE(server, nullptr);
   auto service = st::NetworkService(*server);
   const std::string live = st::MustCreate(*service, st::CreateRequest(500));
-  const std::string dir = testing::MakeTempDir("browser_key");
+  const std::string dir = testing::MakeTempDir(dir_name);
   const std::string key = "browser-key-0123456789";
   std::ofstream(dir + "/key") << key << "\n";
 
-  BackgroundProcess viewer("neuralmesh",
-                           {"view", "--server=" + server->target(), "--listen=127.0.0.1:0",
-                            "--view_key_file=" + dir + "/key"});
-  const int port = WaitForViewerPort(viewer);
+  std::vector<std::string> args = {"view", "--server=" + server->target(), "--listen=127.0.0.1:0",
+                                   "--view_key_file=" + dir + "/key"};
+  std::string driver_flags;
+  if (https != nullptr) {
+    args.push_back("--view_tls_cert_file=" + https->Path("server.pem"));
+    args.push_back("--view_tls_key_file=" + https->Path("server.key"));
+    driver_flags = " --trust_certificate=" + https->Path("server.pem");
+  }
+  const std::string scheme = https != nullptr ? "https" : "http";
+  BackgroundProcess viewer("neuralmesh", args);
+  const int port = WaitForViewerPort(viewer, scheme);
   ASSERT_NE(port, 0) << "neuralmesh view did not start: " << viewer.Stderr();
   const std::string command = absl::StrCat(
       "/usr/bin/python3 tests/client/web/viewer_browser_driver.py --timeout=60 "
-      "--stop_when_watching --url=http://127.0.0.1:",
-      port, "/?key=", key, " --ready_file=", dir, "/ready > ", dir, "/out 2> ", dir, "/err");
+      "--stop_when_watching",
+      driver_flags, " --url=", scheme, "://127.0.0.1:", port, "/?key=", key, " --ready_file=", dir,
+      "/ready > ", dir, "/out 2> ", dir, "/err");
   ASSERT_EQ(std::system(command.c_str()), 0) << testing::ReadWholeFile(dir + "/err");
   EXPECT_EQ(testing::ReadWholeFile(dir + "/out"), absl::StrCat("watching ", live, "\n"));
+}
+
+// neuralmesh view --view_key_file: the browser opens the URL with the key once, the viewer
+// keeps the key in a cookie and sends the browser on to the page, whose requests (scripts,
+// three.js, the API) all bring the cookie: the page shows the learning session.
+TEST(ViewerBrowserTest, AKeyedViewerShowsTheSessionsToTheBrowserGivenTheKey) {
+  ExpectTheKeyedPageWatchesTheLiveSession("browser_key", nullptr);
 }
 
 // The same over HTTPS (--view_tls_cert_file): the browser, trusting the test certificate's key,
@@ -193,28 +209,7 @@ TEST(ViewerBrowserTest, AKeyedViewerOverHttpsShowsTheSessionsToTheBrowserGivenTh
   absl::StatusOr<testing::TestCertificates> certificates =
       testing::MakeTestCertificates(testing::MakeTempDir("browser_https_certificates"));
   ASSERT_TRUE(certificates.ok()) << certificates.status();
-  std::unique_ptr<server::ReconstructionServer> server = st::StartServer(/*listen=*/true);
-  ASSERT_NE(server, nullptr);
-  auto service = st::NetworkService(*server);
-  const std::string live = st::MustCreate(*service, st::CreateRequest(500));
-  const std::string dir = testing::MakeTempDir("browser_https");
-  const std::string key = "browser-key-0123456789";
-  std::ofstream(dir + "/key") << key << "\n";
-
-  BackgroundProcess viewer(
-      "neuralmesh", {"view", "--server=" + server->target(), "--listen=127.0.0.1:0",
-                     "--view_key_file=" + dir + "/key",
-                     "--view_tls_cert_file=" + certificates->Path("server.pem"),
-                     "--view_tls_key_file=" + certificates->Path("server.key")});
-  const int port = WaitForViewerPort(viewer, "https");
-  ASSERT_NE(port, 0) << "neuralmesh view did not start: " << viewer.Stderr();
-  const std::string command = absl::StrCat(
-      "/usr/bin/python3 tests/client/web/viewer_browser_driver.py --timeout=60 "
-      "--stop_when_watching --trust_certificate=",
-      certificates->Path("server.pem"), " --url=https://127.0.0.1:", port, "/?key=", key,
-      " --ready_file=", dir, "/ready > ", dir, "/out 2> ", dir, "/err");
-  ASSERT_EQ(std::system(command.c_str()), 0) << testing::ReadWholeFile(dir + "/err");
-  EXPECT_EQ(testing::ReadWholeFile(dir + "/out"), absl::StrCat("watching ", live, "\n"));
+  ExpectTheKeyedPageWatchesTheLiveSession("browser_https", &*certificates);
 }
 
 }  // namespace

@@ -69,7 +69,8 @@ absl::StatusOr<size_t> RemoveOutliers(PointCloud& cloud, const OutlierOptions& o
 }
 
 absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMode mode,
-                                            const std::optional<OutlierOptions>& outliers) {
+                                            const std::optional<OutlierOptions>& outliers,
+                                            const std::optional<PointColorOptions>& colors) {
   TargetSpace target;
   if (outliers.has_value() &&
       (IsBuiltin(input) || mode == SamplingMode::kArea || mode == SamplingMode::kCurvature)) {
@@ -96,6 +97,13 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
                        " needs a triangle mesh (use uniform or weighted for a point cloud)"));
     }
     const size_t faces = mesh->faces.size();
+    std::string with_colors;
+    if (colors.has_value() && !mesh->colors.empty()) {
+      absl::StatusOr<std::unique_ptr<ColorSource>> source = MakeMeshColorSource(*mesh);
+      if (!source.ok()) return InFile(source.status(), "INPUT", input);
+      target.colors = *std::move(source);
+      with_colors = ", with colours";
+    }
     MeshSamplerOptions options;
     options.mode =
         mode == SamplingMode::kArea ? MeshSamplingMode::kArea : MeshSamplingMode::kCurvature;
@@ -104,7 +112,8 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
     if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
     target.sampler = *std::move(sampler);
     target.description =
-        absl::StrCat("the ", faces, " triangles of ", input, " (", ModeName(mode), " sampling)");
+        absl::StrCat("the ", faces, " triangles of ", input, " (", ModeName(mode), " sampling",
+                     with_colors, ")");
     return target;
   }
   NM_ASSIGN_OR_RETURN(PointCloud cloud, ReadCloud(input));
@@ -119,6 +128,13 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
     if (!removed.ok()) return InFile(removed.status(), "INPUT", input);
     removed_outliers = absl::StrCat(", outliers removed: ", *removed);
   }
+  std::string with_colors;
+  if (colors.has_value() && !cloud.colors.empty()) {
+    absl::StatusOr<std::unique_ptr<ColorSource>> source = MakePointColorSource(cloud, *colors);
+    if (!source.ok()) return InFile(source.status(), "INPUT", input);
+    target.colors = *std::move(source);
+    with_colors = ", with colours";
+  }
   auto shared = std::make_shared<const PointCloud>(std::move(cloud));
   absl::StatusOr<std::unique_ptr<Sampler>> sampler = mode == SamplingMode::kWeighted
                                                          ? WeightedPointCloudSampler::Create(shared)
@@ -126,7 +142,7 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
   if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
   target.sampler = *std::move(sampler);
   target.description = absl::StrCat(points, " points of ", input, " (", ModeName(mode), " sampling",
-                                    removed_outliers, ")");
+                                    removed_outliers, with_colors, ")");
   return target;
 }
 

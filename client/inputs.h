@@ -12,6 +12,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/point_cloud.h"
 #include "core/sampling/sampler.h"
@@ -34,6 +35,8 @@ absl::StatusOr<SamplingMode> ParseSamplingMode(absl::string_view name);
 struct TargetSpace {
   std::unique_ptr<Sampler> sampler;
   std::string description;  // "35947 points from bunny.ply (uniform)".
+  // The input's colours, when it carries them and colours were asked for; else null.
+  std::unique_ptr<ColorSource> colors;
 };
 
 // The target space of `input`: builtin:NAME (its implicit surface; `mode` must be uniform),
@@ -43,10 +46,13 @@ struct TargetSpace {
 // sampling mode the input cannot provide; each message names the file.
 // With `outliers` set, a point cloud's statistical outliers are removed first
 // (statistical_outliers.h) and the description says how many; INVALID_ARGUMENT for another
-// kind of input.
+// kind of input. With `colors` set and a point cloud that carries colours (the points left
+// after outlier removal), or a mesh whose vertices do, `colors` of the result is set and the
+// description ends "with colours".
 absl::StatusOr<TargetSpace> LoadTargetSpace(
     const std::string& input, SamplingMode mode,
-    const std::optional<OutlierOptions>& outliers = std::nullopt);
+    const std::optional<OutlierOptions>& outliers = std::nullopt,
+    const std::optional<PointColorOptions>& colors = std::nullopt);
 
 // Removes the statistical outliers of `cloud` (statistical_outliers.h); returns how many went.
 absl::StatusOr<size_t> RemoveOutliers(PointCloud& cloud, const OutlierOptions& options);

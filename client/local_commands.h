@@ -13,6 +13,7 @@
 #include "absl/status/status.h"
 #include "absl/time/time.h"
 #include "client/inputs.h"
+#include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
@@ -29,6 +30,8 @@ struct LocalReconstructOptions {
   std::string start_mesh;
   SamplingMode sampling = SamplingMode::kUniform;
   std::optional<OutlierOptions> outliers;  // Set: remove a point cloud's outliers first.
+  // Set: when the input carries colours, every mesh written gets them (color_source.h).
+  std::optional<PointColorOptions> colors = PointColorOptions{};
   absl::Duration time_budget = absl::InfiniteDuration();  // For the whole run.
   uint64_t max_steps = 0;  // Basic Steps for the whole run; 0: no limit.
   DracoOptions draco;      // For .drc outputs.
@@ -36,9 +39,10 @@ struct LocalReconstructOptions {
 };
 
 // Learns the input's surface up to each LOD and then to `vertices`, writing each milestone
-// (OUTPUT stem + "_lod<N>" + extension) and the final mesh, and printing the figures of each
-// on `out`, then a summary line. When the time or step budget runs out first, the mesh
-// learned so far is written as OUTPUT and the summary says which budget stopped it.
+// (OUTPUT stem + "_lod<N>" + extension) and the final mesh (coloured, with `colors`, when the
+// input carries colours), and printing the figures of each on `out`, then a summary line.
+// When the time or step budget runs out first, the mesh learned so far is written as OUTPUT
+// and the summary says which budget stopped it.
 // A first SIGINT or SIGTERM stops learning at a consistent state; the mesh so far is written
 // as OUTPUT and CANCELLED returned.
 // Returns INVALID_ARGUMENT for invalid options, an unknown output extension, a bad input or

@@ -77,7 +77,8 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
                       LodTargets(options.lods, options.vertices,
                                  start_mesh.has_value() ? start_mesh->positions.size() : 0));
   NM_ASSIGN_OR_RETURN(const TargetSpace target,
-                      LoadTargetSpace(options.input, options.sampling, options.outliers));
+                      LoadTargetSpace(options.input, options.sampling, options.outliers,
+                                      options.colors));
   absl::StatusOr<std::unique_ptr<Learner>> created =
       start_mesh.has_value()
           ? Learner::CreateFrom(options.learner, target.sampler.get(), *start_mesh)
@@ -128,7 +129,8 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
     }
     const bool last = i + 1 == targets.size() || reason != StopReason::kTargetReached;
 
-    const TriangleMesh mesh = learner->Snapshot();
+    TriangleMesh mesh = learner->Snapshot();
+    if (target.colors != nullptr) target.colors->Paint(&mesh);
     LodFigures figures;
     figures.kind = reason != StopReason::kTargetReached ? "stopped" : last ? "final" : "lod";
     figures.path = last ? options.output : LodPath(options.output, targets[i]);

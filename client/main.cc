@@ -25,6 +25,7 @@
 #include "client/session_commands.h"
 #include "client/web/run_view.h"
 #include "client/web/viewer_key.h"
+#include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/io/file_contents.h"
@@ -130,6 +131,18 @@ ABSL_FLAG(bool, outliers_on_server, false,
           "With --remove_outliers and --server: the session removes the outliers as the batches "
           "arrive (SessionConfig.outlier_removal), as for a client that streams a scan, instead "
           "of this command filtering the whole file before upload.");
+
+// Colours.
+ABSL_FLAG(bool, colors, true,
+          "When INPUT's points (or, with --sampling area|curvature, its mesh's vertices) carry "
+          "colours, give every mesh written a colour per vertex: the inverse-distance weighted "
+          "mean of its --color_neighbours nearest points' colours (for a mesh INPUT, the colour "
+          "of its nearest surface point). STL files keep none. With --server the colours are "
+          "uploaded and the session paints its meshes so (--nocolors: uploaded without). Not "
+          "in the paper.");
+ABSL_FLAG(int32_t, color_neighbours, neuralmesh::PointColorOptions{}.neighbours,
+          "With --colors, locally: how many of the nearest points a vertex's colour blends, in "
+          "[1, 64] (a session blends 8).");
 
 // Local learning.
 ABSL_FLAG(std::string, sampling, "uniform",
@@ -275,6 +288,18 @@ absl::StatusOr<std::optional<neuralmesh::OutlierOptions>> OutliersFromFlags() {
   return o;
 }
 
+// Unset with --nocolors; checked here so that a bad value is named by its flag.
+absl::StatusOr<std::optional<neuralmesh::PointColorOptions>> ColorsFromFlags() {
+  if (!absl::GetFlag(FLAGS_colors)) return std::nullopt;
+  neuralmesh::PointColorOptions o;
+  o.neighbours = absl::GetFlag(FLAGS_color_neighbours);
+  if (!o.Validate().ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--color_neighbours is ", o.neighbours, "; it must be in [1, 64]"));
+  }
+  return o;
+}
+
 // Checked here so that a bad value is named by its flag, not by DracoOptions' field.
 absl::StatusOr<neuralmesh::DracoOptions> DracoFromFlags() {
   neuralmesh::DracoOptions o;
@@ -367,7 +392,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
   const bool progress = neuralmesh::client::ShowProgressOnStderr(absl::GetFlag(FLAGS_progress));
   if (args.Has("server")) {
     NM_RETURN_IF_ERROR(RejectFlags(
-        args, {"output", "sampling", "time_budget", "max_steps"},
+        args, {"output", "sampling", "time_budget", "max_steps", "color_neighbours"},
         "applies to a local reconstruct only (the server picks its own budget; use --out-dir)"));
     neuralmesh::client::RemoteReconstructOptions o;
     o.input = args.positional[0];
@@ -378,6 +403,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     NM_ASSIGN_OR_RETURN(o.learner, LearnerFromFlags());
     NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
     o.outliers_on_server = absl::GetFlag(FLAGS_outliers_on_server);
+    o.colors = absl::GetFlag(FLAGS_colors);
     if (o.outliers_on_server && !o.outliers.has_value()) {
       return absl::InvalidArgumentError("--outliers_on_server needs --remove_outliers");
     }
@@ -408,6 +434,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
   NM_ASSIGN_OR_RETURN(o.sampling,
                       neuralmesh::client::ParseSamplingMode(absl::GetFlag(FLAGS_sampling)));
   o.start_mesh = absl::GetFlag(FLAGS_start_mesh);
+  NM_ASSIGN_OR_RETURN(o.colors, ColorsFromFlags());
   o.time_budget = absl::GetFlag(FLAGS_time_budget);
   o.max_steps = absl::GetFlag(FLAGS_max_steps);
   NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
@@ -522,9 +549,9 @@ std::vector<Subcommand> Commands() {
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
       "start_mesh", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
-      "outliers_on_server", "sampling", "time_budget", "max_steps", "quantization_bits",
-      "encode_speed", "progress", "server", "out-dir", "batch-size", "points", "ply", "resume",
-      "reconnect_for"};
+      "outliers_on_server", "colors", "color_neighbours", "sampling", "time_budget", "max_steps",
+      "quantization_bits", "encode_speed", "progress", "server", "out-dir", "batch-size", "points",
+      "ply", "resume", "reconnect_for"};
   // clang-format on
   return {
       {"reconstruct",

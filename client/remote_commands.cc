@@ -76,6 +76,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointsForUpload(options.input, options.builtin_points,
                                                             options.learner.seed));
   const size_t points_read = cloud.size();
+  if (!options.colors) cloud.colors.clear();
   const bool outliers_on_server = options.outliers.has_value() && options.outliers_on_server;
   if (options.outliers.has_value() && !outliers_on_server) {
     NM_ASSIGN_OR_RETURN(const size_t removed, RemoveOutliers(cloud, *options.outliers));

@@ -35,6 +35,7 @@ struct RemoteReconstructOptions {
   LearnerOptions learner;
   std::optional<OutlierOptions> outliers;  // Set: remove the points' outliers before upload,
   bool outliers_on_server = false;         // or, when this is set, the session as they arrive.
+  bool colors = true;  // Upload the points' colours, which the session paints its meshes with.
   DracoOptions draco;              // Quantization bits and encode speed of the server's meshes.
   size_t batch_size = 10000;       // Points per uploaded batch.
   size_t builtin_points = 100000;  // Points sampled from a builtin:NAME input.

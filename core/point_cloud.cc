@@ -38,6 +38,11 @@ absl::Status ValidatePointCloud(const PointCloud& cloud) {
                                                    " normals for ", cloud.positions.size(),
                                                    " points"));
   }
+  if (!cloud.colors.empty() && cloud.colors.size() != cloud.positions.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("there are ", cloud.colors.size(),
+                                                   " colours for ", cloud.positions.size(),
+                                                   " points"));
+  }
   for (size_t i = 0; i < cloud.normals.size(); ++i) {
     const Vec3f& n = cloud.normals[i];
     if (!std::isfinite(n[0]) || !std::isfinite(n[1]) || !std::isfinite(n[2])) {
@@ -56,6 +61,9 @@ PointCloud PointRange(const PointCloud& cloud, size_t begin, size_t end) {
   }
   if (!cloud.normals.empty()) {
     part.normals.assign(cloud.normals.begin() + begin, cloud.normals.begin() + end);
+  }
+  if (!cloud.colors.empty()) {
+    part.colors.assign(cloud.colors.begin() + begin, cloud.colors.begin() + end);
   }
   return part;
 }

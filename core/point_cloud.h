@@ -1,4 +1,4 @@
-// A point set with optional per-point confidence weights and normals.
+// A point set with optional per-point confidence weights, normals and colours.
 #ifndef NEURALMESH_CORE_POINT_CLOUD_H_
 #define NEURALMESH_CORE_POINT_CLOUD_H_
 
@@ -6,6 +6,7 @@
 
 #include "absl/status/status.h"
 #include "core/mesh.h"
+#include "core/rgb.h"
 
 namespace neuralmesh {
 
@@ -13,17 +14,19 @@ struct PointCloud {
   std::vector<Vec3f> positions;
   std::vector<float> weights;   // Empty, or one non-negative weight per point (Section 4.1).
   std::vector<Vec3f> normals;   // Empty, or one normal per point.
+  std::vector<Rgb> colors;      // Empty, or one colour per point (scans that carry them).
 
   size_t size() const { return positions.size(); }
   bool empty() const { return positions.empty(); }
 };
 
-// Checks that `cloud` is usable as a target space: every coordinate finite, weights and
-// normals either absent or one per point, weights finite and non-negative with a positive sum.
+// Checks that `cloud` is usable as a target space: every coordinate finite, weights, normals
+// and colours either absent or one per point, weights finite and non-negative with a positive
+// sum.
 // Returns INVALID_ARGUMENT with the first offending index otherwise.
 absl::Status ValidatePointCloud(const PointCloud& cloud);
 
-// Points [begin, end) of `cloud`, with their weights and normals; begin <= end <= size().
+// Points [begin, end) of `cloud`, with their weights, normals and colours; begin <= end <= size().
 PointCloud PointRange(const PointCloud& cloud, size_t begin, size_t end);
 
 }  // namespace neuralmesh

@@ -10,12 +10,14 @@
 
 #include "absl/status/statusor.h"
 #include "core/mesh.h"
+#include "core/rgb.h"
 
 namespace neuralmesh {
 
 struct TriangleMesh {
   std::vector<Vec3f> positions;
   std::vector<std::array<uint32_t, 3>> faces;  // Counter-clockwise seen from outside.
+  std::vector<Rgb> colors;  // Empty, or one colour per vertex (point_colors.h paints them).
 
   bool empty() const { return positions.empty(); }
 };

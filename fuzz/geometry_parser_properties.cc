@@ -41,6 +41,8 @@ void CheckGeometry(const ParsedGeometry& geometry) {
              "%zu normals for %zu positions", geometry.normals.size(), n);
   FUZZ_CHECK(geometry.weights.empty() || geometry.weights.size() == n,
              "%zu weights for %zu positions", geometry.weights.size(), n);
+  FUZZ_CHECK(geometry.colors.empty() || geometry.colors.size() == n,
+             "%zu colours for %zu positions", geometry.colors.size(), n);
   for (size_t f = 0; f < geometry.faces.size(); ++f) {
     for (uint32_t index : geometry.faces[f]) {
       FUZZ_CHECK(index < n, "face %zu refers to vertex %u of %zu", f, index, n);
@@ -50,7 +52,7 @@ void CheckGeometry(const ParsedGeometry& geometry) {
 
 bool SamePoints(const ParsedGeometry& a, const ParsedGeometry& b) {
   return BitwiseEqual(a.positions, b.positions) && BitwiseEqual(a.normals, b.normals) &&
-         BitwiseEqual(a.weights, b.weights);
+         BitwiseEqual(a.weights, b.weights) && BitwiseEqual(a.colors, b.colors);
 }
 
 }  // namespace
@@ -79,7 +81,8 @@ void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size
   CheckGeometry(*mesh);
 
   if (format.format) {
-    const GeometryView view{mesh->positions, mesh->normals, mesh->weights, mesh->faces};
+    const GeometryView view{mesh->positions, mesh->normals, mesh->weights, mesh->faces,
+                            mesh->colors};
     const std::string written = format.format(view);
     const absl::StatusOr<ParsedGeometry> reread = format.parse(written, FaceHandling::kRead);
     FUZZ_CHECK(reread.ok(), "the writer's output does not parse: %s",
@@ -88,6 +91,9 @@ void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size
                           ? SamePoints(*mesh, *reread)
                           : BitwiseEqual(mesh->positions, reread->positions);
     FUZZ_CHECK(same, "points change when written and read back");
+    FUZZ_CHECK(BitwiseEqual(mesh->colors, reread->colors),
+               "colours change when written and read back (%zu, then %zu)", mesh->colors.size(),
+               reread->colors.size());
     FUZZ_CHECK(BitwiseEqual(mesh->faces, reread->faces),
                "faces change when written and read back (%zu, then %zu)", mesh->faces.size(),
                reread->faces.size());

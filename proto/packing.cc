@@ -22,6 +22,7 @@ v1::PackedPoints PackPoints(const PointCloud& cloud, size_t begin, size_t end) {
   packed.set_positions(PackRange(cloud.positions, begin, end));
   if (!cloud.weights.empty()) packed.set_weights(PackRange(cloud.weights, begin, end));
   if (!cloud.normals.empty()) packed.set_normals(PackRange(cloud.normals, begin, end));
+  if (!cloud.colors.empty()) packed.set_colors(PackRange(cloud.colors, begin, end));
   return packed;
 }
 

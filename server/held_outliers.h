@@ -1,6 +1,6 @@
 // The points of a session that its outlier filter holds back (streaming_outlier_filter.h),
-// kept whole (position, weight, normal) by arrival index until the filter accepts them after
-// all or drops them for good.
+// kept whole (position, weight, normal, colour) by arrival index until the filter accepts them
+// after all or drops them for good.
 #ifndef NEURALMESH_SERVER_HELD_OUTLIERS_H_
 #define NEURALMESH_SERVER_HELD_OUTLIERS_H_
 
@@ -24,7 +24,8 @@ class HeldOutliers {
 
   // Appends the points of arrival indices `indices`, all held, to `cloud`. Where only one side
   // has weights (normals), the other's points get weight 1 (a zero normal), as a point cloud
-  // that grows gives them.
+  // that grows gives them; colours are kept only when every point, in `cloud` and among the
+  // held, has one (they paint meshes, and a made-up colour would show).
   void AppendTo(absl::Span<const uint32_t> indices, PointCloud* cloud) const;
 
   // Forgets the points of arrival indices `indices` (accepted or dropped).
@@ -37,6 +38,7 @@ class HeldOutliers {
     Vec3f position;
     std::optional<float> weight;
     std::optional<Vec3f> normal;
+    std::optional<Rgb> color;
   };
   absl::flat_hash_map<uint32_t, Point> points_;
 };

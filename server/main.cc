@@ -45,8 +45,8 @@ ABSL_FLAG(int64_t, max_points_per_session, int64_t{1} << 26,
           "Points one session accepts in total.");
 ABSL_FLAG(int64_t, max_batch_points,
           static_cast<int64_t>(neuralmesh::server::SessionLimits().max_batch_points),
-          "Points one batch may hold. A packed batch takes 12 bytes a point, 28 with weights "
-          "and normals, and must also fit --max_message_bytes.");
+          "Points one batch may hold. A packed batch takes 12 bytes a point, 31 with weights, "
+          "normals and colours, and must also fit --max_message_bytes.");
 ABSL_FLAG(int, max_message_bytes, 64 << 20,
           "Largest gRPC message accepted or sent, in bytes.");
 ABSL_FLAG(absl::Duration, idle_timeout, absl::Minutes(30),
@@ -366,12 +366,13 @@ int main(int argc, char** argv) {
     return 2;
   }
   options.metrics_token = *std::move(metrics_token);
-  // PackedPoints: 12 bytes a point for the position, 4 for a weight, 12 for a normal.
-  constexpr int64_t kLargestPackedPointBytes = 28;
+  // PackedPoints: 12 bytes a point for the position, 4 for a weight, 12 for a normal, 3 for a
+  // colour.
+  constexpr int64_t kLargestPackedPointBytes = 31;
   if (max_batch > options.max_message_bytes / kLargestPackedPointBytes) {
     std::fprintf(stderr,
                  "neuralmesh-server: warning: a packed batch of --max_batch_points=%lld points "
-                 "with weights and normals takes about %.0f bytes, more than "
+                 "with weights, normals and colours takes about %.0f bytes, more than "
                  "--max_message_bytes=%d; gRPC refuses such messages before the server sees "
                  "them\n",
                  static_cast<long long>(max_batch),

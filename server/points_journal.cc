@@ -25,7 +25,7 @@ namespace {
 
 constexpr uint32_t kMagic = 0x42504D4E;  // "NMPB" in little-endian byte order.
 constexpr size_t kHeaderBytes = 12;
-// Far above the largest batch the server takes (2M points of 28 bytes); a length beyond it is
+// Far above the largest batch the server takes (2M points of 31 bytes); a length beyond it is
 // damage, not a record to allocate for.
 constexpr uint32_t kMaxPayloadBytes = uint32_t{1} << 30;
 
@@ -76,12 +76,13 @@ absl::string_view BytesOf(const std::vector<T>& values) {
 // PackPoints makes them), written without copying the arrays: copies would cost
 // more than the write, in fresh pages for each batch.
 std::vector<absl::string_view> RecordPieces(const PointCloud& batch, std::string* framing) {
-  // PackedPoints fields 1-3 (positions, weights, normals) and PointBatch field 1 (packed), all
-  // length-delimited.
-  constexpr char kArrayTags[3] = {0x0a, 0x12, 0x1a};
+  // PackedPoints fields 1-4 (positions, weights, normals, colors) and PointBatch field 1
+  // (packed), all length-delimited.
+  constexpr int kArrays = 4;
+  constexpr char kArrayTags[kArrays] = {0x0a, 0x12, 0x1a, 0x22};
   constexpr char kPackedTag = 0x0a;
-  const absl::string_view arrays[3] = {BytesOf(batch.positions), BytesOf(batch.weights),
-                                       BytesOf(batch.normals)};
+  const absl::string_view arrays[kArrays] = {BytesOf(batch.positions), BytesOf(batch.weights),
+                                             BytesOf(batch.normals), BytesOf(batch.colors)};
   size_t packed_size = 0;
   for (const absl::string_view array : arrays) {
     if (!array.empty()) packed_size += 1 + VarintSize(array.size()) + array.size();
@@ -101,7 +102,7 @@ std::vector<absl::string_view> RecordPieces(const PointCloud& batch, std::string
     layout.push_back({begin, framing->size() - begin, -1});
   };
   frame(kPackedTag, packed_size);
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < kArrays; ++i) {
     if (arrays[i].empty()) continue;
     frame(kArrayTags[i], arrays[i].size());
     layout.push_back({0, 0, i});

@@ -13,17 +13,23 @@ namespace neuralmesh::server {
 namespace {
 
 template <typename T>
-absl::Status UnpackFloats(const std::string& bytes, const char* field, size_t expected,
-                          std::vector<T>& out) {
+absl::Status UnpackArray(const std::string& bytes, const char* field, size_t expected,
+                         const char* layout, std::vector<T>& out) {
   constexpr size_t kElementBytes = sizeof(T);
   if (bytes.size() != expected * kElementBytes) {
     return absl::InvalidArgumentError(absl::StrCat(
         "PackedPoints.", field, " has ", bytes.size(), " bytes; ", expected, " points need ",
-        expected * kElementBytes, " (", kElementBytes, " per point, little-endian float32)"));
+        expected * kElementBytes, " (", kElementBytes, " per point, ", layout, ")"));
   }
   out.resize(expected);
   if (expected > 0) std::memcpy(out.data(), bytes.data(), bytes.size());
   return absl::OkStatus();
+}
+
+template <typename T>
+absl::Status UnpackFloats(const std::string& bytes, const char* field, size_t expected,
+                          std::vector<T>& out) {
+  return UnpackArray(bytes, field, expected, "little-endian float32", out);
 }
 
 }  // namespace
@@ -235,6 +241,10 @@ absl::StatusOr<PointCloud> PointBatchFromProto(const v1::PointBatch& batch,
       }
       if (status.ok() && !packed.normals().empty()) {
         status = UnpackFloats(packed.normals(), "normals", n, cloud.normals);
+      }
+      if (status.ok() && !packed.colors().empty()) {
+        status = UnpackArray(packed.colors(), "colors", n, "red, green, blue bytes",
+                             cloud.colors);
       }
       if (!status.ok()) return status;
       return cloud;

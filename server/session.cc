@@ -161,6 +161,11 @@ absl::StatusOr<size_t> Session::AddPointsAndMaybeWake(const PointCloud& sent, si
     const PointCloud& batch = *new_points;
     NM_RETURN_IF_ERROR(
         GrowingPointCloud::ValidateBatch(batch.positions, batch.weights, batch.normals));
+    if (!batch.colors.empty() && batch.colors.size() != batch.positions.size()) {
+      return absl::InvalidArgumentError(absl::StrCat("the batch has ", batch.colors.size(),
+                                                     " colours for ", batch.positions.size(),
+                                                     " points"));
+    }
     // The filter keeps every point received, outliers too: they count toward the limit.
     if (outlier_filter_ != nullptr &&
         batch.positions.size() >
@@ -213,6 +218,7 @@ absl::StatusOr<size_t> Session::AddPointsAndMaybeWake(const PointCloud& sent, si
     const size_t first_index = points_.size();
     // A batch of outliers only: nothing to append.
     if (!appended->positions.empty()) NM_RETURN_IF_ERROR(points_.Append(*appended));
+    point_colors_.Append(appended->positions, appended->colors);
     if (outlier_filter_ != nullptr) {
       held_outliers_.Hold(batch, judgement.held, static_cast<uint32_t>(outlier_filter_->size()));
       held_outliers_.Forget(judgement.released);
@@ -842,6 +848,12 @@ absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Session::Encode(const Snapshot& 
       }
     }
     mesh = &clamped;
+  }
+  TriangleMesh painted;
+  if (point_colors_.size() > 0) {
+    painted = *mesh;
+    point_colors_.Paint(&painted);
+    mesh = &painted;
   }
   DracoOptions options = config_.draco;
   options.quantization_box = box;

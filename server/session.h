@@ -52,6 +52,7 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "absl/types/span.h"
+#include "core/analysis/color_source.h"
 #include "core/analysis/streaming_outlier_filter.h"
 #include "core/bounding_box.h"
 #include "core/io/draco_codec.h"
@@ -138,9 +139,10 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // `*held_back` when it is not null (0 otherwise); the rest is appended, with the points held
   // back by earlier batches that the filter now accepts. Returns the session's running total.
   // FAILED_PRECONDITION when the session no longer accepts points (finishing, finished,
-  // cancelled, failed); INVALID_ARGUMENT for non-finite values or mismatched weights/normals;
-  // RESOURCE_EXHAUSTED when the session's point limit would be exceeded (with outlier removal,
-  // by the points received, outliers included). On error nothing changes.
+  // cancelled, failed); INVALID_ARGUMENT for non-finite values or mismatched
+  // weights/normals/colours; RESOURCE_EXHAUSTED when the session's point limit would be
+  // exceeded (with outlier removal, by the points received, outliers included). On error
+  // nothing changes.
   //
   // With `first_point` (the batch's place in the client's upload, PointBatch.first_point), the
   // points the session has taken already are skipped, their count going to `*skipped`: a
@@ -256,6 +258,9 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   const std::shared_ptr<EventLog> log_;  // May be null.
 
   GrowingPointCloud points_;
+  // The coloured points taken (outliers left out), which paint the meshes the encoder
+  // publishes. Synchronised internally.
+  mutable GrowingPointColors point_colors_;
   UpdateChannel updates_;
   std::atomic<bool> cancel_{false};  // Polled by the learner.
 

@@ -37,8 +37,8 @@ struct SessionLimits {
   // limit of its own. Sessions without an owner count against max_sessions only.
   size_t max_sessions_per_client = 0;
   size_t max_points_per_session = 1u << 26;  // 67M points.
-  // Points per batch: 2M, so that a packed batch of as many points with weights and normals
-  // (28 bytes a point) fits the default message limit of 64 MiB.
+  // Points per batch: 2M, so that a packed batch of as many points with weights, normals and
+  // colours (31 bytes a point) fits the default message limit of 64 MiB.
   size_t max_batch_points = 1u << 21;
   // Sessions without an open stream and without activity (RPCs, learning) for this long are
   // deleted. InfiniteDuration: never.

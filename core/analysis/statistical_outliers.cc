@@ -80,6 +80,7 @@ PointCloud WithoutPoints(const PointCloud& cloud, const std::vector<bool>& drop)
     kept.positions.push_back(cloud.positions[i]);
     if (!cloud.weights.empty()) kept.weights.push_back(cloud.weights[i]);
     if (!cloud.normals.empty()) kept.normals.push_back(cloud.normals[i]);
+    if (!cloud.colors.empty()) kept.colors.push_back(cloud.colors[i]);
   }
   return kept;
 }

@@ -39,8 +39,8 @@ absl::StatusOr<std::vector<bool>> FindStatisticalOutliers(const PointCloud& clou
 // Infinity for fewer than 2 distances.
 double OutlierDistanceLimit(absl::Span<const double> mean_distances, double std_ratio);
 
-// `cloud` without the points flagged in `drop` (one flag per point), weights and normals kept
-// with their points.
+// `cloud` without the points flagged in `drop` (one flag per point), weights, normals and
+// colours kept with their points.
 PointCloud WithoutPoints(const PointCloud& cloud, const std::vector<bool>& drop);
 
 }  // namespace neuralmesh

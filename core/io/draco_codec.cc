@@ -211,6 +211,23 @@ int AddFloatAttribute(draco::PointCloud& geometry, draco::GeometryAttribute::Typ
   return id;
 }
 
+// Adds a per-point COLOR attribute of three normalized bytes (Draco codes integers losslessly,
+// without quantization).
+void AddColorAttribute(draco::PointCloud& geometry, const std::vector<Rgb>& colors) {
+  draco::GeometryAttribute layout;
+  layout.Init(draco::GeometryAttribute::COLOR, nullptr, 3, draco::DT_UINT8, /*normalized=*/true,
+              sizeof(Rgb), /*byte_offset=*/0);
+  const int id = geometry.AddAttribute(layout, /*identity_mapping=*/true,
+                                       static_cast<uint32_t>(colors.size()));
+  geometry.attribute(id)->buffer()->Write(0, colors.data(), colors.size() * sizeof(Rgb));
+}
+
+absl::Status CheckColorCount(size_t colors, size_t points, const char* what) {
+  if (colors == 0 || colors == points) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat("there are ", colors, " colours for ", points, " ", what));
+}
+
 void SetPositionQuantization(draco::ExpertEncoder& encoder, int attribute_id,
                              const DracoOptions& options) {
   if (options.quantization_box.has_value()) {
@@ -462,6 +479,61 @@ absl::StatusOr<Vec3f> ReadVec3(const draco::PointAttribute& attribute,
   return value;
 }
 
+// The COLOR attribute of `geometry` when it has one with at least three components (a fourth,
+// alpha, is dropped); nullptr otherwise.
+absl::StatusOr<const draco::PointAttribute*> ColorAttribute(const draco::PointCloud& geometry) {
+  const draco::PointAttribute* colors =
+      geometry.GetNamedAttribute(draco::GeometryAttribute::COLOR);
+  if (colors == nullptr || colors->num_components() < 3) return nullptr;
+  NM_RETURN_IF_ERROR(CheckNumeric(*colors, "colour"));
+  return colors;
+}
+
+// The largest level of an integer Draco type (colour channels of that type are levels from 0).
+double LargestLevel(draco::DataType type) {
+  switch (type) {
+    case draco::DT_INT8:
+      return 127;
+    case draco::DT_UINT8:
+      return 255;
+    case draco::DT_INT16:
+      return 32767;
+    case draco::DT_UINT16:
+      return 65535;
+    case draco::DT_INT32:
+      return 2147483647.0;
+    case draco::DT_UINT32:
+      return 4294967295.0;
+    case draco::DT_INT64:
+      return 9223372036854775807.0;
+    default:
+      return 18446744073709551615.0;
+  }
+}
+
+// One colour: bytes as they are, other integers as levels of their type (fractions when the
+// attribute is normalized, which Draco's conversion has already applied), floats as fractions.
+absl::StatusOr<Rgb> ReadColor(const draco::PointAttribute& attribute,
+                              draco::AttributeValueIndex index) {
+  Rgb color;
+  if (attribute.data_type() == draco::DT_UINT8) {
+    if (!attribute.ConvertValue<uint8_t, 3>(index, color.data())) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("cannot read Draco colour value ", index.value()));
+    }
+    return color;
+  }
+  float channels[3];
+  if (!attribute.ConvertValue<float, 3>(index, channels)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot read Draco colour value ", index.value()));
+  }
+  const bool levels = attribute.data_type() < draco::DT_FLOAT32 && !attribute.normalized();
+  const double max = levels ? LargestLevel(attribute.data_type()) : 1.0;
+  for (int c = 0; c < 3; ++c) color[c] = ChannelFromLevel(channels[c], max);
+  return color;
+}
+
 }  // namespace
 
 // Draco's encoder passes the box's origin and edge to its quantizer as text, with
@@ -559,11 +631,13 @@ absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOpti
         "every face repeats a vertex index; Edgebreaker drops such degenerate faces, so nothing "
         "would remain");
   }
+  NM_RETURN_IF_ERROR(CheckColorCount(mesh.colors.size(), num_vertices, "vertices"));
 
   draco::Mesh geometry;
   geometry.set_num_points(static_cast<uint32_t>(num_vertices));
   const int position_id = AddFloatAttribute(geometry, draco::GeometryAttribute::POSITION, 3,
                                             mesh.positions.front().data(), num_vertices);
+  if (!mesh.colors.empty()) AddColorAttribute(geometry, mesh.colors);
   geometry.SetNumFaces(mesh.faces.size());
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     draco::Mesh::Face face;
@@ -616,10 +690,12 @@ absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const Drac
     weight_id =
         AddFloatAttribute(geometry, draco::GeometryAttribute::GENERIC, 1, cloud.weights.data(), n);
   }
+  if (!cloud.colors.empty()) AddColorAttribute(geometry, cloud.colors);
 
   draco::ExpertEncoder encoder(geometry);
   encoder.SetSpeedOptions(options.encode_speed, options.decode_speed);
-  // Every attribute is quantized, so the kd-tree coder always applies below speed 10.
+  // Every attribute is quantized or an integer, so the kd-tree coder always applies below
+  // speed 10.
   encoder.SetEncodingMethod(options.encode_speed == 10 ? draco::POINT_CLOUD_SEQUENTIAL_ENCODING
                                                        : draco::POINT_CLOUD_KD_TREE_ENCODING);
   SetPositionQuantization(encoder, position_id, options);
@@ -634,11 +710,21 @@ absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes) {
   if (positions->size() == 0 || geometry->num_faces() == 0) {
     return absl::InvalidArgumentError("the Draco mesh is empty");
   }
+  NM_ASSIGN_OR_RETURN(const draco::PointAttribute* colors, ColorAttribute(*geometry));
   TriangleMesh mesh;
   mesh.positions.reserve(positions->size());
   for (draco::AttributeValueIndex i(0); i < static_cast<uint32_t>(positions->size()); ++i) {
     NM_ASSIGN_OR_RETURN(Vec3f p, ReadVec3(*positions, i, "position"));
     mesh.positions.push_back(p);
+  }
+  // A vertex takes the colour of the last point at its position.
+  if (colors != nullptr) {
+    mesh.colors.resize(mesh.positions.size());
+    for (draco::PointIndex i(0); i < geometry->num_points(); ++i) {
+      const uint32_t vertex = positions->mapped_index(i).value();
+      if (vertex >= mesh.positions.size()) continue;  // Corrupt: the faces' check says so.
+      NM_ASSIGN_OR_RETURN(mesh.colors[vertex], ReadColor(*colors, colors->mapped_index(i)));
+    }
   }
   // Faces index points; a point may differ from another only in a non-position attribute
   // (e.g. a texture seam), so faces are mapped to position values, which merges such points.
@@ -681,11 +767,13 @@ absl::StatusOr<PointCloud> DecodePointCloud(std::string_view bytes, uint64_t max
   }
   if (normals != nullptr) NM_RETURN_IF_ERROR(CheckNumeric(*normals, "normal"));
   if (weights != nullptr) NM_RETURN_IF_ERROR(CheckNumeric(*weights, "weight"));
+  NM_ASSIGN_OR_RETURN(const draco::PointAttribute* colors, ColorAttribute(*geometry));
 
   PointCloud cloud;
   cloud.positions.reserve(n);
   if (normals != nullptr) cloud.normals.reserve(n);
   if (weights != nullptr) cloud.weights.reserve(n);
+  if (colors != nullptr) cloud.colors.reserve(n);
   for (draco::PointIndex i(0); i < n; ++i) {
     NM_ASSIGN_OR_RETURN(Vec3f p, ReadVec3(*positions, positions->mapped_index(i), "position"));
     cloud.positions.push_back(p);
@@ -700,6 +788,10 @@ absl::StatusOr<PointCloud> DecodePointCloud(std::string_view bytes, uint64_t max
             absl::StrCat("cannot read the Draco weight of point ", i.value()));
       }
       cloud.weights.push_back(w);
+    }
+    if (colors != nullptr) {
+      NM_ASSIGN_OR_RETURN(Rgb color, ReadColor(*colors, colors->mapped_index(i)));
+      cloud.colors.push_back(color);
     }
   }
   const absl::Status valid = ValidatePointCloud(cloud);

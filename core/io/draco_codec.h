@@ -85,23 +85,26 @@ absl::Status CheckQuantizationBox(const QuantizationBox& box, int bits);
 // boxes come back unchanged.
 QuantizationBox BoxAsDracoReadsIt(const QuantizationBox& box);
 
-// Encodes `mesh` (positions and faces) with Edgebreaker; see shrink_small_meshes for meshes
-// under 64 vertices.
+// Encodes `mesh` (positions, faces, and colours as a COLOR attribute of three normalized bytes,
+// coded losslessly) with Edgebreaker; see shrink_small_meshes for meshes under 64 vertices.
 // Returns INVALID_ARGUMENT when `options` is invalid, the mesh has no vertices or no
 // non-degenerate faces, a face index is out of range, a coordinate is not finite, a position
-// lies outside `options.quantization_box` (as Draco reads it), or the grid cannot be quantized
-// in float (an edge too small for its step, or spanning nearly the whole float range); INTERNAL
-// if Draco fails for another reason.
+// lies outside `options.quantization_box` (as Draco reads it), the colours are not one per
+// vertex, or the grid cannot be quantized in float (an edge too small for its step, or
+// spanning nearly the whole float range); INTERNAL if Draco fails for another reason.
 absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOptions& options);
 
-// Encodes the positions of `cloud`, its normals when present and its weights (as a generic
-// one-component attribute) when present.
+// Encodes the positions of `cloud`, its normals, its weights (as a generic one-component
+// attribute) and its colours (COLOR, three bytes) when present.
 // Returns INVALID_ARGUMENT as EncodeMesh does, also when the cloud is empty or fails
 // ValidatePointCloud, or its weights' spread cannot be quantized; INTERNAL if Draco fails for
 // another reason.
 absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const DracoOptions& options);
 
-// Decodes a Draco mesh: one position per distinct position value and the triangles.
+// Decodes a Draco mesh: one position per distinct position value, the triangles, and colours
+// when there is a COLOR attribute of three or four components (bytes as they are, other
+// integers as levels of their type, floats and normalized integers as fractions; alpha is
+// dropped).
 // Returns INVALID_ARGUMENT when `bytes` is not a valid Draco mesh (corrupt, truncated, a point
 // cloud, no numeric position attribute, non-finite positions, counts of vertices or faces far
 // beyond what its size can hold: more than 2^20 and 256 per byte, or a bitstream version older
@@ -109,7 +112,8 @@ absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const Drac
 absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes);
 
 // Decodes a Draco point cloud, or the points of a Draco mesh; restores normals (the NORMAL
-// attribute) and weights (the first one-component GENERIC attribute) when present.
+// attribute), weights (the first one-component GENERIC attribute) and colours (COLOR, as
+// DecodeMesh reads them) when present.
 // Returns INVALID_ARGUMENT when `bytes` is not valid Draco data (as for DecodeMesh), has no
 // numeric positions, or decodes to a cloud that fails ValidatePointCloud; RESOURCE_EXHAUSTED,
 // before anything is decoded, when it declares more than `max_points` points (for a mesh:

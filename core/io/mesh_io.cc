@@ -59,11 +59,17 @@ absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data
   TriangleMesh mesh;
   mesh.positions = std::move(parsed->positions);
   mesh.faces = std::move(parsed->faces);
+  mesh.colors = std::move(parsed->colors);
   return mesh;
 }
 
 absl::Status CheckWritable(const TriangleMesh& mesh, FileFormat format) {
   if (mesh.positions.empty()) return absl::InvalidArgumentError("the mesh is empty");
+  if (!mesh.colors.empty() && mesh.colors.size() != mesh.positions.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("there are ", mesh.colors.size(),
+                                                   " colours for ", mesh.positions.size(),
+                                                   " vertices"));
+  }
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     const Vec3f& p = mesh.positions[i];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
@@ -113,7 +119,7 @@ absl::Status WriteMesh(const TriangleMesh& mesh, const std::string& path,
     return absl::InvalidArgumentError(
         absl::StrCat("cannot write '", path, "': ", writable.message()));
   }
-  const io_internal::GeometryView view{mesh.positions, {}, {}, mesh.faces};
+  const io_internal::GeometryView view{mesh.positions, {}, {}, mesh.faces, mesh.colors};
   std::string data;
   switch (format) {
     case FileFormat::kPly:

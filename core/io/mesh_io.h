@@ -21,6 +21,7 @@ bool IsSupportedMeshExtension(std::string_view path);
 //   .ply  ASCII or binary (either byte order); 'vertex' x, y, z and 'face' vertex_indices.
 //   .obj  'v' and 'f' lines (v, v/vt, v/vt/vn, v//vn; negative indices count back).
 //   .off  OFF, COFF, NOFF, STOFF.
+//   Vertex colours are read from PLY, OBJ and COFF as internal/ply.h, obj.h and off.h say.
 //   .stl  binary or ASCII; identical vertex positions are merged.
 //   .drc  a Draco mesh (see draco_codec.h: positions are quantized, order may change).
 // Polygons are fan-triangulated. A file may hold vertices and no faces.
@@ -31,12 +32,13 @@ bool IsSupportedMeshExtension(std::string_view path);
 absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path);
 
 // Writes `mesh` to `path`, replacing any file there: binary little-endian .ply, .obj, .off,
-// binary .stl, or .drc encoded with `draco`.
-// Returns INVALID_ARGUMENT for an unsupported extension, an empty mesh, a non-finite
-// coordinate, a face index out of range, a mesh without faces for .stl or .drc, or invalid
-// `draco` options (including positions outside its quantization box); otherwise the status of
-// the write ("cannot write 'path': reason", e.g. NOT_FOUND for a missing directory,
-// PERMISSION_DENIED).
+// binary .stl, or .drc encoded with `draco`. Vertex colours go to every format but STL (PLY
+// uchar red, green, blue; OBJ 'v x y z r g b' fractions; COFF; a Draco COLOR attribute).
+// Returns INVALID_ARGUMENT for an unsupported extension, an empty mesh, colours that are not one
+// per vertex, a non-finite coordinate, a face index out of range, a mesh without faces for .stl
+// or .drc, or invalid `draco` options (including positions outside its quantization box);
+// otherwise the status of the write ("cannot write 'path': reason", e.g. NOT_FOUND for a
+// missing directory, PERMISSION_DENIED).
 absl::Status WriteMesh(const TriangleMesh& mesh, const std::string& path,
                        const DracoOptions& draco = {});
 

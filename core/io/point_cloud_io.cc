@@ -61,6 +61,7 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
   cloud.positions = std::move(parsed->positions);
   cloud.normals = std::move(parsed->normals);
   cloud.weights = std::move(parsed->weights);
+  cloud.colors = std::move(parsed->colors);
   return cloud;
 }
 
@@ -98,7 +99,8 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
   if (!valid.ok()) {
     return absl::InvalidArgumentError(absl::StrCat("cannot write '", path, "': ", valid.message()));
   }
-  const io_internal::GeometryView view{cloud.positions, cloud.normals, cloud.weights, {}};
+  const io_internal::GeometryView view{cloud.positions, cloud.normals, cloud.weights, {},
+                                       cloud.colors};
   std::string data;
   if (format == FileFormat::kPly) {
     data = io_internal::FormatPly(view);

@@ -1,5 +1,5 @@
-// Reads and writes point clouds (positions, optional normals and weights) in PLY, XYZ, OBJ, OFF
-// and Draco files, chosen by the file-name extension (case-insensitive).
+// Reads and writes point clouds (positions, optional normals, weights and colours) in PLY, XYZ,
+// OBJ, OFF and Draco files, chosen by the file-name extension (case-insensitive).
 #ifndef NEURALMESH_CORE_IO_POINT_CLOUD_IO_H_
 #define NEURALMESH_CORE_IO_POINT_CLOUD_IO_H_
 
@@ -23,10 +23,11 @@ bool IsWritablePointCloudExtension(std::string_view path);
 // Reads the points at `path`; faces in the file are skipped without being checked:
 //   .ply  ASCII or binary (either byte order): 'vertex' x, y, z of any scalar type; nx, ny, nz
 //         when all present; the first of confidence, weight, quality, intensity, scalar as
-//         weights.
+//         weights; red, green, blue (or r, g, b) as colours.
 //   .xyz, .txt, .pts  "x y z [nx ny nz] [w]" lines, '#' comments (see internal/xyz.h).
-//   .obj  the 'v' lines ('vn' is ignored: OBJ normals belong to face corners).
-//   .off  the vertices of OFF, COFF, NOFF (with normals), STOFF.
+//   .obj  the 'v' lines, 'v x y z r g b' with colours ('vn' is ignored: OBJ normals belong to
+//         face corners).
+//   .off  the vertices of OFF, COFF (with colours), NOFF (with normals), STOFF.
 //   .drc  a Draco point cloud, or the points of a Draco mesh.
 // Returns NOT_FOUND when the file cannot be opened or read; INVALID_ARGUMENT for an
 // unsupported extension (listing the supported ones), an empty file, a file with no points,
@@ -35,8 +36,8 @@ bool IsWritablePointCloudExtension(std::string_view path);
 absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path);
 
 // Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
-// nx, ny, nz, confidence as present), "x y z [nx ny nz] [w]" text for .xyz/.txt/.pts, or .drc
-// encoded with `draco`.
+// nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [w]" text for
+// .xyz/.txt/.pts (without colours), or .drc encoded with `draco`.
 // Returns INVALID_ARGUMENT for an unsupported extension, an empty cloud, a cloud that fails
 // ValidatePointCloud, or invalid `draco` options; otherwise the status of the write ("cannot
 // write 'path': reason").

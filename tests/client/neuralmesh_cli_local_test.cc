@@ -1,5 +1,6 @@
 // End-to-end tests of the local subcommands of build/bin/neuralmesh (client/main.cc), run as
 // a subprocess: reconstruct, stats and eval on the built-in shapes.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -9,6 +10,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
+#include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
@@ -240,6 +242,67 @@ TEST_F(LocalCliTest, RemoveOutliersTakesAStrayPointOutBeforeLearning) {
   double hausdorff = 0;
   ASSERT_TRUE(absl::SimpleAtod(JsonValue(eval.out, "hausdorff"), &hausdorff)) << eval.out;
   EXPECT_LT(hausdorff, 0.01) << "a spike toward the stray point is left: " << eval.out;
+}
+
+// The largest difference of a channel between a mesh's vertex colours and the colours of their
+// positions (ColorOfPosition); -1 when the mesh has no colours.
+int WorstColorError(const std::string& path) {
+  const absl::StatusOr<TriangleMesh> mesh = ReadMesh(path);
+  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  if (!mesh.ok() || mesh->colors.empty()) return -1;
+  EXPECT_EQ(mesh->colors.size(), mesh->positions.size()) << path;
+  int worst = 0;
+  for (size_t v = 0; v < mesh->positions.size(); ++v) {
+    worst = std::max(worst, ColorError(mesh->colors[v], mesh->positions[v]));
+  }
+  return worst;
+}
+
+// Points coloured by position give meshes (milestones too) whose vertices carry the colours of
+// their positions; a coloured mesh remeshed keeps its colours; --nocolors drops them.
+TEST_F(LocalCliTest, ColouredInputsGiveColouredMeshes) {
+  const std::string cloud = *dir_ + "/colored.ply";
+  ASSERT_TRUE(WritePointCloud(ColoredUnitSpherePoints(20000, 5), cloud).ok());
+  const std::string mesh = *dir_ + "/colored_mesh.ply";
+  const RunResult run =
+      RunNeuralmesh({"reconstruct", cloud, "-o", mesh, "--vertices", "1000", "--lod", "300"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "with colours)")) << run.out;
+  // Vertices lie near the sphere, their 8 nearest points within about 0.05 (6 levels); the
+  // worst vertex was 3 levels off.
+  for (const std::string& path : {mesh, *dir_ + "/colored_mesh_lod300.ply"}) {
+    const int worst = WorstColorError(path);
+    EXPECT_GE(worst, 0) << path << " has no colours";
+    EXPECT_LE(worst, 6) << path;
+  }
+
+  const std::string plain = *dir_ + "/plain_mesh.obj";
+  const RunResult off =
+      RunNeuralmesh({"reconstruct", cloud, "-o", plain, "--vertices", "300", "--nocolors"});
+  ASSERT_EQ(off.exit_code, 0) << off.Describe();
+  EXPECT_EQ(WorstColorError(plain), -1) << "--nocolors wrote colours";
+
+  // The 1,000-vertex mesh, coloured, remeshed by area into Draco.
+  const std::string remeshed = *dir_ + "/colored_remesh.drc";
+  const RunResult remesh = RunNeuralmesh(
+      {"reconstruct", mesh, "-o", remeshed, "--vertices", "400", "--sampling", "area"});
+  ASSERT_EQ(remesh.exit_code, 0) << remesh.Describe();
+  const int worst = WorstColorError(remeshed);
+  EXPECT_GE(worst, 0) << "the remeshed mesh has no colours";
+  EXPECT_LE(worst, 6);
+
+  const RunResult bad =
+      RunNeuralmesh({"reconstruct", cloud, "-o", plain, "--vertices", "300", "--color_neighbours",
+                     "0"});
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_TRUE(absl::StrContains(bad.err, "--color_neighbours is 0; it must be in [1, 64]"))
+      << bad.Describe();
+  const RunResult remote = RunNeuralmesh({"reconstruct", cloud, "--server", "127.0.0.1:1",
+                                          "--out-dir", *dir_, "--color_neighbours", "4"});
+  EXPECT_NE(remote.exit_code, 0);
+  EXPECT_TRUE(
+      absl::StrContains(remote.err, "--color_neighbours applies to a local reconstruct only"))
+      << remote.Describe();
 }
 
 TEST_F(LocalCliTest, AnInterruptWritesTheMeshLearnedSoFar) {

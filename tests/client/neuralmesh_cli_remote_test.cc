@@ -2,6 +2,7 @@
 // neuralmesh-server on 127.0.0.1, both run as subprocesses.
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <filesystem>
 #include <memory>
@@ -323,6 +324,36 @@ TEST_F(RemoteCliTest, RemoveOutliersOnTheServer) {
   const double hausdorff = HausdorffToTheUnitSphere(*dir_ + "/on_server/sphere_and_far_stray.drc");
   EXPECT_GE(hausdorff, 0);
   EXPECT_LT(hausdorff, 0.05) << "a spike toward the stray point is left";
+}
+
+// A coloured point cloud's colours go up with its points, and the meshes that come back (Draco
+// and PLY) carry the colours of their vertices' positions; --nocolors uploads none.
+TEST_F(RemoteCliTest, ColouredPointsComeBackAsColouredMeshes) {
+  const std::string cloud = *dir_ + "/colored_sphere.ply";
+  ASSERT_TRUE(WritePointCloud(ColoredUnitSpherePoints(8000, 12), cloud).ok());
+  for (const bool colors : {true, false}) {
+    SCOPED_TRACE(colors ? "colours" : "--nocolors");
+    const std::string out_dir = *dir_ + (colors ? "/colored" : "/uncolored");
+    std::vector<std::string> args = {"reconstruct", cloud, "--server", server_->address(),
+                                     "--out-dir", out_dir, "--vertices", "600", "--ply"};
+    if (!colors) args.push_back("--nocolors");
+    const RunResult run = RunNeuralmesh(args);
+    ASSERT_EQ(run.exit_code, 0) << run.Describe();
+    for (const char* name : {"/colored_sphere.drc", "/colored_sphere.ply"}) {
+      const absl::StatusOr<TriangleMesh> mesh = ReadMesh(out_dir + name);
+      ASSERT_TRUE(mesh.ok()) << mesh.status();
+      if (!colors) {
+        EXPECT_TRUE(mesh->colors.empty()) << name;
+        continue;
+      }
+      ASSERT_EQ(mesh->colors.size(), mesh->positions.size()) << name;
+      int worst = 0;
+      for (size_t v = 0; v < mesh->positions.size(); ++v) {
+        worst = std::max(worst, ColorError(mesh->colors[v], mesh->positions[v]));
+      }
+      EXPECT_LE(worst, 8) << name;
+    }
+  }
 }
 
 TEST_F(RemoteCliTest, SessionsListsTheFinishedSession) {

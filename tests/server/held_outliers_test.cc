@@ -56,5 +56,32 @@ TEST(HeldOutliersTest, MissingWeightsAndNormalsGetTheDefaults) {
   EXPECT_EQ(held.size(), 2u);
 }
 
+// Colours stay with their points when every point has one, and are left out rather than made
+// up when some point has none.
+TEST(HeldOutliersTest, ColoursAreKeptOnlyWhenEveryPointHasOne) {
+  auto colored = [](int n, uint8_t shade) {
+    PointCloud cloud = Cloud(n, false, false);
+    cloud.colors.assign(n, Rgb{shade, shade, shade});
+    return cloud;
+  };
+  HeldOutliers held;
+  held.Hold(colored(2, 7), {true, true}, 0);
+  held.Hold(Cloud(1, false, false), {true}, 2);
+  PointCloud all_colored = colored(1, 9);
+  held.AppendTo({1, 0}, &all_colored);
+  EXPECT_EQ(all_colored.colors, (std::vector<Rgb>{{9, 9, 9}, {7, 7, 7}, {7, 7, 7}}));
+  PointCloud with_uncolored = colored(1, 9);
+  held.AppendTo({0, 2}, &with_uncolored);
+  EXPECT_EQ(with_uncolored.size(), 3u);
+  EXPECT_TRUE(with_uncolored.colors.empty());
+  PointCloud plain = Cloud(1, false, false);
+  held.AppendTo({0}, &plain);
+  EXPECT_EQ(plain.size(), 2u);
+  EXPECT_TRUE(plain.colors.empty()) << "the cloud's own point has no colour";
+  PointCloud none;  // Nothing but released points, all coloured.
+  held.AppendTo({1}, &none);
+  EXPECT_EQ(none.colors, (std::vector<Rgb>{{7, 7, 7}}));
+}
+
 }  // namespace
 }  // namespace neuralmesh::server

@@ -29,7 +29,8 @@ PointCloud RandomBatch(size_t n, uint64_t seed, bool weights, bool normals) {
 }
 
 bool SameCloud(const PointCloud& a, const PointCloud& b) {
-  return a.positions == b.positions && a.weights == b.weights && a.normals == b.normals;
+  return a.positions == b.positions && a.weights == b.weights && a.normals == b.normals &&
+         a.colors == b.colors;
 }
 
 std::vector<PointCloud> ReadAll(const std::string& path, JournalReadResult* result) {
@@ -49,6 +50,10 @@ class PointsJournalTest : public ::testing::Test {
     path_ = neuralmesh::testing::MakeTempDir("journal") + "/points.journal";
     batches_ = {RandomBatch(100, 1, false, false), RandomBatch(1, 2, true, false),
                 RandomBatch(5000, 3, true, true)};
+    for (size_t i = 0; i < batches_[2].size(); ++i) {  // The last batch has colours too.
+      batches_[2].colors.push_back(
+          {static_cast<uint8_t>(i), static_cast<uint8_t>(i >> 8), static_cast<uint8_t>(i % 7)});
+    }
     absl::StatusOr<std::unique_ptr<PointsJournal>> journal = PointsJournal::Open(path_, 0, true);
     ASSERT_TRUE(journal.ok()) << journal.status();
     for (const PointCloud& batch : batches_) {

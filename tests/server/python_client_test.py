@@ -49,6 +49,31 @@ def sphere_points(n, seed):
     return bytes(out)
 
 
+def color_of_position(x, y, z):
+    """Each channel 255 (c + 1) / 2, as the C++ tests colour points (tests/testing/shapes.h)."""
+    return tuple(min(255, max(0, round(255.0 * (c + 1.0) / 2.0))) for c in (x, y, z))
+
+
+def colors_of(points):
+    """PackedPoints.colors for packed positions: three bytes a point."""
+    out = bytearray()
+    for i in range(0, len(points), 12):
+        out += bytes(color_of_position(*struct.unpack_from("<3f", points, i)))
+    return bytes(out)
+
+
+def ply_vertex_colors(path):
+    """(x, y, z, r, g, b) of each vertex of a binary PLY of float x, y, z and uchar red, green,
+    blue, as draco_decoder writes a coloured mesh."""
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode()
+    check("property uchar red" in header, "the decoded mesh has no colours:\n" + header)
+    count = int(header.split("element vertex ")[1].split()[0])
+    return [struct.unpack_from("<3f3B", data, end + 15 * i) for i in range(count)]
+
+
 def check(condition, message):
     if not condition:
         print("FAILED: " + message, file=sys.stderr)
@@ -136,11 +161,12 @@ def main():
     points = sphere_points(6000, 1)
     batches = [points[i:i + 12 * 600] for i in range(0, len(points), 12 * 600)]
 
-    def requests():
+    def requests():  # With a colour per point.
         for index, chunk in enumerate(batches):
             yield pb.UploadPointsRequest(
                 session_id=sid if index == 0 else "",
-                batch=pb.PointBatch(packed=pb.PackedPoints(positions=chunk)))
+                batch=pb.PointBatch(packed=pb.PackedPoints(positions=chunk,
+                                                           colors=colors_of(chunk))))
 
     ack = service.UploadPoints(requests(), timeout=60)
     check(ack.total_points == 6000 and ack.batches_accepted == 10,
@@ -183,9 +209,11 @@ def main():
     check(all(a.sequence < b.sequence for a, b in zip(updates, updates[1:])),
           "sequence numbers do not increase")
 
-    # The reference Draco decoder reads the final mesh.
+    # The reference Draco decoder reads the final mesh, and its vertices' colours are those of
+    # their positions.
     drc = os.path.join(out_dir, "final.drc")
     obj = os.path.join(out_dir, "final.obj")
+    ply = os.path.join(out_dir, "final.ply")
     with open(drc, "wb") as f:
         f.write(final.draco_mesh)
     subprocess.run(["draco_decoder", "-i", drc, "-o", obj], check=True,
@@ -194,6 +222,14 @@ def main():
         faces = sum(1 for line in f if line.startswith("f "))
     check(faces == final.face_count, "draco_decoder read %d faces, expected %d" %
           (faces, final.face_count))
+    subprocess.run(["draco_decoder", "-i", drc, "-o", ply], check=True,
+                   stdout=subprocess.DEVNULL)
+    vertices = ply_vertex_colors(ply)
+    check(len(vertices) == final.vertex_count, "draco_decoder read %d coloured vertices" %
+          len(vertices))
+    worst = max(abs(a - b) for v in vertices
+                for a, b in zip(v[3:], color_of_position(*v[:3])))
+    check(worst <= 8, "a vertex colour is %d levels from its position's colour" % worst)
 
     # Reconstruct: points in, meshes out, in one bidirectional call, with outlier removal
     # dropping a stray point sent alone in the last batch.

@@ -16,6 +16,7 @@
 #include "core/io/draco_codec.h"
 #include "core/random.h"
 #include "tests/server/server_test_support.h"
+#include "tests/testing/shapes.h"
 
 namespace neuralmesh::server {
 namespace {
@@ -560,6 +561,82 @@ TEST_F(ReconstructionServiceTest, OutlierRemovalDropsStraysBeforeTheSessionTakes
 // each batch's leading edge are held back, and accepted once the next batch brings their other
 // side. Fewer points are lost for good than the whole-cloud filter drops (16 against 52);
 // judged on arrival only, every point held back was lost (492).
+// The largest difference of a channel between a decoded mesh's vertex colours and the colours
+// of their positions (testing::ColorOfPosition); -1 without colours.
+int WorstColorError(const v1::MeshUpdate& update) {
+  const absl::StatusOr<TriangleMesh> mesh = DecodeMesh(update.draco_mesh());
+  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  if (!mesh.ok() || mesh->colors.empty()) return -1;
+  int worst = 0;
+  for (size_t v = 0; v < mesh->positions.size(); ++v) {
+    worst = std::max(worst, neuralmesh::testing::ColorError(mesh->colors[v], mesh->positions[v]));
+  }
+  return worst;
+}
+
+// Points with colours, packed or in Draco, give meshes whose vertices carry the colours of
+// their positions, with outlier removal too (a black stray, held back and dropped, paints
+// nothing); points without give meshes without; colours of the wrong size are refused and
+// the session goes on.
+TEST_F(ReconstructionServiceTest, ColouredPointsGiveColouredMeshes) {
+  const PointCloud sphere = neuralmesh::testing::ColoredUnitSpherePoints(20000, 9);
+  for (const bool filtered : {false, true}) {
+    SCOPED_TRACE(filtered ? "with outlier removal" : "without outlier removal");
+    v1::CreateSessionRequest create = CreateRequest(1500);
+    create.mutable_config()->add_lod_milestones(500);
+    if (filtered) create.mutable_config()->mutable_outlier_removal();
+    const std::string id = MustCreate(*service_, create);
+    PointCloud first = PointRange(sphere, 0, 10000);
+    if (filtered) {
+      first.positions.emplace_back(0.f, 0.f, 60.f);  // A black stray far above.
+      first.colors.push_back({0, 0, 0});
+    }
+    v1::UploadPointsResponse response;
+    ASSERT_TRUE(testing::Upload(*service_, id, first, 5, &response).ok());
+    v1::UploadPointsRequest draco;  // A quarter as one Draco batch.
+    draco.set_session_id(id);
+    const absl::StatusOr<std::string> encoded =
+        EncodePointCloud(PointRange(sphere, 10000, 15000), DracoOptions{});
+    ASSERT_TRUE(encoded.ok()) << encoded.status();
+    draco.mutable_batch()->set_draco_point_cloud(*encoded);
+    const grpc::Status draco_status = testing::UploadOne(*service_, draco, &response);
+    ASSERT_TRUE(draco_status.ok()) << draco_status.error_message();
+    ASSERT_TRUE(
+        testing::Upload(*service_, id, PointRange(sphere, 15000, 20000), 2, &response).ok());
+
+    v1::UploadPointsRequest bad;
+    bad.set_session_id(id);
+    *bad.mutable_batch() = Batch(PointRange(sphere, 0, 2));
+    bad.mutable_batch()->mutable_packed()->set_colors("\x01\x02\x03\x04\x05");
+    const grpc::Status refused = testing::UploadOne(*service_, bad, &response);
+    EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(refused.error_message(),
+                HasSubstr("PackedPoints.colors has 5 bytes; 2 points need 6 (3 per point"));
+
+    ASSERT_TRUE(testing::Finish(*service_, id).ok());
+    std::vector<v1::MeshUpdate> updates;
+    ASSERT_TRUE(testing::WatchAll(*service_, id, &updates).ok());
+    ASSERT_FALSE(updates.empty());
+    int milestones = 0;
+    for (const v1::MeshUpdate& update : updates) {
+      if (update.kind() == v1::UPDATE_KIND_REFRESH) continue;
+      ++milestones;
+      const int worst = WorstColorError(update);
+      EXPECT_GE(worst, 0) << "mesh " << update.sequence() << " has no colours";
+      EXPECT_LE(worst, 6) << "mesh " << update.sequence();
+    }
+    EXPECT_GE(milestones, 1);
+  }
+
+  const std::string plain = MustCreate(*service_, CreateRequest(300));
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(testing::Upload(*service_, plain, testing::SpherePoints(5000, 3), 2, &response).ok());
+  ASSERT_TRUE(testing::Finish(*service_, plain).ok());
+  v1::MeshUpdate final_mesh;
+  ASSERT_TRUE(testing::WaitFinal(*service_, plain, &final_mesh).ok());
+  EXPECT_EQ(WorstColorError(final_mesh), -1) << "colours without coloured points";
+}
+
 TEST_F(ReconstructionServiceTest, OutlierRemovalAcceptsTheLeadingEdgesOfASweptScanLater) {
   PointCloud sphere = testing::SpherePoints(20000, 25);
   std::sort(sphere.positions.begin(), sphere.positions.end(),

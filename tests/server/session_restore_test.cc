@@ -5,6 +5,7 @@
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -19,6 +20,7 @@
 #include "server/server.h"
 #include "tests/server/server_test_support.h"
 #include "tests/testing/file_size_limit.h"
+#include "tests/testing/shapes.h"
 #include "tests/testing/temp_dir.h"
 
 namespace neuralmesh::server {
@@ -200,9 +202,10 @@ storage::v1::LearnerCheckpoint AwaitCheckpoint(const std::string& directory, siz
 // learning goes on from: the counters go on from it, and the final mesh takes about 100 Basic
 // Steps per vertex added since, where learning from the tetrahedron takes that per vertex of
 // all 4,000.
+// The points carry colours, which the journal keeps: the final mesh is painted with them.
 TEST_F(SessionRestoreTest, LearningGoesOnFromTheLatestMilestonesMesh) {
   Restart();
-  const PointCloud cloud = SpherePoints(40000, 11);
+  const PointCloud cloud = neuralmesh::testing::ColoredUnitSpherePoints(40000, 11);
   v1::CreateSessionRequest request = CreateRequest(4000, /*refresh_ms=*/20);
   request.mutable_config()->add_lod_milestones(1000);
   request.mutable_config()->add_lod_milestones(2000);
@@ -237,6 +240,13 @@ TEST_F(SessionRestoreTest, LearningGoesOnFromTheLatestMilestonesMesh) {
   absl::StatusOr<std::unique_ptr<ImplicitSurface>> sphere = MakeSphere(Vec3(0, 0, 0), 1.0);
   ASSERT_TRUE(sphere.ok());
   EXPECT_LT(testing::MaxVertexDistance(*decoded, **sphere), 0.02);
+  ASSERT_EQ(decoded->colors.size(), decoded->positions.size()) << "the colours were lost";
+  int worst = 0;
+  for (size_t v = 0; v < decoded->positions.size(); ++v) {
+    worst = std::max(worst, neuralmesh::testing::ColorError(decoded->colors[v],
+                                                            decoded->positions[v]));
+  }
+  EXPECT_LE(worst, 6);
 }
 
 // A session with no milestone below its target, restarted while paused for lack of points:

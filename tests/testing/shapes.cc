@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <utility>
 
@@ -59,6 +60,25 @@ PointCloud UnitSpherePointsAndAStray(size_t n, uint64_t seed, const Vec3f& stray
   PointCloud cloud = SamplePoints(*MakeSphere(Vec3(0, 0, 0), 1.0).value(), n, seed);
   cloud.positions.push_back(stray);
   return cloud;
+}
+
+Rgb ColorOfPosition(const Vec3f& p) {
+  Rgb color;
+  for (int c = 0; c < 3; ++c) color[c] = ChannelFromFraction((p[c] + 1.0) / 2.0);
+  return color;
+}
+
+PointCloud ColoredUnitSpherePoints(size_t n, uint64_t seed) {
+  PointCloud cloud = SamplePoints(*MakeSphere(Vec3(0, 0, 0), 1.0).value(), n, seed);
+  for (const Vec3f& p : cloud.positions) cloud.colors.push_back(ColorOfPosition(p));
+  return cloud;
+}
+
+int ColorError(const Rgb& color, const Vec3f& p) {
+  const Rgb expected = ColorOfPosition(p);
+  int error = 0;
+  for (int c = 0; c < 3; ++c) error = std::max(error, std::abs(int{color[c]} - int{expected[c]}));
+  return error;
 }
 
 TriangleMesh GridPatch(int nx, int ny) {

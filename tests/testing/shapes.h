@@ -19,6 +19,16 @@ TriangleMesh Icosphere(int levels, double radius = 1.0);
 // `n` points drawn uniformly from the unit sphere with `seed`, then one stray point at `stray`.
 PointCloud UnitSpherePointsAndAStray(size_t n, uint64_t seed, const Vec3f& stray);
 
+// A colour that varies smoothly with position, for the colour tests: each channel is
+// 255 * (coordinate + 1) / 2, rounded and clamped, so a unit sphere spans every level.
+Rgb ColorOfPosition(const Vec3f& p);
+
+// `n` points drawn uniformly from the unit sphere with `seed`, each coloured ColorOfPosition.
+PointCloud ColoredUnitSpherePoints(size_t n, uint64_t seed);
+
+// The largest difference of a channel between `color` and ColorOfPosition(`p`).
+int ColorError(const Rgb& color, const Vec3f& p);
+
 // A regular triangulated grid of (nx+1) x (ny+1) vertices on the square [0,1]^2 at z = 0:
 // an open disc with one boundary loop.
 TriangleMesh GridPatch(int nx, int ny);

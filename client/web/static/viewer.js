@@ -98,8 +98,19 @@ function frameCamera(geometry) {
   }
 }
 
+// Meshes of sessions whose points carry colours have a colour per vertex (a Draco COLOR
+// attribute); the others are drawn in one colour.
+function useVertexColors(colored) {
+  statusElement.dataset.colors = String(colored);
+  if (material.vertexColors === colored) return;
+  material.vertexColors = colored;
+  material.color.set(colored ? 0xffffff : 0x9fb8d8);
+  material.needsUpdate = true;
+}
+
 function showGeometry(geometry) {
   geometry.computeVertexNormals();
+  useVertexColors(geometry.getAttribute('color') !== undefined);
   if (surface === null) {
     surface = new THREE.Mesh(geometry, material);
     scene.add(surface);

@@ -9,6 +9,7 @@
 
 #include "absl/types/span.h"
 #include "core/mesh.h"
+#include "core/rgb.h"
 
 namespace neuralmesh::io_internal {
 
@@ -20,6 +21,7 @@ struct ParsedGeometry {
   std::vector<Vec3f> positions;                // All finite.
   std::vector<Vec3f> normals;                  // Empty or one per position.
   std::vector<float> weights;                  // Empty or one per position.
+  std::vector<Rgb> colors;                     // Empty or one per position.
   std::vector<std::array<uint32_t, 3>> faces;  // Polygons fan-triangulated; indices in range.
 };
 
@@ -28,6 +30,7 @@ struct GeometryView {
   absl::Span<const Vec3f> normals;  // Empty or one per position.
   absl::Span<const float> weights;  // Empty or one per position.
   absl::Span<const std::array<uint32_t, 3>> faces;
+  absl::Span<const Rgb> colors;  // Empty or one per position.
 };
 
 }  // namespace neuralmesh::io_internal

@@ -1,5 +1,7 @@
 #include "core/io/internal/obj.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -7,15 +9,25 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/internal/text.h"
+#include "core/rgb.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::io_internal {
 namespace {
 
 constexpr const char* kAxisNames[3] = {"x", "y", "z"};
+constexpr const char* kChannelNames[3] = {"red", "green", "blue"};
+
+// The colours of 'v x y z r g b' lines as written, until the whole file says whether they are
+// fractions (MeshLab, CloudCompare: every channel at most 1) or 0-255 levels.
+struct ObjColors {
+  std::vector<std::array<float, 3>> channels;
+  bool every_vertex = true;  // False once a vertex without a colour is read.
+  float largest = 0;
+};
 
 absl::Status ParseVertex(const std::vector<absl::string_view>& tokens, int line,
-                         ParsedGeometry* out) {
+                         ParsedGeometry* out, ObjColors* colors) {
   if (tokens.size() < 4) {
     return LineError(line,
                      absl::StrCat("expected 'v x y z', found ", tokens.size() - 1, " coordinates"));
@@ -31,7 +43,34 @@ absl::Status ParseVertex(const std::vector<absl::string_view>& tokens, int line,
     return LineError(line, "vertex has a non-finite coordinate");
   }
   out->positions.push_back(p);
+  // 'v x y z w' carries a homogeneous weight, ignored; 'v x y z r g b', a colour.
+  if (tokens.size() < 7) {
+    colors->every_vertex = false;
+    return absl::OkStatus();
+  }
+  std::array<float, 3> rgb;
+  for (int c = 0; c < 3; ++c) {
+    if (!ParseFloat(tokens[4 + c], &rgb[c]) || !std::isfinite(rgb[c])) {
+      return LineError(line, absl::StrCat("expected a finite number for the ", kChannelNames[c],
+                                          " of a vertex colour, found ", Quoted(tokens[4 + c])));
+    }
+    colors->largest = std::max(colors->largest, rgb[c]);
+  }
+  colors->channels.push_back(rgb);
   return absl::OkStatus();
+}
+
+// Colours for every vertex or none.
+std::vector<Rgb> ResolveColors(const ObjColors& colors) {
+  std::vector<Rgb> out;
+  if (!colors.every_vertex || colors.channels.empty()) return out;
+  const double max = colors.largest <= 1.0f ? 1.0 : 255.0;
+  out.reserve(colors.channels.size());
+  for (const std::array<float, 3>& rgb : colors.channels) {
+    out.push_back({ChannelFromLevel(rgb[0], max), ChannelFromLevel(rgb[1], max),
+                   ChannelFromLevel(rgb[2], max)});
+  }
+  return out;
 }
 
 // Resolves the vertex part of one face reference ("7", "7/2", "7/2/5", "7//5", "-1").
@@ -87,12 +126,13 @@ absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling fac
   std::vector<uint32_t> polygon;
   int64_t largest_index = -1;
   int largest_index_line = 0;
+  ObjColors colors;
   while (cursor.Next(&line)) {
     const int n = cursor.line_number();
     SplitWhitespace(StripHashComment(line), &tokens);
     if (tokens.empty()) continue;
     if (tokens[0] == "v") {
-      NM_RETURN_IF_ERROR(ParseVertex(tokens, n, &out));
+      NM_RETURN_IF_ERROR(ParseVertex(tokens, n, &out, &colors));
     } else if (tokens[0] == "f" && faces == FaceHandling::kRead) {
       if (tokens.size() < 4) {
         return LineError(
@@ -118,17 +158,25 @@ absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling fac
                      absl::StrCat("face uses vertex ", largest_index + 1, " but the file has ",
                                   out.positions.size(), " vertices"));
   }
+  out.colors = ResolveColors(colors);
   return out;
 }
 
 std::string FormatObj(const GeometryView& geometry) {
   std::string out = "# written by neuralmesh\n";
   out.reserve(geometry.positions.size() * 32 + geometry.faces.size() * 24);
-  for (const Vec3f& p : geometry.positions) {
+  const bool colors = !geometry.colors.empty();
+  for (size_t i = 0; i < geometry.positions.size(); ++i) {
     out += "v";
     for (int c = 0; c < 3; ++c) {
       out += ' ';
-      AppendFloat(p[c], &out);
+      AppendFloat(geometry.positions[i][c], &out);
+    }
+    if (colors) {
+      for (int c = 0; c < 3; ++c) {
+        out += ' ';
+        AppendFloat(ChannelFraction(geometry.colors[i][c]), &out);
+      }
     }
     out += '\n';
   }

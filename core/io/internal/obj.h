@@ -10,15 +10,17 @@
 
 namespace neuralmesh::io_internal {
 
-// Parses the 'v x y z [w | r g b]' lines of an OBJ file, and with FaceHandling::kRead the 'f'
-// lines (references v, v/vt, v/vt/vn or v//vn; 1-based, or negative to count back from the
-// last vertex so far), fan-triangulating polygons. 'vn', 'vt', groups, materials and other
-// statements are ignored, as is anything after '#'.
+// Parses the 'v x y z [w | r g b]' lines of an OBJ file (colours, kept when every vertex has
+// one, are fractions when no channel in the file exceeds 1, else 0-255 levels), and with
+// FaceHandling::kRead the 'f' lines (references v, v/vt, v/vt/vn or v//vn; 1-based, or
+// negative to count back from the last vertex so far), fan-triangulating polygons. 'vn',
+// 'vt', groups, materials and other statements are ignored, as is anything after '#'.
 // Returns INVALID_ARGUMENT "line N: ..." for a malformed 'v' or 'f' line, a non-finite
 // coordinate, or a face index that is 0 or out of range.
 absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling faces);
 
-// Formats the positions and faces of `geometry` as OBJ text.
+// Formats the positions, colours (as fractions, 'v x y z r g b') and faces of `geometry` as OBJ
+// text.
 std::string FormatObj(const GeometryView& geometry);
 
 }  // namespace neuralmesh::io_internal

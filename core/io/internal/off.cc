@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/strip.h"
 #include "core/io/internal/text.h"
+#include "core/rgb.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::io_internal {
@@ -28,8 +29,9 @@ bool NextContentLine(LineCursor& cursor, std::vector<absl::string_view>* tokens)
   return false;
 }
 
-// Parses "[ST][C][N]OFF"; sets `has_normals` for the N variants.
-absl::Status ParseKeyword(absl::string_view keyword, int line, bool* has_normals) {
+// Parses "[ST][C][N]OFF"; sets `has_colors` for the C variants, `has_normals` for the N ones.
+absl::Status ParseKeyword(absl::string_view keyword, int line, bool* has_colors,
+                          bool* has_normals) {
   *has_normals = false;
   if (!absl::EndsWith(keyword, "OFF")) {
     return LineError(line, absl::StrCat("not an OFF file: expected the keyword OFF (or COFF, "
@@ -38,7 +40,7 @@ absl::Status ParseKeyword(absl::string_view keyword, int line, bool* has_normals
   }
   absl::string_view prefix = keyword.substr(0, keyword.size() - 3);
   absl::ConsumePrefix(&prefix, "ST");  // Texture coordinates, ignored.
-  absl::ConsumePrefix(&prefix, "C");   // Colors, ignored.
+  *has_colors = absl::ConsumePrefix(&prefix, "C");
   *has_normals = absl::ConsumePrefix(&prefix, "N");
   if (!prefix.empty()) {
     return LineError(line, absl::StrCat("unsupported OFF variant ", Quoted(keyword),
@@ -56,6 +58,32 @@ absl::Status ParseCount(absl::string_view token, int line, const char* what, int
   return absl::OkStatus();
 }
 
+// A COFF vertex colour from the tokens after its position (and normal): "r g b [a]", integers
+// from 0 to 255 or fractions from 0 to 1 (Geomview's rule: integers are levels). False when
+// the tokens are missing; a malformed one is an error.
+absl::StatusOr<bool> ParseColor(const std::vector<absl::string_view>& tokens, size_t first,
+                                int line, int64_t vertex, Rgb* color) {
+  if (tokens.size() < first + 3) return false;
+  bool integers = true;
+  double channels[3];
+  for (int c = 0; c < 3; ++c) {
+    const absl::string_view token = tokens[first + c];
+    int64_t level = 0;
+    if (ParseInt64(token, &level)) {
+      channels[c] = static_cast<double>(level);
+      continue;
+    }
+    integers = false;
+    if (!ParseDouble(token, &channels[c]) || !std::isfinite(channels[c])) {
+      return LineError(line, absl::StrCat("expected a colour channel in vertex ", vertex,
+                                          ", found ", Quoted(token)));
+    }
+  }
+  const double max = integers ? 255.0 : 1.0;
+  for (int c = 0; c < 3; ++c) (*color)[c] = ChannelFromLevel(channels[c], max);
+  return true;
+}
+
 }  // namespace
 
 absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling faces) {
@@ -64,8 +92,8 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
   if (!NextContentLine(cursor, &tokens)) {
     return LineError(cursor.line_number(), "expected the keyword OFF, found only comments");
   }
-  bool has_normals = false;
-  NM_RETURN_IF_ERROR(ParseKeyword(tokens[0], cursor.line_number(), &has_normals));
+  bool has_colors = false, has_normals = false;
+  NM_RETURN_IF_ERROR(ParseKeyword(tokens[0], cursor.line_number(), &has_colors, &has_normals));
   if (tokens.size() > 1 && tokens[1] == "BINARY") {
     return LineError(cursor.line_number(), "binary OFF is not supported");
   }
@@ -112,6 +140,16 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
     }
     out.positions.emplace_back(values[0], values[1], values[2]);
     if (has_normals) out.normals.emplace_back(values[3], values[4], values[5]);
+    if (has_colors) {
+      Rgb color;
+      NM_ASSIGN_OR_RETURN(const bool present, ParseColor(tokens, min_tokens, n, i, &color));
+      if (present) {
+        out.colors.push_back(color);
+      } else {
+        has_colors = false;  // Colours for every vertex or none.
+        out.colors = {};
+      }
+    }
   }
   if (faces == FaceHandling::kSkip) return out;
 
@@ -158,13 +196,19 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
 }
 
 std::string FormatOff(const GeometryView& geometry) {
-  std::string out =
-      absl::StrCat("OFF\n", geometry.positions.size(), " ", geometry.faces.size(), " 0\n");
-  out.reserve(out.size() + geometry.positions.size() * 32 + geometry.faces.size() * 24);
-  for (const Vec3f& p : geometry.positions) {
+  const bool colors = !geometry.colors.empty();
+  std::string out = absl::StrCat(colors ? "COFF\n" : "OFF\n", geometry.positions.size(), " ",
+                                 geometry.faces.size(), " 0\n");
+  out.reserve(out.size() + geometry.positions.size() * (colors ? 48 : 32) +
+              geometry.faces.size() * 24);
+  for (size_t i = 0; i < geometry.positions.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
       if (c > 0) out += ' ';
-      AppendFloat(p[c], &out);
+      AppendFloat(geometry.positions[i][c], &out);
+    }
+    if (colors) {
+      const Rgb& rgb = geometry.colors[i];
+      absl::StrAppend(&out, " ", rgb[0], " ", rgb[1], " ", rgb[2], " 255");
     }
     out += '\n';
   }

@@ -12,13 +12,15 @@ namespace neuralmesh::io_internal {
 
 // Parses an ASCII OFF file: a keyword ([ST][C][N]OFF), the counts "vertices faces [edges]"
 // (on the keyword line or the next), one vertex per line ("x y z", then "nx ny nz" for NOFF,
-// then colors or texture coordinates, which are ignored), then with FaceHandling::kRead one
+// then for COFF "r g b [a]", integers 0-255 or fractions 0-1, kept when every vertex has them;
+// texture coordinates are ignored), then with FaceHandling::kRead one
 // polygon per line ("n i_1 ... i_n [color]", 0-based), fan-triangulated. '#' starts a comment.
 // Returns INVALID_ARGUMENT "line N: ..." for a bad keyword or count, a malformed or missing
 // vertex or face line, a non-finite coordinate or an out-of-range index.
 absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling faces);
 
-// Formats the positions and faces of `geometry` as ASCII OFF.
+// Formats the positions and faces of `geometry` as ASCII OFF, or COFF ("x y z r g b 255") when
+// it has colours.
 std::string FormatOff(const GeometryView& geometry);
 
 }  // namespace neuralmesh::io_internal

@@ -13,6 +13,7 @@
 #include "core/io/internal/binary.h"
 #include "core/io/internal/ply_header.h"
 #include "core/io/internal/text.h"
+#include "core/rgb.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::io_internal {
@@ -209,11 +210,16 @@ absl::Status SkipElement(Body& body, const PlyElement& element) {
   return absl::OkStatus();
 }
 
-enum Role { kOther, kX, kY, kZ, kNx, kNy, kNz, kWeight };
+enum Role { kOther, kX, kY, kZ, kNx, kNy, kNz, kWeight, kRed, kGreen, kBlue, kNumRoles };
+
+// The names colour channels go by: red, green, blue in most files, r, g, b and diffuse_red,
+// ... in some.
+constexpr const char* kChannelNames[][3] = {
+    {"red", "green", "blue"}, {"r", "g", "b"}, {"diffuse_red", "diffuse_green", "diffuse_blue"}};
 
 // Assigns a role to each vertex property; fails when x, y or z is missing.
 absl::StatusOr<std::vector<Role>> VertexRoles(const PlyElement& element, bool* has_normals,
-                                              bool* has_weights) {
+                                              bool* has_weights, bool* has_colors) {
   std::vector<Role> roles(element.properties.size(), kOther);
   auto find = [&](absl::string_view name) -> int {
     for (size_t i = 0; i < element.properties.size(); ++i) {
@@ -249,6 +255,17 @@ absl::StatusOr<std::vector<Role>> VertexRoles(const PlyElement& element, bool* h
       break;
     }
   }
+  *has_colors = false;
+  for (const auto& names : kChannelNames) {
+    const int r = find(names[0]), g = find(names[1]), b = find(names[2]);
+    if (r >= 0 && g >= 0 && b >= 0) {
+      roles[r] = kRed;
+      roles[g] = kGreen;
+      roles[b] = kBlue;
+      *has_colors = true;
+      break;
+    }
+  }
   return roles;
 }
 
@@ -259,13 +276,24 @@ absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry*
                      absl::StrCat("the header declares ", element.count, " vertices; at most ",
                                   kMaxVertices, " are supported"));
   }
-  bool has_normals = false, has_weights = false;
-  NM_ASSIGN_OR_RETURN(std::vector<Role> roles, VertexRoles(element, &has_normals, &has_weights));
+  bool has_normals = false, has_weights = false, has_colors = false;
+  NM_ASSIGN_OR_RETURN(std::vector<Role> roles,
+                      VertexRoles(element, &has_normals, &has_weights, &has_colors));
+  // Integer channels are levels of their type (uchar 0-255, ushort 0-65535, ...), floating
+  // ones fractions from 0 to 1.
+  double channel_max[3] = {1, 1, 1};
+  for (size_t k = 0; k < roles.size(); ++k) {
+    const PlyType type = element.properties[k].type;
+    if (roles[k] >= kRed && roles[k] <= kBlue && IsIntegralPlyType(type)) {
+      channel_max[roles[k] - kRed] = IntegralPlyRange(type).second;
+    }
+  }
   // BeginElement has bounded the count by the remaining bytes.
   out->positions.reserve(element.count);
   if (has_normals) out->normals.reserve(element.count);
   if (has_weights) out->weights.reserve(element.count);
-  double values[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  if (has_colors) out->colors.reserve(element.count);
+  double values[kNumRoles] = {};
   for (uint64_t i = 0; i < element.count; ++i) {
     NM_RETURN_IF_ERROR(body.BeginRecord(element, i));
     for (size_t k = 0; k < element.properties.size(); ++k) {
@@ -300,6 +328,11 @@ absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry*
             absl::StrCat(body.Where(), ": vertex ", i, " has a non-finite weight"));
       }
       out->weights.push_back(w);
+    }
+    if (has_colors) {
+      out->colors.push_back({ChannelFromLevel(values[kRed], channel_max[0]),
+                             ChannelFromLevel(values[kGreen], channel_max[1]),
+                             ChannelFromLevel(values[kBlue], channel_max[2])});
     }
   }
   return absl::OkStatus();
@@ -410,17 +443,19 @@ absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling fac
 std::string FormatPly(const GeometryView& geometry) {
   const bool normals = !geometry.normals.empty();
   const bool weights = !geometry.weights.empty();
+  const bool colors = !geometry.colors.empty();
   std::string out = absl::StrCat(
       "ply\nformat binary_little_endian 1.0\ncomment written by neuralmesh\nelement vertex ",
       geometry.positions.size(), "\nproperty float x\nproperty float y\nproperty float z\n");
   if (normals) out += "property float nx\nproperty float ny\nproperty float nz\n";
   if (weights) out += "property float confidence\n";
+  if (colors) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   if (!geometry.faces.empty()) {
     absl::StrAppend(&out, "element face ", geometry.faces.size(),
                     "\nproperty list uchar uint vertex_indices\n");
   }
   out += "end_header\n";
-  const size_t vertex_size = 4 * (3 + (normals ? 3 : 0) + (weights ? 1 : 0));
+  const size_t vertex_size = 4 * (3 + (normals ? 3 : 0) + (weights ? 1 : 0)) + (colors ? 3 : 0);
   out.reserve(out.size() + geometry.positions.size() * vertex_size + geometry.faces.size() * 13);
   for (size_t i = 0; i < geometry.positions.size(); ++i) {
     for (int c = 0; c < 3; ++c) AppendLittleEndian(geometry.positions[i][c], &out);
@@ -428,6 +463,7 @@ std::string FormatPly(const GeometryView& geometry) {
       for (int c = 0; c < 3; ++c) AppendLittleEndian(geometry.normals[i][c], &out);
     }
     if (weights) AppendLittleEndian(geometry.weights[i], &out);
+    if (colors) out.append(reinterpret_cast<const char*>(geometry.colors[i].data()), 3);
   }
   for (const auto& face : geometry.faces) {
     out.push_back(3);

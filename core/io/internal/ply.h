@@ -12,7 +12,9 @@ namespace neuralmesh::io_internal {
 
 // Parses a PLY file held in `data`. Reads the 'vertex' element's x, y, z (any scalar type),
 // nx, ny, nz when all three are present, and as weights the first scalar property named
-// confidence, weight, quality, intensity or scalar (case-insensitive). With FaceHandling::kRead
+// confidence, weight, quality, intensity or scalar (case-insensitive), and colours from red,
+// green, blue (or r, g, b, or diffuse_red, ...): integer types as levels of their range
+// (uchar 0-255, ushort 0-65535), floating ones as fractions from 0 to 1. With FaceHandling::kRead
 // the 'face' element's 'vertex_indices' (or 'vertex_index') lists are fan-triangulated.
 // Every other element and property, lists included, is skipped.
 // Returns INVALID_ARGUMENT naming the line (header, ASCII body) or byte offset (binary body) and
@@ -20,9 +22,9 @@ namespace neuralmesh::io_internal {
 // hold, missing or malformed values, non-finite coordinates or out-of-range face indices.
 absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces);
 
-// Formats `geometry` as binary little-endian PLY: float x, y, z, then float nx, ny, nz and a
-// float 'confidence' when present, and a 'face' element (uchar count, uint indices) when there
-// are faces.
+// Formats `geometry` as binary little-endian PLY: float x, y, z, then float nx, ny, nz, a float
+// 'confidence' and uchar red, green, blue when present, and a 'face' element (uchar count,
+// uint indices) when there are faces.
 std::string FormatPly(const GeometryView& geometry);
 
 }  // namespace neuralmesh::io_internal

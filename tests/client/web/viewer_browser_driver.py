@@ -121,19 +121,24 @@ def decode_png(data):
     return width, height, channels, rows
 
 
+# The page's background (viewer.js: scene.background).
+BACKGROUND = (0xf4, 0xf5, 0xf7)
+
+
 def mesh_coverage(png, rect):
-    """Share of the pixels inside rect (left, top, right, bottom) that are bluish: the mesh."""
+    """Share of the pixels inside rect (left, top, right, bottom) that are not the background:
+    the mesh, in its one colour or in its vertices' colours."""
     width, height, channels, rows = decode_png(png)
     left, top = max(0, int(rect[0])), max(0, int(rect[1]))
     right, bottom = min(width, int(rect[2])), min(height, int(rect[3]))
-    bluish = total = 0
+    drawn = total = 0
     for y in range(top, bottom, 2):
         row = rows[y]
         for x in range(left, right, 2):
-            r, b = row[x * channels], row[x * channels + 2]
+            pixel = row[x * channels:x * channels + 3]
             total += 1
-            bluish += b > r + 15
-    return bluish / max(total, 1)
+            drawn += max(abs(p - b) for p, b in zip(pixel, BACKGROUND)) > 16
+    return drawn / max(total, 1)
 
 
 class Page:
@@ -193,11 +198,11 @@ def main():
                 sequence = int(status.get("sequence", "0"))
                 if sequence > 0 and sequence not in shown:
                     shown.add(sequence)
-                    print("mesh %d %s %s %s %s %s %s %s %s" % (
+                    print("mesh %d %s %s %s %s %s %s %s %s %s" % (
                         sequence, status.get("kind"), status.get("vertices"), status.get("faces"),
                         status.get("serverVertices"), status.get("serverFaces"),
-                        status.get("frames", "0"), status.get("bytes"), status.get("delayMs")),
-                        flush=True)
+                        status.get("frames", "0"), status.get("bytes"), status.get("delayMs"),
+                        status.get("colors")), flush=True)
                 if status.get("ended"):
                     print("end %s %s %s %s" % (status["ended"], status.get("webgl"),
                                                status.get("meshes"),

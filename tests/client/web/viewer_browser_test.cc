@@ -2,7 +2,8 @@
 // `neuralmesh view` serves while a session learns on a neuralmesh server, and
 // viewer_browser_driver.py reads what the page shows through the DevTools protocol. Checks
 // that the page decodes every Draco mesh it gets to the server's counts, refines coarse to
-// fine, ends on the final mesh, and draws it.
+// fine, ends on the final mesh, and draws it, in its vertices' colours once points with colours
+// came.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -20,6 +21,7 @@
 #include "tests/client/subprocess.h"
 #include "tests/client/web/viewer_test_support.h"
 #include "tests/server/server_test_support.h"
+#include "tests/testing/shapes.h"
 #include "tests/testing/temp_dir.h"
 #include "tests/testing/test_certificates.h"
 
@@ -35,6 +37,7 @@ struct ShownMesh {
   std::string kind;
   uint64_t vertices = 0, faces = 0, server_vertices = 0, server_faces = 0, frames = 0;
   uint64_t draco_bytes = 0, delay_ms = 0;
+  std::string colors;  // "true" when drawn in its vertices' colours.
 };
 
 TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh) {
@@ -68,9 +71,12 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
     absl::SleepFor(absl::Milliseconds(50));
   }
   EXPECT_TRUE(std::filesystem::exists(ready)) << "the page never started watching";
-  const PointCloud points = st::TorusPoints(40000, 11);
+  // The first half without colours, the second with.
+  PointCloud points = st::TorusPoints(40000, 11);
+  for (const Vec3f& p : points.positions) points.colors.push_back(testing::ColorOfPosition(p));
   for (size_t part = 0; part < 8; ++part) {
-    const PointCloud batch = PointRange(points, part * 5000, (part + 1) * 5000);
+    PointCloud batch = PointRange(points, part * 5000, (part + 1) * 5000);
+    if (part < 4) batch.colors.clear();
     v1::UploadPointsResponse response;
     ASSERT_TRUE(st::Upload(*service, id, batch, 1, &response).ok());
     absl::SleepFor(absl::Milliseconds(250));
@@ -92,7 +98,7 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
     if (word == "mesh") {
       ShownMesh m;
       words >> m.sequence >> m.kind >> m.vertices >> m.faces >> m.server_vertices >>
-          m.server_faces >> m.frames >> m.draco_bytes >> m.delay_ms;
+          m.server_faces >> m.frames >> m.draco_bytes >> m.delay_ms >> m.colors;
       shown.push_back(m);
     } else if (word == "end") {
       end_line = line;
@@ -112,6 +118,13 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
     }
   }
   EXPECT_LT(shown.front().vertices, shown.back().vertices) << "coarse to fine";
+  EXPECT_EQ(shown.front().colors, "false") << "a mesh of points without colours";
+  EXPECT_EQ(shown.back().colors, "true") << "drawn in the colours of the last points";
+  for (size_t i = 1; i < shown.size(); ++i) {
+    if (shown[i - 1].colors == "true") {
+      EXPECT_EQ(shown[i].colors, "true") << "colours went away";
+    }
+  }
   EXPECT_EQ(shown.back().kind, "final");
   EXPECT_EQ(shown.back().vertices, 8000u);
   EXPECT_GT(shown.back().frames, 0u) << "the final mesh was drawn";
@@ -124,7 +137,7 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
   EXPECT_EQ(error, "\"\"") << "no error on the page";
   // The driver looks every 50 ms, so it may miss a mesh the page showed between two looks.
   EXPECT_GE(meshes, shown.size());
-  EXPECT_GT(coverage, 0.05) << "the torus covers part of the canvas";
+  EXPECT_GT(coverage, 0.05) << "the coloured torus covers part of the canvas";
 
   EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << "Ctrl-C stops the viewer cleanly";
 }

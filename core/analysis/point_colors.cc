@@ -1,0 +1,129 @@
+// Colours from coloured points, a fixed set (MakePointColorSource) or a growing one
+// (GrowingPointColors): the k nearest, weighted by inverse distance.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/analysis/color_source.h"
+
+namespace neuralmesh {
+namespace {
+
+constexpr int kMaxNeighbours = 64;
+
+// A point this close counts as the vertex's own: its weight 1 / distance outweighs the rest.
+constexpr double kMinDistance = 1e-12;
+
+// The inverse-distance weighted mean of the colours of the points in `heap`, which it empties;
+// at least one.
+Rgb BlendNearest(NeighbourHeap& heap, absl::Span<const Rgb> colors) {
+  double sum[3] = {0, 0, 0};
+  double total = 0;
+  for (; !heap.empty(); heap.pop()) {
+    const auto [squared_distance, index] = heap.top();
+    const double weight = 1.0 / std::max(std::sqrt(double{squared_distance}), kMinDistance);
+    for (int c = 0; c < 3; ++c) sum[c] += weight * colors[index][c];
+    total += weight;
+  }
+  Rgb color;
+  for (int c = 0; c < 3; ++c) color[c] = ChannelFromLevel(sum[c] / total, 255.0);
+  return color;
+}
+
+class PointColorSource final : public ColorSource {
+ public:
+  PointColorSource(const PointCloud& cloud, size_t neighbours)
+      : positions_(cloud.positions),
+        colors_(cloud.colors),
+        neighbours_(neighbours),
+        tree_(positions_, 0, static_cast<uint32_t>(positions_.size())) {}
+
+  Rgb ColorAt(const Vec3f& position) const override {
+    NeighbourHeap heap;
+    tree_.Search(positions_, position, UINT32_MAX, neighbours_, &heap);
+    return BlendNearest(heap, colors_);
+  }
+
+ private:
+  std::vector<Vec3f> positions_;
+  std::vector<Rgb> colors_;
+  size_t neighbours_;
+  PointKdTree tree_;
+};
+
+}  // namespace
+
+void ColorSource::Paint(TriangleMesh* mesh) const {
+  mesh->colors.resize(mesh->positions.size());
+  for (size_t v = 0; v < mesh->positions.size(); ++v) mesh->colors[v] = ColorAt(mesh->positions[v]);
+}
+
+absl::Status PointColorOptions::Validate() const {
+  if (neighbours < 1 || neighbours > kMaxNeighbours) {
+    return absl::InvalidArgumentError(absl::StrCat("colour neighbours = ", neighbours,
+                                                   " is out of range; it must be in [1, ",
+                                                   kMaxNeighbours, "]"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::unique_ptr<ColorSource>> MakePointColorSource(
+    const PointCloud& cloud, const PointColorOptions& options) {
+  if (absl::Status valid = options.Validate(); !valid.ok()) return valid;
+  if (cloud.empty()) return absl::InvalidArgumentError("there are no points to take colours from");
+  if (cloud.colors.size() != cloud.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("the points carry ", cloud.colors.size(),
+                                                   " colours for ", cloud.size(), " points"));
+  }
+  return std::make_unique<PointColorSource>(cloud, static_cast<size_t>(options.neighbours));
+}
+
+GrowingPointColors::GrowingPointColors(const PointColorOptions& options)
+    : neighbours_(static_cast<size_t>(options.neighbours)) {}
+
+void GrowingPointColors::Append(absl::Span<const Vec3f> positions, absl::Span<const Rgb> colors) {
+  const size_t n = std::min(positions.size(), colors.size());
+  absl::MutexLock lock(&queue_mu_);
+  queued_positions_.insert(queued_positions_.end(), positions.begin(), positions.begin() + n);
+  queued_colors_.insert(queued_colors_.end(), colors.begin(), colors.begin() + n);
+}
+
+size_t GrowingPointColors::size() const {
+  absl::MutexLock lock(&queue_mu_);
+  return taken_ + queued_positions_.size();
+}
+
+void GrowingPointColors::Paint(TriangleMesh* mesh) {
+  absl::MutexLock lock(&paint_mu_);
+  {
+    absl::MutexLock queue(&queue_mu_);
+    positions_.insert(positions_.end(), queued_positions_.begin(), queued_positions_.end());
+    colors_.insert(colors_.end(), queued_colors_.begin(), queued_colors_.end());
+    taken_ += queued_positions_.size();
+    queued_positions_.clear();
+    queued_colors_.clear();
+  }
+  const auto n = static_cast<uint32_t>(positions_.size());
+  if (n == 0) return;
+  const uint32_t head_end = head_.has_value() ? head_->end() : 0;
+  if (n - head_end > head_end / 4) {
+    head_.emplace(positions_, 0, n);
+    tail_.reset();
+  } else if (n > head_end && (!tail_.has_value() || tail_->end() != n)) {
+    tail_.emplace(positions_, head_end, n);
+  }
+  mesh->colors.resize(mesh->positions.size());
+  NeighbourHeap heap;
+  for (size_t v = 0; v < mesh->positions.size(); ++v) {
+    head_->Search(positions_, mesh->positions[v], UINT32_MAX, neighbours_, &heap);
+    if (tail_.has_value()) {
+      tail_->Search(positions_, mesh->positions[v], UINT32_MAX, neighbours_, &heap);
+    }
+    mesh->colors[v] = BlendNearest(heap, colors_);
+  }
+}
+
+}  // namespace neuralmesh

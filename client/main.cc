@@ -222,7 +222,8 @@ ABSL_FLAG(std::string, view_key_file, "",
 ABSL_FLAG(std::string, view_tls_cert_file, "",
           "view: PEM file with the viewer's certificate (then any intermediates): browsers "
           "connect over HTTPS (https://HOST:PORT/), and the key's cookie is sent over HTTPS "
-          "only. Needs --view_tls_key_file. Read once, at start.");
+          "only. Needs --view_tls_key_file. SIGHUP reads it and the key again (a renewed "
+          "certificate, for the connections that follow).");
 ABSL_FLAG(std::string, view_tls_key_file, "",
           "view: PEM file with the private key of --view_tls_cert_file.");
 
@@ -531,12 +532,21 @@ absl::Status View(const ParsedArgs& args) {
     }
     o.key = *std::move(contents);
   }
-  NM_ASSIGN_OR_RETURN(o.tls_certificate_chain,
-                      neuralmesh::ReadFileNamedByFlag("view_tls_cert_file",
-                                                      absl::GetFlag(FLAGS_view_tls_cert_file)));
-  NM_ASSIGN_OR_RETURN(
-      o.tls_private_key,
-      neuralmesh::ReadFileNamedByFlag("view_tls_key_file", absl::GetFlag(FLAGS_view_tls_key_file)));
+  using TlsPem = neuralmesh::client::web::ViewOptions::TlsPem;
+  const auto read_tls = []() -> absl::StatusOr<TlsPem> {
+    TlsPem pem;
+    NM_ASSIGN_OR_RETURN(pem.certificate_chain,
+                        neuralmesh::ReadFileNamedByFlag("view_tls_cert_file",
+                                                        absl::GetFlag(FLAGS_view_tls_cert_file)));
+    NM_ASSIGN_OR_RETURN(pem.private_key,
+                        neuralmesh::ReadFileNamedByFlag("view_tls_key_file",
+                                                        absl::GetFlag(FLAGS_view_tls_key_file)));
+    return pem;
+  };
+  NM_ASSIGN_OR_RETURN(TlsPem pem, read_tls());
+  o.tls_certificate_chain = std::move(pem.certificate_chain);
+  o.tls_private_key = std::move(pem.private_key);
+  o.reread_tls = read_tls;
   return neuralmesh::client::web::RunView(o, std::cout, std::cerr);
 }
 
@@ -617,7 +627,8 @@ std::vector<Subcommand> Commands() {
        "Draco-encoded, decoded in the browser and drawn with three.js, coarse to fine, until\n"
        "the final mesh. It opens on the newest session still learning;\n"
        "http://HOST:PORT/?session=ID goes straight to a session. With --view_tls_cert_file\n"
-       "and --view_tls_key_file it serves https:// instead. Runs until Ctrl-C.",
+       "and --view_tls_key_file it serves https:// instead (SIGHUP reads them again). Runs\n"
+       "until Ctrl-C.",
        WithConnectionFlags({"server", "listen", "web_root", "view_key_file", "view_tls_cert_file",
                             "view_tls_key_file"}),
        View},

@@ -1,6 +1,7 @@
 #include "client/web/run_view.h"
 
 #include <memory>
+#include <string_view>
 #include <utility>
 
 #include "absl/strings/match.h"
@@ -9,6 +10,7 @@
 #include "absl/time/clock.h"
 #include "client/interrupt.h"
 #include "client/reconstruction_client.h"
+#include "client/reload_signal.h"
 #include "client/web/viewer_service.h"
 #include "core/status_macros.h"
 #include "http/http_server.h"
@@ -47,6 +49,28 @@ absl::StatusOr<HostPort> ParseListenAddress(const std::string& address) {
 // Whether `host` (as --listen names it) is a loopback address: localhost, 127.0.0.0/8, ::1.
 bool IsLoopback(absl::string_view host) {
   return host == "localhost" || host == "::1" || absl::StartsWith(host, "127.");
+}
+
+// SIGHUP: the certificate and key read again replace those of `http`'s new handshakes.
+void RenewCertificate(const ViewOptions& options, HttpServer& http, std::ostream& out,
+                      std::ostream& err) {
+  if (std::string_view(http.scheme()) != "https" || !options.reread_tls) {
+    out << "neuralmesh view: SIGHUP received; no HTTPS certificate to read again" << std::endl;
+    return;
+  }
+  absl::StatusOr<ViewOptions::TlsPem> pem = options.reread_tls();
+  absl::Status replaced = pem.status();
+  if (pem.ok()) {
+    absl::StatusOr<std::shared_ptr<const TlsServerContext>> tls =
+        TlsServerContext::Create(pem->certificate_chain, pem->private_key);
+    replaced = tls.ok() ? http.ReplaceTls(*std::move(tls)) : tls.status();
+  }
+  if (replaced.ok()) {
+    out << "neuralmesh view: SIGHUP received; HTTPS certificate and key read again" << std::endl;
+  } else {
+    err << "neuralmesh view: SIGHUP received; the old HTTPS certificate stays: "
+        << replaced.message() << std::endl;
+  }
 }
 
 }  // namespace
@@ -102,9 +126,11 @@ absl::Status RunView(const ViewOptions& options, std::ostream& out, std::ostream
   }
 
   InterruptScope interrupt;
+  ReloadSignalScope reload;
   for (int tick = 1; !InterruptScope::interrupted(); ++tick) {
     absl::SleepFor(absl::Milliseconds(100));
     if (tick % 50 == 0) viewer.DropIdleRelays();
+    if (ReloadSignalScope::TakeRequest()) RenewCertificate(options, *http, out, err);
   }
   viewer.Stop();
   http->Shutdown();

@@ -3,10 +3,12 @@
 #ifndef NEURALMESH_CLIENT_WEB_RUN_VIEW_H_
 #define NEURALMESH_CLIENT_WEB_RUN_VIEW_H_
 
+#include <functional>
 #include <ostream>
 #include <string>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "client/reconstruction_client.h"
 
 namespace neuralmesh::client::web {
@@ -21,6 +23,13 @@ struct ViewOptions {
   // its key. Empty: plain HTTP.
   std::string tls_certificate_chain;
   std::string tls_private_key;
+  // With HTTPS: called on SIGHUP for the certificate chain and key read again (from their
+  // files), PEM text as above. Null: SIGHUP changes nothing.
+  struct TlsPem {
+    std::string certificate_chain;
+    std::string private_key;
+  };
+  std::function<absl::StatusOr<TlsPem>()> reread_tls;
 };
 
 // The client/web folder of the source tree this binary was built from.
@@ -28,7 +37,10 @@ std::string DefaultWebRoot();
 
 // Checks the web root, connects to the server, listens, prints
 // "viewer: http://HOST:PORT/ (sessions of SERVER)" (https:// with a certificate) and serves
-// until interrupted. Errors: NOT_FOUND for a web root without the viewer's files,
+// until interrupted. On SIGHUP an HTTPS viewer takes the certificate and key of
+// `reread_tls` for the connections that follow (a renewed certificate, without a restart),
+// and says so on `out`; when they do not make a TLS identity it keeps the old ones and says
+// why on `err`. Errors: NOT_FOUND for a web root without the viewer's files,
 // INVALID_ARGUMENT for a malformed --listen or a certificate and key that do not make a TLS
 // identity (one without the other included), UNAVAILABLE when the server cannot be reached or
 // the address cannot be bound, UNAUTHENTICATED when the server refuses the viewer's access

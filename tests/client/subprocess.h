@@ -154,6 +154,13 @@ class BackgroundProcess {
 
   std::string Stdout() const { return ReadWholeFile(out_path_); }
   std::string Stderr() const { return ReadWholeFile(err_path_); }
+  // Waits up to 5 s for the standard output (error) to hold `text`; whether it came.
+  bool AwaitStdout(const std::string& text) const {
+    return Await([this] { return Stdout(); }, text);
+  }
+  bool AwaitStderr(const std::string& text) const {
+    return Await([this] { return Stderr(); }, text);
+  }
 
   void Stop() {
     if (pid_ <= 0) return;
@@ -171,6 +178,15 @@ class BackgroundProcess {
   }
 
  private:
+  template <typename Read>
+  static bool Await(const Read& read, const std::string& text) {
+    for (int i = 0; i < 100; ++i) {
+      if (read().find(text) != std::string::npos) return true;
+      usleep(50 * 1000);
+    }
+    return read().find(text) != std::string::npos;
+  }
+
   pid_t pid_ = -1;
   int exit_code_ = -1;
   std::string out_path_;

@@ -47,26 +47,13 @@ class TestServer {
   std::string Stdout() const { return process_.Stdout(); }
   std::string Stderr() const { return process_.Stderr(); }
   // Wait up to 5 s for the server's standard output (error) to hold `text`; whether it came.
-  bool AwaitStdout(const std::string& text) const {
-    return Await([this] { return Stdout(); }, text);
-  }
-  bool AwaitStderr(const std::string& text) const {
-    return Await([this] { return Stderr(); }, text);
-  }
+  bool AwaitStdout(const std::string& text) const { return process_.AwaitStdout(text); }
+  bool AwaitStderr(const std::string& text) const { return process_.AwaitStderr(text); }
   // Sends `signal` to the server process (SIGSTOP: it stops answering, connections stay open).
   void Signal(int signal) { process_.Signal(signal); }
 
  private:
   explicit TestServer(const std::vector<std::string>& args) : process_("neuralmesh-server", args) {}
-
-  template <typename Read>
-  static bool Await(const Read& read, const std::string& text) {
-    for (int i = 0; i < 100; ++i) {
-      if (read().find(text) != std::string::npos) return true;
-      usleep(50 * 1000);
-    }
-    return read().find(text) != std::string::npos;
-  }
 
   BackgroundProcess process_;
   std::string address_;

@@ -66,11 +66,15 @@ TEST(NeuralmeshViewTest, ServesTheSessionsOfTheServerUntilSigterm) {
 }
 
 TEST(NeuralmeshViewTest, ServesHttpsWithItsCertificateAndKeepsTheKeyOffPlainHttp) {
-  absl::StatusOr<TestCertificates> certificates =
-      MakeTestCertificates(MakeTempDir("view_tls"));
+  const std::string dir = MakeTempDir("view_tls");
+  absl::StatusOr<TestCertificates> certificates = MakeTestCertificates(dir + "/first");
   ASSERT_TRUE(certificates.ok()) << certificates.status();
-  const std::string cert = "--view_tls_cert_file=" + certificates->Path("server.pem");
-  const std::string key = "--view_tls_key_file=" + certificates->Path("server.key");
+  // Files the viewer reads again on SIGHUP, below.
+  const std::string cert_file = dir + "/live.pem", key_file_tls = dir + "/live.key";
+  ASSERT_TRUE(WriteFileContents(cert_file, certificates->server_chain).ok());
+  ASSERT_TRUE(WriteFileContents(key_file_tls, certificates->server_key).ok());
+  const std::string cert = "--view_tls_cert_file=" + cert_file;
+  const std::string key = "--view_tls_key_file=" + key_file_tls;
 
   // A certificate without its key, or with another's, is refused before anything is served.
   RunResult run = RunNeuralmesh({"view", "--server=127.0.0.1:1", cert});
@@ -109,6 +113,30 @@ TEST(NeuralmeshViewTest, ServesHttpsWithItsCertificateAndKeepsTheKeyOffPlainHttp
   EXPECT_THAT(redirect.Header("set-cookie"), HasSubstr("; Secure"));
   EXPECT_EQ(HttpsGet(target, "/api/sessions").status, 401);
   EXPECT_EQ(HttpGet(port, "/api/sessions").status, 400) << "plain HTTP on the HTTPS port";
+
+  // A renewed certificate written over the files applies after SIGHUP, without a restart.
+  absl::StatusOr<TestCertificates> renewed = MakeTestCertificates(dir + "/renewed");
+  ASSERT_TRUE(renewed.ok()) << renewed.status();
+  ASSERT_TRUE(WriteFileContents(cert_file, renewed->server_chain).ok());
+  ASSERT_TRUE(WriteFileContents(key_file_tls, renewed->server_key).ok());
+  viewer.Signal(SIGHUP);
+  EXPECT_TRUE(viewer.AwaitStdout("SIGHUP received; HTTPS certificate and key read again"))
+      << viewer.Stdout() << viewer.Stderr();
+  HttpsTarget renewed_target = target;
+  renewed_target.ca = renewed->ca;
+  EXPECT_EQ(HttpsGet(renewed_target, "/api/sessions", "view-key-0123456789abcdef", &error).status,
+            200)
+      << error;
+  std::string stale_error;
+  EXPECT_EQ(HttpsGet(target, "/api/sessions", "", &stale_error).status, 0)
+      << "the old certificate is still served";
+  EXPECT_THAT(stale_error, HasSubstr("certificate verify failed"));
+  // Another certificate's key: refused, the renewed certificate stays.
+  ASSERT_TRUE(WriteFileContents(key_file_tls, certificates->server_key).ok());
+  viewer.Signal(SIGHUP);
+  EXPECT_TRUE(viewer.AwaitStderr("the old HTTPS certificate stays: "));
+  EXPECT_THAT(viewer.Stderr(), HasSubstr("the TLS private key does not belong to the certificate"));
+  EXPECT_EQ(HttpsGet(renewed_target, "/api/sessions", "view-key-0123456789abcdef").status, 200);
   EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << viewer.Stderr();
 }
 

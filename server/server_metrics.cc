@@ -61,6 +61,11 @@ void ServerMetrics::AddMeshPublished(uint64_t draco_bytes) {
   mesh_bytes_published_.fetch_add(draco_bytes);
 }
 
+void ServerMetrics::AddMeshPainted(absl::Duration took) {
+  meshes_painted_.fetch_add(1);
+  painting_nanoseconds_.fetch_add(absl::ToInt64Nanoseconds(took));
+}
+
 void ServerMetrics::CountSessionEnded(v1::SessionState state) {
   switch (state) {
     case v1::SESSION_STATE_FINISHED:
@@ -121,6 +126,12 @@ void ServerMetrics::AppendTo(PrometheusText& out) const {
   out.Single("neuralmesh_mesh_bytes_published_total", "counter",
              "Draco bytes of the meshes published (once per mesh, whatever the watchers).",
              mesh_bytes_published_.load());
+  out.Single("neuralmesh_meshes_painted_total", "counter",
+             "Meshes given vertex colours from their session's coloured points before encoding.",
+             meshes_painted_.load());
+  out.Single("neuralmesh_painting_seconds_total", "counter",
+             "Time the encoder threads spent painting meshes, summed over the threads.",
+             static_cast<double>(painting_nanoseconds_.load()) * 1e-9);
   out.Single("neuralmesh_sessions_created_total", "counter", "Sessions created by clients.",
              sessions_created_.load());
   out.Family("neuralmesh_sessions_ended_total", "counter",

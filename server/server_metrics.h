@@ -1,5 +1,6 @@
 // The server's counters for its metrics endpoint (metrics_http.h): what its sessions did (points
-// accepted, Basic Steps learned, meshes published, sessions created, ended and deleted) and the
+// accepted, Basic Steps learned, meshes painted and published, sessions created, ended and
+// deleted) and the
 // gRPC calls it handled (rpc_metrics_interceptor.h), from the start of the process. Sessions
 // add to them as the work happens; a restored session's earlier work is not counted again.
 //
@@ -38,6 +39,8 @@ class ServerMetrics {
   void AddPointsAccepted(uint64_t points) { points_accepted_.fetch_add(points); }
   void AddLearning(uint64_t basic_steps, absl::Duration took);
   void AddMeshPublished(uint64_t draco_bytes);
+  // A mesh painted with its session's point colours (color_source.h), which took `took`.
+  void AddMeshPainted(absl::Duration took);
   void CountSessionCreated() { sessions_created_.fetch_add(1); }
   // `state`: FINISHED, CANCELLED or FAILED (others are ignored).
   void CountSessionEnded(v1::SessionState state);
@@ -70,6 +73,8 @@ class ServerMetrics {
   std::atomic<int64_t> learning_nanoseconds_{0};
   std::atomic<uint64_t> meshes_published_{0};
   std::atomic<uint64_t> mesh_bytes_published_{0};
+  std::atomic<uint64_t> meshes_painted_{0};
+  std::atomic<int64_t> painting_nanoseconds_{0};
   std::atomic<uint64_t> sessions_created_{0};
   std::atomic<uint64_t> sessions_finished_{0};
   std::atomic<uint64_t> sessions_cancelled_{0};

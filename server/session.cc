@@ -851,9 +851,11 @@ absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Session::Encode(const Snapshot& 
   }
   TriangleMesh painted;
   if (point_colors_.size() > 0) {
+    const absl::Time paint_start = absl::Now();
     painted = *mesh;
     point_colors_.Paint(&painted);
     mesh = &painted;
+    if (metrics_ != nullptr) metrics_->AddMeshPainted(absl::Now() - paint_start);
   }
   DracoOptions options = config_.draco;
   options.quantization_box = box;

@@ -18,6 +18,7 @@
 #include "tests/server/server_test_support.h"
 #include "tests/testing/http_client.h"
 #include "tests/testing/https_client.h"
+#include "tests/testing/shapes.h"
 #include "tests/testing/temp_dir.h"
 #include "tests/testing/test_certificates.h"
 
@@ -77,7 +78,10 @@ TEST(MetricsHttpTest, CountsASessionsWorkAndTheCallsByStatus) {
 
   const std::string id = testing::MustCreate(*stub, testing::CreateRequest(300));
   v1::UploadPointsResponse uploaded;
-  ASSERT_TRUE(testing::Upload(*stub, id, testing::SpherePoints(3000, 1), 3, &uploaded).ok());
+  // With colours: the meshes are painted.
+  ASSERT_TRUE(testing::Upload(*stub, id, neuralmesh::testing::ColoredUnitSpherePoints(3000, 1), 3,
+                              &uploaded)
+                  .ok());
   grpc::Status missing;
   testing::GetSession(*stub, "s-nosuchsession", &missing);
   ASSERT_EQ(missing.error_code(), grpc::StatusCode::NOT_FOUND);
@@ -99,6 +103,9 @@ TEST(MetricsHttpTest, CountsASessionsWorkAndTheCallsByStatus) {
   EXPECT_GT(after["neuralmesh_learning_seconds_total"], 0);
   EXPECT_GE(after["neuralmesh_meshes_published_total"], 1);
   EXPECT_GE(after["neuralmesh_mesh_bytes_published_total"], final_mesh.draco_mesh().size());
+  EXPECT_EQ(before["neuralmesh_meshes_painted_total"], 0);
+  EXPECT_GE(after["neuralmesh_meshes_painted_total"], after["neuralmesh_meshes_published_total"]);
+  EXPECT_GT(after["neuralmesh_painting_seconds_total"], 0);
   EXPECT_EQ(after[Handled("CreateSession", "unary", "OK")], 1);
   EXPECT_EQ(after[Handled("UploadPoints", "client_stream", "OK")], 1);
   EXPECT_EQ(after[Handled("GetSession", "unary", "NotFound")], 1);

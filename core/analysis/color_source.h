@@ -11,13 +11,12 @@
 #define NEURALMESH_CORE_ANALYSIS_COLOR_SOURCE_H_
 
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <vector>
 
-#include "absl/base/thread_annotations.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "absl/synchronization/mutex.h"
 #include "absl/types/span.h"
 #include "core/analysis/point_kd_tree.h"
 #include "core/point_cloud.h"
@@ -69,27 +68,28 @@ class GrowingPointColors {
   explicit GrowingPointColors(const PointColorOptions& options = {});
 
   // Appends points and their colours (one per point; extra colours or points are ignored).
-  void Append(absl::Span<const Vec3f> positions, absl::Span<const Rgb> colors)
-      ABSL_LOCKS_EXCLUDED(queue_mu_);
+  void Append(absl::Span<const Vec3f> positions, absl::Span<const Rgb> colors);
 
   // The points appended so far.
-  size_t size() const ABSL_LOCKS_EXCLUDED(queue_mu_);
+  size_t size() const;
 
   // Sets `mesh->colors` from every point appended so far; leaves `mesh` as it is when there
   // are none. O(v k log n) plus the rebuilds above.
-  void Paint(TriangleMesh* mesh) ABSL_LOCKS_EXCLUDED(paint_mu_, queue_mu_);
+  void Paint(TriangleMesh* mesh);
 
  private:
   const size_t neighbours_;
-  mutable absl::Mutex queue_mu_;
-  std::vector<Vec3f> queued_positions_ ABSL_GUARDED_BY(queue_mu_);
-  std::vector<Rgb> queued_colors_ ABSL_GUARDED_BY(queue_mu_);
-  size_t taken_ ABSL_GUARDED_BY(queue_mu_) = 0;  // Points Paint has taken from the queue.
-  absl::Mutex paint_mu_ ABSL_ACQUIRED_BEFORE(queue_mu_);
-  std::vector<Vec3f> positions_ ABSL_GUARDED_BY(paint_mu_);
-  std::vector<Rgb> colors_ ABSL_GUARDED_BY(paint_mu_);
-  std::optional<PointKdTree> head_ ABSL_GUARDED_BY(paint_mu_);  // Points [0, M).
-  std::optional<PointKdTree> tail_ ABSL_GUARDED_BY(paint_mu_);  // Points [M, n).
+  // std::mutex rather than absl::Mutex, as in growing_point_cloud.h: ThreadSanitizer sees the
+  // hand-offs of pthreads' mutexes, not those of Debian's uninstrumented Abseil.
+  mutable std::mutex queue_mu_;  // Guards the three below.
+  std::vector<Vec3f> queued_positions_;
+  std::vector<Rgb> queued_colors_;
+  size_t taken_ = 0;  // Points Paint has taken from the queue.
+  std::mutex paint_mu_;  // Guards the four below; taken before queue_mu_.
+  std::vector<Vec3f> positions_;
+  std::vector<Rgb> colors_;
+  std::optional<PointKdTree> head_;  // Points [0, M).
+  std::optional<PointKdTree> tail_;  // Points [M, n).
 };
 
 // Colours from the surface of `mesh` (copied). INVALID_ARGUMENT for a mesh without faces,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -86,20 +87,20 @@ GrowingPointColors::GrowingPointColors(const PointColorOptions& options)
 
 void GrowingPointColors::Append(absl::Span<const Vec3f> positions, absl::Span<const Rgb> colors) {
   const size_t n = std::min(positions.size(), colors.size());
-  absl::MutexLock lock(&queue_mu_);
+  std::lock_guard<std::mutex> lock(queue_mu_);
   queued_positions_.insert(queued_positions_.end(), positions.begin(), positions.begin() + n);
   queued_colors_.insert(queued_colors_.end(), colors.begin(), colors.begin() + n);
 }
 
 size_t GrowingPointColors::size() const {
-  absl::MutexLock lock(&queue_mu_);
+  std::lock_guard<std::mutex> lock(queue_mu_);
   return taken_ + queued_positions_.size();
 }
 
 void GrowingPointColors::Paint(TriangleMesh* mesh) {
-  absl::MutexLock lock(&paint_mu_);
+  std::lock_guard<std::mutex> lock(paint_mu_);
   {
-    absl::MutexLock queue(&queue_mu_);
+    std::lock_guard<std::mutex> queue(queue_mu_);
     positions_.insert(positions_.end(), queued_positions_.begin(), queued_positions_.end());
     colors_.insert(colors_.end(), queued_colors_.begin(), queued_colors_.end());
     taken_ += queued_positions_.size();

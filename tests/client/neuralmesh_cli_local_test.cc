@@ -1,6 +1,5 @@
 // End-to-end tests of the local subcommands of build/bin/neuralmesh (client/main.cc), run as
 // a subprocess: reconstruct, stats and eval on the built-in shapes.
-#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -244,18 +243,11 @@ TEST_F(LocalCliTest, RemoveOutliersTakesAStrayPointOutBeforeLearning) {
   EXPECT_LT(hausdorff, 0.01) << "a spike toward the stray point is left: " << eval.out;
 }
 
-// The largest difference of a channel between a mesh's vertex colours and the colours of their
-// positions (ColorOfPosition); -1 when the mesh has no colours.
+// WorstColorErrorOnTheUnitSphere of the mesh file at `path`.
 int WorstColorError(const std::string& path) {
   const absl::StatusOr<TriangleMesh> mesh = ReadMesh(path);
   EXPECT_TRUE(mesh.ok()) << mesh.status();
-  if (!mesh.ok() || mesh->colors.empty()) return -1;
-  EXPECT_EQ(mesh->colors.size(), mesh->positions.size()) << path;
-  int worst = 0;
-  for (size_t v = 0; v < mesh->positions.size(); ++v) {
-    worst = std::max(worst, ColorError(mesh->colors[v], mesh->positions[v]));
-  }
-  return worst;
+  return mesh.ok() ? WorstColorErrorOnTheUnitSphere(*mesh) : -1;
 }
 
 // Points coloured by position give meshes (milestones too) whose vertices carry the colours of

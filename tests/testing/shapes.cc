@@ -81,6 +81,16 @@ int ColorError(const Rgb& color, const Vec3f& p) {
   return error;
 }
 
+int WorstColorErrorOnTheUnitSphere(const TriangleMesh& mesh) {
+  if (mesh.colors.empty()) return -1;
+  EXPECT_EQ(mesh.colors.size(), mesh.positions.size());
+  int worst = 0;
+  for (size_t v = 0; v < mesh.colors.size(); ++v) {
+    worst = std::max(worst, ColorError(mesh.colors[v], mesh.positions[v].normalized()));
+  }
+  return worst;
+}
+
 TriangleMesh GridPatch(int nx, int ny) {
   TriangleMesh m;
   for (int j = 0; j <= ny; ++j) {

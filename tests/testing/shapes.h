@@ -29,6 +29,11 @@ PointCloud ColoredUnitSpherePoints(size_t n, uint64_t seed);
 // The largest difference of a channel between `color` and ColorOfPosition(`p`).
 int ColorError(const Rgb& color, const Vec3f& p);
 
+// For a mesh learned from ColoredUnitSpherePoints: the largest ColorError of a vertex's colour
+// against the unit sphere's point nearest the vertex (where the coloured points are; a coarse
+// mesh's vertices lie inside the sphere). -1 when the mesh has no colours.
+int WorstColorErrorOnTheUnitSphere(const TriangleMesh& mesh);
+
 // A regular triangulated grid of (nx+1) x (ny+1) vertices on the square [0,1]^2 at z = 0:
 // an open disc with one boundary loop.
 TriangleMesh GridPatch(int nx, int ny);

@@ -218,7 +218,7 @@ absl::StatusOr<size_t> Session::AddPointsAndMaybeWake(const PointCloud& sent, si
     const size_t first_index = points_.size();
     // A batch of outliers only: nothing to append.
     if (!appended->positions.empty()) NM_RETURN_IF_ERROR(points_.Append(*appended));
-    point_colors_.Append(appended->positions, appended->colors);
+    if (!appended->colors.empty()) point_colors_.Append(appended->positions, appended->colors);
     if (outlier_filter_ != nullptr) {
       held_outliers_.Hold(batch, judgement.held, static_cast<uint32_t>(outlier_filter_->size()));
       held_outliers_.Forget(judgement.released);
@@ -838,23 +838,26 @@ absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Session::Encode(const Snapshot& 
     }
     return true;
   };
+  // A clamped or painted mesh is one copy of the snapshot, clamped first.
+  const bool clamp = !std::all_of(snapshot.mesh.positions.begin(),
+                                  snapshot.mesh.positions.end(), inside);
+  const bool paint = point_colors_.size() > 0;
   const TriangleMesh* mesh = &snapshot.mesh;
-  TriangleMesh clamped;
-  if (!std::all_of(mesh->positions.begin(), mesh->positions.end(), inside)) {
-    clamped = snapshot.mesh;
-    for (Vec3f& p : clamped.positions) {
+  TriangleMesh copy;
+  if (clamp || paint) {
+    copy = snapshot.mesh;
+    mesh = &copy;
+  }
+  if (clamp) {
+    for (Vec3f& p : copy.positions) {
       for (int c = 0; c < 3; ++c) {
         p[c] = std::clamp(p[c], box.origin[c], box.origin[c] + box.range);
       }
     }
-    mesh = &clamped;
   }
-  TriangleMesh painted;
-  if (point_colors_.size() > 0) {
+  if (paint) {
     const absl::Time paint_start = absl::Now();
-    painted = *mesh;
-    point_colors_.Paint(&painted);
-    mesh = &painted;
+    point_colors_.Paint(&copy);
     if (metrics_ != nullptr) metrics_->AddMeshPainted(absl::Now() - paint_start);
   }
   DracoOptions options = config_.draco;

@@ -22,6 +22,7 @@
 #include "draco/compression/decode.h"
 #include "draco/compression/expert_encode.h"
 #include "draco/core/decoder_buffer.h"
+#include "draco/core/draco_types.h"
 #include "draco/core/encoder_buffer.h"
 #include "draco/core/options.h"
 #include "draco/core/varint_decoding.h"
@@ -491,24 +492,9 @@ absl::StatusOr<const draco::PointAttribute*> ColorAttribute(const draco::PointCl
 
 // The largest level of an integer Draco type (colour channels of that type are levels from 0).
 double LargestLevel(draco::DataType type) {
-  switch (type) {
-    case draco::DT_INT8:
-      return 127;
-    case draco::DT_UINT8:
-      return 255;
-    case draco::DT_INT16:
-      return 32767;
-    case draco::DT_UINT16:
-      return 65535;
-    case draco::DT_INT32:
-      return 2147483647.0;
-    case draco::DT_UINT32:
-      return 4294967295.0;
-    case draco::DT_INT64:
-      return 9223372036854775807.0;
-    default:
-      return 18446744073709551615.0;
-  }
+  const bool is_signed = type == draco::DT_INT8 || type == draco::DT_INT16 ||
+                         type == draco::DT_INT32 || type == draco::DT_INT64;
+  return std::ldexp(1.0, 8 * draco::DataTypeLength(type) - (is_signed ? 1 : 0)) - 1.0;
 }
 
 // One colour: bytes as they are, other integers as levels of their type (fractions when the

@@ -79,9 +79,8 @@ TEST(MetricsHttpTest, CountsASessionsWorkAndTheCallsByStatus) {
   const std::string id = testing::MustCreate(*stub, testing::CreateRequest(300));
   v1::UploadPointsResponse uploaded;
   // With colours: the meshes are painted.
-  ASSERT_TRUE(testing::Upload(*stub, id, neuralmesh::testing::ColoredUnitSpherePoints(3000, 1), 3,
-                              &uploaded)
-                  .ok());
+  const PointCloud colored = neuralmesh::testing::ColoredUnitSpherePoints(3000, 1);
+  ASSERT_TRUE(testing::Upload(*stub, id, colored, 3, &uploaded).ok());
   grpc::Status missing;
   testing::GetSession(*stub, "s-nosuchsession", &missing);
   ASSERT_EQ(missing.error_code(), grpc::StatusCode::NOT_FOUND);

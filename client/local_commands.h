@@ -16,6 +16,7 @@
 #include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
+#include "core/io/mesh_io.h"
 #include "core/learning/learner_options.h"
 
 namespace neuralmesh::client {
@@ -34,7 +35,7 @@ struct LocalReconstructOptions {
   std::optional<PointColorOptions> colors = PointColorOptions{};
   absl::Duration time_budget = absl::InfiniteDuration();  // For the whole run.
   uint64_t max_steps = 0;  // Basic Steps for the whole run; 0: no limit.
-  DracoOptions draco;      // For .drc outputs.
+  MeshWriteOptions writing;  // For OUTPUT and the LOD files: Draco settings, glTF compression.
   bool progress = false;   // Draw a progress bar on `err`.
 };
 

@@ -26,8 +26,9 @@ namespace {
 absl::Status CheckOutputPath(const std::string& output) {
   if (output.empty()) return absl::InvalidArgumentError("-o OUTPUT is required");
   if (!IsSupportedMeshExtension(output)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "OUTPUT '", output, "': unsupported mesh format; use .ply, .obj, .off, .stl or .drc"));
+    return absl::InvalidArgumentError(absl::StrCat("OUTPUT '", output,
+                                                   "': unsupported mesh format; use one of ",
+                                                   kMeshExtensions));
   }
   const std::filesystem::path parent = std::filesystem::path(output).parent_path();
   std::error_code error;
@@ -63,7 +64,7 @@ const char* StopReasonText(StopReason reason) {
 absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::ostream& out,
                                  std::ostream& err) {
   NM_RETURN_IF_ERROR(options.learner.Validate());
-  NM_RETURN_IF_ERROR(options.draco.Validate());
+  NM_RETURN_IF_ERROR(options.writing.draco.Validate());
   if (options.time_budget <= absl::ZeroDuration()) {
     return absl::InvalidArgumentError(absl::StrCat("--time_budget must be positive, not ",
                                                    absl::FormatDuration(options.time_budget)));
@@ -134,7 +135,7 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
     LodFigures figures;
     figures.kind = reason != StopReason::kTargetReached ? "stopped" : last ? "final" : "lod";
     figures.path = last ? options.output : LodPath(options.output, targets[i]);
-    NM_RETURN_IF_ERROR(WriteMesh(mesh, figures.path, options.draco));
+    NM_RETURN_IF_ERROR(WriteMesh(mesh, figures.path, options.writing));
     const MeshReport report = ComputeMeshReport(mesh);
     figures.vertices = mesh.positions.size();
     figures.faces = mesh.faces.size();

@@ -41,8 +41,8 @@ const neuralmesh::DracoOptions kDracoDefaults;
 // Output and size.
 ABSL_FLAG(std::string, output, "",
           "Local reconstruct: the mesh to write; the extension picks the format (.ply .obj .off "
-          ".stl .drc). LOD files go beside it as <stem>_lod<N><ext>. get: where the session's "
-          "mesh goes.");
+          ".stl .drc .glb .gltf). LOD files go beside it as <stem>_lod<N><ext>. get: where the "
+          "session's mesh goes.");
 ABSL_FLAG(uint64_t, vertices, 0,
           "Vertex count of the final mesh (met exactly). Required for a local reconstruct; with "
           "--server, 0 means one vertex per 2 points, at most 10000.");
@@ -108,7 +108,8 @@ ABSL_FLAG(std::string, initial_mesh,
           "terrain or a facade).");
 
 ABSL_FLAG(std::string, start_mesh, "",
-          "Learn on from this mesh (.ply .obj .off .stl .drc, for example an earlier OUTPUT or "
+          "Learn on from this mesh (.ply .obj .off .stl .drc .glb .gltf, for example an earlier "
+          "OUTPUT or "
           "final mesh) instead of --initial_mesh, refining it with INPUT's points to "
           "--vertices, which must exceed its vertex count. It must be an orientable manifold "
           "triangle mesh, with or without borders, every vertex on a face and no face of zero "
@@ -141,8 +142,9 @@ ABSL_FLAG(bool, colors, true,
           "uploaded and the session paints its meshes so (--nocolors: uploaded without). Not "
           "in the paper.");
 ABSL_FLAG(int32_t, color_neighbours, neuralmesh::PointColorOptions{}.neighbours,
-          "With --colors, locally: how many of the nearest points a vertex's colour blends, in "
-          "[1, 64] (a session blends 8).");
+          "With --colors: how many of the nearest points a vertex's colour blends, in [1, 64] "
+          "(1: the nearest point's colour); with --server the session's "
+          "(SessionConfig.color_neighbours).");
 
 // Local learning.
 ABSL_FLAG(std::string, sampling, "uniform",
@@ -153,9 +155,12 @@ ABSL_FLAG(absl::Duration, time_budget, absl::InfiniteDuration(),
 ABSL_FLAG(uint64_t, max_steps, 0,
           "Stop learning after this many Basic Steps and write the mesh so far; 0: no limit.");
 ABSL_FLAG(int32_t, quantization_bits, kDracoDefaults.position_quantization_bits,
-          "Draco position quantization bits (1..24) for .drc meshes.");
+          "Draco position quantization bits (1..24) for .drc meshes and --gltf_draco.");
 ABSL_FLAG(int32_t, encode_speed, kDracoDefaults.encode_speed,
-          "Draco encoder speed, 0 (smallest) .. 10 (fastest), for .drc meshes.");
+          "Draco encoder speed, 0 (smallest) .. 10 (fastest), for .drc meshes and --gltf_draco.");
+ABSL_FLAG(bool, gltf_draco, false,
+          "Compress .glb and .gltf outputs with Draco (KHR_draco_mesh_compression; positions "
+          "quantized by --quantization_bits). Off: plain glTF, which every glTF reader takes.");
 ABSL_FLAG(bool, progress, false, "Draw progress bars on stderr even when it is not a terminal.");
 
 // Server.
@@ -317,6 +322,14 @@ absl::StatusOr<neuralmesh::DracoOptions> DracoFromFlags() {
   return o;
 }
 
+// How meshes are written: the Draco flags, and --gltf_draco.
+absl::StatusOr<neuralmesh::MeshWriteOptions> MeshWritingFromFlags() {
+  neuralmesh::MeshWriteOptions o;
+  NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
+  o.gltf_draco = absl::GetFlag(FLAGS_gltf_draco);
+  return o;
+}
+
 constexpr const char* kConnectionFlags[] = {
     "connect_timeout", "tls",          "tls_ca_file",       "tls_cert_file",
     "tls_key_file",    "tls_server_name", "access_token_file", "max_message_bytes"};
@@ -393,7 +406,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
   const bool progress = neuralmesh::client::ShowProgressOnStderr(absl::GetFlag(FLAGS_progress));
   if (args.Has("server")) {
     NM_RETURN_IF_ERROR(RejectFlags(
-        args, {"output", "sampling", "time_budget", "max_steps", "color_neighbours"},
+        args, {"output", "sampling", "time_budget", "max_steps", "gltf_draco"},
         "applies to a local reconstruct only (the server picks its own budget; use --out-dir)"));
     neuralmesh::client::RemoteReconstructOptions o;
     o.input = args.positional[0];
@@ -404,7 +417,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     NM_ASSIGN_OR_RETURN(o.learner, LearnerFromFlags());
     NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
     o.outliers_on_server = absl::GetFlag(FLAGS_outliers_on_server);
-    o.colors = absl::GetFlag(FLAGS_colors);
+    NM_ASSIGN_OR_RETURN(o.colors, ColorsFromFlags());
     if (o.outliers_on_server && !o.outliers.has_value()) {
       return absl::InvalidArgumentError("--outliers_on_server needs --remove_outliers");
     }
@@ -438,7 +451,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
   NM_ASSIGN_OR_RETURN(o.colors, ColorsFromFlags());
   o.time_budget = absl::GetFlag(FLAGS_time_budget);
   o.max_steps = absl::GetFlag(FLAGS_max_steps);
-  NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
+  NM_ASSIGN_OR_RETURN(o.writing, MeshWritingFromFlags());
   o.progress = progress;
   return neuralmesh::client::RunLocalReconstruct(o, std::cout, std::cerr);
 }
@@ -510,6 +523,7 @@ absl::Status Get(const ParsedArgs& args) {
   o.server = absl::GetFlag(FLAGS_server);
   o.output = absl::GetFlag(FLAGS_output);
   o.final = absl::GetFlag(FLAGS_final);
+  NM_ASSIGN_OR_RETURN(o.writing, MeshWritingFromFlags());
   NM_ASSIGN_OR_RETURN(o.wait, FiniteDurationFlag("wait", absl::GetFlag(FLAGS_wait)));
   NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
   return neuralmesh::client::RunGetMesh(o, std::cout);
@@ -560,8 +574,8 @@ std::vector<Subcommand> Commands() {
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
       "start_mesh", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
       "outliers_on_server", "colors", "color_neighbours", "sampling", "time_budget", "max_steps",
-      "quantization_bits", "encode_speed", "progress", "server", "out-dir", "batch-size", "points",
-      "ply", "resume", "reconnect_for"};
+      "quantization_bits", "encode_speed", "gltf_draco", "progress", "server", "out-dir",
+      "batch-size", "points", "ply", "resume", "reconnect_for"};
   // clang-format on
   return {
       {"reconstruct",
@@ -569,10 +583,10 @@ std::vector<Subcommand> Commands() {
        "       neuralmesh reconstruct INPUT --server HOST:PORT --out-dir DIR [--vertices N] "
        "[--batch-size K] [--ply] [--resume SESSION] [--reconnect_for D]",
        "Learns a mesh of a point cloud, a mesh or a built-in surface, locally or on a server.",
-       "Learns a mesh of INPUT: a point cloud (.ply .xyz .obj .off .drc), a triangle mesh with\n"
-       "--sampling area|curvature, or builtin:sphere|torus|genus2. Locally it writes OUTPUT and\n"
-       "one OUTPUT_lod<N> file per --lod; with --server it uploads the points and saves each\n"
-       "mesh the server publishes into --out-dir. Prints the figures of every level.",
+       "Learns a mesh of INPUT: a point cloud (.ply .xyz .obj .off .drc .glb .gltf), a triangle\n"
+       "mesh with --sampling area|curvature, or builtin:sphere|torus|genus2. Locally it writes\n"
+       "OUTPUT and one OUTPUT_lod<N> file per --lod; with --server it uploads the points and\n"
+       "saves each mesh the server publishes into --out-dir. Prints the figures of every level.",
        WithConnectionFlags(reconstruct), Reconstruct},
       {"stats",
        "stats MESH [--json]",
@@ -605,9 +619,11 @@ std::vector<Subcommand> Commands() {
        "get SESSION --server HOST:PORT -o OUTPUT [--final] [--wait D]",
        "Saves a session's latest or final mesh.",
        "Saves the latest mesh of a server session (with --final its final mesh) to OUTPUT:\n"
-       ".drc keeps the server's Draco bytes as they are; .ply .obj .off .stl are decoded.\n"
+       ".drc keeps the server's Draco bytes as they are; .ply .obj .off .stl .glb .gltf are\n"
+       "decoded (and re-encoded with --gltf_draco).\n"
        "Prints its figures.",
-       WithConnectionFlags({"server", "output", "final", "wait"}),
+       WithConnectionFlags({"server", "output", "final", "wait", "quantization_bits",
+                            "encode_speed", "gltf_draco"}),
        Get},
       SessionActionCommand(
           "finish", "Tells a server session that all its points have arrived.",

@@ -104,6 +104,9 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     for (size_t m : milestones) config.add_lod_milestones(m);
   }
   *config.mutable_draco() = ToProto(options.draco);
+  if (options.colors.has_value()) {
+    config.mutable_color_neighbours()->set_value(static_cast<uint32_t>(options.colors->neighbours));
+  }
   if (outliers_on_server) {
     // The session's cube grows with what it accepts: bounds taken here would hold the strays.
     v1::OutlierRemoval& removal = *config.mutable_outlier_removal();

@@ -16,6 +16,7 @@
 #include "absl/time/time.h"
 #include "client/reconnecting_calls.h"
 #include "client/reconstruction_client.h"
+#include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
@@ -35,7 +36,9 @@ struct RemoteReconstructOptions {
   LearnerOptions learner;
   std::optional<OutlierOptions> outliers;  // Set: remove the points' outliers before upload,
   bool outliers_on_server = false;         // or, when this is set, the session as they arrive.
-  bool colors = true;  // Upload the points' colours, which the session paints its meshes with.
+  // Set: upload the points' colours, which the session paints its meshes with, blending
+  // `neighbours` points (SessionConfig.color_neighbours).
+  std::optional<PointColorOptions> colors = PointColorOptions{};
   DracoOptions draco;              // Quantization bits and encode speed of the server's meshes.
   size_t batch_size = 10000;       // Points per uploaded batch.
   size_t builtin_points = 100000;  // Points sampled from a builtin:NAME input.

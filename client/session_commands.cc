@@ -54,8 +54,8 @@ absl::Status RunGetMesh(const GetMeshOptions& options, std::ostream& out) {
   if (options.session_id.empty()) return absl::InvalidArgumentError("SESSION is empty");
   if (options.output.empty()) return absl::InvalidArgumentError("-o OUTPUT is required");
   if (!IsSupportedMeshExtension(options.output)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "cannot write '", options.output, "': use .drc, .ply, .obj, .off or .stl"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot write '", options.output, "': use one of ", kMeshExtensions));
   }
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ConnectTo(options.server, options.connection));
@@ -74,7 +74,7 @@ absl::Status RunGetMesh(const GetMeshOptions& options, std::ostream& out) {
                                               options.session_id,
                                               " does not decode: ", mesh.status().message()));
     }
-    NM_RETURN_IF_ERROR(WriteMesh(*mesh, options.output));
+    NM_RETURN_IF_ERROR(WriteMesh(*mesh, options.output, options.writing));
   }
   LodFigures figures = FiguresOf(update);
   figures.path = options.output;

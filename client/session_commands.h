@@ -9,6 +9,7 @@
 #include "absl/status/status.h"
 #include "absl/time/time.h"
 #include "client/reconstruction_client.h"
+#include "core/io/mesh_io.h"
 
 namespace neuralmesh::client {
 
@@ -35,8 +36,9 @@ struct GetMeshOptions {
   std::string session_id;
   std::string server;
   // Where the mesh goes, its format by extension: .drc holds the server's Draco bytes as they
-  // came; .ply, .obj, .off and .stl the decoded mesh.
+  // came; the other formats of kMeshExtensions the decoded mesh, written with `writing`.
   std::string output;
+  MeshWriteOptions writing;
   bool final = false;  // The final mesh of a finished session instead of the latest one.
   // Zero (or less): the mesh must exist now (NOT_FOUND otherwise); more: wait up to this long
   // for it (DEADLINE_EXCEEDED after).

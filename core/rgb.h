@@ -28,6 +28,30 @@ inline uint8_t ChannelFromLevel(double level, double max) {
 // The channel as a fraction in [0, 1].
 inline float ChannelFraction(uint8_t channel) { return static_cast<float>(channel) / 255.0f; }
 
+// Channels are sRGB-encoded, as scanners and PLY files store them; glTF stores vertex colours
+// as linear light. The two conversions follow IEC 61966-2-1's transfer function.
+
+// The linear light, in [0, 1], of an sRGB-encoded channel.
+inline double LinearFromSrgb(uint8_t channel) {
+  const double c = channel / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+// The sRGB-encoded channel nearest to linear light `linear`, clamped to [0, 1]; NaN gives 0.
+// Exact back from LinearFromSrgb rounded to 16 bits.
+inline uint8_t SrgbFromLinear(double linear) {
+  if (!(linear > 0)) return 0;
+  if (linear >= 1) return 255;
+  return ChannelFromFraction(linear <= 0.0031308 ? 12.92 * linear
+                                                 : 1.055 * std::pow(linear, 1 / 2.4) - 0.055);
+}
+
+// LinearFromSrgb(channel) as a normalized 16-bit integer, as glTF files store vertex colours:
+// 8 bits of linear light would merge the darkest sRGB levels.
+inline uint16_t LinearShortFromSrgb(uint8_t channel) {
+  return static_cast<uint16_t>(std::lround(LinearFromSrgb(channel) * 65535.0));
+}
+
 }  // namespace neuralmesh
 
 #endif  // NEURALMESH_CORE_RGB_H_

@@ -129,6 +129,11 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
     if (o.has_std_ratio()) outliers.std_ratio = o.std_ratio().value();
     config.outlier_removal = outliers;
   }
+  if (proto.has_color_neighbours()) {
+    // Clamped into int's range; ResolveSessionConfig refuses what is beyond 64.
+    config.colors.neighbours =
+        static_cast<int>(std::min<uint32_t>(proto.color_neighbours().value(), 1u << 30));
+  }
   return config;
 }
 
@@ -193,6 +198,7 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
     o.mutable_neighbours()->set_value(config.outlier_removal->neighbours);
     o.mutable_std_ratio()->set_value(config.outlier_removal->std_ratio);
   }
+  proto.mutable_color_neighbours()->set_value(static_cast<uint32_t>(config.colors.neighbours));
   return proto;
 }
 
@@ -213,6 +219,7 @@ v1::MeshReport MeshReportToProto(const MeshReport& report) {
   proto.set_genus(report.genus);
   proto.set_euler_characteristic(static_cast<int32_t>(report.euler_characteristic));
   proto.set_manifold(report.manifold());
+  proto.set_colored(report.colored);
   return proto;
 }
 

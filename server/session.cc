@@ -70,7 +70,8 @@ Session::Session(std::string id, std::string name, SessionConfig config, size_t 
       pool_(pool),
       encoder_(encoder),
       log_(std::move(log)),
-      points_(max_points) {
+      points_(max_points),
+      point_colors_(config_.colors) {
   if (config_.outlier_removal.has_value()) {
     absl::MutexLock ingest(&ingest_mu_);
     outlier_filter_ = std::make_unique<StreamingOutlierFilter>(*config_.outlier_removal);
@@ -860,6 +861,7 @@ absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Session::Encode(const Snapshot& 
     point_colors_.Paint(&copy);
     if (metrics_ != nullptr) metrics_->AddMeshPainted(absl::Now() - paint_start);
   }
+  update->mutable_report()->set_colored(!mesh->colors.empty());
   DracoOptions options = config_.draco;
   options.quantization_box = box;
   const absl::Time start = absl::Now();

@@ -102,6 +102,9 @@ absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& 
       return absl::InvalidArgumentError(absl::StrCat("outlier_removal: ", valid.message()));
     }
   }
+  if (const absl::Status valid = config.colors.Validate(); !valid.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("color_neighbours: ", valid.message()));
+  }
   if (config.bounds.has_value()) {
     const absl::StatusOr<QuantizationBox> cube = QuantizationCube(
         *config.bounds, kDeclaredBoundsEnlargement, config.draco.position_quantization_bits);

@@ -9,6 +9,7 @@
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
+#include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/bounding_box.h"
 #include "core/io/draco_codec.h"
@@ -56,6 +57,8 @@ struct SessionConfig {
   FinalPass final_pass = FinalPass::kAuto;
   // Drop each batch's statistical outliers before accepting it; unset: accept every point.
   std::optional<OutlierOptions> outlier_removal;
+  // How published meshes are painted when the points carry colours.
+  PointColorOptions colors;
 };
 
 // The 1-2-5 series from kFirstDefaultMilestone, 50, 100, 200, 500, 1000, ... below `target`,
@@ -67,8 +70,8 @@ std::vector<size_t> DefaultLodMilestones(size_t target);
 // above kMaxTargetVertices or unreachable within `max_points_per_session` points, milestones not
 // strictly increasing, below 4, above the target or more than 256 of them, a refresh interval
 // between 0 and 10 ms, points_per_vertex not finite and positive, bounds not finite or inverted,
-// and whatever LearnerOptions::Validate, DracoOptions::Validate and OutlierOptions::Validate
-// reject.
+// and whatever LearnerOptions::Validate, DracoOptions::Validate, OutlierOptions::Validate and
+// PointColorOptions::Validate reject.
 absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& config);
 
 }  // namespace neuralmesh::server

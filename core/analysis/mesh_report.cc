@@ -159,6 +159,7 @@ int ValenceColumn(int valence) {
 
 MeshReport ComputeMeshReport(const TriangleMesh& mesh) {
   MeshReport report;
+  report.colored = !mesh.colors.empty() && mesh.colors.size() == mesh.positions.size();
   const size_t n = mesh.positions.size();
 
   std::vector<Face> faces;
@@ -405,6 +406,7 @@ std::string MeshReportToText(const MeshReport& r) {
   out += ")\n";
   absl::StrAppendFormat(&out, "%-22s %10s\n", "oriented", yes_no(r.oriented));
   absl::StrAppendFormat(&out, "%-22s %10s\n", "closed", yes_no(r.closed));
+  absl::StrAppendFormat(&out, "%-22s %10s\n", "colours", yes_no(r.colored));
   // Both rows' labels get the width of the longer one, so the columns stay under each other.
   const std::string valence_label = absl::StrCat("valence (", r.interior_vertices, " interior)");
   const int label_width = std::max<int>(22, static_cast<int>(valence_label.size()));
@@ -454,6 +456,7 @@ std::string MeshReportToJson(const MeshReport& r, int indent) {
   json.Key("non_manifold_edges").Uint(r.non_manifold_edges);
   json.Key("non_manifold_vertices").Uint(r.non_manifold_vertices);
   json.Key("misoriented_edges").Uint(r.misoriented_edges);
+  json.Key("colored").Bool(r.colored);
   json.EndObject();
   // The calls above always form one complete object; Finish() cannot fail here.
   absl::StatusOr<std::string> text = json.Finish();

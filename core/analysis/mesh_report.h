@@ -77,6 +77,7 @@ struct MeshReport {
   size_t non_manifold_edges = 0;     // Edges in three or more faces.
   size_t non_manifold_vertices = 0;  // Vertices whose faces do not form one fan.
   size_t misoriented_edges = 0;      // Edges in two faces used in the same direction.
+  bool colored = false;              // A colour per vertex (TriangleMesh::colors).
 
   // Edge and vertex manifold, with no degenerate or invalid face.
   bool manifold() const {

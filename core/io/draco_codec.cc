@@ -212,15 +212,30 @@ int AddFloatAttribute(draco::PointCloud& geometry, draco::GeometryAttribute::Typ
   return id;
 }
 
-// Adds a per-point COLOR attribute of three normalized bytes (Draco codes integers losslessly,
-// without quantization).
-void AddColorAttribute(draco::PointCloud& geometry, const std::vector<Rgb>& colors) {
+// How a COLOR attribute stores the sRGB channels of Rgb: as they are, in bytes, or as linear
+// light in 16-bit integers (glTF).
+enum class ColorStorage { kSrgbBytes, kLinearShorts };
+
+// Adds a per-point COLOR attribute of three normalized integers (Draco codes integers
+// losslessly, without quantization).
+void AddColorAttribute(draco::PointCloud& geometry, const std::vector<Rgb>& colors,
+                       ColorStorage storage = ColorStorage::kSrgbBytes) {
+  const bool linear = storage == ColorStorage::kLinearShorts;
   draco::GeometryAttribute layout;
-  layout.Init(draco::GeometryAttribute::COLOR, nullptr, 3, draco::DT_UINT8, /*normalized=*/true,
-              sizeof(Rgb), /*byte_offset=*/0);
+  layout.Init(draco::GeometryAttribute::COLOR, nullptr, 3,
+              linear ? draco::DT_UINT16 : draco::DT_UINT8, /*normalized=*/true,
+              linear ? 3 * sizeof(uint16_t) : sizeof(Rgb), /*byte_offset=*/0);
   const int id = geometry.AddAttribute(layout, /*identity_mapping=*/true,
                                        static_cast<uint32_t>(colors.size()));
-  geometry.attribute(id)->buffer()->Write(0, colors.data(), colors.size() * sizeof(Rgb));
+  if (!linear) {
+    geometry.attribute(id)->buffer()->Write(0, colors.data(), colors.size() * sizeof(Rgb));
+    return;
+  }
+  std::vector<std::array<uint16_t, 3>> shorts(colors.size());
+  for (size_t i = 0; i < colors.size(); ++i) {
+    for (int c = 0; c < 3; ++c) shorts[i][c] = LinearShortFromSrgb(colors[i][c]);
+  }
+  geometry.attribute(id)->buffer()->Write(0, shorts.data(), shorts.size() * sizeof(shorts[0]));
 }
 
 absl::Status CheckColorCount(size_t colors, size_t points, const char* what) {
@@ -499,10 +514,13 @@ double LargestLevel(draco::DataType type) {
 
 // One colour: bytes as they are, other integers as levels of their type (fractions when the
 // attribute is normalized, which Draco's conversion has already applied), floats as fractions.
+// With ColorStorage::kLinearShorts every channel is linear light, converted to sRGB.
 absl::StatusOr<Rgb> ReadColor(const draco::PointAttribute& attribute,
-                              draco::AttributeValueIndex index) {
+                              draco::AttributeValueIndex index,
+                              ColorStorage storage = ColorStorage::kSrgbBytes) {
   Rgb color;
-  if (attribute.data_type() == draco::DT_UINT8) {
+  const bool linear = storage == ColorStorage::kLinearShorts;
+  if (attribute.data_type() == draco::DT_UINT8 && !linear) {
     if (!attribute.ConvertValue<uint8_t, 3>(index, color.data())) {
       return absl::InvalidArgumentError(
           absl::StrCat("cannot read Draco colour value ", index.value()));
@@ -516,7 +534,9 @@ absl::StatusOr<Rgb> ReadColor(const draco::PointAttribute& attribute,
   }
   const bool levels = attribute.data_type() < draco::DT_FLOAT32 && !attribute.normalized();
   const double max = levels ? LargestLevel(attribute.data_type()) : 1.0;
-  for (int c = 0; c < 3; ++c) color[c] = ChannelFromLevel(channels[c], max);
+  for (int c = 0; c < 3; ++c) {
+    color[c] = linear ? SrgbFromLinear(channels[c] / max) : ChannelFromLevel(channels[c], max);
+  }
   return color;
 }
 
@@ -589,7 +609,10 @@ absl::Status DracoOptions::Validate() const {
   return absl::OkStatus();
 }
 
-absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOptions& options) {
+// EncodeMesh, with colours stored as `storage` says.
+static absl::StatusOr<std::string> EncodeMeshStoring(const TriangleMesh& mesh,
+                                                     const DracoOptions& options,
+                                                     ColorStorage storage) {
   NM_RETURN_IF_ERROR(options.Validate());
   if (mesh.positions.empty()) {
     return absl::InvalidArgumentError("cannot encode an empty mesh (no vertices)");
@@ -623,7 +646,7 @@ absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOpti
   geometry.set_num_points(static_cast<uint32_t>(num_vertices));
   const int position_id = AddFloatAttribute(geometry, draco::GeometryAttribute::POSITION, 3,
                                             mesh.positions.front().data(), num_vertices);
-  if (!mesh.colors.empty()) AddColorAttribute(geometry, mesh.colors);
+  if (!mesh.colors.empty()) AddColorAttribute(geometry, mesh.colors, storage);
   geometry.SetNumFaces(mesh.faces.size());
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     draco::Mesh::Face face;
@@ -643,6 +666,18 @@ absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOpti
     if (bytes.size() < best.size()) best = std::move(bytes);
   }
   return best;
+}
+
+absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOptions& options) {
+  return EncodeMeshStoring(mesh, options, ColorStorage::kSrgbBytes);
+}
+
+absl::StatusOr<std::string> EncodeMeshForGltf(const TriangleMesh& mesh,
+                                              const DracoOptions& options) {
+  // A new draco::Mesh gives its attributes the unique ids 0, 1, ... in the order they are
+  // added: positions first, then colours (DracoCodecTest checks it).
+  static_assert(kGltfDracoPositionId == 0 && kGltfDracoColorId == 1);
+  return EncodeMeshStoring(mesh, options, ColorStorage::kLinearShorts);
 }
 
 absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const DracoOptions& options) {
@@ -727,6 +762,60 @@ absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes) {
       if (triangle[k] >= mesh.positions.size()) {
         return absl::InvalidArgumentError(
             absl::StrCat("Draco face ", f.value(), " maps to a position out of range"));
+      }
+    }
+    mesh.faces.push_back(triangle);
+  }
+  return mesh;
+}
+
+absl::StatusOr<TriangleMesh> DecodeGltfDracoMesh(std::string_view bytes, int position_id,
+                                                 int color_id) {
+  NM_ASSIGN_OR_RETURN(std::unique_ptr<draco::Mesh> geometry, DecodeDraco<draco::Mesh>(bytes));
+  const auto attribute =
+      [&](int id, const char* what) -> absl::StatusOr<const draco::PointAttribute*> {
+    const draco::PointAttribute* found = geometry->GetAttributeByUniqueId(id);
+    if (found == nullptr) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("the Draco data has no attribute with unique id ", id, " for ", what));
+    }
+    if (found->num_components() < 3) {
+      return absl::InvalidArgumentError(absl::StrCat("the Draco ", what, " attribute has ",
+                                                     int{found->num_components()},
+                                                     " components; expected 3 or more"));
+    }
+    NM_RETURN_IF_ERROR(CheckNumeric(*found, what));
+    return found;
+  };
+  NM_ASSIGN_OR_RETURN(const draco::PointAttribute* positions, attribute(position_id, "POSITION"));
+  const draco::PointAttribute* colors = nullptr;
+  if (color_id >= 0) {
+    NM_ASSIGN_OR_RETURN(colors, attribute(color_id, "COLOR_0"));
+  }
+  const uint32_t points = geometry->num_points();
+  if (points == 0 || geometry->num_faces() == 0) {
+    return absl::InvalidArgumentError("the Draco mesh is empty");
+  }
+  TriangleMesh mesh;
+  mesh.positions.reserve(points);
+  if (colors != nullptr) mesh.colors.reserve(points);
+  for (draco::PointIndex i(0); i < points; ++i) {
+    NM_ASSIGN_OR_RETURN(Vec3f p, ReadVec3(*positions, positions->mapped_index(i), "position"));
+    mesh.positions.push_back(p);
+    if (colors == nullptr) continue;
+    NM_ASSIGN_OR_RETURN(Rgb color,
+                        ReadColor(*colors, colors->mapped_index(i), ColorStorage::kLinearShorts));
+    mesh.colors.push_back(color);
+  }
+  mesh.faces.reserve(geometry->num_faces());
+  for (draco::FaceIndex f(0); f < geometry->num_faces(); ++f) {
+    const draco::Mesh::Face& face = geometry->face(f);
+    std::array<uint32_t, 3> triangle;
+    for (int k = 0; k < 3; ++k) {
+      triangle[k] = face[k].value();
+      if (triangle[k] >= points) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("Draco face ", f.value(), " uses a point out of range"));
       }
     }
     mesh.faces.push_back(triangle);

@@ -94,6 +94,27 @@ QuantizationBox BoxAsDracoReadsIt(const QuantizationBox& box);
 // spanning nearly the whole float range); INTERNAL if Draco fails for another reason.
 absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOptions& options);
 
+// How EncodeMeshForGltf stores colours and which attributes a decoder of glTF's
+// KHR_draco_mesh_compression finds them in (the extension names attributes by unique id).
+inline constexpr int kGltfDracoPositionId = 0;
+inline constexpr int kGltfDracoColorId = 1;
+
+// Encodes `mesh` as EncodeMesh does, for a glTF primitive: POSITION has unique id
+// kGltfDracoPositionId and colours, when present, are linear light (glTF's COLOR_0) in a COLOR
+// attribute of three normalized 16-bit integers with unique id kGltfDracoColorId. Returns what
+// EncodeMesh returns.
+absl::StatusOr<std::string> EncodeMeshForGltf(const TriangleMesh& mesh,
+                                              const DracoOptions& options);
+
+// Decodes the Draco mesh of a glTF primitive (KHR_draco_mesh_compression) as glTF's accessors
+// count it: one vertex per Draco point (vertices at one position are not merged), positions from
+// the attribute with unique id `position_id`, and colours, when `color_id` is not negative,
+// from that attribute, read as linear light and converted to sRGB channels. Returns
+// INVALID_ARGUMENT as DecodeMesh does, and when an attribute with either id is missing, has
+// fewer than three components or is not numeric.
+absl::StatusOr<TriangleMesh> DecodeGltfDracoMesh(std::string_view bytes, int position_id,
+                                                 int color_id);
+
 // Encodes the positions of `cloud`, its normals, its weights (as a generic one-component
 // attribute) and its colours (COLOR, three bytes) when present.
 // Returns INVALID_ARGUMENT as EncodeMesh does, also when the cloud is empty or fails

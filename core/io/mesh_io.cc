@@ -8,6 +8,7 @@
 #include "core/io/file_contents.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/gltf.h"
 #include "core/io/internal/obj.h"
 #include "core/io/internal/off.h"
 #include "core/io/internal/ply.h"
@@ -19,8 +20,6 @@ namespace {
 
 using io_internal::FileFormat;
 
-constexpr char kSupported[] = ".ply, .obj, .off, .stl, .drc";
-
 absl::StatusOr<FileFormat> MeshFormat(const std::string& path) {
   const FileFormat format = io_internal::FormatFromPath(path);
   if (format == FileFormat::kUnknown || format == FileFormat::kXyz) {
@@ -29,12 +28,13 @@ absl::StatusOr<FileFormat> MeshFormat(const std::string& path) {
         "'", path, "': ",
         extension.empty() ? std::string("no file extension")
                           : absl::StrCat("unsupported mesh file extension '", extension, "'"),
-        "; supported: ", kSupported));
+        "; supported: ", kMeshExtensions));
   }
   return format;
 }
 
-absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data) {
+absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data,
+                                       const std::string& path) {
   absl::StatusOr<io_internal::ParsedGeometry> parsed;
   switch (format) {
     case FileFormat::kPly:
@@ -51,6 +51,10 @@ absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data
       break;
     case FileFormat::kDraco:
       return DecodeMesh(std::string_view(data.data(), data.size()));
+    case FileFormat::kGltf:
+      parsed = io_internal::ParseGltf(data, io_internal::FaceHandling::kRead,
+                                      io_internal::GltfBuffersBeside(path));
+      break;
     case FileFormat::kXyz:
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
@@ -61,6 +65,11 @@ absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data
   mesh.faces = std::move(parsed->faces);
   mesh.colors = std::move(parsed->colors);
   return mesh;
+}
+
+// `status` with "cannot write 'path': " in front of its message.
+absl::Status CannotWrite(const std::string& path, const absl::Status& status) {
+  return absl::Status(status.code(), absl::StrCat("cannot write '", path, "': ", status.message()));
 }
 
 absl::Status CheckWritable(const TriangleMesh& mesh, FileFormat format) {
@@ -94,6 +103,8 @@ absl::Status CheckWritable(const TriangleMesh& mesh, FileFormat format) {
 
 }  // namespace
 
+const char kMeshExtensions[] = ".ply, .obj, .off, .stl, .drc, .glb, .gltf";
+
 bool IsSupportedMeshExtension(std::string_view path) {
   const FileFormat format =
       io_internal::FormatFromPath(absl::string_view(path.data(), path.size()));
@@ -103,7 +114,7 @@ bool IsSupportedMeshExtension(std::string_view path) {
 absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path) {
   NM_ASSIGN_OR_RETURN(const FileFormat format, MeshFormat(path));
   NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
-  absl::StatusOr<TriangleMesh> mesh = ParseMesh(format, data);
+  absl::StatusOr<TriangleMesh> mesh = ParseMesh(format, data, path);
   if (!mesh.ok()) return io_internal::WithPath(mesh.status(), path);
   if (mesh->positions.empty()) {
     return absl::InvalidArgumentError(absl::StrCat("'", path, "' contains no vertices"));
@@ -111,14 +122,11 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path) {
   return mesh;
 }
 
-absl::Status WriteMesh(const TriangleMesh& mesh, const std::string& path,
-                       const DracoOptions& draco) {
+absl::StatusOr<std::string> FormatMesh(const TriangleMesh& mesh, const std::string& path,
+                                       const MeshWriteOptions& options) {
   NM_ASSIGN_OR_RETURN(const FileFormat format, MeshFormat(path));
   const absl::Status writable = CheckWritable(mesh, format);
-  if (!writable.ok()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("cannot write '", path, "': ", writable.message()));
-  }
+  if (!writable.ok()) return CannotWrite(path, writable);
   const io_internal::GeometryView view{mesh.positions, {}, {}, mesh.faces, mesh.colors};
   std::string data;
   switch (format) {
@@ -135,19 +143,31 @@ absl::Status WriteMesh(const TriangleMesh& mesh, const std::string& path,
       data = io_internal::FormatStl(view);
       break;
     case FileFormat::kDraco: {
-      absl::StatusOr<std::string> encoded = EncodeMesh(mesh, draco);
-      if (!encoded.ok()) {
-        return absl::Status(
-            encoded.status().code(),
-            absl::StrCat("cannot write '", path, "': ", encoded.status().message()));
-      }
+      absl::StatusOr<std::string> encoded = EncodeMesh(mesh, options.draco);
+      if (!encoded.ok()) return CannotWrite(path, encoded.status());
       data = *std::move(encoded);
+      break;
+    }
+    case FileFormat::kGltf: {
+      io_internal::GltfWriteOptions gltf;
+      gltf.binary = io_internal::LowercaseExtension(path) == ".glb";
+      gltf.draco = options.gltf_draco;
+      gltf.draco_options = options.draco;
+      absl::StatusOr<std::string> formatted = io_internal::FormatGltf(view, gltf);
+      if (!formatted.ok()) return CannotWrite(path, formatted.status());
+      data = *std::move(formatted);
       break;
     }
     case FileFormat::kXyz:
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
   }
+  return data;
+}
+
+absl::Status WriteMesh(const TriangleMesh& mesh, const std::string& path,
+                       const MeshWriteOptions& options) {
+  NM_ASSIGN_OR_RETURN(const std::string data, FormatMesh(mesh, path, options));
   return WriteFileContents(path, data);
 }
 

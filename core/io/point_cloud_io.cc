@@ -5,6 +5,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "core/io/file_contents.h"
+#include "core/io/internal/gltf.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/geometry_data.h"
 #include "core/io/internal/obj.h"
@@ -35,7 +36,8 @@ absl::Status UnsupportedExtension(const std::string& path, const char* supported
       "; supported: ", supported));
 }
 
-absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view data) {
+absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view data,
+                                           const std::string& path) {
   absl::StatusOr<io_internal::ParsedGeometry> parsed;
   switch (format) {
     case FileFormat::kPly:
@@ -52,6 +54,10 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
       break;
     case FileFormat::kDraco:
       return DecodePointCloud(std::string_view(data.data(), data.size()));
+    case FileFormat::kGltf:
+      parsed = io_internal::ParseGltf(data, io_internal::FaceHandling::kSkip,
+                                      io_internal::GltfBuffersBeside(path));
+      break;
     case FileFormat::kStl:
     case FileFormat::kUnknown:
       return absl::InternalError("not a point cloud format");
@@ -78,10 +84,10 @@ bool IsWritablePointCloudExtension(std::string_view path) {
 absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path) {
   const FileFormat format = io_internal::FormatFromPath(path);
   if (!IsReadable(format)) {
-    return UnsupportedExtension(path, ".ply, .xyz, .txt, .pts, .obj, .off, .drc");
+    return UnsupportedExtension(path, ".ply, .xyz, .txt, .pts, .obj, .off, .drc, .glb, .gltf");
   }
   NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
-  absl::StatusOr<PointCloud> cloud = ParsePointCloud(format, data);
+  absl::StatusOr<PointCloud> cloud = ParsePointCloud(format, data, path);
   if (!cloud.ok()) return io_internal::WithPath(cloud.status(), path);
   if (cloud->empty()) {
     return absl::InvalidArgumentError(absl::StrCat("'", path, "' contains no points"));

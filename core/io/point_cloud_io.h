@@ -1,5 +1,6 @@
 // Reads and writes point clouds (positions, optional normals, weights and colours) in PLY, XYZ,
-// OBJ, OFF and Draco files, chosen by the file-name extension (case-insensitive).
+// OBJ, OFF and Draco files, and reads them from glTF, chosen by the file-name extension
+// (case-insensitive).
 #ifndef NEURALMESH_CORE_IO_POINT_CLOUD_IO_H_
 #define NEURALMESH_CORE_IO_POINT_CLOUD_IO_H_
 
@@ -14,7 +15,7 @@
 namespace neuralmesh {
 
 // True when ReadPointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .obj,
-// .off, .drc.
+// .off, .drc, .glb, .gltf.
 bool IsReadablePointCloudExtension(std::string_view path);
 
 // True when WritePointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .drc.
@@ -29,6 +30,8 @@ bool IsWritablePointCloudExtension(std::string_view path);
 //         face corners).
 //   .off  the vertices of OFF, COFF (with colours), NOFF (with normals), STOFF.
 //   .drc  a Draco point cloud, or the points of a Draco mesh.
+//   .glb, .gltf  the vertices of every mesh primitive the default scene draws, placed by their
+//         nodes, with COLOR_0 colours; vertices at identical positions merged (as ReadMesh).
 // Returns NOT_FOUND when the file cannot be opened or read; INVALID_ARGUMENT for an
 // unsupported extension (listing the supported ones), an empty file, a file with no points,
 // malformed content (the message gives the line or byte offset and what was expected), or a

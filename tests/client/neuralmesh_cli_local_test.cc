@@ -290,10 +290,67 @@ TEST_F(LocalCliTest, ColouredInputsGiveColouredMeshes) {
   EXPECT_TRUE(absl::StrContains(bad.err, "--color_neighbours is 0; it must be in [1, 64]"))
       << bad.Describe();
   const RunResult remote = RunNeuralmesh({"reconstruct", cloud, "--server", "127.0.0.1:1",
-                                          "--out-dir", *dir_, "--color_neighbours", "4"});
+                                          "--out-dir", *dir_, "--color_neighbours", "65"});
   EXPECT_NE(remote.exit_code, 0);
-  EXPECT_TRUE(
-      absl::StrContains(remote.err, "--color_neighbours applies to a local reconstruct only"))
+  EXPECT_TRUE(absl::StrContains(remote.err, "--color_neighbours is 65; it must be in [1, 64]"))
+      << "checked before connecting: " << remote.Describe();
+}
+
+// glTF both ways: learned meshes and their LODs written as .glb (plain and with Draco) and
+// .gltf, read back by stats, eval and a remeshing; coloured points read from a .glb.
+TEST_F(LocalCliTest, GltfFilesAreWrittenAndRead) {
+  const std::string torus = *dir_ + "/torus.glb";
+  const RunResult run = RunNeuralmesh(
+      {"reconstruct", "builtin:torus", "-o", torus, "--vertices", "800", "--lod", "200"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(std::filesystem::exists(*dir_ + "/torus_lod200.glb"));
+  const RunResult stats = RunNeuralmesh({"stats", torus, "--json"});
+  ASSERT_EQ(stats.exit_code, 0) << stats.Describe();
+  EXPECT_EQ(JsonValue(stats.out, "vertices"), "800") << stats.out;
+  EXPECT_EQ(JsonValue(stats.out, "genus"), "1") << stats.out;
+  EXPECT_EQ(JsonValue(stats.out, "closed"), "true") << stats.out;
+  const RunResult eval = RunNeuralmesh({"eval", torus, "--reference", "builtin:torus", "--json"});
+  ASSERT_EQ(eval.exit_code, 0) << eval.Describe();
+  double chamfer = 1;
+  ASSERT_TRUE(absl::SimpleAtod(JsonValue(eval.out, "chamfer_l1"), &chamfer)) << eval.out;
+  EXPECT_LT(chamfer, 0.01);
+
+  const std::string compressed = *dir_ + "/torus_draco.glb";
+  const RunResult draco = RunNeuralmesh({"reconstruct", "builtin:torus", "-o", compressed,
+                                         "--vertices", "800", "--gltf_draco"});
+  ASSERT_EQ(draco.exit_code, 0) << draco.Describe();
+  EXPECT_LT(std::filesystem::file_size(compressed) * 3, std::filesystem::file_size(torus));
+  const absl::StatusOr<TriangleMesh> decoded = ReadMesh(compressed);
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_EQ(decoded->positions.size(), 800u);
+
+  const std::string remeshed = *dir_ + "/torus_remeshed.gltf";
+  const RunResult remesh = RunNeuralmesh(
+      {"reconstruct", torus, "-o", remeshed, "--vertices", "400", "--sampling", "area"});
+  ASSERT_EQ(remesh.exit_code, 0) << remesh.Describe();
+  const RunResult remeshed_stats = RunNeuralmesh({"stats", remeshed, "--json"});
+  EXPECT_EQ(JsonValue(remeshed_stats.out, "vertices"), "400") << remeshed_stats.Describe();
+
+  // Coloured points as a .glb of vertices without faces.
+  const PointCloud points = ColoredUnitSpherePoints(20000, 7);
+  TriangleMesh vertices;
+  vertices.positions = points.positions;
+  vertices.colors = points.colors;
+  const std::string cloud = *dir_ + "/points.glb";
+  ASSERT_TRUE(WriteMesh(vertices, cloud).ok());
+  const std::string colored = *dir_ + "/colored.gltf";
+  const RunResult from_points =
+      RunNeuralmesh({"reconstruct", cloud, "-o", colored, "--vertices", "800"});
+  ASSERT_EQ(from_points.exit_code, 0) << from_points.Describe();
+  EXPECT_TRUE(absl::StrContains(from_points.out, "with colours)")) << from_points.out;
+  const int worst = WorstColorError(colored);
+  EXPECT_GE(worst, 0) << "the .gltf has no colours";
+  EXPECT_LE(worst, 6);
+
+  const RunResult remote = RunNeuralmesh({"reconstruct", cloud, "--server", "127.0.0.1:1",
+                                          "--out-dir", *dir_, "--gltf_draco"});
+  EXPECT_NE(remote.exit_code, 0);
+  EXPECT_TRUE(absl::StrContains(remote.err, "--gltf_draco applies to a local reconstruct only"))
       << remote.Describe();
 }
 

@@ -334,7 +334,8 @@ TEST_F(RemoteCliTest, ColouredPointsComeBackAsColouredMeshes) {
     SCOPED_TRACE(colors ? "colours" : "--nocolors");
     const std::string out_dir = *dir_ + (colors ? "/colored" : "/uncolored");
     std::vector<std::string> args = {"reconstruct", cloud, "--server", server_->address(),
-                                     "--out-dir", out_dir, "--vertices", "600", "--ply"};
+                                     "--out-dir", out_dir, "--vertices", "600", "--ply",
+                                     "--color_neighbours", "4"};
     if (!colors) args.push_back("--nocolors");
     const RunResult run = RunNeuralmesh(args);
     ASSERT_EQ(run.exit_code, 0) << run.Describe();
@@ -350,6 +351,19 @@ TEST_F(RemoteCliTest, ColouredPointsComeBackAsColouredMeshes) {
       EXPECT_LE(worst, 8) << name;
     }
   }
+  // --color_neighbours went to the coloured session's configuration.
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
+      client::ReconstructionClient::Connect(server_->address());
+  ASSERT_TRUE(service.ok()) << service.status();
+  absl::StatusOr<std::vector<client::v1::Session>> sessions = (*service)->ListSessions();
+  ASSERT_TRUE(sessions.ok()) << sessions.status();
+  std::vector<uint32_t> neighbours;
+  for (const client::v1::Session& session : *sessions) {
+    if (session.name() == "colored_sphere") {
+      neighbours.push_back(session.config().color_neighbours().value());
+    }
+  }
+  EXPECT_THAT(neighbours, ::testing::UnorderedElementsAre(4u, 8u));
 }
 
 TEST_F(RemoteCliTest, SessionsListsTheFinishedSession) {
@@ -407,6 +421,12 @@ TEST_F(RemoteCliTest, SessionCommandsGetFinishCancelAndDelete) {
   ASSERT_TRUE(latest_mesh.ok()) << latest_mesh.status();
   EXPECT_GE(latest_mesh->positions.size(), 4u);
   EXPECT_THAT(latest.out, ::testing::HasSubstr(out + "/latest.ply"));
+  const RunResult as_gltf = RunNeuralmesh(
+      {"get", id, "--server", address, "-o", out + "/latest.glb", "--gltf_draco"});
+  ASSERT_EQ(as_gltf.exit_code, 0) << as_gltf.Describe();
+  absl::StatusOr<TriangleMesh> gltf_mesh = ReadMesh(out + "/latest.glb");
+  ASSERT_TRUE(gltf_mesh.ok()) << gltf_mesh.status();
+  EXPECT_GE(gltf_mesh->positions.size(), 4u);
   const RunResult no_final =
       RunNeuralmesh({"get", id, "--server", address, "--final", "-o", out + "/final.drc"});
   EXPECT_EQ(no_final.exit_code, 1) << no_final.Describe();
@@ -441,7 +461,7 @@ TEST_F(RemoteCliTest, SessionCommandsGetFinishCancelAndDelete) {
   const RunResult bad_format =
       RunNeuralmesh({"get", id, "--server", address, "-o", out + "/mesh.txt"});
   EXPECT_EQ(bad_format.exit_code, 1) << bad_format.Describe();
-  EXPECT_THAT(bad_format.err, ::testing::HasSubstr("use .drc, .ply, .obj, .off or .stl"));
+  EXPECT_THAT(bad_format.err, ::testing::HasSubstr("use one of .ply, .obj, .off, .stl, .drc, .glb, .gltf"));
   const RunResult bad_wait =
       RunNeuralmesh({"get", id, "--server", address, "-o", out + "/m.ply", "--wait", "-1s"});
   EXPECT_EQ(bad_wait.exit_code, 1) << bad_wait.Describe();

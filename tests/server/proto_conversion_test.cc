@@ -124,6 +124,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_FALSE(config->bounds.has_value());
   EXPECT_FALSE(config->outlier_removal.has_value()) << "unset: every point is accepted";
   EXPECT_FALSE(SessionConfigToProto(*config).has_outlier_removal());
+  EXPECT_EQ(config->colors.neighbours, PointColorOptions().neighbours);
 
   proto.mutable_learner()->mutable_alpha_l()->set_value(0);  // A valid zero, not "unset".
   proto.mutable_learner()->mutable_remove_triangles()->set_value(false);
@@ -135,6 +136,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   proto.mutable_refresh_interval_ms()->set_value(0);
   proto.mutable_draco()->mutable_position_quantization_bits()->set_value(14);
   proto.mutable_outlier_removal()->mutable_std_ratio()->set_value(2.5);
+  proto.mutable_color_neighbours()->set_value(3);
   config = SessionConfigFromProto(proto);
   ASSERT_TRUE(config.ok());
   EXPECT_EQ(config->learner.alpha_l, 0.0);
@@ -149,6 +151,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   ASSERT_TRUE(config->outlier_removal.has_value()) << "an empty message turns it on";
   EXPECT_EQ(config->outlier_removal->neighbours, OutlierOptions().neighbours);
   EXPECT_EQ(config->outlier_removal->std_ratio, 2.5);
+  EXPECT_EQ(config->colors.neighbours, 3);
 
   // The echo has every field set and reads back to the same configuration.
   v1::SessionConfig echo = SessionConfigToProto(*config);
@@ -166,6 +169,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   ASSERT_TRUE(again->outlier_removal.has_value());
   EXPECT_EQ(again->outlier_removal->neighbours, OutlierOptions().neighbours);
   EXPECT_EQ(again->outlier_removal->std_ratio, 2.5);
+  EXPECT_EQ(again->colors.neighbours, 3);
 }
 
 TEST(SessionConfigFromProtoTest, UnknownInitialMeshIsInvalidArgument) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -613,6 +614,7 @@ TEST_F(ReconstructionServiceTest, ColouredPointsGiveColouredMeshes) {
       ++milestones;
       const int worst = WorstColorError(update);
       EXPECT_GE(worst, 0) << "mesh " << update.sequence() << " has no colours";
+      EXPECT_TRUE(update.report().colored()) << "mesh " << update.sequence();
       // The final mesh is painted from all 20,000 points (8 nearest within about 0.04, 5
       // levels; 3-4 measured); a milestone from those that had come (3-5 measured from
       // 10,000, up to 16 levels from 2,000).
@@ -629,6 +631,53 @@ TEST_F(ReconstructionServiceTest, ColouredPointsGiveColouredMeshes) {
   v1::MeshUpdate final_mesh;
   ASSERT_TRUE(testing::WaitFinal(*service_, plain, &final_mesh).ok());
   EXPECT_EQ(WorstColorError(final_mesh), -1) << "colours without coloured points";
+  EXPECT_FALSE(final_mesh.report().colored());
+}
+
+// SessionConfig.color_neighbours: with 1 every vertex takes the colour of one point exactly;
+// with the default 8 colours blend, so that points coloured at random give vertices of colours
+// no point has. Values outside [1, 64] are refused.
+TEST_F(ReconstructionServiceTest, ColourNeighboursSetHowMeshesArePainted) {
+  PointCloud sphere = testing::SpherePoints(6000, 31);
+  Random random(5);
+  for (size_t i = 0; i < sphere.size(); ++i) {
+    sphere.colors.push_back({static_cast<uint8_t>(random.NextIndex(256)),
+                             static_cast<uint8_t>(random.NextIndex(256)),
+                             static_cast<uint8_t>(random.NextIndex(256))});
+  }
+  const std::set<Rgb> point_colors(sphere.colors.begin(), sphere.colors.end());
+  for (const uint32_t neighbours : {1u, 8u}) {
+    SCOPED_TRACE(neighbours);
+    v1::CreateSessionRequest create = CreateRequest(500);
+    create.mutable_config()->mutable_color_neighbours()->set_value(neighbours);
+    const std::string id = MustCreate(*service_, create);
+    v1::UploadPointsResponse response;
+    ASSERT_TRUE(testing::Upload(*service_, id, sphere, 3, &response).ok());
+    ASSERT_TRUE(testing::Finish(*service_, id).ok());
+    v1::MeshUpdate final_mesh;
+    ASSERT_TRUE(testing::WaitFinal(*service_, id, &final_mesh).ok());
+    EXPECT_TRUE(final_mesh.report().colored());
+    const absl::StatusOr<TriangleMesh> mesh = DecodeMesh(final_mesh.draco_mesh());
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    ASSERT_EQ(mesh->colors.size(), mesh->positions.size());
+    size_t found = 0;
+    for (const Rgb& color : mesh->colors) found += point_colors.count(color);
+    if (neighbours == 1) {
+      EXPECT_EQ(found, mesh->colors.size()) << "vertices of colours no point has";
+    } else {
+      EXPECT_LT(found, mesh->colors.size() / 10) << "vertices took single points' colours";
+    }
+  }
+  for (const uint32_t bad : {0u, 65u, 4000000000u}) {
+    v1::CreateSessionRequest create = CreateRequest(500);
+    create.mutable_config()->mutable_color_neighbours()->set_value(bad);
+    v1::Session session;
+    grpc::ClientContext context;
+    const grpc::Status status = service_->CreateSession(&context, create, &session);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << bad;
+    EXPECT_THAT(status.error_message(), HasSubstr("color_neighbours: colour neighbours = "))
+        << bad;
+  }
 }
 
 // A sphere scanned region by region (its points sorted along x, batches of 500): the points on

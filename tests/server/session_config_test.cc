@@ -71,6 +71,8 @@ TEST(ResolveSessionConfigTest, RejectsInvalidOptionsNamingTheField) {
        "refresh_interval_ms"},
       {"quantization bits", [](SessionConfig& c) { c.draco.position_quantization_bits = 0; },
        "position_quantization_bits"},
+      {"colour neighbours", [](SessionConfig& c) { c.colors.neighbours = 65; },
+       "color_neighbours: colour neighbours = 65"},
       {"bounds beyond what a float cube can hold",
        [](SessionConfig& c) {
          BoundingBox b;

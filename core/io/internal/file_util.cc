@@ -20,6 +20,7 @@ FileFormat FormatFromPath(absl::string_view path) {
   if (extension == ".off") return FileFormat::kOff;
   if (extension == ".stl") return FileFormat::kStl;
   if (extension == ".drc") return FileFormat::kDraco;
+  if (extension == ".glb" || extension == ".gltf") return FileFormat::kGltf;
   if (extension == ".xyz" || extension == ".txt" || extension == ".pts") return FileFormat::kXyz;
   return FileFormat::kUnknown;
 }

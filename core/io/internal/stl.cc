@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <unordered_map>
 #include <vector>
 
 #include "absl/strings/ascii.h"
@@ -12,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/internal/binary.h"
 #include "core/io/internal/text.h"
+#include "core/io/internal/vertex_merger.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::io_internal {
@@ -22,35 +22,6 @@ constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 constexpr size_t kHeaderBytes = 80;
 constexpr size_t kPreambleBytes = kHeaderBytes + 4;  // Header and triangle count.
 constexpr size_t kTriangleBytes = 50;  // Normal, three vertices, attribute byte count.
-
-// Gives each distinct position one index. Keys are bit patterns, with -0 folded onto +0.
-class VertexMerger {
- public:
-  explicit VertexMerger(ParsedGeometry* out) : out_(out) {}
-
-  uint32_t Add(const Vec3f& p) {
-    std::array<uint32_t, 3> key;
-    for (int c = 0; c < 3; ++c) {
-      const float value = p[c] == 0.0f ? 0.0f : p[c];
-      std::memcpy(&key[c], &value, sizeof(float));
-    }
-    const auto [it, inserted] = index_.emplace(key, static_cast<uint32_t>(out_->positions.size()));
-    if (inserted) out_->positions.push_back(p);
-    return it->second;
-  }
-
- private:
-  struct KeyHash {
-    size_t operator()(const std::array<uint32_t, 3>& k) const {
-      uint64_t h = k[0];
-      h = h * 0x9E3779B97F4A7C15ull ^ k[1];
-      h = h * 0x9E3779B97F4A7C15ull ^ k[2];
-      return static_cast<size_t>(h ^ (h >> 29));
-    }
-  };
-  ParsedGeometry* out_;
-  std::unordered_map<std::array<uint32_t, 3>, uint32_t, KeyHash> index_;
-};
 
 bool IsFinite(const Vec3f& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
@@ -69,7 +40,7 @@ bool IsText(absl::string_view data) {
 
 absl::StatusOr<ParsedGeometry> ParseBinary(absl::string_view data, uint32_t count) {
   ParsedGeometry out;
-  VertexMerger merger(&out);
+  VertexMerger merger(&out.positions);
   out.faces.reserve(count);
   for (uint32_t t = 0; t < count; ++t) {
     const size_t offset = kPreambleBytes + size_t{t} * kTriangleBytes;
@@ -101,7 +72,7 @@ absl::Status ExpectFacetEnd(int line, int vertices_in_facet) {
 // "endloop", "endfacet", ..., "endsolid". Several solids may follow each other.
 absl::StatusOr<ParsedGeometry> ParseAscii(absl::string_view data) {
   ParsedGeometry out;
-  VertexMerger merger(&out);
+  VertexMerger merger(&out.positions);
   LineCursor cursor(data);
   absl::string_view line;
   std::vector<absl::string_view> tokens;

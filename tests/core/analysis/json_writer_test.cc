@@ -5,13 +5,11 @@
 #include <string>
 
 #include "gtest/gtest.h"
-#include "tests/core/analysis/json_parse_for_test.h"
+#include "core/analysis/json_reader.h"
 
 namespace neuralmesh {
 namespace {
 
-using ::neuralmesh::testing::JsonTestParser;
-using ::neuralmesh::testing::JsonValue;
 
 TEST(JsonWriterTest, WritesCompactNestedDocument) {
   JsonWriter json;
@@ -43,8 +41,9 @@ TEST(JsonWriterTest, IndentedOutputParsesToSameValues) {
   ASSERT_TRUE(text.ok()) << text.status();
   EXPECT_EQ(*text, "{\n  \"a\": [\n    1,\n    2\n  ],\n  \"b\": \"x\"\n}")
       << "indented layout differs from the expected text";
-  const std::optional<JsonValue> parsed = JsonTestParser::Parse(*text);
-  ASSERT_TRUE(parsed.has_value()) << "indented output is not valid JSON: " << *text;
+  const absl::StatusOr<JsonValue> parsed = ParseJson(*text);
+  ASSERT_TRUE(parsed.ok())
+      << "indented output is not valid JSON (" << parsed.status() << "): " << *text;
   ASSERT_NE(parsed->Find("a"), nullptr) << "member \"a\" lost";
   EXPECT_EQ(parsed->Find("a")->items.size(), 2u) << "array \"a\" lost elements";
 }
@@ -58,8 +57,9 @@ TEST(JsonWriterTest, EscapesQuotesBackslashesAndControlCharacters) {
   json.BeginObject().Key(nasty).String(nasty).EndObject();
   const absl::StatusOr<std::string> text = json.Finish();
   ASSERT_TRUE(text.ok()) << text.status();
-  const std::optional<JsonValue> parsed = JsonTestParser::Parse(*text);
-  ASSERT_TRUE(parsed.has_value()) << "escaped output is not valid JSON: " << *text;
+  const absl::StatusOr<JsonValue> parsed = ParseJson(*text);
+  ASSERT_TRUE(parsed.ok())
+      << "escaped output is not valid JSON (" << parsed.status() << "): " << *text;
   ASSERT_EQ(parsed->members.size(), 1u) << "expected one member";
   EXPECT_EQ(parsed->members[0].first, nasty) << "key did not round-trip";
   EXPECT_EQ(parsed->members[0].second.text, nasty) << "string value did not round-trip";
@@ -94,8 +94,9 @@ TEST(JsonWriterTest, DoublesRoundTripAndNonFiniteBecomesNull) {
   json.EndArray();
   const absl::StatusOr<std::string> text = json.Finish();
   ASSERT_TRUE(text.ok()) << text.status();
-  const std::optional<JsonValue> parsed = JsonTestParser::Parse(*text);
-  ASSERT_TRUE(parsed.has_value()) << "double output is not valid JSON: " << *text;
+  const absl::StatusOr<JsonValue> parsed = ParseJson(*text);
+  ASSERT_TRUE(parsed.ok())
+      << "double output is not valid JSON (" << parsed.status() << "): " << *text;
   const size_t n = sizeof(values) / sizeof(values[0]);
   ASSERT_EQ(parsed->items.size(), n + 2) << "wrong number of array elements in " << *text;
   for (size_t i = 0; i < n; ++i) {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "gtest/gtest.h"
-#include "tests/core/analysis/json_parse_for_test.h"
+#include "core/analysis/json_reader.h"
 #include "tests/testing/shapes.h"
 
 namespace neuralmesh {
@@ -20,8 +20,6 @@ namespace {
 
 using ::neuralmesh::testing::GridPatch;
 using ::neuralmesh::testing::Icosphere;
-using ::neuralmesh::testing::JsonTestParser;
-using ::neuralmesh::testing::JsonValue;
 using ::neuralmesh::testing::MustToMesh;
 
 // Appends `b` to `a`, renumbering its vertices.
@@ -414,8 +412,8 @@ TEST(MeshReportTest, JsonIsValidAndMatchesReport) {
   const MeshReport r = ComputeMeshReport(OpenCylinder(10, 3));
   for (int indent : {0, 2}) {
     const std::string json = MeshReportToJson(r, indent);
-    const std::optional<JsonValue> parsed = JsonTestParser::Parse(json);
-    ASSERT_TRUE(parsed.has_value()) << "report JSON does not parse:\n" << json;
+    const absl::StatusOr<JsonValue> parsed = ParseJson(json);
+    ASSERT_TRUE(parsed.ok()) << "report JSON does not parse (" << parsed.status() << "):\n" << json;
     auto number = [&](const char* key) {
       const JsonValue* v = parsed->Find(key);
       EXPECT_NE(v, nullptr) << "JSON lacks key " << key;
@@ -450,6 +448,23 @@ TEST(MeshReportTest, MillionFaceTorusIsFast) {
   EXPECT_EQ(r.genus, 1) << "the big torus is still genus 1";
   EXPECT_LT(seconds, 10.0) << "the report of 1M faces took too long";
   RecordProperty("seconds_for_1M_faces", std::to_string(seconds));
+}
+
+TEST(MeshReportTest, SaysWhetherEveryVertexHasAColour) {
+  TriangleMesh mesh = Icosphere(1);
+  MeshReport report = ComputeMeshReport(mesh);
+  EXPECT_FALSE(report.colored);
+  EXPECT_NE(MeshReportToText(report).find("colours                        no"), std::string::npos)
+      << MeshReportToText(report);
+  mesh.colors.assign(mesh.positions.size(), Rgb{1, 2, 3});
+  report = ComputeMeshReport(mesh);
+  EXPECT_TRUE(report.colored);
+  const absl::StatusOr<JsonValue> json = ParseJson(MeshReportToJson(report));
+  ASSERT_TRUE(json.ok()) << json.status();
+  ASSERT_NE(json->Find("colored"), nullptr);
+  EXPECT_TRUE(json->Find("colored")->boolean);
+  mesh.colors.pop_back();  // Not one per vertex: not a coloured mesh.
+  EXPECT_FALSE(ComputeMeshReport(mesh).colored);
 }
 
 }  // namespace

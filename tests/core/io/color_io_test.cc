@@ -59,7 +59,7 @@ TEST(ColorIoTest, MeshColorsSurviveEveryFormatButStl) {
   }
   const std::string drc = TempPath("colored.drc");
   DracoOptions draco;
-  ASSERT_TRUE(WriteMesh(mesh, drc, draco).ok());
+  ASSERT_TRUE(WriteMesh(mesh, drc, {draco}).ok());
   const absl::StatusOr<TriangleMesh> decoded = ReadMesh(drc);
   ASSERT_TRUE(decoded.ok()) << decoded.status();
   ExpectSameColorsByPosition(mesh.positions, mesh.colors, decoded->positions, decoded->colors,

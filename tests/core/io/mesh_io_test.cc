@@ -567,7 +567,7 @@ TEST(MeshIoTest, WriteRejectsInvalidMeshesAndReportsIoFailures) {
       {"outside the Draco box", good, "box.drc", small_box, "outside the quantization box"},
   };
   for (const auto& c : cases) {
-    const absl::Status status = WriteMesh(c.mesh, TempPath(c.name), c.options);
+    const absl::Status status = WriteMesh(c.mesh, TempPath(c.name), {c.options});
     EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << c.what << ": " << status;
     EXPECT_THAT(std::string(status.message()), HasSubstr(c.message)) << c.what;
   }

@@ -1,6 +1,8 @@
 #include "client/web/viewer_service.h"
 
+#include <algorithm>
 #include <filesystem>
+#include <iterator>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -15,7 +17,9 @@
 #include "client/session_json.h"
 #include "core/analysis/json_writer.h"
 #include "client/web/viewer_key.h"
+#include "core/io/draco_codec.h"
 #include "core/io/file_contents.h"
+#include "core/io/mesh_io.h"
 
 namespace neuralmesh::client::web {
 
@@ -50,6 +54,8 @@ int HttpStatusOf(const absl::Status& status) {
       return 404;
     case absl::StatusCode::kInvalidArgument:
       return 400;
+    case absl::StatusCode::kFailedPrecondition:  // E.g. a session without a mesh yet.
+      return 409;
     case absl::StatusCode::kCancelled:
     case absl::StatusCode::kAborted:
       return 410;
@@ -84,6 +90,24 @@ bool IsPlainRelativePath(absl::string_view path) {
     }
   }
   return true;
+}
+
+// The formats a download may take, by the extension it is saved with, and their media types.
+constexpr std::pair<const char*, const char*> kDownloadFormats[] = {
+    {"glb", "model/gltf-binary"}, {"gltf", "model/gltf+json"},
+    {"ply", "application/octet-stream"}, {"obj", "text/plain; charset=utf-8"},
+    {"off", "text/plain; charset=utf-8"}, {"stl", "model/stl"},
+    {"drc", "application/x-draco"}};
+
+// `name` with everything but letters, digits, '.', '_' and '-' replaced by '_', for a file name.
+std::string FileNameOf(absl::string_view name) {
+  std::string out(name);
+  for (char& c : out) {
+    if (!absl::ascii_isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') {
+      c = '_';
+    }
+  }
+  return out;
 }
 
 HttpResponse MeshResponse(const v1::MeshUpdate& update) {
@@ -173,6 +197,9 @@ HttpResponse ViewerService::Handle(const HttpRequest& request) {
     if (parts.size() == 1 && !parts[0].empty()) return GetSession(std::string(parts[0]));
     if (parts.size() == 2 && !parts[0].empty() && parts[1] == "mesh") {
       return GetMesh(std::string(parts[0]), request);
+    }
+    if (parts.size() == 2 && !parts[0].empty() && parts[1] == "download") {
+      return Download(std::string(parts[0]), request);
     }
   }
   return ErrorResponse(404, absl::StrCat("no such page: ", request.path));
@@ -311,6 +338,43 @@ HttpResponse ViewerService::GetMesh(const std::string& session_id, const HttpReq
                           state.latest == nullptr ? 0 : state.latest->sequence()));
   }
   return ServerErrorResponse(state.end_status);
+}
+
+HttpResponse ViewerService::Download(const std::string& session_id, const HttpRequest& request) {
+  std::string format = "glb";
+  if (auto it = request.query.find("format"); it != request.query.end()) format = it->second;
+  const auto* known = std::find_if(std::begin(kDownloadFormats), std::end(kDownloadFormats),
+                                   [&format](const auto& f) { return format == f.first; });
+  if (known == std::end(kDownloadFormats)) {
+    return ErrorResponse(400, absl::StrCat("format=", format,
+                                           " is not one of glb, gltf, ply, obj, off, stl, drc"));
+  }
+  absl::StatusOr<v1::Session> session = client_->GetSession(session_id);
+  if (!session.ok()) return ServerErrorResponse(session.status());
+  absl::StatusOr<v1::MeshUpdate> update = client_->GetMesh(
+      session_id, v1::MESH_VERSION_LATEST, /*wait=*/false, client_->options().call_timeout);
+  if (!update.ok()) return ServerErrorResponse(update.status());
+  HttpResponse response;
+  response.content_type = known->second;
+  const std::string file = absl::StrCat(
+      FileNameOf(session->name().empty() ? session_id : session->name()), "-", update->sequence(),
+      ".", format);
+  response.headers.emplace_back("Content-Disposition",
+                                absl::StrCat("attachment; filename=\"", file, "\""));
+  if (format == "drc") {
+    response.body = update->draco_mesh();
+    return response;
+  }
+  absl::StatusOr<TriangleMesh> mesh = DecodeMesh(update->draco_mesh());
+  if (!mesh.ok()) {
+    return ErrorResponse(502, absl::StrCat("mesh ", update->sequence(), " of session ",
+                                           session_id, " does not decode: ",
+                                           mesh.status().message()));
+  }
+  absl::StatusOr<std::string> bytes = FormatMesh(*mesh, file);
+  if (!bytes.ok()) return ErrorResponse(500, bytes.status().message());
+  response.body = *std::move(bytes);
+  return response;
 }
 
 }  // namespace neuralmesh::client::web

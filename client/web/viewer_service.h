@@ -9,6 +9,11 @@
 //   GET /api/sessions/ID/mesh?after=N  the first published mesh with a sequence above N
 //                                      (default 0), as Draco bytes, waiting for it up to the
 //                                      poll timeout (a long poll)
+//   GET /api/sessions/ID/download?format=F
+//                                      the session's latest mesh as a file to save: F is glb
+//                                      (the default), gltf, ply, obj, off, stl or drc (the
+//                                      server's Draco bytes as they are; the others decoded,
+//                                      with their colours)
 //
 // The mesh answer is 200 with the Draco-encoded mesh as the body (application/x-draco, exactly
 // the bytes of MeshUpdate.draco_mesh) and its figures in X-Neuralmesh-* headers (Sequence,
@@ -19,6 +24,10 @@
 // the body says which); 404 for an unknown session; 400 for a malformed `after`; 502 when the
 // server cannot be reached. Errors have a JSON body
 // {"error": "..."}.
+//
+// A download is 200 with Content-Disposition: attachment; filename="NAME-SEQUENCE.F" (the
+// session's name, or its id when it has none); 400 for an unknown format; 404 for an unknown
+// session; 409 for one that has published no mesh yet; 502 as above.
 #ifndef NEURALMESH_CLIENT_WEB_VIEWER_SERVICE_H_
 #define NEURALMESH_CLIENT_WEB_VIEWER_SERVICE_H_
 
@@ -82,6 +91,7 @@ class ViewerService {
   http::HttpResponse ListSessions();
   http::HttpResponse GetSession(const std::string& session_id);
   http::HttpResponse GetMesh(const std::string& session_id, const http::HttpRequest& request);
+  http::HttpResponse Download(const std::string& session_id, const http::HttpRequest& request);
   // The relay of `session_id`, made when missing or when its watch lost the connection.
   std::shared_ptr<MeshRelay> RelayFor(const std::string& session_id);
 

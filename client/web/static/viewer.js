@@ -13,6 +13,9 @@ const sessionsError = document.getElementById('sessions-error');
 const canvas = document.getElementById('canvas');
 const wireframeBox = document.getElementById('wireframe');
 const flatBox = document.getElementById('flat');
+const download = document.getElementById('download');
+const downloadLink = document.getElementById('download-link');
+const downloadFormat = document.getElementById('download-format');
 
 const draco = new DRACOLoader();
 draco.setDecoderPath('/vendor/three/examples/jsm/libs/draco/');
@@ -162,6 +165,7 @@ async function errorText(response) {
 
 async function follow(sessionId) {
   following = sessionId;
+  updateDownload();
   const mine = ++generation;
   const current = () => generation === mine;
   framed = false;
@@ -228,6 +232,17 @@ async function follow(sessionId) {
     await sleep(2000);
   }
 }
+
+// The link that saves the followed session's latest mesh (/api/sessions/ID/download) in the
+// chosen format; #status's data-download carries it for the browser test.
+function updateDownload() {
+  download.hidden = following === null;
+  if (following === null) return;
+  downloadLink.href = `/api/sessions/${encodeURIComponent(following)}/download?format=` +
+                      downloadFormat.value;
+  statusElement.dataset.download = downloadLink.getAttribute('href');
+}
+downloadFormat.addEventListener('change', updateDownload);
 
 function choose(sessionId) {
   const url = new URL(window.location.href);

@@ -11,7 +11,8 @@ Chromium could not be driven, 2 on a timeout.
 
 At the end it takes a screenshot and prints "coverage F": the share of the canvas's pixels
 that show the mesh (the surface's blue or its edges; the background is grey), and with
---screenshot=PATH saves the PNG. With --stop_when_watching it prints "watching SESSION" once
+--screenshot=PATH saves the PNG; then it follows the page's save link and prints "download
+HREF STATUS BYTES MAGIC" (its first four bytes). With --stop_when_watching it prints "watching SESSION" once
 the page follows a session, and stops there.
 
 Usage: viewer_browser_driver.py --url=URL --ready_file=PATH [--timeout=60] [--screenshot=PATH]
@@ -218,6 +219,15 @@ def main():
                         ".getBoundingClientRect(); return [r.left, r.top, r.right, r.bottom]; })()"
                     ))["result"]["value"]
                     print("coverage %.4f" % mesh_coverage(png, rect), flush=True)
+                    # What the page's save link gives: its status, size and first bytes.
+                    saved = page.call("Runtime.evaluate", returnByValue=True, awaitPromise=True,
+                                      expression=(
+                        "(async () => { const a = document.getElementById('download-link');"
+                        " if (document.getElementById('download').hidden) return 'hidden';"
+                        " const r = await fetch(a.href); const b = new Uint8Array("
+                        "await r.arrayBuffer()); return r.status + ' ' + b.length + ' ' +"
+                        " String.fromCharCode(...b.slice(0, 4)); })()"))["result"]["value"]
+                    print("download %s %s" % (status.get("download"), saved), flush=True)
                     return 0
             time.sleep(0.05)
         print("timeout; last status: %s" % json.dumps(page.status()), flush=True)

@@ -90,6 +90,8 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
   std::vector<ShownMesh> shown;
   std::string end_line;
   double coverage = -1;
+  std::string download_href, download_status, download_magic;
+  size_t download_bytes = 0;
   std::istringstream lines(output);
   for (std::string line; std::getline(lines, line);) {
     std::istringstream words(line);
@@ -104,6 +106,8 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
       end_line = line;
     } else if (word == "coverage") {
       words >> coverage;
+    } else if (word == "download") {
+      words >> download_href >> download_status >> download_bytes >> download_magic;
     }
   }
   SCOPED_TRACE(output);
@@ -138,6 +142,10 @@ TEST(ViewerBrowserTest, ThePageShowsALiveSessionCoarseToFineAndDrawsTheFinalMesh
   // The driver looks every 50 ms, so it may miss a mesh the page showed between two looks.
   EXPECT_GE(meshes, shown.size());
   EXPECT_GT(coverage, 0.05) << "the coloured torus covers part of the canvas";
+  EXPECT_EQ(download_href, absl::StrCat("/api/sessions/", id, "/download?format=glb"));
+  EXPECT_EQ(download_status, "200") << "the page's save link gives the mesh";
+  EXPECT_EQ(download_magic, "glTF");
+  EXPECT_GT(download_bytes, 8000u * 12) << "the final mesh's positions at least";
 
   EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << "Ctrl-C stops the viewer cleanly";
 }

@@ -6,6 +6,7 @@
 #include <grpcpp/server_builder.h>
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <memory>
 #include <string>
 #include <thread>
@@ -17,10 +18,13 @@
 #include "client/web/run_view.h"
 #include "client/web/viewer_key.h"
 #include "core/io/draco_codec.h"
+#include "core/io/mesh_io.h"
 #include "core/sampling/implicit_surfaces.h"
 #include "http/http_server.h"
 #include "tests/client/web/viewer_test_support.h"
 #include "tests/server/server_test_support.h"
+#include "tests/testing/shapes.h"
+#include "tests/testing/temp_dir.h"
 
 namespace neuralmesh::client::web {
 
@@ -284,6 +288,56 @@ TEST_F(ViewerServiceTest, RejectsUnknownSessionsAndMalformedSequenceNumbers) {
     EXPECT_EQ(reply.status, 400) << after;
     EXPECT_THAT(reply.body, HasSubstr("is not a sequence number")) << after;
   }
+}
+
+// /api/sessions/ID/download: the latest mesh as a file in the format asked, named after the
+// session, with its colours; the Draco bytes as the server published them.
+TEST_F(ViewerServiceTest, DownloadsTheLatestMeshInTheFormatAsked) {
+  v1::CreateSessionRequest request = st::CreateRequest(500);
+  request.set_name("my scan/1");
+  const std::string id = st::MustCreate(*service_, request);
+  const std::string target = absl::StrCat("/api/sessions/", id, "/download");
+  HttpReply reply = HttpGet(port_, target);
+  EXPECT_EQ(reply.status, 409);
+  EXPECT_THAT(reply.body, HasSubstr("has published no mesh yet"));
+
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(
+      st::Upload(*service_, id, testing::ColoredUnitSpherePoints(4000, 8), 2, &response).ok());
+  ASSERT_TRUE(st::Finish(*service_, id).ok());
+  v1::MeshUpdate final_mesh;
+  ASSERT_TRUE(st::WaitFinal(*service_, id, &final_mesh).ok());
+
+  const std::string dir = testing::MakeTempDir("downloads");
+  for (const std::string format : {"glb", "gltf", "ply", "obj", "off", "stl", "drc"}) {
+    SCOPED_TRACE(format);
+    reply = HttpGet(port_, absl::StrCat(target, "?format=", format));
+    ASSERT_EQ(reply.status, 200) << reply.body;
+    const std::string name = absl::StrCat("my_scan_1-", final_mesh.sequence(), ".", format);
+    EXPECT_EQ(reply.Header("content-disposition"),
+              absl::StrCat("attachment; filename=\"", name, "\""));
+    if (format == "drc") EXPECT_EQ(reply.body, final_mesh.draco_mesh());
+    const std::string path = dir + "/" + name;
+    {
+      std::ofstream out(path, std::ios::binary);
+      out << reply.body;
+    }
+    const absl::StatusOr<TriangleMesh> mesh = ReadMesh(path);
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    EXPECT_EQ(mesh->positions.size(), 500u);
+    EXPECT_EQ(mesh->colors.empty(), format == "stl") << "colours in every format but STL";
+  }
+  reply = HttpGet(port_, target);
+  EXPECT_EQ(reply.status, 200);
+  EXPECT_EQ(reply.Header("content-type"), "model/gltf-binary") << "glb unless asked";
+  EXPECT_EQ(reply.body.substr(0, 4), "glTF");
+
+  reply = HttpGet(port_, target + "?format=xyz");
+  EXPECT_EQ(reply.status, 400);
+  EXPECT_THAT(reply.body, HasSubstr("format=xyz is not one of glb, gltf, ply, obj, off, stl, drc"));
+  reply = HttpGet(port_, "/api/sessions/s-missing/download");
+  EXPECT_EQ(reply.status, 404);
+  EXPECT_THAT(reply.body, HasSubstr("s-missing"));
 }
 
 TEST_F(ViewerServiceTest, StopWakesAWaitingPollAtOnce) {

@@ -173,6 +173,7 @@ ABSL_FLAG(uint64_t, batch_size, 10000, "Points per uploaded batch.");
 ABSL_FLAG(uint64_t, points, 100000,
           "Points sampled from a builtin:NAME input before it is uploaded.");
 ABSL_FLAG(bool, ply, false, "Also write each mesh received from the server as .ply.");
+ABSL_FLAG(bool, glb, false, "Also write each mesh received from the server as .glb (glTF).");
 ABSL_FLAG(std::string, resume, "",
           "reconstruct --server: the id of a session whose upload lost its connection; the "
           "upload goes on from the points the session has taken (run with the same INPUT and "
@@ -322,6 +323,14 @@ absl::StatusOr<neuralmesh::DracoOptions> DracoFromFlags() {
   return o;
 }
 
+// The formats meshes received are also written in: --ply, --glb.
+std::vector<std::string> AlsoWriteFromFlags() {
+  std::vector<std::string> also;
+  if (absl::GetFlag(FLAGS_ply)) also.push_back(".ply");
+  if (absl::GetFlag(FLAGS_glb)) also.push_back(".glb");
+  return also;
+}
+
 // How meshes are written: the Draco flags, and --gltf_draco.
 absl::StatusOr<neuralmesh::MeshWriteOptions> MeshWritingFromFlags() {
   neuralmesh::MeshWriteOptions o;
@@ -424,7 +433,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
     o.batch_size = absl::GetFlag(FLAGS_batch_size);
     o.builtin_points = absl::GetFlag(FLAGS_points);
-    o.ply = absl::GetFlag(FLAGS_ply);
+    o.also = AlsoWriteFromFlags();
     o.progress = progress;
     o.resume_session = absl::GetFlag(FLAGS_resume);
     o.start_mesh = absl::GetFlag(FLAGS_start_mesh);
@@ -434,7 +443,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
   }
   NM_RETURN_IF_ERROR(RejectFlags(
       args,
-      WithConnectionFlags({"out-dir", "batch-size", "points", "ply", "outliers_on_server",
+      WithConnectionFlags({"out-dir", "batch-size", "points", "ply", "glb", "outliers_on_server",
                            "resume", "reconnect_for"}),
       "needs --server (a local reconstruct writes -o OUTPUT)"));
   if (!args.Has("vertices")) return absl::InvalidArgumentError("--vertices N is required");
@@ -479,7 +488,7 @@ absl::Status Watch(const ParsedArgs& args) {
   o.session_id = args.positional[0];
   o.server = absl::GetFlag(FLAGS_server);
   o.out_dir = absl::GetFlag(FLAGS_out_dir);
-  o.ply = absl::GetFlag(FLAGS_ply);
+  o.also = AlsoWriteFromFlags();
   NM_ASSIGN_OR_RETURN(o.reconnect_for, ReconnectForFromFlags());
   NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
   return neuralmesh::client::RunWatch(o, std::cout, std::cerr);
@@ -575,13 +584,13 @@ std::vector<Subcommand> Commands() {
       "start_mesh", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
       "outliers_on_server", "colors", "color_neighbours", "sampling", "time_budget", "max_steps",
       "quantization_bits", "encode_speed", "gltf_draco", "progress", "server", "out-dir",
-      "batch-size", "points", "ply", "resume", "reconnect_for"};
+      "batch-size", "points", "ply", "glb", "resume", "reconnect_for"};
   // clang-format on
   return {
       {"reconstruct",
        "reconstruct INPUT -o OUTPUT --vertices N [flags]\n"
        "       neuralmesh reconstruct INPUT --server HOST:PORT --out-dir DIR [--vertices N] "
-       "[--batch-size K] [--ply] [--resume SESSION] [--reconnect_for D]",
+       "[--batch-size K] [--ply] [--glb] [--resume SESSION] [--reconnect_for D]",
        "Learns a mesh of a point cloud, a mesh or a built-in surface, locally or on a server.",
        "Learns a mesh of INPUT: a point cloud (.ply .xyz .obj .off .drc .glb .gltf), a triangle\n"
        "mesh with --sampling area|curvature, or builtin:sphere|torus|genus2. Locally it writes\n"
@@ -603,10 +612,10 @@ std::vector<Subcommand> Commands() {
        {"reference", "json", "samples", "seed"},
        Eval},
       {"watch",
-       "watch SESSION --server HOST:PORT --out-dir DIR [--ply] [--reconnect_for D]",
+       "watch SESSION --server HOST:PORT --out-dir DIR [--ply] [--glb] [--reconnect_for D]",
        "Watches a server session until it ends, saving every milestone and the final mesh.",
        "",
-       WithConnectionFlags({"server", "out-dir", "ply", "reconnect_for"}),
+       WithConnectionFlags({"server", "out-dir", "ply", "glb", "reconnect_for"}),
        Watch},
       {"sessions",
        "sessions --server HOST:PORT [--json] [--reconnect_for D]",

@@ -59,13 +59,15 @@ absl::Status MeshUpdateWriter::Write(const v1::MeshUpdate& update) {
     const std::filesystem::path base = std::filesystem::path(options_.out_dir) / name;
     figures.path = base.string() + ".drc";
     NM_RETURN_IF_ERROR(WriteFileContents(figures.path, update.draco_mesh()));
-    if (options_.ply) {
+    if (!options_.also.empty()) {
       absl::StatusOr<TriangleMesh> mesh = DecodeMesh(update.draco_mesh());
       if (!mesh.ok()) {
         return absl::InvalidArgumentError(
             absl::StrCat("update ", update.sequence(), ": ", mesh.status().message()));
       }
-      NM_RETURN_IF_ERROR(WriteMesh(*mesh, base.string() + ".ply"));
+      for (const std::string& extension : options_.also) {
+        NM_RETURN_IF_ERROR(WriteMesh(*mesh, base.string() + extension));
+      }
     }
     saved_.push_back(figures);
   }

@@ -17,7 +17,9 @@ namespace neuralmesh::client {
 struct MeshUpdateWriterOptions {
   std::string out_dir;  // Created when missing.
   std::string stem;     // File name stem: <stem>_lod<N>.drc per milestone, <stem>.drc final.
-  bool ply = false;     // Also decode each saved mesh and write it as .ply beside the .drc.
+  // Extensions (".ply", ".glb", any of kMeshExtensions) each saved mesh is also written in,
+  // decoded, beside the .drc.
+  std::vector<std::string> also;
 };
 
 // The figures of one update, as printed in the LOD table.
@@ -30,7 +32,7 @@ class MeshUpdateWriter {
 
   // Saves `update` when it is a milestone or the final mesh (refreshes are only printed),
   // then prints its row. Returns the error of creating the directory or writing a file, or
-  // INVALID_ARGUMENT when a mesh that must be written as .ply does not decode.
+  // INVALID_ARGUMENT when a mesh that must be written in another format does not decode.
   absl::Status Write(const v1::MeshUpdate& update);
 
   bool final_received() const { return final_received_; }

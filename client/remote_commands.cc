@@ -175,7 +175,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   absl::Mutex mu;
   ProgressBar upload_bar(err, options.progress, "upload  ", "points");
   ProgressBar learn_bar(err, options.progress, "learning", "vertices");
-  MeshUpdateWriter writer({options.out_dir, stem, options.ply}, out);
+  MeshUpdateWriter writer({options.out_dir, stem, options.also}, out);
   absl::Status write_status;
   absl::Status watch_status;
   ReconnectOptions reconnect;
@@ -282,7 +282,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
       "%d basic steps, %.2fs learning; files written to %s: %d\n",
       last.vertices, last.faces, last.genus, last.boundaries, last.valence6_percent,
       last.basic_steps, absl::ToDoubleSeconds(last.elapsed), options.out_dir,
-      writer.saved().size() * (options.ply ? 2 : 1));
+      writer.saved().size() * (1 + options.also.size()));
   return absl::OkStatus();
 }
 
@@ -291,7 +291,7 @@ absl::Status RunWatch(const WatchOptions& options, std::ostream& out, std::ostre
   if (options.out_dir.empty()) return absl::InvalidArgumentError("--out-dir DIR is required");
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ConnectTo(options.server, options.connection));
-  MeshUpdateWriter writer({options.out_dir, options.session_id, options.ply}, out);
+  MeshUpdateWriter writer({options.out_dir, options.session_id, options.also}, out);
   absl::Status write_status;
   ReconnectOptions reconnect;
   reconnect.give_up_after = options.reconnect_for;

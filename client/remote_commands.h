@@ -42,7 +42,7 @@ struct RemoteReconstructOptions {
   DracoOptions draco;              // Quantization bits and encode speed of the server's meshes.
   size_t batch_size = 10000;       // Points per uploaded batch.
   size_t builtin_points = 100000;  // Points sampled from a builtin:NAME input.
-  bool ply = false;                // Also write each LOD as .ply.
+  std::vector<std::string> also;   // Extensions each mesh saved is also written in (".ply").
   bool progress = false;           // Draw progress bars on `err`.
   ClientOptions connection;        // Connect timeout, TLS, access token.
   // How long the upload, the watch and the finish keep trying after a lost connection
@@ -72,7 +72,7 @@ struct WatchOptions {
   std::string session_id;
   std::string server;
   std::string out_dir;
-  bool ply = false;
+  std::vector<std::string> also;  // As above.
   ClientOptions connection;
   absl::Duration reconnect_for = ReconnectOptions().give_up_after;  // As above.
 };

@@ -34,7 +34,7 @@ v1::MeshUpdate MakeUpdate(v1::UpdateKind kind, uint64_t sequence, const Triangle
 TEST(MeshUpdateWriterTest, SavesMilestonesAndTheFinalMeshButOnlyPrintsRefreshes) {
   const std::string dir = testing::MakeTempDir("update_writer") + "/nested/out";
   std::ostringstream out;
-  MeshUpdateWriter writer({dir, "ball", /*ply=*/true}, out);
+  MeshUpdateWriter writer({dir, "ball", {".ply", ".glb"}}, out);
   const TriangleMesh coarse = testing::Icosphere(1);  // 42 vertices.
   const TriangleMesh fine = testing::Icosphere(2);    // 162 vertices.
 
@@ -51,6 +51,11 @@ TEST(MeshUpdateWriterTest, SavesMilestonesAndTheFinalMeshButOnlyPrintsRefreshes)
   absl::StatusOr<TriangleMesh> ply = ReadMesh(dir + "/ball.ply");
   ASSERT_TRUE(ply.ok()) << ply.status();
   EXPECT_EQ(ply->faces.size(), fine.faces.size());
+  EXPECT_TRUE(std::filesystem::exists(dir + "/ball_lod42.glb"));
+  absl::StatusOr<TriangleMesh> glb = ReadMesh(dir + "/ball.glb");
+  ASSERT_TRUE(glb.ok()) << glb.status();
+  EXPECT_EQ(glb->positions, ply->positions) << "both decoded from the same Draco bytes";
+  EXPECT_EQ(glb->faces, ply->faces);
 
   ASSERT_EQ(writer.saved().size(), 2u);
   EXPECT_EQ(writer.saved()[0].kind, "lod");
@@ -65,7 +70,7 @@ TEST(MeshUpdateWriterTest, SavesMilestonesAndTheFinalMeshButOnlyPrintsRefreshes)
 TEST(MeshUpdateWriterTest, ACorruptMeshFailsWhenItMustBecomePly) {
   const std::string dir = testing::MakeTempDir("update_writer_corrupt");
   std::ostringstream out;
-  MeshUpdateWriter writer({dir, "bad", /*ply=*/true}, out);
+  MeshUpdateWriter writer({dir, "bad", {".ply"}}, out);
   v1::MeshUpdate update = MakeUpdate(v1::UPDATE_KIND_FINAL, 1, testing::Icosphere(1));
   update.set_draco_mesh("not draco");
   EXPECT_TRUE(absl::IsInvalidArgument(writer.Write(update)));

@@ -335,11 +335,12 @@ TEST_F(RemoteCliTest, ColouredPointsComeBackAsColouredMeshes) {
     const std::string out_dir = *dir_ + (colors ? "/colored" : "/uncolored");
     std::vector<std::string> args = {"reconstruct", cloud, "--server", server_->address(),
                                      "--out-dir", out_dir, "--vertices", "600", "--ply",
-                                     "--color_neighbours", "4"};
+                                     "--glb", "--color_neighbours", "4"};
     if (!colors) args.push_back("--nocolors");
     const RunResult run = RunNeuralmesh(args);
     ASSERT_EQ(run.exit_code, 0) << run.Describe();
-    for (const char* name : {"/colored_sphere.drc", "/colored_sphere.ply"}) {
+    for (const char* name :
+         {"/colored_sphere.drc", "/colored_sphere.ply", "/colored_sphere.glb"}) {
       const absl::StatusOr<TriangleMesh> mesh = ReadMesh(out_dir + name);
       ASSERT_TRUE(mesh.ok()) << mesh.status();
       if (!colors) {

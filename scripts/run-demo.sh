@@ -2,7 +2,7 @@
 # The main job: builds everything (CLI, server, tests, benchmarks), starts neuralmesh-server on
 # a free port of 127.0.0.1, reconstructs the built-in torus through it (100000 points sampled
 # from the implicit surface, streamed in batches; 5000 vertices), writes every level of detail
-# to out/demo as .drc and .ply, prints the LOD table and stops the server.
+# to out/demo as .drc, .ply and .glb, prints the LOD table and stops the server.
 #
 # Usage: scripts/run-demo.sh            (from anywhere; paths are relative to the repository)
 # Environment: BUILD_DIR (default build), JOBS (parallel build jobs, default: all cores),
@@ -76,7 +76,7 @@ say "neuralmesh-server is up on ${ADDRESS}"
 rm -rf "${OUT_DIR}"
 say "Reconstructing builtin:torus to ${VERTICES} vertices through ${ADDRESS}"
 "${CLI}" reconstruct builtin:torus --server "${ADDRESS}" --out-dir "${OUT_DIR}" \
-  --vertices "${VERTICES}" --ply | tee "${LOG_DIR}/reconstruct.out"
+  --vertices "${VERTICES}" --ply --glb | tee "${LOG_DIR}/reconstruct.out"
 
 # The LOD table: the milestones and the final mesh (without the periodic refreshes).
 echo

@@ -66,6 +66,17 @@ struct EvalOptions {
 // Prints the geometric error of MESH against REFERENCE (core/analysis/geometric_error.h).
 absl::Status RunEval(const EvalOptions& options, std::ostream& out);
 
+struct ConvertOptions {
+  std::string mesh;          // A mesh file, or builtin:NAME for its dense tessellation.
+  std::string output;        // Its extension picks the format (kMeshExtensions).
+  MeshWriteOptions writing;  // Draco settings, glTF compression.
+};
+
+// Writes MESH to OUTPUT, colours included where the format holds them, and prints "OUTPUT: V
+// vertices, F faces" (", with colours"). INVALID_ARGUMENT for an unknown output extension
+// (before reading MESH), and the reader's and writer's errors.
+absl::Status RunConvert(const ConvertOptions& options, std::ostream& out);
+
 }  // namespace neuralmesh::client
 
 #endif  // NEURALMESH_CLIENT_LOCAL_COMMANDS_H_

@@ -42,7 +42,7 @@ const neuralmesh::DracoOptions kDracoDefaults;
 ABSL_FLAG(std::string, output, "",
           "Local reconstruct: the mesh to write; the extension picks the format (.ply .obj .off "
           ".stl .drc .glb .gltf). LOD files go beside it as <stem>_lod<N><ext>. get: where the "
-          "session's mesh goes.");
+          "session's mesh goes. convert: the file written.");
 ABSL_FLAG(uint64_t, vertices, 0,
           "Vertex count of the final mesh (met exactly). Required for a local reconstruct; with "
           "--server, 0 means one vertex per 2 points, at most 10000.");
@@ -470,6 +470,15 @@ absl::Status Stats(const ParsedArgs& args) {
   return neuralmesh::client::RunStats(args.positional[0], absl::GetFlag(FLAGS_json), std::cout);
 }
 
+absl::Status Convert(const ParsedArgs& args) {
+  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "MESH"));
+  neuralmesh::client::ConvertOptions o;
+  o.mesh = args.positional[0];
+  o.output = absl::GetFlag(FLAGS_output);
+  NM_ASSIGN_OR_RETURN(o.writing, MeshWritingFromFlags());
+  return neuralmesh::client::RunConvert(o, std::cout);
+}
+
 absl::Status Eval(const ParsedArgs& args) {
   NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "MESH"));
   if (!args.Has("reference")) return absl::InvalidArgumentError("--reference REF is required");
@@ -604,6 +613,14 @@ std::vector<Subcommand> Commands() {
        "boundaries, manifoldness.",
        {"json"},
        Stats},
+      {"convert",
+       "convert MESH -o OUTPUT [--gltf_draco] [--quantization_bits B] [--encode_speed S]",
+       "Writes a mesh in another format.",
+       "Writes MESH (a mesh file or builtin:NAME, its dense reference tessellation) to OUTPUT,\n"
+       "in the format of its extension (.ply .obj .off .stl .drc .glb .gltf), colours included\n"
+       "where the format holds them.",
+       {"output", "gltf_draco", "quantization_bits", "encode_speed"},
+       Convert},
       {"eval",
        "eval MESH --reference REF [--json] [--samples N]",
        "Prints the geometric error of a mesh against a reference surface.",

@@ -1,4 +1,4 @@
-// RunStats and RunEval (declared in client/local_commands.h).
+// RunStats, RunEval and RunConvert (declared in client/local_commands.h).
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/inputs.h"
@@ -6,6 +6,7 @@
 #include "core/analysis/geometric_error.h"
 #include "core/analysis/json_writer.h"
 #include "core/analysis/mesh_report.h"
+#include "core/io/mesh_io.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::client {
@@ -62,6 +63,19 @@ absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
       "  completeness        %.6g  (reference -> reconstruction)\n",
       options.mesh, options.reference, error_options.samples, error.diagonal, error.chamfer_l1,
       error.hausdorff, error.normal_consistency, error.accuracy, error.completeness);
+  return absl::OkStatus();
+}
+
+absl::Status RunConvert(const ConvertOptions& options, std::ostream& out) {
+  if (options.output.empty()) return absl::InvalidArgumentError("-o OUTPUT is required");
+  if (!IsSupportedMeshExtension(options.output)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "OUTPUT '", options.output, "': unsupported mesh format; use one of ", kMeshExtensions));
+  }
+  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(options.mesh, "MESH"));
+  NM_RETURN_IF_ERROR(WriteMesh(mesh, options.output, options.writing));
+  out << options.output << ": " << mesh.positions.size() << " vertices, " << mesh.faces.size()
+      << " faces" << (mesh.colors.empty() ? "" : ", with colours") << "\n";
   return absl::OkStatus();
 }
 

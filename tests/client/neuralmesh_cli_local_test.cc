@@ -324,6 +324,26 @@ TEST_F(LocalCliTest, GltfFilesAreWrittenAndRead) {
   ASSERT_TRUE(decoded.ok()) << decoded.status();
   EXPECT_EQ(decoded->positions.size(), 800u);
 
+  // convert: the .glb to PLY and back to a Draco-compressed .gltf, same vertices and faces.
+  const std::string converted = *dir_ + "/torus_converted.ply";
+  const RunResult convert = RunNeuralmesh({"convert", torus, "-o", converted});
+  ASSERT_EQ(convert.exit_code, 0) << convert.Describe();
+  EXPECT_EQ(convert.out, converted + ": 800 vertices, 1600 faces\n");
+  const RunResult back = RunNeuralmesh(
+      {"convert", converted, "-o", *dir_ + "/torus_back.gltf", "--gltf_draco"});
+  ASSERT_EQ(back.exit_code, 0) << back.Describe();
+  const absl::StatusOr<TriangleMesh> from_ply = ReadMesh(converted);
+  const absl::StatusOr<TriangleMesh> from_glb = ReadMesh(torus);
+  ASSERT_TRUE(from_ply.ok() && from_glb.ok());
+  EXPECT_EQ(from_ply->positions, from_glb->positions);
+  EXPECT_EQ(from_ply->faces, from_glb->faces);
+  const RunResult bad = RunNeuralmesh({"convert", torus, "-o", *dir_ + "/torus.xyz"});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_TRUE(absl::StrContains(bad.err, "unsupported mesh format; use one of")) << bad.err;
+  const RunResult missing = RunNeuralmesh({"convert", *dir_ + "/none.glb", "-o", converted});
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_TRUE(absl::StrContains(missing.err, "none.glb")) << missing.err;
+
   const std::string remeshed = *dir_ + "/torus_remeshed.gltf";
   const RunResult remesh = RunNeuralmesh(
       {"reconstruct", torus, "-o", remeshed, "--vertices", "400", "--sampling", "area"});

@@ -502,14 +502,16 @@ class GltfReader {
       const Vec3f& p = positions[i];
       Vec3f q;
       for (int row = 0; row < 3; ++row) {
-        q[row] = static_cast<float>(world[row] * p[0] + world[4 + row] * p[1] +
-                                    world[8 + row] * p[2] + world[12 + row]);
+        const double placed = world[row] * p[0] + world[4 + row] * p[1] +
+                              world[8 + row] * p[2] + world[12 + row];
+        // Beyond a float's range (or NaN) the conversion would be undefined.
+        if (!(std::abs(placed) <= std::numeric_limits<float>::max())) {
+          return Invalid(where, ": vertex ", i, " is not finite where its node places it");
+        }
+        q[row] = static_cast<float>(placed);
         // A sum with +0 terms gives +0 where a coordinate was -0, and a tiny negative sum
         // rounds to -0: zeros are +0, so that a file reads the same however it places them.
         if (q[row] == 0.0f) q[row] = 0.0f;
-      }
-      if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2])) {
-        return Invalid(where, ": vertex ", i, " is not finite where its node places it");
       }
       merged[i] = merger_.Add(q);
       if (merged[i] == colors_.size()) colors_.push_back(colors.empty() ? Rgb{} : colors[i]);

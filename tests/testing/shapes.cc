@@ -68,6 +68,12 @@ Rgb ColorOfPosition(const Vec3f& p) {
   return color;
 }
 
+TriangleMesh ColoredIcosphere(int levels) {
+  TriangleMesh mesh = Icosphere(levels);
+  for (const Vec3f& p : mesh.positions) mesh.colors.push_back(ColorOfPosition(p));
+  return mesh;
+}
+
 PointCloud ColoredUnitSpherePoints(size_t n, uint64_t seed) {
   PointCloud cloud = SamplePoints(*MakeSphere(Vec3(0, 0, 0), 1.0).value(), n, seed);
   for (const Vec3f& p : cloud.positions) cloud.colors.push_back(ColorOfPosition(p));

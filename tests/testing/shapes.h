@@ -23,6 +23,9 @@ PointCloud UnitSpherePointsAndAStray(size_t n, uint64_t seed, const Vec3f& stray
 // 255 * (coordinate + 1) / 2, rounded and clamped, so a unit sphere spans every level.
 Rgb ColorOfPosition(const Vec3f& p);
 
+// Icosphere(levels) with each vertex coloured ColorOfPosition.
+TriangleMesh ColoredIcosphere(int levels);
+
 // `n` points drawn uniformly from the unit sphere with `seed`, each coloured ColorOfPosition.
 PointCloud ColoredUnitSpherePoints(size_t n, uint64_t seed);
 

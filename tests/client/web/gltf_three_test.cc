@@ -106,8 +106,7 @@ TEST(GltfThreeJsTest, ThreeJsReadsAndDrawsTheGltfFilesWeWrite) {
       0) {
     FAIL() << "chromium and Debian's python3-websocket are required (scripts/install-deps.sh)";
   }
-  TriangleMesh colored = testing::Icosphere(3);
-  for (const Vec3f& p : colored.positions) colored.colors.push_back(testing::ColorOfPosition(p));
+  const TriangleMesh colored = testing::ColoredIcosphere(3);
   const TriangleMesh large = testing::Icosphere(7);  // 163,842 vertices: 32-bit indices.
   TriangleMesh points = testing::Icosphere(1);
   points.faces.clear();

@@ -316,7 +316,9 @@ TEST_F(ViewerServiceTest, DownloadsTheLatestMeshInTheFormatAsked) {
     const std::string name = absl::StrCat("my_scan_1-", final_mesh.sequence(), ".", format);
     EXPECT_EQ(reply.Header("content-disposition"),
               absl::StrCat("attachment; filename=\"", name, "\""));
-    if (format == "drc") EXPECT_EQ(reply.body, final_mesh.draco_mesh());
+    if (format == "drc") {
+      EXPECT_EQ(reply.body, final_mesh.draco_mesh());
+    }
     const std::string path = dir + "/" + name;
     {
       std::ofstream out(path, std::ios::binary);

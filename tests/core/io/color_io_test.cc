@@ -21,12 +21,6 @@ using io_test::WriteBytes;
 using testing::ColorOfPosition;
 using ::testing::HasSubstr;
 
-TriangleMesh ColoredIcosphere() {
-  TriangleMesh mesh = testing::Icosphere(2);
-  for (const Vec3f& p : mesh.positions) mesh.colors.push_back(ColorOfPosition(p));
-  return mesh;
-}
-
 // Colours of `actual` against those of `expected`, matched by position within `tolerance`
 // (Draco may reorder).
 void ExpectSameColorsByPosition(const std::vector<Vec3f>& expected_positions,
@@ -47,7 +41,7 @@ void ExpectSameColorsByPosition(const std::vector<Vec3f>& expected_positions,
 }
 
 TEST(ColorIoTest, MeshColorsSurviveEveryFormatButStl) {
-  const TriangleMesh mesh = ColoredIcosphere();
+  const TriangleMesh mesh = testing::ColoredIcosphere(2);
   for (const char* name : {"colored.ply", "colored.obj", "colored.off"}) {
     SCOPED_TRACE(name);
     const std::string path = TempPath(name);
@@ -172,7 +166,7 @@ TEST(ColorIoTest, MalformedColoursAreRejectedWithTheirLine) {
 }
 
 TEST(ColorIoTest, ColoursThatAreNotOnePerPointAreRefused) {
-  TriangleMesh mesh = ColoredIcosphere();
+  TriangleMesh mesh = testing::ColoredIcosphere(2);
   mesh.colors.pop_back();
   for (const char* name : {"short.ply", "short.drc"}) {
     const absl::Status written = WriteMesh(mesh, TempPath(name));

@@ -31,12 +31,6 @@ using io_test::TempPath;
 using io_test::WriteBytes;
 using ::testing::HasSubstr;
 
-TriangleMesh ColoredIcosphere() {
-  TriangleMesh mesh = testing::Icosphere(2);
-  for (const Vec3f& p : mesh.positions) mesh.colors.push_back(testing::ColorOfPosition(p));
-  return mesh;
-}
-
 // A .glb container of `json` and, when not empty, the BIN chunk `bin`.
 std::string Glb(std::string json, std::string bin) {
   while (json.size() % 4 != 0) json.push_back(' ');
@@ -82,7 +76,7 @@ TEST(GltfIoTest, LinearColoursKeepEverySrgbLevel) {
 }
 
 TEST(GltfIoTest, MeshesRoundTripInEveryVariant) {
-  const TriangleMesh mesh = ColoredIcosphere();
+  const TriangleMesh mesh = testing::ColoredIcosphere(2);
   for (const char* name : {"plain.glb", "plain.gltf"}) {
     SCOPED_TRACE(name);
     const std::string path = TempPath(name);

@@ -675,7 +675,8 @@ absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOpti
 absl::StatusOr<std::string> EncodeMeshForGltf(const TriangleMesh& mesh,
                                               const DracoOptions& options) {
   // A new draco::Mesh gives its attributes the unique ids 0, 1, ... in the order they are
-  // added: positions first, then colours (DracoCodecTest checks it).
+  // added: positions first, then colours (GltfIoTest and three.js, in GltfThreeJsTest, read
+  // them by these ids).
   static_assert(kGltfDracoPositionId == 0 && kGltfDracoColorId == 1);
   return EncodeMeshStoring(mesh, options, ColorStorage::kLinearShorts);
 }

@@ -736,7 +736,9 @@ absl::StatusOr<std::string> FormatGltf(const GeometryView& geometry,
         "the mesh has no faces, and glTF's Draco compression stores only triangles");
   }
   // What the accessors describe: the geometry as given, or as a Draco decoder will give it.
-  TriangleMesh described;
+  absl::Span<const Vec3f> positions = geometry.positions;
+  absl::Span<const std::array<uint32_t, 3>> faces = geometry.faces;
+  TriangleMesh decoded;
   std::string bin;
   std::vector<Range> views;
   if (options.draco) {
@@ -745,34 +747,33 @@ absl::StatusOr<std::string> FormatGltf(const GeometryView& geometry,
     mesh.faces.assign(geometry.faces.begin(), geometry.faces.end());
     mesh.colors.assign(geometry.colors.begin(), geometry.colors.end());
     NM_ASSIGN_OR_RETURN(bin, EncodeMeshForGltf(mesh, options.draco_options));
-    NM_ASSIGN_OR_RETURN(described, DecodeGltfDracoMesh(bin, kGltfDracoPositionId,
-                                                       colored ? kGltfDracoColorId : -1));
+    NM_ASSIGN_OR_RETURN(decoded, DecodeGltfDracoMesh(bin, kGltfDracoPositionId,
+                                                     colored ? kGltfDracoColorId : -1));
+    positions = decoded.positions;
+    faces = decoded.faces;
     views.push_back({0, bin.size()});
     while (bin.size() % 4 != 0) bin.push_back('\0');
   } else {
-    described.positions.assign(geometry.positions.begin(), geometry.positions.end());
-    described.faces.assign(geometry.faces.begin(), geometry.faces.end());
-    described.colors.assign(geometry.colors.begin(), geometry.colors.end());
-    for (const Vec3f& p : described.positions) {
+    for (const Vec3f& p : positions) {
       for (float c : p) AppendLittleEndian(c, &bin);
     }
     views.push_back({0, bin.size()});
     if (colored) {
       // Three channels and two bytes of padding: vertex attributes are aligned to 4 bytes.
       const size_t start = bin.size();
-      for (const Rgb& color : described.colors) {
+      for (const Rgb& color : geometry.colors) {
         for (uint8_t c : color) AppendLittleEndian(LinearShortFromSrgb(c), &bin);
         AppendLittleEndian(uint16_t{0}, &bin);
       }
       views.push_back({start, bin.size() - start});
     }
   }
-  const size_t vertices = described.positions.size();
+  const size_t vertices = positions.size();
   // The largest index of a type is reserved (primitive restart), so 16 bits take 65535 vertices.
   const bool short_indices = vertices <= 65535;
   if (has_faces && !options.draco) {
     const size_t start = bin.size();
-    for (const std::array<uint32_t, 3>& face : described.faces) {
+    for (const std::array<uint32_t, 3>& face : faces) {
       for (uint32_t v : face) {
         if (short_indices) {
           AppendLittleEndian(static_cast<uint16_t>(v), &bin);
@@ -788,7 +789,7 @@ absl::StatusOr<std::string> FormatGltf(const GeometryView& geometry,
   std::array<float, 3> low, high;
   low.fill(std::numeric_limits<float>::infinity());
   high.fill(-std::numeric_limits<float>::infinity());
-  for (const Vec3f& p : described.positions) {
+  for (const Vec3f& p : positions) {
     for (int c = 0; c < 3; ++c) {
       low[c] = std::min(low[c], p[c]);
       high[c] = std::max(high[c], p[c]);
@@ -855,7 +856,7 @@ absl::StatusOr<std::string> FormatGltf(const GeometryView& geometry,
     json.BeginObject();
     view_of(json);
     json.Key("componentType").Uint(short_indices ? kUnsignedShort : kUnsignedInt);
-    json.Key("count").Uint(described.faces.size() * 3).Key("type").String("SCALAR").EndObject();
+    json.Key("count").Uint(faces.size() * 3).Key("type").String("SCALAR").EndObject();
   }
   json.EndArray();
 

@@ -68,6 +68,14 @@ absl::StatusOr<size_t> RemoveOutliers(PointCloud& cloud, const OutlierOptions& o
   return removed;
 }
 
+// Paints with `source` (built from INPUT `input`); ", with colours" for the description.
+absl::StatusOr<std::string> UseColors(absl::StatusOr<std::unique_ptr<ColorSource>> source,
+                                      const std::string& input, TargetSpace& target) {
+  if (!source.ok()) return InFile(source.status(), "INPUT", input);
+  target.colors = *std::move(source);
+  return std::string(", with colours");
+}
+
 absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMode mode,
                                             const std::optional<OutlierOptions>& outliers,
                                             const std::optional<PointColorOptions>& colors) {
@@ -99,10 +107,7 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
     const size_t faces = mesh->faces.size();
     std::string with_colors;
     if (colors.has_value() && !mesh->colors.empty()) {
-      absl::StatusOr<std::unique_ptr<ColorSource>> source = MakeMeshColorSource(*mesh);
-      if (!source.ok()) return InFile(source.status(), "INPUT", input);
-      target.colors = *std::move(source);
-      with_colors = ", with colours";
+      NM_ASSIGN_OR_RETURN(with_colors, UseColors(MakeMeshColorSource(*mesh), input, target));
     }
     MeshSamplerOptions options;
     options.mode =
@@ -130,10 +135,8 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
   }
   std::string with_colors;
   if (colors.has_value() && !cloud.colors.empty()) {
-    absl::StatusOr<std::unique_ptr<ColorSource>> source = MakePointColorSource(cloud, *colors);
-    if (!source.ok()) return InFile(source.status(), "INPUT", input);
-    target.colors = *std::move(source);
-    with_colors = ", with colours";
+    NM_ASSIGN_OR_RETURN(with_colors,
+                        UseColors(MakePointColorSource(cloud, *colors), input, target));
   }
   auto shared = std::make_shared<const PointCloud>(std::move(cloud));
   absl::StatusOr<std::unique_ptr<Sampler>> sampler = mode == SamplingMode::kWeighted

@@ -11,6 +11,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "absl/time/clock.h"
@@ -77,17 +78,18 @@ std::string ContentTypeOf(absl::string_view file) {
   return "application/octet-stream";
 }
 
-// Whether `path` is a relative path of plain names: letters, digits, '.', '_', '-', no name
-// starting with a dot (so no "..", no hidden files), no empty names.
+// Letters, digits, '.', '_' and '-': the characters of the file names served and saved.
+bool IsFileNameCharacter(char c) {
+  return absl::ascii_isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
+}
+
+// Whether `path` is a relative path of plain names: IsFileNameCharacter's, no name starting
+// with a dot (so no "..", no hidden files), no empty names.
 bool IsPlainRelativePath(absl::string_view path) {
   if (path.empty()) return false;
   for (absl::string_view name : absl::StrSplit(path, '/')) {
     if (name.empty() || name[0] == '.') return false;
-    for (char c : name) {
-      if (!absl::ascii_isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') {
-        return false;
-      }
-    }
+    if (!std::all_of(name.begin(), name.end(), IsFileNameCharacter)) return false;
   }
   return true;
 }
@@ -99,13 +101,11 @@ constexpr std::pair<const char*, const char*> kDownloadFormats[] = {
     {"off", "text/plain; charset=utf-8"}, {"stl", "model/stl"},
     {"drc", "application/x-draco"}};
 
-// `name` with everything but letters, digits, '.', '_' and '-' replaced by '_', for a file name.
+// `name` with every character but IsFileNameCharacter's replaced by '_', for a file name.
 std::string FileNameOf(absl::string_view name) {
   std::string out(name);
   for (char& c : out) {
-    if (!absl::ascii_isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') {
-      c = '_';
-    }
+    if (!IsFileNameCharacter(c)) c = '_';
   }
   return out;
 }
@@ -346,8 +346,9 @@ HttpResponse ViewerService::Download(const std::string& session_id, const HttpRe
   const auto* known = std::find_if(std::begin(kDownloadFormats), std::end(kDownloadFormats),
                                    [&format](const auto& f) { return format == f.first; });
   if (known == std::end(kDownloadFormats)) {
-    return ErrorResponse(400, absl::StrCat("format=", format,
-                                           " is not one of glb, gltf, ply, obj, off, stl, drc"));
+    const auto extension = [](std::string* out, const auto& f) { out->append(f.first); };
+    return ErrorResponse(400, absl::StrCat("format=", format, " is not one of ",
+                                           absl::StrJoin(kDownloadFormats, ", ", extension)));
   }
   absl::StatusOr<v1::Session> session = client_->GetSession(session_id);
   if (!session.ok()) return ServerErrorResponse(session.status());

@@ -609,10 +609,12 @@ absl::Status DracoOptions::Validate() const {
   return absl::OkStatus();
 }
 
+namespace {
+
 // EncodeMesh, with colours stored as `storage` says.
-static absl::StatusOr<std::string> EncodeMeshStoring(const TriangleMesh& mesh,
-                                                     const DracoOptions& options,
-                                                     ColorStorage storage) {
+absl::StatusOr<std::string> EncodeMeshStoring(const TriangleMesh& mesh,
+                                              const DracoOptions& options,
+                                              ColorStorage storage) {
   NM_RETURN_IF_ERROR(options.Validate());
   if (mesh.positions.empty()) {
     return absl::InvalidArgumentError("cannot encode an empty mesh (no vertices)");
@@ -667,6 +669,8 @@ static absl::StatusOr<std::string> EncodeMeshStoring(const TriangleMesh& mesh,
   }
   return best;
 }
+
+}  // namespace
 
 absl::StatusOr<std::string> EncodeMesh(const TriangleMesh& mesh, const DracoOptions& options) {
   return EncodeMeshStoring(mesh, options, ColorStorage::kSrgbBytes);

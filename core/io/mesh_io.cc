@@ -18,6 +18,7 @@
 namespace neuralmesh {
 namespace {
 
+using io_internal::CannotWrite;
 using io_internal::FileFormat;
 
 absl::StatusOr<FileFormat> MeshFormat(const std::string& path) {
@@ -65,11 +66,6 @@ absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data
   mesh.faces = std::move(parsed->faces);
   mesh.colors = std::move(parsed->colors);
   return mesh;
-}
-
-// `status` with "cannot write 'path': " in front of its message.
-absl::Status CannotWrite(const std::string& path, const absl::Status& status) {
-  return absl::Status(status.code(), absl::StrCat("cannot write '", path, "': ", status.message()));
 }
 
 absl::Status CheckWritable(const TriangleMesh& mesh, FileFormat format) {

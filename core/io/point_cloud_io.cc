@@ -100,11 +100,9 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
                              const DracoOptions& draco) {
   const FileFormat format = io_internal::FormatFromPath(path);
   if (!IsWritable(format)) return UnsupportedExtension(path, ".ply, .xyz, .txt, .pts, .drc");
-  absl::Status valid = cloud.empty() ? absl::InvalidArgumentError("the point cloud is empty")
-                                     : ValidatePointCloud(cloud);
-  if (!valid.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("cannot write '", path, "': ", valid.message()));
-  }
+  const absl::Status valid = cloud.empty() ? absl::InvalidArgumentError("the point cloud is empty")
+                                           : ValidatePointCloud(cloud);
+  if (!valid.ok()) return io_internal::CannotWrite(path, valid);
   const io_internal::GeometryView view{cloud.positions, cloud.normals, cloud.weights, {},
                                        cloud.colors};
   std::string data;
@@ -114,10 +112,7 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
     data = io_internal::FormatXyz(view);
   } else {
     absl::StatusOr<std::string> encoded = EncodePointCloud(cloud, draco);
-    if (!encoded.ok()) {
-      return absl::Status(encoded.status().code(),
-                          absl::StrCat("cannot write '", path, "': ", encoded.status().message()));
-    }
+    if (!encoded.ok()) return io_internal::CannotWrite(path, encoded.status());
     data = *std::move(encoded);
   }
   return WriteFileContents(path, data);

@@ -30,4 +30,8 @@ absl::Status WithPath(const absl::Status& status, const std::string& path) {
   return absl::Status(status.code(), absl::StrCat("'", path, "': ", status.message()));
 }
 
+absl::Status CannotWrite(const std::string& path, const absl::Status& status) {
+  return absl::Status(status.code(), absl::StrCat("cannot write '", path, "': ", status.message()));
+}
+
 }  // namespace neuralmesh::io_internal

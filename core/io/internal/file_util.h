@@ -24,6 +24,10 @@ std::string LowercaseExtension(absl::string_view path);
 // Returns `status` with "'path': " in front of its message; OK stays OK.
 absl::Status WithPath(const absl::Status& status, const std::string& path);
 
+// Returns the error `status` with "cannot write 'path': " in front of its message, for the
+// writers.
+absl::Status CannotWrite(const std::string& path, const absl::Status& status);
+
 }  // namespace neuralmesh::io_internal
 
 #endif  // NEURALMESH_CORE_IO_INTERNAL_FILE_UTIL_H_

@@ -246,6 +246,8 @@ struct AccessorData {
   std::vector<double> values;
   uint64_t count = 0;
   int components = 0;
+  int component_type = 0;
+  bool normalized = false;  // Integers already mapped to [0, 1] or [-1, 1].
 };
 
 class GltfReader {
@@ -437,8 +439,9 @@ class GltfReader {
                   static_cast<int>(component_type)) == component_types.end()) {
       return Invalid(where, " has componentType ", component_type, ", which does not fit");
     }
+    data.component_type = static_cast<int>(component_type);
     const JsonValue* normalized = accessor->Find("normalized");
-    const bool is_normalized = normalized != nullptr && normalized->boolean;
+    data.normalized = normalized != nullptr && normalized->boolean;
     NM_ASSIGN_OR_RETURN(data.count, IntegerMember(*accessor, "count", std::nullopt, where));
     NM_ASSIGN_OR_RETURN(const uint64_t offset, IntegerMember(*accessor, "byteOffset", 0, where));
     if (accessor->Find("bufferView") == nullptr) {
@@ -448,7 +451,8 @@ class GltfReader {
                         IntegerMember(*accessor, "bufferView", std::nullopt, where));
     uint64_t stride = 0;
     NM_ASSIGN_OR_RETURN(const absl::string_view view, BufferView(view_index, &stride));
-    const uint64_t element = ComponentBytes(static_cast<int>(component_type)) * data.components;
+    const size_t component_bytes = ComponentBytes(data.component_type);
+    const uint64_t element = component_bytes * data.components;
     if (stride == 0) stride = element;
     if (stride < element) {
       return Invalid(where, ": bufferViews[", view_index, "].byteStride ", stride,
@@ -460,12 +464,11 @@ class GltfReader {
                      " do not fit in bufferViews[", view_index, "] (", view.size(), " bytes)");
     }
     data.values.resize(data.count * data.components);
-    const size_t component_bytes = ComponentBytes(static_cast<int>(component_type));
     for (uint64_t i = 0; i < data.count; ++i) {
       const char* p = view.data() + offset + i * stride;
       for (int c = 0; c < data.components; ++c) {
-        data.values[i * data.components + c] = ComponentValue(
-            p + c * component_bytes, static_cast<int>(component_type), is_normalized);
+        data.values[i * data.components + c] =
+            ComponentValue(p + c * component_bytes, data.component_type, data.normalized);
       }
     }
     return data;
@@ -576,12 +579,9 @@ class GltfReader {
                        " positions");
       }
       // Integer colours are normalized in valid files; those that are not count as levels.
-      const JsonValue* accessor = *Element("accessors", color_accessor);
-      const int type = static_cast<int>(accessor->Find("componentType")->number);
-      const JsonValue* normalized = accessor->Find("normalized");
-      const double max = type == kFloat || (normalized != nullptr && normalized->boolean)
-                             ? 1.0
-                             : (type == kUnsignedByte ? 255.0 : 65535.0);
+      const double max = color.component_type == kFloat || color.normalized ? 1.0
+                         : color.component_type == kUnsignedByte         ? 255.0
+                                                                         : 65535.0;
       colors->resize(color.count);
       for (uint64_t i = 0; i < color.count; ++i) {
         for (int c = 0; c < 3; ++c) {

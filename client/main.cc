@@ -224,7 +224,8 @@ ABSL_FLAG(std::string, view_key_file, "",
           "must bring: it opens http://HOST:PORT/?key=KEY once (printed at start) and keeps "
           "the key in a cookie; other clients send 'Authorization: Bearer KEY'. Over plain "
           "HTTP it keeps out who does not know the URL, not who can read the traffic (see "
-          "--view_tls_cert_file). Empty: anyone who reaches --listen is let in.");
+          "--view_tls_cert_file). SIGHUP reads the file again (the old key's cookies stop "
+          "working). Empty: anyone who reaches --listen is let in.");
 ABSL_FLAG(std::string, view_tls_cert_file, "",
           "view: PEM file with the viewer's certificate (then any intermediates): browsers "
           "connect over HTTPS (https://HOST:PORT/), and the key's cookie is sent over HTTPS "
@@ -555,14 +556,18 @@ absl::Status View(const ParsedArgs& args) {
   o.web_root = absl::GetFlag(FLAGS_web_root);
   NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
   if (const std::string key_file = absl::GetFlag(FLAGS_view_key_file); !key_file.empty()) {
-    absl::StatusOr<std::string> contents =
-        neuralmesh::ReadFileNamedByFlag("view_key_file", key_file);
-    if (contents.ok()) contents = neuralmesh::client::web::ParseViewerKey(*contents);
-    if (!contents.ok()) {
-      return absl::Status(contents.status().code(),
-                          absl::StrCat("--view_key_file: ", contents.status().message()));
-    }
-    o.key = *std::move(contents);
+    const auto read_key = [key_file]() -> absl::StatusOr<std::string> {
+      absl::StatusOr<std::string> contents =
+          neuralmesh::ReadFileNamedByFlag("view_key_file", key_file);
+      if (contents.ok()) contents = neuralmesh::client::web::ParseViewerKey(*contents);
+      if (!contents.ok()) {
+        return absl::Status(contents.status().code(),
+                            absl::StrCat("--view_key_file: ", contents.status().message()));
+      }
+      return contents;
+    };
+    NM_ASSIGN_OR_RETURN(o.key, read_key());
+    o.reread_key = read_key;
   }
   using TlsPem = neuralmesh::client::web::ViewOptions::TlsPem;
   const auto read_tls = []() -> absl::StatusOr<TlsPem> {

@@ -54,10 +54,6 @@ bool IsLoopback(absl::string_view host) {
 // SIGHUP: the certificate and key read again replace those of `http`'s new handshakes.
 void RenewCertificate(const ViewOptions& options, HttpServer& http, std::ostream& out,
                       std::ostream& err) {
-  if (std::string_view(http.scheme()) != "https" || !options.reread_tls) {
-    out << "neuralmesh view: SIGHUP received; no HTTPS certificate to read again" << std::endl;
-    return;
-  }
   absl::StatusOr<ViewOptions::TlsPem> pem = options.reread_tls();
   absl::Status replaced = pem.status();
   if (pem.ok()) {
@@ -71,6 +67,34 @@ void RenewCertificate(const ViewOptions& options, HttpServer& http, std::ostream
     err << "neuralmesh view: SIGHUP received; the old HTTPS certificate stays: "
         << replaced.message() << std::endl;
   }
+}
+
+// SIGHUP: the viewer key read again replaces the one requests must bring.
+void RenewKey(const ViewOptions& options, const std::string& url, ViewerService& viewer,
+              std::ostream& out, std::ostream& err) {
+  absl::StatusOr<std::string> key = options.reread_key();
+  if (key.ok()) {
+    viewer.ReplaceKey(*key);
+    out << "neuralmesh view: SIGHUP received; viewer key read again: browsers open " << url
+        << "?key=" << *key << std::endl;
+  } else {
+    err << "neuralmesh view: SIGHUP received; the old viewer key stays: "
+        << key.status().message() << std::endl;
+  }
+}
+
+// SIGHUP: the HTTPS certificate and the viewer key, each where the viewer has one.
+void Reload(const ViewOptions& options, const std::string& url, HttpServer& http,
+            ViewerService& viewer, std::ostream& out, std::ostream& err) {
+  const bool https = std::string_view(http.scheme()) == "https" && options.reread_tls;
+  const bool keyed = !options.key.empty() && options.reread_key;
+  if (!https && !keyed) {
+    out << "neuralmesh view: SIGHUP received; no HTTPS certificate or viewer key to read again"
+        << std::endl;
+    return;
+  }
+  if (https) RenewCertificate(options, http, out, err);
+  if (keyed) RenewKey(options, url, viewer, out, err);
 }
 
 }  // namespace
@@ -130,7 +154,7 @@ absl::Status RunView(const ViewOptions& options, std::ostream& out, std::ostream
   for (int tick = 1; !InterruptScope::interrupted(); ++tick) {
     absl::SleepFor(absl::Milliseconds(100));
     if (tick % 50 == 0) viewer.DropIdleRelays();
-    if (ReloadSignalScope::TakeRequest()) RenewCertificate(options, *http, out, err);
+    if (ReloadSignalScope::TakeRequest()) Reload(options, url, *http, viewer, out, err);
   }
   viewer.Stop();
   http->Shutdown();

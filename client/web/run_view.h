@@ -30,6 +30,9 @@ struct ViewOptions {
     std::string private_key;
   };
   std::function<absl::StatusOr<TlsPem>()> reread_tls;
+  // With a key: called on SIGHUP for the key read again (from its file, checked by
+  // ParseViewerKey). Null: SIGHUP keeps the key.
+  std::function<absl::StatusOr<std::string>()> reread_key;
 };
 
 // The client/web folder of the source tree this binary was built from.
@@ -39,8 +42,10 @@ std::string DefaultWebRoot();
 // "viewer: http://HOST:PORT/ (sessions of SERVER)" (https:// with a certificate) and serves
 // until interrupted. On SIGHUP an HTTPS viewer takes the certificate and key of
 // `reread_tls` for the connections that follow (a renewed certificate, without a restart),
-// and says so on `out`; when they do not make a TLS identity it keeps the old ones and says
-// why on `err`. Errors: NOT_FOUND for a web root without the viewer's files,
+// and a keyed viewer the key of `reread_key` for the requests that follow (browsers holding
+// the old key's cookie are let in no more), saying so on `out`; a certificate and key that
+// do not make a TLS identity, or a key file that does not hold a key, leave the old ones in
+// place, and `err` says why. Errors: NOT_FOUND for a web root without the viewer's files,
 // INVALID_ARGUMENT for a malformed --listen or a certificate and key that do not make a TLS
 // identity (one without the other included), UNAVAILABLE when the server cannot be reached or
 // the address cannot be bound, UNAUTHENTICATED when the server refuses the viewer's access

@@ -149,7 +149,12 @@ absl::Status CheckWebRoot(const std::string& web_root) {
 }
 
 ViewerService::ViewerService(std::unique_ptr<ReconstructionClient> client, ViewerOptions options)
-    : client_(std::move(client)), options_(std::move(options)) {}
+    : client_(std::move(client)), options_(std::move(options)), key_(options_.key) {}
+
+void ViewerService::ReplaceKey(std::string key) {
+  absl::MutexLock lock(&mu_);
+  key_ = std::move(key);
+}
 
 ViewerService::~ViewerService() { Stop(); }
 
@@ -164,12 +169,17 @@ void ViewerService::Stop() {
 }
 
 HttpResponse ViewerService::Handle(const HttpRequest& request) {
-  if (!options_.key.empty()) {
-    switch (CheckViewerKey(request, options_.key)) {
+  std::string key;
+  {
+    absl::MutexLock lock(&mu_);
+    key = key_;
+  }
+  if (!key.empty()) {
+    switch (CheckViewerKey(request, key)) {
       case ViewerKeyCheck::kGranted:
         break;
       case ViewerKeyCheck::kGrantedFromUrl:
-        return ViewerKeyRedirect(request, options_.key, options_.https);
+        return ViewerKeyRedirect(request, key, options_.https);
       case ViewerKeyCheck::kRefused:
         return ErrorResponse(401,
                              "this viewer needs its key: open the URL with ?key= that "

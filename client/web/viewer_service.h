@@ -54,7 +54,7 @@ struct ViewerOptions {
   absl::Duration relay_idle_timeout = absl::Seconds(60);
   // Empty: every request is answered. Else every request must bring this key (viewer_key.h):
   // one with the key in its query is sent on without it, keeping the key in a cookie, and one
-  // without the key gets 401.
+  // without the key gets 401. ReplaceKey changes it.
   std::string key;
   // Whether browsers reach the viewer over HTTPS: the key's cookie is then Secure.
   bool https = false;
@@ -81,6 +81,10 @@ class ViewerService {
   // Ends every watch and wakes every waiting mesh request; later requests for meshes get 503.
   void Stop();
 
+  // The key that requests from now on must bring (a key file read again on SIGHUP); cookies
+  // of the old key no longer let a browser in. Empty lets every request in.
+  void ReplaceKey(std::string key);
+
  private:
   // The answer to a browser whose request failed at the server with `status`, as an HTTP status
   // that says what it means: UNAVAILABLE from a server that answered it (the channel is
@@ -99,6 +103,7 @@ class ViewerService {
   const ViewerOptions options_;
 
   absl::Mutex mu_;
+  std::string key_ ABSL_GUARDED_BY(mu_);  // ViewerOptions::key, then each ReplaceKey.
   std::map<std::string, std::shared_ptr<MeshRelay>> relays_ ABSL_GUARDED_BY(mu_);
   bool stopped_ ABSL_GUARDED_BY(mu_) = false;
 };

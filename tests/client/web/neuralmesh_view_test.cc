@@ -4,12 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <csignal>
+#include <cstdio>
 #include <string>
 
 #include "core/io/file_contents.h"
 #include "tests/client/subprocess.h"
 #include "tests/client/test_server.h"
 #include "tests/client/web/viewer_test_support.h"
+#include "tests/testing/http_client.h"
 #include "tests/testing/https_client.h"
 #include "tests/testing/temp_dir.h"
 #include "tests/testing/test_certificates.h"
@@ -62,6 +64,65 @@ TEST(NeuralmeshViewTest, ServesTheSessionsOfTheServerUntilSigterm) {
   EXPECT_EQ(sessions.status, 200);
   EXPECT_EQ(sessions.body, "[]");
   EXPECT_EQ(HttpGet(port, "/").status, 200);
+  EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << viewer.Stderr();
+}
+
+// A GET of `path` with `header` ("Name: value") over plain HTTP.
+HttpReply GetWith(int port, const std::string& path, const std::string& header) {
+  return SendRawHttp(port, "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\n" + header +
+                               "\r\n\r\n");
+}
+
+// SIGHUP reads --view_key_file again: the new key lets browsers in, the old key and its cookie
+// no longer do; a file that holds no key leaves the key as it was.
+TEST(NeuralmeshViewTest, SighupReadsTheViewerKeyAgain) {
+  std::string error;
+  std::unique_ptr<TestServer> server = TestServer::Start({}, &error);
+  ASSERT_NE(server, nullptr) << error;
+  BackgroundProcess unkeyed("neuralmesh",
+                            {"view", "--server=" + server->address(), "--listen=127.0.0.1:0"});
+  ASSERT_NE(WaitForViewerPort(unkeyed), 0) << unkeyed.Stderr();
+  unkeyed.Signal(SIGHUP);
+  EXPECT_TRUE(unkeyed.AwaitStdout(
+      "SIGHUP received; no HTTPS certificate or viewer key to read again"))
+      << unkeyed.Stdout() << unkeyed.Stderr();
+  EXPECT_EQ(unkeyed.SignalAndWait(SIGTERM), 0) << unkeyed.Stderr();
+
+  const std::string old_key = "first-key-0123456789", new_key = "second-key-9876543210";
+  const std::string key_file = MakeTempDir("view_key_reload") + "/key";
+  ASSERT_TRUE(WriteFileContents(key_file, old_key + "\n").ok());
+  BackgroundProcess viewer("neuralmesh", {"view", "--server=" + server->address(),
+                                          "--listen=127.0.0.1:0", "--view_key_file=" + key_file});
+  const int port = WaitForViewerPort(viewer);
+  ASSERT_NE(port, 0) << viewer.Stderr();
+  const HttpReply opened = HttpGet(port, "/?key=" + old_key);
+  ASSERT_EQ(opened.status, 303);
+  const std::string set_cookie = opened.Header("set-cookie");
+  const std::string old_cookie = "Cookie: " + set_cookie.substr(0, set_cookie.find(';'));
+  EXPECT_EQ(GetWith(port, "/api/sessions", old_cookie).status, 200);
+  EXPECT_EQ(GetWith(port, "/api/sessions", "Authorization: Bearer " + new_key).status, 401);
+
+  ASSERT_TRUE(WriteFileContents(key_file, new_key).ok());
+  viewer.Signal(SIGHUP);
+  EXPECT_TRUE(viewer.AwaitStdout("SIGHUP received; viewer key read again: browsers open http://"
+                                 "127.0.0.1:" + std::to_string(port) + "/?key=" + new_key))
+      << viewer.Stdout() << viewer.Stderr();
+  EXPECT_EQ(GetWith(port, "/api/sessions", "Authorization: Bearer " + new_key).status, 200);
+  EXPECT_EQ(GetWith(port, "/api/sessions", "Authorization: Bearer " + old_key).status, 401);
+  EXPECT_EQ(GetWith(port, "/api/sessions", old_cookie).status, 401);
+  EXPECT_EQ(HttpGet(port, "/?key=" + old_key).status, 401);
+  EXPECT_EQ(HttpGet(port, "/?key=" + new_key).status, 303);
+
+  // A key too short, then no file: refused, and the key read last stays.
+  ASSERT_TRUE(WriteFileContents(key_file, "short").ok());
+  viewer.Signal(SIGHUP);
+  EXPECT_TRUE(viewer.AwaitStderr("SIGHUP received; the old viewer key stays: --view_key_file: "))
+      << viewer.Stderr();
+  ASSERT_EQ(std::remove(key_file.c_str()), 0);
+  viewer.Signal(SIGHUP);
+  EXPECT_TRUE(viewer.AwaitStderr("cannot open '" + key_file + "'")) << viewer.Stderr();
+  EXPECT_EQ(GetWith(port, "/api/sessions", "Authorization: Bearer " + new_key).status, 200);
+  EXPECT_EQ(GetWith(port, "/api/sessions", "Authorization: Bearer short").status, 401);
   EXPECT_EQ(viewer.SignalAndWait(SIGTERM), 0) << viewer.Stderr();
 }
 

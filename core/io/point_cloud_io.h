@@ -25,7 +25,8 @@ bool IsWritablePointCloudExtension(std::string_view path);
 //   .ply  ASCII or binary (either byte order): 'vertex' x, y, z of any scalar type; nx, ny, nz
 //         when all present; the first of confidence, weight, quality, intensity, scalar as
 //         weights; red, green, blue (or r, g, b) as colours.
-//   .xyz, .txt, .pts  "x y z [nx ny nz] [w]" lines, '#' comments (see internal/xyz.h).
+//   .xyz, .txt, .pts  "x y z [nx ny nz] [w]", "x y z r g b", "x y z i r g b" (PTS) lines
+//         and others a header comment names ("# x y z nx ny nz r g b w"); see internal/xyz.h.
 //   .obj  the 'v' lines, 'v x y z r g b' with colours ('vn' is ignored: OBJ normals belong to
 //         face corners).
 //   .off  the vertices of OFF, COFF (with colours), NOFF (with normals), STOFF.
@@ -39,8 +40,8 @@ bool IsWritablePointCloudExtension(std::string_view path);
 absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path);
 
 // Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
-// nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [w]" text for
-// .xyz/.txt/.pts (without colours), or .drc encoded with `draco`.
+// nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"
+// text for .xyz/.txt/.pts (a header comment names the columns), or .drc encoded with `draco`.
 // Returns INVALID_ARGUMENT for an unsupported extension, an empty cloud, a cloud that fails
 // ValidatePointCloud, or invalid `draco` options; otherwise the status of the write ("cannot
 // write 'path': reason").

@@ -1,5 +1,5 @@
 // Per-point and per-vertex colours through every reader and writer that carries them: PLY,
-// OBJ, OFF (COFF) and Draco, as neuralmesh writes them and as other tools do.
+// OBJ, OFF (COFF), XYZ and Draco, as neuralmesh writes them and as other tools do.
 #include <string>
 #include <vector>
 
@@ -66,13 +66,27 @@ TEST(ColorIoTest, MeshColorsSurviveEveryFormatButStl) {
   EXPECT_TRUE(from_stl->colors.empty()) << "STL stores no colours";
 }
 
-TEST(ColorIoTest, PointColorsSurvivePlyAndDraco) {
+TEST(ColorIoTest, PointColorsSurvivePlyXyzAndDraco) {
   const PointCloud cloud = testing::ColoredUnitSpherePoints(500, 3);
-  const std::string ply = TempPath("colored_points.ply");
-  ASSERT_TRUE(WritePointCloud(cloud, ply).ok());
-  const absl::StatusOr<PointCloud> from_ply = ReadPointCloud(ply);
-  ASSERT_TRUE(from_ply.ok()) << from_ply.status();
-  EXPECT_EQ(from_ply->colors, cloud.colors);
+  for (const bool normals : {false, true}) {
+    for (const bool weights : {false, true}) {
+      // The header written names the columns, so every combination reads back.
+      SCOPED_TRACE(::testing::Message() << "normals " << normals << ", weights " << weights);
+      PointCloud written = cloud;
+      if (normals) written.normals = written.positions;  // A unit sphere's.
+      if (weights) written.weights.assign(written.size(), 0.5f);
+      for (const char* name : {"colored_points.ply", "colored_points.xyz"}) {
+        SCOPED_TRACE(name);
+        ASSERT_TRUE(WritePointCloud(written, TempPath(name)).ok());
+        const absl::StatusOr<PointCloud> read = ReadPointCloud(TempPath(name));
+        ASSERT_TRUE(read.ok()) << read.status();
+        EXPECT_EQ(read->positions, written.positions);
+        EXPECT_EQ(read->colors, written.colors);
+        EXPECT_EQ(read->normals, written.normals);
+        EXPECT_EQ(read->weights, written.weights);
+      }
+    }
+  }
 
   for (const int speed : {5, 10}) {  // The kd-tree coder, and the sequential one.
     SCOPED_TRACE(speed);

@@ -231,15 +231,106 @@ TEST(XyzCloudTest, ColumnLayoutsCommentsAndCountLine) {
               "seven columns: normals and weights");
 }
 
+// Colours as scanners and tools write them: "x y z r g b" (levels or fractions), Leica PTS and
+// Semantic3D's "x y z intensity r g b", normals and colours in either order, and columns a
+// header names (CloudCompare's "//X,Y,Z,..." with commas too).
+TEST(XyzCloudTest, ColoursAsScannersAndToolsWriteThem) {
+  const std::vector<Rgb> colors = {{255, 0, 128}, {1, 2, 3}, {10, 20, 30}};
+  const std::vector<Rgb> from_fractions = {{255, 0, 128}, {1, 2, 3}, {0, 128, 255}};
+  struct Case {
+    const char* name;
+    std::string content;
+    std::vector<Vec3f> normals;
+    std::vector<float> weights;
+    std::vector<Rgb> colors;
+  };
+  const Case cases[] = {
+      {"levels.xyz", "0 0 0 255 0 128\n1 2 3 1 2 3\n-1.5 0.25 8 10 20 30\n", {}, {}, colors},
+      {"fractions.txt",
+       "0 0 0 1 0 0.50196\n1 2 3 0.00392 0.00784 0.01176\n-1.5 0.25 8 0 0.50196 1\n",
+       {},
+       {},
+       from_fractions},
+      {"leica.pts",
+       "3\n0 0 0 -1024 255 0 128\n1 2 3 2047 1 2 3\n-1.5 0.25 8 0 10 20 30\n",
+       {},
+       {},
+       colors},
+      {"normals_then_colors.xyz",
+       "0 0 0 0 0 1 255 0 128\n1 2 3 0 1 0 1 2 3\n-1.5 0.25 8 1 0 0 10 20 30\n",
+       kThreeNormals,
+       {},
+       colors},
+      {"colors_then_normals.xyz",
+       "0 0 0 255 0 128 0 0 1\n1 2 3 1 2 3 0 1 0\n-1.5 0.25 8 10 20 30 1 0 0\n",
+       kThreeNormals,
+       {},
+       colors},
+      {"cloudcompare.txt",
+       "//X,Y,Z,R,G,B\n0,0,0,255,0,128\n1,2,3,1,2,3\n-1.5,0.25,8,10,20,30\n",
+       {},
+       {},
+       colors},
+      {"named.xyz",
+       "# scanner export\n# x y z intensity Nx Ny Nz red green blue scalar confidence\n"
+       "0 0 0 7 0 0 1 255 0 128 -4 3\n1 2 3 7 0 1 0 1 2 3 -4 2\n"
+       "-1.5 0.25 8 7 1 0 0 10 20 30 -4 1\n",
+       kThreeNormals,
+       {3, 2, 1},
+       colors},
+      {"two_channels_named.xyz", "# x y z r g w\n0 0 0 1 1 3\n1 2 3 1 1 2\n-1.5 0.25 8 1 1 1\n",
+       {},
+       {3, 2, 1},
+       {}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const absl::StatusOr<PointCloud> cloud = ReadContent(c.name, c.content);
+    ExpectCloud(MakeCloud(kThree.positions, c.normals, c.weights), cloud, c.name);
+    if (cloud.ok()) {
+      EXPECT_EQ(cloud->colors, c.colors);
+    }
+  }
+  // Three columns that are unit vectors in every row are normals, even when they could be
+  // colours.
+  const absl::StatusOr<PointCloud> unit =
+      ReadContent("unit.xyz", "0 0 0 0 0 1\n1 2 3 0 1 0\n-1.5 0.25 8 1 0 0\n");
+  ExpectCloud(MakeCloud(kThree.positions, kThreeNormals), unit, "unit vectors");
+}
+
+// Normals that are not unit vectors and lie in [0, 1], like colours as fractions: the header
+// written with them says what they are.
+TEST(XyzCloudTest, WrittenNormalsThatCouldBeColoursReadBackAsNormals) {
+  const PointCloud cloud = MakeCloud(kThree.positions, {Vec3f(0.25f, 0.5f, 0), Vec3f(0, 0, 0.5f),
+                                                        Vec3f(0.125f, 0.125f, 0.125f)});
+  const std::string path = TempPath("short_normals.xyz");
+  ASSERT_TRUE(WritePointCloud(cloud, path).ok());
+  ExpectCloud(cloud, ReadPointCloud(path), "written with a header");
+  const absl::StatusOr<PointCloud> headless =
+      ReadContent("headless.xyz", "0 0 0 0.25 0.5 0\n1 2 3 0 0 0.5\n-1.5 0.25 8 0.125 0.125 0.125");
+  ASSERT_TRUE(headless.ok()) << headless.status();
+  EXPECT_TRUE(headless->normals.empty()) << "without a header they read as colours";
+  EXPECT_EQ(headless->colors.size(), 3u);
+}
+
 TEST(XyzCloudTest, MalformedFilesAreRejectedWithAReason) {
+  std::string seventy_columns = "0 0 0";
+  for (int k = 3; k < 70; ++k) seventy_columns += " 1";
   const struct {
     const char* what;
     std::string content;
     const char* message;
   } cases[] = {
       {"letters", "0 0 0\n1 two 3\n", "line 2: expected a number in column 2, found 'two'"},
-      {"five columns", "0 0 0 1 1\n", "line 1: expected 3, 4, 6 or 7 numbers"},
-      {"two columns", "# header\n0 0\n", "line 2: expected 3, 4, 6 or 7 numbers"},
+      {"five columns", "0 0 0 1 1\n", "line 1: expected 3, 4, 6, 7 or 9 numbers"},
+      {"eight columns after another file's header", "# x y z r g b\n0 0 0 1 1 1 1 1\n",
+       "line 2: expected 3, 4, 6, 7 or 9 numbers"},
+      {"two columns", "# header\n0 0\n", "line 2: expected x y z and at most 61 more"},
+      {"nine columns of neither normals nor colours",
+       "0 0 0 0 0 1 0 0 300\n0 0 0 0 0 1 0 0 1\n",
+       "line 1: 9 columns are x y z, a normal and a colour"},
+      {"seventy columns", seventy_columns, "line 1: expected x y z and at most 61 more numbers, "
+                                            "found 70 values"},
       {"ragged columns", "0 0 0\n1 2 3\n1 2 3 0 0 1\n", "line 3: expected 3 numbers like line 1"},
       {"NaN", "0 0 0\nnan 1 1\n", "line 2: column 1 is not finite"},
       {"infinity", "0 0 0\n1 -inf 1\n", "line 2: column 2 is not finite"},

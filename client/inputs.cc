@@ -43,13 +43,6 @@ absl::Status InFile(const absl::Status& status, absl::string_view role, const st
   return absl::Status(status.code(), absl::StrCat(role, " '", path, "': ", status.message()));
 }
 
-absl::StatusOr<PointCloud> ReadCloud(const std::string& path) {
-  NM_RETURN_IF_ERROR(CheckInputFile(path, "INPUT"));
-  absl::StatusOr<PointCloud> cloud = ReadPointCloud(path);
-  if (!cloud.ok()) return InFile(cloud.status(), "INPUT", path);
-  return cloud;
-}
-
 }  // namespace
 
 absl::StatusOr<SamplingMode> ParseSamplingMode(absl::string_view name) {
@@ -121,7 +114,7 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
                      with_colors, ")");
     return target;
   }
-  NM_ASSIGN_OR_RETURN(PointCloud cloud, ReadCloud(input));
+  NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(input, "INPUT"));
   if (mode == SamplingMode::kWeighted && cloud.weights.empty()) {
     return absl::InvalidArgumentError(
         absl::StrCat("INPUT '", input, "' has no per-point weights for --sampling weighted"));
@@ -160,7 +153,14 @@ absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t 
     NM_ASSIGN_OR_RETURN(const std::unique_ptr<ImplicitSurface> surface, MakeBuiltinSurface(input));
     return SamplePoints(*surface, builtin_points, seed);
   }
-  return ReadCloud(input);
+  return LoadPointCloud(input, "INPUT");
+}
+
+absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role) {
+  NM_RETURN_IF_ERROR(CheckInputFile(input, role));
+  absl::StatusOr<PointCloud> cloud = ReadPointCloud(input);
+  if (!cloud.ok()) return InFile(cloud.status(), role, input);
+  return cloud;
 }
 
 absl::StatusOr<TriangleMesh> LoadMesh(const std::string& input, absl::string_view role) {

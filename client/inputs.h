@@ -67,6 +67,10 @@ inline constexpr size_t kMaxBuiltinUploadPoints = size_t{1} << 26;
 absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t builtin_points,
                                                uint64_t seed);
 
+// The points of a point cloud file (any extension ReadPointCloud reads). Errors as
+// LoadTargetSpace; `role` names the argument in messages.
+absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role);
+
 // A mesh to report on or compare: a mesh file, or for builtin:NAME the reference mesh of the
 // implicit surface. Errors as LoadTargetSpace; `role` names the argument in messages.
 absl::StatusOr<TriangleMesh> LoadMesh(const std::string& input, absl::string_view role);

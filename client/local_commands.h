@@ -67,14 +67,25 @@ struct EvalOptions {
 absl::Status RunEval(const EvalOptions& options, std::ostream& out);
 
 struct ConvertOptions {
-  std::string mesh;          // A mesh file, or builtin:NAME for its dense tessellation.
-  std::string output;        // Its extension picks the format (kMeshExtensions).
-  MeshWriteOptions writing;  // Draco settings, glTF compression.
+  // A mesh or point cloud file, or builtin:NAME for its dense tessellation.
+  std::string input;
+  // Its extension picks the format: a mesh's (kMeshExtensions) or a point cloud's (.ply .xyz
+  // .txt .pts .drc .glb .gltf).
+  std::string output;
+  MeshWriteOptions writing;  // Draco settings, glTF compression (meshes only).
+  // Set: a point cloud's statistical outliers are removed before it is written.
+  std::optional<OutlierOptions> outliers;
 };
 
-// Writes MESH to OUTPUT, colours included where the format holds them, and prints "OUTPUT: V
-// vertices, F faces" (", with colours"). INVALID_ARGUMENT for an unknown output extension
-// (before reading MESH), and the reader's and writer's errors.
+// Writes INPUT to OUTPUT, colours included where the format holds them. A mesh (a file with
+// faces, or builtin:NAME) is written as a mesh, and "OUTPUT: V vertices, F faces" printed
+// (", with colours"). Points (a .xyz/.txt/.pts file, a file without faces, or any file
+// written to .xyz/.txt/.pts) are written as a point cloud with their normals, weights and
+// colours where the format holds them, and "OUTPUT: N points" printed (", with normals,
+// weights, colours"; how many outliers went; what glTF leaves out). INVALID_ARGUMENT for an
+// unknown output extension (before reading INPUT), a mesh format for points that are not a
+// mesh (.obj, .off, .stl), a point format for a builtin surface, --remove_outliers for a
+// mesh, --gltf_draco for points, and the reader's and writer's errors.
 absl::Status RunConvert(const ConvertOptions& options, std::ostream& out);
 
 }  // namespace neuralmesh::client

@@ -42,7 +42,8 @@ const neuralmesh::DracoOptions kDracoDefaults;
 ABSL_FLAG(std::string, output, "",
           "Local reconstruct: the mesh to write; the extension picks the format (.ply .obj .off "
           ".stl .drc .glb .gltf). LOD files go beside it as <stem>_lod<N><ext>. get: where the "
-          "session's mesh goes. convert: the file written.");
+          "session's mesh goes. convert: the file written (a mesh's format, or a point cloud's: "
+          ".ply .xyz .txt .pts .drc .glb .gltf).");
 ABSL_FLAG(uint64_t, vertices, 0,
           "Vertex count of the final mesh (met exactly). Required for a local reconstruct; with "
           "--server, 0 means one vertex per 2 points, at most 10000.");
@@ -118,7 +119,8 @@ ABSL_FLAG(std::string, start_mesh, "",
 
 // Input clean-up.
 ABSL_FLAG(bool, remove_outliers, false,
-          "Remove a point cloud's statistical outliers before learning or upload: points whose "
+          "Remove a point cloud's statistical outliers before learning, upload or convert: "
+          "points whose "
           "mean distance to their --outlier_neighbours nearest points exceeds the mean of "
           "that distance by more than --outlier_std_ratio standard deviations (as PCL and "
           "Open3D define them). Not in the paper.");
@@ -472,11 +474,12 @@ absl::Status Stats(const ParsedArgs& args) {
 }
 
 absl::Status Convert(const ParsedArgs& args) {
-  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "MESH"));
+  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "INPUT"));
   neuralmesh::client::ConvertOptions o;
-  o.mesh = args.positional[0];
+  o.input = args.positional[0];
   o.output = absl::GetFlag(FLAGS_output);
   NM_ASSIGN_OR_RETURN(o.writing, MeshWritingFromFlags());
+  NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
   return neuralmesh::client::RunConvert(o, std::cout);
 }
 
@@ -619,12 +622,17 @@ std::vector<Subcommand> Commands() {
        {"json"},
        Stats},
       {"convert",
-       "convert MESH -o OUTPUT [--gltf_draco] [--quantization_bits B] [--encode_speed S]",
-       "Writes a mesh in another format.",
-       "Writes MESH (a mesh file or builtin:NAME, its dense reference tessellation) to OUTPUT,\n"
-       "in the format of its extension (.ply .obj .off .stl .drc .glb .gltf), colours included\n"
-       "where the format holds them.",
-       {"output", "gltf_draco", "quantization_bits", "encode_speed"},
+       "convert INPUT -o OUTPUT [--gltf_draco] [--remove_outliers] [--quantization_bits B]\n"
+       "        [--encode_speed S]",
+       "Writes a mesh or a point cloud in another format.",
+       "Writes INPUT to OUTPUT in the format of its extension, colours included where the\n"
+       "format holds them. A mesh (a file with faces, or builtin:NAME, its dense reference\n"
+       "tessellation) goes to .ply .obj .off .stl .drc .glb .gltf; points (.xyz .txt .pts, a\n"
+       "file without faces, or anything written to .xyz .txt .pts) go to .ply .xyz .txt .pts\n"
+       ".drc .glb .gltf with their normals and weights (glTF: positions and colours only),\n"
+       "after --remove_outliers if given.",
+       {"output", "gltf_draco", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
+        "quantization_bits", "encode_speed"},
        Convert},
       {"eval",
        "eval MESH --reference REF [--json] [--samples N]",

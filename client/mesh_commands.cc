@@ -1,12 +1,16 @@
 // RunStats, RunEval and RunConvert (declared in client/local_commands.h).
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/match.h"
+#include "client/builtin_shapes.h"
 #include "client/inputs.h"
 #include "client/local_commands.h"
 #include "core/analysis/geometric_error.h"
 #include "core/analysis/json_writer.h"
 #include "core/analysis/mesh_report.h"
 #include "core/io/mesh_io.h"
+#include "core/io/point_cloud_io.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::client {
@@ -66,13 +70,73 @@ absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
   return absl::OkStatus();
 }
 
+namespace {
+
+constexpr char kPointCloudWriteExtensions[] = ".ply, .xyz, .txt, .pts, .drc, .glb, .gltf";
+
+// RunConvert for points: read as a point cloud, outliers removed, written as one.
+absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
+  if (!IsWritablePointCloudExtension(options.output)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("INPUT '", options.input, "' holds points without faces: OUTPUT '",
+                     options.output, "' must be a point cloud format (", kPointCloudWriteExtensions,
+                     ")"));
+  }
+  const bool gltf = absl::EndsWithIgnoreCase(options.output, ".glb") ||
+                    absl::EndsWithIgnoreCase(options.output, ".gltf");
+  if (gltf && options.writing.gltf_draco) {
+    return absl::InvalidArgumentError(
+        "--gltf_draco compresses meshes; points are written to glTF uncompressed (or to .drc)");
+  }
+  NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(options.input, "INPUT"));
+  const size_t read = cloud.size();
+  size_t removed = 0;
+  if (options.outliers.has_value()) {
+    NM_ASSIGN_OR_RETURN(removed, RemoveOutliers(cloud, *options.outliers));
+  }
+  NM_RETURN_IF_ERROR(WritePointCloud(cloud, options.output, options.writing.draco));
+  std::vector<std::string> carried;
+  if (!cloud.normals.empty()) carried.push_back("normals");
+  if (!cloud.weights.empty()) carried.push_back("weights");
+  if (!cloud.colors.empty()) carried.push_back("colours");
+  out << options.output << ": " << cloud.size() << " points";
+  if (!carried.empty()) out << ", with " << absl::StrJoin(carried, ", ");
+  if (options.outliers.has_value()) out << " (" << removed << " outliers of " << read << " removed)";
+  out << "\n";
+  if (gltf && (!cloud.normals.empty() || !cloud.weights.empty())) {
+    out << "note: glTF keeps positions and colours; the normals and weights were left out\n";
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::Status RunConvert(const ConvertOptions& options, std::ostream& out) {
   if (options.output.empty()) return absl::InvalidArgumentError("-o OUTPUT is required");
-  if (!IsSupportedMeshExtension(options.output)) {
+  const bool mesh_output = IsSupportedMeshExtension(options.output);
+  if (!mesh_output && !IsWritablePointCloudExtension(options.output)) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "OUTPUT '", options.output, "': unsupported mesh format; use one of ", kMeshExtensions));
+        "OUTPUT '", options.output, "': unsupported format; use one of ", kMeshExtensions,
+        " for meshes, or ", kPointCloudWriteExtensions, " for points"));
   }
-  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(options.mesh, "MESH"));
+  if (IsBuiltin(options.input) && !mesh_output) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        options.input, " is a surface, not points: convert writes its tessellation to a mesh "
+        "format (", kMeshExtensions, ")"));
+  }
+  if (!IsBuiltin(options.input) &&
+      (!mesh_output || !IsSupportedMeshExtension(options.input))) {
+    return ConvertPoints(options, out);
+  }
+  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(options.input, "INPUT"));
+  if (mesh.faces.empty() && IsWritablePointCloudExtension(options.output)) {
+    return ConvertPoints(options, out);  // Read again as points: normals and weights too.
+  }
+  if (options.outliers.has_value()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--remove_outliers removes points from point clouds; INPUT '", options.input,
+        "' is a mesh of ", mesh.faces.size(), " faces"));
+  }
   NM_RETURN_IF_ERROR(WriteMesh(mesh, options.output, options.writing));
   out << options.output << ": " << mesh.positions.size() << " vertices, " << mesh.faces.size()
       << " faces" << (mesh.colors.empty() ? "" : ", with colours") << "\n";

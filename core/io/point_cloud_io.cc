@@ -24,7 +24,8 @@ bool IsReadable(FileFormat format) {
 }
 
 bool IsWritable(FileFormat format) {
-  return format == FileFormat::kPly || format == FileFormat::kXyz || format == FileFormat::kDraco;
+  return format == FileFormat::kPly || format == FileFormat::kXyz ||
+         format == FileFormat::kDraco || format == FileFormat::kGltf;
 }
 
 absl::Status UnsupportedExtension(const std::string& path, const char* supported) {
@@ -99,7 +100,9 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path) {
 absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
                              const DracoOptions& draco) {
   const FileFormat format = io_internal::FormatFromPath(path);
-  if (!IsWritable(format)) return UnsupportedExtension(path, ".ply, .xyz, .txt, .pts, .drc");
+  if (!IsWritable(format)) {
+    return UnsupportedExtension(path, ".ply, .xyz, .txt, .pts, .drc, .glb, .gltf");
+  }
   const absl::Status valid = cloud.empty() ? absl::InvalidArgumentError("the point cloud is empty")
                                            : ValidatePointCloud(cloud);
   if (!valid.ok()) return io_internal::CannotWrite(path, valid);
@@ -110,6 +113,13 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
     data = io_internal::FormatPly(view);
   } else if (format == FileFormat::kXyz) {
     data = io_internal::FormatXyz(view);
+  } else if (format == FileFormat::kGltf) {
+    io_internal::GltfWriteOptions gltf;
+    gltf.binary = io_internal::LowercaseExtension(path) == ".glb";
+    const io_internal::GeometryView points{cloud.positions, {}, {}, {}, cloud.colors};
+    absl::StatusOr<std::string> formatted = io_internal::FormatGltf(points, gltf);
+    if (!formatted.ok()) return io_internal::CannotWrite(path, formatted.status());
+    data = *std::move(formatted);
   } else {
     absl::StatusOr<std::string> encoded = EncodePointCloud(cloud, draco);
     if (!encoded.ok()) return io_internal::CannotWrite(path, encoded.status());

@@ -18,7 +18,8 @@ namespace neuralmesh {
 // .off, .drc, .glb, .gltf.
 bool IsReadablePointCloudExtension(std::string_view path);
 
-// True when WritePointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .drc.
+// True when WritePointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .drc,
+// .glb, .gltf.
 bool IsWritablePointCloudExtension(std::string_view path);
 
 // Reads the points at `path`; faces in the file are skipped without being checked:
@@ -41,7 +42,9 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path);
 
 // Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
 // nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"
-// text for .xyz/.txt/.pts (a header comment names the columns), or .drc encoded with `draco`.
+// text for .xyz/.txt/.pts (a header comment names the columns), .drc encoded with `draco`, or
+// glTF 2.0 POINTS (.glb, or .gltf with its buffer embedded) of the positions and colours
+// (COLOR_0), without normals and weights.
 // Returns INVALID_ARGUMENT for an unsupported extension, an empty cloud, a cloud that fails
 // ValidatePointCloud, or invalid `draco` options; otherwise the status of the write ("cannot
 // write 'path': reason").

@@ -337,9 +337,9 @@ TEST_F(LocalCliTest, GltfFilesAreWrittenAndRead) {
   ASSERT_TRUE(from_ply.ok() && from_glb.ok());
   EXPECT_EQ(from_ply->positions, from_glb->positions);
   EXPECT_EQ(from_ply->faces, from_glb->faces);
-  const RunResult bad = RunNeuralmesh({"convert", torus, "-o", *dir_ + "/torus.xyz"});
+  const RunResult bad = RunNeuralmesh({"convert", torus, "-o", *dir_ + "/torus.abc"});
   EXPECT_EQ(bad.exit_code, 1);
-  EXPECT_TRUE(absl::StrContains(bad.err, "unsupported mesh format; use one of")) << bad.err;
+  EXPECT_TRUE(absl::StrContains(bad.err, "unsupported format; use one of")) << bad.err;
   const RunResult missing = RunNeuralmesh({"convert", *dir_ + "/none.glb", "-o", converted});
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_TRUE(absl::StrContains(missing.err, "none.glb")) << missing.err;
@@ -372,6 +372,88 @@ TEST_F(LocalCliTest, GltfFilesAreWrittenAndRead) {
   EXPECT_NE(remote.exit_code, 0);
   EXPECT_TRUE(absl::StrContains(remote.err, "--gltf_draco applies to a local reconstruct only"))
       << remote.Describe();
+}
+
+// convert for points: normals, weights and colours kept by PLY, XYZ and Draco, positions and
+// colours by glTF; outliers removed on the way; what cannot be done refused with a reason.
+TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
+  PointCloud cloud = ColoredUnitSpherePoints(5000, 11);
+  cloud.normals = cloud.positions;  // The unit sphere's.
+  cloud.weights.assign(cloud.size(), 2.0f);
+  const std::string ply = *dir_ + "/points.ply";
+  ASSERT_TRUE(WritePointCloud(cloud, ply).ok());
+
+  const std::string xyz = *dir_ + "/points.xyz";
+  const RunResult to_xyz = RunNeuralmesh({"convert", ply, "-o", xyz});
+  ASSERT_EQ(to_xyz.exit_code, 0) << to_xyz.Describe();
+  EXPECT_EQ(to_xyz.out, xyz + ": 5000 points, with normals, weights, colours\n");
+  absl::StatusOr<PointCloud> read = ReadPointCloud(xyz);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->positions, cloud.positions);
+  EXPECT_EQ(read->normals, cloud.normals);
+  EXPECT_EQ(read->weights, cloud.weights);
+  EXPECT_EQ(read->colors, cloud.colors);
+
+  const std::string drc = *dir_ + "/points.drc";
+  const RunResult to_drc = RunNeuralmesh({"convert", xyz, "-o", drc});
+  ASSERT_EQ(to_drc.exit_code, 0) << to_drc.Describe();
+  read = ReadPointCloud(drc);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->size(), cloud.size());
+  EXPECT_EQ(read->colors.size(), cloud.size());
+  EXPECT_EQ(read->weights.size(), cloud.size());
+
+  const std::string glb = *dir_ + "/points.glb";
+  const RunResult to_glb = RunNeuralmesh({"convert", xyz, "-o", glb});
+  ASSERT_EQ(to_glb.exit_code, 0) << to_glb.Describe();
+  EXPECT_TRUE(absl::StrContains(
+      to_glb.out, "note: glTF keeps positions and colours; the normals and weights were left out"))
+      << to_glb.out;
+  read = ReadPointCloud(glb);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->positions, cloud.positions);
+  EXPECT_EQ(read->colors, cloud.colors);
+  EXPECT_TRUE(read->normals.empty());
+
+  // One stray point a hundred radii out is removed; the sphere's points stay.
+  PointCloud strayed = cloud;
+  strayed.positions.push_back(Vec3f(100, 0, 0));
+  strayed.normals.push_back(Vec3f(1, 0, 0));
+  strayed.weights.push_back(2.0f);
+  strayed.colors.push_back({0, 0, 0});
+  const std::string stray_ply = *dir_ + "/strayed.ply";
+  ASSERT_TRUE(WritePointCloud(strayed, stray_ply).ok());
+  const std::string clean = *dir_ + "/clean.ply";
+  const RunResult cleaned = RunNeuralmesh({"convert", stray_ply, "-o", clean, "--remove_outliers"});
+  ASSERT_EQ(cleaned.exit_code, 0) << cleaned.Describe();
+  read = ReadPointCloud(clean);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_LT(read->size(), strayed.size());
+  EXPECT_GT(read->size(), strayed.size() * 99 / 100);
+  for (const Vec3f& p : read->positions) ASSERT_LT(p.norm(), 1.01f) << "the stray was kept";
+  EXPECT_TRUE(absl::StrContains(cleaned.out, " outliers of 5001 removed)")) << cleaned.out;
+
+  struct Refused {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const Refused refused[] = {
+      {{"convert", xyz, "-o", *dir_ + "/points.obj"},
+       "holds points without faces: OUTPUT '" + *dir_ + "/points.obj' must be a point cloud "
+       "format (.ply, .xyz, .txt, .pts, .drc, .glb, .gltf)"},
+      {{"convert", "builtin:torus", "-o", *dir_ + "/torus.xyz"},
+       "builtin:torus is a surface, not points"},
+      {{"convert", xyz, "-o", glb, "--gltf_draco"}, "--gltf_draco compresses meshes"},
+      {{"convert", "builtin:sphere", "-o", *dir_ + "/sphere.ply", "--remove_outliers"},
+       "--remove_outliers removes points from point clouds; INPUT 'builtin:sphere' is a mesh"},
+      {{"convert", xyz, "-o", clean, "--remove_outliers", "--outlier_neighbours", "0"},
+       "--outlier_neighbours is 0"},
+  };
+  for (const Refused& r : refused) {
+    const RunResult run = RunNeuralmesh(r.args);
+    EXPECT_EQ(run.exit_code, 1) << run.Describe();
+    EXPECT_TRUE(absl::StrContains(run.err, r.message)) << run.Describe();
+  }
 }
 
 TEST_F(LocalCliTest, AnInterruptWritesTheMeshLearnedSoFar) {

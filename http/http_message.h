@@ -23,6 +23,9 @@ struct HttpRequest {
   std::string path;                            // Percent-decoded, starts with '/'.
   std::map<std::string, std::string> query;    // Percent-decoded; the last of repeated names.
   std::map<std::string, std::string> headers;  // Names lower-cased, values trimmed.
+  // Set by HttpServer: the client sent a certificate that the TLS context's client CAs signed
+  // (TlsServerContext::Create).
+  bool client_certificate = false;
 };
 
 // Parses a request head: the request line and the header lines, each ending in CRLF (or LF),

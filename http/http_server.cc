@@ -234,6 +234,7 @@ void HttpServer::Serve(int fd, absl::Time read_deadline) {
         response.headers.emplace_back("Allow", "GET, HEAD");
         Respond(connection, response, true);
       } else {
+        request->client_certificate = connection.client_certificate_verified();
         Respond(connection, handler_(*request), request->method == "GET");
       }
     } else if (absl::IsResourceExhausted(head.status())) {

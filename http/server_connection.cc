@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <openssl/err.h>
 #include <openssl/ssl.h>
+#include <openssl/x509.h>
 #include <poll.h>
 #include <sys/socket.h>
 
@@ -60,6 +61,14 @@ bool ServerConnection::StartsWithTlsHandshake() const {
     }
     return false;
   }
+}
+
+bool ServerConnection::client_certificate_verified() const {
+  if (tls_ == nullptr) return false;
+  X509* certificate = SSL_get1_peer_certificate(tls_);
+  if (certificate == nullptr) return false;
+  X509_free(certificate);
+  return SSL_get_verify_result(tls_) == X509_V_OK;
 }
 
 absl::Status ServerConnection::AcceptTls(const TlsServerContext& context) {

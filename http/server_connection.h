@@ -35,6 +35,10 @@ class ServerConnection {
   // speaks no TLS, or has not finished by the read deadline).
   absl::Status AcceptTls(const TlsServerContext& context);
 
+  // Whether the client sent, in the handshake of AcceptTls, a certificate that the context's
+  // client CAs signed (false without TLS or without client CAs).
+  bool client_certificate_verified() const;
+
   // Up to `size` bytes; 0 when the peer closed, the read deadline passed or the connection
   // failed.
   size_t Receive(char* buffer, size_t size);

@@ -43,8 +43,47 @@ std::string TakeOpenSslError(absl::string_view fallback) {
   return reason;
 }
 
+namespace {
+
+// Makes `context` ask clients for a certificate and verify one that is sent against the CAs
+// of `pem`, which it names to clients as those it takes.
+absl::Status AskClientCertificates(SSL_CTX* context, absl::string_view pem) {
+  if (pem.find("-----BEGIN CERTIFICATE-----") == absl::string_view::npos) {
+    return absl::InvalidArgumentError("the client CA file holds no PEM certificate");
+  }
+  X509_STORE* store = SSL_CTX_get_cert_store(context);
+  STACK_OF(X509_NAME)* names = sk_X509_NAME_new_null();
+  std::unique_ptr<BIO, BioFree> bio = ReadOnlyBio(pem);
+  int count = 0;
+  while (true) {
+    std::unique_ptr<X509, X509Free> ca(PEM_read_bio_X509(bio.get(), nullptr, nullptr, nullptr));
+    if (ca == nullptr) break;
+    ++count;
+    X509_NAME* name = X509_NAME_dup(X509_get_subject_name(ca.get()));
+    if (X509_STORE_add_cert(store, ca.get()) != 1 || name == nullptr ||
+        sk_X509_NAME_push(names, name) == 0) {
+      X509_NAME_free(name);
+      sk_X509_NAME_pop_free(names, X509_NAME_free);
+      return absl::InvalidArgumentError(absl::StrCat("client CA certificate ", count,
+                                                     " cannot be used: ",
+                                                     TakeOpenSslError("refused")));
+    }
+  }
+  ERR_clear_error();  // The end of the file reads as "no start line".
+  if (count == 0) {
+    sk_X509_NAME_pop_free(names, X509_NAME_free);
+    return absl::InvalidArgumentError("the client CA certificates cannot be read");
+  }
+  SSL_CTX_set_client_CA_list(context, names);  // Takes `names`.
+  SSL_CTX_set_verify(context, SSL_VERIFY_PEER, nullptr);
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::StatusOr<std::shared_ptr<const TlsServerContext>> TlsServerContext::Create(
-    absl::string_view certificate_chain, absl::string_view private_key) {
+    absl::string_view certificate_chain, absl::string_view private_key,
+    absl::string_view client_ca_certificates) {
   ERR_clear_error();
   if (certificate_chain.find("-----BEGIN CERTIFICATE-----") == absl::string_view::npos) {
     return absl::InvalidArgumentError("the TLS certificate file holds no PEM certificate");
@@ -90,6 +129,10 @@ absl::StatusOr<std::shared_ptr<const TlsServerContext>> TlsServerContext::Create
     return absl::InvalidArgumentError(
         absl::StrCat("the TLS private key does not belong to the certificate: ",
                      TakeOpenSslError("they do not match")));
+  }
+  if (!client_ca_certificates.empty()) {
+    const absl::Status asked = AskClientCertificates(context.get(), client_ca_certificates);
+    if (!asked.ok()) return asked;
   }
   return std::shared_ptr<const TlsServerContext>(new TlsServerContext(context.release()));
 }

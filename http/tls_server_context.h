@@ -19,10 +19,16 @@ namespace neuralmesh::http {
 class TlsServerContext {
  public:
   // From PEM text: `certificate_chain` holds the server's certificate, then any intermediates;
-  // `private_key` is the certificate's key. INVALID_ARGUMENT saying which part is wrong (no
-  // certificate, not PEM, a key that does not belong to the certificate) with OpenSSL's reason.
+  // `private_key` is the certificate's key. With `client_ca_certificates` (PEM, one or more
+  // CAs) the handshake asks the client for a certificate and fails when one is sent that
+  // those CAs did not sign; a client may still send none (ServerConnection::
+  // client_certificate_verified says which, so that pages for probes can stay open).
+  // INVALID_ARGUMENT saying which part is wrong (no certificate, not PEM, a key that does not
+  // belong to the certificate, client CAs that are not PEM certificates) with OpenSSL's
+  // reason.
   static absl::StatusOr<std::shared_ptr<const TlsServerContext>> Create(
-      absl::string_view certificate_chain, absl::string_view private_key);
+      absl::string_view certificate_chain, absl::string_view private_key,
+      absl::string_view client_ca_certificates = {});
   ~TlsServerContext();
 
   TlsServerContext(const TlsServerContext&) = delete;

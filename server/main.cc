@@ -115,8 +115,13 @@ ABSL_FLAG(std::string, metrics_host, "",
           "Address the metrics page listens on; empty: --host's.");
 ABSL_FLAG(bool, metrics_tls, false,
           "Serve the metrics page over HTTPS with the certificate and key of --tls_cert_file "
-          "and --tls_key_file (SIGHUP renews it with them); no client certificate is asked "
-          "for. Needs --metrics_port and --tls_cert_file.");
+          "and --tls_key_file (SIGHUP renews it with them); a client certificate is asked for "
+          "only with --metrics_client_certificate. Needs --metrics_port and --tls_cert_file.");
+ABSL_FLAG(bool, metrics_client_certificate, false,
+          "With --metrics_tls and --tls_client_ca_file: /metrics answers only clients that "
+          "present a certificate the client CAs signed (403 otherwise; Prometheus: "
+          "tls_config.cert_file and key_file); /healthz stays open to probes without one. "
+          "SIGHUP reads the CAs again with the certificate.");
 ABSL_FLAG(std::string, metrics_token_file, "",
           "File holding a token (16 or more letters, digits or -._~) that /metrics asks for "
           "as 'Authorization: Bearer TOKEN' (401 otherwise; Prometheus: authorization."
@@ -335,6 +340,7 @@ int main(int argc, char** argv) {
   options.metrics_port = absl::GetFlag(FLAGS_metrics_port);
   options.metrics_host = absl::GetFlag(FLAGS_metrics_host);
   options.metrics_tls = absl::GetFlag(FLAGS_metrics_tls);
+  options.metrics_client_certificate = absl::GetFlag(FLAGS_metrics_client_certificate);
   if (options.checkpoint_interval < absl::ZeroDuration() ||
       options.checkpoint_interval == absl::InfiniteDuration()) {
     std::fprintf(stderr,

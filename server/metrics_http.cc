@@ -84,6 +84,11 @@ std::string RenderMetrics(const MetricsSources& sources) {
 http::HttpResponse AnswerMetricsRequest(const http::HttpRequest& request,
                                         const MetricsSources& sources) {
   if (request.path == "/metrics") {
+    if (sources.require_client_certificate && !request.client_certificate) {
+      return http::TextResponse(403,
+                                "/metrics needs a client certificate signed by the server's "
+                                "client CA (--tls_client_ca_file)");
+    }
     if (sources.access != nullptr && !sources.access->Admits(request)) {
       return http::BearerChallenge(
           "neuralmesh metrics",

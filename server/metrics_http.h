@@ -9,8 +9,10 @@
 //
 // Totals only, like ServerMetrics: no session id, name or client. Other paths get 404, other
 // methods 405 (http/http_server.h). With a token (--metrics_token_file), /metrics answers only
-// requests that bring it ("Authorization: Bearer TOKEN"; 401 otherwise); /healthz and / stay
-// open to probes, as they tell nothing but whether the server serves.
+// requests that bring it ("Authorization: Bearer TOKEN"; 401 otherwise), and with client
+// certificates (--metrics_client_certificate) only clients that present one the server's
+// client CAs signed (403 otherwise); /healthz and / stay open to probes, as they tell nothing
+// but whether the server serves.
 #ifndef NEURALMESH_SERVER_METRICS_HTTP_H_
 #define NEURALMESH_SERVER_METRICS_HTTP_H_
 
@@ -55,6 +57,9 @@ struct MetricsSources {
   int worker_threads = 0;
   absl::Time start_time;  // Of the process, or of the server.
   std::shared_ptr<const MetricsAccess> access;  // Null: anyone may read /metrics.
+  // Whether /metrics needs a verified client certificate (http::HttpRequest::
+  // client_certificate) besides what `access` asks.
+  bool require_client_certificate = false;
 };
 
 // The /metrics page's text.

@@ -34,6 +34,15 @@ std::string HostOf(absl::string_view address) {
   return std::string(host);
 }
 
+// The metrics page's TLS: the certificate and key of `tls`, and with
+// metrics_client_certificate its client CAs.
+absl::StatusOr<std::shared_ptr<const http::TlsServerContext>> MetricsTlsContext(
+    const ServerOptions& options, const ServerTls& tls) {
+  return http::TlsServerContext::Create(
+      tls.certificate_chain, tls.private_key,
+      options.metrics_client_certificate ? tls.client_ca_certificates : std::string());
+}
+
 }  // namespace
 
 ReconstructionServer::ReconstructionServer(const ServerOptions& options) : options_(options) {}
@@ -76,6 +85,12 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
         "metrics_tls serves the metrics page with the server's TLS certificate, and there is "
         "none (tls_cert_file)");
   }
+  if (options.metrics_client_certificate &&
+      (!options.metrics_tls || options.security.tls.client_ca_certificates.empty())) {
+    return absl::InvalidArgumentError(
+        "metrics_client_certificate asks the metrics page's clients for a certificate signed "
+        "by the server's client CAs: it needs metrics_tls and client CAs (tls_client_ca_file)");
+  }
   if (!options.metrics_token.empty()) {
     absl::StatusOr<std::string> token =
         http::ParseSecret(options.metrics_token, "the metrics token");
@@ -87,8 +102,7 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
   std::shared_ptr<const http::TlsServerContext> metrics_tls;
   if (options.metrics_tls) {
     absl::StatusOr<std::shared_ptr<const http::TlsServerContext>> context =
-        http::TlsServerContext::Create(options.security.tls.certificate_chain,
-                                       options.security.tls.private_key);
+        MetricsTlsContext(options, options.security.tls);
     if (!context.ok()) {
       return absl::Status(context.status().code(),
                           absl::StrCat("metrics page: ", context.status().message()));
@@ -179,6 +193,7 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
       server->metrics_access_ = std::make_shared<MetricsAccess>(options.metrics_token);
       sources.access = server->metrics_access_;
     }
+    sources.require_client_certificate = options.metrics_client_certificate;
     std::string host =
         options.metrics_host.empty() ? HostOf(options.address) : options.metrics_host;
     if (host.empty()) host = "127.0.0.1";  // In-process only: no network the server listens on.
@@ -242,7 +257,7 @@ absl::Status ReconstructionServer::ReplaceTls(const ServerTls& tls) {
   std::shared_ptr<const http::TlsServerContext> metrics_tls;
   if (options_.metrics_tls && metrics_http_ != nullptr) {
     absl::StatusOr<std::shared_ptr<const http::TlsServerContext>> context =
-        http::TlsServerContext::Create(tls.certificate_chain, tls.private_key);
+        MetricsTlsContext(options_, tls);
     if (!context.ok()) return context.status();
     metrics_tls = *std::move(context);
   }

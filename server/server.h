@@ -63,6 +63,10 @@ struct ServerOptions {
   // The metrics page speaks HTTPS with the certificate and key of security.tls (needs TLS),
   // and ReplaceTls renews it with them; false: plain HTTP.
   bool metrics_tls = false;
+  // With metrics_tls and client CAs (security.tls.client_ca_certificates): /metrics answers
+  // only clients that present a certificate those CAs signed (403 otherwise); / and /healthz
+  // stay open to probes without one.
+  bool metrics_client_certificate = false;
   // Set: /metrics asks for this token (http::ParseSecret's rules) as "Authorization: Bearer";
   // empty: anyone who reaches the page reads it.
   std::string metrics_token;
@@ -109,7 +113,7 @@ class ReconstructionServer {
 
   // Replaces the server's TLS certificate, key and client CAs for the connections that start
   // about a second from now (ServerTlsIdentity::Replace), and with metrics_tls the metrics
-  // page's certificate and key at once; connections and calls already running go on.
+  // page's certificate and key (and client CAs, with metrics_client_certificate) at once; connections and calls already running go on.
   // FAILED_PRECONDITION when the server was started without TLS, INVALID_ARGUMENT (the old
   // identity kept) when gRPC or OpenSSL does not take the new one or it would turn mutual TLS
   // on or off.

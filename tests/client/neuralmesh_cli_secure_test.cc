@@ -379,6 +379,9 @@ TEST_F(SecureCliTest, TheServerRefusesSecurityFlagsThatDoNotGoTogetherAndDocumen
        "none (tls_cert_file)"},
       {{"--port=0", "--metrics_token_file=" + Path("token")},
        "there is none (metrics_port)"},
+      {{"--port=0", cert, key, "--metrics_port=0", "--metrics_tls",
+        "--metrics_client_certificate"},
+       "it needs metrics_tls and client CAs (tls_client_ca_file)"},
       {{"--port=0", "--metrics_port=0", "--metrics_token_file=" + certs().Path("ca.pem")},
        "--metrics_token_file: the metrics token may hold letters"},
       {{"--port=0", "--metrics_port=0", "--metrics_token_file=" + Path("missing")},
@@ -393,7 +396,7 @@ TEST_F(SecureCliTest, TheServerRefusesSecurityFlagsThatDoNotGoTogetherAndDocumen
   const RunResult help = RunBinary("neuralmesh-server", {"--help"});
   for (const char* flag : {"--tls_cert_file", "--tls_key_file", "--tls_client_ca_file",
                            "--access_tokens_file", "--max_sessions", "--port", "--metrics_tls",
-                           "--metrics_token_file"}) {
+                           "--metrics_token_file", "--metrics_client_certificate"}) {
     EXPECT_THAT(help.out, HasSubstr(flag)) << help.Describe();
   }
 }

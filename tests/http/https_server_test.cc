@@ -1,5 +1,5 @@
 // HttpServer over TLS (HttpServerOptions::tls): the handshake with a client that checks the
-// certificate, a renewed certificate for new connections, plain HTTP on the HTTPS port, stalled
+// certificate, client certificates, a renewed certificate for new connections, plain HTTP on the HTTPS port, stalled
 // handshakes at shutdown, and the certificate and key files TlsServerContext refuses.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -137,6 +137,45 @@ TEST_F(HttpsServerTest, NewConnectionsGetTheReplacedCertificate) {
   EXPECT_EQ(refused.message(), "this HTTP server was started without TLS");
 }
 
+// With client CAs the server asks for a client certificate: one those CAs signed is marked on
+// the request, none is let through unmarked, and one signed by another CA ends the handshake.
+TEST_F(HttpsServerTest, AClientCertificateSignedByTheClientCaIsMarkedOnTheRequest) {
+  HttpServerOptions options;
+  absl::StatusOr<std::shared_ptr<const TlsServerContext>> context = TlsServerContext::Create(
+      certificates_->server_chain, certificates_->server_key, certificates_->ca);
+  ASSERT_TRUE(context.ok()) << context.status();
+  options.tls = *context;
+  const auto handler = [](const HttpRequest& request) {
+    return TextResponse(200, request.client_certificate ? "certificate" : "none");
+  };
+  absl::StatusOr<std::unique_ptr<HttpServer>> server =
+      HttpServer::Start("127.0.0.1", 0, handler, options);
+  ASSERT_TRUE(server.ok()) << server.status();
+  HttpsTarget target = Target((*server)->port(), certificates_->ca, "127.0.0.1");
+  std::string error;
+  HttpReply reply = HttpsGet(target, "/", "", &error);
+  EXPECT_EQ(reply.status, 200) << error;
+  EXPECT_EQ(reply.body, "none\n");
+
+  target.client_chain = certificates_->client_chain;
+  target.client_key = certificates_->client_key;
+  reply = HttpsGet(target, "/", "", &error);
+  EXPECT_EQ(reply.status, 200) << error;
+  EXPECT_EQ(reply.body, "certificate\n");
+
+  target.client_chain = certificates_->other_client_chain;
+  target.client_key = certificates_->other_client_key;
+  EXPECT_EQ(HttpsGet(target, "/", "", &error).status, 0) << "another CA's client was let in";
+
+  // Without client CAs no certificate is asked for, so none is marked.
+  std::unique_ptr<HttpServer> plain_tls = StartHttps();
+  ASSERT_NE(plain_tls, nullptr);
+  HttpsTarget unasked = Target(plain_tls->port(), certificates_->ca, "127.0.0.1");
+  unasked.client_chain = certificates_->client_chain;
+  unasked.client_key = certificates_->client_key;
+  EXPECT_EQ(HttpsGet(unasked, "/x").body, "/x\n");
+}
+
 TEST_F(HttpsServerTest, ShutdownEndsAHandshakeThatStalls) {
   HttpServerOptions options;
   options.read_timeout = absl::Minutes(5);
@@ -175,6 +214,16 @@ TEST_F(HttpsServerTest, TlsServerContextSaysWhichPartIsWrong) {
               StartsWith("the TLS private key cannot be read: "));
   EXPECT_THAT(message(certificates_->server_chain, certificates_->client_key),
               StartsWith("the TLS private key does not belong to the certificate: "));
+  const auto client_ca_message = [](const std::string& client_ca) {
+    absl::StatusOr<std::shared_ptr<const TlsServerContext>> context = TlsServerContext::Create(
+        certificates_->server_chain, certificates_->server_key, client_ca);
+    EXPECT_EQ(context.status().code(), absl::StatusCode::kInvalidArgument);
+    return std::string(context.status().message());
+  };
+  EXPECT_EQ(client_ca_message(certificates_->server_key),
+            "the client CA file holds no PEM certificate");
+  EXPECT_EQ(client_ca_message("-----BEGIN CERTIFICATE-----\nnot base64\n-----END CERTIFICATE-----\n"),
+            "the client CA certificates cannot be read");
   // A chain with an intermediate after the leaf (here the CA itself) is taken.
   EXPECT_TRUE(TlsServerContext::Create(certificates_->server_chain + certificates_->ca,
                                        certificates_->server_key)

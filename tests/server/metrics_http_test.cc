@@ -312,6 +312,60 @@ TEST(MetricsHttpTest, OverTlsWithATokenOnlyTheTokensHolderReadsTheMetrics) {
             absl::StatusCode::kFailedPrecondition);
 }
 
+// --metrics_client_certificate: /metrics for clients with a certificate of the server's client
+// CAs only; probes without one still reach /healthz; a renewed CA takes over on ReplaceTls.
+TEST(MetricsHttpTest, WithClientCertificatesOnlyAClientOfTheClientCaReadsTheMetrics) {
+  absl::StatusOr<neuralmesh::testing::TestCertificates> certificates =
+      neuralmesh::testing::MakeTestCertificates(neuralmesh::testing::MakeTempDir("metrics_mtls"));
+  ASSERT_TRUE(certificates.ok()) << certificates.status();
+  ServerOptions options;
+  options.security.tls.certificate_chain = certificates->server_chain;
+  options.security.tls.private_key = certificates->server_key;
+  options.security.tls.client_ca_certificates = certificates->ca;
+  options.metrics_tls = true;
+  options.metrics_client_certificate = true;
+  std::unique_ptr<ReconstructionServer> server = StartWithMetrics(options);
+  ASSERT_NE(server, nullptr);
+  HttpsTarget target;
+  target.port = server->metrics_port();
+  target.ca = certificates->ca;
+
+  std::string error;
+  const HttpReply bare = HttpsGet(target, "/metrics", "", &error);
+  EXPECT_EQ(bare.status, 403) << error;
+  EXPECT_EQ(bare.body,
+            "/metrics needs a client certificate signed by the server's client CA "
+            "(--tls_client_ca_file)\n");
+  EXPECT_EQ(HttpsGet(target, "/healthz").status, 200) << "probes need no certificate";
+
+  HttpsTarget client = target;
+  client.client_chain = certificates->client_chain;
+  client.client_key = certificates->client_key;
+  const HttpReply scraped = HttpsGet(client, "/metrics", "", &error);
+  EXPECT_EQ(scraped.status, 200) << error;
+  EXPECT_THAT(scraped.body, HasSubstr("neuralmesh_sessions{state=\"learning\"} 0"));
+  HttpsTarget stranger = target;
+  stranger.client_chain = certificates->other_client_chain;
+  stranger.client_key = certificates->other_client_key;
+  EXPECT_EQ(HttpsGet(stranger, "/metrics").status, 0) << "another CA's client was let in";
+
+  // The client CAs renewed with the certificate: the other CA's clients now, not the first's.
+  ServerTls renewed = options.security.tls;
+  renewed.client_ca_certificates = certificates->other_ca;
+  ASSERT_TRUE(server->ReplaceTls(renewed).ok());
+  EXPECT_EQ(HttpsGet(stranger, "/metrics", "", &error).status, 200) << error;
+  EXPECT_EQ(HttpsGet(client, "/metrics").status, 0);
+
+  // It needs the page over TLS, and client CAs.
+  options.metrics_client_certificate = true;
+  options.security.tls.client_ca_certificates.clear();
+  options.address = "127.0.0.1:0";
+  options.metrics_port = 0;
+  absl::Status status = ReconstructionServer::Start(options).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("it needs metrics_tls and client CAs"));
+}
+
 TEST(MetricsHttpTest, TlsAndATokenNeedAMetricsPageAndTlsNeedsACertificate) {
   ServerOptions options;
   options.address = "127.0.0.1:0";

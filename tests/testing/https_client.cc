@@ -38,6 +38,23 @@ bool TrustPem(SSL_CTX* context, const std::string& pem) {
   return trusted > 0;
 }
 
+// Presents the certificate of `chain` with `key` when the server asks; false when they do
+// not make one.
+bool UseClientCertificate(SSL_CTX* context, const std::string& chain, const std::string& key) {
+  BIO* chain_bio = BIO_new_mem_buf(chain.data(), static_cast<int>(chain.size()));
+  X509* certificate = PEM_read_bio_X509(chain_bio, nullptr, nullptr, nullptr);
+  BIO_free(chain_bio);
+  BIO* key_bio = BIO_new_mem_buf(key.data(), static_cast<int>(key.size()));
+  EVP_PKEY* private_key = PEM_read_bio_PrivateKey(key_bio, nullptr, nullptr, nullptr);
+  BIO_free(key_bio);
+  const bool used = certificate != nullptr && private_key != nullptr &&
+                    SSL_CTX_use_certificate(context, certificate) == 1 &&
+                    SSL_CTX_use_PrivateKey(context, private_key) == 1;
+  X509_free(certificate);
+  EVP_PKEY_free(private_key);
+  return used;
+}
+
 }  // namespace
 
 HttpReply SendRawHttps(const HttpsTarget& target, const std::string& request, std::string* error) {
@@ -51,6 +68,11 @@ HttpReply SendRawHttps(const HttpsTarget& target, const std::string& request, st
     return HttpReply();
   }
   SSL_CTX_set_verify(context.get(), SSL_VERIFY_PEER, nullptr);
+  if (!target.client_chain.empty() &&
+      !UseClientCertificate(context.get(), target.client_chain, target.client_key)) {
+    why = "the client certificate and key cannot be used: " + OpenSslReason();
+    return HttpReply();
+  }
   const int fd = ConnectToLoopback(target.port);
   if (fd < 0) {
     why = "cannot connect";

@@ -14,6 +14,8 @@ struct HttpsTarget {
   int port = 0;                    // On 127.0.0.1.
   std::string ca;                  // PEM: the CA the server's certificate must chain to.
   std::string host = "127.0.0.1";  // The name or address it must be for (and SNI for a name).
+  // PEM: a client certificate and its key to present when the server asks. Empty: none.
+  std::string client_chain, client_key;
 };
 
 // Sends `request` as is over TLS and reads until the server closes. A failed connection or

@@ -54,13 +54,6 @@ absl::StatusOr<SamplingMode> ParseSamplingMode(absl::string_view name) {
                                                  "'; use uniform, weighted, area or curvature"));
 }
 
-absl::StatusOr<size_t> RemoveOutliers(PointCloud& cloud, const OutlierOptions& options) {
-  NM_ASSIGN_OR_RETURN(const std::vector<bool> outlier, FindStatisticalOutliers(cloud, options));
-  const size_t removed = static_cast<size_t>(std::count(outlier.begin(), outlier.end(), true));
-  if (removed > 0) cloud = WithoutPoints(cloud, outlier);
-  return removed;
-}
-
 // Paints with `source` (built from INPUT `input`); ", with colours" for the description.
 absl::StatusOr<std::string> UseColors(absl::StatusOr<std::unique_ptr<ColorSource>> source,
                                       const std::string& input, TargetSpace& target) {
@@ -122,7 +115,7 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
   const size_t points = cloud.size();
   std::string removed_outliers;
   if (outliers.has_value()) {
-    absl::StatusOr<size_t> removed = RemoveOutliers(cloud, *outliers);
+    absl::StatusOr<size_t> removed = RemoveStatisticalOutliers(cloud, *outliers);
     if (!removed.ok()) return InFile(removed.status(), "INPUT", input);
     removed_outliers = absl::StrCat(", outliers removed: ", *removed);
   }

@@ -54,9 +54,6 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(
     const std::optional<OutlierOptions>& outliers = std::nullopt,
     const std::optional<PointColorOptions>& colors = std::nullopt);
 
-// Removes the statistical outliers of `cloud` (statistical_outliers.h); returns how many went.
-absl::StatusOr<size_t> RemoveOutliers(PointCloud& cloud, const OutlierOptions& options);
-
 // The most points LoadPointsForUpload samples from a builtin surface: the server's default
 // limit of points per session (neuralmesh-server --max_points_per_session), 1.6 GB here.
 inline constexpr size_t kMaxBuiltinUploadPoints = size_t{1} << 26;

@@ -130,6 +130,10 @@ ABSL_FLAG(int32_t, outlier_neighbours, neuralmesh::OutlierOptions{}.neighbours,
 ABSL_FLAG(double, outlier_std_ratio, neuralmesh::OutlierOptions{}.std_ratio,
           "With --remove_outliers: how many standard deviations above the mean distance "
           "make an outlier, > 0.");
+ABSL_FLAG(int32_t, outlier_passes, neuralmesh::OutlierOptions{}.passes,
+          "With --remove_outliers: passes over the cloud, in [1, 16], each judging the points "
+          "the one before kept (a few far strays widen the deviation enough to hide milder "
+          "ones from the first). The server's filter (--outliers_on_server) makes one.");
 ABSL_FLAG(bool, outliers_on_server, false,
           "With --remove_outliers and --server: the session removes the outliers as the batches "
           "arrive (SessionConfig.outlier_removal), as for a client that streams a scan, instead "
@@ -295,6 +299,11 @@ absl::StatusOr<std::optional<neuralmesh::OutlierOptions>> OutliersFromFlags() {
     return absl::InvalidArgumentError(
         absl::StrCat("--outlier_std_ratio is ", o.std_ratio, "; it must be finite and > 0"));
   }
+  o.passes = absl::GetFlag(FLAGS_outlier_passes);
+  if (o.passes < 1 || o.passes > 16) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--outlier_passes is ", o.passes, "; it must be in [1, 16]"));
+  }
   return o;
 }
 
@@ -432,6 +441,10 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     NM_ASSIGN_OR_RETURN(o.colors, ColorsFromFlags());
     if (o.outliers_on_server && !o.outliers.has_value()) {
       return absl::InvalidArgumentError("--outliers_on_server needs --remove_outliers");
+    }
+    if (o.outliers_on_server && o.outliers->passes > 1) {
+      return absl::InvalidArgumentError(
+          "--outlier_passes: the server's filter makes one pass (--outliers_on_server)");
     }
     NM_ASSIGN_OR_RETURN(o.draco, DracoFromFlags());
     o.batch_size = absl::GetFlag(FLAGS_batch_size);
@@ -599,9 +612,9 @@ std::vector<Subcommand> Commands() {
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
       "start_mesh", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
-      "outliers_on_server", "colors", "color_neighbours", "sampling", "time_budget", "max_steps",
-      "quantization_bits", "encode_speed", "gltf_draco", "progress", "server", "out-dir",
-      "batch-size", "points", "ply", "glb", "resume", "reconnect_for"};
+      "outlier_passes", "outliers_on_server", "colors", "color_neighbours", "sampling",
+      "time_budget", "max_steps", "quantization_bits", "encode_speed", "gltf_draco", "progress",
+      "server", "out-dir", "batch-size", "points", "ply", "glb", "resume", "reconnect_for"};
   // clang-format on
   return {
       {"reconstruct",
@@ -632,7 +645,7 @@ std::vector<Subcommand> Commands() {
        ".drc .glb .gltf with their normals and weights (glTF: positions and colours only),\n"
        "after --remove_outliers if given.",
        {"output", "gltf_draco", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
-        "quantization_bits", "encode_speed"},
+        "outlier_passes", "quantization_bits", "encode_speed"},
        Convert},
       {"eval",
        "eval MESH --reference REF [--json] [--samples N]",

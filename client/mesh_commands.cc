@@ -92,7 +92,7 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   const size_t read = cloud.size();
   size_t removed = 0;
   if (options.outliers.has_value()) {
-    NM_ASSIGN_OR_RETURN(removed, RemoveOutliers(cloud, *options.outliers));
+    NM_ASSIGN_OR_RETURN(removed, RemoveStatisticalOutliers(cloud, *options.outliers));
   }
   NM_RETURN_IF_ERROR(WritePointCloud(cloud, options.output, options.writing.draco));
   std::vector<std::string> carried;

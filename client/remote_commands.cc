@@ -79,7 +79,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   if (!options.colors) cloud.colors.clear();
   const bool outliers_on_server = options.outliers.has_value() && options.outliers_on_server;
   if (options.outliers.has_value() && !outliers_on_server) {
-    NM_ASSIGN_OR_RETURN(const size_t removed, RemoveOutliers(cloud, *options.outliers));
+    NM_ASSIGN_OR_RETURN(const size_t removed, RemoveStatisticalOutliers(cloud, *options.outliers));
     out << "outliers removed: " << removed << " of " << points_read << " points\n";
   }
   std::optional<TriangleMesh> start_mesh;

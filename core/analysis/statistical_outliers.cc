@@ -13,6 +13,7 @@ namespace neuralmesh {
 namespace {
 
 constexpr int kMaxNeighbours = 256;
+constexpr int kMaxPasses = 16;
 
 }  // namespace
 
@@ -27,6 +28,11 @@ absl::Status OutlierOptions::Validate() const {
                                                    " is out of range; it must be finite and > 0"));
   }
   if (threads < 0) return absl::InvalidArgumentError("outlier threads must be >= 0");
+  if (passes < 1 || passes > kMaxPasses) {
+    return absl::InvalidArgumentError(absl::StrCat("outlier passes = ", passes,
+                                                   " is out of range; it must be in [1, ",
+                                                   kMaxPasses, "]"));
+  }
   return absl::OkStatus();
 }
 
@@ -71,6 +77,21 @@ double OutlierDistanceLimit(absl::Span<const double> mean_distances, double std_
   for (double d : mean_distances) squares += (d - mean) * (d - mean);
   const double deviation = std::sqrt(squares / static_cast<double>(n - 1));
   return mean + std_ratio * deviation;
+}
+
+absl::StatusOr<size_t> RemoveStatisticalOutliers(PointCloud& cloud,
+                                                 const OutlierOptions& options) {
+  if (absl::Status valid = options.Validate(); !valid.ok()) return valid;
+  size_t removed = 0;
+  for (int pass = 0; pass < options.passes; ++pass) {
+    absl::StatusOr<std::vector<bool>> outlier = FindStatisticalOutliers(cloud, options);
+    if (!outlier.ok()) return outlier.status();
+    const size_t found = static_cast<size_t>(std::count(outlier->begin(), outlier->end(), true));
+    if (found == 0) break;
+    cloud = WithoutPoints(cloud, *outlier);
+    removed += found;
+  }
+  return removed;
 }
 
 PointCloud WithoutPoints(const PointCloud& cloud, const std::vector<bool>& drop) {

@@ -5,7 +5,8 @@
 // like any other and pulls a spike out to it (README, Status): a scan's stray points are
 // best removed before learning. One pass, as those libraries make it: a few points very far
 // away widen the deviation enough to hide milder outliers (strays at 1,000 radii from a unit
-// sphere hide one at 2 radii); a second pass over the kept points finds those.
+// sphere hide one at 2 radii); a second pass over the kept points finds those
+// (RemoveStatisticalOutliers with `passes`).
 #ifndef NEURALMESH_CORE_ANALYSIS_STATISTICAL_OUTLIERS_H_
 #define NEURALMESH_CORE_ANALYSIS_STATISTICAL_OUTLIERS_H_
 
@@ -23,6 +24,9 @@ struct OutlierOptions {
   int neighbours = 16;     // k, in [1, 256].
   double std_ratio = 3.0;  // > 0: how many standard deviations above the mean is too far.
   int threads = 0;  // Query threads; 0: one per hardware thread. Results do not depend on it.
+  // In [1, 16]: the passes of RemoveStatisticalOutliers, each over the points the one before
+  // kept. FindStatisticalOutliers makes one.
+  int passes = 1;
 
   // INVALID_ARGUMENT naming the first field out of range.
   absl::Status Validate() const;
@@ -38,6 +42,11 @@ absl::StatusOr<std::vector<bool>> FindStatisticalOutliers(const PointCloud& clou
 // deviation of `mean_distances` (each point's mean distance to its k nearest neighbours).
 // Infinity for fewer than 2 distances.
 double OutlierDistanceLimit(absl::Span<const double> mean_distances, double std_ratio);
+
+// Removes the outliers of `cloud` in up to options.passes passes, each judging the points the
+// one before kept (stopping at a pass that finds none); weights, normals and colours go with
+// their points. Returns how many points went; INVALID_ARGUMENT for invalid options.
+absl::StatusOr<size_t> RemoveStatisticalOutliers(PointCloud& cloud, const OutlierOptions& options);
 
 // `cloud` without the points flagged in `drop` (one flag per point), weights, normals and
 // colours kept with their points.

@@ -415,23 +415,32 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   EXPECT_EQ(read->colors, cloud.colors);
   EXPECT_TRUE(read->normals.empty());
 
-  // One stray point a hundred radii out is removed; the sphere's points stay.
+  // Strays at 100 and 1,000 radii, which hide one at 2 radii from a first pass: two passes
+  // remove the three; the sphere's points stay.
   PointCloud strayed = cloud;
-  strayed.positions.push_back(Vec3f(100, 0, 0));
-  strayed.normals.push_back(Vec3f(1, 0, 0));
-  strayed.weights.push_back(2.0f);
-  strayed.colors.push_back({0, 0, 0});
+  for (const Vec3f& p : {Vec3f(100, 0, 0), Vec3f(0, 0, 1000), Vec3f(2, 0, 0)}) {
+    strayed.positions.push_back(p);
+    strayed.normals.push_back(Vec3f(1, 0, 0));
+    strayed.weights.push_back(2.0f);
+    strayed.colors.push_back({0, 0, 0});
+  }
   const std::string stray_ply = *dir_ + "/strayed.ply";
   ASSERT_TRUE(WritePointCloud(strayed, stray_ply).ok());
   const std::string clean = *dir_ + "/clean.ply";
-  const RunResult cleaned = RunNeuralmesh({"convert", stray_ply, "-o", clean, "--remove_outliers"});
+  const RunResult once = RunNeuralmesh({"convert", stray_ply, "-o", clean, "--remove_outliers"});
+  ASSERT_EQ(once.exit_code, 0) << once.Describe();
+  read = ReadPointCloud(clean);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->positions.back(), Vec3f(2, 0, 0)) << "one pass found the stray at 2 radii";
+  const RunResult cleaned = RunNeuralmesh(
+      {"convert", stray_ply, "-o", clean, "--remove_outliers", "--outlier_passes", "2"});
   ASSERT_EQ(cleaned.exit_code, 0) << cleaned.Describe();
   read = ReadPointCloud(clean);
   ASSERT_TRUE(read.ok()) << read.status();
   EXPECT_LT(read->size(), strayed.size());
   EXPECT_GT(read->size(), strayed.size() * 99 / 100);
-  for (const Vec3f& p : read->positions) ASSERT_LT(p.norm(), 1.01f) << "the stray was kept";
-  EXPECT_TRUE(absl::StrContains(cleaned.out, " outliers of 5001 removed)")) << cleaned.out;
+  for (const Vec3f& p : read->positions) ASSERT_LT(p.norm(), 1.01f) << "a stray was kept";
+  EXPECT_TRUE(absl::StrContains(cleaned.out, " outliers of 5003 removed)")) << cleaned.out;
 
   struct Refused {
     std::vector<std::string> args;
@@ -448,6 +457,11 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
        "--remove_outliers removes points from point clouds; INPUT 'builtin:sphere' is a mesh"},
       {{"convert", xyz, "-o", clean, "--remove_outliers", "--outlier_neighbours", "0"},
        "--outlier_neighbours is 0"},
+      {{"convert", xyz, "-o", clean, "--remove_outliers", "--outlier_passes", "17"},
+       "--outlier_passes is 17; it must be in [1, 16]"},
+      {{"reconstruct", xyz, "--server", "127.0.0.1:1", "--remove_outliers", "--outliers_on_server",
+        "--outlier_passes", "2"},
+       "--outlier_passes: the server's filter makes one pass"},
   };
   for (const Refused& r : refused) {
     const RunResult run = RunNeuralmesh(r.args);

@@ -65,6 +65,48 @@ TEST(StatisticalOutliersTest, StrayPointsAreFoundAndTheSurfaceIsKept) {
   }
 }
 
+// Strays at 100 and 1,000 radii widen the deviation enough to hide one at 2 radii from the
+// first pass; the second, over the points the first kept, finds it. A pass that finds nothing
+// ends the removal.
+TEST(StatisticalOutliersTest, ASecondPassFindsTheStraysTheFarthestHid) {
+  PointCloud cloud = SpherePoints(20000, 1);
+  cloud.weights.assign(cloud.size(), 1.0f);
+  for (const Vec3f& p : {Vec3f(0, -100, 0), Vec3f(0, 0, 1000), Vec3f(2, 0, 0)}) {
+    cloud.positions.push_back(p);
+    cloud.weights.push_back(7.0f);
+  }
+  const auto one_pass = FindStatisticalOutliers(cloud, OutlierOptions{});
+  ASSERT_TRUE(one_pass.ok()) << one_pass.status();
+  EXPECT_TRUE((*one_pass)[20000] && (*one_pass)[20001]);
+  EXPECT_FALSE((*one_pass)[20002]) << "the first pass found the mild stray: nothing to show";
+
+  OutlierOptions options;
+  options.passes = 2;
+  PointCloud cleaned = cloud;
+  const absl::StatusOr<size_t> removed = RemoveStatisticalOutliers(cleaned, options);
+  ASSERT_TRUE(removed.ok()) << removed.status();
+  EXPECT_EQ(*removed, cloud.size() - cleaned.size());
+  // The three strays and no point of the sphere (a third pass would take its own far end: 55
+  // points here, a fourth 53 more).
+  EXPECT_EQ(*removed, 3u);
+  ASSERT_EQ(cleaned.weights.size(), cleaned.size());
+  for (size_t i = 0; i < cleaned.size(); ++i) {
+    ASSERT_LT(cleaned.positions[i].norm(), 1.01f) << "a stray was kept";
+    ASSERT_EQ(cleaned.weights[i], 1.0f) << "weights left their points";
+  }
+
+  options.passes = 1;
+  PointCloud once = cloud;
+  ASSERT_TRUE(RemoveStatisticalOutliers(once, options).ok());
+  EXPECT_EQ(once.positions.back(), Vec3f(2, 0, 0)) << "one pass is FindStatisticalOutliers";
+  for (const int passes : {0, 17}) {
+    options.passes = passes;
+    const absl::Status status = RemoveStatisticalOutliers(once, options).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(status.message().find("passes"), absl::string_view::npos) << status;
+  }
+}
+
 TEST(StatisticalOutliersTest, AgreesWithTheDefinitionComputedByBruteForce) {
   Random rng(5);
   PointCloud cloud = SpherePoints(1500, 2);

@@ -6,6 +6,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "client/builtin_shapes.h"
 #include "client/file_util.h"
 #include "core/io/mesh_io.h"
@@ -113,6 +114,7 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
         absl::StrCat("INPUT '", input, "' has no per-point weights for --sampling weighted"));
   }
   const size_t points = cloud.size();
+  const std::string origin = OriginNote(cloud);
   std::string removed_outliers;
   if (outliers.has_value()) {
     absl::StatusOr<size_t> removed = RemoveStatisticalOutliers(cloud, *outliers);
@@ -131,7 +133,7 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
   if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
   target.sampler = *std::move(sampler);
   target.description = absl::StrCat(points, " points of ", input, " (", ModeName(mode), " sampling",
-                                    removed_outliers, with_colors, ")");
+                                    removed_outliers, with_colors, origin, ")");
   return target;
 }
 
@@ -154,6 +156,12 @@ absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string
   absl::StatusOr<PointCloud> cloud = ReadPointCloud(input);
   if (!cloud.ok()) return InFile(cloud.status(), role, input);
   return cloud;
+}
+
+std::string OriginNote(const PointCloud& cloud) {
+  if (cloud.origin == std::array<double, 3>{0, 0, 0}) return "";
+  return absl::StrFormat("; coordinates relative to (%.15g, %.15g, %.15g), as the meshes' are",
+                         cloud.origin[0], cloud.origin[1], cloud.origin[2]);
 }
 
 absl::StatusOr<TriangleMesh> LoadMesh(const std::string& input, absl::string_view role) {

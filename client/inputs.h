@@ -40,7 +40,7 @@ struct TargetSpace {
 };
 
 // The target space of `input`: builtin:NAME (its implicit surface; `mode` must be uniform),
-// a point cloud file (.ply .xyz .obj .off .drc; uniform or weighted), or a triangle mesh
+// a point cloud file (.ply .xyz .las .obj .off .drc .glb; uniform or weighted), or a triangle mesh
 // file for area and curvature sampling. Returns NOT_FOUND for a missing file and
 // INVALID_ARGUMENT for an empty or malformed one, an unknown extension or builtin name, or a
 // sampling mode the input cannot provide; each message names the file.
@@ -67,6 +67,10 @@ absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t 
 // The points of a point cloud file (any extension ReadPointCloud reads). Errors as
 // LoadTargetSpace; `role` names the argument in messages.
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role);
+
+// "" for a cloud whose positions are the file's coordinates; else (georeferenced LAS) what to
+// tell the user: "; coordinates relative to (X, Y, Z), as the meshes' are".
+std::string OriginNote(const PointCloud& cloud);
 
 // A mesh to report on or compare: a mesh file, or for builtin:NAME the reference mesh of the
 // implicit surface. Errors as LoadTargetSpace; `role` names the argument in messages.

@@ -622,10 +622,11 @@ std::vector<Subcommand> Commands() {
        "       neuralmesh reconstruct INPUT --server HOST:PORT --out-dir DIR [--vertices N] "
        "[--batch-size K] [--ply] [--glb] [--resume SESSION] [--reconnect_for D]",
        "Learns a mesh of a point cloud, a mesh or a built-in surface, locally or on a server.",
-       "Learns a mesh of INPUT: a point cloud (.ply .xyz .obj .off .drc .glb .gltf), a triangle\n"
-       "mesh with --sampling area|curvature, or builtin:sphere|torus|genus2. Locally it writes\n"
-       "OUTPUT and one OUTPUT_lod<N> file per --lod; with --server it uploads the points and\n"
-       "saves each mesh the server publishes into --out-dir. Prints the figures of every level.",
+       "Learns a mesh of INPUT: a point cloud (.ply .xyz .txt .pts .las .obj .off .drc .glb\n"
+       ".gltf), a triangle mesh with --sampling area|curvature, or builtin:sphere|torus|genus2.\n"
+       "Locally it writes OUTPUT and one OUTPUT_lod<N> file per --lod; with --server it\n"
+       "uploads the points and saves each mesh the server publishes into --out-dir. Prints\n"
+       "the figures of every level.",
        WithConnectionFlags(reconstruct), Reconstruct},
       {"stats",
        "stats MESH [--json]",
@@ -640,10 +641,10 @@ std::vector<Subcommand> Commands() {
        "Writes a mesh or a point cloud in another format.",
        "Writes INPUT to OUTPUT in the format of its extension, colours included where the\n"
        "format holds them. A mesh (a file with faces, or builtin:NAME, its dense reference\n"
-       "tessellation) goes to .ply .obj .off .stl .drc .glb .gltf; points (.xyz .txt .pts, a\n"
-       "file without faces, or anything written to .xyz .txt .pts) go to .ply .xyz .txt .pts\n"
-       ".drc .glb .gltf with their normals and weights (glTF: positions and colours only),\n"
-       "after --remove_outliers if given.",
+       "tessellation) goes to .ply .obj .off .stl .drc .glb .gltf; points (.xyz .txt .pts\n"
+       ".las, a file without faces, or anything written to .xyz .txt .pts) go to .ply .xyz .txt\n"
+       ".pts .drc .glb .gltf with their normals and weights (glTF: positions and colours\n"
+       "only), after --remove_outliers if given.",
        {"output", "gltf_draco", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "quantization_bits", "encode_speed"},
        Convert},

@@ -101,8 +101,10 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   if (!cloud.colors.empty()) carried.push_back("colours");
   out << options.output << ": " << cloud.size() << " points";
   if (!carried.empty()) out << ", with " << absl::StrJoin(carried, ", ");
-  if (options.outliers.has_value()) out << " (" << removed << " outliers of " << read << " removed)";
-  out << "\n";
+  if (options.outliers.has_value()) {
+    out << " (" << removed << " outliers of " << read << " removed)";
+  }
+  out << OriginNote(cloud) << "\n";
   if (gltf && (!cloud.normals.empty() || !cloud.weights.empty())) {
     out << "note: glTF keeps positions and colours; the normals and weights were left out\n";
   }

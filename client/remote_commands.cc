@@ -82,6 +82,9 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     NM_ASSIGN_OR_RETURN(const size_t removed, RemoveStatisticalOutliers(cloud, *options.outliers));
     out << "outliers removed: " << removed << " of " << points_read << " points\n";
   }
+  if (const std::string origin = OriginNote(cloud); !origin.empty()) {
+    out << "INPUT '" << options.input << "'" << origin << "\n";
+  }
   std::optional<TriangleMesh> start_mesh;
   if (!options.start_mesh.empty()) {
     if (!options.resume_session.empty()) {

@@ -55,6 +55,7 @@ absl::Status ValidatePointCloud(const PointCloud& cloud) {
 
 PointCloud PointRange(const PointCloud& cloud, size_t begin, size_t end) {
   PointCloud part;
+  part.origin = cloud.origin;
   part.positions.assign(cloud.positions.begin() + begin, cloud.positions.begin() + end);
   if (!cloud.weights.empty()) {
     part.weights.assign(cloud.weights.begin() + begin, cloud.weights.begin() + end);

@@ -2,6 +2,7 @@
 #ifndef NEURALMESH_CORE_POINT_CLOUD_H_
 #define NEURALMESH_CORE_POINT_CLOUD_H_
 
+#include <array>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -15,6 +16,9 @@ struct PointCloud {
   std::vector<float> weights;   // Empty, or one non-negative weight per point (Section 4.1).
   std::vector<Vec3f> normals;   // Empty, or one normal per point.
   std::vector<Rgb> colors;      // Empty, or one colour per point (scans that carry them).
+  // Where the file's coordinates put position (0, 0, 0): a reader of georeferenced data (LAS)
+  // moves the points there to keep a float's resolution. Zero for most files.
+  std::array<double, 3> origin = {0, 0, 0};
 
   size_t size() const { return positions.size(); }
   bool empty() const { return positions.empty(); }

@@ -96,6 +96,7 @@ absl::StatusOr<size_t> RemoveStatisticalOutliers(PointCloud& cloud,
 
 PointCloud WithoutPoints(const PointCloud& cloud, const std::vector<bool>& drop) {
   PointCloud kept;
+  kept.origin = cloud.origin;
   for (size_t i = 0; i < cloud.size(); ++i) {
     if (i < drop.size() && drop[i]) continue;
     kept.positions.push_back(cloud.positions[i]);

@@ -23,7 +23,7 @@ using io_internal::FileFormat;
 
 absl::StatusOr<FileFormat> MeshFormat(const std::string& path) {
   const FileFormat format = io_internal::FormatFromPath(path);
-  if (format == FileFormat::kUnknown || format == FileFormat::kXyz) {
+  if (format == FileFormat::kUnknown || format == FileFormat::kXyz || format == FileFormat::kLas) {
     const std::string extension = io_internal::LowercaseExtension(path);
     return absl::InvalidArgumentError(absl::StrCat(
         "'", path, "': ",
@@ -57,6 +57,7 @@ absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data
                                       io_internal::GltfBuffersBeside(path));
       break;
     case FileFormat::kXyz:
+    case FileFormat::kLas:
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
   }
@@ -104,7 +105,8 @@ const char kMeshExtensions[] = ".ply, .obj, .off, .stl, .drc, .glb, .gltf";
 bool IsSupportedMeshExtension(std::string_view path) {
   const FileFormat format =
       io_internal::FormatFromPath(absl::string_view(path.data(), path.size()));
-  return format != FileFormat::kUnknown && format != FileFormat::kXyz;
+  return format != FileFormat::kUnknown && format != FileFormat::kXyz &&
+         format != FileFormat::kLas;
 }
 
 absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path) {
@@ -155,6 +157,7 @@ absl::StatusOr<std::string> FormatMesh(const TriangleMesh& mesh, const std::stri
       break;
     }
     case FileFormat::kXyz:
+    case FileFormat::kLas:
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
   }

@@ -8,6 +8,7 @@
 #include "core/io/internal/gltf.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/las.h"
 #include "core/io/internal/obj.h"
 #include "core/io/internal/off.h"
 #include "core/io/internal/ply.h"
@@ -47,6 +48,9 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
     case FileFormat::kXyz:
       parsed = io_internal::ParseXyz(data);
       break;
+    case FileFormat::kLas:
+      parsed = io_internal::ParseLas(data);
+      break;
     case FileFormat::kObj:
       parsed = io_internal::ParseObj(data, io_internal::FaceHandling::kSkip);
       break;
@@ -69,6 +73,7 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
   cloud.normals = std::move(parsed->normals);
   cloud.weights = std::move(parsed->weights);
   cloud.colors = std::move(parsed->colors);
+  cloud.origin = parsed->origin;
   return cloud;
 }
 
@@ -85,7 +90,8 @@ bool IsWritablePointCloudExtension(std::string_view path) {
 absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path) {
   const FileFormat format = io_internal::FormatFromPath(path);
   if (!IsReadable(format)) {
-    return UnsupportedExtension(path, ".ply, .xyz, .txt, .pts, .obj, .off, .drc, .glb, .gltf");
+    return UnsupportedExtension(path,
+                                ".ply, .xyz, .txt, .pts, .las, .obj, .off, .drc, .glb, .gltf");
   }
   NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
   absl::StatusOr<PointCloud> cloud = ParsePointCloud(format, data, path);

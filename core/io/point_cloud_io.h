@@ -14,8 +14,8 @@
 
 namespace neuralmesh {
 
-// True when ReadPointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .obj,
-// .off, .drc, .glb, .gltf.
+// True when ReadPointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .las,
+// .obj, .off, .drc, .glb, .gltf.
 bool IsReadablePointCloudExtension(std::string_view path);
 
 // True when WritePointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .drc,
@@ -28,6 +28,8 @@ bool IsWritablePointCloudExtension(std::string_view path);
 //         weights; red, green, blue (or r, g, b) as colours.
 //   .xyz, .txt, .pts  "x y z [nx ny nz] [w]", "x y z r g b", "x y z i r g b" (PTS) lines
 //         and others a header comment names ("# x y z nx ny nz r g b w"); see internal/xyz.h.
+//   .las  LAS 1.0-1.4 point records of formats 0-10, with colours where the format has them;
+//         georeferenced coordinates relative to PointCloud::origin (see internal/las.h).
 //   .obj  the 'v' lines, 'v x y z r g b' with colours ('vn' is ignored: OBJ normals belong to
 //         face corners).
 //   .off  the vertices of OFF, COFF (with colours), NOFF (with normals), STOFF.

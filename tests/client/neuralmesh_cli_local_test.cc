@@ -1,5 +1,6 @@
 // End-to-end tests of the local subcommands of build/bin/neuralmesh (client/main.cc), run as
 // a subprocess: reconstruct, stats and eval on the built-in shapes.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -13,6 +14,7 @@
 #include "core/io/point_cloud_io.h"
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
+#include "tests/testing/las_file.h"
 #include "tests/testing/shapes.h"
 
 namespace neuralmesh::testing {
@@ -468,6 +470,53 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
     EXPECT_EQ(run.exit_code, 1) << run.Describe();
     EXPECT_TRUE(absl::StrContains(run.err, r.message)) << run.Describe();
   }
+}
+
+// A LiDAR scan in LAS, georeferenced (UTM, millimetres): a sphere of radius 10 m centred at
+// (500123.5, 4100456.25, 80). The mesh is learned relative to the origin the reader chose and
+// lies on the sphere; both commands say where that origin is.
+TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
+  const PointCloud unit = ColoredUnitSpherePoints(20000, 5);
+  testing::LasLayout layout;
+  layout.version_minor = 4;
+  layout.format = 7;
+  for (double& s : layout.scale) s = 0.001;
+  layout.offset[0] = 500000;
+  layout.offset[1] = 4100000;
+  const double centre[3] = {500123.5, 4100456.25, 80};
+  std::vector<testing::LasPoint> points;
+  for (size_t i = 0; i < unit.size(); ++i) {
+    testing::LasPoint p{};
+    int32_t* fields[3] = {&p.x, &p.y, &p.z};
+    for (int c = 0; c < 3; ++c) {
+      *fields[c] = static_cast<int32_t>(
+          std::lround((centre[c] + 10.0 * unit.positions[i][c] - layout.offset[c]) / 0.001));
+    }
+    p.red = unit.colors[i][0] * 257;
+    p.green = unit.colors[i][1] * 257;
+    p.blue = unit.colors[i][2] * 257;
+    points.push_back(p);
+  }
+  const std::string las = *dir_ + "/scan.las";
+  std::ofstream(las, std::ios::binary) << testing::LasFile(layout, points);
+
+  const std::string mesh = *dir_ + "/scan.ply";
+  const RunResult run = RunNeuralmesh({"reconstruct", las, "-o", mesh, "--vertices", "1000"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(
+      run.out, "with colours; coordinates relative to (500000, 4100000, 0), as the meshes' are)"))
+      << run.out;
+  const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);
+  ASSERT_TRUE(learned.ok()) << learned.status();
+  EXPECT_FALSE(learned->colors.empty());
+  for (const Vec3f& v : learned->positions) {
+    const Vec3f local(centre[0] - 500000, centre[1] - 4100000, centre[2]);
+    ASSERT_NEAR((v - local).norm(), 10.0f, 0.25f) << "a vertex off the sphere";
+  }
+  const RunResult convert = RunNeuralmesh({"convert", las, "-o", *dir_ + "/scan.xyz"});
+  ASSERT_EQ(convert.exit_code, 0) << convert.Describe();
+  EXPECT_EQ(convert.out, *dir_ + "/scan.xyz: 20000 points, with colours; coordinates relative "
+                                 "to (500000, 4100000, 0), as the meshes' are\n");
 }
 
 TEST_F(LocalCliTest, AnInterruptWritesTheMeshLearnedSoFar) {

@@ -286,13 +286,15 @@ TEST(MetricsHttpTest, OverTlsWithATokenOnlyTheTokensHolderReadsTheMetrics) {
   EXPECT_EQ(HttpsGet(target, "/metrics", "another-metrics-token").status, 200);
 
   // A renewed certificate (here for 127.0.0.1) serves the metrics page too.
-  EXPECT_EQ(HttpsGet(HttpsTarget{target.port, certificates->ca, "127.0.0.1"}, "/healthz").status,
+  HttpsTarget at_address = target;
+  at_address.host = "127.0.0.1";
+  EXPECT_EQ(HttpsGet(at_address, "/healthz").status,
             0);
   ServerTls renewed;
   renewed.certificate_chain = certificates->server_chain;
   renewed.private_key = certificates->server_key;
   ASSERT_TRUE(server->ReplaceTls(renewed).ok());
-  EXPECT_EQ(HttpsGet(HttpsTarget{target.port, certificates->ca, "127.0.0.1"}, "/healthz", "",
+  EXPECT_EQ(HttpsGet(at_address, "/healthz", "",
                      &error)
                 .status,
             200)
@@ -300,7 +302,7 @@ TEST(MetricsHttpTest, OverTlsWithATokenOnlyTheTokensHolderReadsTheMetrics) {
   // A key of another certificate is refused, and the page keeps the renewed one.
   renewed.private_key = certificates->client_key;
   EXPECT_EQ(server->ReplaceTls(renewed).code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_EQ(HttpsGet(HttpsTarget{target.port, certificates->ca, "127.0.0.1"}, "/healthz").status,
+  EXPECT_EQ(HttpsGet(at_address, "/healthz").status,
             200);
 
   // Without a token from the start, none can be added.

@@ -22,6 +22,7 @@ FileFormat FormatFromPath(absl::string_view path) {
   if (extension == ".drc") return FileFormat::kDraco;
   if (extension == ".glb" || extension == ".gltf") return FileFormat::kGltf;
   if (extension == ".xyz" || extension == ".txt" || extension == ".pts") return FileFormat::kXyz;
+  if (extension == ".las") return FileFormat::kLas;
   return FileFormat::kUnknown;
 }
 

@@ -23,6 +23,9 @@ struct ParsedGeometry {
   std::vector<float> weights;                  // Empty or one per position.
   std::vector<Rgb> colors;                     // Empty or one per position.
   std::vector<std::array<uint32_t, 3>> faces;  // Polygons fan-triangulated; indices in range.
+  // The positions are relative to this point (a reader of georeferenced data moved them there
+  // to keep a float's resolution); zero for most files.
+  std::array<double, 3> origin = {0, 0, 0};
 };
 
 struct GeometryView {

@@ -1,0 +1,160 @@
+#include "core/io/internal/las.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "absl/strings/str_cat.h"
+#include "core/io/internal/binary.h"
+#include "core/io/internal/text.h"
+#include "core/rgb.h"
+
+namespace neuralmesh::io_internal {
+namespace {
+
+// Offsets in the public header block (LAS 1.4, Table 3; earlier versions share the first 227
+// bytes).
+constexpr size_t kVersionMajor = 24;
+constexpr size_t kVersionMinor = 25;
+constexpr size_t kHeaderSize = 94;
+constexpr size_t kOffsetToPoints = 96;
+constexpr size_t kPointFormat = 104;
+constexpr size_t kRecordLength = 105;
+constexpr size_t kLegacyPointCount = 107;
+constexpr size_t kScale = 131;       // x, y, z: doubles.
+constexpr size_t kOffset = 155;      // x, y, z: doubles.
+constexpr size_t kMaxX = 179;        // max x, min x, max y, min y, max z, min z: doubles.
+constexpr size_t kPointCount = 247;  // LAS 1.4: uint64.
+constexpr size_t kLegacyHeaderSize = 227;
+constexpr size_t kHeaderSize14 = 375;
+
+// Format bits that LASzip sets on compressed (LAZ) files.
+constexpr uint8_t kCompressedBits = 0xC0;
+
+// The shortest record of each point format, and where its red channel is (0: no colour).
+struct PointFormat {
+  size_t length;
+  size_t rgb;
+};
+constexpr PointFormat kFormats[] = {{20, 0}, {28, 0},  {26, 20}, {34, 28}, {57, 0}, {63, 28},
+                                    {30, 0}, {36, 30}, {38, 30}, {59, 0},  {67, 30}};
+
+template <typename T>
+T Load(absl::string_view data, size_t offset) {
+  return LoadScalar<T>(data.data() + offset, /*big_endian=*/false);
+}
+
+absl::Status Invalid(absl::string_view message) {
+  return absl::InvalidArgumentError(absl::StrCat("LAS: ", message));
+}
+
+// Float positions keep a file's resolution `scale` up to this many scales from zero (a float
+// has 24 bits; half a scale of error at most).
+constexpr double kFloatExactScales = 1 << 22;
+
+}  // namespace
+
+absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
+  if (data.size() < kLegacyHeaderSize || data.substr(0, 4) != "LASF") {
+    return Invalid(data.size() >= 4 && data.substr(0, 4) == "LASF"
+                       ? absl::StrCat("the file ends within its header (", data.size(), " bytes)")
+                       : std::string("no LASF signature: not a LAS file"));
+  }
+  const int major = static_cast<uint8_t>(data[kVersionMajor]);
+  const int minor = static_cast<uint8_t>(data[kVersionMinor]);
+  if (major != 1 || minor > 4) {
+    return Invalid(absl::StrCat("version ", major, ".", minor, " is not 1.0 to 1.4"));
+  }
+  const size_t header_size = Load<uint16_t>(data, kHeaderSize);
+  const size_t offset_to_points = Load<uint32_t>(data, kOffsetToPoints);
+  const uint8_t format_byte = static_cast<uint8_t>(data[kPointFormat]);
+  const size_t record_length = Load<uint16_t>(data, kRecordLength);
+  if (header_size < kLegacyHeaderSize || header_size > data.size()) {
+    return Invalid(absl::StrCat("header size ", header_size, " is not between ", kLegacyHeaderSize,
+                                " and the file's ", data.size(), " bytes"));
+  }
+  if (format_byte & kCompressedBits) {
+    return Invalid(
+        "the points are compressed (LAZ); decompress them first (laszip, pdal "
+        "translate) or write them as .las");
+  }
+  if (format_byte > 10) {
+    return Invalid(absl::StrCat("point data format ", int{format_byte}, " is not 0 to 10"));
+  }
+  const PointFormat format = kFormats[format_byte];
+  if (record_length < format.length) {
+    return Invalid(absl::StrCat("records of ", record_length, " bytes are shorter than format ",
+                                int{format_byte}, "'s ", format.length));
+  }
+  uint64_t count = Load<uint32_t>(data, kLegacyPointCount);
+  if (minor >= 4 && header_size >= kHeaderSize14) {
+    const uint64_t count14 = Load<uint64_t>(data, kPointCount);
+    if (count14 != 0) count = count14;
+  }
+  if (offset_to_points < header_size || offset_to_points > data.size() ||
+      count > (data.size() - offset_to_points) / record_length) {
+    return Invalid(absl::StrCat(count, " points of ", record_length, " bytes from byte ",
+                                offset_to_points, " do not fit in the file's ", data.size(),
+                                " bytes"));
+  }
+  double scale[3], offset[3], min[3];
+  for (int c = 0; c < 3; ++c) {
+    scale[c] = Load<double>(data, kScale + 8 * c);
+    offset[c] = Load<double>(data, kOffset + 8 * c);
+    min[c] = Load<double>(data, kMaxX + 16 * c + 8);
+    if (!(scale[c] != 0) || !std::isfinite(scale[c]) || !std::isfinite(offset[c])) {
+      return Invalid(absl::StrCat("the scale and offset of axis ",
+                                  absl::string_view("xyz").substr(c, 1), " (", scale[c], ", ",
+                                  offset[c], ") are not finite numbers and a nonzero scale"));
+    }
+  }
+
+  ParsedGeometry out;
+  out.positions.resize(count);
+  // Where the coordinates lie (the header's bounds may be stale: the records decide).
+  double low[3] = {INFINITY, INFINITY, INFINITY}, high[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (uint64_t i = 0; i < count; ++i) {
+    const size_t at = offset_to_points + i * record_length;
+    for (int c = 0; c < 3; ++c) {
+      const double value = Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
+      low[c] = std::min(low[c], value);
+      high[c] = std::max(high[c], value);
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    const double far = std::max(std::fabs(low[c]), std::fabs(high[c]));
+    if (count > 0 && far > kFloatExactScales * std::fabs(scale[c])) {
+      // The header's minimum when it bounds the points, else theirs.
+      const double base = std::isfinite(min[c]) && min[c] <= low[c] ? min[c] : low[c];
+      out.origin[c] = std::floor(base / 1000) * 1000;
+    }
+  }
+  for (uint64_t i = 0; i < count; ++i) {
+    const size_t at = offset_to_points + i * record_length;
+    for (int c = 0; c < 3; ++c) {
+      const double value = Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
+      out.positions[i][c] = NarrowToFloat(value - out.origin[c]);
+      if (!std::isfinite(out.positions[i][c])) {
+        return Invalid(absl::StrCat("point ", i, " lies beyond a float's range"));
+      }
+    }
+  }
+  if (format.rgb != 0 && count > 0) {
+    uint16_t largest = 0;
+    for (uint64_t i = 0; i < count; ++i) {
+      const size_t at = offset_to_points + i * record_length + format.rgb;
+      for (int c = 0; c < 3; ++c) largest = std::max(largest, Load<uint16_t>(data, at + 2 * c));
+    }
+    const double max = largest <= 255 ? 255.0 : 65535.0;
+    out.colors.resize(count);
+    for (uint64_t i = 0; i < count; ++i) {
+      const size_t at = offset_to_points + i * record_length + format.rgb;
+      for (int c = 0; c < 3; ++c) {
+        out.colors[i][c] = ChannelFromLevel(Load<uint16_t>(data, at + 2 * c), max);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace neuralmesh::io_internal

@@ -1,0 +1,28 @@
+// ASPRS LAS 1.0-1.4 point clouds (.las), the exchange format of airborne and terrestrial LiDAR:
+// a header, then fixed-size point records of formats 0 to 10.
+#ifndef NEURALMESH_CORE_IO_INTERNAL_LAS_H_
+#define NEURALMESH_CORE_IO_INTERNAL_LAS_H_
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "core/io/internal/geometry_data.h"
+
+namespace neuralmesh::io_internal {
+
+// Parses a LAS file: the positions of its point records (integer X, Y, Z times the header's
+// scale, plus its offset) and, for the formats that carry them (2, 3, 5, 7, 8, 10), their
+// colours (16-bit channels scaled to 8 bits, or taken as they are when no channel of the
+// file exceeds 255, as some writers store 8-bit values). Positions are floats: on an axis
+// where the file's coordinates are too far from 0 for a float to keep its resolution (the
+// scale: georeferenced data such as UTM), they are taken relative to an origin, the header's
+// minimum rounded down to a multiple of 1,000, and ParsedGeometry::origin says so (a
+// translation: the shape is the same).
+// Returns INVALID_ARGUMENT saying what is wrong for a file without the "LASF" signature, a
+// header or records that run past the end of the file, a compressed (LAZ) file, a point
+// format above 10, a record shorter than its format, a zero or non-finite scale, or a point
+// count that does not fit the file.
+absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data);
+
+}  // namespace neuralmesh::io_internal
+
+#endif  // NEURALMESH_CORE_IO_INTERNAL_LAS_H_

@@ -1,0 +1,139 @@
+// LAS point clouds (core/io/internal/las.h) through ReadPointCloud: every point format, with
+// and without colours, LAS 1.2 and 1.4 headers, georeferenced coordinates moved to an origin,
+// and malformed or compressed files refused with what is wrong.
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/io/point_cloud_io.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/core/io/io_test_util.h"
+#include "tests/testing/las_file.h"
+
+namespace neuralmesh {
+namespace {
+
+using io_test::TempPath;
+using io_test::WriteBytes;
+using ::testing::HasSubstr;
+using testing::kLasRgbOffset;
+using testing::LasFile;
+using testing::LasLayout;
+using testing::LasPoint;
+
+absl::StatusOr<PointCloud> ReadLas(const std::string& name, const std::string& bytes) {
+  const std::string path = TempPath(name);
+  WriteBytes(path, bytes);
+  return ReadPointCloud(path);
+}
+
+const std::vector<LasPoint> kPoints = {
+    {0, 0, 0, 65535, 0, 32896}, {100, -250, 7, 257, 514, 771}, {-12345, 678, -9, 0, 65535, 0}};
+
+TEST(LasIoTest, ReadsThePositionsAndColoursOfEveryPointFormat) {
+  const std::vector<Rgb> colors = {{255, 0, 128}, {1, 2, 3}, {0, 255, 0}};
+  for (int format = 0; format <= 10; ++format) {
+    SCOPED_TRACE(::testing::Message() << "format " << format);
+    LasLayout layout;
+    layout.version_minor = format <= 5 ? 2 : 4;
+    layout.format = format;
+    layout.offset[0] = 10;
+    layout.offset[2] = -3;
+    const absl::StatusOr<PointCloud> cloud = ReadLas("format.las", LasFile(layout, kPoints));
+    ASSERT_TRUE(cloud.ok()) << cloud.status();
+    ASSERT_EQ(cloud->size(), 3u);
+    for (size_t i = 0; i < kPoints.size(); ++i) {
+      EXPECT_FLOAT_EQ(cloud->positions[i][0], kPoints[i].x * 0.01 + 10);
+      EXPECT_FLOAT_EQ(cloud->positions[i][1], kPoints[i].y * 0.01);
+      EXPECT_FLOAT_EQ(cloud->positions[i][2], kPoints[i].z * 0.01 - 3);
+    }
+    EXPECT_EQ(cloud->colors, kLasRgbOffset[format] != 0 ? colors : std::vector<Rgb>{});
+    EXPECT_EQ(cloud->origin, (std::array<double, 3>{0, 0, 0}));
+  }
+  // Records longer than their format (extra bytes) are read by the header's length; 8-bit
+  // colours stored in 16-bit channels (no channel above 255) are taken as they are.
+  LasLayout padded;
+  padded.format = 2;
+  padded.record_length = 31;
+  const std::vector<LasPoint> dim = {{1, 2, 3, 255, 0, 128}, {4, 5, 6, 1, 2, 3}};
+  const absl::StatusOr<PointCloud> cloud = ReadLas("padded.las", LasFile(padded, dim));
+  ASSERT_TRUE(cloud.ok()) << cloud.status();
+  EXPECT_FLOAT_EQ(cloud->positions[1][2], 0.06f);
+  EXPECT_EQ(cloud->colors, (std::vector<Rgb>{{255, 0, 128}, {1, 2, 3}}));
+}
+
+// UTM coordinates at millimetre resolution: a float holds 500,000 m to about 3 cm (and
+// 4,100,000 m to 25 cm), so x and y are taken relative to the origin (the minimum rounded down
+// to 1,000 m) and keep their millimetres; z, near 0, stays as it is.
+TEST(LasIoTest, GeoreferencedCoordinatesKeepTheirResolutionRelativeToAnOrigin) {
+  LasLayout layout;
+  layout.version_minor = 4;
+  layout.format = 6;
+  for (double& s : layout.scale) s = 0.001;
+  layout.offset[0] = 500000;
+  layout.offset[1] = 4100000;
+  const std::vector<LasPoint> points = {
+      {-1234567, 2345678, 12345}, {1, -1, 1}, {2, -1, 1}, {1000001, 999, -5000}};
+  const absl::StatusOr<PointCloud> cloud = ReadLas("utm.las", LasFile(layout, points));
+  ASSERT_TRUE(cloud.ok()) << cloud.status();
+  EXPECT_EQ(cloud->origin, (std::array<double, 3>{498000, 4099000, 0}));
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double x = points[i].x * 0.001 + 500000, y = points[i].y * 0.001 + 4100000;
+    EXPECT_NEAR(cloud->positions[i][0] + 498000.0, x, 2e-4) << i;
+    EXPECT_NEAR(cloud->positions[i][1] + 4099000.0, y, 2e-4) << i;
+    EXPECT_FLOAT_EQ(cloud->positions[i][2], points[i].z * 0.001);
+  }
+  // A millimetre apart stays a millimetre apart, to a float's spacing 2 km from the origin.
+  EXPECT_NEAR(cloud->positions[2][0] - cloud->positions[1][0], 0.001, 2.5e-4);
+}
+
+TEST(LasIoTest, MalformedAndCompressedFilesAreRefusedWithWhatIsWrong) {
+  LasLayout layout;
+  layout.format = 3;
+  const std::string good = LasFile(layout, kPoints);
+  struct Case {
+    const char* what;
+    std::string bytes;
+    const char* message;
+  };
+  std::string laz = good;
+  laz[104] = static_cast<char>(3 | 0x80);
+  std::string format11 = good;
+  format11[104] = 11;
+  std::string short_records = good;
+  short_records[105] = 20;
+  short_records[106] = 0;
+  std::string too_many = good;
+  too_many[107] = 4;
+  std::string zero_scale = good;
+  std::fill(zero_scale.begin() + 131, zero_scale.begin() + 139, '\0');
+  std::string version = good;
+  version[24] = 2;
+  const Case cases[] = {
+      {"not LAS", "ply\nformat ascii 1.0\n", "LAS: no LASF signature"},
+      {"truncated header", good.substr(0, 100), "the file ends within its header (100 bytes)"},
+      {"truncated points", good.substr(0, good.size() - 1),
+       "3 points of 34 bytes from byte 227 do not fit in the file's 328 bytes"},
+      {"LAZ", laz, "the points are compressed (LAZ)"},
+      {"format 11", format11, "point data format 11 is not 0 to 10"},
+      {"short records", short_records, "records of 20 bytes are shorter than format 3's 34"},
+      {"too many points", too_many, "4 points of 34 bytes"},
+      {"zero scale", zero_scale, "the scale and offset of axis x"},
+      {"version 2", version, "version 2.2 is not 1.0 to 1.4"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    const absl::StatusOr<PointCloud> cloud = ReadLas("bad.las", c.bytes);
+    ASSERT_FALSE(cloud.ok());
+    EXPECT_EQ(cloud.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(std::string(cloud.status().message()), HasSubstr(c.message));
+    EXPECT_THAT(std::string(cloud.status().message()), HasSubstr("bad.las"));
+  }
+  EXPECT_TRUE(IsReadablePointCloudExtension("scan.LAS"));
+  EXPECT_FALSE(IsWritablePointCloudExtension("scan.las"));
+}
+
+}  // namespace
+}  // namespace neuralmesh

@@ -23,7 +23,6 @@ constexpr size_t kRecordLength = 105;
 constexpr size_t kLegacyPointCount = 107;
 constexpr size_t kScale = 131;       // x, y, z: doubles.
 constexpr size_t kOffset = 155;      // x, y, z: doubles.
-constexpr size_t kMaxX = 179;        // max x, min x, max y, min y, max z, min z: doubles.
 constexpr size_t kPointCount = 247;  // LAS 1.4: uint64.
 constexpr size_t kLegacyHeaderSize = 227;
 constexpr size_t kHeaderSize14 = 375;
@@ -97,11 +96,10 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
                                 offset_to_points, " do not fit in the file's ", data.size(),
                                 " bytes"));
   }
-  double scale[3], offset[3], min[3];
+  double scale[3], offset[3];
   for (int c = 0; c < 3; ++c) {
     scale[c] = Load<double>(data, kScale + 8 * c);
     offset[c] = Load<double>(data, kOffset + 8 * c);
-    min[c] = Load<double>(data, kMaxX + 16 * c + 8);
     if (!(scale[c] != 0) || !std::isfinite(scale[c]) || !std::isfinite(offset[c])) {
       return Invalid(absl::StrCat("the scale and offset of axis ",
                                   absl::string_view("xyz").substr(c, 1), " (", scale[c], ", ",
@@ -124,9 +122,12 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
   for (int c = 0; c < 3; ++c) {
     const double far = std::max(std::fabs(low[c]), std::fabs(high[c]));
     if (count > 0 && far > kFloatExactScales * std::fabs(scale[c])) {
-      // The header's minimum when it bounds the points, else theirs.
-      const double base = std::isfinite(min[c]) && min[c] <= low[c] ? min[c] : low[c];
-      out.origin[c] = std::floor(base / 1000) * 1000;
+      // The points' minimum (the header's bounds may be stale or zero), when that brings
+      // them nearer.
+      const double origin = std::floor(low[c] / 1000) * 1000;
+      if (std::max(std::fabs(low[c] - origin), std::fabs(high[c] - origin)) < far) {
+        out.origin[c] = origin;
+      }
     }
   }
   for (uint64_t i = 0; i < count; ++i) {

@@ -87,6 +87,16 @@ TEST(LasIoTest, GeoreferencedCoordinatesKeepTheirResolutionRelativeToAnOrigin) {
   }
   // A millimetre apart stays a millimetre apart, to a float's spacing 2 km from the origin.
   EXPECT_NEAR(cloud->positions[2][0] - cloud->positions[1][0], 0.001, 2.5e-4);
+
+  // A scan near 0 at a resolution finer than a float keeps at 50 m: an origin 1,000 m off would
+  // only take it farther, so there is none.
+  LasLayout fine;
+  for (double& s : fine.scale) s = 1e-5;
+  const absl::StatusOr<PointCloud> near_zero =
+      ReadLas("fine.las", LasFile(fine, {{-5000000, 0, 0}, {5000000, 1, 2}}));
+  ASSERT_TRUE(near_zero.ok()) << near_zero.status();
+  EXPECT_EQ(near_zero->origin, (std::array<double, 3>{0, 0, 0}));
+  EXPECT_FLOAT_EQ(near_zero->positions[0][0], -50.0f);
 }
 
 TEST(LasIoTest, MalformedAndCompressedFilesAreRefusedWithWhatIsWrong) {

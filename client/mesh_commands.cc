@@ -1,8 +1,8 @@
 // RunStats, RunEval and RunConvert (declared in client/local_commands.h).
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "absl/strings/str_join.h"
 #include "absl/strings/match.h"
+#include "absl/strings/str_join.h"
 #include "client/builtin_shapes.h"
 #include "client/inputs.h"
 #include "client/local_commands.h"
@@ -72,14 +72,12 @@ absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
 
 namespace {
 
-constexpr char kPointCloudWriteExtensions[] = ".ply, .xyz, .txt, .pts, .drc, .glb, .gltf";
-
 // RunConvert for points: read as a point cloud, outliers removed, written as one.
 absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   if (!IsWritablePointCloudExtension(options.output)) {
     return absl::InvalidArgumentError(
         absl::StrCat("INPUT '", options.input, "' holds points without faces: OUTPUT '",
-                     options.output, "' must be a point cloud format (", kPointCloudWriteExtensions,
+                     options.output, "' must be a point cloud format (", kWritablePointCloudExtensions,
                      ")"));
   }
   const bool gltf = absl::EndsWithIgnoreCase(options.output, ".glb") ||
@@ -119,7 +117,7 @@ absl::Status RunConvert(const ConvertOptions& options, std::ostream& out) {
   if (!mesh_output && !IsWritablePointCloudExtension(options.output)) {
     return absl::InvalidArgumentError(absl::StrCat(
         "OUTPUT '", options.output, "': unsupported format; use one of ", kMeshExtensions,
-        " for meshes, or ", kPointCloudWriteExtensions, " for points"));
+        " for meshes, or ", kWritablePointCloudExtensions, " for points"));
   }
   if (IsBuiltin(options.input) && !mesh_output) {
     return absl::InvalidArgumentError(absl::StrCat(

@@ -83,6 +83,10 @@ bool IsReadablePointCloudExtension(std::string_view path) {
   return IsReadable(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
 }
 
+const char kReadablePointCloudExtensions[] =
+    ".ply, .xyz, .txt, .pts, .las, .obj, .off, .drc, .glb, .gltf";
+const char kWritablePointCloudExtensions[] = ".ply, .xyz, .txt, .pts, .drc, .glb, .gltf";
+
 bool IsWritablePointCloudExtension(std::string_view path) {
   return IsWritable(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
 }
@@ -90,8 +94,7 @@ bool IsWritablePointCloudExtension(std::string_view path) {
 absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path) {
   const FileFormat format = io_internal::FormatFromPath(path);
   if (!IsReadable(format)) {
-    return UnsupportedExtension(path,
-                                ".ply, .xyz, .txt, .pts, .las, .obj, .off, .drc, .glb, .gltf");
+    return UnsupportedExtension(path, kReadablePointCloudExtensions);
   }
   NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
   absl::StatusOr<PointCloud> cloud = ParsePointCloud(format, data, path);
@@ -107,7 +110,7 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
                              const DracoOptions& draco) {
   const FileFormat format = io_internal::FormatFromPath(path);
   if (!IsWritable(format)) {
-    return UnsupportedExtension(path, ".ply, .xyz, .txt, .pts, .drc, .glb, .gltf");
+    return UnsupportedExtension(path, kWritablePointCloudExtensions);
   }
   const absl::Status valid = cloud.empty() ? absl::InvalidArgumentError("the point cloud is empty")
                                            : ValidatePointCloud(cloud);

@@ -14,12 +14,17 @@
 
 namespace neuralmesh {
 
-// True when ReadPointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .las,
-// .obj, .off, .drc, .glb, .gltf.
+// The extensions ReadPointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .obj,
+// .off, .drc, .glb, .gltf".
+extern const char kReadablePointCloudExtensions[];
+// The extensions WritePointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .drc, .glb,
+// .gltf".
+extern const char kWritablePointCloudExtensions[];
+
+// True when ReadPointCloud handles the extension of `path` (kReadablePointCloudExtensions).
 bool IsReadablePointCloudExtension(std::string_view path);
 
-// True when WritePointCloud handles the extension of `path`: .ply, .xyz, .txt, .pts, .drc,
-// .glb, .gltf.
+// True when WritePointCloud handles the extension of `path` (kWritablePointCloudExtensions).
 bool IsWritablePointCloudExtension(std::string_view path);
 
 // Reads the points at `path`; faces in the file are skipped without being checked:

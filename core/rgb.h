@@ -25,6 +25,13 @@ inline uint8_t ChannelFromLevel(double level, double max) {
   return ChannelFromFraction(level / max);
 }
 
+// The full scale of the colour channels of a text file that does not say which it uses, from
+// its largest channel: 1 when none exceeds 1 (fractions, as MeshLab and CloudCompare write
+// them), else 255 (0-255 levels). For ChannelFromLevel.
+inline double TextChannelScale(float largest_channel) {
+  return largest_channel <= 1.0f ? 1.0 : 255.0;
+}
+
 // The channel as a fraction in [0, 1].
 inline float ChannelFraction(uint8_t channel) { return static_cast<float>(channel) / 255.0f; }
 

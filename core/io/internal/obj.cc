@@ -64,7 +64,7 @@ absl::Status ParseVertex(const std::vector<absl::string_view>& tokens, int line,
 std::vector<Rgb> ResolveColors(const ObjColors& colors) {
   std::vector<Rgb> out;
   if (!colors.every_vertex || colors.channels.empty()) return out;
-  const double max = colors.largest <= 1.0f ? 1.0 : 255.0;
+  const double max = TextChannelScale(colors.largest);
   out.reserve(colors.channels.size());
   for (const std::array<float, 3>& rgb : colors.channels) {
     out.push_back({ChannelFromLevel(rgb[0], max), ChannelFromLevel(rgb[1], max),

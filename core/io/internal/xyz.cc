@@ -160,7 +160,7 @@ void TakeColumns(const XyzLayout& layout, const ExtraColumns& extra, ParsedGeome
     for (size_t i = 0; i < rows; ++i) {
       for (int column : layout.color) largest = std::max(largest, extra.at(i, column));
     }
-    const double max = largest <= 1.0f ? 1.0 : 255.0;
+    const double max = TextChannelScale(largest);
     out->colors.reserve(rows);
     for (size_t i = 0; i < rows; ++i) {
       Rgb rgb;

@@ -92,6 +92,7 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
                        " needs a triangle mesh (use uniform or weighted for a point cloud)"));
     }
     const size_t faces = mesh->faces.size();
+    target.origin = mesh->origin;
     std::string with_colors;
     if (colors.has_value() && !mesh->colors.empty()) {
       NM_ASSIGN_OR_RETURN(with_colors, UseColors(MakeMeshColorSource(*mesh), input, target));
@@ -105,7 +106,7 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
     target.sampler = *std::move(sampler);
     target.description =
         absl::StrCat("the ", faces, " triangles of ", input, " (", ModeName(mode), " sampling",
-                     with_colors, ")");
+                     with_colors, OriginNote(target.origin), ")");
     return target;
   }
   NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(input, "INPUT"));
@@ -114,7 +115,8 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
         absl::StrCat("INPUT '", input, "' has no per-point weights for --sampling weighted"));
   }
   const size_t points = cloud.size();
-  const std::string origin = OriginNote(cloud);
+  const std::string origin = OriginNote(cloud.origin);
+  target.origin = cloud.origin;
   std::string removed_outliers;
   if (outliers.has_value()) {
     absl::StatusOr<size_t> removed = RemoveStatisticalOutliers(cloud, *outliers);
@@ -158,10 +160,20 @@ absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string
   return cloud;
 }
 
-std::string OriginNote(const PointCloud& cloud) {
-  if (cloud.origin == std::array<double, 3>{0, 0, 0}) return "";
-  return absl::StrFormat("; coordinates relative to (%.15g, %.15g, %.15g), as the meshes' are",
-                         cloud.origin[0], cloud.origin[1], cloud.origin[2]);
+std::string OriginNote(const std::array<double, 3>& origin) {
+  if (origin == std::array<double, 3>{0, 0, 0}) return "";
+  return absl::StrFormat(
+      "; coordinates taken relative to (%.15g, %.15g, %.15g), and put back in the files written",
+      origin[0], origin[1], origin[2]);
+}
+
+std::string StlOriginNote(const std::string& output, const std::array<double, 3>& origin) {
+  if (origin == std::array<double, 3>{0, 0, 0} || !absl::EndsWithIgnoreCase(output, ".stl")) {
+    return "";
+  }
+  return absl::StrFormat(
+      "%s: STL holds only floats; its coordinates stay relative to (%.15g, %.15g, %.15g)\n",
+      output, origin[0], origin[1], origin[2]);
 }
 
 absl::StatusOr<TriangleMesh> LoadMesh(const std::string& input, absl::string_view role) {

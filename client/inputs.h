@@ -4,6 +4,7 @@
 #ifndef NEURALMESH_CLIENT_INPUTS_H_
 #define NEURALMESH_CLIENT_INPUTS_H_
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -37,6 +38,9 @@ struct TargetSpace {
   std::string description;  // "35947 points from bunny.ply (uniform)".
   // The input's colours, when it carries them and colours were asked for; else null.
   std::unique_ptr<ColorSource> colors;
+  // Where the sampled positions' (0, 0, 0) lies in the input's coordinates (georeferenced
+  // data: PointCloud::origin); the learned meshes carry it.
+  std::array<double, 3> origin = {0, 0, 0};
 };
 
 // The target space of `input`: builtin:NAME (its implicit surface; `mode` must be uniform),
@@ -68,9 +72,13 @@ absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t 
 // LoadTargetSpace; `role` names the argument in messages.
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role);
 
-// "" for a cloud whose positions are the file's coordinates; else (georeferenced LAS) what to
-// tell the user: "; coordinates relative to (X, Y, Z), as the meshes' are".
-std::string OriginNote(const PointCloud& cloud);
+// "" for a zero origin; else (georeferenced data) what to tell the user: "; coordinates taken
+// relative to (X, Y, Z), and put back in the files written".
+std::string OriginNote(const std::array<double, 3>& origin);
+
+// "" unless `output` is an STL file and `origin` is not zero; else a line that says its
+// coordinates stay relative to the origin (STL holds only floats).
+std::string StlOriginNote(const std::string& output, const std::array<double, 3>& origin);
 
 // A mesh to report on or compare: a mesh file, or for builtin:NAME the reference mesh of the
 // implicit surface. Errors as LoadTargetSpace; `role` names the argument in messages.

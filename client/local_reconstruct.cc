@@ -80,6 +80,13 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
   NM_ASSIGN_OR_RETURN(const TargetSpace target,
                       LoadTargetSpace(options.input, options.sampling, options.outliers,
                                       options.colors));
+  if (start_mesh.has_value()) {
+    const absl::Status moved = MoveOrigin(target.origin, &*start_mesh);
+    if (!moved.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--start_mesh '", options.start_mesh, "': ", moved.message()));
+    }
+  }
   absl::StatusOr<std::unique_ptr<Learner>> created =
       start_mesh.has_value()
           ? Learner::CreateFrom(options.learner, target.sampler.get(), *start_mesh)
@@ -96,6 +103,7 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
     out << " from " << options.start_mesh << " (" << start_mesh->positions.size() << " vertices)";
   }
   out << " (seed " << options.learner.seed << ")\n";
+  out << StlOriginNote(options.output, target.origin);
 
   // Ctrl-C stops learning at a consistent state; the mesh so far is still written.
   InterruptScope interrupt;
@@ -131,6 +139,7 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
     const bool last = i + 1 == targets.size() || reason != StopReason::kTargetReached;
 
     TriangleMesh mesh = learner->Snapshot();
+    mesh.origin = target.origin;
     if (target.colors != nullptr) target.colors->Paint(&mesh);
     LodFigures figures;
     figures.kind = reason != StopReason::kTargetReached ? "stopped" : last ? "final" : "lod";

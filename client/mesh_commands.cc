@@ -27,8 +27,14 @@ absl::Status RunStats(const std::string& mesh_path, bool json, std::ostream& out
 }
 
 absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
-  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(options.mesh, "MESH"));
+  NM_ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(options.mesh, "MESH"));
   NM_ASSIGN_OR_RETURN(const TriangleMesh reference, LoadMesh(options.reference, "--reference"));
+  // Georeferenced files may have been read relative to different origins.
+  if (const absl::Status moved = MoveOrigin(reference.origin, &mesh); !moved.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("MESH '", options.mesh,
+                                                   "' against --reference '", options.reference,
+                                                   "': ", moved.message()));
+  }
   GeometricErrorOptions error_options;
   if (options.samples > 0) error_options.samples = options.samples;
   error_options.seed = options.seed;
@@ -102,7 +108,7 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   if (options.outliers.has_value()) {
     out << " (" << removed << " outliers of " << read << " removed)";
   }
-  out << OriginNote(cloud) << "\n";
+  out << OriginNote(cloud.origin) << "\n";
   if (gltf && (!cloud.normals.empty() || !cloud.weights.empty())) {
     out << "note: glTF keeps positions and colours; the normals and weights were left out\n";
   }
@@ -139,7 +145,9 @@ absl::Status RunConvert(const ConvertOptions& options, std::ostream& out) {
   }
   NM_RETURN_IF_ERROR(WriteMesh(mesh, options.output, options.writing));
   out << options.output << ": " << mesh.positions.size() << " vertices, " << mesh.faces.size()
-      << " faces" << (mesh.colors.empty() ? "" : ", with colours") << "\n";
+      << " faces" << (mesh.colors.empty() ? "" : ", with colours") << OriginNote(mesh.origin)
+      << "\n"
+      << StlOriginNote(options.output, mesh.origin);
   return absl::OkStatus();
 }
 

@@ -82,7 +82,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     NM_ASSIGN_OR_RETURN(const size_t removed, RemoveStatisticalOutliers(cloud, *options.outliers));
     out << "outliers removed: " << removed << " of " << points_read << " points\n";
   }
-  if (const std::string origin = OriginNote(cloud); !origin.empty()) {
+  if (const std::string origin = OriginNote(cloud.origin); !origin.empty()) {
     out << "INPUT '" << options.input << "'" << origin << "\n";
   }
   std::optional<TriangleMesh> start_mesh;
@@ -92,6 +92,11 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
           "--start_mesh applies to a new session; --resume goes on with the session's own");
     }
     NM_ASSIGN_OR_RETURN(start_mesh, ReadStartMesh(options.start_mesh));
+    const absl::Status moved = MoveOrigin(cloud.origin, &*start_mesh);
+    if (!moved.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--start_mesh '", options.start_mesh, "': ", moved.message()));
+    }
   }
   const size_t affordable = static_cast<size_t>(std::floor(cloud.size() / kDefaultPointsPerVertex));
   size_t target =
@@ -107,6 +112,11 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     for (size_t m : milestones) config.add_lod_milestones(m);
   }
   *config.mutable_draco() = ToProto(options.draco);
+  if (cloud.origin != std::array<double, 3>{0, 0, 0}) {
+    config.mutable_origin()->set_x(cloud.origin[0]);
+    config.mutable_origin()->set_y(cloud.origin[1]);
+    config.mutable_origin()->set_z(cloud.origin[2]);
+  }
   if (options.colors.has_value()) {
     config.mutable_color_neighbours()->set_value(static_cast<uint32_t>(options.colors->neighbours));
   }

@@ -37,6 +37,10 @@ void WriteSessionJson(const neuralmesh::v1::Session& s, JsonWriter& json) {
   json.Key("vertices").Uint(s.vertex_count());
   json.Key("faces").Uint(s.face_count());
   json.Key("target_vertices").Uint(s.config().target_vertices());
+  // Where the session's coordinates' zero lies in the data's (SessionConfig.origin).
+  json.Key("origin").BeginArray();
+  json.Double(s.config().origin().x()).Double(s.config().origin().y());
+  json.Double(s.config().origin().z()).EndArray();
   json.Key("basic_steps").Uint(s.learning().basic_steps());
   json.Key("latest_sequence").Uint(s.latest_sequence());
   json.Key("watchers").Uint(s.watchers());

@@ -1,10 +1,33 @@
 #include "core/triangle_mesh.h"
 
+#include <cmath>
+#include <limits>
 #include <string>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 
 namespace neuralmesh {
+
+absl::Status MoveOrigin(const std::array<double, 3>& origin, TriangleMesh* mesh) {
+  if (origin == mesh->origin) return absl::OkStatus();
+  std::vector<Vec3f> moved(mesh->positions.size());
+  for (size_t i = 0; i < moved.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const double value = mesh->origin[c] - origin[c] + double{mesh->positions[i][c]};
+      if (!(std::fabs(value) <= std::numeric_limits<float>::max())) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "relative to (%.15g, %.15g, %.15g), vertex %d would lie beyond a float's range",
+            origin[0], origin[1], origin[2], i));
+      }
+      moved[i][c] = static_cast<float>(value);
+    }
+  }
+  mesh->positions = std::move(moved);
+  mesh->origin = origin;
+  return absl::OkStatus();
+}
 
 TriangleMesh ToTriangleMesh(const Mesh& mesh) {
   TriangleMesh out;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/mesh.h"
 #include "core/rgb.h"
@@ -18,9 +19,19 @@ struct TriangleMesh {
   std::vector<Vec3f> positions;
   std::vector<std::array<uint32_t, 3>> faces;  // Counter-clockwise seen from outside.
   std::vector<Rgb> colors;  // Empty, or one colour per vertex (point_colors.h paints them).
+  // Where the positions' (0, 0, 0) lies in the coordinates of the data they came from
+  // (georeferenced scans: see PointCloud::origin); writers put it back. Zero for most meshes.
+  std::array<double, 3> origin = {0, 0, 0};
 
   bool empty() const { return positions.empty(); }
 };
+
+// Expresses the positions of `mesh` relative to `origin` instead of mesh->origin (the same
+// places, so a translation by their difference), and sets mesh->origin. Positions far from the
+// new origin keep only a float's resolution there.
+// Returns INVALID_ARGUMENT, leaving `mesh` as it was, when a position would lie beyond a
+// float's range.
+absl::Status MoveOrigin(const std::array<double, 3>& origin, TriangleMesh* mesh);
 
 // Copies the live (not deleted) vertices and faces of `mesh`, renumbered densely in
 // handle order. O(v + f).

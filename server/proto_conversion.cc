@@ -134,6 +134,9 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
     config.colors.neighbours =
         static_cast<int>(std::min<uint32_t>(proto.color_neighbours().value(), 1u << 30));
   }
+  if (proto.has_origin()) {
+    config.origin = {proto.origin().x(), proto.origin().y(), proto.origin().z()};
+  }
   return config;
 }
 
@@ -199,6 +202,12 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
     o.mutable_std_ratio()->set_value(config.outlier_removal->std_ratio);
   }
   proto.mutable_color_neighbours()->set_value(static_cast<uint32_t>(config.colors.neighbours));
+  if (config.origin != std::array<double, 3>{0, 0, 0}) {
+    v1::Origin& origin = *proto.mutable_origin();
+    origin.set_x(config.origin[0]);
+    origin.set_y(config.origin[1]);
+    origin.set_z(config.origin[2]);
+  }
   return proto;
 }
 

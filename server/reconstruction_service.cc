@@ -59,6 +59,13 @@ absl::StatusOr<std::shared_ptr<Session>> CreateFromRequest(SessionManager& manag
   std::optional<TriangleMesh> start_mesh;
   if (request.has_start_mesh()) {
     NM_ASSIGN_OR_RETURN(start_mesh, StartMeshFromProto(request.start_mesh()));
+    // A Draco mesh whose metadata give an origin is moved from it into the session's frame.
+    if (start_mesh->origin != std::array<double, 3>{0, 0, 0}) {
+      const absl::Status moved = MoveOrigin(config.origin, &*start_mesh);
+      if (!moved.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("start_mesh: ", moved.message()));
+      }
+    }
   }
   return manager.Create(std::move(config), request.name(), peer, caller.client,
                         std::move(start_mesh));

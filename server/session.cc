@@ -721,6 +721,7 @@ absl::StatusOr<std::unique_ptr<Learner>> Session::CreateLearner() {
 void Session::TakeSnapshot(v1::UpdateKind kind, size_t milestone, uint32_t lod_index) {
   Snapshot snapshot;
   snapshot.mesh = learner_->Snapshot();
+  snapshot.mesh.origin = config_.origin;
   snapshot.kind = kind;
   snapshot.lod_milestone = milestone;
   snapshot.lod_index = lod_index;

@@ -94,6 +94,13 @@ absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& 
       }
     }
   }
+  for (int c = 0; c < 3; ++c) {
+    if (!std::isfinite(config.origin[c])) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "origin.", absl::string_view("xyz").substr(c, 1), " is ", config.origin[c],
+          "; it must be finite"));
+    }
+  }
   NM_RETURN_IF_ERROR(config.learner.Validate());
   NM_RETURN_IF_ERROR(config.draco.Validate());
   if (config.outlier_removal.has_value()) {

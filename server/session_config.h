@@ -3,6 +3,7 @@
 #ifndef NEURALMESH_SERVER_SESSION_CONFIG_H_
 #define NEURALMESH_SERVER_SESSION_CONFIG_H_
 
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -59,6 +60,9 @@ struct SessionConfig {
   std::optional<OutlierOptions> outlier_removal;
   // How published meshes are painted when the points carry colours.
   PointColorOptions colors;
+  // Where the points' (0, 0, 0) lies in the data's coordinates; carried by every published
+  // mesh (TriangleMesh::origin).
+  std::array<double, 3> origin = {0, 0, 0};
 };
 
 // The 1-2-5 series from kFirstDefaultMilestone, 50, 100, 200, 500, 1000, ... below `target`,
@@ -70,6 +74,7 @@ std::vector<size_t> DefaultLodMilestones(size_t target);
 // above kMaxTargetVertices or unreachable within `max_points_per_session` points, milestones not
 // strictly increasing, below 4, above the target or more than 256 of them, a refresh interval
 // between 0 and 10 ms, points_per_vertex not finite and positive, bounds not finite or inverted,
+// an origin not finite,
 // and whatever LearnerOptions::Validate, DracoOptions::Validate, OutlierOptions::Validate and
 // PointColorOptions::Validate reject.
 absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& config);

@@ -256,6 +256,34 @@ void SetPositionQuantization(draco::ExpertEncoder& encoder, int attribute_id,
   }
 }
 
+// The metadata entry that holds where the positions' (0, 0, 0) lies (TriangleMesh::origin,
+// PointCloud::origin): three doubles, written only when the origin is not zero.
+constexpr char kOriginEntry[] = "origin";
+
+void AddOrigin(draco::PointCloud& geometry, const std::array<double, 3>& origin) {
+  if (origin == std::array<double, 3>{0, 0, 0}) return;
+  auto metadata = std::make_unique<draco::GeometryMetadata>();
+  metadata->AddEntryDoubleArray(kOriginEntry, {origin[0], origin[1], origin[2]});
+  geometry.AddMetadata(std::move(metadata));
+}
+
+// The origin a stream's metadata gives, or zero.
+absl::StatusOr<std::array<double, 3>> ReadOrigin(const draco::PointCloud& geometry) {
+  std::array<double, 3> origin = {0, 0, 0};
+  const draco::GeometryMetadata* metadata = geometry.GetMetadata();
+  std::vector<double> values;
+  if (metadata == nullptr || !metadata->GetEntryDoubleArray(kOriginEntry, &values)) {
+    return origin;
+  }
+  if (values.size() != 3 || !std::all_of(values.begin(), values.end(),
+                                         [](double v) { return std::isfinite(v); })) {
+    return absl::InvalidArgumentError(
+        "the Draco metadata's 'origin' is not three finite numbers");
+  }
+  std::copy(values.begin(), values.end(), origin.begin());
+  return origin;
+}
+
 absl::StatusOr<std::string> RunEncoder(draco::ExpertEncoder& encoder, const char* what) {
   draco::EncoderBuffer buffer;
   const draco::Status status = encoder.EncodeToBuffer(&buffer);
@@ -649,6 +677,7 @@ absl::StatusOr<std::string> EncodeMeshStoring(const TriangleMesh& mesh,
   const int position_id = AddFloatAttribute(geometry, draco::GeometryAttribute::POSITION, 3,
                                             mesh.positions.front().data(), num_vertices);
   if (!mesh.colors.empty()) AddColorAttribute(geometry, mesh.colors, storage);
+  AddOrigin(geometry, mesh.origin);
   geometry.SetNumFaces(mesh.faces.size());
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     draco::Mesh::Face face;
@@ -717,6 +746,7 @@ absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const Drac
         AddFloatAttribute(geometry, draco::GeometryAttribute::GENERIC, 1, cloud.weights.data(), n);
   }
   if (!cloud.colors.empty()) AddColorAttribute(geometry, cloud.colors);
+  AddOrigin(geometry, cloud.origin);
 
   draco::ExpertEncoder encoder(geometry);
   encoder.SetSpeedOptions(options.encode_speed, options.decode_speed);
@@ -738,6 +768,7 @@ absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes) {
   }
   NM_ASSIGN_OR_RETURN(const draco::PointAttribute* colors, ColorAttribute(*geometry));
   TriangleMesh mesh;
+  NM_ASSIGN_OR_RETURN(mesh.origin, ReadOrigin(*geometry));
   mesh.positions.reserve(positions->size());
   for (draco::AttributeValueIndex i(0); i < static_cast<uint32_t>(positions->size()); ++i) {
     NM_ASSIGN_OR_RETURN(Vec3f p, ReadVec3(*positions, i, "position"));
@@ -850,6 +881,7 @@ absl::StatusOr<PointCloud> DecodePointCloud(std::string_view bytes, uint64_t max
   NM_ASSIGN_OR_RETURN(const draco::PointAttribute* colors, ColorAttribute(*geometry));
 
   PointCloud cloud;
+  NM_ASSIGN_OR_RETURN(cloud.origin, ReadOrigin(*geometry));
   cloud.positions.reserve(n);
   if (normals != nullptr) cloud.normals.reserve(n);
   if (weights != nullptr) cloud.weights.reserve(n);

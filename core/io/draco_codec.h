@@ -11,6 +11,10 @@
 // Draco may reorder vertices and faces. Edgebreaker keeps only vertices that some face uses,
 // drops degenerate faces (a repeated vertex index), and splits non-manifold vertices (and
 // vertices where orientation is inconsistent) into copies at the same position.
+//
+// A mesh's or cloud's non-zero origin (TriangleMesh::origin, PointCloud::origin) is stored as
+// the geometry metadata entry "origin", three doubles, and decoded back; decoders that ignore
+// metadata see the positions relative to it.
 #ifndef NEURALMESH_CORE_IO_DRACO_CODEC_H_
 #define NEURALMESH_CORE_IO_DRACO_CODEC_H_
 
@@ -129,7 +133,8 @@ absl::StatusOr<std::string> EncodePointCloud(const PointCloud& cloud, const Drac
 // Returns INVALID_ARGUMENT when `bytes` is not a valid Draco mesh (corrupt, truncated, a point
 // cloud, no numeric position attribute, non-finite positions, counts of vertices or faces far
 // beyond what its size can hold: more than 2^20 and 256 per byte, or a bitstream version older
-// than what current Draco encoders write: 2.2 for meshes, 2.3 for point clouds).
+// than what current Draco encoders write: 2.2 for meshes, 2.3 for point clouds), and when its
+// metadata entry "origin" is not three finite numbers.
 absl::StatusOr<TriangleMesh> DecodeMesh(std::string_view bytes);
 
 // Decodes a Draco point cloud, or the points of a Draco mesh; restores normals (the NORMAL

@@ -66,6 +66,7 @@ absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data
   mesh.positions = std::move(parsed->positions);
   mesh.faces = std::move(parsed->faces);
   mesh.colors = std::move(parsed->colors);
+  mesh.origin = parsed->origin;
   return mesh;
 }
 
@@ -125,7 +126,8 @@ absl::StatusOr<std::string> FormatMesh(const TriangleMesh& mesh, const std::stri
   NM_ASSIGN_OR_RETURN(const FileFormat format, MeshFormat(path));
   const absl::Status writable = CheckWritable(mesh, format);
   if (!writable.ok()) return CannotWrite(path, writable);
-  const io_internal::GeometryView view{mesh.positions, {}, {}, mesh.faces, mesh.colors};
+  const io_internal::GeometryView view{mesh.positions, {},          {},
+                                       mesh.faces,     mesh.colors, mesh.origin};
   std::string data;
   switch (format) {
     case FileFormat::kPly:

@@ -31,7 +31,9 @@ bool IsSupportedMeshExtension(std::string_view path);
 //         scene draws, placed by their nodes, with COLOR_0 colours; vertices at identical
 //         positions merged (internal/gltf.h). A .gltf's external buffers are read relative to
 //         it.
-// Polygons are fan-triangulated. A file may hold vertices and no faces.
+// Polygons are fan-triangulated. A file may hold vertices and no faces. Georeferenced
+// coordinates, too far from zero for a float to keep their resolution, are read relative to
+// TriangleMesh::origin (internal/position_collector.h; Draco: its metadata; STL: never).
 // Returns NOT_FOUND when the file cannot be opened or read; INVALID_ARGUMENT for an
 // unsupported extension (listing the supported ones), an empty file, a file with no vertices,
 // or malformed content (the message gives the line or byte offset and what was expected),
@@ -47,7 +49,9 @@ struct MeshWriteOptions {
 // binary .stl, .drc encoded with `options.draco`, or glTF 2.0: binary .glb, or .gltf with the
 // buffer embedded (one mesh, one primitive; see internal/gltf.h). Vertex colours go to every
 // format but STL (PLY uchar red, green, blue; OBJ 'v x y z r g b' fractions; COFF; a Draco COLOR
-// attribute; glTF COLOR_0, as linear light).
+// attribute; glTF COLOR_0, as linear light). A non-zero mesh.origin is put back: PLY double
+// coordinates, OBJ and OFF text of the exact sums, a glTF node's translation, Draco metadata
+// ("origin"); STL keeps the positions as they are.
 // Returns INVALID_ARGUMENT for an unsupported extension, an empty mesh, colours that are not one
 // per vertex, a non-finite coordinate, a face index out of range, a mesh without faces for .stl,
 // .drc or Draco-compressed glTF, or invalid Draco options (including positions outside the

@@ -116,7 +116,7 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
                                            : ValidatePointCloud(cloud);
   if (!valid.ok()) return io_internal::CannotWrite(path, valid);
   const io_internal::GeometryView view{cloud.positions, cloud.normals, cloud.weights, {},
-                                       cloud.colors};
+                                       cloud.colors,    cloud.origin};
   std::string data;
   if (format == FileFormat::kPly) {
     data = io_internal::FormatPly(view);
@@ -125,7 +125,8 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
   } else if (format == FileFormat::kGltf) {
     io_internal::GltfWriteOptions gltf;
     gltf.binary = io_internal::LowercaseExtension(path) == ".glb";
-    const io_internal::GeometryView points{cloud.positions, {}, {}, {}, cloud.colors};
+    const io_internal::GeometryView points{cloud.positions, {}, {}, {}, cloud.colors,
+                                           cloud.origin};
     absl::StatusOr<std::string> formatted = io_internal::FormatGltf(points, gltf);
     if (!formatted.ok()) return io_internal::CannotWrite(path, formatted.status());
     data = *std::move(formatted);

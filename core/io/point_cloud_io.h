@@ -33,14 +33,15 @@ bool IsWritablePointCloudExtension(std::string_view path);
 //         weights; red, green, blue (or r, g, b) as colours.
 //   .xyz, .txt, .pts  "x y z [nx ny nz] [w]", "x y z r g b", "x y z i r g b" (PTS) lines
 //         and others a header comment names ("# x y z nx ny nz r g b w"); see internal/xyz.h.
-//   .las  LAS 1.0-1.4 point records of formats 0-10, with colours where the format has them;
-//         georeferenced coordinates relative to PointCloud::origin (see internal/las.h).
+//   .las  LAS 1.0-1.4 point records of formats 0-10, with colours where the format has them.
 //   .obj  the 'v' lines, 'v x y z r g b' with colours ('vn' is ignored: OBJ normals belong to
 //         face corners).
 //   .off  the vertices of OFF, COFF (with colours), NOFF (with normals), STOFF.
 //   .drc  a Draco point cloud, or the points of a Draco mesh.
 //   .glb, .gltf  the vertices of every mesh primitive the default scene draws, placed by their
 //         nodes, with COLOR_0 colours; vertices at identical positions merged (as ReadMesh).
+// Georeferenced coordinates, too far from zero for a float to keep their resolution, are read
+// relative to PointCloud::origin (internal/position_collector.h; Draco: its metadata).
 // Returns NOT_FOUND when the file cannot be opened or read; INVALID_ARGUMENT for an
 // unsupported extension (listing the supported ones), an empty file, a file with no points,
 // malformed content (the message gives the line or byte offset and what was expected), or a
@@ -51,7 +52,8 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path);
 // nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"
 // text for .xyz/.txt/.pts (a header comment names the columns), .drc encoded with `draco`, or
 // glTF 2.0 POINTS (.glb, or .gltf with its buffer embedded) of the positions and colours
-// (COLOR_0), without normals and weights.
+// (COLOR_0), without normals and weights. The positions are written with cloud.origin put back
+// (PLY doubles, exact text, a glTF node's translation, Draco metadata).
 // Returns INVALID_ARGUMENT for an unsupported extension, an empty cloud, a cloud that fails
 // ValidatePointCloud, or invalid `draco` options; otherwise the status of the write ("cannot
 // write 'path': reason").

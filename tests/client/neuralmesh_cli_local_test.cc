@@ -473,8 +473,9 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
 }
 
 // A LiDAR scan in LAS, georeferenced (UTM, millimetres): a sphere of radius 10 m centred at
-// (500123.5, 4100456.25, 80). The mesh is learned relative to the origin the reader chose and
-// lies on the sphere; both commands say where that origin is.
+// (500123.5, 4100456.25, 80). The mesh is learned relative to the origin the reader chose,
+// written in the scan's coordinates (PLY doubles) and lies on the sphere; both commands say
+// where that origin is. STL, which holds only floats, stays relative to it, and says so.
 TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
   const PointCloud unit = ColoredUnitSpherePoints(20000, 5);
   testing::LasLayout layout;
@@ -503,20 +504,66 @@ TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
   const std::string mesh = *dir_ + "/scan.ply";
   const RunResult run = RunNeuralmesh({"reconstruct", las, "-o", mesh, "--vertices", "1000"});
   ASSERT_EQ(run.exit_code, 0) << run.Describe();
-  EXPECT_TRUE(absl::StrContains(
-      run.out, "with colours; coordinates relative to (500000, 4100000, 0), as the meshes' are)"))
+  EXPECT_TRUE(absl::StrContains(run.out,
+                                "with colours; coordinates taken relative to (500000, 4100000, 0), "
+                                "and put back in the files written)"))
       << run.out;
+  std::ifstream written(mesh, std::ios::binary);
+  std::string header;
+  std::getline(written, header, '\0');
+  EXPECT_TRUE(absl::StrContains(header, "property double x\n")) << "absolute coordinates";
+  const auto expect_on_sphere = [&](const TriangleMesh& learned) {
+    EXPECT_EQ(learned.origin, (std::array<double, 3>{500000, 4100000, 0}));
+    for (const Vec3f& v : learned.positions) {
+      double squared = 0;
+      for (int c = 0; c < 3; ++c) squared += std::pow(learned.origin[c] + v[c] - centre[c], 2);
+      ASSERT_NEAR(std::sqrt(squared), 10.0, 0.25) << "a vertex off the sphere";
+    }
+  };
   const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);
   ASSERT_TRUE(learned.ok()) << learned.status();
   EXPECT_FALSE(learned->colors.empty());
-  for (const Vec3f& v : learned->positions) {
-    const Vec3f local(centre[0] - 500000, centre[1] - 4100000, centre[2]);
-    ASSERT_NEAR((v - local).norm(), 10.0f, 0.25f) << "a vertex off the sphere";
-  }
+  expect_on_sphere(*learned);
+  // The mesh in Draco, whose metadata keep another origin 400 m away.
+  TriangleMesh moved = *learned;
+  ASSERT_TRUE(MoveOrigin({500100, 4100400, 0}, &moved).ok());
+  const std::string drc = *dir_ + "/scan_moved.drc";
+  ASSERT_TRUE(WriteMesh(moved, drc).ok());
+  // Learning goes on from it, moved into the scan's frame: after a few steps (which a start
+  // mesh 400 m off could not make up) it still lies on the sphere.
+  const std::string refined = *dir_ + "/scan_refined.obj";
+  const RunResult again = RunNeuralmesh({"reconstruct", las, "-o", refined, "--vertices", "1500",
+                                         "--start_mesh", drc, "--max_steps", "100"});
+  ASSERT_EQ(again.exit_code, 0) << again.Describe();
+  const absl::StatusOr<TriangleMesh> refined_mesh = ReadMesh(refined);
+  ASSERT_TRUE(refined_mesh.ok()) << refined_mesh.status();
+  expect_on_sphere(*refined_mesh);
   const RunResult convert = RunNeuralmesh({"convert", las, "-o", *dir_ + "/scan.xyz"});
   ASSERT_EQ(convert.exit_code, 0) << convert.Describe();
-  EXPECT_EQ(convert.out, *dir_ + "/scan.xyz: 20000 points, with colours; coordinates relative "
-                                 "to (500000, 4100000, 0), as the meshes' are\n");
+  EXPECT_EQ(convert.out, *dir_ + "/scan.xyz: 20000 points, with colours; coordinates taken "
+                                 "relative to (500000, 4100000, 0), and put back in the files "
+                                 "written\n");
+  const absl::StatusOr<PointCloud> converted = ReadPointCloud(*dir_ + "/scan.xyz");
+  ASSERT_TRUE(converted.ok()) << converted.status();
+  EXPECT_EQ(converted->origin, (std::array<double, 3>{500000, 4100000, 0}));
+
+  // eval compares files read relative to different origins in one frame: the mesh against
+  // itself in Draco.
+  const RunResult self = RunNeuralmesh({"eval", mesh, "--reference", drc, "--json"});
+  ASSERT_EQ(self.exit_code, 0) << self.Describe();
+  const std::smatch hausdorff = [&] {
+    std::smatch m;
+    std::regex_search(self.out, m, std::regex("\"hausdorff\": ([0-9.e+-]+)"));
+    return m;
+  }();
+  ASSERT_FALSE(hausdorff.empty()) << self.out;
+  EXPECT_LT(std::stod(hausdorff[1]), 1e-3) << "Draco's quantization only: " << self.out;
+  const std::string stl = *dir_ + "/scan.stl";
+  const RunResult as_stl = RunNeuralmesh({"convert", mesh, "-o", stl});
+  ASSERT_EQ(as_stl.exit_code, 0) << as_stl.Describe();
+  EXPECT_TRUE(absl::StrContains(as_stl.out, stl + ": STL holds only floats; its coordinates "
+                                                  "stay relative to (500000, 4100000, 0)\n"))
+      << as_stl.out;
 }
 
 TEST_F(LocalCliTest, AnInterruptWritesTheMeshLearnedSoFar) {

@@ -2,8 +2,10 @@
 // neuralmesh-server on 127.0.0.1, both run as subprocesses.
 #include <unistd.h>
 
+#include <cmath>
 #include <csignal>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <regex>
 #include <string>
@@ -12,6 +14,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
 #include "client/inputs.h"
@@ -365,6 +368,45 @@ TEST_F(RemoteCliTest, ColouredPointsComeBackAsColouredMeshes) {
     }
   }
   EXPECT_THAT(neighbours, ::testing::UnorderedElementsAre(4u, 8u));
+}
+
+// A georeferenced scan (a unit sphere at UTM (500123.5, 4100456.25, 80), in XYZ text) is
+// uploaded relative to the origin its reader chose; the session carries that origin, and the
+// meshes come back in the scan's coordinates: the Draco files' metadata and the PLY files'
+// doubles both place the mesh on the sphere.
+TEST_F(RemoteCliTest, GeoreferencedScansComeBackInTheirCoordinates) {
+  const PointCloud unit = ColoredUnitSpherePoints(6000, 8);
+  const double centre[3] = {500123.5, 4100456.25, 80};
+  std::string xyz;
+  for (const Vec3f& p : unit.positions) {
+    xyz += absl::StrFormat("%.4f %.4f %.4f\n", centre[0] + p[0], centre[1] + p[1],
+                           centre[2] + p[2]);
+  }
+  const std::string scan = *dir_ + "/utm_scan.xyz";
+  std::ofstream(scan) << xyz;
+  const std::string out_dir = *dir_ + "/utm";
+  const RunResult run =
+      RunNeuralmesh({"reconstruct", scan, "--server", server_->address(), "--out-dir", out_dir,
+                     "--vertices", "500", "--ply"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "coordinates taken relative to (500000, 4100000, 0)"))
+      << run.out;
+  for (const char* name : {"/utm_scan.drc", "/utm_scan.ply"}) {
+    SCOPED_TRACE(name);
+    const absl::StatusOr<TriangleMesh> mesh = ReadMesh(out_dir + name);
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    EXPECT_EQ(mesh->origin, (std::array<double, 3>{500000, 4100000, 0}));
+    for (const Vec3f& v : mesh->positions) {
+      double squared = 0;
+      for (int c = 0; c < 3; ++c) squared += std::pow(mesh->origin[c] + v[c] - centre[c], 2);
+      ASSERT_NEAR(std::sqrt(squared), 1.0, 0.05) << "a vertex off the sphere";
+    }
+  }
+  const RunResult sessions = RunNeuralmesh({"sessions", "--server", server_->address(), "--json"});
+  ASSERT_EQ(sessions.exit_code, 0) << sessions.Describe();
+  EXPECT_TRUE(std::regex_search(sessions.out,
+                                std::regex("\"origin\": \\[\\s*5e\\+05,\\s*4100000,\\s*0\\s*\\]")))
+      << sessions.out;
 }
 
 TEST_F(RemoteCliTest, SessionsListsTheFinishedSession) {

@@ -137,6 +137,8 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   proto.mutable_draco()->mutable_position_quantization_bits()->set_value(14);
   proto.mutable_outlier_removal()->mutable_std_ratio()->set_value(2.5);
   proto.mutable_color_neighbours()->set_value(3);
+  proto.mutable_origin()->set_x(500000);
+  proto.mutable_origin()->set_y(4100000.5);
   config = SessionConfigFromProto(proto);
   ASSERT_TRUE(config.ok());
   EXPECT_EQ(config->learner.alpha_l, 0.0);
@@ -152,6 +154,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(config->outlier_removal->neighbours, OutlierOptions().neighbours);
   EXPECT_EQ(config->outlier_removal->std_ratio, 2.5);
   EXPECT_EQ(config->colors.neighbours, 3);
+  EXPECT_EQ(config->origin, (std::array<double, 3>{500000, 4100000.5, 0}));
 
   // The echo has every field set and reads back to the same configuration.
   v1::SessionConfig echo = SessionConfigToProto(*config);
@@ -170,6 +173,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(again->outlier_removal->neighbours, OutlierOptions().neighbours);
   EXPECT_EQ(again->outlier_removal->std_ratio, 2.5);
   EXPECT_EQ(again->colors.neighbours, 3);
+  EXPECT_EQ(again->origin, config->origin);
 }
 
 TEST(SessionConfigFromProtoTest, UnknownInitialMeshIsInvalidArgument) {

@@ -680,6 +680,33 @@ TEST_F(ReconstructionServiceTest, ColourNeighboursSetHowMeshesArePainted) {
   }
 }
 
+// SessionConfig.origin: georeferenced points uploaded relative to an origin give meshes whose
+// Draco data carry it, so that watchers write the data's own coordinates; GetSession echoes
+// it. A non-finite origin is refused.
+TEST_F(ReconstructionServiceTest, TheSessionOriginTravelsWithEveryMesh) {
+  v1::CreateSessionRequest create = CreateRequest(200);
+  create.mutable_config()->mutable_origin()->set_x(500000);
+  create.mutable_config()->mutable_origin()->set_y(4100000);
+  const std::string id = MustCreate(*service_, create);
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(testing::Upload(*service_, id, testing::SpherePoints(2000, 3), 2, &response).ok());
+  ASSERT_TRUE(testing::Finish(*service_, id).ok());
+  v1::MeshUpdate final_mesh;
+  ASSERT_TRUE(testing::WaitFinal(*service_, id, &final_mesh).ok());
+  const absl::StatusOr<TriangleMesh> mesh = DecodeMesh(final_mesh.draco_mesh());
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->origin, (std::array<double, 3>{500000, 4100000, 0}));
+  for (const Vec3f& p : mesh->positions) ASSERT_LT(p.norm(), 1.5f) << "positions stay local";
+  v1::Session session = testing::GetSession(*service_, id);
+  EXPECT_EQ(session.config().origin().y(), 4100000);
+
+  create.mutable_config()->mutable_origin()->set_z(NAN);
+  grpc::ClientContext refused_context;
+  const grpc::Status refused = service_->CreateSession(&refused_context, create, &session);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(refused.error_message(), HasSubstr("origin.z is nan; it must be finite"));
+}
+
 // A sphere scanned region by region (its points sorted along x, batches of 500): the points on
 // each batch's leading edge are held back, and accepted once the next batch brings their other
 // side. Fewer points are lost for good than the whole-cloud filter drops (16 against 52);

@@ -81,6 +81,8 @@ TEST(ResolveSessionConfigTest, RejectsInvalidOptionsNamingTheField) {
          c.bounds = b;
        },
        "bounds: points from"},
+      {"origin not finite", [](SessionConfig& c) { c.origin[1] = INFINITY; },
+       "origin.y is inf; it must be finite"},
       {"inverted bounds",
        [](SessionConfig& c) {
          BoundingBox b;

@@ -145,6 +145,39 @@ TEST_F(StartMeshTest, ADracoStartMeshIsTakenToo) {
   EXPECT_LT(MaxDistanceToUnitSphere(final_mesh), 0.02);
 }
 
+// A Draco start mesh whose metadata give another origin than the session's (a mesh written
+// relative to (499990, 4100000, 0), so 10 m off in the session's frame) is moved into the
+// session's frame: the first mesh published, the start mesh itself, lies on the sphere.
+TEST_F(StartMeshTest, ADracoStartMeshIsMovedIntoTheSessionsFrame) {
+  TriangleMesh start = LearnedSphere(300);
+  start.origin = {500000, 4100000, 0};
+  ASSERT_TRUE(MoveOrigin({499990, 4100000, 0}, &start).ok());
+  v1::CreateSessionRequest request = RequestFrom(start, 400);
+  request.mutable_config()->clear_lod_milestones();
+  request.mutable_config()->mutable_origin()->set_x(500000);
+  request.mutable_config()->mutable_origin()->set_y(4100000);
+  DracoOptions draco;
+  draco.position_quantization_bits = 16;
+  request.mutable_start_mesh()->set_draco_mesh(EncodeMesh(start, draco).value());
+  const std::string id = MustCreate(*service_, request);
+  std::vector<v1::MeshUpdate> watched;
+  grpc::Status watch_status;
+  std::thread watcher([&] { watch_status = WatchAll(*service_, id, &watched); });
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(Upload(*service_, id, SpherePoints(4000, 6), 2, &response).ok());
+  ASSERT_TRUE(testing::Finish(*service_, id).ok());
+  v1::MeshUpdate final_mesh;
+  ASSERT_TRUE(WaitFinal(*service_, id, &final_mesh).ok());
+  watcher.join();
+  ASSERT_TRUE(watch_status.ok()) << watch_status.error_message();
+  ASSERT_FALSE(watched.empty());
+  EXPECT_EQ(watched.front().learning().basic_steps(), 0u) << "the start mesh comes first";
+  EXPECT_LT(MaxDistanceToUnitSphere(watched.front()), 0.05) << "not 10 m off";
+  const absl::StatusOr<TriangleMesh> first = DecodeMesh(watched.front().draco_mesh());
+  ASSERT_TRUE(first.ok()) << first.status();
+  EXPECT_EQ(first->origin, (std::array<double, 3>{500000, 4100000, 0}));
+}
+
 TEST_F(StartMeshTest, AStartMeshThatCannotBeLearnedFromIsInvalidArgument) {
   const TriangleMesh start = LearnedSphere(100);
   auto create = [&](const v1::CreateSessionRequest& request) {

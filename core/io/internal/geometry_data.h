@@ -23,8 +23,8 @@ struct ParsedGeometry {
   std::vector<float> weights;                  // Empty or one per position.
   std::vector<Rgb> colors;                     // Empty or one per position.
   std::vector<std::array<uint32_t, 3>> faces;  // Polygons fan-triangulated; indices in range.
-  // The positions are relative to this point (a reader of georeferenced data moved them there
-  // to keep a float's resolution); zero for most files.
+  // The positions are relative to this point: readers move georeferenced data there to keep a
+  // float's resolution (position_collector.h); zero for most files.
   std::array<double, 3> origin = {0, 0, 0};
 };
 
@@ -34,6 +34,11 @@ struct GeometryView {
   absl::Span<const float> weights;  // Empty or one per position.
   absl::Span<const std::array<uint32_t, 3>> faces;
   absl::Span<const Rgb> colors;  // Empty or one per position.
+  // The positions are relative to this point; writers put it back where the format can hold
+  // it (coordinates in double or as text, a glTF node's translation, Draco metadata).
+  std::array<double, 3> origin = {0, 0, 0};
+
+  bool has_origin() const { return origin != std::array<double, 3>{0, 0, 0}; }
 };
 
 }  // namespace neuralmesh::io_internal

@@ -19,6 +19,7 @@
 #include "core/analysis/json_writer.h"
 #include "core/io/file_contents.h"
 #include "core/io/internal/binary.h"
+#include "core/io/internal/position_collector.h"
 #include "core/io/internal/vertex_merger.h"
 #include "core/status_macros.h"
 #include "core/version.h"
@@ -254,7 +255,7 @@ class GltfReader {
  public:
   GltfReader(JsonValue doc, std::optional<absl::string_view> bin, const GltfBufferLoader& loader,
              FaceHandling faces)
-      : doc_(std::move(doc)), bin_(bin), loader_(loader), faces_(faces), merger_(&out_.positions) {}
+      : doc_(std::move(doc)), bin_(bin), loader_(loader), faces_(faces), merger_(&placed_) {}
 
   absl::StatusOr<ParsedGeometry> Read() {
     NM_RETURN_IF_ERROR(CheckAssetAndExtensions());
@@ -279,7 +280,7 @@ class GltfReader {
         NM_RETURN_IF_ERROR(AddMesh(mesh, kIdentity));
       }
     }
-    if (colored_) out_.colors = std::move(colors_);
+    NarrowAndMerge();
     return std::move(out_);
   }
 
@@ -495,7 +496,7 @@ class GltfReader {
       NM_RETURN_IF_ERROR(ReadPrimitive(*attributes, primitive, where, &positions, &colors, &indices,
                                        &has_indices));
     }
-    if (out_.positions.size() + positions.size() > kMaxVertices) {
+    if (placed_.size() + positions.size() > kMaxVertices) {
       return Invalid("the scene draws more than ", kMaxVertices, " vertices");
     }
     const bool mirrored = LinearPartDeterminant(world) < 0;
@@ -503,18 +504,17 @@ class GltfReader {
     std::vector<uint32_t> merged(positions.size());
     for (size_t i = 0; i < positions.size(); ++i) {
       const Vec3f& p = positions[i];
-      Vec3f q;
+      Point3d q;
       for (int row = 0; row < 3; ++row) {
-        const double placed = world[row] * p[0] + world[4 + row] * p[1] +
-                              world[8 + row] * p[2] + world[12 + row];
-        // Beyond a float's range (or NaN) the conversion would be undefined.
-        if (!(std::abs(placed) <= std::numeric_limits<float>::max())) {
+        q[row] = world[row] * p[0] + world[4 + row] * p[1] + world[8 + row] * p[2] +
+                 world[12 + row];
+        // Beyond a float's range (or NaN) the position could not be narrowed.
+        if (!(std::abs(q[row]) <= std::numeric_limits<float>::max())) {
           return Invalid(where, ": vertex ", i, " is not finite where its node places it");
         }
-        q[row] = static_cast<float>(placed);
         // A sum with +0 terms gives +0 where a coordinate was -0, and a tiny negative sum
         // rounds to -0: zeros are +0, so that a file reads the same however it places them.
-        if (q[row] == 0.0f) q[row] = 0.0f;
+        if (q[row] == 0.0) q[row] = 0.0;
       }
       merged[i] = merger_.Add(q);
       if (merged[i] == colors_.size()) colors_.push_back(colors.empty() ? Rgb{} : colors[i]);
@@ -642,15 +642,42 @@ class GltfReader {
     return absl::OkStatus();
   }
 
+  // Narrows the placed vertices to floats, relative to an origin where they lie far from 0
+  // (position_collector.h), and merges those that became identical.
+  void NarrowAndMerge() {
+    PositionCollector collector;
+    collector.Reserve(placed_.size());
+    for (const Point3d& p : placed_) collector.Add(p);
+    ParsedGeometry narrowed;
+    collector.MoveTo(&narrowed);
+    out_.origin = narrowed.origin;
+    VertexMerger merger(&out_.positions);
+    std::vector<uint32_t> index(narrowed.positions.size());
+    std::vector<Rgb> colors;
+    for (size_t i = 0; i < narrowed.positions.size(); ++i) {
+      index[i] = merger.Add(narrowed.positions[i]);
+      if (index[i] == colors.size()) colors.push_back(colors_[i]);
+    }
+    std::vector<std::array<uint32_t, 3>> faces;
+    faces.reserve(out_.faces.size());
+    for (const std::array<uint32_t, 3>& placed : out_.faces) {
+      const std::array<uint32_t, 3> face = {index[placed[0]], index[placed[1]], index[placed[2]]};
+      if (face[0] != face[1] && face[1] != face[2] && face[2] != face[0]) faces.push_back(face);
+    }
+    out_.faces = std::move(faces);
+    if (colored_) out_.colors = std::move(colors);
+  }
+
   JsonValue doc_;
   std::optional<absl::string_view> bin_;
   const GltfBufferLoader& loader_;
   const FaceHandling faces_;
   std::vector<std::optional<std::string>> loaded_;
   std::vector<bool> visited_;
-  ParsedGeometry out_;
-  VertexMerger merger_;
-  std::vector<Rgb> colors_;  // One per merged vertex; black for vertices without colour.
+  ParsedGeometry out_;  // Faces index placed_ until NarrowAndMerge.
+  std::vector<Point3d> placed_;  // Where the nodes place the vertices, identical ones merged.
+  VertexMergerOf<Point3d> merger_;
+  std::vector<Rgb> colors_;  // One per placed vertex; black for vertices without colour.
   bool colored_ = true;      // Every primitive so far has COLOR_0.
 };
 
@@ -807,7 +834,13 @@ absl::StatusOr<std::string> FormatGltf(const GeometryView& geometry,
   json.Key("scene").Uint(0);
   json.Key("scenes").BeginArray().BeginObject().Key("nodes").BeginArray().Uint(0).EndArray();
   json.EndObject().EndArray();
-  json.Key("nodes").BeginArray().BeginObject().Key("mesh").Uint(0).EndObject().EndArray();
+  json.Key("nodes").BeginArray().BeginObject().Key("mesh").Uint(0);
+  if (geometry.has_origin()) {  // Positions relative to an origin: the node puts it back.
+    json.Key("translation").BeginArray();
+    for (double c : geometry.origin) json.Double(c);
+    json.EndArray();
+  }
+  json.EndObject().EndArray();
   json.Key("materials").BeginArray().BeginObject();
   json.Key("pbrMetallicRoughness").BeginObject().Key("metallicFactor").Double(0);
   json.Key("roughnessFactor").Double(0.8).EndObject();

@@ -27,7 +27,9 @@ GltfBufferLoader GltfBuffersBeside(const std::string& path);
 // primitives (winding reversed under a mirroring transform) and the COLOR_0 colours (linear
 // light, converted to sRGB) when every primitive has them. Vertices at identical positions
 // are merged, since glTF splits vertices where normals or texture coordinates differ; faces
-// that repeat a vertex are dropped. Buffers come from the .glb's BIN chunk, base64 data URIs,
+// that repeat a vertex are dropped. Where the nodes place vertices far from zero (a
+// georeferenced model), positions are relative to an origin (position_collector.h), and
+// merged after that. Buffers come from the .glb's BIN chunk, base64 data URIs,
 // or `load_buffer` (none: external buffers are refused).
 // Returns INVALID_ARGUMENT, saying which element is wrong and how, for a truncated or
 // malformed container or JSON, a glTF version other than 2, a reference or range out of
@@ -44,7 +46,8 @@ struct GltfWriteOptions {
 };
 
 // Formats one mesh of one primitive: positions, faces (TRIANGLES; POINTS without faces), and
-// colours as COLOR_0 (linear light, normalized 16-bit), with a matte double-sided material
+// colours as COLOR_0 (linear light, normalized 16-bit), placed by a node whose translation is
+// geometry.origin when that is not zero, with a matte double-sided material
 // (glTF's default material is fully metallic, which renders dark without an environment).
 // With `draco`, the primitive is a Draco stream (EncodeMeshForGltf) and the file requires
 // KHR_draco_mesh_compression. Returns INVALID_ARGUMENT for `draco` without faces, and what

@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/internal/binary.h"
+#include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/rgb.h"
 
@@ -46,10 +47,6 @@ T Load(absl::string_view data, size_t offset) {
 absl::Status Invalid(absl::string_view message) {
   return absl::InvalidArgumentError(absl::StrCat("LAS: ", message));
 }
-
-// Float positions keep a file's resolution `scale` up to this many scales from zero (a float
-// has 24 bits; half a scale of error at most).
-constexpr double kFloatExactScales = 1 << 22;
 
 }  // namespace
 
@@ -96,7 +93,7 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
                                 offset_to_points, " do not fit in the file's ", data.size(),
                                 " bytes"));
   }
-  double scale[3], offset[3];
+  Point3d scale, offset;
   for (int c = 0; c < 3; ++c) {
     scale[c] = Load<double>(data, kScale + 8 * c);
     offset[c] = Load<double>(data, kOffset + 8 * c);
@@ -110,7 +107,7 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
   ParsedGeometry out;
   out.positions.resize(count);
   // Where the coordinates lie (the header's bounds may be stale: the records decide).
-  double low[3] = {INFINITY, INFINITY, INFINITY}, high[3] = {-INFINITY, -INFINITY, -INFINITY};
+  Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
   for (uint64_t i = 0; i < count; ++i) {
     const size_t at = offset_to_points + i * record_length;
     for (int c = 0; c < 3; ++c) {
@@ -119,16 +116,9 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
       high[c] = std::max(high[c], value);
     }
   }
-  for (int c = 0; c < 3; ++c) {
-    const double far = std::max(std::fabs(low[c]), std::fabs(high[c]));
-    if (count > 0 && far > kFloatExactScales * std::fabs(scale[c])) {
-      // The points' minimum (the header's bounds may be stale or zero), when that brings
-      // them nearer.
-      const double origin = std::floor(low[c] / 1000) * 1000;
-      if (std::max(std::fabs(low[c] - origin), std::fabs(high[c] - origin)) < far) {
-        out.origin[c] = origin;
-      }
-    }
+  if (count > 0) {
+    const Point3d step = {std::fabs(scale[0]), std::fabs(scale[1]), std::fabs(scale[2])};
+    out.origin = OriginKeepingResolution(low, high, step);
   }
   for (uint64_t i = 0; i < count; ++i) {
     const size_t at = offset_to_points + i * record_length;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/rgb.h"
 #include "core/status_macros.h"
@@ -27,22 +28,22 @@ struct ObjColors {
 };
 
 absl::Status ParseVertex(const std::vector<absl::string_view>& tokens, int line,
-                         ParsedGeometry* out, ObjColors* colors) {
+                         PositionCollector* positions, ObjColors* colors) {
   if (tokens.size() < 4) {
     return LineError(line,
                      absl::StrCat("expected 'v x y z', found ", tokens.size() - 1, " coordinates"));
   }
-  Vec3f p;
+  Point3d p;
   for (int c = 0; c < 3; ++c) {
-    if (!ParseFloat(tokens[1 + c], &p[c])) {
+    if (!ParseDouble(tokens[1 + c], &p[c])) {
       return LineError(line, absl::StrCat("expected a number for coordinate ", kAxisNames[c],
                                           " of a vertex, found ", Quoted(tokens[1 + c])));
     }
+    if (!std::isfinite(NarrowToFloat(p[c]))) {
+      return LineError(line, "vertex has a non-finite coordinate");
+    }
   }
-  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-    return LineError(line, "vertex has a non-finite coordinate");
-  }
-  out->positions.push_back(p);
+  positions->Add(p);
   // 'v x y z w' carries a homogeneous weight, ignored; 'v x y z r g b', a colour.
   if (tokens.size() < 7) {
     colors->every_vertex = false;
@@ -120,6 +121,7 @@ absl::StatusOr<int64_t> ParseReference(absl::string_view reference, int line, si
 
 absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling faces) {
   ParsedGeometry out;
+  PositionCollector positions;
   LineCursor cursor(data);
   absl::string_view line;
   std::vector<absl::string_view> tokens;
@@ -132,7 +134,7 @@ absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling fac
     SplitWhitespace(StripHashComment(line), &tokens);
     if (tokens.empty()) continue;
     if (tokens[0] == "v") {
-      NM_RETURN_IF_ERROR(ParseVertex(tokens, n, &out, &colors));
+      NM_RETURN_IF_ERROR(ParseVertex(tokens, n, &positions, &colors));
     } else if (tokens[0] == "f" && faces == FaceHandling::kRead) {
       if (tokens.size() < 4) {
         return LineError(
@@ -141,7 +143,7 @@ absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling fac
       polygon.clear();
       for (size_t k = 1; k < tokens.size(); ++k) {
         NM_ASSIGN_OR_RETURN(const int64_t index,
-                            ParseReference(tokens[k], n, out.positions.size()));
+                            ParseReference(tokens[k], n, positions.size()));
         if (index > largest_index) {
           largest_index = index;
           largest_index_line = n;
@@ -153,11 +155,12 @@ absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling fac
       }
     }
   }
-  if (largest_index >= static_cast<int64_t>(out.positions.size())) {
+  if (largest_index >= static_cast<int64_t>(positions.size())) {
     return LineError(largest_index_line,
                      absl::StrCat("face uses vertex ", largest_index + 1, " but the file has ",
-                                  out.positions.size(), " vertices"));
+                                  positions.size(), " vertices"));
   }
+  positions.MoveTo(&out);
   out.colors = ResolveColors(colors);
   return out;
 }
@@ -170,7 +173,7 @@ std::string FormatObj(const GeometryView& geometry) {
     out += "v";
     for (int c = 0; c < 3; ++c) {
       out += ' ';
-      AppendFloat(geometry.positions[i][c], &out);
+      AppendCoordinate(geometry.positions[i][c], geometry.origin[c], &out);
     }
     if (colors) {
       for (int c = 0; c < 3; ++c) {

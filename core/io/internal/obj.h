@@ -19,8 +19,8 @@ namespace neuralmesh::io_internal {
 // coordinate, or a face index that is 0 or out of range.
 absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling faces);
 
-// Formats the positions, colours (as fractions, 'v x y z r g b') and faces of `geometry` as OBJ
-// text.
+// Formats the positions (with geometry.origin added: AppendCoordinate), colours (as fractions,
+// 'v x y z r g b') and faces of `geometry` as OBJ text.
 std::string FormatObj(const GeometryView& geometry);
 
 }  // namespace neuralmesh::io_internal

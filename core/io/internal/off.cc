@@ -8,6 +8,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/strip.h"
+#include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/rgb.h"
 #include "core/status_macros.h"
@@ -117,7 +118,8 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
   }
 
   ParsedGeometry out;
-  out.positions.reserve(num_vertices);
+  PositionCollector positions;
+  positions.Reserve(num_vertices);
   if (has_normals) out.normals.reserve(num_vertices);
   const size_t min_tokens = has_normals ? 6 : 3;
   for (int64_t i = 0; i < num_vertices; ++i) {
@@ -131,15 +133,18 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
       return LineError(n, absl::StrCat("expected ", has_normals ? "'x y z nx ny nz'" : "'x y z'",
                                        " for vertex ", i, ", found ", tokens.size(), " values"));
     }
-    float values[6];
+    double values[6];
     for (size_t k = 0; k < min_tokens; ++k) {
-      if (!ParseFloat(tokens[k], &values[k]) || !std::isfinite(values[k])) {
+      if (!ParseDouble(tokens[k], &values[k]) || !std::isfinite(NarrowToFloat(values[k]))) {
         return LineError(n, absl::StrCat("expected a finite number in vertex ", i, ", found ",
                                          Quoted(tokens[k])));
       }
     }
-    out.positions.emplace_back(values[0], values[1], values[2]);
-    if (has_normals) out.normals.emplace_back(values[3], values[4], values[5]);
+    positions.Add({values[0], values[1], values[2]});
+    if (has_normals) {
+      out.normals.emplace_back(NarrowToFloat(values[3]), NarrowToFloat(values[4]),
+                               NarrowToFloat(values[5]));
+    }
     if (has_colors) {
       Rgb color;
       NM_ASSIGN_OR_RETURN(const bool present, ParseColor(tokens, min_tokens, n, i, &color));
@@ -151,6 +156,7 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
       }
     }
   }
+  positions.MoveTo(&out);
   if (faces == FaceHandling::kSkip) return out;
 
   if (static_cast<uint64_t>(num_faces) > cursor.remaining() / kMinFaceBytes + 1) {
@@ -204,7 +210,7 @@ std::string FormatOff(const GeometryView& geometry) {
   for (size_t i = 0; i < geometry.positions.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
       if (c > 0) out += ' ';
-      AppendFloat(geometry.positions[i][c], &out);
+      AppendCoordinate(geometry.positions[i][c], geometry.origin[c], &out);
     }
     if (colors) {
       const Rgb& rgb = geometry.colors[i];

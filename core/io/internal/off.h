@@ -19,8 +19,8 @@ namespace neuralmesh::io_internal {
 // vertex or face line, a non-finite coordinate or an out-of-range index.
 absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling faces);
 
-// Formats the positions and faces of `geometry` as ASCII OFF, or COFF ("x y z r g b 255") when
-// it has colours.
+// Formats the positions (with geometry.origin added: AppendCoordinate) and faces of `geometry`
+// as ASCII OFF, or COFF ("x y z r g b 255") when it has colours.
 std::string FormatOff(const GeometryView& geometry);
 
 }  // namespace neuralmesh::io_internal

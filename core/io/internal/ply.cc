@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/internal/binary.h"
 #include "core/io/internal/ply_header.h"
+#include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/rgb.h"
 #include "core/status_macros.h"
@@ -289,7 +290,8 @@ absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry*
     }
   }
   // BeginElement has bounded the count by the remaining bytes.
-  out->positions.reserve(element.count);
+  PositionCollector positions;
+  positions.Reserve(element.count);
   if (has_normals) out->normals.reserve(element.count);
   if (has_weights) out->weights.reserve(element.count);
   if (has_colors) out->colors.reserve(element.count);
@@ -311,7 +313,7 @@ absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry*
                                                      " has a non-finite coordinate (", values[kX],
                                                      ", ", values[kY], ", ", values[kZ], ")"));
     }
-    out->positions.push_back(p);
+    positions.Add({values[kX], values[kY], values[kZ]});
     if (has_normals) {
       const Vec3f n(NarrowToFloat(values[kNx]), NarrowToFloat(values[kNy]),
                     NarrowToFloat(values[kNz]));
@@ -335,6 +337,7 @@ absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry*
                              ChannelFromLevel(values[kBlue], channel_max[2])});
     }
   }
+  positions.MoveTo(out);
   return absl::OkStatus();
 }
 
@@ -446,7 +449,11 @@ std::string FormatPly(const GeometryView& geometry) {
   const bool colors = !geometry.colors.empty();
   std::string out = absl::StrCat(
       "ply\nformat binary_little_endian 1.0\ncomment written by neuralmesh\nelement vertex ",
-      geometry.positions.size(), "\nproperty float x\nproperty float y\nproperty float z\n");
+      geometry.positions.size(), "\n");
+  // Relative to an origin, the coordinates are written whole, as doubles.
+  const bool doubles = geometry.has_origin();
+  out += doubles ? "property double x\nproperty double y\nproperty double z\n"
+                 : "property float x\nproperty float y\nproperty float z\n";
   if (normals) out += "property float nx\nproperty float ny\nproperty float nz\n";
   if (weights) out += "property float confidence\n";
   if (colors) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
@@ -455,10 +462,17 @@ std::string FormatPly(const GeometryView& geometry) {
                     "\nproperty list uchar uint vertex_indices\n");
   }
   out += "end_header\n";
-  const size_t vertex_size = 4 * (3 + (normals ? 3 : 0) + (weights ? 1 : 0)) + (colors ? 3 : 0);
+  const size_t vertex_size =
+      (doubles ? 24 : 12) + 4 * ((normals ? 3 : 0) + (weights ? 1 : 0)) + (colors ? 3 : 0);
   out.reserve(out.size() + geometry.positions.size() * vertex_size + geometry.faces.size() * 13);
   for (size_t i = 0; i < geometry.positions.size(); ++i) {
-    for (int c = 0; c < 3; ++c) AppendLittleEndian(geometry.positions[i][c], &out);
+    for (int c = 0; c < 3; ++c) {
+      if (doubles) {
+        AppendLittleEndian(geometry.origin[c] + double{geometry.positions[i][c]}, &out);
+      } else {
+        AppendLittleEndian(geometry.positions[i][c], &out);
+      }
+    }
     if (normals) {
       for (int c = 0; c < 3; ++c) AppendLittleEndian(geometry.normals[i][c], &out);
     }

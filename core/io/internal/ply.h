@@ -22,7 +22,8 @@ namespace neuralmesh::io_internal {
 // hold, missing or malformed values, non-finite coordinates or out-of-range face indices.
 absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces);
 
-// Formats `geometry` as binary little-endian PLY: float x, y, z, then float nx, ny, nz, a float
+// Formats `geometry` as binary little-endian PLY: float x, y, z (double, with geometry.origin
+// added, when the origin is not zero), then float nx, ny, nz, a float
 // 'confidence' and uchar red, green, blue when present, and a 'face' element (uchar count,
 // uint indices) when there are faces.
 std::string FormatPly(const GeometryView& geometry);

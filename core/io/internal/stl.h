@@ -18,7 +18,7 @@ namespace neuralmesh::io_internal {
 absl::StatusOr<ParsedGeometry> ParseStl(absl::string_view data);
 
 // Formats the positions and faces of `geometry` as binary STL, with unit facet normals (zero
-// for degenerate triangles).
+// for degenerate triangles). STL holds floats: positions stay relative to geometry.origin.
 std::string FormatStl(const GeometryView& geometry);
 
 }  // namespace neuralmesh::io_internal

@@ -89,4 +89,15 @@ void AppendFloat(float value, std::string* out) {
   out->append(buffer, result.ptr);
 }
 
+void AppendCoordinate(float local, double origin, std::string* out) {
+  if (origin == 0) {
+    AppendFloat(local, out);
+    return;
+  }
+  char buffer[32];
+  const double value = origin + double{local};
+  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  out->append(buffer, result.ptr);
+}
+
 }  // namespace neuralmesh::io_internal

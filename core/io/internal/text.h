@@ -61,6 +61,10 @@ absl::Status LineError(int line, absl::string_view message);
 
 // Appends the shortest decimal text that reads back as exactly `value`.
 void AppendFloat(float value, std::string* out);
+// Appends coordinate `local` + `origin`: as AppendFloat when `origin` is 0, else the shortest
+// text that reads back as exactly the sum in double (which holds it exactly for origins
+// below 2^29 and the coordinates of a float).
+void AppendCoordinate(float local, double origin, std::string* out);
 
 }  // namespace neuralmesh::io_internal
 

@@ -12,6 +12,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/rgb.h"
 
@@ -195,6 +196,7 @@ std::optional<absl::string_view> CommentText(absl::string_view line) {
 
 absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data) {
   ParsedGeometry out;
+  PositionCollector positions;
   ExtraColumns extra;
   LineCursor cursor(data);
   absl::string_view line;
@@ -234,19 +236,20 @@ absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data) {
       return LineError(n, absl::StrCat("expected ", columns, " numbers like line ",
                                        first_point_line, ", found ", tokens.size()));
     }
-    float values[kMaxColumns];
+    double values[kMaxColumns];
     for (size_t k = 0; k < columns; ++k) {
-      if (!ParseFloat(tokens[k], &values[k])) {
+      if (!ParseDouble(tokens[k], &values[k])) {
         return LineError(
             n, absl::StrCat("expected a number in column ", k + 1, ", found ", Quoted(tokens[k])));
       }
-      if (!std::isfinite(values[k])) {
+      if (!std::isfinite(NarrowToFloat(values[k]))) {
         return LineError(n, absl::StrCat("column ", k + 1, " is not finite: ", Quoted(tokens[k])));
       }
     }
-    out.positions.emplace_back(values[0], values[1], values[2]);
-    extra.values.insert(extra.values.end(), values + 3, values + columns);
+    positions.Add({values[0], values[1], values[2]});
+    for (size_t k = 3; k < columns; ++k) extra.values.push_back(NarrowToFloat(values[k]));
   }
+  positions.MoveTo(&out);
   if (columns == 0) return out;
   XyzLayout layout;
   if (header.has_value()) {
@@ -280,7 +283,7 @@ std::string FormatXyz(const GeometryView& geometry) {
   for (size_t i = 0; i < geometry.positions.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
       if (c > 0) out += ' ';
-      AppendFloat(geometry.positions[i][c], &out);
+      AppendCoordinate(geometry.positions[i][c], geometry.origin[c], &out);
     }
     if (normals) {
       for (int c = 0; c < 3; ++c) {

@@ -35,7 +35,8 @@ namespace neuralmesh::io_internal {
 // header nor the list above explains.
 absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data);
 
-// Formats `geometry` as "x y z [nx ny nz] [r g b] [w]" lines (colours as 0-255 levels, or as
+// Formats `geometry` as "x y z [nx ny nz] [r g b] [w]" lines (positions with geometry.origin
+// added: AppendCoordinate; colours as 0-255 levels, or as
 // fractions when no channel is above 1), after a header comment naming the columns when there
 // are normals or colours.
 std::string FormatXyz(const GeometryView& geometry);

@@ -1,0 +1,66 @@
+#include "core/io/internal/position_collector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "core/io/internal/text.h"
+
+namespace neuralmesh::io_internal {
+namespace {
+
+// A float keeps a resolution `step` up to this many steps from zero (24 bits; half a step of
+// error at most).
+constexpr double kFloatExactSteps = 1 << 22;
+
+// The resolution assumed for a file that states none: 1/65,536 of the bounding box's longest
+// side, finer than a reconstruction resolves by far (a mesh of 100,000 vertices has edges of
+// about 1/300 of it). Origins are then taken for points farther from 0 than 64 such sides.
+constexpr double kUnstatedStepsPerSide = 1 << 16;
+
+}  // namespace
+
+Point3d OriginKeepingResolution(const Point3d& low, const Point3d& high, const Point3d& step) {
+  Point3d origin = {0, 0, 0};
+  for (int c = 0; c < 3; ++c) {
+    const double far = std::max(std::fabs(low[c]), std::fabs(high[c]));
+    if (!(step[c] > 0) || !(far > kFloatExactSteps * step[c])) continue;
+    const double candidate = std::floor(low[c] / 1000) * 1000;
+    if (std::max(std::fabs(low[c] - candidate), std::fabs(high[c] - candidate)) < far) {
+      origin[c] = candidate;
+    }
+  }
+  return origin;
+}
+
+void PositionCollector::MoveTo(ParsedGeometry* out, const Point3d& step) { MoveTo(out, &step); }
+
+void PositionCollector::MoveTo(ParsedGeometry* out) { MoveTo(out, nullptr); }
+
+void PositionCollector::MoveTo(ParsedGeometry* out, const Point3d* step) {
+  Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
+  for (const Point3d& p : positions_) {
+    for (int c = 0; c < 3; ++c) {
+      low[c] = std::min(low[c], p[c]);
+      high[c] = std::max(high[c], p[c]);
+    }
+  }
+  out->origin = {0, 0, 0};
+  if (!positions_.empty()) {
+    double side = 0;
+    for (int c = 0; c < 3; ++c) side = std::max(side, high[c] - low[c]);
+    const double unstated = side / kUnstatedStepsPerSide;
+    out->origin = OriginKeepingResolution(
+        low, high, step != nullptr ? *step : Point3d{unstated, unstated, unstated});
+  }
+  out->positions.resize(positions_.size());
+  for (size_t i = 0; i < positions_.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      // Nearer to 0 than the coordinate itself, which narrows to a finite float.
+      out->positions[i][c] = NarrowToFloat(positions_[i][c] - out->origin[c]);
+    }
+  }
+  std::vector<Point3d>().swap(positions_);
+}
+
+}  // namespace neuralmesh::io_internal

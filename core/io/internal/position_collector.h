@@ -1,0 +1,47 @@
+// Positions as a reader parses them, kept in double until the last one is known: then the
+// origin is chosen and they become floats relative to it. Georeferenced data (UTM eastings of
+// 500,000 m, northings of 4,100,000 m) would lose centimetres in a float, and the learner's
+// float arithmetic far more; relative to an origin near the points they keep their detail.
+#ifndef NEURALMESH_CORE_IO_INTERNAL_POSITION_COLLECTOR_H_
+#define NEURALMESH_CORE_IO_INTERNAL_POSITION_COLLECTOR_H_
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "core/io/internal/geometry_data.h"
+
+namespace neuralmesh::io_internal {
+
+using Point3d = std::array<double, 3>;
+
+// Per axis, where to put position 0 so that floats keep the data's resolution `step` (the
+// finest difference the data resolve, e.g. a LAS file's scale): zero while a float's step at
+// the farthest coordinate is at most half of `step`, otherwise the points' minimum `low`
+// rounded down to a multiple of 1,000, when that brings them nearer to 0. `low` and `high` are
+// the points' bounds; a zero `step` never moves the axis.
+Point3d OriginKeepingResolution(const Point3d& low, const Point3d& high, const Point3d& step);
+
+class PositionCollector {
+ public:
+  void Reserve(size_t count) { positions_.reserve(count); }
+  // `p` must narrow to a finite float (the readers check, to name the offending line).
+  void Add(const Point3d& p) { positions_.push_back(p); }
+  size_t size() const { return positions_.size(); }
+  const Point3d& operator[](size_t i) const { return positions_[i]; }
+
+  // Sets out->positions to the positions relative to out->origin, chosen by
+  // OriginKeepingResolution with `step`: the file's resolution per axis, or, for files that do
+  // not state one, 1/65,536 of the bounding box's longest side. Clears the collector.
+  void MoveTo(ParsedGeometry* out, const Point3d& step);
+  void MoveTo(ParsedGeometry* out);
+
+ private:
+  void MoveTo(ParsedGeometry* out, const Point3d* step);
+
+  std::vector<Point3d> positions_;
+};
+
+}  // namespace neuralmesh::io_internal
+
+#endif  // NEURALMESH_CORE_IO_INTERNAL_POSITION_COLLECTOR_H_

@@ -109,13 +109,14 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
                      with_colors, OriginNote(target.origin), ")");
     return target;
   }
-  NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(input, "INPUT"));
+  PointsLeftOut left_out;
+  NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(input, "INPUT", &left_out));
   if (mode == SamplingMode::kWeighted && cloud.weights.empty()) {
     return absl::InvalidArgumentError(
         absl::StrCat("INPUT '", input, "' has no per-point weights for --sampling weighted"));
   }
   const size_t points = cloud.size();
-  const std::string origin = OriginNote(cloud.origin);
+  const std::string notes = absl::StrCat(LeftOutNote(left_out), OriginNote(cloud.origin));
   target.origin = cloud.origin;
   std::string removed_outliers;
   if (outliers.has_value()) {
@@ -135,12 +136,12 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
   if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
   target.sampler = *std::move(sampler);
   target.description = absl::StrCat(points, " points of ", input, " (", ModeName(mode), " sampling",
-                                    removed_outliers, with_colors, origin, ")");
+                                    removed_outliers, with_colors, notes, ")");
   return target;
 }
 
 absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t builtin_points,
-                                               uint64_t seed) {
+                                               uint64_t seed, PointsLeftOut* left_out) {
   if (IsBuiltin(input)) {
     if (builtin_points == 0) return absl::InvalidArgumentError("--points must be > 0");
     if (builtin_points > kMaxBuiltinUploadPoints) {
@@ -150,14 +151,29 @@ absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t 
     NM_ASSIGN_OR_RETURN(const std::unique_ptr<ImplicitSurface> surface, MakeBuiltinSurface(input));
     return SamplePoints(*surface, builtin_points, seed);
   }
-  return LoadPointCloud(input, "INPUT");
+  return LoadPointCloud(input, "INPUT", left_out);
 }
 
-absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role) {
+absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role,
+                                          PointsLeftOut* left_out) {
   NM_RETURN_IF_ERROR(CheckInputFile(input, role));
-  absl::StatusOr<PointCloud> cloud = ReadPointCloud(input);
+  absl::StatusOr<PointCloud> cloud = ReadPointCloud(input, left_out);
   if (!cloud.ok()) return InFile(cloud.status(), role, input);
   return cloud;
+}
+
+std::string LeftOutNote(const PointsLeftOut& left_out) {
+  if (left_out.total() == 0) return "";
+  std::string note = "; left out ";
+  if (left_out.withheld > 0) {
+    absl::StrAppend(&note, left_out.withheld, " withheld point", left_out.withheld > 1 ? "s" : "");
+  }
+  if (left_out.noise > 0) {
+    absl::StrAppend(&note, left_out.withheld > 0 ? " and " : "", left_out.noise,
+                    left_out.withheld > 0 ? "" : (left_out.noise > 1 ? " points" : " point"),
+                    " classified as noise");
+  }
+  return note;
 }
 
 std::string OriginNote(const std::array<double, 3>& origin) {

@@ -65,12 +65,20 @@ inline constexpr size_t kMaxBuiltinUploadPoints = size_t{1} << 26;
 // The points of `input` for upload: a point cloud file as read, or `builtin_points` samples
 // of a builtin:NAME surface drawn with `seed` (1 to kMaxBuiltinUploadPoints). Errors as
 // LoadTargetSpace.
+// With `left_out`, the points the file marks as not to be used (ReadPointCloud) are counted
+// there.
 absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t builtin_points,
-                                               uint64_t seed);
+                                               uint64_t seed, PointsLeftOut* left_out = nullptr);
 
 // The points of a point cloud file (any extension ReadPointCloud reads). Errors as
-// LoadTargetSpace; `role` names the argument in messages.
-absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role);
+// LoadTargetSpace; `role` names the argument in messages. With `left_out`, as
+// LoadPointsForUpload.
+absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role,
+                                          PointsLeftOut* left_out = nullptr);
+
+// "" when no point was left out; else what to tell the user: "; left out 3 withheld points
+// and 117 classified as noise".
+std::string LeftOutNote(const PointsLeftOut& left_out);
 
 // "" for a zero origin; else (georeferenced data) what to tell the user: "; coordinates taken
 // relative to (X, Y, Z), and put back in the files written".

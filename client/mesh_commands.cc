@@ -92,7 +92,8 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
     return absl::InvalidArgumentError(
         "--gltf_draco compresses meshes; points are written to glTF uncompressed (or to .drc)");
   }
-  NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(options.input, "INPUT"));
+  PointsLeftOut left_out;
+  NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(options.input, "INPUT", &left_out));
   const size_t read = cloud.size();
   size_t removed = 0;
   if (options.outliers.has_value()) {
@@ -108,7 +109,7 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   if (options.outliers.has_value()) {
     out << " (" << removed << " outliers of " << read << " removed)";
   }
-  out << OriginNote(cloud.origin) << "\n";
+  out << LeftOutNote(left_out) << OriginNote(cloud.origin) << "\n";
   if (gltf && (!cloud.normals.empty() || !cloud.weights.empty())) {
     out << "note: glTF keeps positions and colours; the normals and weights were left out\n";
   }

@@ -73,8 +73,9 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   NM_RETURN_IF_ERROR(options.draco.Validate());
   if (options.out_dir.empty()) return absl::InvalidArgumentError("--out-dir DIR is required");
   if (options.batch_size == 0) return absl::InvalidArgumentError("--batch-size must be > 0");
+  PointsLeftOut left_out;
   NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointsForUpload(options.input, options.builtin_points,
-                                                            options.learner.seed));
+                                                            options.learner.seed, &left_out));
   const size_t points_read = cloud.size();
   if (!options.colors) cloud.colors.clear();
   const bool outliers_on_server = options.outliers.has_value() && options.outliers_on_server;
@@ -82,8 +83,9 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     NM_ASSIGN_OR_RETURN(const size_t removed, RemoveStatisticalOutliers(cloud, *options.outliers));
     out << "outliers removed: " << removed << " of " << points_read << " points\n";
   }
-  if (const std::string origin = OriginNote(cloud.origin); !origin.empty()) {
-    out << "INPUT '" << options.input << "'" << origin << "\n";
+  if (const std::string notes = absl::StrCat(LeftOutNote(left_out), OriginNote(cloud.origin));
+      !notes.empty()) {
+    out << "INPUT '" << options.input << "'" << notes << "\n";
   }
   std::optional<TriangleMesh> start_mesh;
   if (!options.start_mesh.empty()) {

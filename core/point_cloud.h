@@ -3,6 +3,7 @@
 #define NEURALMESH_CORE_POINT_CLOUD_H_
 
 #include <array>
+#include <cstddef>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -10,6 +11,15 @@
 #include "core/rgb.h"
 
 namespace neuralmesh {
+
+// Points of a file that its reader left out because the file marks them as not to be used
+// (LAS: the withheld flag, and the noise classes 7 and 18).
+struct PointsLeftOut {
+  size_t withheld = 0;
+  size_t noise = 0;
+
+  size_t total() const { return withheld + noise; }
+};
 
 struct PointCloud {
   std::vector<Vec3f> positions;

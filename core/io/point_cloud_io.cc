@@ -39,7 +39,8 @@ absl::Status UnsupportedExtension(const std::string& path, const char* supported
 }
 
 absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view data,
-                                           const std::string& path) {
+                                           const std::string& path, PointsLeftOut* left_out) {
+  *left_out = {};
   absl::StatusOr<io_internal::ParsedGeometry> parsed;
   switch (format) {
     case FileFormat::kPly:
@@ -74,6 +75,7 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
   cloud.weights = std::move(parsed->weights);
   cloud.colors = std::move(parsed->colors);
   cloud.origin = parsed->origin;
+  *left_out = parsed->left_out;
   return cloud;
 }
 
@@ -91,13 +93,15 @@ bool IsWritablePointCloudExtension(std::string_view path) {
   return IsWritable(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
 }
 
-absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path) {
+absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, PointsLeftOut* left_out) {
   const FileFormat format = io_internal::FormatFromPath(path);
   if (!IsReadable(format)) {
     return UnsupportedExtension(path, kReadablePointCloudExtensions);
   }
   NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
-  absl::StatusOr<PointCloud> cloud = ParsePointCloud(format, data, path);
+  PointsLeftOut ignored;
+  absl::StatusOr<PointCloud> cloud =
+      ParsePointCloud(format, data, path, left_out != nullptr ? left_out : &ignored);
   if (!cloud.ok()) return io_internal::WithPath(cloud.status(), path);
   if (cloud->empty()) {
     return absl::InvalidArgumentError(absl::StrCat("'", path, "' contains no points"));

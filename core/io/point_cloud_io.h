@@ -33,7 +33,9 @@ bool IsWritablePointCloudExtension(std::string_view path);
 //         weights; red, green, blue (or r, g, b) as colours.
 //   .xyz, .txt, .pts  "x y z [nx ny nz] [w]", "x y z r g b", "x y z i r g b" (PTS) lines
 //         and others a header comment names ("# x y z nx ny nz r g b w"); see internal/xyz.h.
-//   .las  LAS 1.0-1.4 point records of formats 0-10, with colours where the format has them.
+//   .las  LAS 1.0-1.4 point records of formats 0-10, with colours where the format has them;
+//         withheld points and those classified as noise (classes 7 and 18) are left out, and
+//         counted in `left_out` when it is given.
 //   .obj  the 'v' lines, 'v x y z r g b' with colours ('vn' is ignored: OBJ normals belong to
 //         face corners).
 //   .off  the vertices of OFF, COFF (with colours), NOFF (with normals), STOFF.
@@ -46,7 +48,8 @@ bool IsWritablePointCloudExtension(std::string_view path);
 // unsupported extension (listing the supported ones), an empty file, a file with no points,
 // malformed content (the message gives the line or byte offset and what was expected), or a
 // cloud that fails ValidatePointCloud (e.g. negative weights).
-absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path);
+absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,
+                                          PointsLeftOut* left_out = nullptr);
 
 // Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
 // nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"

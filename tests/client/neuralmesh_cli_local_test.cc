@@ -566,6 +566,46 @@ TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
       << as_stl.out;
 }
 
+// A scan whose noise is classified (and one point withheld): reconstruct and convert leave
+// those points out and say how many.
+TEST_F(LocalCliTest, ClassifiedNoiseInLasScansIsLeftOutAndCounted) {
+  const PointCloud unit = ColoredUnitSpherePoints(4000, 9);
+  testing::LasLayout layout;
+  layout.format = 1;
+  for (double& s : layout.scale) s = 0.0001;
+  std::vector<testing::LasPoint> points;
+  for (const Vec3f& p : unit.positions) {
+    points.push_back({static_cast<int32_t>(std::lround(p[0] / 0.0001)),
+                      static_cast<int32_t>(std::lround(p[1] / 0.0001)),
+                      static_cast<int32_t>(std::lround(p[2] / 0.0001))});
+  }
+  for (int i = 0; i < 40; ++i) {  // Strays 3 to 5 radii out, classified as high noise.
+    testing::LasPoint stray{30000 + 500 * i, -50000 + 1000 * i, 40000};
+    stray.classification = 18;
+    points.push_back(stray);
+  }
+  points[0].withheld = true;
+  const std::string las = *dir_ + "/classified.las";
+  std::ofstream(las, std::ios::binary) << testing::LasFile(layout, points);
+
+  const std::string xyz = *dir_ + "/classified.xyz";
+  const RunResult convert = RunNeuralmesh({"convert", las, "-o", xyz});
+  ASSERT_EQ(convert.exit_code, 0) << convert.Describe();
+  EXPECT_EQ(convert.out,
+            xyz + ": 3999 points; left out 1 withheld point and 40 classified as noise\n");
+  const std::string mesh = *dir_ + "/classified.ply";
+  const RunResult run = RunNeuralmesh({"reconstruct", las, "-o", mesh, "--vertices", "300"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "3999 points of " + las + " (uniform sampling; left out "
+                                         "1 withheld point and 40 classified as noise)"))
+      << run.out;
+  const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);
+  ASSERT_TRUE(learned.ok()) << learned.status();
+  for (const Vec3f& v : learned->positions) {
+    ASSERT_NEAR(v.norm(), 1.0f, 0.05f) << "no vertex pulled toward the noise";
+  }
+}
+
 TEST_F(LocalCliTest, AnInterruptWritesTheMeshLearnedSoFar) {
   const std::string path = *dir_ + "/interrupted.ply";
   BackgroundProcess run("neuralmesh",

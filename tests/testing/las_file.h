@@ -15,6 +15,8 @@ namespace neuralmesh::testing {
 struct LasPoint {
   int32_t x, y, z;
   uint16_t red = 0, green = 0, blue = 0;
+  uint8_t classification = 0;  // ASPRS class: 2 ground, 7 low noise, 18 high noise, ...
+  bool withheld = false;
 };
 
 struct LasLayout {
@@ -73,6 +75,14 @@ inline std::string LasFile(const LasLayout& layout, const std::vector<LasPoint>&
     io_internal::AppendLittleEndian(p.y, &fields);
     io_internal::AppendLittleEndian(p.z, &fields);
     record.replace(0, 12, fields);
+    // Formats 0-5: the class in the low five bits of byte 15, withheld in its top bit; formats
+    // 6-10: withheld in bit 2 of byte 15, the class in byte 16.
+    if (layout.format >= 6) {
+      record[15] = static_cast<char>(p.withheld ? 0x04 : 0);
+      record[16] = static_cast<char>(p.classification);
+    } else {
+      record[15] = static_cast<char>((p.classification & 0x1F) | (p.withheld ? 0x80 : 0));
+    }
     if (kLasRgbOffset[layout.format] != 0) {
       std::string rgb;
       for (uint16_t channel : {p.red, p.green, p.blue})

@@ -9,6 +9,7 @@
 
 #include "absl/types/span.h"
 #include "core/mesh.h"
+#include "core/point_cloud.h"
 #include "core/rgb.h"
 
 namespace neuralmesh::io_internal {
@@ -26,6 +27,8 @@ struct ParsedGeometry {
   // The positions are relative to this point: readers move georeferenced data there to keep a
   // float's resolution (position_collector.h); zero for most files.
   std::array<double, 3> origin = {0, 0, 0};
+  // Points the file marks as not to be used, which the reader left out.
+  PointsLeftOut left_out;
 };
 
 struct GeometryView {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/internal/binary.h"
@@ -46,6 +47,25 @@ T Load(absl::string_view data, size_t offset) {
 
 absl::Status Invalid(absl::string_view message) {
   return absl::InvalidArgumentError(absl::StrCat("LAS: ", message));
+}
+
+// The ASPRS classes of noise: 7, low point, and 18, high noise (LAS 1.4, Table 17).
+constexpr int kLowNoiseClass = 7;
+constexpr int kHighNoiseClass = 18;
+
+enum RecordUsability { kUsable, kWithheld, kNoise };
+
+// Whether the record at `at` is to be used: the withheld flag (the specification: to be
+// treated as deleted) and the noise classes leave it out. Formats 0-5 hold the class in the
+// low five bits of byte 15 and the withheld flag in its top bit; formats 6-10 the flag in bit
+// 2 of byte 15 and the class in byte 16.
+RecordUsability Usability(absl::string_view data, size_t at, int format) {
+  const uint8_t flags = static_cast<uint8_t>(data[at + 15]);
+  const bool extended = format >= 6;
+  if (extended ? (flags & 0x04) != 0 : (flags & 0x80) != 0) return kWithheld;
+  const int classification = extended ? static_cast<uint8_t>(data[at + 16]) : flags & 0x1F;
+  return classification == kLowNoiseClass || classification == kHighNoiseClass ? kNoise
+                                                                                : kUsable;
 }
 
 }  // namespace
@@ -105,43 +125,62 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
   }
 
   ParsedGeometry out;
-  out.positions.resize(count);
-  // Where the coordinates lie (the header's bounds may be stale: the records decide).
+  // The records to read, and where the coordinates lie (the header's bounds may be stale: the
+  // records decide).
+  std::vector<size_t> records;
+  records.reserve(count);
   Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
   for (uint64_t i = 0; i < count; ++i) {
     const size_t at = offset_to_points + i * record_length;
+    switch (Usability(data, at, format_byte)) {
+      case kWithheld:
+        ++out.left_out.withheld;
+        continue;
+      case kNoise:
+        ++out.left_out.noise;
+        continue;
+      case kUsable:
+        break;
+    }
+    records.push_back(at);
     for (int c = 0; c < 3; ++c) {
       const double value = Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
       low[c] = std::min(low[c], value);
       high[c] = std::max(high[c], value);
     }
   }
-  if (count > 0) {
+  if (records.empty() && count > 0) {
+    return Invalid(absl::StrCat("all ", count, " points are withheld (", out.left_out.withheld,
+                                ") or classified as noise (", out.left_out.noise, ")"));
+  }
+  if (!records.empty()) {
     const Point3d step = {std::fabs(scale[0]), std::fabs(scale[1]), std::fabs(scale[2])};
     out.origin = OriginKeepingResolution(low, high, step);
   }
-  for (uint64_t i = 0; i < count; ++i) {
-    const size_t at = offset_to_points + i * record_length;
+  out.positions.resize(records.size());
+  for (size_t i = 0; i < records.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
-      const double value = Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
+      const double value = Load<int32_t>(data, records[i] + 4 * c) * scale[c] + offset[c];
       out.positions[i][c] = NarrowToFloat(value - out.origin[c]);
       if (!std::isfinite(out.positions[i][c])) {
-        return Invalid(absl::StrCat("point ", i, " lies beyond a float's range"));
+        return Invalid(absl::StrCat("point ", (records[i] - offset_to_points) / record_length,
+                                    " lies beyond a float's range"));
       }
     }
   }
-  if (format.rgb != 0 && count > 0) {
+  if (format.rgb != 0 && !records.empty()) {
     uint16_t largest = 0;
-    for (uint64_t i = 0; i < count; ++i) {
-      const size_t at = offset_to_points + i * record_length + format.rgb;
-      for (int c = 0; c < 3; ++c) largest = std::max(largest, Load<uint16_t>(data, at + 2 * c));
+    for (size_t at : records) {
+      for (int c = 0; c < 3; ++c) {
+        largest = std::max(largest, Load<uint16_t>(data, at + format.rgb + 2 * c));
+      }
     }
     const double max = largest <= 255 ? 255.0 : 65535.0;
-    out.colors.resize(count);
-    for (uint64_t i = 0; i < count; ++i) {
-      const size_t at = offset_to_points + i * record_length + format.rgb;
+    out.colors.resize(records.size());
+    for (size_t i = 0; i < records.size(); ++i) {
       for (int c = 0; c < 3; ++c) {
-        out.colors[i][c] = ChannelFromLevel(Load<uint16_t>(data, at + 2 * c), max);
+        out.colors[i][c] =
+            ChannelFromLevel(Load<uint16_t>(data, records[i] + format.rgb + 2 * c), max);
       }
     }
   }

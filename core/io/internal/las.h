@@ -10,16 +10,17 @@
 namespace neuralmesh::io_internal {
 
 // Parses a LAS file: the positions of its point records (integer X, Y, Z times the header's
-// scale, plus its offset) and, for the formats that carry them (2, 3, 5, 7, 8, 10), their
-// colours (16-bit channels scaled to 8 bits, or taken as they are when no channel of the
-// file exceeds 255, as some writers store 8-bit values). Positions are floats, relative to
-// ParsedGeometry::origin where the file's coordinates are too far from 0 for a float to keep
-// its resolution, the scale (georeferenced data such as UTM: OriginKeepingResolution in
-// position_collector.h).
+// scale, plus its offset; withheld records and those classified as noise, ASPRS classes 7 and
+// 18, left out and counted in ParsedGeometry::left_out) and, for the formats that carry them
+// (2, 3, 5, 7, 8, 10), their colours (16-bit channels scaled to 8 bits, or taken as they are
+// when no channel of the file exceeds 255, as some writers store 8-bit values). Positions are
+// floats, relative to ParsedGeometry::origin where the file's coordinates are too far from 0
+// for a float to keep its resolution, the scale (georeferenced data such as UTM:
+// OriginKeepingResolution in position_collector.h).
 // Returns INVALID_ARGUMENT saying what is wrong for a file without the "LASF" signature, a
 // header or records that run past the end of the file, a compressed (LAZ) file, a point
 // format above 10, a record shorter than its format, a zero or non-finite scale, or a point
-// count that does not fit the file.
+// count that does not fit the file, or points that are all withheld or noise.
 absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data);
 
 }  // namespace neuralmesh::io_internal

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "core/io/point_cloud_io.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -67,6 +68,47 @@ TEST(LasIoTest, ReadsThePositionsAndColoursOfEveryPointFormat) {
 // UTM coordinates at millimetre resolution: a float holds 500,000 m to about 3 cm (and
 // 4,100,000 m to 25 cm), so x and y are taken relative to the origin (the minimum rounded down
 // to 1,000 m) and keep their millimetres; z, near 0, stays as it is.
+// Withheld points (to be treated as deleted) and those classified as noise (class 7, low
+// point; 18, high noise) are left out and counted, in both record families; they do not move
+// the origin. A file of nothing else says so.
+TEST(LasIoTest, WithheldAndNoisePointsAreLeftOutAndCounted) {
+  for (const int format : {1, 6}) {
+    SCOPED_TRACE(::testing::Message() << "format " << format);
+    LasLayout layout;
+    layout.version_minor = format >= 6 ? 4 : 2;
+    layout.format = format;
+    for (double& s : layout.scale) s = 0.001;
+    layout.offset[0] = 500000;
+    std::vector<LasPoint> points = {{1000, 2000, 3000}, {1500, 2500, 3500}, {1, 2, 3},
+                                    {-400000000, 0, 0}, {7, 8, 9}, {4, 5, 6}};
+    points[0].classification = 2;  // Ground: kept.
+    points[1].classification = 6;  // Building: kept.
+    points[2].classification = 7;
+    points[3].classification = 18;  // 100 km away: it would have moved the origin.
+    points[4].withheld = true;
+    points[4].classification = 2;
+    points[5].classification = 31;  // Unassigned user classes are kept.
+    PointsLeftOut left_out;
+    const std::string path = TempPath(absl::StrCat("classes", format, ".las"));
+    WriteBytes(path, LasFile(layout, points));
+    const absl::StatusOr<PointCloud> cloud = ReadPointCloud(path, &left_out);
+    ASSERT_TRUE(cloud.ok()) << cloud.status();
+    EXPECT_EQ(left_out.noise, 2u);
+    EXPECT_EQ(left_out.withheld, 1u);
+    ASSERT_EQ(cloud->size(), 3u);
+    EXPECT_EQ(cloud->origin, (std::array<double, 3>{500000, 0, 0}));
+    EXPECT_FLOAT_EQ(cloud->positions[0][0], 1.0f);
+    EXPECT_FLOAT_EQ(cloud->positions[1][1], 2.5f);
+    EXPECT_FLOAT_EQ(cloud->positions[2][2], 0.006f);
+
+    for (LasPoint& p : points) p.classification = 7;
+    const absl::StatusOr<PointCloud> none = ReadLas("noise.las", LasFile(layout, points));
+    EXPECT_EQ(none.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(std::string(none.status().message()),
+                HasSubstr("all 6 points are withheld (1) or classified as noise (5)"));
+  }
+}
+
 TEST(LasIoTest, GeoreferencedCoordinatesKeepTheirResolutionRelativeToAnOrigin) {
   LasLayout layout;
   layout.version_minor = 4;

@@ -209,6 +209,13 @@ absl::StatusOr<TriangleMesh> ReadStartMesh(const std::string& path) {
   return mesh;
 }
 
+absl::Status MoveStartMesh(const std::array<double, 3>& origin, const std::string& path,
+                           TriangleMesh* mesh) {
+  const absl::Status moved = MoveOrigin(origin, mesh);
+  if (moved.ok()) return moved;
+  return absl::InvalidArgumentError(absl::StrCat("--start_mesh '", path, "': ", moved.message()));
+}
+
 std::string InputStem(const std::string& input) {
   if (IsBuiltin(input)) return input.substr(kBuiltinPrefix.size());
   return std::filesystem::path(input).stem().string();

@@ -97,6 +97,11 @@ absl::StatusOr<TriangleMesh> LoadMesh(const std::string& input, absl::string_vie
 // learner (Learner::CreateFrom) or the server.
 absl::StatusOr<TriangleMesh> ReadStartMesh(const std::string& path);
 
+// Moves the start mesh read from `path` into the frame of the points, relative to `origin`
+// (MoveOrigin); INVALID_ARGUMENT "--start_mesh 'path': ..." when it cannot be.
+absl::Status MoveStartMesh(const std::array<double, 3>& origin, const std::string& path,
+                           TriangleMesh* mesh);
+
 // A short name for output files: the file name without directory and extension, or NAME for
 // builtin:NAME.
 std::string InputStem(const std::string& input);

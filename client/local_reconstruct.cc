@@ -81,11 +81,7 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
                       LoadTargetSpace(options.input, options.sampling, options.outliers,
                                       options.colors));
   if (start_mesh.has_value()) {
-    const absl::Status moved = MoveOrigin(target.origin, &*start_mesh);
-    if (!moved.ok()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("--start_mesh '", options.start_mesh, "': ", moved.message()));
-    }
+    NM_RETURN_IF_ERROR(MoveStartMesh(target.origin, options.start_mesh, &*start_mesh));
   }
   absl::StatusOr<std::unique_ptr<Learner>> created =
       start_mesh.has_value()

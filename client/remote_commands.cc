@@ -94,11 +94,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
           "--start_mesh applies to a new session; --resume goes on with the session's own");
     }
     NM_ASSIGN_OR_RETURN(start_mesh, ReadStartMesh(options.start_mesh));
-    const absl::Status moved = MoveOrigin(cloud.origin, &*start_mesh);
-    if (!moved.ok()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("--start_mesh '", options.start_mesh, "': ", moved.message()));
-    }
+    NM_RETURN_IF_ERROR(MoveStartMesh(cloud.origin, options.start_mesh, &*start_mesh));
   }
   const size_t affordable = static_cast<size_t>(std::floor(cloud.size() / kDefaultPointsPerVertex));
   size_t target =
@@ -166,6 +162,14 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
           "session ", session.session_id(), " has taken ", session.points_taken(),
           " points, more than the ", cloud.size(),
           " of this input: resume with the input (and its flags) of the first run"));
+    }
+    const v1::Origin& origin = session.config().origin();
+    if (std::array<double, 3>{origin.x(), origin.y(), origin.z()} != cloud.origin) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "session %s holds points relative to (%.15g, %.15g, %.15g), this input is read "
+          "relative to (%.15g, %.15g, %.15g): resume with the input of the first run",
+          session.session_id(), origin.x(), origin.y(), origin.z(), cloud.origin[0],
+          cloud.origin[1], cloud.origin[2]));
     }
     first_point = static_cast<size_t>(session.points_taken());
     target = session.config().target_vertices();

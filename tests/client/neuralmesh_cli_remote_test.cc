@@ -402,6 +402,21 @@ TEST_F(RemoteCliTest, GeoreferencedScansComeBackInTheirCoordinates) {
       ASSERT_NEAR(std::sqrt(squared), 1.0, 0.05) << "a vertex off the sphere";
     }
   }
+  // Resuming a session of points in another frame would mix the two: refused.
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
+      client::ReconstructionClient::Connect(server_->address());
+  ASSERT_TRUE(service.ok()) << service.status();
+  v1::SessionConfig config;
+  config.set_target_vertices(400);
+  absl::StatusOr<v1::Session> local = (*service)->CreateSession(config, "local");
+  ASSERT_TRUE(local.ok()) << local.status();
+  const RunResult resume = RunNeuralmesh({"reconstruct", scan, "--server", server_->address(),
+                                          "--out-dir", out_dir, "--resume", local->session_id()});
+  EXPECT_EQ(resume.exit_code, 1) << resume.Describe();
+  EXPECT_THAT(resume.err, ::testing::HasSubstr(
+                              "holds points relative to (0, 0, 0), this input is read relative "
+                              "to (500000, 4100000, 0): resume with the input of the first run"));
+
   const RunResult sessions = RunNeuralmesh({"sessions", "--server", server_->address(), "--json"});
   ASSERT_EQ(sessions.exit_code, 0) << sessions.Describe();
   EXPECT_TRUE(std::regex_search(sessions.out,

@@ -33,6 +33,18 @@ const std::vector<Point3d> kSurveyed = {{500123.456, 4100234.567, 101.234},
                                         {500140.25, 4100250.125, 140.875}};
 const std::vector<std::array<uint32_t, 3>> kFaces = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
 
+// kSurveyed relative to (500000, 4100000, 0), as a tetrahedron.
+TriangleMesh SurveyedMesh() {
+  TriangleMesh mesh;
+  for (const Point3d& p : kSurveyed) {
+    mesh.positions.emplace_back(static_cast<float>(p[0] - 500000),
+                                static_cast<float>(p[1] - 4100000), static_cast<float>(p[2]));
+  }
+  mesh.faces = kFaces;
+  mesh.origin = {500000, 4100000, 0};
+  return mesh;
+}
+
 // Where each point lies, with its origin put back.
 std::vector<Point3d> Placed(const std::vector<Vec3f>& positions, const Point3d& origin) {
   std::vector<Point3d> placed;
@@ -113,36 +125,9 @@ TEST(GeoreferencedIoTest, MeshFilesAreReadRelativeToAnOrigin) {
   }
 }
 
-TEST(GeoreferencedIoTest, GltfNodesThatPlaceAMeshFarAwayGiveAnOrigin) {
-  // The writer stores an origin as the node's translation; the reader takes it back.
-  TriangleMesh local;
-  for (const Point3d& p : kSurveyed) {
-    local.positions.emplace_back(static_cast<float>(p[0] - 500000),
-                                 static_cast<float>(p[1] - 4100000), static_cast<float>(p[2]));
-  }
-  local.faces = kFaces;
-  local.origin = {500000, 4100000, 0};
-  for (const std::string name : {"survey.glb", "survey.gltf"}) {
-    SCOPED_TRACE(name);
-    const std::string path = TempPath(name);
-    ASSERT_TRUE(WriteMesh(local, path).ok());
-    EXPECT_THAT(ReadBytes(path), HasSubstr("\"translation\":[5e+05,4100000,0]"));
-    const absl::StatusOr<TriangleMesh> mesh = ReadMesh(path);
-    ASSERT_TRUE(mesh.ok()) << mesh.status();
-    EXPECT_EQ(mesh->origin, local.origin);
-    EXPECT_EQ(mesh->positions, local.positions);
-  }
-}
-
 TEST(GeoreferencedIoTest, MeshesAreWrittenInTheirDataCoordinatesAndReadBackExactly) {
-  TriangleMesh mesh;
-  for (const Point3d& p : kSurveyed) {
-    mesh.positions.emplace_back(static_cast<float>(p[0] - 500000),
-                                static_cast<float>(p[1] - 4100000), static_cast<float>(p[2]));
-  }
-  mesh.faces = kFaces;
+  TriangleMesh mesh = SurveyedMesh();
   mesh.colors = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {9, 9, 9}};
-  mesh.origin = {500000, 4100000, 0};
   for (const std::string name : {"out.ply", "out.obj", "out.off", "out.glb", "out.gltf"}) {
     SCOPED_TRACE(name);
     const std::string path = TempPath(name);
@@ -157,6 +142,8 @@ TEST(GeoreferencedIoTest, MeshesAreWrittenInTheirDataCoordinatesAndReadBackExact
   // The text formats hold the coordinates themselves, to the float's last bit.
   EXPECT_THAT(ReadBytes(TempPath("out.obj")), HasSubstr("v 500123.45600128174 4100234.567001343 "));
   EXPECT_THAT(ReadBytes(TempPath("out.ply")), HasSubstr("property double x\n"));
+  // glTF places the mesh with its node's translation.
+  EXPECT_THAT(ReadBytes(TempPath("out.gltf")), HasSubstr("\"translation\":[5e+05,4100000,0]"));
   // Draco keeps the origin as metadata beside its quantized positions.
   const std::string drc = TempPath("out.drc");
   ASSERT_TRUE(WriteMesh(mesh, drc).ok());
@@ -176,11 +163,8 @@ TEST(GeoreferencedIoTest, MeshesAreWrittenInTheirDataCoordinatesAndReadBackExact
 
 TEST(GeoreferencedIoTest, PointCloudsAreWrittenInTheirDataCoordinatesAndReadBackExactly) {
   PointCloud cloud;
-  for (const Point3d& p : kSurveyed) {
-    cloud.positions.emplace_back(static_cast<float>(p[0] - 500000),
-                                 static_cast<float>(p[1] - 4100000), static_cast<float>(p[2]));
-    cloud.normals.emplace_back(0.0f, 0.0f, 1.0f);
-  }
+  cloud.positions = SurveyedMesh().positions;
+  cloud.normals.assign(cloud.size(), Vec3f(0.0f, 0.0f, 1.0f));
   cloud.origin = {500000, 4100000, 0};
   for (const std::string name : {"out.ply", "out.xyz", "out.glb"}) {
     SCOPED_TRACE(name);

@@ -1,5 +1,6 @@
 #include "core/io/internal/text.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -94,9 +95,26 @@ void AppendCoordinate(float local, double origin, std::string* out) {
     AppendFloat(local, out);
     return;
   }
-  char buffer[32];
+  // As many decimals as `local` needs on its own (956.034 for the float nearest 956.034), and
+  // more only when the sum's text would not read back as `local` relative to `origin`.
+  char buffer[400];  // Fixed notation of a double up to 1.8e308, and its decimals.
+  std::to_chars_result result =
+      std::to_chars(buffer, buffer + sizeof(buffer), local, std::chars_format::fixed);
+  const char* point = std::find(buffer, result.ptr, '.');
+  const int own_decimals = point == result.ptr ? 0 : static_cast<int>(result.ptr - point - 1);
   const double value = origin + double{local};
-  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  for (int decimals = own_decimals; decimals <= own_decimals + 3; ++decimals) {
+    result = std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::fixed,
+                           decimals);
+    double back = 0;
+    if (result.ec == std::errc() &&
+        ParseDouble(absl::string_view(buffer, result.ptr - buffer), &back) &&
+        NarrowToFloat(back - origin) == local) {
+      out->append(buffer, result.ptr);
+      return;
+    }
+  }
+  result = std::to_chars(buffer, buffer + sizeof(buffer), value);  // The sum itself, exactly.
   out->append(buffer, result.ptr);
 }
 

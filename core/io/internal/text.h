@@ -61,9 +61,9 @@ absl::Status LineError(int line, absl::string_view message);
 
 // Appends the shortest decimal text that reads back as exactly `value`.
 void AppendFloat(float value, std::string* out);
-// Appends coordinate `local` + `origin`: as AppendFloat when `origin` is 0, else the shortest
-// text that reads back as exactly the sum in double (which holds it exactly for origins
-// below 2^29 and the coordinates of a float).
+// Appends coordinate `local` + `origin`: as AppendFloat when `origin` is 0, else the sum in
+// fixed notation with the fewest decimals (from as many as `local` needs alone) whose value,
+// less `origin`, narrows back to `local`: 500956.034 for 500000 and the float nearest 956.034.
 void AppendCoordinate(float local, double origin, std::string* out);
 
 }  // namespace neuralmesh::io_internal

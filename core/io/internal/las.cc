@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/internal/binary.h"
@@ -125,63 +124,63 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
   }
 
   ParsedGeometry out;
-  // The records to read, and where the coordinates lie (the header's bounds may be stale: the
-  // records decide).
-  std::vector<size_t> records;
-  records.reserve(count);
+  // Which records to read (checked again in each pass below, to keep no list of them), and
+  // where the coordinates lie (the header's bounds may be stale: the records decide).
   Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
   for (uint64_t i = 0; i < count; ++i) {
     const size_t at = offset_to_points + i * record_length;
-    switch (Usability(data, at, format_byte)) {
-      case kWithheld:
-        ++out.left_out.withheld;
-        continue;
-      case kNoise:
-        ++out.left_out.noise;
-        continue;
-      case kUsable:
-        break;
-    }
-    records.push_back(at);
+    const RecordUsability usability = Usability(data, at, format_byte);
+    out.left_out.withheld += usability == kWithheld;
+    out.left_out.noise += usability == kNoise;
+    if (usability != kUsable) continue;
     for (int c = 0; c < 3; ++c) {
       const double value = Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
       low[c] = std::min(low[c], value);
       high[c] = std::max(high[c], value);
     }
   }
-  if (records.empty() && count > 0) {
+  const size_t kept = count - out.left_out.total();
+  if (kept == 0 && count > 0) {
     return Invalid(absl::StrCat("all ", count, " points are withheld (", out.left_out.withheld,
                                 ") or classified as noise (", out.left_out.noise, ")"));
   }
-  if (!records.empty()) {
+  if (kept > 0) {
     const Point3d step = {std::fabs(scale[0]), std::fabs(scale[1]), std::fabs(scale[2])};
     out.origin = OriginKeepingResolution(low, high, step);
   }
-  out.positions.resize(records.size());
-  for (size_t i = 0; i < records.size(); ++i) {
+  out.positions.reserve(kept);
+  for (uint64_t i = 0; i < count; ++i) {
+    const size_t at = offset_to_points + i * record_length;
+    if (Usability(data, at, format_byte) != kUsable) continue;
+    Vec3f p;
     for (int c = 0; c < 3; ++c) {
-      const double value = Load<int32_t>(data, records[i] + 4 * c) * scale[c] + offset[c];
-      out.positions[i][c] = NarrowToFloat(value - out.origin[c]);
-      if (!std::isfinite(out.positions[i][c])) {
-        return Invalid(absl::StrCat("point ", (records[i] - offset_to_points) / record_length,
-                                    " lies beyond a float's range"));
+      const double value = Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
+      p[c] = NarrowToFloat(value - out.origin[c]);
+      if (!std::isfinite(p[c])) {
+        return Invalid(absl::StrCat("point ", i, " lies beyond a float's range"));
       }
     }
+    out.positions.push_back(p);
   }
-  if (format.rgb != 0 && !records.empty()) {
+  if (format.rgb != 0 && kept > 0) {
     uint16_t largest = 0;
-    for (size_t at : records) {
+    for (uint64_t i = 0; i < count; ++i) {
+      const size_t at = offset_to_points + i * record_length;
+      if (Usability(data, at, format_byte) != kUsable) continue;
       for (int c = 0; c < 3; ++c) {
         largest = std::max(largest, Load<uint16_t>(data, at + format.rgb + 2 * c));
       }
     }
     const double max = largest <= 255 ? 255.0 : 65535.0;
-    out.colors.resize(records.size());
-    for (size_t i = 0; i < records.size(); ++i) {
+    out.colors.reserve(kept);
+    for (uint64_t i = 0; i < count; ++i) {
+      const size_t at = offset_to_points + i * record_length;
+      if (Usability(data, at, format_byte) != kUsable) continue;
+      Rgb color;
       for (int c = 0; c < 3; ++c) {
-        out.colors[i][c] =
-            ChannelFromLevel(Load<uint16_t>(data, records[i] + format.rgb + 2 * c), max);
+        color[c] = ChannelFromLevel(Load<uint16_t>(data, at + format.rgb + 2 * c), max);
       }
+      out.colors.push_back(color);
     }
   }
   return out;

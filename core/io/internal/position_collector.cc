@@ -33,11 +33,7 @@ Point3d OriginKeepingResolution(const Point3d& low, const Point3d& high, const P
   return origin;
 }
 
-void PositionCollector::MoveTo(ParsedGeometry* out, const Point3d& step) { MoveTo(out, &step); }
-
-void PositionCollector::MoveTo(ParsedGeometry* out) { MoveTo(out, nullptr); }
-
-void PositionCollector::MoveTo(ParsedGeometry* out, const Point3d* step) {
+void PositionCollector::MoveTo(ParsedGeometry* out) {
   Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
   for (const Point3d& p : positions_) {
     for (int c = 0; c < 3; ++c) {
@@ -50,8 +46,7 @@ void PositionCollector::MoveTo(ParsedGeometry* out, const Point3d* step) {
     double side = 0;
     for (int c = 0; c < 3; ++c) side = std::max(side, high[c] - low[c]);
     const double unstated = side / kUnstatedStepsPerSide;
-    out->origin = OriginKeepingResolution(
-        low, high, step != nullptr ? *step : Point3d{unstated, unstated, unstated});
+    out->origin = OriginKeepingResolution(low, high, {unstated, unstated, unstated});
   }
   out->positions.resize(positions_.size());
   for (size_t i = 0; i < positions_.size(); ++i) {

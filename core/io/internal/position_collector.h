@@ -31,14 +31,11 @@ class PositionCollector {
   const Point3d& operator[](size_t i) const { return positions_[i]; }
 
   // Sets out->positions to the positions relative to out->origin, chosen by
-  // OriginKeepingResolution with `step`: the file's resolution per axis, or, for files that do
-  // not state one, 1/65,536 of the bounding box's longest side. Clears the collector.
-  void MoveTo(ParsedGeometry* out, const Point3d& step);
+  // OriginKeepingResolution with the step of a file that states none: 1/65,536 of the bounding
+  // box's longest side. Clears the collector.
   void MoveTo(ParsedGeometry* out);
 
  private:
-  void MoveTo(ParsedGeometry* out, const Point3d* step);
-
   std::vector<Point3d> positions_;
 };
 

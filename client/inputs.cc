@@ -176,15 +176,15 @@ std::string LeftOutNote(const PointsLeftOut& left_out) {
   return note;
 }
 
-std::string OriginNote(const std::array<double, 3>& origin) {
-  if (origin == std::array<double, 3>{0, 0, 0}) return "";
+std::string OriginNote(const Origin& origin) {
+  if (origin == kNoOrigin) return "";
   return absl::StrFormat(
       "; coordinates taken relative to (%.15g, %.15g, %.15g), and put back in the files written",
       origin[0], origin[1], origin[2]);
 }
 
-std::string StlOriginNote(const std::string& output, const std::array<double, 3>& origin) {
-  if (origin == std::array<double, 3>{0, 0, 0} || !absl::EndsWithIgnoreCase(output, ".stl")) {
+std::string StlOriginNote(const std::string& output, const Origin& origin) {
+  if (origin == kNoOrigin || !absl::EndsWithIgnoreCase(output, ".stl")) {
     return "";
   }
   return absl::StrFormat(
@@ -209,7 +209,7 @@ absl::StatusOr<TriangleMesh> ReadStartMesh(const std::string& path) {
   return mesh;
 }
 
-absl::Status MoveStartMesh(const std::array<double, 3>& origin, const std::string& path,
+absl::Status MoveStartMesh(const Origin& origin, const std::string& path,
                            TriangleMesh* mesh) {
   const absl::Status moved = MoveOrigin(origin, mesh);
   if (moved.ok()) return moved;

@@ -4,7 +4,6 @@
 #ifndef NEURALMESH_CLIENT_INPUTS_H_
 #define NEURALMESH_CLIENT_INPUTS_H_
 
-#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -40,7 +39,7 @@ struct TargetSpace {
   std::unique_ptr<ColorSource> colors;
   // Where the sampled positions' (0, 0, 0) lies in the input's coordinates (georeferenced
   // data: PointCloud::origin); the learned meshes carry it.
-  std::array<double, 3> origin = {0, 0, 0};
+  Origin origin = kNoOrigin;
 };
 
 // The target space of `input`: builtin:NAME (its implicit surface; `mode` must be uniform),
@@ -82,11 +81,11 @@ std::string LeftOutNote(const PointsLeftOut& left_out);
 
 // "" for a zero origin; else (georeferenced data) what to tell the user: "; coordinates taken
 // relative to (X, Y, Z), and put back in the files written".
-std::string OriginNote(const std::array<double, 3>& origin);
+std::string OriginNote(const Origin& origin);
 
 // "" unless `output` is an STL file and `origin` is not zero; else a line that says its
 // coordinates stay relative to the origin (STL holds only floats).
-std::string StlOriginNote(const std::string& output, const std::array<double, 3>& origin);
+std::string StlOriginNote(const std::string& output, const Origin& origin);
 
 // A mesh to report on or compare: a mesh file, or for builtin:NAME the reference mesh of the
 // implicit surface. Errors as LoadTargetSpace; `role` names the argument in messages.
@@ -99,7 +98,7 @@ absl::StatusOr<TriangleMesh> ReadStartMesh(const std::string& path);
 
 // Moves the start mesh read from `path` into the frame of the points, relative to `origin`
 // (MoveOrigin); INVALID_ARGUMENT "--start_mesh 'path': ..." when it cannot be.
-absl::Status MoveStartMesh(const std::array<double, 3>& origin, const std::string& path,
+absl::Status MoveStartMesh(const Origin& origin, const std::string& path,
                            TriangleMesh* mesh);
 
 // A short name for output files: the file name without directory and extension, or NAME for

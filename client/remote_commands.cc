@@ -110,7 +110,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     for (size_t m : milestones) config.add_lod_milestones(m);
   }
   *config.mutable_draco() = ToProto(options.draco);
-  if (cloud.origin != std::array<double, 3>{0, 0, 0}) {
+  if (cloud.origin != kNoOrigin) {
     config.mutable_origin()->set_x(cloud.origin[0]);
     config.mutable_origin()->set_y(cloud.origin[1]);
     config.mutable_origin()->set_z(cloud.origin[2]);
@@ -164,7 +164,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
           " of this input: resume with the input (and its flags) of the first run"));
     }
     const v1::Origin& origin = session.config().origin();
-    if (std::array<double, 3>{origin.x(), origin.y(), origin.z()} != cloud.origin) {
+    if (Origin{origin.x(), origin.y(), origin.z()} != cloud.origin) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "session %s holds points relative to (%.15g, %.15g, %.15g), this input is read "
           "relative to (%.15g, %.15g, %.15g): resume with the input of the first run",

@@ -8,6 +8,7 @@
 
 #include "absl/status/status.h"
 #include "core/mesh.h"
+#include "core/origin.h"
 #include "core/rgb.h"
 
 namespace neuralmesh {
@@ -28,7 +29,7 @@ struct PointCloud {
   std::vector<Rgb> colors;      // Empty, or one colour per point (scans that carry them).
   // Where the file's coordinates put position (0, 0, 0): a reader of georeferenced data (LAS)
   // moves the points there to keep a float's resolution. Zero for most files.
-  std::array<double, 3> origin = {0, 0, 0};
+  Origin origin = kNoOrigin;
 
   size_t size() const { return positions.size(); }
   bool empty() const { return positions.empty(); }

@@ -10,7 +10,7 @@
 
 namespace neuralmesh {
 
-absl::Status MoveOrigin(const std::array<double, 3>& origin, TriangleMesh* mesh) {
+absl::Status MoveOrigin(const Origin& origin, TriangleMesh* mesh) {
   if (origin == mesh->origin) return absl::OkStatus();
   std::vector<Vec3f> moved(mesh->positions.size());
   for (size_t i = 0; i < moved.size(); ++i) {

@@ -11,6 +11,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/mesh.h"
+#include "core/origin.h"
 #include "core/rgb.h"
 
 namespace neuralmesh {
@@ -21,7 +22,7 @@ struct TriangleMesh {
   std::vector<Rgb> colors;  // Empty, or one colour per vertex (point_colors.h paints them).
   // Where the positions' (0, 0, 0) lies in the coordinates of the data they came from
   // (georeferenced scans: see PointCloud::origin); writers put it back. Zero for most meshes.
-  std::array<double, 3> origin = {0, 0, 0};
+  Origin origin = kNoOrigin;
 
   bool empty() const { return positions.empty(); }
 };
@@ -31,7 +32,7 @@ struct TriangleMesh {
 // new origin keep only a float's resolution there.
 // Returns INVALID_ARGUMENT, leaving `mesh` as it was, when a position would lie beyond a
 // float's range.
-absl::Status MoveOrigin(const std::array<double, 3>& origin, TriangleMesh* mesh);
+absl::Status MoveOrigin(const Origin& origin, TriangleMesh* mesh);
 
 // Copies the live (not deleted) vertices and faces of `mesh`, renumbered densely in
 // handle order. O(v + f).

@@ -202,7 +202,7 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
     o.mutable_std_ratio()->set_value(config.outlier_removal->std_ratio);
   }
   proto.mutable_color_neighbours()->set_value(static_cast<uint32_t>(config.colors.neighbours));
-  if (config.origin != std::array<double, 3>{0, 0, 0}) {
+  if (config.origin != kNoOrigin) {
     v1::Origin& origin = *proto.mutable_origin();
     origin.set_x(config.origin[0]);
     origin.set_y(config.origin[1]);

@@ -60,7 +60,7 @@ absl::StatusOr<std::shared_ptr<Session>> CreateFromRequest(SessionManager& manag
   if (request.has_start_mesh()) {
     NM_ASSIGN_OR_RETURN(start_mesh, StartMeshFromProto(request.start_mesh()));
     // A Draco mesh whose metadata give an origin is moved from it into the session's frame.
-    if (start_mesh->origin != std::array<double, 3>{0, 0, 0}) {
+    if (start_mesh->origin != kNoOrigin) {
       const absl::Status moved = MoveOrigin(config.origin, &*start_mesh);
       if (!moved.ok()) {
         return absl::InvalidArgumentError(absl::StrCat("start_mesh: ", moved.message()));

@@ -3,7 +3,6 @@
 #ifndef NEURALMESH_SERVER_SESSION_CONFIG_H_
 #define NEURALMESH_SERVER_SESSION_CONFIG_H_
 
-#include <array>
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -15,6 +14,7 @@
 #include "core/bounding_box.h"
 #include "core/io/draco_codec.h"
 #include "core/learning/learner_options.h"
+#include "core/origin.h"
 
 namespace neuralmesh::server {
 
@@ -62,7 +62,7 @@ struct SessionConfig {
   PointColorOptions colors;
   // Where the points' (0, 0, 0) lies in the data's coordinates; carried by every published
   // mesh (TriangleMesh::origin).
-  std::array<double, 3> origin = {0, 0, 0};
+  Origin origin = kNoOrigin;
 };
 
 // The 1-2-5 series from kFirstDefaultMilestone, 50, 100, 200, 500, 1000, ... below `target`,

@@ -260,16 +260,16 @@ void SetPositionQuantization(draco::ExpertEncoder& encoder, int attribute_id,
 // PointCloud::origin): three doubles, written only when the origin is not zero.
 constexpr char kOriginEntry[] = "origin";
 
-void AddOrigin(draco::PointCloud& geometry, const std::array<double, 3>& origin) {
-  if (origin == std::array<double, 3>{0, 0, 0}) return;
+void AddOrigin(draco::PointCloud& geometry, const Origin& origin) {
+  if (origin == kNoOrigin) return;
   auto metadata = std::make_unique<draco::GeometryMetadata>();
   metadata->AddEntryDoubleArray(kOriginEntry, {origin[0], origin[1], origin[2]});
   geometry.AddMetadata(std::move(metadata));
 }
 
 // The origin a stream's metadata gives, or zero.
-absl::StatusOr<std::array<double, 3>> ReadOrigin(const draco::PointCloud& geometry) {
-  std::array<double, 3> origin = {0, 0, 0};
+absl::StatusOr<Origin> ReadOrigin(const draco::PointCloud& geometry) {
+  Origin origin = kNoOrigin;
   const draco::GeometryMetadata* metadata = geometry.GetMetadata();
   std::vector<double> values;
   if (metadata == nullptr || !metadata->GetEntryDoubleArray(kOriginEntry, &values)) {

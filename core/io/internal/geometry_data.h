@@ -26,7 +26,7 @@ struct ParsedGeometry {
   std::vector<std::array<uint32_t, 3>> faces;  // Polygons fan-triangulated; indices in range.
   // The positions are relative to this point: readers move georeferenced data there to keep a
   // float's resolution (position_collector.h); zero for most files.
-  std::array<double, 3> origin = {0, 0, 0};
+  Origin origin = kNoOrigin;
   // Points the file marks as not to be used, which the reader left out.
   PointsLeftOut left_out;
 };
@@ -39,9 +39,9 @@ struct GeometryView {
   absl::Span<const Rgb> colors;  // Empty or one per position.
   // The positions are relative to this point; writers put it back where the format can hold
   // it (coordinates in double or as text, a glTF node's translation, Draco metadata).
-  std::array<double, 3> origin = {0, 0, 0};
+  Origin origin = kNoOrigin;
 
-  bool has_origin() const { return origin != std::array<double, 3>{0, 0, 0}; }
+  bool has_origin() const { return origin != kNoOrigin; }
 };
 
 }  // namespace neuralmesh::io_internal

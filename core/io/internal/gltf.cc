@@ -645,9 +645,7 @@ class GltfReader {
   // Narrows the placed vertices to floats, relative to an origin where they lie far from 0
   // (position_collector.h), and merges those that became identical.
   void NarrowAndMerge() {
-    PositionCollector collector;
-    collector.Reserve(placed_.size());
-    for (const Point3d& p : placed_) collector.Add(p);
+    PositionCollector collector(std::move(placed_));
     ParsedGeometry narrowed;
     collector.MoveTo(&narrowed);
     out_.origin = narrowed.origin;

@@ -123,10 +123,27 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
     }
   }
 
+  const auto coordinate = [&](size_t at, int c) {
+    return Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
+  };
+  const auto channel = [&](size_t at, int c) {
+    return Load<uint16_t>(data, at + format.rgb + 2 * c);
+  };
+  // Calls visit(i, at) for each record to read, in order: checked again in each pass, to keep
+  // no list of them.
+  const auto for_each_usable = [&](auto&& visit) {
+    for (uint64_t i = 0; i < count; ++i) {
+      const size_t at = offset_to_points + i * record_length;
+      if (Usability(data, at, format_byte) == kUsable && !visit(i, at)) return false;
+    }
+    return true;
+  };
+
   ParsedGeometry out;
-  // Which records to read (checked again in each pass below, to keep no list of them), and
-  // where the coordinates lie (the header's bounds may be stale: the records decide).
+  // Where the coordinates lie (the header's bounds may be stale: the records decide), and the
+  // largest colour channel.
   Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
+  uint16_t largest = 0;
   for (uint64_t i = 0; i < count; ++i) {
     const size_t at = offset_to_points + i * record_length;
     const RecordUsability usability = Usability(data, at, format_byte);
@@ -134,9 +151,9 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
     out.left_out.noise += usability == kNoise;
     if (usability != kUsable) continue;
     for (int c = 0; c < 3; ++c) {
-      const double value = Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
-      low[c] = std::min(low[c], value);
-      high[c] = std::max(high[c], value);
+      low[c] = std::min(low[c], coordinate(at, c));
+      high[c] = std::max(high[c], coordinate(at, c));
+      if (format.rgb != 0) largest = std::max(largest, channel(at, c));
     }
   }
   const size_t kept = count - out.left_out.total();
@@ -149,39 +166,29 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
     out.origin = OriginKeepingResolution(low, high, step);
   }
   out.positions.reserve(kept);
-  for (uint64_t i = 0; i < count; ++i) {
-    const size_t at = offset_to_points + i * record_length;
-    if (Usability(data, at, format_byte) != kUsable) continue;
+  uint64_t beyond = count;  // A record whose position a float cannot hold.
+  for_each_usable([&](uint64_t i, size_t at) {
     Vec3f p;
-    for (int c = 0; c < 3; ++c) {
-      const double value = Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
-      p[c] = NarrowToFloat(value - out.origin[c]);
-      if (!std::isfinite(p[c])) {
-        return Invalid(absl::StrCat("point ", i, " lies beyond a float's range"));
-      }
+    for (int c = 0; c < 3; ++c) p[c] = NarrowToFloat(coordinate(at, c) - out.origin[c]);
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      beyond = i;
+      return false;
     }
     out.positions.push_back(p);
+    return true;
+  });
+  if (beyond < count) {
+    return Invalid(absl::StrCat("point ", beyond, " lies beyond a float's range"));
   }
-  if (format.rgb != 0 && kept > 0) {
-    uint16_t largest = 0;
-    for (uint64_t i = 0; i < count; ++i) {
-      const size_t at = offset_to_points + i * record_length;
-      if (Usability(data, at, format_byte) != kUsable) continue;
-      for (int c = 0; c < 3; ++c) {
-        largest = std::max(largest, Load<uint16_t>(data, at + format.rgb + 2 * c));
-      }
-    }
+  if (format.rgb != 0) {
     const double max = largest <= 255 ? 255.0 : 65535.0;
     out.colors.reserve(kept);
-    for (uint64_t i = 0; i < count; ++i) {
-      const size_t at = offset_to_points + i * record_length;
-      if (Usability(data, at, format_byte) != kUsable) continue;
-      Rgb color;
-      for (int c = 0; c < 3; ++c) {
-        color[c] = ChannelFromLevel(Load<uint16_t>(data, at + format.rgb + 2 * c), max);
-      }
-      out.colors.push_back(color);
-    }
+    for_each_usable([&](uint64_t, size_t at) {
+      out.colors.push_back({ChannelFromLevel(channel(at, 0), max),
+                            ChannelFromLevel(channel(at, 1), max),
+                            ChannelFromLevel(channel(at, 2), max)});
+      return true;
+    });
   }
   return out;
 }

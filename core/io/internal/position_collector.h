@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include "core/io/internal/geometry_data.h"
@@ -24,6 +25,10 @@ Point3d OriginKeepingResolution(const Point3d& low, const Point3d& high, const P
 
 class PositionCollector {
  public:
+  PositionCollector() = default;
+  // Takes positions already gathered (each narrowing to a finite float, as for Add).
+  explicit PositionCollector(std::vector<Point3d> positions) : positions_(std::move(positions)) {}
+
   void Reserve(size_t count) { positions_.reserve(count); }
   // `p` must narrow to a finite float (the readers check, to name the offending line).
   void Add(const Point3d& p) { positions_.push_back(p); }

@@ -70,7 +70,7 @@ struct ConvertOptions {
   // A mesh or point cloud file, or builtin:NAME for its dense tessellation.
   std::string input;
   // Its extension picks the format: a mesh's (kMeshExtensions) or a point cloud's (.ply .xyz
-  // .txt .pts .drc .glb .gltf).
+  // .txt .pts .las .drc .glb .gltf).
   std::string output;
   MeshWriteOptions writing;  // Draco settings, glTF compression (meshes only).
   // Set: a point cloud's statistical outliers are removed before it is written.

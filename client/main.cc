@@ -43,7 +43,7 @@ ABSL_FLAG(std::string, output, "",
           "Local reconstruct: the mesh to write; the extension picks the format (.ply .obj .off "
           ".stl .drc .glb .gltf). LOD files go beside it as <stem>_lod<N><ext>. get: where the "
           "session's mesh goes. convert: the file written (a mesh's format, or a point cloud's: "
-          ".ply .xyz .txt .pts .drc .glb .gltf).");
+          ".ply .xyz .txt .pts .las .drc .glb .gltf).");
 ABSL_FLAG(uint64_t, vertices, 0,
           "Vertex count of the final mesh (met exactly). Required for a local reconstruct; with "
           "--server, 0 means one vertex per 2 points, at most 10000.");
@@ -193,6 +193,9 @@ ABSL_FLAG(absl::Duration, reconnect_for,
           "for a server that is out of reach or still restoring its sessions after a restart.");
 ABSL_FLAG(bool, final, false,
           "get: the final mesh of a finished session instead of the latest mesh.");
+ABSL_FLAG(std::string, to, "",
+          "transfer: the client that is to own the session (a client name of the server's "
+          "tokens file, or a client certificate's common name).");
 ABSL_FLAG(absl::Duration, wait, absl::ZeroDuration(),
           "get: wait up to this long for the mesh to exist (a first mesh, or with --final the "
           "final one); 0: it must exist now.");
@@ -535,19 +538,25 @@ absl::Status OnSession(neuralmesh::client::SessionAction action, const ParsedArg
   neuralmesh::client::SessionActionOptions o;
   o.session_id = args.positional[0];
   o.server = absl::GetFlag(FLAGS_server);
+  o.new_owner = absl::GetFlag(FLAGS_to);
   NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
   return neuralmesh::client::RunSessionAction(action, o, std::cout);
 }
 
-// `neuralmesh NAME SESSION --server HOST:PORT`, which asks the server for `action`.
+// `neuralmesh NAME SESSION --server HOST:PORT`, which asks the server for `action`; `flags`
+// beyond --server and the connection's.
 Subcommand SessionActionCommand(const std::string& name, std::string summary,
                                 std::string description,
-                                neuralmesh::client::SessionAction action) {
+                                neuralmesh::client::SessionAction action,
+                                const std::string& usage_flags = "",
+                                std::vector<std::string> flags = {}) {
+  flags.insert(flags.begin(), "server");
   return {name,
-          absl::StrCat(name, " SESSION --server HOST:PORT"),
+          absl::StrCat(name, " SESSION ", usage_flags, usage_flags.empty() ? "" : " ",
+                       "--server HOST:PORT"),
           std::move(summary),
           std::move(description),
-          WithConnectionFlags({"server"}),
+          WithConnectionFlags(std::move(flags)),
           [action](const ParsedArgs& args) { return OnSession(action, args); }};
 }
 
@@ -642,9 +651,9 @@ std::vector<Subcommand> Commands() {
        "Writes INPUT to OUTPUT in the format of its extension, colours included where the\n"
        "format holds them. A mesh (a file with faces, or builtin:NAME, its dense reference\n"
        "tessellation) goes to .ply .obj .off .stl .drc .glb .gltf; points (.xyz .txt .pts\n"
-       ".las, a file without faces, or anything written to .xyz .txt .pts) go to .ply .xyz .txt\n"
-       ".pts .drc .glb .gltf with their normals and weights (glTF: positions and colours\n"
-       "only), after --remove_outliers if given.",
+       ".las, a file without faces, or anything written to .xyz .txt .pts .las) go to .ply\n"
+       ".xyz .txt .pts .las .drc .glb .gltf with their normals and weights (LAS: positions\n"
+       "and colours only), after --remove_outliers if given.",
        {"output", "gltf_draco", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "quantization_bits", "encode_speed"},
        Convert},
@@ -687,6 +696,12 @@ std::vector<Subcommand> Commands() {
                            "", neuralmesh::client::SessionAction::kCancel),
       SessionActionCommand("delete", "Removes a server session, its meshes and its files.", "",
                            neuralmesh::client::SessionAction::kDelete),
+      SessionActionCommand(
+          "transfer", "Hands a server session to another client.",
+          "The client named by --to owns the session from now on: its user token (or client\n"
+          "certificate) may use it as its creator could, and the previous owner's no longer\n"
+          "can. An admin may hand over any session, a user only its own.",
+          neuralmesh::client::SessionAction::kTransfer, "--to CLIENT", {"to"}),
       {"view",
        "view --server HOST:PORT [--listen HOST:PORT] [--view_key_file FILE]\n"
        "     [--view_tls_cert_file FILE --view_tls_key_file FILE]",

@@ -100,9 +100,12 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
     NM_ASSIGN_OR_RETURN(removed, RemoveStatisticalOutliers(cloud, *options.outliers));
   }
   NM_RETURN_IF_ERROR(WritePointCloud(cloud, options.output, options.writing.draco));
+  // What the file holds: LAS has no place for normals and weights.
+  const bool las = absl::EndsWithIgnoreCase(options.output, ".las");
+  const bool dropped = las && (!cloud.normals.empty() || !cloud.weights.empty());
   std::vector<std::string> carried;
-  if (!cloud.normals.empty()) carried.push_back("normals");
-  if (!cloud.weights.empty()) carried.push_back("weights");
+  if (!cloud.normals.empty() && !las) carried.push_back("normals");
+  if (!cloud.weights.empty() && !las) carried.push_back("weights");
   if (!cloud.colors.empty()) carried.push_back("colours");
   out << options.output << ": " << cloud.size() << " points";
   if (!carried.empty()) out << ", with " << absl::StrJoin(carried, ", ");
@@ -110,8 +113,8 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
     out << " (" << removed << " outliers of " << read << " removed)";
   }
   out << LeftOutNote(left_out) << OriginNote(cloud.origin) << "\n";
-  if (gltf && (!cloud.normals.empty() || !cloud.weights.empty())) {
-    out << "note: glTF keeps positions and colours; the normals and weights were left out\n";
+  if (dropped) {
+    out << "note: LAS keeps positions and colours; the normals and weights were left out\n";
   }
   return absl::OkStatus();
 }

@@ -360,6 +360,20 @@ absl::Status ReconstructionClient::Delete(const std::string& session_id) {
   return FromGrpcStatus(stub_->DeleteSession(&context, request, &response), "DeleteSession");
 }
 
+absl::StatusOr<v1::Session> ReconstructionClient::Transfer(const std::string& session_id,
+                                                           const std::string& new_owner) {
+  grpc::ClientContext context;
+  const OpenCall open(*this, context);
+  SetDeadline(context, options_.call_timeout);
+  v1::TransferSessionRequest request;
+  request.set_session_id(session_id);
+  request.set_new_owner(new_owner);
+  v1::Session session;
+  const grpc::Status status = stub_->TransferSession(&context, request, &session);
+  if (!status.ok()) return FromGrpcStatus(status, "TransferSession");
+  return session;
+}
+
 absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& session_id,
                                                              v1::MeshVersion version, bool wait,
                                                              absl::Duration timeout) {

@@ -156,6 +156,9 @@ class ReconstructionClient {
   // The same with its own deadline (for a best-effort cancel that must not wait long).
   absl::StatusOr<v1::Session> Cancel(const std::string& session_id, absl::Duration timeout);
   absl::Status Delete(const std::string& session_id);
+  // TransferSession: hands the session to the client `new_owner`.
+  absl::StatusOr<v1::Session> Transfer(const std::string& session_id,
+                                       const std::string& new_owner);
 
   // GetMesh; with `wait`, blocks up to `timeout` until the mesh exists (DEADLINE_EXCEEDED
   // after).

@@ -29,6 +29,9 @@ std::string SessionLine(const v1::Session& session) {
 absl::Status RunSessionAction(SessionAction action, const SessionActionOptions& options,
                               std::ostream& out) {
   if (options.session_id.empty()) return absl::InvalidArgumentError("SESSION is empty");
+  if (action == SessionAction::kTransfer && options.new_owner.empty()) {
+    return absl::InvalidArgumentError("--to CLIENT is required: the client to hand the session to");
+  }
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ConnectTo(options.server, options.connection));
   switch (action) {
@@ -46,6 +49,12 @@ absl::Status RunSessionAction(SessionAction action, const SessionActionOptions& 
       NM_RETURN_IF_ERROR(client->Delete(options.session_id));
       out << "session " << options.session_id << " deleted\n";
       return absl::OkStatus();
+    case SessionAction::kTransfer: {
+      NM_ASSIGN_OR_RETURN(const v1::Session session,
+                          client->Transfer(options.session_id, options.new_owner));
+      out << SessionLine(session) << ", owned by client " << session.owner() << "\n";
+      return absl::OkStatus();
+    }
   }
   return absl::InternalError("unknown session action");
 }

@@ -1,5 +1,5 @@
 // The subcommands that act on one session of a neuralmesh-server: `finish`, `cancel`,
-// `delete` and `get`.
+// `delete`, `transfer` and `get`.
 #ifndef NEURALMESH_CLIENT_SESSION_COMMANDS_H_
 #define NEURALMESH_CLIENT_SESSION_COMMANDS_H_
 
@@ -17,18 +17,22 @@ enum class SessionAction {
   kFinish,  // FinishSession: every point has arrived; learn to the target, publish the final mesh.
   kCancel,  // CancelSession: stop learning; the latest mesh stays.
   kDelete,  // DeleteSession: the session, its meshes and its files are gone.
+  kTransfer,  // TransferSession: another client owns the session.
 };
 
 struct SessionActionOptions {
   std::string session_id;
   std::string server;  // host:port.
+  std::string new_owner;  // kTransfer: the client that is to own the session.
   ClientOptions connection;
 };
 
 // Asks the server for `action` on the session and prints what became of it on `out`
-// ("session ID: finishing, 40000 points, 1532 of 5000 vertices"; "session ID deleted").
-// The server's status otherwise (NOT_FOUND for an unknown session, FAILED_PRECONDITION for a
-// session that has ended or, for a finish, has too few points, ...).
+// ("session ID: finishing, 40000 points, 1532 of 5000 vertices"; "session ID deleted";
+// "session ID: collecting, ..., owned by client bob").
+// INVALID_ARGUMENT for a transfer without a new owner; the server's status otherwise
+// (NOT_FOUND for an unknown session, FAILED_PRECONDITION for a session that has ended or, for
+// a finish, has too few points, PERMISSION_DENIED, ...).
 absl::Status RunSessionAction(SessionAction action, const SessionActionOptions& options,
                               std::ostream& out);
 

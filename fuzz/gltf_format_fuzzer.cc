@@ -16,9 +16,9 @@ absl::StatusOr<neuralmesh::io_internal::ParsedGeometry> Parse(
   return neuralmesh::io_internal::ParseGltf(data, faces);
 }
 
-// Plain glTF holds positions, triangles and colours, and nothing else (no normals or weights,
-// which the parser never reads). A file of no vertices is written as a document without
-// meshes, which WriteMesh never writes (it refuses empty meshes).
+// Plain glTF as the mesh writer gives it: positions, triangles and colours (normals and weights
+// are read for point clouds only, and a mesh has none). A file of no vertices is written as a
+// document without meshes, which WriteMesh never writes (it refuses empty meshes).
 std::string Format(const neuralmesh::io_internal::GeometryView& geometry) {
   if (geometry.positions.empty()) return R"({"asset":{"version":"2.0"}})";
   const absl::StatusOr<std::string> written =

@@ -848,6 +848,22 @@ grpc::ServerUnaryReactor* ReconstructionService::DeleteSession(
   return FinishUnary(context, manager_->Delete(request->session_id()));
 }
 
+grpc::ServerUnaryReactor* ReconstructionService::TransferSession(
+    grpc::CallbackServerContext* context, const v1::TransferSessionRequest* request,
+    v1::Session* response) {
+  const Caller caller = CallerOf(*context);
+  absl::StatusOr<std::shared_ptr<Session>> session =
+      GetSessionFor(*manager_, caller, request->session_id(), SessionUse::kChange);
+  if (!session.ok()) return FinishUnary(context, session.status());
+  const std::string by = caller.client.empty()
+                             ? context->peer()
+                             : absl::StrCat("client ", caller.client, " at ", context->peer());
+  session = manager_->Transfer(request->session_id(), request->new_owner(), by);
+  if (!session.ok()) return FinishUnary(context, session.status());
+  *response = (*session)->ToProto();
+  return FinishUnary(context, absl::OkStatus());
+}
+
 grpc::ServerUnaryReactor* ReconstructionService::GetMesh(grpc::CallbackServerContext* context,
                                                          const v1::GetMeshRequest* request,
                                                          v1::MeshUpdate* response) {

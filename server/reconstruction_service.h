@@ -44,6 +44,9 @@ class ReconstructionService final : public v1::ReconstructionService::CallbackSe
   grpc::ServerUnaryReactor* DeleteSession(grpc::CallbackServerContext* context,
                                           const v1::DeleteSessionRequest* request,
                                           v1::DeleteSessionResponse* response) override;
+  grpc::ServerUnaryReactor* TransferSession(grpc::CallbackServerContext* context,
+                                            const v1::TransferSessionRequest* request,
+                                            v1::Session* response) override;
   grpc::ServerUnaryReactor* GetMesh(grpc::CallbackServerContext* context,
                                     const v1::GetMeshRequest* request,
                                     v1::MeshUpdate* response) override;

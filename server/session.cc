@@ -501,11 +501,21 @@ bool Session::IdleSince(absl::Time now, absl::Duration timeout) const {
   return open_streams_ == 0 && now - last_activity_ >= timeout;
 }
 
+std::string Session::owner() const {
+  absl::MutexLock lock(&owner_mu_);
+  return owner_;
+}
+
+void Session::SetOwner(std::string owner) {
+  absl::MutexLock lock(&owner_mu_);
+  owner_ = std::move(owner);
+}
+
 v1::Session Session::ToProto() const {
   v1::Session out;
   out.set_session_id(id_);
   out.set_name(name_);
-  out.set_owner(owner_);
+  out.set_owner(owner());
   *out.mutable_config() = SessionConfigToProto(config_);
   out.set_create_time_us(absl::ToUnixMicros(create_time_));
   if (MeshUpdatePtr latest = updates_.latest(); latest != nullptr) {

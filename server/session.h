@@ -127,7 +127,10 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
 
   const std::string& id() const { return id_; }
   const std::string& name() const { return name_; }
-  const std::string& owner() const { return owner_; }
+  // The client that owns the session (session_access.h): its creator, or the client it was
+  // handed to since (SetOwner).
+  std::string owner() const ABSL_LOCKS_EXCLUDED(owner_mu_);
+  void SetOwner(std::string owner) ABSL_LOCKS_EXCLUDED(owner_mu_);
   const SessionConfig& config() const { return config_; }
   // Whether AddPoints filters outliers (SessionConfig::outlier_removal): work proportional to
   // the batch times log^2 of the points so far, too long for a gRPC callback thread.
@@ -247,7 +250,8 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
 
   const std::string id_;
   const std::string name_;
-  const std::string owner_;
+  mutable absl::Mutex owner_mu_;  // Taken alone, or last (after mu_).
+  std::string owner_ ABSL_GUARDED_BY(owner_mu_);
   const SessionConfig config_;
   const absl::Time create_time_;
   // The vertices of the start mesh or restored checkpoint (0: none). Set before the session is

@@ -42,7 +42,7 @@ absl::Status CheckMayUse(const Caller& caller, const Session& session, SessionUs
     case AccessRole::kReader:
       if (use == SessionUse::kSee) return absl::OkStatus();
       return absl::PermissionDeniedError(
-          absl::StrCat(Named(caller), " is a reader: it may not upload into, finish, "
+          absl::StrCat(Named(caller), " is a reader: it may not upload into, finish, hand over, "
                        "cancel or delete session ", session.id()));
     case AccessRole::kUser:
       if (session.owner() == caller.client) return absl::OkStatus();

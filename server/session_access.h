@@ -32,7 +32,8 @@ Caller CallerOf(const grpc::ServerContextBase& context);
 // What a call does with a session.
 enum class SessionUse {
   kSee,     // GetSession, ListSessions, WatchSession, GetMesh.
-  kChange,  // UploadPoints, Reconstruct, FinishSession, CancelSession, DeleteSession.
+  kChange,  // UploadPoints, Reconstruct, FinishSession, CancelSession, DeleteSession,
+            // TransferSession.
 };
 
 // OK, or PERMISSION_DENIED saying why not.

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "absl/random/random.h"
+#include "absl/strings/ascii.h"
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -157,6 +158,55 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(
   }
   if (metrics_ != nullptr) metrics_->CountSessionCreated();
   if (log_ != nullptr) log_->Record(session->id(), event);
+  return session;
+}
+
+absl::StatusOr<std::shared_ptr<Session>> SessionManager::Transfer(absl::string_view id,
+                                                                  std::string new_owner,
+                                                                  absl::string_view by) {
+  if (id.empty()) return absl::InvalidArgumentError("session_id is empty");
+  if (new_owner.empty()) return absl::InvalidArgumentError("new_owner is empty");
+  if (new_owner.size() > kMaxNameBytes) {
+    return absl::InvalidArgumentError(absl::StrCat("new_owner has ", new_owner.size(),
+                                                   " bytes; at most 256 are allowed"));
+  }
+  if (std::any_of(new_owner.begin(), new_owner.end(),
+                  [](char c) { return absl::ascii_iscntrl(static_cast<unsigned char>(c)); })) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("new_owner \"", absl::CHexEscape(new_owner), "\" holds control characters"));
+  }
+  std::shared_ptr<Session> session;
+  std::string previous;
+  {
+    absl::MutexLock lock(&mu_);
+    if (shutdown_) return absl::UnavailableError("the server is shutting down");
+    auto it = sessions_.find(std::string(id));
+    if (it == sessions_.end()) return NotHeldLocked(id);
+    session = it->second;
+    session->Touch();
+    previous = session->owner();
+    if (previous == new_owner) return session;
+    if (limits_.max_sessions_per_client > 0 &&
+        HeldLocked(new_owner) >= limits_.max_sessions_per_client) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "client ", new_owner, " holds its maximum of ", limits_.max_sessions_per_client,
+          " sessions; it must delete some before it can take session ", id));
+    }
+    if (session->record() != nullptr) {
+      if (absl::Status written = session->record()->SetOwner(new_owner); !written.ok()) {
+        return absl::Status(written.code(), absl::StrCat("the server cannot keep the new owner "
+                                                         "on disk: ", written.message()));
+      }
+    }
+    session->SetOwner(new_owner);
+  }
+  if (log_ != nullptr) {
+    std::string event = "handed";
+    if (!previous.empty()) absl::StrAppend(&event, " from client ", previous);
+    absl::StrAppend(&event, " to client ", new_owner);
+    if (!by.empty()) absl::StrAppend(&event, " by ", by);
+    log_->Record(session->id(), event);
+  }
   return session;
 }
 

@@ -92,6 +92,15 @@ class SessionManager {
       std::string owner = "", std::optional<TriangleMesh> start_mesh = std::nullopt)
       ABSL_LOCKS_EXCLUDED(mu_);
 
+  // Hands the session `id` to the client `new_owner` (TransferSession), on disk first with a
+  // store; `by` says who asked, for the event log ("client ops at ipv4:..."). Nothing changes
+  // when `new_owner` owns it already. INVALID_ARGUMENT for a new owner that is empty, longer
+  // than 256 bytes or holds control characters; RESOURCE_EXHAUSTED when it holds
+  // max_sessions_per_client; the errors of Get; with a store, the error of writing the owner.
+  absl::StatusOr<std::shared_ptr<Session>> Transfer(absl::string_view id, std::string new_owner,
+                                                    absl::string_view by = "")
+      ABSL_LOCKS_EXCLUDED(mu_);
+
   // NOT_FOUND for an unknown id (INVALID_ARGUMENT for an empty one), UNAVAILABLE after
   // Shutdown. Counts as activity.
   absl::StatusOr<std::shared_ptr<Session>> Get(absl::string_view id) const

@@ -148,6 +148,16 @@ absl::Status SessionRecord::SetState(v1::SessionState state, const std::string& 
   return absl::OkStatus();
 }
 
+absl::Status SessionRecord::SetOwner(const std::string& owner) {
+  absl::MutexLock lock(&mu_);
+  if (removed_) return absl::OkStatus();
+  storage::v1::StoredSession changed = stored_;
+  changed.set_owner(owner);
+  NM_RETURN_IF_ERROR(ReplaceFile(kStoredSessionFile, changed, /*durable=*/true));
+  stored_ = std::move(changed);
+  return absl::OkStatus();
+}
+
 absl::Status SessionRecord::WriteLatestMesh(const v1::MeshUpdate& update, bool durable) {
   absl::MutexLock lock(&mu_);
   if (removed_) return absl::OkStatus();

@@ -62,6 +62,8 @@ class SessionRecord {
   // state (finished, cancelled, failed) removes the learner checkpoint.
   absl::Status SetState(v1::SessionState state, const std::string& error)
       ABSL_LOCKS_EXCLUDED(mu_);
+  // Records a new owner (TransferSession), synced like a state.
+  absl::Status SetOwner(const std::string& owner) ABSL_LOCKS_EXCLUDED(mu_);
   // Replaces the stored latest mesh; with `durable` (the final mesh) synced like a state.
   absl::Status WriteLatestMesh(const v1::MeshUpdate& update, bool durable)
       ABSL_LOCKS_EXCLUDED(mu_);

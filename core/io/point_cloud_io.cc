@@ -26,7 +26,8 @@ bool IsReadable(FileFormat format) {
 
 bool IsWritable(FileFormat format) {
   return format == FileFormat::kPly || format == FileFormat::kXyz ||
-         format == FileFormat::kDraco || format == FileFormat::kGltf;
+         format == FileFormat::kLas || format == FileFormat::kDraco ||
+         format == FileFormat::kGltf;
 }
 
 absl::Status UnsupportedExtension(const std::string& path, const char* supported) {
@@ -87,7 +88,7 @@ bool IsReadablePointCloudExtension(std::string_view path) {
 
 const char kReadablePointCloudExtensions[] =
     ".ply, .xyz, .txt, .pts, .las, .obj, .off, .drc, .glb, .gltf";
-const char kWritablePointCloudExtensions[] = ".ply, .xyz, .txt, .pts, .drc, .glb, .gltf";
+const char kWritablePointCloudExtensions[] = ".ply, .xyz, .txt, .pts, .las, .drc, .glb, .gltf";
 
 bool IsWritablePointCloudExtension(std::string_view path) {
   return IsWritable(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
@@ -126,12 +127,14 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
     data = io_internal::FormatPly(view);
   } else if (format == FileFormat::kXyz) {
     data = io_internal::FormatXyz(view);
+  } else if (format == FileFormat::kLas) {
+    absl::StatusOr<std::string> formatted = io_internal::FormatLas(view);
+    if (!formatted.ok()) return io_internal::CannotWrite(path, formatted.status());
+    data = *std::move(formatted);
   } else if (format == FileFormat::kGltf) {
     io_internal::GltfWriteOptions gltf;
     gltf.binary = io_internal::LowercaseExtension(path) == ".glb";
-    const io_internal::GeometryView points{cloud.positions, {}, {}, {}, cloud.colors,
-                                           cloud.origin};
-    absl::StatusOr<std::string> formatted = io_internal::FormatGltf(points, gltf);
+    absl::StatusOr<std::string> formatted = io_internal::FormatGltf(view, gltf);
     if (!formatted.ok()) return io_internal::CannotWrite(path, formatted.status());
     data = *std::move(formatted);
   } else {

@@ -17,8 +17,8 @@ namespace neuralmesh {
 // The extensions ReadPointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .obj,
 // .off, .drc, .glb, .gltf".
 extern const char kReadablePointCloudExtensions[];
-// The extensions WritePointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .drc, .glb,
-// .gltf".
+// The extensions WritePointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .drc,
+// .glb, .gltf".
 extern const char kWritablePointCloudExtensions[];
 
 // True when ReadPointCloud handles the extension of `path` (kReadablePointCloudExtensions).
@@ -41,7 +41,8 @@ bool IsWritablePointCloudExtension(std::string_view path);
 //   .off  the vertices of OFF, COFF (with colours), NOFF (with normals), STOFF.
 //   .drc  a Draco point cloud, or the points of a Draco mesh.
 //   .glb, .gltf  the vertices of every mesh primitive the default scene draws, placed by their
-//         nodes, with COLOR_0 colours; vertices at identical positions merged (as ReadMesh).
+//         nodes, with COLOR_0 colours, NORMAL normals and _WEIGHT weights (see internal/gltf.h);
+//         vertices at identical positions merged (as ReadMesh).
 // Georeferenced coordinates, too far from zero for a float to keep their resolution, are read
 // relative to PointCloud::origin (internal/position_collector.h; Draco: its metadata).
 // Returns NOT_FOUND when the file cannot be opened or read; INVALID_ARGUMENT for an
@@ -53,12 +54,14 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,
 
 // Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
 // nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"
-// text for .xyz/.txt/.pts (a header comment names the columns), .drc encoded with `draco`, or
-// glTF 2.0 POINTS (.glb, or .gltf with its buffer embedded) of the positions and colours
-// (COLOR_0), without normals and weights. The positions are written with cloud.origin put back
-// (PLY doubles, exact text, a glTF node's translation, Draco metadata).
+// text for .xyz/.txt/.pts (a header comment names the columns), LAS 1.2 of point format 0 or
+// 2 (with colours; no normals or weights: internal/las.h), .drc encoded with `draco`, or
+// glTF 2.0 POINTS (.glb, or .gltf with its buffer embedded) with COLOR_0, NORMAL (unit length)
+// and _WEIGHT attributes as present. The positions are written with cloud.origin put back
+// (PLY doubles, exact text, the LAS offset, a glTF node's translation, Draco metadata).
 // Returns INVALID_ARGUMENT for an unsupported extension, an empty cloud, a cloud that fails
-// ValidatePointCloud, or invalid `draco` options; otherwise the status of the write ("cannot
+// ValidatePointCloud, more points than LAS counts, or invalid `draco` options; otherwise the
+// status of the write ("cannot
 // write 'path': reason").
 absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
                              const DracoOptions& draco = {});

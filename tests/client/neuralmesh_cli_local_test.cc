@@ -376,8 +376,8 @@ TEST_F(LocalCliTest, GltfFilesAreWrittenAndRead) {
       << remote.Describe();
 }
 
-// convert for points: normals, weights and colours kept by PLY, XYZ and Draco, positions and
-// colours by glTF; outliers removed on the way; what cannot be done refused with a reason.
+// convert for points: normals, weights and colours kept by PLY, XYZ, Draco and glTF, positions
+// and colours by LAS; outliers removed on the way; what cannot be done refused with a reason.
 TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   PointCloud cloud = ColoredUnitSpherePoints(5000, 11);
   cloud.normals = cloud.positions;  // The unit sphere's.
@@ -408,12 +408,25 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   const std::string glb = *dir_ + "/points.glb";
   const RunResult to_glb = RunNeuralmesh({"convert", xyz, "-o", glb});
   ASSERT_EQ(to_glb.exit_code, 0) << to_glb.Describe();
-  EXPECT_TRUE(absl::StrContains(
-      to_glb.out, "note: glTF keeps positions and colours; the normals and weights were left out"))
-      << to_glb.out;
+  EXPECT_EQ(to_glb.out, glb + ": 5000 points, with normals, weights, colours\n");
   read = ReadPointCloud(glb);
   ASSERT_TRUE(read.ok()) << read.status();
   EXPECT_EQ(read->positions, cloud.positions);
+  EXPECT_EQ(read->colors, cloud.colors);
+  EXPECT_EQ(read->normals, cloud.normals);
+  EXPECT_EQ(read->weights, cloud.weights);
+
+  const std::string las = *dir_ + "/points.las";
+  const RunResult to_las = RunNeuralmesh({"convert", glb, "-o", las});
+  ASSERT_EQ(to_las.exit_code, 0) << to_las.Describe();
+  EXPECT_EQ(to_las.out, las + ": 5000 points, with colours\nnote: LAS keeps positions and "
+                             "colours; the normals and weights were left out\n");
+  read = ReadPointCloud(las);
+  ASSERT_TRUE(read.ok()) << read.status();
+  ASSERT_EQ(read->size(), cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_LT((read->positions[i] - cloud.positions[i]).norm(), 2e-8f) << i;
+  }
   EXPECT_EQ(read->colors, cloud.colors);
   EXPECT_TRUE(read->normals.empty());
 
@@ -451,7 +464,7 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   const Refused refused[] = {
       {{"convert", xyz, "-o", *dir_ + "/points.obj"},
        "holds points without faces: OUTPUT '" + *dir_ + "/points.obj' must be a point cloud "
-       "format (.ply, .xyz, .txt, .pts, .drc, .glb, .gltf)"},
+       "format (.ply, .xyz, .txt, .pts, .las, .drc, .glb, .gltf)"},
       {{"convert", "builtin:torus", "-o", *dir_ + "/torus.xyz"},
        "builtin:torus is a surface, not points"},
       {{"convert", xyz, "-o", glb, "--gltf_draco"}, "--gltf_draco compresses meshes"},

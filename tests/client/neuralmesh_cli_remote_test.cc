@@ -452,7 +452,7 @@ TEST_F(RemoteCliTest, WatchingAFinishedSessionSavesItsFinalMesh) {
 // get, finish, cancel and delete on sessions made through the client library: the latest
 // mesh while points arrive, the final one once `finish` has told the session that all have,
 // a cancelled session, and a deleted one that is gone.
-TEST_F(RemoteCliTest, SessionCommandsGetFinishCancelAndDelete) {
+TEST_F(RemoteCliTest, SessionCommandsGetFinishCancelTransferAndDelete) {
   absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
       client::ReconstructionClient::Connect(server_->address());
   ASSERT_TRUE(service.ok()) << service.status();
@@ -504,6 +504,14 @@ TEST_F(RemoteCliTest, SessionCommandsGetFinishCancelAndDelete) {
   EXPECT_THAT(late_cancel.err, ::testing::HasSubstr("cannot be cancelled"));
 
   const std::string other = (*service)->CreateSession(config, "dropped").value().session_id();
+  const RunResult transfer = RunNeuralmesh({"transfer", other, "--to", "bob", "--server", address});
+  ASSERT_EQ(transfer.exit_code, 0) << transfer.Describe();
+  EXPECT_EQ(transfer.out, "session " + other + ": collecting, 0 points, 0 of 400 vertices, " +
+                              "owned by client bob\n");
+  EXPECT_EQ((*service)->GetSession(other).value().owner(), "bob");
+  const RunResult nobody = RunNeuralmesh({"transfer", other, "--server", address});
+  EXPECT_EQ(nobody.exit_code, 1) << nobody.Describe();
+  EXPECT_THAT(nobody.err, ::testing::HasSubstr("--to CLIENT is required"));
   const RunResult cancel = RunNeuralmesh({"cancel", other, "--server", address});
   ASSERT_EQ(cancel.exit_code, 0) << cancel.Describe();
   EXPECT_THAT(cancel.out, ::testing::HasSubstr("session " + other + ": cancelled, 0 points"));

@@ -266,6 +266,55 @@ TEST_F(SessionAccessTest, AClientHoldsAtMostItsShareOfSessions) {
   EXPECT_FALSE(MustCreate(*alice_, CreateRequest(200)).empty()) << "room again";
 }
 
+TEST_F(SessionAccessTest, SessionsAreHandedToAnotherClientByTheirOwnerOrAnAdmin) {
+  const auto transfer = [](Service& service, const std::string& id, const std::string& to,
+                           v1::Session* session = nullptr) {
+    grpc::ClientContext context;
+    v1::TransferSessionRequest request;
+    request.set_session_id(id);
+    request.set_new_owner(to);
+    v1::Session ignored;
+    return service.TransferSession(&context, request, session != nullptr ? session : &ignored);
+  };
+  const std::string a = MustCreate(*alice_, CreateRequest(200));
+  const grpc::Status by_bob = transfer(*bob_, a, "bob");
+  EXPECT_EQ(by_bob.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_TRUE(absl::StrContains(by_bob.error_message(), "belongs to another client"))
+      << by_bob.error_message();
+  const grpc::Status by_reader = transfer(*wall_, a, "wall");
+  EXPECT_EQ(by_reader.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_TRUE(
+      absl::StrContains(by_reader.error_message(), "may not upload into, finish, hand over"))
+      << by_reader.error_message();
+  EXPECT_EQ(transfer(*alice_, a, "").error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(transfer(*alice_, "s-0000000000000000", "bob").error_code(),
+            grpc::StatusCode::NOT_FOUND);
+
+  // Alice hands her session to bob: from then on it is his, and no longer hers.
+  v1::Session handed;
+  const grpc::Status by_alice = transfer(*alice_, a, "bob", &handed);
+  ASSERT_TRUE(by_alice.ok()) << by_alice.error_message();
+  EXPECT_EQ(handed.owner(), "bob");
+  EXPECT_EQ(Listed(*alice_), std::set<std::string>{});
+  EXPECT_EQ(Listed(*bob_), (std::set<std::string>{a}));
+  for (const auto& [call, status] : Refusals(*alice_, a, /*see_too=*/true)) {
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED) << call;
+  }
+  v1::UploadPointsResponse uploaded;
+  EXPECT_TRUE(testing::Upload(*bob_, a, testing::SpherePoints(1000, 2), 1, &uploaded).ok());
+  EXPECT_EQ(testing::GetSession(*wall_, a).owner(), "bob");
+  EXPECT_EQ(testing::GetSession(*ops_, a).points_taken(), 1000u);
+  EXPECT_TRUE(absl::StrContains(events_.Await("handed"),
+                                absl::StrCat("session ", a, " handed from client alice to client "
+                                             "bob by client alice at ipv4:")))
+      << events_.Await("handed");
+
+  // An admin hands any session over, here back to alice.
+  ASSERT_TRUE(transfer(*ops_, a, "alice", &handed).ok());
+  EXPECT_EQ(handed.owner(), "alice");
+  EXPECT_TRUE(testing::Finish(*alice_, a).ok());
+}
+
 // Under mutual TLS without tokens, --client_certificate_role names clients by their
 // certificates' common names.
 TEST_F(SessionAccessTest, ClientCertificatesNameTheirClientsUnderMutualTls) {

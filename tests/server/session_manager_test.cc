@@ -3,11 +3,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "absl/synchronization/notification.h"
 #include "absl/time/clock.h"
 #include "tests/server/server_test_support.h"
@@ -284,6 +287,63 @@ TEST_F(SessionManagerRestoreTest, AShutdownStopsTheRestoreAndTheRestStaysOnDisk)
     EXPECT_TRUE(state == v1::SESSION_STATE_COLLECTING || state == v1::SESSION_STATE_LEARNING)
         << id << ": " << v1::SessionState_Name(state);
   }
+}
+
+TEST_F(SessionManagerRestoreTest, AHandedOverSessionKeepsItsNewOwnerAfterARestart) {
+  const std::vector<std::string> stored = StoreSessions(2);
+  testing::CapturedEvents captured;
+  {
+    std::unique_ptr<SessionStore> store = SessionStore::Open(dir_, false).value();
+    auto log = std::make_shared<EventLog>(captured.Sink());
+    SessionLimits limits;
+    limits.max_sessions_per_client = 2;
+    SessionManager manager(limits, &pool_, &encoder_, log, store.get());
+    manager.StartRestore();
+    manager.WaitForRestore();
+    absl::StatusOr<std::shared_ptr<Session>> handed =
+        manager.Transfer(stored[1], "bob", "client ops at ipv4:127.0.0.1:1");
+    ASSERT_TRUE(handed.ok()) << handed.status();
+    EXPECT_EQ((*handed)->owner(), "bob");
+    EXPECT_EQ((*handed)->ToProto().owner(), "bob");
+    EXPECT_EQ((*handed)->points_received(), 2000u) << "its points stay";
+    // Handing it to its owner changes nothing and records nothing.
+    ASSERT_TRUE(manager.Transfer(stored[1], "bob").ok());
+    // Bob may hold two sessions; alice's second would be his third.
+    ASSERT_TRUE(manager.Create(SmallConfig(), "bob's own", "", "bob").ok());
+    const absl::Status full = manager.Transfer(stored[0], "bob").status();
+    EXPECT_TRUE(absl::IsResourceExhausted(full)) << full;
+    EXPECT_THAT(full.message(), ::testing::HasSubstr("client bob holds its maximum of 2"));
+    EXPECT_EQ(manager.Get(stored[0]).value()->owner(), "alice") << "a refused transfer";
+    const struct {
+      std::string owner;
+      std::string message;
+    } invalid[] = {{"", "new_owner is empty"},
+                   {"bad\nname", "new_owner \"bad\\nname\" holds control characters"},
+                   {std::string(257, 'x'), "new_owner has 257 bytes; at most 256"}};
+    for (const auto& [owner, message] : invalid) {
+      const absl::Status refused = manager.Transfer(stored[0], owner).status();
+      EXPECT_TRUE(absl::IsInvalidArgument(refused)) << refused;
+      EXPECT_THAT(refused.message(), ::testing::HasSubstr(message));
+    }
+    EXPECT_TRUE(absl::IsNotFound(manager.Transfer("s-0000000000000000", "bob").status()));
+  }
+  const std::vector<std::string> events = captured.lines();
+  size_t handed_events = 0;
+  for (const std::string& line : events) {
+    handed_events += absl::StrContains(line, "handed");
+  }
+  EXPECT_EQ(handed_events, 1u);
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [&](const std::string& line) {
+    return absl::StrContains(line, absl::StrCat("session ", stored[1], " handed from client "
+                                                "alice to client bob by client ops at ipv4:"));
+  })) << absl::StrJoin(events, "\n");
+
+  std::unique_ptr<SessionStore> store = SessionStore::Open(dir_, false).value();
+  SessionManager manager(SessionLimits(), &pool_, &encoder_, nullptr, store.get());
+  manager.StartRestore();
+  manager.WaitForRestore();
+  EXPECT_EQ(manager.Get(stored[0]).value()->owner(), "alice");
+  EXPECT_EQ(manager.Get(stored[1]).value()->owner(), "bob") << "the new owner was on disk";
 }
 
 TEST_F(SessionManagerRestoreTest, WithoutAStoreThereIsNothingToWaitFor) {

@@ -33,6 +33,8 @@ constexpr uint32_t kBinChunkType = 0x004E4942;   // "BIN\0"
 constexpr size_t kGlbHeaderBytes = 12;
 constexpr size_t kChunkHeaderBytes = 8;
 constexpr char kDracoExtension[] = "KHR_draco_mesh_compression";
+// The attribute of per-point weights (glTF: application-specific semantics begin with "_").
+constexpr char kWeightAttribute[] = "_WEIGHT";
 
 // glTF's accessor component types and primitive modes, and the buffer-view targets.
 enum ComponentType : int {
@@ -178,6 +180,38 @@ Matrix Multiply(const Matrix& a, const Matrix& b) {
 double LinearPartDeterminant(const Matrix& m) {
   return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) +
          m[8] * (m[1] * m[6] - m[5] * m[2]);
+}
+
+// The transform of normals under `m`: its linear part's cofactor matrix (the inverse transpose
+// times the determinant), signed so that it keeps a normal's side under a mirroring transform.
+Matrix NormalMatrix(const Matrix& m) {
+  const auto at = [&](int row, int col) { return m[col * 4 + row]; };
+  Matrix n = kIdentity;
+  const double sign = LinearPartDeterminant(m) < 0 ? -1.0 : 1.0;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) {
+      const int r1 = (row + 1) % 3, r2 = (row + 2) % 3, c1 = (col + 1) % 3, c2 = (col + 2) % 3;
+      n[col * 4 + row] = sign * (at(r1, c1) * at(r2, c2) - at(r1, c2) * at(r2, c1));
+    }
+  }
+  return n;
+}
+
+// `normal` turned by `normal_matrix` and made unit length (a zero normal stays zero); as it is
+// under the identity.
+Vec3f Transformed(const Matrix& normal_matrix, const Vec3f& normal) {
+  if (normal_matrix == kIdentity) return normal;
+  double turned[3];
+  double length = 0;
+  for (int row = 0; row < 3; ++row) {
+    turned[row] = normal_matrix[row] * normal[0] + normal_matrix[4 + row] * normal[1] +
+                  normal_matrix[8 + row] * normal[2];
+    length += turned[row] * turned[row];
+  }
+  length = std::sqrt(length);
+  if (!(length > 0) || !std::isfinite(length)) return Vec3f(0, 0, 0);
+  return Vec3f(static_cast<float>(turned[0] / length), static_cast<float>(turned[1] / length),
+               static_cast<float>(turned[2] / length));
 }
 
 // `count` numbers of member `key` of `node`, or nullopt when it is absent.
@@ -485,6 +519,8 @@ class GltfReader {
     }
     std::vector<Vec3f> positions;
     std::vector<Rgb> colors;
+    std::vector<Vec3f> normals;
+    std::vector<float> weights;
     std::vector<uint32_t> indices;  // Empty: the vertices in order.
     bool has_indices = false;
     const JsonValue* extensions = primitive.Find("extensions");
@@ -495,12 +531,19 @@ class GltfReader {
     } else {
       NM_RETURN_IF_ERROR(ReadPrimitive(*attributes, primitive, where, &positions, &colors, &indices,
                                        &has_indices));
+      if (faces_ == FaceHandling::kSkip) {
+        NM_RETURN_IF_ERROR(ReadPointAttributes(*attributes, where, positions.size(), &normals,
+                                               &weights));
+      }
     }
     if (placed_.size() + positions.size() > kMaxVertices) {
       return Invalid("the scene draws more than ", kMaxVertices, " vertices");
     }
     const bool mirrored = LinearPartDeterminant(world) < 0;
     colored_ = colored_ && !colors.empty();
+    with_normals_ = with_normals_ && !normals.empty();
+    weighted_ = weighted_ && !weights.empty();
+    const Matrix normal_matrix = NormalMatrix(world);
     std::vector<uint32_t> merged(positions.size());
     for (size_t i = 0; i < positions.size(); ++i) {
       const Vec3f& p = positions[i];
@@ -517,7 +560,12 @@ class GltfReader {
         if (q[row] == 0.0) q[row] = 0.0;
       }
       merged[i] = merger_.Add(q);
-      if (merged[i] == colors_.size()) colors_.push_back(colors.empty() ? Rgb{} : colors[i]);
+      if (merged[i] == colors_.size()) {
+        colors_.push_back(colors.empty() ? Rgb{} : colors[i]);
+        normals_.push_back(normals.empty() ? Vec3f(0, 0, 0)
+                                           : Transformed(normal_matrix, normals[i]));
+        weights_.push_back(weights.empty() ? 0.0f : weights[i]);
+      }
     }
     if (faces_ == FaceHandling::kSkip || mode < kTriangles) return absl::OkStatus();
     const size_t corners = has_indices ? indices.size() : positions.size();
@@ -605,6 +653,48 @@ class GltfReader {
     return absl::OkStatus();
   }
 
+  // A primitive's NORMAL and weights (_WEIGHT, or the first of _CONFIDENCE, _QUALITY,
+  // _INTENSITY and _SCALAR, as the PLY reader names them), for point clouds: `count` of each,
+  // or none when the primitive has none.
+  absl::Status ReadPointAttributes(const JsonValue& attributes, const std::string& where,
+                                   size_t count, std::vector<Vec3f>* normals,
+                                   std::vector<float>* weights) {
+    if (attributes.Find("NORMAL") != nullptr) {
+      NM_ASSIGN_OR_RETURN(const uint64_t accessor,
+                          IntegerMember(attributes, "NORMAL", std::nullopt, where));
+      NM_ASSIGN_OR_RETURN(const AccessorData normal,
+                          ReadAccessor(accessor, "NORMAL", {3}, {kByte, kShort, kFloat}));
+      if (normal.count != count) {
+        return Invalid(where, ": NORMAL has ", normal.count, " elements for ", count,
+                       " positions");
+      }
+      normals->resize(count);
+      for (size_t i = 0; i < count; ++i) {
+        for (int c = 0; c < 3; ++c) {
+          (*normals)[i][c] = static_cast<float>(normal.values[3 * i + c]);
+        }
+      }
+    }
+    for (const char* name :
+         {kWeightAttribute, "_CONFIDENCE", "_QUALITY", "_INTENSITY", "_SCALAR"}) {
+      if (attributes.Find(name) == nullptr) continue;
+      NM_ASSIGN_OR_RETURN(const uint64_t accessor,
+                          IntegerMember(attributes, name, std::nullopt, where));
+      NM_ASSIGN_OR_RETURN(
+          const AccessorData weight,
+          ReadAccessor(accessor, name, {1},
+                       {kByte, kUnsignedByte, kShort, kUnsignedShort, kUnsignedInt, kFloat}));
+      if (weight.count != count) {
+        return Invalid(where, ": ", name, " has ", weight.count, " elements for ", count,
+                       " positions");
+      }
+      weights->resize(count);
+      for (size_t i = 0; i < count; ++i) (*weights)[i] = static_cast<float>(weight.values[i]);
+      break;
+    }
+    return absl::OkStatus();
+  }
+
   absl::Status ReadDracoPrimitive(const JsonValue& draco, const std::string& where,
                                   std::vector<Vec3f>* positions, std::vector<Rgb>* colors,
                                   std::vector<uint32_t>* indices) {
@@ -652,9 +742,15 @@ class GltfReader {
     VertexMerger merger(&out_.positions);
     std::vector<uint32_t> index(narrowed.positions.size());
     std::vector<Rgb> colors;
+    std::vector<Vec3f> normals;
+    std::vector<float> weights;
     for (size_t i = 0; i < narrowed.positions.size(); ++i) {
       index[i] = merger.Add(narrowed.positions[i]);
-      if (index[i] == colors.size()) colors.push_back(colors_[i]);
+      if (index[i] == colors.size()) {
+        colors.push_back(colors_[i]);
+        normals.push_back(normals_[i]);
+        weights.push_back(weights_[i]);
+      }
     }
     std::vector<std::array<uint32_t, 3>> faces;
     faces.reserve(out_.faces.size());
@@ -664,6 +760,8 @@ class GltfReader {
     }
     out_.faces = std::move(faces);
     if (colored_) out_.colors = std::move(colors);
+    if (with_normals_ && faces_ == FaceHandling::kSkip) out_.normals = std::move(normals);
+    if (weighted_ && faces_ == FaceHandling::kSkip) out_.weights = std::move(weights);
   }
 
   JsonValue doc_;
@@ -675,8 +773,13 @@ class GltfReader {
   ParsedGeometry out_;  // Faces index placed_ until NarrowAndMerge.
   std::vector<Point3d> placed_;  // Where the nodes place the vertices, identical ones merged.
   VertexMergerOf<Point3d> merger_;
-  std::vector<Rgb> colors_;  // One per placed vertex; black for vertices without colour.
-  bool colored_ = true;      // Every primitive so far has COLOR_0.
+  // One of each per placed vertex; black, zero and 0 for vertices without them.
+  std::vector<Rgb> colors_;
+  std::vector<Vec3f> normals_;  // Turned by the nodes, unit length.
+  std::vector<float> weights_;
+  bool colored_ = true;       // Every primitive so far has COLOR_0,
+  bool with_normals_ = true;  // NORMAL (read for point clouds only),
+  bool weighted_ = true;      // and weights (likewise).
 };
 
 // Splits a .glb into its JSON text and its BIN chunk (when it has one).
@@ -718,6 +821,27 @@ struct Range {
   size_t offset;
   size_t length;
 };
+
+// A vertex attribute as the writer lays it out and its accessor describes it.
+struct VertexAttribute {
+  const char* semantic;
+  int component_type;
+  bool normalized;
+  const char* type;
+  size_t stride;  // 0: tightly packed.
+};
+
+// `normal` as glTF wants NORMAL, unit length: as it is when it nearly is, so that unit normals
+// come back bitwise; a zero normal stays zero.
+Vec3f UnitNormal(const Vec3f& normal) {
+  const double squared = static_cast<double>(normal[0]) * normal[0] +
+                         static_cast<double>(normal[1]) * normal[1] +
+                         static_cast<double>(normal[2]) * normal[2];
+  if (std::abs(squared - 1) < 1e-6 || !(squared > 0)) return normal;
+  const double length = std::sqrt(squared);
+  return Vec3f(static_cast<float>(normal[0] / length), static_cast<float>(normal[1] / length),
+               static_cast<float>(normal[2] / length));
+}
 
 }  // namespace
 
@@ -765,7 +889,13 @@ absl::StatusOr<std::string> FormatGltf(const GeometryView& geometry,
   absl::Span<const std::array<uint32_t, 3>> faces = geometry.faces;
   TriangleMesh decoded;
   std::string bin;
-  std::vector<Range> views;
+  std::vector<VertexAttribute> attributes;
+  std::vector<Range> views;  // The attributes' (without Draco), then the indices'.
+  const auto append_view = [&](auto&& append_values) {
+    const size_t start = bin.size();
+    append_values();
+    views.push_back({start, bin.size() - start});
+  };
   if (options.draco) {
     TriangleMesh mesh;
     mesh.positions.assign(geometry.positions.begin(), geometry.positions.end());
@@ -778,36 +908,55 @@ absl::StatusOr<std::string> FormatGltf(const GeometryView& geometry,
     faces = decoded.faces;
     views.push_back({0, bin.size()});
     while (bin.size() % 4 != 0) bin.push_back('\0');
+    attributes.push_back({"POSITION", kFloat, false, "VEC3", 0});
+    if (colored) attributes.push_back({"COLOR_0", kUnsignedShort, true, "VEC3", 8});
   } else {
-    for (const Vec3f& p : positions) {
-      for (float c : p) AppendLittleEndian(c, &bin);
-    }
-    views.push_back({0, bin.size()});
+    attributes.push_back({"POSITION", kFloat, false, "VEC3", 0});
+    append_view([&] {
+      for (const Vec3f& p : positions) {
+        for (float c : p) AppendLittleEndian(c, &bin);
+      }
+    });
     if (colored) {
       // Three channels and two bytes of padding: vertex attributes are aligned to 4 bytes.
-      const size_t start = bin.size();
-      for (const Rgb& color : geometry.colors) {
-        for (uint8_t c : color) AppendLittleEndian(LinearShortFromSrgb(c), &bin);
-        AppendLittleEndian(uint16_t{0}, &bin);
-      }
-      views.push_back({start, bin.size() - start});
+      attributes.push_back({"COLOR_0", kUnsignedShort, true, "VEC3", 8});
+      append_view([&] {
+        for (const Rgb& color : geometry.colors) {
+          for (uint8_t c : color) AppendLittleEndian(LinearShortFromSrgb(c), &bin);
+          AppendLittleEndian(uint16_t{0}, &bin);
+        }
+      });
+    }
+    if (!geometry.normals.empty()) {
+      attributes.push_back({"NORMAL", kFloat, false, "VEC3", 0});
+      append_view([&] {
+        for (const Vec3f& n : geometry.normals) {
+          for (float c : UnitNormal(n)) AppendLittleEndian(c, &bin);
+        }
+      });
+    }
+    if (!geometry.weights.empty()) {
+      attributes.push_back({kWeightAttribute, kFloat, false, "SCALAR", 0});
+      append_view([&] {
+        for (float w : geometry.weights) AppendLittleEndian(w, &bin);
+      });
     }
   }
   const size_t vertices = positions.size();
   // The largest index of a type is reserved (primitive restart), so 16 bits take 65535 vertices.
   const bool short_indices = vertices <= 65535;
   if (has_faces && !options.draco) {
-    const size_t start = bin.size();
-    for (const std::array<uint32_t, 3>& face : faces) {
-      for (uint32_t v : face) {
-        if (short_indices) {
-          AppendLittleEndian(static_cast<uint16_t>(v), &bin);
-        } else {
-          AppendLittleEndian(v, &bin);
+    append_view([&] {
+      for (const std::array<uint32_t, 3>& face : faces) {
+        for (uint32_t v : face) {
+          if (short_indices) {
+            AppendLittleEndian(static_cast<uint16_t>(v), &bin);
+          } else {
+            AppendLittleEndian(v, &bin);
+          }
         }
       }
-    }
-    views.push_back({start, bin.size() - start});
+    });
     while (bin.size() % 4 != 0) bin.push_back('\0');
   }
 
@@ -844,12 +993,12 @@ absl::StatusOr<std::string> FormatGltf(const GeometryView& geometry,
   json.Key("roughnessFactor").Double(0.8).EndObject();
   json.Key("doubleSided").Bool(true).EndObject().EndArray();
 
-  // Accessors: 0 positions, then colours, then indices.
-  const uint64_t color_accessor = 1;
-  const uint64_t index_accessor = colored ? 2 : 1;
+  // Accessor a describes attributes[a] and, without Draco, lies in bufferViews[a]; the indices'
+  // accessor and view come last.
+  const uint64_t index_accessor = attributes.size();
   json.Key("meshes").BeginArray().BeginObject().Key("primitives").BeginArray().BeginObject();
-  json.Key("attributes").BeginObject().Key("POSITION").Uint(0);
-  if (colored) json.Key("COLOR_0").Uint(color_accessor);
+  json.Key("attributes").BeginObject();
+  for (size_t a = 0; a < attributes.size(); ++a) json.Key(attributes[a].semantic).Uint(a);
   json.EndObject();
   if (has_faces) json.Key("indices").Uint(index_accessor);
   json.Key("material").Uint(0);
@@ -863,29 +1012,26 @@ absl::StatusOr<std::string> FormatGltf(const GeometryView& geometry,
   }
   json.EndObject().EndArray().EndObject().EndArray();
 
-  // The accessors' buffer views, in the order the views were laid out above.
-  size_t next_view = 0;
-  const auto view_of = [&](JsonWriter& w) {
-    if (!options.draco) w.Key("bufferView").Uint(next_view++);
-  };
   json.Key("accessors").BeginArray();
-  json.BeginObject();
-  view_of(json);
-  json.Key("componentType").Uint(kFloat).Key("count").Uint(vertices).Key("type").String("VEC3");
-  json.Key("min").BeginArray();
-  for (float c : low) json.Double(c);
-  json.EndArray().Key("max").BeginArray();
-  for (float c : high) json.Double(c);
-  json.EndArray().EndObject();
-  if (colored) {
+  for (size_t a = 0; a < attributes.size(); ++a) {
+    const VertexAttribute& attribute = attributes[a];
     json.BeginObject();
-    view_of(json);
-    json.Key("componentType").Uint(kUnsignedShort).Key("normalized").Bool(true);
-    json.Key("count").Uint(vertices).Key("type").String("VEC3").EndObject();
+    if (!options.draco) json.Key("bufferView").Uint(a);
+    json.Key("componentType").Uint(attribute.component_type);
+    if (attribute.normalized) json.Key("normalized").Bool(true);
+    json.Key("count").Uint(vertices).Key("type").String(attribute.type);
+    if (a == 0) {  // POSITION needs its bounds.
+      json.Key("min").BeginArray();
+      for (float c : low) json.Double(c);
+      json.EndArray().Key("max").BeginArray();
+      for (float c : high) json.Double(c);
+      json.EndArray();
+    }
+    json.EndObject();
   }
   if (has_faces) {
     json.BeginObject();
-    view_of(json);
+    if (!options.draco) json.Key("bufferView").Uint(index_accessor);
     json.Key("componentType").Uint(short_indices ? kUnsignedShort : kUnsignedInt);
     json.Key("count").Uint(faces.size() * 3).Key("type").String("SCALAR").EndObject();
   }
@@ -896,9 +1042,11 @@ absl::StatusOr<std::string> FormatGltf(const GeometryView& geometry,
     json.BeginObject().Key("buffer").Uint(0).Key("byteOffset").Uint(views[v].offset);
     json.Key("byteLength").Uint(views[v].length);
     if (!options.draco) {
-      const bool is_indices = has_faces && v + 1 == views.size();
-      if (colored && v == 1) json.Key("byteStride").Uint(8);
-      json.Key("target").Uint(is_indices ? kElementArrayBuffer : kArrayBuffer);
+      const bool is_attribute = v < attributes.size();
+      if (is_attribute && attributes[v].stride != 0) {
+        json.Key("byteStride").Uint(attributes[v].stride);
+      }
+      json.Key("target").Uint(is_attribute ? kArrayBuffer : kElementArrayBuffer);
     }
     json.EndObject();
   }

@@ -25,7 +25,10 @@ GltfBufferLoader GltfBuffersBeside(const std::string& path);
 // primitive the default scene draws (or, without scenes, of every mesh once), placed by their
 // nodes' transforms, with the triangles of TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN
 // primitives (winding reversed under a mirroring transform) and the COLOR_0 colours (linear
-// light, converted to sRGB) when every primitive has them. Vertices at identical positions
+// light, converted to sRGB) when every primitive has them; with FaceHandling::kSkip also the
+// NORMAL vectors (turned by the nodes) and the weights (_WEIGHT, or the first of _CONFIDENCE,
+// _QUALITY, _INTENSITY, _SCALAR) when every primitive has them (not those of
+// Draco-compressed primitives). Vertices at identical positions
 // are merged, since glTF splits vertices where normals or texture coordinates differ; faces
 // that repeat a vertex are dropped. Where the nodes place vertices far from zero (a
 // georeferenced model), positions are relative to an origin (position_collector.h), and
@@ -45,8 +48,10 @@ struct GltfWriteOptions {
   DracoOptions draco_options;  // Used with `draco`.
 };
 
-// Formats one mesh of one primitive: positions, faces (TRIANGLES; POINTS without faces), and
-// colours as COLOR_0 (linear light, normalized 16-bit), placed by a node whose translation is
+// Formats one mesh of one primitive: positions, faces (TRIANGLES; POINTS without faces),
+// colours as COLOR_0 (linear light, normalized 16-bit), and without `draco` normals as NORMAL
+// (made unit length, as glTF requires; zero ones stay zero) and weights as _WEIGHT (floats;
+// glTF's application-specific attributes begin with "_"), placed by a node whose translation is
 // geometry.origin when that is not zero, with a matte double-sided material
 // (glTF's default material is fully metallic, which renders dark without an environment).
 // With `draco`, the primitive is a Draco stream (EncodeMeshForGltf) and the file requires

@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <string>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/internal/binary.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/rgb.h"
+#include "core/version.h"
 
 namespace neuralmesh::io_internal {
 namespace {
@@ -65,6 +68,21 @@ RecordUsability Usability(absl::string_view data, size_t at, int format) {
   const int classification = extended ? static_cast<uint8_t>(data[at + 16]) : flags & 0x1F;
   return classification == kLowNoiseClass || classification == kHighNoiseClass ? kNoise
                                                                                 : kUsable;
+}
+
+// The power of ten at most 1/2^24 of `farthest` (the largest magnitude of an axis's
+// coordinates): a float keeps 24 bits, so the integers keep what the floats hold. 0.001 for an
+// axis that is zero everywhere.
+double ScaleFor(double farthest) {
+  if (!(farthest > 0)) return 0.001;
+  return std::pow(10.0, std::floor(std::log10(farthest / (1 << 24))));
+}
+
+// A fixed-size text field of the header, padded with zeros.
+void AppendText(absl::string_view text, size_t size, std::string* out) {
+  text = text.substr(0, size);
+  out->append(text.data(), text.size());
+  out->append(size - text.size(), '\0');
 }
 
 }  // namespace
@@ -190,6 +208,75 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
       return true;
     });
   }
+  return out;
+}
+
+absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
+  const size_t count = points.positions.size();
+  if (count > std::numeric_limits<uint32_t>::max()) {
+    return Invalid(absl::StrCat(count, " points are more than LAS 1.2 counts (",
+                                std::numeric_limits<uint32_t>::max(), ")"));
+  }
+  const bool colored = !points.colors.empty();
+  const uint8_t format = colored ? 2 : 0;
+  const uint16_t record_length = static_cast<uint16_t>(kFormats[format].length);
+  Point3d scale;
+  for (int c = 0; c < 3; ++c) {
+    double farthest = 0;
+    for (const Vec3f& p : points.positions) farthest = std::max<double>(farthest, std::fabs(p[c]));
+    scale[c] = ScaleFor(farthest);
+  }
+
+  std::string records;
+  records.reserve(count * record_length);
+  Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = 0; i < count; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const int32_t stored =
+          static_cast<int32_t>(std::llround(points.positions[i][c] / scale[c]));
+      AppendLittleEndian(stored, &records);
+      const double coordinate = stored * scale[c] + points.origin[c];
+      low[c] = std::min(low[c], coordinate);
+      high[c] = std::max(high[c], coordinate);
+    }
+    AppendLittleEndian(uint16_t{0}, &records);  // Intensity.
+    records.push_back(static_cast<char>(1 | 1 << 3));  // Return 1 of 1.
+    records.push_back('\0');  // Class 0: created, never classified.
+    records.push_back('\0');  // Scan angle rank.
+    records.push_back('\0');  // User data.
+    AppendLittleEndian(uint16_t{0}, &records);  // Point source.
+    if (colored) {
+      for (uint8_t level : points.colors[i]) {
+        AppendLittleEndian(static_cast<uint16_t>(level * 257), &records);
+      }
+    }
+  }
+
+  std::string out = "LASF";
+  AppendLittleEndian(uint16_t{0}, &out);  // File source.
+  AppendLittleEndian(uint16_t{0}, &out);  // Global encoding: GPS week time.
+  out.append(16, '\0');                   // Project GUID.
+  out.push_back(1);
+  out.push_back(2);
+  AppendText("OTHER", 32, &out);  // System identifier: not a scanner's own file.
+  AppendText(absl::StrCat("neuralmesh ", NeuralmeshVersion()), 32, &out);
+  AppendLittleEndian(uint16_t{0}, &out);  // Creation day of year: not recorded.
+  AppendLittleEndian(uint16_t{0}, &out);  // Creation year.
+  AppendLittleEndian(static_cast<uint16_t>(kLegacyHeaderSize), &out);
+  AppendLittleEndian(static_cast<uint32_t>(kLegacyHeaderSize), &out);  // Offset to the points.
+  AppendLittleEndian(uint32_t{0}, &out);  // Variable-length records.
+  out.push_back(static_cast<char>(format));
+  AppendLittleEndian(record_length, &out);
+  AppendLittleEndian(static_cast<uint32_t>(count), &out);
+  AppendLittleEndian(static_cast<uint32_t>(count), &out);  // Points by return: all first.
+  for (int r = 1; r < 5; ++r) AppendLittleEndian(uint32_t{0}, &out);
+  for (int c = 0; c < 3; ++c) AppendLittleEndian(scale[c], &out);
+  for (int c = 0; c < 3; ++c) AppendLittleEndian(points.origin[c], &out);
+  for (int c = 0; c < 3; ++c) {
+    AppendLittleEndian(count > 0 ? high[c] : 0.0, &out);
+    AppendLittleEndian(count > 0 ? low[c] : 0.0, &out);
+  }
+  out += records;
   return out;
 }
 

@@ -3,6 +3,8 @@
 #ifndef NEURALMESH_CORE_IO_INTERNAL_LAS_H_
 #define NEURALMESH_CORE_IO_INTERNAL_LAS_H_
 
+#include <string>
+
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
@@ -22,6 +24,16 @@ namespace neuralmesh::io_internal {
 // format above 10, a record shorter than its format, a zero or non-finite scale, or a point
 // count that does not fit the file, or points that are all withheld or noise.
 absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data);
+
+// Formats points as a LAS 1.2 file of point format 0, or 2 with their colours (8-bit levels
+// times 257 in the 16-bit channels), without variable-length records. The header's offset is
+// points.origin; each axis's scale is the power of ten at most 1/2^24 of the farthest
+// coordinate from that origin (1e-8 for a unit sphere, 1e-5 for a UTM tile of 1,000 m), so the
+// integers keep what the floats hold to half a scale step. Records say return 1 of 1, class 0
+// (never classified), intensity 0; the creation date is left zero, so the same points give the
+// same bytes. Normals and weights have no place in these formats and are not written.
+// Returns INVALID_ARGUMENT for more points than LAS 1.2 counts (2^32 - 1).
+absl::StatusOr<std::string> FormatLas(const GeometryView& points);
 
 }  // namespace neuralmesh::io_internal
 

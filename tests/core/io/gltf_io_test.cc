@@ -2,6 +2,7 @@
 // .gltf, with and without Draco) read back, files shaped as other tools write them (node
 // transforms, strips and fans, interleaved and external buffers, instancing), and malformed
 // files refused with what is wrong. tests/client/web/gltf_three_test.cc has three.js read them.
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -306,6 +307,103 @@ TEST(GltfIoTest, ReadsStripsFansInstancesAndDropsPartialColours) {
   const absl::StatusOr<PointCloud> points = ReadPointCloud(TempPath("modes.glb"));
   ASSERT_TRUE(points.ok()) << points.status();
   EXPECT_EQ(points->positions.size(), 15u);
+}
+
+TEST(GltfIoTest, PointCloudsKeepTheirNormalsWeightsAndColours) {
+  PointCloud cloud = io_test::RandomCloud(300, 7, /*normals=*/true, /*weights=*/true);
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    cloud.colors.push_back({static_cast<uint8_t>(i), static_cast<uint8_t>(255 - i % 256), 7});
+  }
+  for (const char* name : {"points.glb", "points.gltf"}) {
+    SCOPED_TRACE(name);
+    const std::string path = TempPath(name);
+    ASSERT_TRUE(WritePointCloud(cloud, path).ok());
+    const absl::StatusOr<PointCloud> read = ReadPointCloud(path);
+    ASSERT_TRUE(read.ok()) << read.status();
+    EXPECT_EQ(read->positions, cloud.positions);
+    EXPECT_EQ(read->normals, cloud.normals) << "unit normals come back bitwise";
+    EXPECT_EQ(read->weights, cloud.weights);
+    EXPECT_EQ(read->colors, cloud.colors);
+  }
+  const absl::StatusOr<JsonValue> doc = ParseJson(GlbJson(ReadBytes(TempPath("points.glb"))));
+  ASSERT_TRUE(doc.ok()) << doc.status();
+  const JsonValue& primitive = doc->Find("meshes")->items[0].Find("primitives")->items[0];
+  EXPECT_EQ(primitive.Find("mode")->number, 0) << "POINTS";
+  const JsonValue* attributes = primitive.Find("attributes");
+  ASSERT_NE(attributes->Find("NORMAL"), nullptr);
+  ASSERT_NE(attributes->Find("_WEIGHT"), nullptr) << "application-specific semantics begin with _";
+  const JsonValue& accessors = *doc->Find("accessors");
+  const JsonValue& weight = accessors.items[attributes->Find("_WEIGHT")->number];
+  EXPECT_EQ(weight.Find("type")->text, "SCALAR");
+  EXPECT_EQ(weight.Find("count")->number, cloud.size());
+  const JsonValue& normal = accessors.items[attributes->Find("NORMAL")->number];
+  EXPECT_EQ(normal.Find("componentType")->number, 5126) << "float";
+  const JsonValue& views = *doc->Find("bufferViews");
+  EXPECT_EQ(views.items.size(), 4u) << "positions, colours, normals, weights; no indices";
+  for (const JsonValue& view : views.items) EXPECT_EQ(view.Find("target")->number, 34962);
+
+  // glTF wants unit normals: others are made so, zero ones stay zero.
+  PointCloud odd = io_test::RandomCloud(2, 8, true, false);
+  odd.normals = {Vec3f(0, 3, 4), Vec3f(0, 0, 0)};
+  ASSERT_TRUE(WritePointCloud(odd, TempPath("odd.glb")).ok());
+  const absl::StatusOr<PointCloud> unit = ReadPointCloud(TempPath("odd.glb"));
+  ASSERT_TRUE(unit.ok()) << unit.status();
+  EXPECT_EQ(unit->normals, (std::vector<Vec3f>{Vec3f(0, 0.6f, 0.8f), Vec3f(0, 0, 0)}));
+  // Meshes carry neither.
+  const absl::StatusOr<TriangleMesh> as_mesh = ReadMesh(TempPath("points.glb"));
+  ASSERT_TRUE(as_mesh.ok()) << as_mesh.status();
+  EXPECT_EQ(as_mesh->positions, cloud.positions);
+}
+
+TEST(GltfIoTest, ReadsNormalsTurnedByTheirNodesAndWeightsByOtherNames) {
+  // Two points with float normals and 8-bit normalized confidences, drawn by a node that
+  // stretches x by 2 and mirrors z.
+  std::string bin;
+  for (float c : {0.f, 0.f, 0.f, 1.f, 2.f, 3.f}) Put(c, false, &bin);
+  const float s = 1 / std::sqrt(2.0f);
+  for (float c : {s, s, 0.f, 0.f, 0.f, 1.f}) Put(c, false, &bin);
+  for (uint8_t c : {255, 51}) Put(c, false, &bin);
+  bin += std::string(2, '\0');
+  const auto json = [](const std::string& normal_count, const std::string& second_mesh) {
+    return absl::StrCat(
+        R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],)",
+        R"("nodes":[{"mesh":0,"scale":[2,1,-1]}],)",
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0,"NORMAL":1,"_CONFIDENCE":2},)",
+        R"("mode":0})", second_mesh, R"(]}],)",
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":2,"type":"VEC3"},)",
+        R"({"bufferView":1,"componentType":5126,"count":)", normal_count, R"(,"type":"VEC3"},)",
+        R"({"bufferView":2,"componentType":5121,"normalized":true,"count":2,"type":"SCALAR"}],)",
+        R"("bufferViews":[{"buffer":0,"byteLength":24},{"buffer":0,"byteOffset":24,)",
+        R"("byteLength":24},{"buffer":0,"byteOffset":48,"byteLength":2}],)",
+        R"("buffers":[{"byteLength":52}]})");
+  };
+  const std::string path = TempPath("turned.glb");
+  WriteBytes(path, Glb(json("2", ""), bin));
+  const absl::StatusOr<PointCloud> read = ReadPointCloud(path);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->positions, (std::vector<Vec3f>{Vec3f(0, 0, 0), Vec3f(2, 2, -3)}));
+  ASSERT_EQ(read->normals.size(), 2u);
+  // Normals turn by the inverse transpose: (1, 1, 0) under x stretched by 2 leans toward y.
+  EXPECT_NEAR(read->normals[0][0], 1 / std::sqrt(5.0f), 1e-6);
+  EXPECT_NEAR(read->normals[0][1], 2 / std::sqrt(5.0f), 1e-6);
+  EXPECT_NEAR(read->normals[0][2], 0, 1e-6);
+  EXPECT_NEAR(read->normals[1][2], -1, 1e-6) << "mirrored in z, the normal turns with it";
+  EXPECT_NEAR(read->weights[0], 1.0, 1e-6);
+  EXPECT_NEAR(read->weights[1], 0.2, 1e-6);
+
+  // A second primitive without them: the file's normals and weights are left out.
+  WriteBytes(path, Glb(json("2", R"(,{"attributes":{"POSITION":0},"mode":0})"), bin));
+  const absl::StatusOr<PointCloud> partial = ReadPointCloud(path);
+  ASSERT_TRUE(partial.ok()) << partial.status();
+  EXPECT_TRUE(partial->normals.empty());
+  EXPECT_TRUE(partial->weights.empty());
+
+  WriteBytes(path, Glb(json("1", ""), bin));
+  const absl::StatusOr<PointCloud> short_normals = ReadPointCloud(path);
+  EXPECT_EQ(short_normals.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(short_normals.status().message()),
+              HasSubstr("meshes[0].primitives[0]: NORMAL has 1 elements for 2 positions"));
+  EXPECT_TRUE(ReadMesh(path).ok()) << "a mesh does not read normals";
 }
 
 TEST(GltfIoTest, RefusesMalformedFilesAndSaysWhatIsWrong) {

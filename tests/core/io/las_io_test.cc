@@ -3,6 +3,7 @@
 // and malformed or compressed files refused with what is wrong.
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -184,7 +185,90 @@ TEST(LasIoTest, MalformedAndCompressedFilesAreRefusedWithWhatIsWrong) {
     EXPECT_THAT(std::string(cloud.status().message()), HasSubstr("bad.las"));
   }
   EXPECT_TRUE(IsReadablePointCloudExtension("scan.LAS"));
-  EXPECT_FALSE(IsWritablePointCloudExtension("scan.las"));
+}
+
+// A field of a LAS file's bytes (little-endian).
+template <typename T>
+T Field(const std::string& bytes, size_t offset) {
+  T value;
+  std::memcpy(&value, bytes.data() + offset, sizeof(T));
+  return value;
+}
+
+TEST(LasIoTest, WrittenFilesKeepColoursAndGeoreferencedCoordinates) {
+  PointCloud cloud;
+  cloud.origin = {500000, 4100000, 0};
+  cloud.positions = {Vec3f(956.034f, 234.567f, 101.234f), Vec3f(0.001f, 999.999f, 0),
+                     Vec3f(1500.25f, 12.5f, -3.75f)};
+  cloud.colors = {{255, 0, 128}, {1, 2, 3}, {0, 0, 0}};
+  cloud.normals = {Vec3f(0, 0, 1), Vec3f(0, 0, 1), Vec3f(0, 0, 1)};
+  cloud.weights = {1, 2, 3};
+  const std::string path = TempPath("written.las");
+  ASSERT_TRUE(WritePointCloud(cloud, path).ok());
+  const std::string bytes = io_test::ReadBytes(path);
+
+  // The header, field by field (LAS 1.2, Table 4).
+  ASSERT_EQ(bytes.size(), 227u + 3 * 26);
+  EXPECT_EQ(bytes.substr(0, 4), "LASF");
+  EXPECT_EQ(bytes[24], 1);
+  EXPECT_EQ(bytes[25], 2);
+  EXPECT_EQ(Field<uint16_t>(bytes, 94), 227) << "header size";
+  EXPECT_EQ(Field<uint32_t>(bytes, 96), 227u) << "offset to the points";
+  EXPECT_EQ(Field<uint32_t>(bytes, 100), 0u) << "variable-length records";
+  EXPECT_EQ(bytes[104], 2) << "point format 2: with colours";
+  EXPECT_EQ(Field<uint16_t>(bytes, 105), 26);
+  EXPECT_EQ(Field<uint32_t>(bytes, 107), 3u);
+  EXPECT_EQ(Field<uint32_t>(bytes, 111), 3u) << "every point a first return";
+  // Scales: the power of ten at most 1/2^24 of each axis's farthest coordinate.
+  EXPECT_EQ(Field<double>(bytes, 131), 1e-5);
+  EXPECT_EQ(Field<double>(bytes, 139), 1e-5);
+  EXPECT_EQ(Field<double>(bytes, 147), 1e-6);
+  EXPECT_EQ(Field<double>(bytes, 155), 500000.0) << "the offset is the origin";
+  EXPECT_EQ(Field<double>(bytes, 163), 4100000.0);
+  EXPECT_EQ(Field<double>(bytes, 171), 0.0);
+  EXPECT_NEAR(Field<double>(bytes, 179), 501500.25, 1e-5) << "max x";
+  EXPECT_NEAR(Field<double>(bytes, 187), 500000.001, 1e-5) << "min x";
+  EXPECT_NEAR(Field<double>(bytes, 211), 101.234, 1e-5) << "max z";
+  EXPECT_NEAR(Field<double>(bytes, 219), -3.75, 1e-5) << "min z";
+  // The first record: coordinates, return 1 of 1, class 0, colour levels times 257.
+  EXPECT_NEAR(Field<int32_t>(bytes, 227) * 1e-5, cloud.positions[0][0], 1e-5);
+  EXPECT_NEAR(Field<int32_t>(bytes, 235) * 1e-6, cloud.positions[0][2], 1e-6);
+  EXPECT_EQ(bytes[227 + 14], 9);
+  EXPECT_EQ(bytes[227 + 15], 0);
+  EXPECT_EQ(Field<uint16_t>(bytes, 227 + 20), 65535);
+  EXPECT_EQ(Field<uint16_t>(bytes, 227 + 22), 0);
+  EXPECT_EQ(Field<uint16_t>(bytes, 227 + 24), 128 * 257);
+
+  const absl::StatusOr<PointCloud> read = ReadPointCloud(path);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->origin, cloud.origin);
+  ASSERT_EQ(read->size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(read->positions[i][c], cloud.positions[i][c], c < 2 ? 5e-6 : 5e-7) << i;
+    }
+  }
+  EXPECT_EQ(read->positions[0], cloud.positions[0]) << "floats that the scale resolves";
+  EXPECT_EQ(read->colors, cloud.colors);
+  EXPECT_TRUE(read->normals.empty());
+  EXPECT_TRUE(read->weights.empty());
+
+  // Without colours: format 0; near zero, no offset; the same points give the same bytes.
+  PointCloud plain;
+  plain.positions = {Vec3f(-1, 0.5f, 0), Vec3f(0.25f, -0.125f, 0)};
+  ASSERT_TRUE(WritePointCloud(plain, path).ok());
+  const std::string plain_bytes = io_test::ReadBytes(path);
+  EXPECT_EQ(plain_bytes[104], 0);
+  EXPECT_EQ(Field<uint16_t>(plain_bytes, 105), 20);
+  EXPECT_EQ(Field<double>(plain_bytes, 131), 1e-8);
+  EXPECT_EQ(Field<double>(plain_bytes, 147), 0.001) << "an axis that is zero everywhere";
+  EXPECT_EQ(Field<double>(plain_bytes, 155), 0.0);
+  const absl::StatusOr<PointCloud> plain_read = ReadPointCloud(path);
+  ASSERT_TRUE(plain_read.ok()) << plain_read.status();
+  EXPECT_EQ(plain_read->positions, plain.positions);
+  EXPECT_TRUE(plain_read->colors.empty());
+  ASSERT_TRUE(WritePointCloud(plain, path).ok());
+  EXPECT_EQ(io_test::ReadBytes(path), plain_bytes);
 }
 
 }  // namespace

@@ -74,7 +74,15 @@ TEST_P(CloudRoundTripTest, WriteThenReadGivesTheSameCloud) {
   ASSERT_TRUE(written.ok()) << "writing " << extension << ": " << written;
   const absl::StatusOr<PointCloud> read = ReadPointCloud(path);
   ASSERT_TRUE(read.ok()) << "reading back " << extension << ": " << read.status();
-  if (std::string(extension) == ".drc") {
+  if (std::string(extension) == ".las") {
+    // Integers in steps of 1e-8 (internal/las.h); no normals or weights.
+    ASSERT_EQ(read->size(), cloud.size());
+    for (size_t i = 0; i < cloud.size(); ++i) {
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(read->positions[i][c], cloud.positions[i][c], 1e-8);
+    }
+    EXPECT_TRUE(read->normals.empty());
+    EXPECT_TRUE(read->weights.empty());
+  } else if (std::string(extension) == ".drc") {
     ExpectSameCloud(cloud, *read,
                     io_test::QuantizationTolerance(io_test::BoundingCubeRange(cloud.positions), 11),
                     0.01f, 1.5f / 65535 + 1e-5f, "Draco round trip");
@@ -85,7 +93,7 @@ TEST_P(CloudRoundTripTest, WriteThenReadGivesTheSameCloud) {
 
 INSTANTIATE_TEST_SUITE_P(AllWritableFormats, CloudRoundTripTest,
                          ::testing::Combine(::testing::Values(".ply", ".xyz", ".txt", ".pts",
-                                                              ".drc"),
+                                                              ".las", ".drc", ".glb", ".gltf"),
                                             ::testing::Bool(), ::testing::Bool()),
                          [](const auto& info) {
                            return std::string(std::get<0>(info.param) + 1) +
@@ -100,7 +108,7 @@ TEST(PointCloudIoTest, ExtensionHelpers) {
   for (const char* name : {"a.stl", "b.xyzw", "noextension"}) {
     EXPECT_FALSE(IsReadablePointCloudExtension(name)) << name << " should not be readable";
   }
-  for (const char* name : {"a.ply", "b.xyz", "c.txt", "d.pts", "g.DRC"}) {
+  for (const char* name : {"a.ply", "b.xyz", "c.txt", "d.pts", "g.DRC", "h.las", "i.glb"}) {
     EXPECT_TRUE(IsWritablePointCloudExtension(name)) << name << " should be writable";
   }
   for (const char* name : {"e.obj", "f.off", "a.stl"}) {
@@ -400,7 +408,8 @@ TEST(PointCloudIoTest, MissingFileUnsupportedExtensionAndEmptyFile) {
 
   const absl::Status obj = WritePointCloud(kThree, TempPath("cloud.obj"));
   EXPECT_EQ(obj.code(), absl::StatusCode::kInvalidArgument) << obj;
-  EXPECT_THAT(std::string(obj.message()), HasSubstr(".ply, .xyz, .txt, .pts, .drc, .glb, .gltf"))
+  EXPECT_THAT(std::string(obj.message()),
+              HasSubstr(".ply, .xyz, .txt, .pts, .las, .drc, .glb, .gltf"))
       << "the message should list the writable extensions";
 
   for (const char* name : {"empty.ply", "empty.xyz", "empty.obj", "empty.off", "empty.drc"}) {

@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "client/builtin_shapes.h"
 #include "client/file_util.h"
 #include "core/io/mesh_io.h"
@@ -163,17 +166,21 @@ absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string
 }
 
 std::string LeftOutNote(const PointsLeftOut& left_out) {
-  if (left_out.total() == 0) return "";
-  std::string note = "; left out ";
-  if (left_out.withheld > 0) {
-    absl::StrAppend(&note, left_out.withheld, " withheld point", left_out.withheld > 1 ? "s" : "");
-  }
-  if (left_out.noise > 0) {
-    absl::StrAppend(&note, left_out.withheld > 0 ? " and " : "", left_out.noise,
-                    left_out.withheld > 0 ? "" : (left_out.noise > 1 ? " points" : " point"),
-                    " classified as noise");
-  }
-  return note;
+  // "1 withheld point and 40 classified as noise": the first part names the points.
+  std::vector<std::string> parts;
+  const auto add = [&](size_t count, absl::string_view before, absl::string_view after) {
+    if (count == 0) return;
+    const char* points = !parts.empty() ? "" : count > 1 ? " points" : " point";
+    parts.push_back(absl::StrCat(count, before, points, after));
+  };
+  add(left_out.withheld, " withheld", "");
+  add(left_out.noise, "", " classified as noise");
+  add(left_out.invalid, "", " without a position (NaN)");
+  if (parts.empty()) return "";
+  const std::string last = parts.back();
+  parts.pop_back();
+  return absl::StrCat("; left out ", absl::StrJoin(parts, ", "), parts.empty() ? "" : " and ",
+                      last);
 }
 
 std::string OriginNote(const Origin& origin) {

@@ -14,12 +14,14 @@
 namespace neuralmesh {
 
 // Points of a file that its reader left out because the file marks them as not to be used
-// (LAS: the withheld flag, and the noise classes 7 and 18).
+// (LAS: the withheld flag, and the noise classes 7 and 18) or gives them no position (PCD:
+// NaN coordinates, the empty pixels of an organized cloud).
 struct PointsLeftOut {
   size_t withheld = 0;
   size_t noise = 0;
+  size_t invalid = 0;
 
-  size_t total() const { return withheld + noise; }
+  size_t total() const { return withheld + noise + invalid; }
 };
 
 struct PointCloud {

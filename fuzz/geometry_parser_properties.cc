@@ -67,15 +67,6 @@ bool SamePoints(const ParsedGeometry& a, const ParsedGeometry& b) {
          BitwiseEqual(a.weights, b.weights) && BitwiseEqual(a.colors, b.colors);
 }
 
-// Reading without faces gives the points read with them, and may add what only points carry
-// (glTF's NORMAL and weights are read for point clouds alone).
-bool SameOrMorePoints(const ParsedGeometry& with_faces, const ParsedGeometry& points) {
-  return PlacedPositions(with_faces) == PlacedPositions(points) &&
-         BitwiseEqual(with_faces.colors, points.colors) &&
-         (with_faces.normals.empty() || BitwiseEqual(with_faces.normals, points.normals)) &&
-         (with_faces.weights.empty() || BitwiseEqual(with_faces.weights, points.weights));
-}
-
 }  // namespace
 
 void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size_t size) {
@@ -94,7 +85,7 @@ void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size
       FUZZ_CHECK(points->faces.empty(), "%zu faces read while skipping faces",
                  points->faces.size());
       if (mesh.ok()) {
-        FUZZ_CHECK(SameOrMorePoints(*mesh, *points), "points differ with and without faces");
+        FUZZ_CHECK(SamePoints(*mesh, *points), "points differ with and without faces");
       }
     }
   }

@@ -4,8 +4,7 @@
 //  - what it returns is what geometry_data.h promises: finite positions, normals and weights
 //    empty or one per position, face indices in range;
 //  - a file that parses with its faces also parses without them, to the same points (point
-//    clouds are read with FaceHandling::kSkip, meshes with kRead), which may carry normals and
-//    weights that a mesh does not read (glTF);
+//    clouds are read with FaceHandling::kSkip, meshes with kRead);
 //  - the format's writer output parses back to the same positions, faces and (where the
 //    format holds them) normals and weights, bit for bit;
 //  - a parsed mesh can be reported on (`neuralmesh stats`), however broken its connectivity.

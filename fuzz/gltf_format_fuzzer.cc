@@ -16,9 +16,10 @@ absl::StatusOr<neuralmesh::io_internal::ParsedGeometry> Parse(
   return neuralmesh::io_internal::ParseGltf(data, faces);
 }
 
-// Plain glTF as the mesh writer gives it: positions, triangles and colours (normals and weights
-// are read for point clouds only, and a mesh has none). A file of no vertices is written as a
-// document without meshes, which WriteMesh never writes (it refuses empty meshes).
+// Plain glTF: positions, triangles, colours, normals (made unit length: those the parser gives
+// are, or are the file's own when no node turns them) and weights. A file of no vertices is
+// written as a document without meshes, which WriteMesh never writes (it refuses empty
+// meshes).
 std::string Format(const neuralmesh::io_internal::GeometryView& geometry) {
   if (geometry.positions.empty()) return R"({"asset":{"version":"2.0"}})";
   const absl::StatusOr<std::string> written =

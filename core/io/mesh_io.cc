@@ -21,9 +21,15 @@ namespace {
 using io_internal::CannotWrite;
 using io_internal::FileFormat;
 
+// Formats of points only (XYZ, LAS, PCD) and unknown extensions are not mesh formats.
+bool IsMeshFormat(FileFormat format) {
+  return format != FileFormat::kUnknown && format != FileFormat::kXyz &&
+         format != FileFormat::kLas && format != FileFormat::kPcd;
+}
+
 absl::StatusOr<FileFormat> MeshFormat(const std::string& path) {
   const FileFormat format = io_internal::FormatFromPath(path);
-  if (format == FileFormat::kUnknown || format == FileFormat::kXyz || format == FileFormat::kLas) {
+  if (!IsMeshFormat(format)) {
     const std::string extension = io_internal::LowercaseExtension(path);
     return absl::InvalidArgumentError(absl::StrCat(
         "'", path, "': ",
@@ -58,6 +64,7 @@ absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data
       break;
     case FileFormat::kXyz:
     case FileFormat::kLas:
+    case FileFormat::kPcd:
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
   }
@@ -104,10 +111,7 @@ absl::Status CheckWritable(const TriangleMesh& mesh, FileFormat format) {
 const char kMeshExtensions[] = ".ply, .obj, .off, .stl, .drc, .glb, .gltf";
 
 bool IsSupportedMeshExtension(std::string_view path) {
-  const FileFormat format =
-      io_internal::FormatFromPath(absl::string_view(path.data(), path.size()));
-  return format != FileFormat::kUnknown && format != FileFormat::kXyz &&
-         format != FileFormat::kLas;
+  return IsMeshFormat(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
 }
 
 absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path) {
@@ -160,6 +164,7 @@ absl::StatusOr<std::string> FormatMesh(const TriangleMesh& mesh, const std::stri
     }
     case FileFormat::kXyz:
     case FileFormat::kLas:
+    case FileFormat::kPcd:
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
   }

@@ -11,6 +11,7 @@
 #include "core/io/internal/las.h"
 #include "core/io/internal/obj.h"
 #include "core/io/internal/off.h"
+#include "core/io/internal/pcd.h"
 #include "core/io/internal/ply.h"
 #include "core/io/internal/xyz.h"
 #include "core/status_macros.h"
@@ -26,8 +27,8 @@ bool IsReadable(FileFormat format) {
 
 bool IsWritable(FileFormat format) {
   return format == FileFormat::kPly || format == FileFormat::kXyz ||
-         format == FileFormat::kLas || format == FileFormat::kDraco ||
-         format == FileFormat::kGltf;
+         format == FileFormat::kLas || format == FileFormat::kPcd ||
+         format == FileFormat::kDraco || format == FileFormat::kGltf;
 }
 
 absl::Status UnsupportedExtension(const std::string& path, const char* supported) {
@@ -52,6 +53,9 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
       break;
     case FileFormat::kLas:
       parsed = io_internal::ParseLas(data);
+      break;
+    case FileFormat::kPcd:
+      parsed = io_internal::ParsePcd(data);
       break;
     case FileFormat::kObj:
       parsed = io_internal::ParseObj(data, io_internal::FaceHandling::kSkip);
@@ -87,8 +91,9 @@ bool IsReadablePointCloudExtension(std::string_view path) {
 }
 
 const char kReadablePointCloudExtensions[] =
-    ".ply, .xyz, .txt, .pts, .las, .obj, .off, .drc, .glb, .gltf";
-const char kWritablePointCloudExtensions[] = ".ply, .xyz, .txt, .pts, .las, .drc, .glb, .gltf";
+    ".ply, .xyz, .txt, .pts, .las, .pcd, .obj, .off, .drc, .glb, .gltf";
+const char kWritablePointCloudExtensions[] =
+    ".ply, .xyz, .txt, .pts, .las, .pcd, .drc, .glb, .gltf";
 
 bool IsWritablePointCloudExtension(std::string_view path) {
   return IsWritable(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
@@ -127,6 +132,8 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
     data = io_internal::FormatPly(view);
   } else if (format == FileFormat::kXyz) {
     data = io_internal::FormatXyz(view);
+  } else if (format == FileFormat::kPcd) {
+    data = io_internal::FormatPcd(view);
   } else if (format == FileFormat::kLas) {
     absl::StatusOr<std::string> formatted = io_internal::FormatLas(view);
     if (!formatted.ok()) return io_internal::CannotWrite(path, formatted.status());

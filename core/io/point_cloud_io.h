@@ -14,11 +14,11 @@
 
 namespace neuralmesh {
 
-// The extensions ReadPointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .obj,
-// .off, .drc, .glb, .gltf".
+// The extensions ReadPointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .pcd,
+// .obj, .off, .drc, .glb, .gltf".
 extern const char kReadablePointCloudExtensions[];
-// The extensions WritePointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .drc,
-// .glb, .gltf".
+// The extensions WritePointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .pcd,
+// .drc, .glb, .gltf".
 extern const char kWritablePointCloudExtensions[];
 
 // True when ReadPointCloud handles the extension of `path` (kReadablePointCloudExtensions).
@@ -36,6 +36,9 @@ bool IsWritablePointCloudExtension(std::string_view path);
 //   .las  LAS 1.0-1.4 point records of formats 0-10, with colours where the format has them;
 //         withheld points and those classified as noise (classes 7 and 18) are left out, and
 //         counted in `left_out` when it is given.
+//   .pcd  PCL's Point Cloud Data (ascii, binary, binary_compressed): x y z, normal_x normal_y
+//         normal_z, rgb or rgba, confidence/weight/quality as weights; points without a
+//         position (NaN) left out and counted in `left_out`; see internal/pcd.h.
 //   .obj  the 'v' lines, 'v x y z r g b' with colours ('vn' is ignored: OBJ normals belong to
 //         face corners).
 //   .off  the vertices of OFF, COFF (with colours), NOFF (with normals), STOFF.
@@ -55,10 +58,12 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,
 // Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
 // nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"
 // text for .xyz/.txt/.pts (a header comment names the columns), LAS 1.2 of point format 0 or
-// 2 (with colours; no normals or weights: internal/las.h), .drc encoded with `draco`, or
+// 2 (with colours; no normals or weights: internal/las.h), binary PCD (x y z, normal_x
+// normal_y normal_z, rgb, confidence as present), .drc encoded with `draco`, or
 // glTF 2.0 POINTS (.glb, or .gltf with its buffer embedded) with COLOR_0, NORMAL (unit length)
 // and _WEIGHT attributes as present. The positions are written with cloud.origin put back
-// (PLY doubles, exact text, the LAS offset, a glTF node's translation, Draco metadata).
+// (PLY and PCD doubles, exact text, the LAS offset, a glTF node's translation, Draco
+// metadata).
 // Returns INVALID_ARGUMENT for an unsupported extension, an empty cloud, a cloud that fails
 // ValidatePointCloud, more points than LAS counts, or invalid `draco` options; otherwise the
 // status of the write ("cannot

@@ -10,6 +10,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
+#include "core/io/file_contents.h"
 #include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
 #include "gtest/gtest.h"
@@ -430,6 +431,28 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   EXPECT_EQ(read->colors, cloud.colors);
   EXPECT_TRUE(read->normals.empty());
 
+  const std::string pcd = *dir_ + "/points.pcd";
+  const RunResult to_pcd = RunNeuralmesh({"convert", glb, "-o", pcd});
+  ASSERT_EQ(to_pcd.exit_code, 0) << to_pcd.Describe();
+  EXPECT_EQ(to_pcd.out, pcd + ": 5000 points, with normals, weights, colours\n");
+  read = ReadPointCloud(pcd);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->positions, cloud.positions);
+  EXPECT_EQ(read->normals, cloud.normals);
+  EXPECT_EQ(read->weights, cloud.weights);
+  EXPECT_EQ(read->colors, cloud.colors);
+  // An organized cloud's empty pixels are left out, and counted.
+  const std::string organized = *dir_ + "/organized.pcd";
+  ASSERT_TRUE(WriteFileContents(organized,
+                                "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nHEIGHT 2\n"
+                                "DATA ascii\n0 0 0\nnan nan nan\n1 0 0\n0 1 0\n")
+                  .ok());
+  const RunResult from_organized =
+      RunNeuralmesh({"convert", organized, "-o", *dir_ + "/organized.xyz"});
+  ASSERT_EQ(from_organized.exit_code, 0) << from_organized.Describe();
+  EXPECT_EQ(from_organized.out, *dir_ + "/organized.xyz: 3 points; left out 1 point without a "
+                                        "position (NaN)\n");
+
   // Strays at 100 and 1,000 radii, which hide one at 2 radii from a first pass: two passes
   // remove the three; the sphere's points stay.
   PointCloud strayed = cloud;
@@ -464,7 +487,7 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   const Refused refused[] = {
       {{"convert", xyz, "-o", *dir_ + "/points.obj"},
        "holds points without faces: OUTPUT '" + *dir_ + "/points.obj' must be a point cloud "
-       "format (.ply, .xyz, .txt, .pts, .las, .drc, .glb, .gltf)"},
+       "format (.ply, .xyz, .txt, .pts, .las, .pcd, .drc, .glb, .gltf)"},
       {{"convert", "builtin:torus", "-o", *dir_ + "/torus.xyz"},
        "builtin:torus is a surface, not points"},
       {{"convert", xyz, "-o", glb, "--gltf_draco"}, "--gltf_draco compresses meshes"},

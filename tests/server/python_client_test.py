@@ -4,10 +4,10 @@
 Generates stubs with Debian's python3-grpc-tools into a temporary directory, then, against a
 running server: checks the health service and server reflection, creates a session, uploads a
 sphere in batches (client streaming), watches it (server streaming), finishes it, fetches the
-final mesh, checks that a NaN batch is rejected with INVALID_ARGUMENT, and runs one
-Reconstruct call (bidirectional). With --root_cert and --token it does all of it over TLS
-with the access token, after checking that calls without the token are UNAUTHENTICATED while
-the health service stays open. Exits 0 on success.
+final mesh, checks that a NaN batch is rejected with INVALID_ARGUMENT, runs one Reconstruct
+call (bidirectional) and hands a session to another client. With --root_cert and --token it
+does all of it over TLS with the access token, after checking that calls without the token
+are UNAUTHENTICATED while the health service stays open. Exits 0 on success.
 
 Usage: python_client_test.py --target=127.0.0.1:PORT --proto_root=proto
            [--root_cert=ca.pem --token=TOKEN]
@@ -268,6 +268,18 @@ def main():
 
     listed = service.ListSessions(pb.ListSessionsRequest(), timeout=10)
     check(len(listed.sessions) == 2, "ListSessions returned %d sessions" % len(listed.sessions))
+    # Handing a session to another client: the answer and later reads name the new owner.
+    handed = service.TransferSession(pb.TransferSessionRequest(session_id=sid, new_owner="bob"),
+                                     timeout=10)
+    check(handed.owner == "bob", "TransferSession answered owner %r" % handed.owner)
+    check(service.GetSession(pb.GetSessionRequest(session_id=sid), timeout=10).owner == "bob",
+          "GetSession does not name the new owner")
+    try:
+        service.TransferSession(pb.TransferSessionRequest(session_id=sid), timeout=10)
+        check(False, "a transfer to nobody was accepted")
+    except grpc.RpcError as e:
+        check(e.code() == grpc.StatusCode.INVALID_ARGUMENT and "new_owner is empty" in e.details(),
+              "a transfer to nobody gave %s: %s" % (e.code(), e.details()))
     service.DeleteSession(pb.DeleteSessionRequest(session_id=sid), timeout=10)
     try:
         service.GetSession(pb.GetSessionRequest(session_id=sid), timeout=10)

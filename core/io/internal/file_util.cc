@@ -23,6 +23,7 @@ FileFormat FormatFromPath(absl::string_view path) {
   if (extension == ".glb" || extension == ".gltf") return FileFormat::kGltf;
   if (extension == ".xyz" || extension == ".txt" || extension == ".pts") return FileFormat::kXyz;
   if (extension == ".las") return FileFormat::kLas;
+  if (extension == ".pcd") return FileFormat::kPcd;
   return FileFormat::kUnknown;
 }
 

@@ -197,10 +197,21 @@ Matrix NormalMatrix(const Matrix& m) {
   return n;
 }
 
-// `normal` turned by `normal_matrix` and made unit length (a zero normal stays zero); as it is
-// under the identity.
+// `normal` as glTF wants NORMAL, unit length: as it is when it nearly is, so that unit normals
+// come back bitwise; a zero normal stays zero.
+Vec3f UnitNormal(const Vec3f& normal) {
+  const double squared = static_cast<double>(normal[0]) * normal[0] +
+                         static_cast<double>(normal[1]) * normal[1] +
+                         static_cast<double>(normal[2]) * normal[2];
+  if (std::abs(squared - 1) < 1e-6 || !(squared > 0)) return normal;
+  const double length = std::sqrt(squared);
+  return Vec3f(static_cast<float>(normal[0] / length), static_cast<float>(normal[1] / length),
+               static_cast<float>(normal[2] / length));
+}
+
+// `normal` turned by `normal_matrix` and made unit length (UnitNormal; a zero normal stays zero).
 Vec3f Transformed(const Matrix& normal_matrix, const Vec3f& normal) {
-  if (normal_matrix == kIdentity) return normal;
+  if (normal_matrix == kIdentity) return UnitNormal(normal);
   double turned[3];
   double length = 0;
   for (int row = 0; row < 3; ++row) {
@@ -531,10 +542,8 @@ class GltfReader {
     } else {
       NM_RETURN_IF_ERROR(ReadPrimitive(*attributes, primitive, where, &positions, &colors, &indices,
                                        &has_indices));
-      if (faces_ == FaceHandling::kSkip) {
-        NM_RETURN_IF_ERROR(ReadPointAttributes(*attributes, where, positions.size(), &normals,
-                                               &weights));
-      }
+      NM_RETURN_IF_ERROR(
+          ReadPointAttributes(*attributes, where, positions.size(), &normals, &weights));
     }
     if (placed_.size() + positions.size() > kMaxVertices) {
       return Invalid("the scene draws more than ", kMaxVertices, " vertices");
@@ -654,8 +663,9 @@ class GltfReader {
   }
 
   // A primitive's NORMAL and weights (_WEIGHT, or the first of _CONFIDENCE, _QUALITY,
-  // _INTENSITY and _SCALAR, as the PLY reader names them), for point clouds: `count` of each,
-  // or none when the primitive has none.
+  // _INTENSITY and _SCALAR, as the PLY reader names them): `count` of each, or none when the
+  // primitive has none. An application-specific attribute of such a name that is not a
+  // SCALAR belongs to another application and is passed over.
   absl::Status ReadPointAttributes(const JsonValue& attributes, const std::string& where,
                                    size_t count, std::vector<Vec3f>* normals,
                                    std::vector<float>* weights) {
@@ -680,6 +690,9 @@ class GltfReader {
       if (attributes.Find(name) == nullptr) continue;
       NM_ASSIGN_OR_RETURN(const uint64_t accessor,
                           IntegerMember(attributes, name, std::nullopt, where));
+      NM_ASSIGN_OR_RETURN(const JsonValue* described, Element("accessors", accessor));
+      const JsonValue* type = described->Find("type");
+      if (type == nullptr || !type->is_string() || type->text != "SCALAR") continue;
       NM_ASSIGN_OR_RETURN(
           const AccessorData weight,
           ReadAccessor(accessor, name, {1},
@@ -760,8 +773,8 @@ class GltfReader {
     }
     out_.faces = std::move(faces);
     if (colored_) out_.colors = std::move(colors);
-    if (with_normals_ && faces_ == FaceHandling::kSkip) out_.normals = std::move(normals);
-    if (weighted_ && faces_ == FaceHandling::kSkip) out_.weights = std::move(weights);
+    if (with_normals_) out_.normals = std::move(normals);
+    if (weighted_) out_.weights = std::move(weights);
   }
 
   JsonValue doc_;
@@ -778,8 +791,8 @@ class GltfReader {
   std::vector<Vec3f> normals_;  // Turned by the nodes, unit length.
   std::vector<float> weights_;
   bool colored_ = true;       // Every primitive so far has COLOR_0,
-  bool with_normals_ = true;  // NORMAL (read for point clouds only),
-  bool weighted_ = true;      // and weights (likewise).
+  bool with_normals_ = true;  // NORMAL,
+  bool weighted_ = true;      // and weights.
 };
 
 // Splits a .glb into its JSON text and its BIN chunk (when it has one).
@@ -831,17 +844,6 @@ struct VertexAttribute {
   size_t stride;  // 0: tightly packed.
 };
 
-// `normal` as glTF wants NORMAL, unit length: as it is when it nearly is, so that unit normals
-// come back bitwise; a zero normal stays zero.
-Vec3f UnitNormal(const Vec3f& normal) {
-  const double squared = static_cast<double>(normal[0]) * normal[0] +
-                         static_cast<double>(normal[1]) * normal[1] +
-                         static_cast<double>(normal[2]) * normal[2];
-  if (std::abs(squared - 1) < 1e-6 || !(squared > 0)) return normal;
-  const double length = std::sqrt(squared);
-  return Vec3f(static_cast<float>(normal[0] / length), static_cast<float>(normal[1] / length),
-               static_cast<float>(normal[2] / length));
-}
 
 }  // namespace
 

@@ -25,12 +25,11 @@ GltfBufferLoader GltfBuffersBeside(const std::string& path);
 // primitive the default scene draws (or, without scenes, of every mesh once), placed by their
 // nodes' transforms, with the triangles of TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN
 // primitives (winding reversed under a mirroring transform) and the COLOR_0 colours (linear
-// light, converted to sRGB) when every primitive has them; with FaceHandling::kSkip also the
-// NORMAL vectors (turned by the nodes) and the weights (_WEIGHT, or the first of _CONFIDENCE,
-// _QUALITY, _INTENSITY, _SCALAR) when every primitive has them (not those of
-// Draco-compressed primitives). Vertices at identical positions
-// are merged, since glTF splits vertices where normals or texture coordinates differ; faces
-// that repeat a vertex are dropped. Where the nodes place vertices far from zero (a
+// light, converted to sRGB), the NORMAL vectors (turned by the nodes, unit length) and the
+// weights (a SCALAR _WEIGHT, or the first of _CONFIDENCE, _QUALITY, _INTENSITY, _SCALAR), each
+// when every primitive has them (not those of Draco-compressed primitives; ReadMesh keeps
+// neither). Vertices at identical positions are merged, since glTF splits vertices where
+// normals or texture coordinates differ; faces that repeat a vertex are dropped. Where the nodes place vertices far from zero (a
 // georeferenced model), positions are relative to an origin (position_collector.h), and
 // merged after that. Buffers come from the .glb's BIN chunk, base64 data URIs,
 // or `load_buffer` (none: external buffers are refused).

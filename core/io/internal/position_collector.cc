@@ -13,6 +13,11 @@ namespace {
 // error at most).
 constexpr double kFloatExactSteps = 1 << 22;
 
+// Beyond this distance from zero (1.1e12; a double's step there is 2.4e-4) no data are
+// georeferenced: an origin would not keep a resolution that the doubles themselves lost, and
+// the origin plus a float could not be held exactly.
+constexpr double kFarthestOrigin = 1099511627776.0;  // 2^40
+
 // The resolution assumed for a file that states none: 1/65,536 of the bounding box's longest
 // side, finer than a reconstruction resolves by far (a mesh of 100,000 vertices has edges of
 // about 1/300 of it). Origins are then taken for points farther from 0 than 64 such sides.
@@ -24,7 +29,9 @@ Point3d OriginKeepingResolution(const Point3d& low, const Point3d& high, const P
   Point3d origin = {0, 0, 0};
   for (int c = 0; c < 3; ++c) {
     const double far = std::max(std::fabs(low[c]), std::fabs(high[c]));
-    if (!(step[c] > 0) || !(far > kFloatExactSteps * step[c])) continue;
+    if (!(step[c] > 0) || !(far > kFloatExactSteps * step[c]) || !(far <= kFarthestOrigin)) {
+      continue;
+    }
     const double candidate = std::floor(low[c] / 1000) * 1000;
     if (std::max(std::fabs(low[c] - candidate), std::fabs(high[c] - candidate)) < far) {
       origin[c] = candidate;

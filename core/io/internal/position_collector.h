@@ -20,7 +20,8 @@ using Point3d = std::array<double, 3>;
 // finest difference the data resolve, e.g. a LAS file's scale): zero while a float's step at
 // the farthest coordinate is at most half of `step`, otherwise the points' minimum `low`
 // rounded down to a multiple of 1,000, when that brings them nearer to 0. `low` and `high` are
-// the points' bounds; a zero `step` never moves the axis.
+// the points' bounds; a zero `step` never moves the axis, nor do coordinates beyond 2^40
+// (1.1e12, where a double keeps no more than a float relative to such an origin).
 Point3d OriginKeepingResolution(const Point3d& low, const Point3d& high, const Point3d& step);
 
 class PositionCollector {

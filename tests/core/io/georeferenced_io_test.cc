@@ -80,6 +80,11 @@ TEST(GeoreferencedIoTest, AnOriginIsTakenOnlyWhereAFloatWouldLoseTheResolution) 
   EXPECT_EQ(OriginKeepingResolution({7e6, 7e6, 7e6}, {7e6 + 0.5, 7e6 + 0.5, 7e6 + 0.5},
                                     {1e-4, 1e-4, 1e-4}),
             (Point3d{7e6, 7e6, 7e6}));
+  // Beyond 2^40 no coordinate is georeferenced (a 64-bit integer field of a PCD file can hold
+  // 1e18): doubles there keep no more than floats would, relative to any origin.
+  EXPECT_EQ(OriginKeepingResolution({1e12, 1e12, 2e12}, {1e12 + 1, 1e12 + 1, 2e12 + 1},
+                                    {1e-4, 1e-4, 1e-4}),
+            (Point3d{1e12, 1e12, 0}));
 }
 
 TEST(GeoreferencedIoTest, TextPointCloudsAreReadRelativeToAnOriginWithTheirMillimetres) {

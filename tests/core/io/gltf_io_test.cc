@@ -403,7 +403,21 @@ TEST(GltfIoTest, ReadsNormalsTurnedByTheirNodesAndWeightsByOtherNames) {
   EXPECT_EQ(short_normals.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(short_normals.status().message()),
               HasSubstr("meshes[0].primitives[0]: NORMAL has 1 elements for 2 positions"));
-  EXPECT_TRUE(ReadMesh(path).ok()) << "a mesh does not read normals";
+  EXPECT_EQ(ReadMesh(path).status().code(), absl::StatusCode::kInvalidArgument)
+      << "the file is malformed, whatever is read from it";
+
+  // Another application's "_CONFIDENCE" of three values is not a weight: passed over.
+  std::string vec3 = json("2", "");
+  const std::string scalar = R"("componentType":5121,"normalized":true,"count":2,"type":"SCALAR")";
+  ASSERT_NE(vec3.find(scalar), std::string::npos);
+  vec3.replace(vec3.find(scalar), scalar.size(), R"("componentType":5126,"count":2,"type":"VEC3")");
+  vec3 = absl::StrReplaceAll(vec3, {{R"("byteOffset":48,"byteLength":2)",
+                                     R"("byteOffset":24,"byteLength":24)"}});
+  WriteBytes(path, Glb(vec3, bin));
+  const absl::StatusOr<PointCloud> foreign = ReadPointCloud(path);
+  ASSERT_TRUE(foreign.ok()) << foreign.status();
+  EXPECT_TRUE(foreign->weights.empty());
+  EXPECT_EQ(foreign->normals.size(), 2u);
 }
 
 TEST(GltfIoTest, RefusesMalformedFilesAndSaysWhatIsWrong) {

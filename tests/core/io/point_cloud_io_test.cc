@@ -93,7 +93,8 @@ TEST_P(CloudRoundTripTest, WriteThenReadGivesTheSameCloud) {
 
 INSTANTIATE_TEST_SUITE_P(AllWritableFormats, CloudRoundTripTest,
                          ::testing::Combine(::testing::Values(".ply", ".xyz", ".txt", ".pts",
-                                                              ".las", ".drc", ".glb", ".gltf"),
+                                                              ".las", ".pcd", ".drc", ".glb",
+                                                              ".gltf"),
                                             ::testing::Bool(), ::testing::Bool()),
                          [](const auto& info) {
                            return std::string(std::get<0>(info.param) + 1) +
@@ -108,7 +109,8 @@ TEST(PointCloudIoTest, ExtensionHelpers) {
   for (const char* name : {"a.stl", "b.xyzw", "noextension"}) {
     EXPECT_FALSE(IsReadablePointCloudExtension(name)) << name << " should not be readable";
   }
-  for (const char* name : {"a.ply", "b.xyz", "c.txt", "d.pts", "g.DRC", "h.las", "i.glb"}) {
+  for (const char* name :
+       {"a.ply", "b.xyz", "c.txt", "d.pts", "g.DRC", "h.las", "i.glb", "j.PCD"}) {
     EXPECT_TRUE(IsWritablePointCloudExtension(name)) << name << " should be writable";
   }
   for (const char* name : {"e.obj", "f.off", "a.stl"}) {
@@ -403,13 +405,13 @@ TEST(PointCloudIoTest, MissingFileUnsupportedExtensionAndEmptyFile) {
   const absl::StatusOr<PointCloud> stl = ReadPointCloud(TempPath("part.stl"));
   EXPECT_EQ(stl.status().code(), absl::StatusCode::kInvalidArgument) << stl.status();
   EXPECT_THAT(std::string(stl.status().message()),
-              HasSubstr(".ply, .xyz, .txt, .pts, .las, .obj, .off, .drc, .glb, .gltf"))
+              HasSubstr(".ply, .xyz, .txt, .pts, .las, .pcd, .obj, .off, .drc, .glb, .gltf"))
       << "the message should list the readable extensions";
 
   const absl::Status obj = WritePointCloud(kThree, TempPath("cloud.obj"));
   EXPECT_EQ(obj.code(), absl::StatusCode::kInvalidArgument) << obj;
   EXPECT_THAT(std::string(obj.message()),
-              HasSubstr(".ply, .xyz, .txt, .pts, .las, .drc, .glb, .gltf"))
+              HasSubstr(".ply, .xyz, .txt, .pts, .las, .pcd, .drc, .glb, .gltf"))
       << "the message should list the writable extensions";
 
   for (const char* name : {"empty.ply", "empty.xyz", "empty.obj", "empty.off", "empty.drc"}) {

@@ -1,0 +1,509 @@
+#include "core/io/internal/pcd.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "core/io/internal/binary.h"
+#include "core/io/internal/position_collector.h"
+#include "core/io/internal/text.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh::io_internal {
+namespace {
+
+// Bounds that keep a malformed header from asking for absurd work or memory: fields of a
+// point, values of one field, bytes of a point record.
+constexpr size_t kMaxFields = 1024;
+constexpr uint64_t kMaxCount = 1 << 20;
+constexpr uint64_t kMaxRecordBytes = 1 << 24;
+// LZF turns 3 bytes into at most 264: data claiming more per compressed byte are not LZF.
+constexpr uint64_t kMaxLzfExpansion = 100;
+
+template <typename... Args>
+absl::Status Invalid(const Args&... args) {
+  return absl::InvalidArgumentError(absl::StrCat("PCD: ", args...));
+}
+
+enum class DataKind { kAscii, kBinary, kCompressed };
+
+// One field of the point record: `count` values of `size` bytes of `type` (F float, I signed,
+// U unsigned integer), at byte `offset` of a binary record.
+struct Field {
+  std::string name;
+  int size = 4;
+  char type = 'F';
+  uint64_t count = 1;
+  uint64_t offset = 0;
+
+  uint64_t bytes() const { return size * count; }
+};
+
+struct PcdHeader {
+  std::vector<Field> fields;
+  uint64_t points = 0;
+  uint64_t record_bytes = 0;
+  DataKind kind = DataKind::kAscii;
+  size_t data_offset = 0;  // Where the points begin.
+};
+
+// The index of the field `name`, or -1.
+int FieldIndex(const PcdHeader& header, absl::string_view name) {
+  for (size_t i = 0; i < header.fields.size(); ++i) {
+    if (header.fields[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+absl::StatusOr<uint64_t> Count(absl::string_view token, int line, absl::string_view what) {
+  int64_t value = 0;
+  if (!ParseInt64(token, &value) || value < 0) {
+    return LineError(line,
+                     absl::StrCat(what, " must be a non-negative integer, not ", Quoted(token)));
+  }
+  return static_cast<uint64_t>(value);
+}
+
+absl::StatusOr<PcdHeader> ParseHeader(absl::string_view data) {
+  PcdHeader header;
+  LineCursor cursor(data);
+  absl::string_view line;
+  std::vector<absl::string_view> tokens;
+  std::vector<std::string> names;
+  std::vector<uint64_t> sizes, counts;
+  std::vector<char> types;
+  std::optional<uint64_t> width, height, points;
+  bool has_data = false;
+  while (!has_data && cursor.Next(&line)) {
+    SplitWhitespace(StripHashComment(line), &tokens);
+    if (tokens.empty()) continue;
+    const int at = cursor.line_number();
+    const absl::string_view key = tokens[0];
+    const size_t values = tokens.size() - 1;
+    if (key == "FIELDS" || key == "COLUMNS") {
+      if (values == 0 || values > kMaxFields) {
+        return LineError(at,
+                         absl::StrCat("FIELDS names 1 to ", kMaxFields, " fields, not ", values));
+      }
+      names.clear();
+      for (size_t i = 1; i < tokens.size(); ++i) names.emplace_back(tokens[i]);
+    } else if (key == "SIZE" || key == "COUNT") {
+      std::vector<uint64_t>& list = key == "SIZE" ? sizes : counts;
+      list.clear();
+      for (size_t i = 1; i < tokens.size(); ++i) {
+        NM_ASSIGN_OR_RETURN(const uint64_t value, Count(tokens[i], at, key));
+        list.push_back(value);
+      }
+    } else if (key == "TYPE") {
+      types.clear();
+      for (size_t i = 1; i < tokens.size(); ++i) {
+        if (tokens[i] != "F" && tokens[i] != "I" && tokens[i] != "U") {
+          return LineError(at, absl::StrCat("TYPE ", Quoted(tokens[i]), " is not F, I or U"));
+        }
+        types.push_back(tokens[i][0]);
+      }
+    } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
+      if (values != 1) return LineError(at, absl::StrCat(key, " takes one number"));
+      NM_ASSIGN_OR_RETURN(const uint64_t value, Count(tokens[1], at, key));
+      (key == "WIDTH" ? width : key == "HEIGHT" ? height : points) = value;
+    } else if (key == "DATA") {
+      if (values != 1)
+        return LineError(at, "DATA takes one word: ascii, binary or binary_compressed");
+      if (tokens[1] == "ascii") {
+        header.kind = DataKind::kAscii;
+      } else if (tokens[1] == "binary") {
+        header.kind = DataKind::kBinary;
+      } else if (tokens[1] == "binary_compressed") {
+        header.kind = DataKind::kCompressed;
+      } else {
+        return LineError(at, absl::StrCat("DATA ", Quoted(tokens[1]),
+                                          " is not ascii, binary or binary_compressed"));
+      }
+      has_data = true;
+      header.data_offset = cursor.offset();
+    }
+    // VERSION, VIEWPOINT (the sensor's pose, which does not move the points) and keys of
+    // later versions say nothing this reader needs.
+  }
+  if (!has_data) {
+    return Invalid(names.empty() ? "no FIELDS line: not a PCD file"
+                                 : "the header has no DATA line");
+  }
+  const size_t n = names.size();
+  if (n == 0) return Invalid("the header has no FIELDS line");
+  if (counts.empty()) counts.assign(n, 1);  // COUNT is optional (before version 0.7, absent).
+  if (sizes.size() != n || types.size() != n || counts.size() != n) {
+    return Invalid("FIELDS names ", n, " fields but SIZE gives ", sizes.size(), ", TYPE ",
+                   types.size(), " and COUNT ", counts.size());
+  }
+  for (size_t i = 0; i < n; ++i) {
+    Field field;
+    field.name = names[i];
+    field.type = types[i];
+    if (sizes[i] != 1 && sizes[i] != 2 && sizes[i] != 4 && sizes[i] != 8) {
+      return Invalid("field ", field.name, " has SIZE ", sizes[i], "; sizes are 1, 2, 4 or 8");
+    }
+    field.size = static_cast<int>(sizes[i]);
+    if (field.type == 'F' && field.size < 4) {
+      return Invalid("field ", field.name, " is a float of ", field.size, " bytes");
+    }
+    if (counts[i] == 0 || counts[i] > kMaxCount) {
+      return Invalid("field ", field.name, " has COUNT ", counts[i], "; 1 to ", kMaxCount);
+    }
+    field.count = counts[i];
+    field.offset = header.record_bytes;
+    header.record_bytes += field.bytes();
+    if (header.record_bytes > kMaxRecordBytes) {
+      return Invalid("a point takes more than ", kMaxRecordBytes, " bytes");
+    }
+    header.fields.push_back(std::move(field));
+  }
+  for (const char* axis : {"x", "y", "z"}) {
+    const int i = FieldIndex(header, axis);
+    if (i < 0) return Invalid("no field ", axis, " (FIELDS ", absl::StrJoin(names, " "), ")");
+    if (header.fields[i].count != 1) return Invalid("field ", axis, " has COUNT above 1");
+  }
+  if (!width.has_value() && !points.has_value()) return Invalid("the header has no WIDTH");
+  const uint64_t h = height.value_or(1);
+  if (width.has_value() && h != 0 && *width > UINT64_MAX / h) {
+    return Invalid("WIDTH ", *width, " x HEIGHT ", h, " is too large");
+  }
+  header.points = width.has_value() ? *width * h : *points;
+  if (points.has_value() && *points != header.points) {
+    return Invalid("POINTS ", *points, " is not WIDTH ", *width, " x HEIGHT ", h);
+  }
+  return header;
+}
+
+// LZF (liblzf's format, as PCL writes it): `in` decompressed into exactly `out->size()` bytes.
+absl::Status LzfDecompress(absl::string_view in, std::string* out) {
+  size_t ip = 0, op = 0;
+  const size_t out_size = out->size();
+  const auto corrupt = [&](absl::string_view what) {
+    return Invalid("the compressed points are corrupt at byte ", ip, " of ", in.size(), ": ", what);
+  };
+  while (ip < in.size()) {
+    const unsigned ctrl = static_cast<uint8_t>(in[ip++]);
+    if (ctrl < 32) {  // A literal run of ctrl + 1 bytes.
+      const size_t length = ctrl + 1;
+      if (length > in.size() - ip) return corrupt("a literal run reaches past the end");
+      if (length > out_size - op) return corrupt("more bytes than the header states");
+      std::memcpy(out->data() + op, in.data() + ip, length);
+      ip += length;
+      op += length;
+      continue;
+    }
+    size_t length = ctrl >> 5;  // A back reference of length + 2 bytes.
+    if (ip >= in.size()) return corrupt("a back reference is cut off");
+    if (length == 7) {
+      length += static_cast<uint8_t>(in[ip++]);
+      if (ip >= in.size()) return corrupt("a back reference is cut off");
+    }
+    const size_t distance = ((ctrl & 0x1F) << 8) + static_cast<uint8_t>(in[ip++]) + 1;
+    length += 2;
+    if (distance > op) return corrupt("a back reference points before the start");
+    if (length > out_size - op) return corrupt("more bytes than the header states");
+    for (size_t k = 0; k < length; ++k, ++op) (*out)[op] = (*out)[op - distance];
+  }
+  if (op != out_size) {
+    return Invalid("the compressed points give ", op, " bytes; the header states ", out_size);
+  }
+  return absl::OkStatus();
+}
+
+// A value of `field` stored at `p`, little-endian.
+double ValueAt(const char* p, const Field& field) {
+  switch (field.type) {
+    case 'F':
+      return field.size == 4 ? double{LoadScalar<float>(p, false)} : LoadScalar<double>(p, false);
+    case 'I':
+      switch (field.size) {
+        case 1:
+          return LoadScalar<int8_t>(p, false);
+        case 2:
+          return LoadScalar<int16_t>(p, false);
+        case 4:
+          return LoadScalar<int32_t>(p, false);
+        default:
+          return static_cast<double>(LoadScalar<int64_t>(p, false));
+      }
+    default:
+      switch (field.size) {
+        case 1:
+          return LoadScalar<uint8_t>(p, false);
+        case 2:
+          return LoadScalar<uint16_t>(p, false);
+        case 4:
+          return LoadScalar<uint32_t>(p, false);
+        default:
+          return static_cast<double>(LoadScalar<uint64_t>(p, false));
+      }
+  }
+}
+
+// PCL's packed colour: 0x00RRGGBB (or 0xAARRGGBB), in a float's bits or an unsigned integer.
+uint32_t PackedColorAt(const char* p, const Field& field) {
+  return field.size >= 4 ? LoadScalar<uint32_t>(p, false) : 0;
+}
+
+// The packed colour an ASCII value gives: the integer PCL writes since 1.9, or the bits of the
+// float that older files hold (a colour's bits make a tiny, non-integer float).
+uint32_t PackedColorOfText(double value) {
+  if (value >= 0 && value < 4294967296.0 && value == std::floor(value)) {
+    return static_cast<uint32_t>(value);
+  }
+  const float f = static_cast<float>(value);
+  uint32_t bits;
+  std::memcpy(&bits, &f, sizeof bits);
+  return bits;
+}
+
+Rgb Unpacked(uint32_t packed) {
+  return {static_cast<uint8_t>(packed >> 16), static_cast<uint8_t>(packed >> 8),
+          static_cast<uint8_t>(packed)};
+}
+
+// Which fields become what.
+struct Roles {
+  std::array<int, 3> position = {-1, -1, -1};
+  std::array<int, 3> normal = {-1, -1, -1};
+  int color = -1;
+  int weight = -1;
+};
+
+Roles RolesOf(const PcdHeader& header) {
+  Roles roles;
+  const char* const axes[3] = {"x", "y", "z"};
+  const char* const normals[3] = {"normal_x", "normal_y", "normal_z"};
+  for (int c = 0; c < 3; ++c) {
+    roles.position[c] = FieldIndex(header, axes[c]);
+    roles.normal[c] = FieldIndex(header, normals[c]);
+  }
+  for (int c = 0; c < 3; ++c) {
+    if (roles.normal[c] < 0 || header.fields[roles.normal[c]].count != 1) {
+      roles.normal = {-1, -1, -1};
+      break;
+    }
+  }
+  for (const char* name : {"rgb", "rgba"}) {
+    const int i = FieldIndex(header, name);
+    if (i >= 0 && header.fields[i].size == 4 && header.fields[i].count == 1) {
+      roles.color = i;
+      break;
+    }
+  }
+  for (const char* name : {"confidence", "weight", "quality"}) {
+    const int i = FieldIndex(header, name);
+    if (i >= 0 && header.fields[i].count == 1) {
+      roles.weight = i;
+      break;
+    }
+  }
+  return roles;
+}
+
+// The points as they are read, before their origin is chosen.
+class PointSink {
+ public:
+  PointSink(const Roles& roles, ParsedGeometry* out) : roles_(roles), out_(out) {}
+
+  // A point, from its fields' first values (`value(i)`) and its packed colour; left out
+  // without a finite position.
+  template <typename ValueOf>
+  void Add(const ValueOf& value, uint32_t packed_color) {
+    Point3d p;
+    for (int c = 0; c < 3; ++c) p[c] = value(roles_.position[c]);
+    for (int c = 0; c < 3; ++c) {
+      if (!(std::fabs(p[c]) <= std::numeric_limits<float>::max())) {
+        ++out_->left_out.invalid;
+        return;
+      }
+    }
+    positions_.Add(p);
+    if (roles_.normal[0] >= 0) {
+      out_->normals.emplace_back(NarrowToFloat(value(roles_.normal[0])),
+                                 NarrowToFloat(value(roles_.normal[1])),
+                                 NarrowToFloat(value(roles_.normal[2])));
+    }
+    if (roles_.weight >= 0) out_->weights.push_back(NarrowToFloat(value(roles_.weight)));
+    if (roles_.color >= 0) out_->colors.push_back(Unpacked(packed_color));
+  }
+
+  void Reserve(size_t points) {
+    positions_.Reserve(points);
+    if (roles_.normal[0] >= 0) out_->normals.reserve(points);
+    if (roles_.weight >= 0) out_->weights.reserve(points);
+    if (roles_.color >= 0) out_->colors.reserve(points);
+  }
+
+  absl::Status Finish() {
+    if (positions_.size() == 0 && out_->left_out.invalid > 0) {
+      return Invalid("all ", out_->left_out.invalid,
+                     " points lack a position (NaN or infinite x, y or z)");
+    }
+    positions_.MoveTo(out_);
+    return absl::OkStatus();
+  }
+
+ private:
+  const Roles roles_;
+  ParsedGeometry* const out_;
+  PositionCollector positions_;
+};
+
+absl::Status ReadAscii(absl::string_view body, const PcdHeader& header, const Roles& roles,
+                       int first_line, PointSink* sink) {
+  uint64_t values = 0;
+  std::vector<uint64_t> first_value;  // Of each field, in a line's values.
+  for (const Field& field : header.fields) {
+    first_value.push_back(values);
+    values += field.count;
+  }
+  LineCursor cursor(body);
+  absl::string_view line;
+  std::vector<absl::string_view> tokens;
+  std::vector<double> parsed(header.fields.size());
+  sink->Reserve(std::min<uint64_t>(header.points, body.size() / 2 + 1));
+  uint64_t read = 0;
+  while (read < header.points && cursor.Next(&line)) {
+    SplitWhitespace(line, &tokens);
+    if (tokens.empty()) continue;
+    const int at = first_line + cursor.line_number();
+    if (tokens.size() != values) {
+      return LineError(at, absl::StrCat("point ", read, " has ", tokens.size(),
+                                        " values; the fields take ", values));
+    }
+    for (size_t f = 0; f < header.fields.size(); ++f) {
+      const absl::string_view token = tokens[first_value[f]];
+      if (!ParseDouble(token, &parsed[f])) {
+        return LineError(at, absl::StrCat(header.fields[f].name, " of point ", read, " is ",
+                                          Quoted(token), ", not a number"));
+      }
+    }
+    const uint32_t packed = roles.color >= 0 ? PackedColorOfText(parsed[roles.color]) : 0;
+    sink->Add([&](int f) { return parsed[f]; }, packed);
+    ++read;
+  }
+  if (read < header.points) {
+    return Invalid("the data end after ", read, " of ", header.points, " points");
+  }
+  return absl::OkStatus();
+}
+
+// Binary points: `record(i)` gives where point i's field `f` begins.
+template <typename Locate>
+void ReadBinary(const PcdHeader& header, const Roles& roles, const Locate& locate,
+                PointSink* sink) {
+  sink->Reserve(header.points);
+  for (uint64_t i = 0; i < header.points; ++i) {
+    const uint32_t packed =
+        roles.color >= 0 ? PackedColorAt(locate(i, roles.color), header.fields[roles.color]) : 0;
+    sink->Add([&](int f) { return ValueAt(locate(i, f), header.fields[f]); }, packed);
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data) {
+  NM_ASSIGN_OR_RETURN(const PcdHeader header, ParseHeader(data));
+  const Roles roles = RolesOf(header);
+  ParsedGeometry out;
+  PointSink sink(roles, &out);
+  const absl::string_view body = data.substr(header.data_offset);
+  if (header.kind == DataKind::kAscii) {
+    const int header_lines =
+        static_cast<int>(std::count(data.begin(), data.begin() + header.data_offset, '\n'));
+    NM_RETURN_IF_ERROR(ReadAscii(body, header, roles, header_lines, &sink));
+  } else if (header.kind == DataKind::kBinary) {
+    if (header.points > body.size() / header.record_bytes) {
+      return Invalid(header.points, " points of ", header.record_bytes, " bytes do not fit in the ",
+                     body.size(), " bytes after the header");
+    }
+    ReadBinary(
+        header, roles,
+        [&](uint64_t i, int f) {
+          return body.data() + i * header.record_bytes + header.fields[f].offset;
+        },
+        &sink);
+  } else {
+    if (body.size() < 8) return Invalid("the compressed points lack their sizes");
+    const uint64_t compressed = LoadScalar<uint32_t>(body.data(), false);
+    const uint64_t size = LoadScalar<uint32_t>(body.data() + 4, false);
+    if (compressed > body.size() - 8) {
+      return Invalid(compressed, " compressed bytes do not fit in the ", body.size() - 8,
+                     " after the header");
+    }
+    if (size != header.points * header.record_bytes) {
+      return Invalid("the compressed points decompress to ", size, " bytes, not ", header.points,
+                     " points of ", header.record_bytes);
+    }
+    if (size > compressed * kMaxLzfExpansion + 64) {
+      return Invalid(compressed, " compressed bytes cannot hold ", size);
+    }
+    std::string columns(size, '\0');
+    NM_RETURN_IF_ERROR(LzfDecompress(body.substr(8, compressed), &columns));
+    // Field by field: all points' values of the first field, then of the second, ...
+    ReadBinary(
+        header, roles,
+        [&](uint64_t i, int f) {
+          const Field& field = header.fields[f];
+          return columns.data() + header.points * field.offset + i * field.bytes();
+        },
+        &sink);
+  }
+  NM_RETURN_IF_ERROR(sink.Finish());
+  return out;
+}
+
+std::string FormatPcd(const GeometryView& geometry) {
+  const bool doubles = geometry.has_origin();
+  const size_t n = geometry.positions.size();
+  const bool normals = !geometry.normals.empty();
+  const bool colors = !geometry.colors.empty();
+  const bool weights = !geometry.weights.empty();
+  std::string fields = "x y z", sizes = doubles ? "8 8 8" : "4 4 4", types = "F F F",
+              counts = "1 1 1";
+  const auto add = [&](absl::string_view name, absl::string_view size, absl::string_view type) {
+    absl::StrAppend(&fields, " ", name);
+    absl::StrAppend(&sizes, " ", size);
+    absl::StrAppend(&types, " ", type);
+    absl::StrAppend(&counts, " 1");
+  };
+  if (normals) {
+    for (const char* name : {"normal_x", "normal_y", "normal_z"}) add(name, "4", "F");
+  }
+  if (colors) add("rgb", "4", "F");
+  if (weights) add("confidence", "4", "F");
+  std::string out =
+      absl::StrCat("# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS ", fields,
+                   "\nSIZE ", sizes, "\nTYPE ", types, "\nCOUNT ", counts, "\nWIDTH ", n,
+                   "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS ", n, "\nDATA binary\n");
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      if (doubles) {
+        AppendLittleEndian(geometry.origin[c] + double{geometry.positions[i][c]}, &out);
+      } else {
+        AppendLittleEndian(geometry.positions[i][c], &out);
+      }
+    }
+    if (normals) {
+      for (int c = 0; c < 3; ++c) AppendLittleEndian(geometry.normals[i][c], &out);
+    }
+    if (colors) {
+      const Rgb& rgb = geometry.colors[i];
+      AppendLittleEndian(uint32_t{rgb[0]} << 16 | uint32_t{rgb[1]} << 8 | uint32_t{rgb[2]}, &out);
+    }
+    if (weights) AppendLittleEndian(geometry.weights[i], &out);
+  }
+  return out;
+}
+
+}  // namespace neuralmesh::io_internal

@@ -1,0 +1,18 @@
+// The PCD parser and writer (core/io/internal/pcd.h) against the properties of
+// fuzz/geometry_parser_properties.h: ascii, binary and LZF-compressed (binary_compressed)
+// data, headers of every field type.
+#include <cstddef>
+#include <cstdint>
+
+#include "core/io/internal/pcd.h"
+#include "fuzz/geometry_parser_properties.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const neuralmesh::fuzz::GeometryFormat pcd{
+      [](absl::string_view bytes, neuralmesh::io_internal::FaceHandling) {
+        return neuralmesh::io_internal::ParsePcd(bytes);
+      },
+      neuralmesh::io_internal::FormatPcd, /*skips_faces=*/false};
+  neuralmesh::fuzz::CheckGeometryParser(pcd, data, size);
+  return 0;
+}

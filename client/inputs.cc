@@ -175,7 +175,7 @@ std::string LeftOutNote(const PointsLeftOut& left_out) {
   };
   add(left_out.withheld, " withheld", "");
   add(left_out.noise, "", " classified as noise");
-  add(left_out.invalid, "", " without a position (NaN)");
+  add(left_out.invalid, "", " without a position");
   if (parts.empty()) return "";
   const std::string last = parts.back();
   parts.pop_back();

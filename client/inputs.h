@@ -43,7 +43,7 @@ struct TargetSpace {
 };
 
 // The target space of `input`: builtin:NAME (its implicit surface; `mode` must be uniform),
-// a point cloud file (.ply .xyz .las .pcd .obj .off .drc .glb; uniform or weighted), or a
+// a point cloud file (.ply .xyz .ptx .las .pcd .obj .off .drc .glb; uniform or weighted), or a
 // triangle mesh file for area and curvature sampling. Returns NOT_FOUND for a missing file and
 // INVALID_ARGUMENT for an empty or malformed one, an unknown extension or builtin name, or a
 // sampling mode the input cannot provide; each message names the file.
@@ -76,7 +76,7 @@ absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string
                                           PointsLeftOut* left_out = nullptr);
 
 // "" when no point was left out; else what to tell the user: "; left out 3 withheld points
-// and 117 classified as noise", "; left out 120 points without a position (NaN)".
+// and 117 classified as noise", "; left out 120 points without a position".
 std::string LeftOutNote(const PointsLeftOut& left_out);
 
 // "" for a zero origin; else (georeferenced data) what to tell the user: "; coordinates taken

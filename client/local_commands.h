@@ -79,7 +79,7 @@ struct ConvertOptions {
 
 // Writes INPUT to OUTPUT, colours included where the format holds them. A mesh (a file with
 // faces, or builtin:NAME) is written as a mesh, and "OUTPUT: V vertices, F faces" printed
-// (", with colours"). Points (a .xyz/.txt/.pts/.las/.pcd file, a file without faces, or any
+// (", with colours"). Points (a .xyz/.txt/.pts/.ptx/.las/.pcd file, a file without faces, or any
 // file written to .xyz/.txt/.pts/.las/.pcd) are written as a point cloud with their normals,
 // weights and colours where the format holds them, and "OUTPUT: N points" printed (", with
 // normals, weights, colours"; how many outliers went; what LAS leaves out). INVALID_ARGUMENT for an

@@ -14,8 +14,8 @@
 namespace neuralmesh {
 
 // Points of a file that its reader left out because the file marks them as not to be used
-// (LAS: the withheld flag, and the noise classes 7 and 18) or gives them no position (PCD:
-// NaN coordinates, the empty pixels of an organized cloud).
+// (LAS: the withheld flag, and the noise classes 7 and 18) or gives them no position (the
+// empty cells of a scan's grid: NaN coordinates in PCD, 0 0 0 in PTX).
 struct PointsLeftOut {
   size_t withheld = 0;
   size_t noise = 0;

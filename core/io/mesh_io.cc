@@ -21,10 +21,10 @@ namespace {
 using io_internal::CannotWrite;
 using io_internal::FileFormat;
 
-// Formats of points only (XYZ, LAS, PCD) and unknown extensions are not mesh formats.
+// Formats of points only (XYZ, LAS, PCD, PTX) and unknown extensions are not mesh formats.
 bool IsMeshFormat(FileFormat format) {
   return format != FileFormat::kUnknown && format != FileFormat::kXyz &&
-         format != FileFormat::kLas && format != FileFormat::kPcd;
+         format != FileFormat::kLas && format != FileFormat::kPcd && format != FileFormat::kPtx;
 }
 
 absl::StatusOr<FileFormat> MeshFormat(const std::string& path) {
@@ -65,6 +65,7 @@ absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data
     case FileFormat::kXyz:
     case FileFormat::kLas:
     case FileFormat::kPcd:
+    case FileFormat::kPtx:
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
   }
@@ -165,6 +166,7 @@ absl::StatusOr<std::string> FormatMesh(const TriangleMesh& mesh, const std::stri
     case FileFormat::kXyz:
     case FileFormat::kLas:
     case FileFormat::kPcd:
+    case FileFormat::kPtx:
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
   }

@@ -12,6 +12,7 @@
 #include "core/io/internal/obj.h"
 #include "core/io/internal/off.h"
 #include "core/io/internal/pcd.h"
+#include "core/io/internal/ptx.h"
 #include "core/io/internal/ply.h"
 #include "core/io/internal/xyz.h"
 #include "core/status_macros.h"
@@ -57,6 +58,9 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
     case FileFormat::kPcd:
       parsed = io_internal::ParsePcd(data);
       break;
+    case FileFormat::kPtx:
+      parsed = io_internal::ParsePtx(data);
+      break;
     case FileFormat::kObj:
       parsed = io_internal::ParseObj(data, io_internal::FaceHandling::kSkip);
       break;
@@ -91,7 +95,7 @@ bool IsReadablePointCloudExtension(std::string_view path) {
 }
 
 const char kReadablePointCloudExtensions[] =
-    ".ply, .xyz, .txt, .pts, .las, .pcd, .obj, .off, .drc, .glb, .gltf";
+    ".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .obj, .off, .drc, .glb, .gltf";
 const char kWritablePointCloudExtensions[] =
     ".ply, .xyz, .txt, .pts, .las, .pcd, .drc, .glb, .gltf";
 

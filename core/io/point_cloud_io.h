@@ -14,8 +14,8 @@
 
 namespace neuralmesh {
 
-// The extensions ReadPointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .pcd,
-// .obj, .off, .drc, .glb, .gltf".
+// The extensions ReadPointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .ptx, .las,
+// .pcd, .obj, .off, .drc, .glb, .gltf".
 extern const char kReadablePointCloudExtensions[];
 // The extensions WritePointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .pcd,
 // .drc, .glb, .gltf".
@@ -33,6 +33,9 @@ bool IsWritablePointCloudExtension(std::string_view path);
 //         weights; red, green, blue (or r, g, b) as colours.
 //   .xyz, .txt, .pts  "x y z [nx ny nz] [w]", "x y z r g b", "x y z i r g b" (PTS) lines
 //         and others a header comment names ("# x y z nx ny nz r g b w"); see internal/xyz.h.
+//   .ptx  Leica PTX scans, each moved by its transformation; colours when every point has
+//         them; empty grid cells (0 0 0) left out and counted in `left_out`; see
+//         internal/ptx.h.
 //   .las  LAS 1.0-1.4 point records of formats 0-10, with colours where the format has them;
 //         withheld points and those classified as noise (classes 7 and 18) are left out, and
 //         counted in `left_out` when it is given.

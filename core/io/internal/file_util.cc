@@ -24,6 +24,7 @@ FileFormat FormatFromPath(absl::string_view path) {
   if (extension == ".xyz" || extension == ".txt" || extension == ".pts") return FileFormat::kXyz;
   if (extension == ".las") return FileFormat::kLas;
   if (extension == ".pcd") return FileFormat::kPcd;
+  if (extension == ".ptx") return FileFormat::kPtx;
   return FileFormat::kUnknown;
 }
 

@@ -11,11 +11,13 @@
 namespace neuralmesh::io_internal {
 
 // The formats the readers and writers know, chosen by file-name extension.
-enum class FileFormat { kUnknown, kPly, kObj, kOff, kStl, kXyz, kDraco, kGltf, kLas, kPcd };
+enum class FileFormat {
+  kUnknown, kPly, kObj, kOff, kStl, kXyz, kDraco, kGltf, kLas, kPcd, kPtx
+};
 
 // Maps a path's extension (case-insensitive) to its format: .ply, .obj, .off, .stl, .drc,
-// .glb / .gltf (both kGltf), .xyz / .txt / .pts (all kXyz), .las and .pcd. Anything else, or
-// no extension, is kUnknown.
+// .glb / .gltf (both kGltf), .xyz / .txt / .pts (all kXyz), .las, .pcd and .ptx. Anything
+// else, or no extension, is kUnknown.
 FileFormat FormatFromPath(absl::string_view path);
 
 // The lower-case extension of `path` with its dot (".ply"), or "" when it has none.

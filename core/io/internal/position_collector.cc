@@ -18,6 +18,9 @@ constexpr double kFloatExactSteps = 1 << 22;
 // the origin plus a float could not be held exactly.
 constexpr double kFarthestOrigin = 1099511627776.0;  // 2^40
 
+// The steps of a float's significand between a power of two and the next.
+constexpr double kFloatSteps = 1 << 24;
+
 // The resolution assumed for a file that states none: 1/65,536 of the bounding box's longest
 // side, finer than a reconstruction resolves by far (a mesh of 100,000 vertices has edges of
 // about 1/300 of it). Origins are then taken for points farther from 0 than 64 such sides.
@@ -52,8 +55,15 @@ void PositionCollector::MoveTo(ParsedGeometry* out) {
   if (!positions_.empty()) {
     double side = 0;
     for (int c = 0; c < 3; ++c) side = std::max(side, high[c] - low[c]);
-    const double unstated = side / kUnstatedStepsPerSide;
-    out->origin = OriginKeepingResolution(low, high, {unstated, unstated, unstated});
+    // Points that a float cannot tell apart where they are (a box smaller than a float's step,
+    // or a single point) take the step of that box: the same whether their doubles or the
+    // floats they became are read, so that what is written reads back alike.
+    Point3d step;
+    for (int c = 0; c < 3; ++c) {
+      const double far = std::max(std::fabs(low[c]), std::fabs(high[c]));
+      step[c] = std::max(side, far / kFloatSteps) / kUnstatedStepsPerSide;
+    }
+    out->origin = OriginKeepingResolution(low, high, step);
   }
   out->positions.resize(positions_.size());
   for (size_t i = 0; i < positions_.size(); ++i) {

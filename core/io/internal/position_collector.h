@@ -38,7 +38,8 @@ class PositionCollector {
 
   // Sets out->positions to the positions relative to out->origin, chosen by
   // OriginKeepingResolution with the step of a file that states none: 1/65,536 of the bounding
-  // box's longest side. Clears the collector.
+  // box's longest side, or on an axis where that box is smaller than a float's step (a single
+  // point), of that step. Clears the collector.
   void MoveTo(ParsedGeometry* out);
 
  private:

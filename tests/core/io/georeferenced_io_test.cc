@@ -99,6 +99,13 @@ TEST(GeoreferencedIoTest, TextPointCloudsAreReadRelativeToAnOriginWithTheirMilli
   EXPECT_FLOAT_EQ(cloud->positions[0][0], 123.456f);
   EXPECT_FLOAT_EQ(cloud->positions[0][1], 234.567f);
   ExpectNear(Placed(cloud->positions, cloud->origin), kSurveyed, 1e-4);
+
+  // One surveyed point (or many that a float cannot tell apart) keeps its millimetres too.
+  WriteBytes(path, "500123.456 4100234.567 101.234\n");
+  const absl::StatusOr<PointCloud> one = ReadPointCloud(path);
+  ASSERT_TRUE(one.ok()) << one.status();
+  EXPECT_EQ(one->origin, (Point3d{500000, 4100000, 0}));
+  EXPECT_EQ(one->positions[0], Vec3f(123.456f, 234.567f, 101.234f));
 }
 
 TEST(GeoreferencedIoTest, MeshFilesAreReadRelativeToAnOrigin) {

@@ -103,7 +103,8 @@ INSTANTIATE_TEST_SUITE_P(AllWritableFormats, CloudRoundTripTest,
                          });
 
 TEST(PointCloudIoTest, ExtensionHelpers) {
-  for (const char* name : {"a.ply", "b.XYZ", "c.txt", "d.Pts", "e.obj", "f.off", "g.drc"}) {
+  for (const char* name :
+       {"a.ply", "b.XYZ", "c.txt", "d.Pts", "e.obj", "f.off", "g.drc", "h.ptx", "i.pcd"}) {
     EXPECT_TRUE(IsReadablePointCloudExtension(name)) << name << " should be readable";
   }
   for (const char* name : {"a.stl", "b.xyzw", "noextension"}) {
@@ -113,7 +114,7 @@ TEST(PointCloudIoTest, ExtensionHelpers) {
        {"a.ply", "b.xyz", "c.txt", "d.pts", "g.DRC", "h.las", "i.glb", "j.PCD"}) {
     EXPECT_TRUE(IsWritablePointCloudExtension(name)) << name << " should be writable";
   }
-  for (const char* name : {"e.obj", "f.off", "a.stl"}) {
+  for (const char* name : {"e.obj", "f.off", "a.stl", "b.ptx"}) {
     EXPECT_FALSE(IsWritablePointCloudExtension(name)) << name << " should not be writable";
   }
 }
@@ -405,7 +406,7 @@ TEST(PointCloudIoTest, MissingFileUnsupportedExtensionAndEmptyFile) {
   const absl::StatusOr<PointCloud> stl = ReadPointCloud(TempPath("part.stl"));
   EXPECT_EQ(stl.status().code(), absl::StatusCode::kInvalidArgument) << stl.status();
   EXPECT_THAT(std::string(stl.status().message()),
-              HasSubstr(".ply, .xyz, .txt, .pts, .las, .pcd, .obj, .off, .drc, .glb, .gltf"))
+              HasSubstr(".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .obj, .off, .drc, .glb, .gltf"))
       << "the message should list the readable extensions";
 
   const absl::Status obj = WritePointCloud(kThree, TempPath("cloud.obj"));

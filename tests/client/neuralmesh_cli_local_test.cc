@@ -9,6 +9,8 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "core/io/file_contents.h"
 #include "core/io/mesh_io.h"
@@ -604,6 +606,49 @@ TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
 
 // A scan whose noise is classified (and one point withheld): reconstruct and convert leave
 // those points out and say how many.
+// Two PTX scans of one sphere of radius 10 at a UTM position, each in its scanner's frame: the
+// second scanner stands 30 m east, turned 90 degrees, so its points only meet the first's
+// once its transformation is applied.
+TEST_F(LocalCliTest, PtxScansAreReconstructedInTheirRegisteredFrame) {
+  const PointCloud unit = ColoredUnitSpherePoints(12000, 6);
+  const double centre[3] = {500123.5, 4100456.25, 80};
+  const double second[3] = {500153.5, 4100456.25, 80};  // The second scanner's position.
+  std::string ptx = absl::StrCat(
+      unit.size() / 2, "\n1\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n",
+      absl::StrFormat("%.2f %.2f %.2f 1\n", centre[0], centre[1], centre[2]));
+  for (size_t i = 0; i < unit.size() / 2; ++i) {
+    absl::StrAppend(&ptx, absl::StrFormat("%.4f %.4f %.4f 0.5\n", 10 * unit.positions[i][0],
+                                          10 * unit.positions[i][1], 10 * unit.positions[i][2]));
+  }
+  // The second scanner's x axis points north (its columns: x to (0,1,0), y to (-1,0,0)).
+  absl::StrAppend(&ptx, unit.size() - unit.size() / 2,
+                  "\n1\n0 0 0\n0 1 0\n-1 0 0\n0 0 1\n0 1 0 0\n-1 0 0 0\n0 0 1 0\n",
+                  absl::StrFormat("%.2f %.2f %.2f 1\n", second[0], second[1], second[2]));
+  for (size_t i = unit.size() / 2; i < unit.size(); ++i) {
+    // Registered p = R local + t, so local = R^T (p - t): x_local = p_y - t_y, y_local = t_x - p_x.
+    const double p[3] = {centre[0] + 10 * unit.positions[i][0],
+                         centre[1] + 10 * unit.positions[i][1],
+                         centre[2] + 10 * unit.positions[i][2]};
+    absl::StrAppend(&ptx, absl::StrFormat("%.4f %.4f %.4f 0.5\n", p[1] - second[1],
+                                          second[0] - p[0], p[2] - second[2]));
+  }
+  const std::string path = *dir_ + "/scans.ptx";
+  ASSERT_TRUE(WriteFileContents(path, ptx).ok());
+  const std::string mesh = *dir_ + "/scans.ply";
+  const RunResult run = RunNeuralmesh({"reconstruct", path, "-o", mesh, "--vertices", "800"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "coordinates taken relative to (500000, 4100000, 0)"))
+      << run.out;
+  const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);
+  ASSERT_TRUE(learned.ok()) << learned.status();
+  EXPECT_EQ(learned->positions.size(), 800u);
+  for (const Vec3f& v : learned->positions) {
+    double squared = 0;
+    for (int c = 0; c < 3; ++c) squared += std::pow(learned->origin[c] + v[c] - centre[c], 2);
+    ASSERT_NEAR(std::sqrt(squared), 10.0, 0.3) << "a vertex off the sphere";
+  }
+}
+
 TEST_F(LocalCliTest, ClassifiedNoiseInLasScansIsLeftOutAndCounted) {
   const PointCloud unit = ColoredUnitSpherePoints(4000, 9);
   testing::LasLayout layout;

@@ -552,6 +552,8 @@ class GltfReader {
     colored_ = colored_ && !colors.empty();
     with_normals_ = with_normals_ && !normals.empty();
     weighted_ = weighted_ && !weights.empty();
+    if (!with_normals_) std::vector<Vec3f>().swap(normals_);  // The file's are left out.
+    if (!weighted_) std::vector<float>().swap(weights_);
     const Matrix normal_matrix = NormalMatrix(world);
     std::vector<uint32_t> merged(positions.size());
     for (size_t i = 0; i < positions.size(); ++i) {
@@ -571,9 +573,8 @@ class GltfReader {
       merged[i] = merger_.Add(q);
       if (merged[i] == colors_.size()) {
         colors_.push_back(colors.empty() ? Rgb{} : colors[i]);
-        normals_.push_back(normals.empty() ? Vec3f(0, 0, 0)
-                                           : Transformed(normal_matrix, normals[i]));
-        weights_.push_back(weights.empty() ? 0.0f : weights[i]);
+        if (with_normals_) normals_.push_back(Transformed(normal_matrix, normals[i]));
+        if (weighted_) weights_.push_back(weights[i]);
       }
     }
     if (faces_ == FaceHandling::kSkip || mode < kTriangles) return absl::OkStatus();
@@ -761,8 +762,8 @@ class GltfReader {
       index[i] = merger.Add(narrowed.positions[i]);
       if (index[i] == colors.size()) {
         colors.push_back(colors_[i]);
-        normals.push_back(normals_[i]);
-        weights.push_back(weights_[i]);
+        if (with_normals_) normals.push_back(normals_[i]);
+        if (weighted_) weights.push_back(weights_[i]);
       }
     }
     std::vector<std::array<uint32_t, 3>> faces;
@@ -786,8 +787,9 @@ class GltfReader {
   ParsedGeometry out_;  // Faces index placed_ until NarrowAndMerge.
   std::vector<Point3d> placed_;  // Where the nodes place the vertices, identical ones merged.
   VertexMergerOf<Point3d> merger_;
-  // One of each per placed vertex; black, zero and 0 for vertices without them.
+  // One per placed vertex; black for vertices without colour.
   std::vector<Rgb> colors_;
+  // One per placed vertex while every primitive has them, then none.
   std::vector<Vec3f> normals_;  // Turned by the nodes, unit length.
   std::vector<float> weights_;
   bool colored_ = true;       // Every primitive so far has COLOR_0,

@@ -4,7 +4,9 @@
 #define NEURALMESH_CORE_IO_INTERNAL_GEOMETRY_DATA_H_
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "absl/types/span.h"
@@ -43,6 +45,10 @@ struct GeometryView {
 
   bool has_origin() const { return origin != kNoOrigin; }
 };
+
+// Appends position `i` of `geometry` as the binary formats hold it (PLY, PCD), little-endian:
+// three floats, or with an origin three doubles with the origin put back.
+void AppendPosition(const GeometryView& geometry, size_t i, std::string* out);
 
 }  // namespace neuralmesh::io_internal
 

@@ -487,13 +487,7 @@ std::string FormatPcd(const GeometryView& geometry) {
                    "\nSIZE ", sizes, "\nTYPE ", types, "\nCOUNT ", counts, "\nWIDTH ", n,
                    "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS ", n, "\nDATA binary\n");
   for (size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < 3; ++c) {
-      if (doubles) {
-        AppendLittleEndian(geometry.origin[c] + double{geometry.positions[i][c]}, &out);
-      } else {
-        AppendLittleEndian(geometry.positions[i][c], &out);
-      }
-    }
+    AppendPosition(geometry, i, &out);
     if (normals) {
       for (int c = 0; c < 3; ++c) AppendLittleEndian(geometry.normals[i][c], &out);
     }

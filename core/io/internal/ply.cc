@@ -466,13 +466,7 @@ std::string FormatPly(const GeometryView& geometry) {
       (doubles ? 24 : 12) + 4 * ((normals ? 3 : 0) + (weights ? 1 : 0)) + (colors ? 3 : 0);
   out.reserve(out.size() + geometry.positions.size() * vertex_size + geometry.faces.size() * 13);
   for (size_t i = 0; i < geometry.positions.size(); ++i) {
-    for (int c = 0; c < 3; ++c) {
-      if (doubles) {
-        AppendLittleEndian(geometry.origin[c] + double{geometry.positions[i][c]}, &out);
-      } else {
-        AppendLittleEndian(geometry.positions[i][c], &out);
-      }
-    }
+    AppendPosition(geometry, i, &out);
     if (normals) {
       for (int c = 0; c < 3; ++c) AppendLittleEndian(geometry.normals[i][c], &out);
     }

@@ -463,13 +463,18 @@ cp "${WORK_DIR}/new_token" "${SECRETS}/tokens.txt"
 cp "${WORK_DIR}/renewed/server.pem" "${WORK_DIR}/renewed/server.key" "${SECRETS}/"
 chmod 644 "${SECRETS}"/*
 podman kill -s HUP "${CONTAINER}" >/dev/null || fail "podman kill -s HUP"
+# The tokens are read at once; the certificate after gRPC has taken it on a throw-away port.
 for _ in $(seq 1 50); do
-  podman logs "${CONTAINER}" 2>&1 | grep -q 'access tokens read again' && break
+  logs=$(podman logs "${CONTAINER}" 2>&1)
+  grep -q 'access tokens read again' <<<"${logs}" \
+    && grep -q 'TLS certificate and key read again' <<<"${logs}" && break
   sleep 0.2
 done
-podman logs "${CONTAINER}" 2>&1 | grep -q '1 access tokens read again' \
+# From the captured log, not a pipe: grep -q would end podman logs with SIGPIPE, which
+# pipefail turns into a failure.
+grep -q '1 access tokens read again' <<<"${logs}" \
   || fail "the server did not say it read the tokens again"
-podman logs "${CONTAINER}" 2>&1 | grep -q 'TLS certificate and key read again' \
+grep -q 'TLS certificate and key read again' <<<"${logs}" \
   || fail "the server did not say it read the certificate again"
 sleep 2  # gRPC takes the new certificate within a second.
 expect_refused "certificate verify failed" sessions "${secured[@]}" --access_token_file \

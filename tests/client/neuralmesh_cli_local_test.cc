@@ -388,36 +388,31 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   const std::string ply = *dir_ + "/points.ply";
   ASSERT_TRUE(WritePointCloud(cloud, ply).ok());
 
+  // Each written from the one before, and each keeping all four.
   const std::string xyz = *dir_ + "/points.xyz";
-  const RunResult to_xyz = RunNeuralmesh({"convert", ply, "-o", xyz});
-  ASSERT_EQ(to_xyz.exit_code, 0) << to_xyz.Describe();
-  EXPECT_EQ(to_xyz.out, xyz + ": 5000 points, with normals, weights, colours\n");
-  absl::StatusOr<PointCloud> read = ReadPointCloud(xyz);
-  ASSERT_TRUE(read.ok()) << read.status();
-  EXPECT_EQ(read->positions, cloud.positions);
-  EXPECT_EQ(read->normals, cloud.normals);
-  EXPECT_EQ(read->weights, cloud.weights);
-  EXPECT_EQ(read->colors, cloud.colors);
+  const std::string glb = *dir_ + "/points.glb";
+  const std::string pcd = *dir_ + "/points.pcd";
+  for (const auto& [from, to] : {std::pair{ply, xyz}, {xyz, glb}, {glb, pcd}}) {
+    SCOPED_TRACE(to);
+    const RunResult converted = RunNeuralmesh({"convert", from, "-o", to});
+    ASSERT_EQ(converted.exit_code, 0) << converted.Describe();
+    EXPECT_EQ(converted.out, to + ": 5000 points, with normals, weights, colours\n");
+    const absl::StatusOr<PointCloud> kept = ReadPointCloud(to);
+    ASSERT_TRUE(kept.ok()) << kept.status();
+    EXPECT_EQ(kept->positions, cloud.positions);
+    EXPECT_EQ(kept->normals, cloud.normals);
+    EXPECT_EQ(kept->weights, cloud.weights);
+    EXPECT_EQ(kept->colors, cloud.colors);
+  }
 
   const std::string drc = *dir_ + "/points.drc";
   const RunResult to_drc = RunNeuralmesh({"convert", xyz, "-o", drc});
   ASSERT_EQ(to_drc.exit_code, 0) << to_drc.Describe();
-  read = ReadPointCloud(drc);
+  absl::StatusOr<PointCloud> read = ReadPointCloud(drc);
   ASSERT_TRUE(read.ok()) << read.status();
   EXPECT_EQ(read->size(), cloud.size());
   EXPECT_EQ(read->colors.size(), cloud.size());
   EXPECT_EQ(read->weights.size(), cloud.size());
-
-  const std::string glb = *dir_ + "/points.glb";
-  const RunResult to_glb = RunNeuralmesh({"convert", xyz, "-o", glb});
-  ASSERT_EQ(to_glb.exit_code, 0) << to_glb.Describe();
-  EXPECT_EQ(to_glb.out, glb + ": 5000 points, with normals, weights, colours\n");
-  read = ReadPointCloud(glb);
-  ASSERT_TRUE(read.ok()) << read.status();
-  EXPECT_EQ(read->positions, cloud.positions);
-  EXPECT_EQ(read->colors, cloud.colors);
-  EXPECT_EQ(read->normals, cloud.normals);
-  EXPECT_EQ(read->weights, cloud.weights);
 
   const std::string las = *dir_ + "/points.las";
   const RunResult to_las = RunNeuralmesh({"convert", glb, "-o", las});
@@ -433,16 +428,6 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   EXPECT_EQ(read->colors, cloud.colors);
   EXPECT_TRUE(read->normals.empty());
 
-  const std::string pcd = *dir_ + "/points.pcd";
-  const RunResult to_pcd = RunNeuralmesh({"convert", glb, "-o", pcd});
-  ASSERT_EQ(to_pcd.exit_code, 0) << to_pcd.Describe();
-  EXPECT_EQ(to_pcd.out, pcd + ": 5000 points, with normals, weights, colours\n");
-  read = ReadPointCloud(pcd);
-  ASSERT_TRUE(read.ok()) << read.status();
-  EXPECT_EQ(read->positions, cloud.positions);
-  EXPECT_EQ(read->normals, cloud.normals);
-  EXPECT_EQ(read->weights, cloud.weights);
-  EXPECT_EQ(read->colors, cloud.colors);
   // An organized cloud's empty pixels are left out, and counted.
   const std::string organized = *dir_ + "/organized.pcd";
   ASSERT_TRUE(WriteFileContents(organized,

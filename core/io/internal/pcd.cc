@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <initializer_list>
 #include <limits>
 #include <optional>
 #include <string>
@@ -249,10 +250,9 @@ double ValueAt(const char* p, const Field& field) {
   }
 }
 
-// PCL's packed colour: 0x00RRGGBB (or 0xAARRGGBB), in a float's bits or an unsigned integer.
-uint32_t PackedColorAt(const char* p, const Field& field) {
-  return field.size >= 4 ? LoadScalar<uint32_t>(p, false) : 0;
-}
+// PCL's packed colour: 0x00RRGGBB (or 0xAARRGGBB), in a float's bits or an unsigned integer
+// (RolesOf takes only fields of 4 bytes).
+uint32_t PackedColorAt(const char* p) { return LoadScalar<uint32_t>(p, false); }
 
 // The packed colour an ASCII value gives: the integer PCL writes since 1.9, or the bits of the
 // float that older files hold (a colour's bits make a tiny, non-integer float).
@@ -279,6 +279,18 @@ struct Roles {
   int weight = -1;
 };
 
+// The first of the fields `names` that holds one value (of `size` bytes, when given), or -1.
+int FirstSingleField(const PcdHeader& header, std::initializer_list<const char*> names,
+                     int size = 0) {
+  for (const char* name : names) {
+    const int i = FieldIndex(header, name);
+    if (i >= 0 && header.fields[i].count == 1 && (size == 0 || header.fields[i].size == size)) {
+      return i;
+    }
+  }
+  return -1;
+}
+
 Roles RolesOf(const PcdHeader& header) {
   Roles roles;
   const char* const axes[3] = {"x", "y", "z"};
@@ -293,20 +305,8 @@ Roles RolesOf(const PcdHeader& header) {
       break;
     }
   }
-  for (const char* name : {"rgb", "rgba"}) {
-    const int i = FieldIndex(header, name);
-    if (i >= 0 && header.fields[i].size == 4 && header.fields[i].count == 1) {
-      roles.color = i;
-      break;
-    }
-  }
-  for (const char* name : {"confidence", "weight", "quality"}) {
-    const int i = FieldIndex(header, name);
-    if (i >= 0 && header.fields[i].count == 1) {
-      roles.weight = i;
-      break;
-    }
-  }
+  roles.color = FirstSingleField(header, {"rgb", "rgba"}, /*size=*/4);
+  roles.weight = FirstSingleField(header, {"confidence", "weight", "quality"});
   return roles;
 }
 
@@ -404,8 +404,7 @@ void ReadBinary(const PcdHeader& header, const Roles& roles, const Locate& locat
                 PointSink* sink) {
   sink->Reserve(header.points);
   for (uint64_t i = 0; i < header.points; ++i) {
-    const uint32_t packed =
-        roles.color >= 0 ? PackedColorAt(locate(i, roles.color), header.fields[roles.color]) : 0;
+    const uint32_t packed = roles.color >= 0 ? PackedColorAt(locate(i, roles.color)) : 0;
     sink->Add([&](int f) { return ValueAt(locate(i, f), header.fields[f]); }, packed);
   }
 }

@@ -43,9 +43,9 @@ struct TargetSpace {
 };
 
 // The target space of `input`: builtin:NAME (its implicit surface; `mode` must be uniform),
-// a point cloud file (.ply .xyz .ptx .las .pcd .obj .off .drc .glb; uniform or weighted), or a
-// triangle mesh file for area and curvature sampling. Returns NOT_FOUND for a missing file and
-// INVALID_ARGUMENT for an empty or malformed one, an unknown extension or builtin name, or a
+// a point cloud file (.ply .xyz .ptx .las .pcd .e57 .obj .off .drc .glb; uniform or weighted),
+// or a triangle mesh file for area and curvature sampling. Returns NOT_FOUND for a missing file
+// and INVALID_ARGUMENT for an empty or malformed one, an unknown extension or builtin name, or a
 // sampling mode the input cannot provide; each message names the file.
 // With `outliers` set, a point cloud's statistical outliers are removed first
 // (statistical_outliers.h) and the description says how many; INVALID_ARGUMENT for another

@@ -70,7 +70,7 @@ struct ConvertOptions {
   // A mesh or point cloud file, or builtin:NAME for its dense tessellation.
   std::string input;
   // Its extension picks the format: a mesh's (kMeshExtensions) or a point cloud's (.ply .xyz
-  // .txt .pts .las .pcd .drc .glb .gltf).
+  // .txt .pts .las .pcd .e57 .drc .glb .gltf).
   std::string output;
   MeshWriteOptions writing;  // Draco settings, glTF compression (meshes only).
   // Set: a point cloud's statistical outliers are removed before it is written.
@@ -79,13 +79,13 @@ struct ConvertOptions {
 
 // Writes INPUT to OUTPUT, colours included where the format holds them. A mesh (a file with
 // faces, or builtin:NAME) is written as a mesh, and "OUTPUT: V vertices, F faces" printed
-// (", with colours"). Points (a .xyz/.txt/.pts/.ptx/.las/.pcd file, a file without faces, or any
-// file written to .xyz/.txt/.pts/.las/.pcd) are written as a point cloud with their normals,
-// weights and colours where the format holds them, and "OUTPUT: N points" printed (", with
-// normals, weights, colours"; how many outliers went; what LAS leaves out). INVALID_ARGUMENT for an
-// unknown output extension (before reading INPUT), a mesh format for points that are not a
-// mesh (.obj, .off, .stl), a point format for a builtin surface, --remove_outliers for a
-// mesh, --gltf_draco for points, and the reader's and writer's errors.
+// (", with colours"). Points (a .xyz/.txt/.pts/.ptx/.las/.pcd/.e57 file, a file without faces,
+// or any file written to .xyz/.txt/.pts/.las/.pcd/.e57) are written as a point cloud with their
+// normals, weights and colours where the format holds them, and "OUTPUT: N points" printed
+// (", with normals, weights, colours"; how many outliers went; what LAS or E57 leaves out).
+// INVALID_ARGUMENT for an unknown output extension (before reading INPUT), a mesh format for
+// points that are not a mesh (.obj, .off, .stl), a point format for a builtin surface,
+// --remove_outliers for a mesh, --gltf_draco for points, and the reader's and writer's errors.
 absl::Status RunConvert(const ConvertOptions& options, std::ostream& out);
 
 }  // namespace neuralmesh::client

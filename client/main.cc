@@ -43,7 +43,7 @@ ABSL_FLAG(std::string, output, "",
           "Local reconstruct: the mesh to write; the extension picks the format (.ply .obj .off "
           ".stl .drc .glb .gltf). LOD files go beside it as <stem>_lod<N><ext>. get: where the "
           "session's mesh goes. convert: the file written (a mesh's format, or a point cloud's: "
-          ".ply .xyz .txt .pts .las .pcd .drc .glb .gltf).");
+          ".ply .xyz .txt .pts .las .pcd .e57 .drc .glb .gltf).");
 ABSL_FLAG(uint64_t, vertices, 0,
           "Vertex count of the final mesh (met exactly). Required for a local reconstruct; with "
           "--server, 0 means one vertex per 2 points, at most 10000.");
@@ -631,8 +631,8 @@ std::vector<Subcommand> Commands() {
        "       neuralmesh reconstruct INPUT --server HOST:PORT --out-dir DIR [--vertices N] "
        "[--batch-size K] [--ply] [--glb] [--resume SESSION] [--reconnect_for D]",
        "Learns a mesh of a point cloud, a mesh or a built-in surface, locally or on a server.",
-       "Learns a mesh of INPUT: a point cloud (.ply .xyz .txt .pts .ptx .las .pcd .obj .off\n"
-       ".drc .glb .gltf), a triangle mesh with --sampling area|curvature, or\n"
+       "Learns a mesh of INPUT: a point cloud (.ply .xyz .txt .pts .ptx .las .pcd .e57 .obj\n"
+       ".off .drc .glb .gltf), a triangle mesh with --sampling area|curvature, or\n"
        "builtin:sphere|torus|genus2.\n"
        "Locally it writes OUTPUT and one OUTPUT_lod<N> file per --lod; with --server it\n"
        "uploads the points and saves each mesh the server publishes into --out-dir. Prints\n"
@@ -652,9 +652,10 @@ std::vector<Subcommand> Commands() {
        "Writes INPUT to OUTPUT in the format of its extension, colours included where the\n"
        "format holds them. A mesh (a file with faces, or builtin:NAME, its dense reference\n"
        "tessellation) goes to .ply .obj .off .stl .drc .glb .gltf; points (.xyz .txt .pts\n"
-       ".ptx .las .pcd, a file without faces, or anything written to .xyz .txt .pts .las\n"
-       ".pcd) go to .ply .xyz .txt .pts .las .pcd .drc .glb .gltf with their normals and\n"
-       "weights (LAS: positions and colours only), after --remove_outliers if given.",
+       ".ptx .las .pcd .e57, a file without faces, or anything written to .xyz .txt .pts\n"
+       ".las .pcd .e57) go to .ply .xyz .txt .pts .las .pcd .e57 .drc .glb .gltf with their\n"
+       "normals and weights (LAS: positions and colours only; E57: no weights), after\n"
+       "--remove_outliers if given.",
        {"output", "gltf_draco", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "quantization_bits", "encode_speed"},
        Convert},

@@ -100,12 +100,12 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
     NM_ASSIGN_OR_RETURN(removed, RemoveStatisticalOutliers(cloud, *options.outliers));
   }
   NM_RETURN_IF_ERROR(WritePointCloud(cloud, options.output, options.writing.draco));
-  // What the file holds: LAS has no place for normals and weights.
+  // What the file holds: LAS has no place for normals and weights, E57 none for weights.
   const bool las = absl::EndsWithIgnoreCase(options.output, ".las");
-  const bool dropped = las && (!cloud.normals.empty() || !cloud.weights.empty());
-  std::vector<std::string> carried;
-  if (!cloud.normals.empty() && !las) carried.push_back("normals");
-  if (!cloud.weights.empty() && !las) carried.push_back("weights");
+  const bool e57 = absl::EndsWithIgnoreCase(options.output, ".e57");
+  std::vector<std::string> carried, dropped;
+  if (!cloud.normals.empty()) (las ? dropped : carried).push_back("normals");
+  if (!cloud.weights.empty()) (las || e57 ? dropped : carried).push_back("weights");
   if (!cloud.colors.empty()) carried.push_back("colours");
   out << options.output << ": " << cloud.size() << " points";
   if (!carried.empty()) out << ", with " << absl::StrJoin(carried, ", ");
@@ -113,8 +113,10 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
     out << " (" << removed << " outliers of " << read << " removed)";
   }
   out << LeftOutNote(left_out) << OriginNote(cloud.origin) << "\n";
-  if (dropped) {
-    out << "note: LAS keeps positions and colours; the normals and weights were left out\n";
+  if (!dropped.empty()) {
+    out << "note: "
+        << (las ? "LAS keeps positions and colours" : "E57 keeps positions, colours and normals")
+        << "; the " << absl::StrJoin(dropped, " and ") << " were left out\n";
   }
   return absl::OkStatus();
 }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package that building, testing and running neuralmesh needs, and
-# the live viewer's three.js from the npm registry into client/web/node_modules (`npm ci`, the
-# version pinned by client/web/package-lock.json).
+# Installs every Debian 12 package that building, testing and running neuralmesh needs, the
+# live viewer's three.js from the npm registry into client/web/node_modules, and the tests'
+# independent E57 reader (web-e57) into tests/tools/node_modules (`npm ci`, the versions pinned
+# by each folder's package-lock.json).
 # Idempotent: when everything is already installed it only checks and returns.
 #
 # Usage: scripts/install-deps.sh [EXTRA_PACKAGE...]
@@ -27,7 +28,7 @@ packages=(
   chromium python3-websocket
   "$@"
 )
-# npm, for the viewer's three.js: Debian's, unless the machine already has one (Node.js from
+# npm, for three.js and web-e57: Debian's, unless the machine already has one (Node.js from
 # another source brings its own npm, which Debian's package would conflict with).
 if ! command -v npm >/dev/null 2>&1; then packages+=(npm); fi
 
@@ -49,12 +50,16 @@ else
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# three.js for the viewer, once per change of the lock file.
-web="$(cd "$(dirname "$0")/.." && pwd)/client/web"
-if cmp -s "${web}/package-lock.json" "${web}/node_modules/.installed-package-lock.json"; then
-  echo "install-deps: client/web/node_modules up to date"
-else
-  echo "install-deps: npm ci in client/web"
-  (cd "${web}" && npm ci --no-audit --no-fund --loglevel=error)
-  cp "${web}/package-lock.json" "${web}/node_modules/.installed-package-lock.json"
-fi
+# npm packages, once per change of a lock file: three.js for the viewer (client/web), and the
+# independent readers the tests check written files with (tests/tools: web-e57).
+root="$(cd "$(dirname "$0")/.." && pwd)"
+for dir in client/web tests/tools; do
+  lock="${root}/${dir}/package-lock.json"
+  if cmp -s "${lock}" "${root}/${dir}/node_modules/.installed-package-lock.json"; then
+    echo "install-deps: ${dir}/node_modules up to date"
+  else
+    echo "install-deps: npm ci in ${dir}"
+    (cd "${root}/${dir}" && npm ci --no-audit --no-fund --loglevel=error)
+    cp "${lock}" "${root}/${dir}/node_modules/.installed-package-lock.json"
+  fi
+done

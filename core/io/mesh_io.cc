@@ -21,10 +21,11 @@ namespace {
 using io_internal::CannotWrite;
 using io_internal::FileFormat;
 
-// Formats of points only (XYZ, LAS, PCD, PTX) and unknown extensions are not mesh formats.
+// Formats of points only (XYZ, LAS, PCD, PTX, E57) and unknown extensions are not mesh formats.
 bool IsMeshFormat(FileFormat format) {
   return format != FileFormat::kUnknown && format != FileFormat::kXyz &&
-         format != FileFormat::kLas && format != FileFormat::kPcd && format != FileFormat::kPtx;
+         format != FileFormat::kLas && format != FileFormat::kPcd && format != FileFormat::kPtx &&
+         format != FileFormat::kE57;
 }
 
 absl::StatusOr<FileFormat> MeshFormat(const std::string& path) {
@@ -66,6 +67,7 @@ absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data
     case FileFormat::kLas:
     case FileFormat::kPcd:
     case FileFormat::kPtx:
+    case FileFormat::kE57:
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
   }
@@ -167,6 +169,7 @@ absl::StatusOr<std::string> FormatMesh(const TriangleMesh& mesh, const std::stri
     case FileFormat::kLas:
     case FileFormat::kPcd:
     case FileFormat::kPtx:
+    case FileFormat::kE57:
     case FileFormat::kUnknown:
       return absl::InternalError("not a mesh format");
   }

@@ -6,6 +6,7 @@
 #include "absl/strings/string_view.h"
 #include "core/io/file_contents.h"
 #include "core/io/internal/gltf.h"
+#include "core/io/internal/e57.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/geometry_data.h"
 #include "core/io/internal/las.h"
@@ -28,7 +29,7 @@ bool IsReadable(FileFormat format) {
 
 bool IsWritable(FileFormat format) {
   return format == FileFormat::kPly || format == FileFormat::kXyz ||
-         format == FileFormat::kLas || format == FileFormat::kPcd ||
+         format == FileFormat::kLas || format == FileFormat::kPcd || format == FileFormat::kE57 ||
          format == FileFormat::kDraco || format == FileFormat::kGltf;
 }
 
@@ -60,6 +61,9 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
       break;
     case FileFormat::kPtx:
       parsed = io_internal::ParsePtx(data);
+      break;
+    case FileFormat::kE57:
+      parsed = io_internal::ParseE57(data);
       break;
     case FileFormat::kObj:
       parsed = io_internal::ParseObj(data, io_internal::FaceHandling::kSkip);
@@ -95,9 +99,9 @@ bool IsReadablePointCloudExtension(std::string_view path) {
 }
 
 const char kReadablePointCloudExtensions[] =
-    ".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .obj, .off, .drc, .glb, .gltf";
+    ".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .e57, .obj, .off, .drc, .glb, .gltf";
 const char kWritablePointCloudExtensions[] =
-    ".ply, .xyz, .txt, .pts, .las, .pcd, .drc, .glb, .gltf";
+    ".ply, .xyz, .txt, .pts, .las, .pcd, .e57, .drc, .glb, .gltf";
 
 bool IsWritablePointCloudExtension(std::string_view path) {
   return IsWritable(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
@@ -138,6 +142,8 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
     data = io_internal::FormatXyz(view);
   } else if (format == FileFormat::kPcd) {
     data = io_internal::FormatPcd(view);
+  } else if (format == FileFormat::kE57) {
+    data = io_internal::FormatE57(view);
   } else if (format == FileFormat::kLas) {
     absl::StatusOr<std::string> formatted = io_internal::FormatLas(view);
     if (!formatted.ok()) return io_internal::CannotWrite(path, formatted.status());

@@ -15,10 +15,10 @@
 namespace neuralmesh {
 
 // The extensions ReadPointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .ptx, .las,
-// .pcd, .obj, .off, .drc, .glb, .gltf".
+// .pcd, .e57, .obj, .off, .drc, .glb, .gltf".
 extern const char kReadablePointCloudExtensions[];
 // The extensions WritePointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .pcd,
-// .drc, .glb, .gltf".
+// .e57, .drc, .glb, .gltf".
 extern const char kWritablePointCloudExtensions[];
 
 // True when ReadPointCloud handles the extension of `path` (kReadablePointCloudExtensions).
@@ -42,6 +42,9 @@ bool IsWritablePointCloudExtension(std::string_view path);
 //   .pcd  PCL's Point Cloud Data (ascii, binary, binary_compressed): x y z, normal_x normal_y
 //         normal_z, rgb or rgba, confidence/weight/quality as weights; points without a
 //         position (NaN) left out and counted in `left_out`; see internal/pcd.h.
+//   .e57  ASTM E57: every scan, from cartesian or spherical coordinates, moved by its pose;
+//         colours and surface normals when every scan has them; invalid points left out and
+//         counted in `left_out`; see internal/e57.h.
 //   .obj  the 'v' lines, 'v x y z r g b' with colours ('vn' is ignored: OBJ normals belong to
 //         face corners).
 //   .off  the vertices of OFF, COFF (with colours), NOFF (with normals), STOFF.
@@ -62,10 +65,11 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,
 // nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"
 // text for .xyz/.txt/.pts (a header comment names the columns), LAS 1.2 of point format 0 or
 // 2 (with colours; no normals or weights: internal/las.h), binary PCD (x y z, normal_x
-// normal_y normal_z, rgb, confidence as present), .drc encoded with `draco`, or
+// normal_y normal_z, rgb, confidence as present), E57 of one scan (scaled integer
+// coordinates, colours, normals; no weights: internal/e57.h), .drc encoded with `draco`, or
 // glTF 2.0 POINTS (.glb, or .gltf with its buffer embedded) with COLOR_0, NORMAL (unit length)
 // and _WEIGHT attributes as present. The positions are written with cloud.origin put back
-// (PLY and PCD doubles, exact text, the LAS offset, a glTF node's translation, Draco
+// (PLY and PCD doubles, exact text, the LAS and E57 offsets, a glTF node's translation, Draco
 // metadata).
 // Returns INVALID_ARGUMENT for an unsupported extension, an empty cloud, a cloud that fails
 // ValidatePointCloud, more points than LAS counts, or invalid `draco` options; otherwise the

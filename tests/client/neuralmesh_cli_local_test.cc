@@ -428,6 +428,21 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   EXPECT_EQ(read->colors, cloud.colors);
   EXPECT_TRUE(read->normals.empty());
 
+  const std::string e57 = *dir_ + "/points.e57";
+  const RunResult to_e57 = RunNeuralmesh({"convert", pcd, "-o", e57});
+  ASSERT_EQ(to_e57.exit_code, 0) << to_e57.Describe();
+  EXPECT_EQ(to_e57.out, e57 + ": 5000 points, with normals, colours\nnote: E57 keeps positions, "
+                             "colours and normals; the weights were left out\n");
+  read = ReadPointCloud(e57);
+  ASSERT_TRUE(read.ok()) << read.status();
+  ASSERT_EQ(read->size(), cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_LT((read->positions[i] - cloud.positions[i]).norm(), 2e-8f) << i;
+  }
+  EXPECT_EQ(read->normals, cloud.normals);
+  EXPECT_EQ(read->colors, cloud.colors);
+  EXPECT_TRUE(read->weights.empty());
+
   // An organized cloud's empty pixels are left out, and counted.
   const std::string organized = *dir_ + "/organized.pcd";
   ASSERT_TRUE(WriteFileContents(organized,
@@ -474,7 +489,7 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   const Refused refused[] = {
       {{"convert", xyz, "-o", *dir_ + "/points.obj"},
        "holds points without faces: OUTPUT '" + *dir_ + "/points.obj' must be a point cloud "
-       "format (.ply, .xyz, .txt, .pts, .las, .pcd, .drc, .glb, .gltf)"},
+       "format (.ply, .xyz, .txt, .pts, .las, .pcd, .e57, .drc, .glb, .gltf)"},
       {{"convert", "builtin:torus", "-o", *dir_ + "/torus.xyz"},
        "builtin:torus is a surface, not points"},
       {{"convert", xyz, "-o", glb, "--gltf_draco"}, "--gltf_draco compresses meshes"},

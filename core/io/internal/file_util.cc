@@ -25,6 +25,7 @@ FileFormat FormatFromPath(absl::string_view path) {
   if (extension == ".las") return FileFormat::kLas;
   if (extension == ".pcd") return FileFormat::kPcd;
   if (extension == ".ptx") return FileFormat::kPtx;
+  if (extension == ".e57") return FileFormat::kE57;
   return FileFormat::kUnknown;
 }
 

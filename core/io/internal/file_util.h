@@ -12,11 +12,11 @@ namespace neuralmesh::io_internal {
 
 // The formats the readers and writers know, chosen by file-name extension.
 enum class FileFormat {
-  kUnknown, kPly, kObj, kOff, kStl, kXyz, kDraco, kGltf, kLas, kPcd, kPtx
+  kUnknown, kPly, kObj, kOff, kStl, kXyz, kDraco, kGltf, kLas, kPcd, kPtx, kE57
 };
 
 // Maps a path's extension (case-insensitive) to its format: .ply, .obj, .off, .stl, .drc,
-// .glb / .gltf (both kGltf), .xyz / .txt / .pts (all kXyz), .las, .pcd and .ptx. Anything
+// .glb / .gltf (both kGltf), .xyz / .txt / .pts (all kXyz), .las, .pcd, .ptx and .e57. Anything
 // else, or no extension, is kUnknown.
 FileFormat FormatFromPath(absl::string_view path);
 

@@ -70,14 +70,6 @@ RecordUsability Usability(absl::string_view data, size_t at, int format) {
                                                                                 : kUsable;
 }
 
-// The power of ten at most 1/2^24 of `farthest` (the largest magnitude of an axis's
-// coordinates): a float keeps 24 bits, so the integers keep what the floats hold. 0.001 for an
-// axis that is zero everywhere.
-double ScaleFor(double farthest) {
-  if (!(farthest > 0)) return 0.001;
-  return std::pow(10.0, std::floor(std::log10(farthest / (1 << 24))));
-}
-
 // A fixed-size text field of the header, padded with zeros.
 void AppendText(absl::string_view text, size_t size, std::string* out) {
   text = text.substr(0, size);
@@ -224,7 +216,7 @@ absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
   for (int c = 0; c < 3; ++c) {
     double farthest = 0;
     for (const Vec3f& p : points.positions) farthest = std::max<double>(farthest, std::fabs(p[c]));
-    scale[c] = ScaleFor(farthest);
+    scale[c] = IntegerScaleKeepingFloats(farthest);
   }
 
   std::string records;

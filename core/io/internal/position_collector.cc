@@ -28,6 +28,11 @@ constexpr double kUnstatedStepsPerSide = 1 << 16;
 
 }  // namespace
 
+double IntegerScaleKeepingFloats(double farthest) {
+  if (!(farthest > 0)) return 0.001;
+  return std::pow(10.0, std::floor(std::log10(farthest / kFloatSteps)));
+}
+
 Point3d OriginKeepingResolution(const Point3d& low, const Point3d& high, const Point3d& step) {
   Point3d origin = {0, 0, 0};
   for (int c = 0; c < 3; ++c) {

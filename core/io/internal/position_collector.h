@@ -24,6 +24,11 @@ using Point3d = std::array<double, 3>;
 // (1.1e12, where a double keeps no more than a float relative to such an origin).
 Point3d OriginKeepingResolution(const Point3d& low, const Point3d& high, const Point3d& step);
 
+// The power of ten at most 1/2^24 of `farthest` (the largest magnitude of an axis's coordinates
+// relative to the origin): the scale of integer coordinates (LAS, E57) that keep what floats
+// hold, a float keeping 24 bits. 0.001 for an axis that is zero everywhere.
+double IntegerScaleKeepingFloats(double farthest);
+
 class PositionCollector {
  public:
   PositionCollector() = default;

@@ -74,13 +74,15 @@ TEST_P(CloudRoundTripTest, WriteThenReadGivesTheSameCloud) {
   ASSERT_TRUE(written.ok()) << "writing " << extension << ": " << written;
   const absl::StatusOr<PointCloud> read = ReadPointCloud(path);
   ASSERT_TRUE(read.ok()) << "reading back " << extension << ": " << read.status();
-  if (std::string(extension) == ".las") {
-    // Integers in steps of 1e-8 (internal/las.h); no normals or weights.
+  const bool e57 = std::string(extension) == ".e57";
+  if (std::string(extension) == ".las" || e57) {
+    // Integers in steps of 1e-8 (internal/las.h, internal/e57.h); no weights, and in LAS no
+    // normals.
     ASSERT_EQ(read->size(), cloud.size());
     for (size_t i = 0; i < cloud.size(); ++i) {
       for (int c = 0; c < 3; ++c) EXPECT_NEAR(read->positions[i][c], cloud.positions[i][c], 1e-8);
     }
-    EXPECT_TRUE(read->normals.empty());
+    EXPECT_EQ(read->normals, e57 ? cloud.normals : std::vector<Vec3f>{});
     EXPECT_TRUE(read->weights.empty());
   } else if (std::string(extension) == ".drc") {
     ExpectSameCloud(cloud, *read,
@@ -93,8 +95,8 @@ TEST_P(CloudRoundTripTest, WriteThenReadGivesTheSameCloud) {
 
 INSTANTIATE_TEST_SUITE_P(AllWritableFormats, CloudRoundTripTest,
                          ::testing::Combine(::testing::Values(".ply", ".xyz", ".txt", ".pts",
-                                                              ".las", ".pcd", ".drc", ".glb",
-                                                              ".gltf"),
+                                                              ".las", ".pcd", ".e57", ".drc",
+                                                              ".glb", ".gltf"),
                                             ::testing::Bool(), ::testing::Bool()),
                          [](const auto& info) {
                            return std::string(std::get<0>(info.param) + 1) +
@@ -104,14 +106,15 @@ INSTANTIATE_TEST_SUITE_P(AllWritableFormats, CloudRoundTripTest,
 
 TEST(PointCloudIoTest, ExtensionHelpers) {
   for (const char* name :
-       {"a.ply", "b.XYZ", "c.txt", "d.Pts", "e.obj", "f.off", "g.drc", "h.ptx", "i.pcd"}) {
+       {"a.ply", "b.XYZ", "c.txt", "d.Pts", "e.obj", "f.off", "g.drc", "h.ptx", "i.pcd",
+        "j.E57"}) {
     EXPECT_TRUE(IsReadablePointCloudExtension(name)) << name << " should be readable";
   }
   for (const char* name : {"a.stl", "b.xyzw", "noextension"}) {
     EXPECT_FALSE(IsReadablePointCloudExtension(name)) << name << " should not be readable";
   }
   for (const char* name :
-       {"a.ply", "b.xyz", "c.txt", "d.pts", "g.DRC", "h.las", "i.glb", "j.PCD"}) {
+       {"a.ply", "b.xyz", "c.txt", "d.pts", "g.DRC", "h.las", "i.glb", "j.PCD", "k.e57"}) {
     EXPECT_TRUE(IsWritablePointCloudExtension(name)) << name << " should be writable";
   }
   for (const char* name : {"e.obj", "f.off", "a.stl", "b.ptx"}) {
@@ -406,13 +409,14 @@ TEST(PointCloudIoTest, MissingFileUnsupportedExtensionAndEmptyFile) {
   const absl::StatusOr<PointCloud> stl = ReadPointCloud(TempPath("part.stl"));
   EXPECT_EQ(stl.status().code(), absl::StatusCode::kInvalidArgument) << stl.status();
   EXPECT_THAT(std::string(stl.status().message()),
-              HasSubstr(".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .obj, .off, .drc, .glb, .gltf"))
+              HasSubstr(".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .e57, .obj, .off, .drc, .glb, "
+                        ".gltf"))
       << "the message should list the readable extensions";
 
   const absl::Status obj = WritePointCloud(kThree, TempPath("cloud.obj"));
   EXPECT_EQ(obj.code(), absl::StatusCode::kInvalidArgument) << obj;
   EXPECT_THAT(std::string(obj.message()),
-              HasSubstr(".ply, .xyz, .txt, .pts, .las, .pcd, .drc, .glb, .gltf"))
+              HasSubstr(".ply, .xyz, .txt, .pts, .las, .pcd, .e57, .drc, .glb, .gltf"))
       << "the message should list the writable extensions";
 
   for (const char* name : {"empty.ply", "empty.xyz", "empty.obj", "empty.off", "empty.drc"}) {

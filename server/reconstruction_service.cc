@@ -852,13 +852,15 @@ grpc::ServerUnaryReactor* ReconstructionService::TransferSession(
     grpc::CallbackServerContext* context, const v1::TransferSessionRequest* request,
     v1::Session* response) {
   const Caller caller = CallerOf(*context);
-  absl::StatusOr<std::shared_ptr<Session>> session =
-      GetSessionFor(*manager_, caller, request->session_id(), SessionUse::kChange);
-  if (!session.ok()) return FinishUnary(context, session.status());
   const std::string by = caller.client.empty()
                              ? context->peer()
                              : absl::StrCat("client ", caller.client, " at ", context->peer());
-  session = manager_->Transfer(request->session_id(), request->new_owner(), by);
+  // The caller's right to the session is checked as the owner changes, not before.
+  const absl::StatusOr<std::shared_ptr<Session>> session =
+      manager_->Transfer(request->session_id(), request->new_owner(), by,
+                         [&caller](const Session& current) {
+                           return CheckMayUse(caller, current, SessionUse::kChange);
+                         });
   if (!session.ok()) return FinishUnary(context, session.status());
   *response = (*session)->ToProto();
   return FinishUnary(context, absl::OkStatus());

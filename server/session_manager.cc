@@ -161,9 +161,9 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Create(
   return session;
 }
 
-absl::StatusOr<std::shared_ptr<Session>> SessionManager::Transfer(absl::string_view id,
-                                                                  std::string new_owner,
-                                                                  absl::string_view by) {
+absl::StatusOr<std::shared_ptr<Session>> SessionManager::Transfer(
+    absl::string_view id, std::string new_owner, absl::string_view by,
+    absl::FunctionRef<absl::Status(const Session&)> allowed) {
   if (id.empty()) return absl::InvalidArgumentError("session_id is empty");
   if (new_owner.empty()) return absl::InvalidArgumentError("new_owner is empty");
   if (new_owner.size() > kMaxNameBytes) {
@@ -184,6 +184,7 @@ absl::StatusOr<std::shared_ptr<Session>> SessionManager::Transfer(absl::string_v
     if (it == sessions_.end()) return NotHeldLocked(id);
     session = it->second;
     session->Touch();
+    if (absl::Status may = allowed(*session); !may.ok()) return may;
     previous = session->owner();
     if (previous == new_owner) return session;
     if (limits_.max_sessions_per_client > 0 &&

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "absl/base/thread_annotations.h"
+#include "absl/functional/function_ref.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
@@ -93,13 +94,17 @@ class SessionManager {
       ABSL_LOCKS_EXCLUDED(mu_);
 
   // Hands the session `id` to the client `new_owner` (TransferSession), on disk first with a
-  // store; `by` says who asked, for the event log ("client ops at ipv4:..."). Nothing changes
-  // when `new_owner` owns it already. INVALID_ARGUMENT for a new owner that is empty, longer
-  // than 256 bytes or holds control characters; RESOURCE_EXHAUSTED when it holds
-  // max_sessions_per_client; the errors of Get; with a store, the error of writing the owner.
-  absl::StatusOr<std::shared_ptr<Session>> Transfer(absl::string_view id, std::string new_owner,
-                                                    absl::string_view by = "")
-      ABSL_LOCKS_EXCLUDED(mu_);
+  // store; `by` says who asked, for the event log ("client ops at ipv4:..."). `allowed` decides
+  // whether the caller may hand the session over, under the lock that owner changes take, so
+  // that two transfers cannot both pass a check of the owner before either changes it; its
+  // error is returned. Nothing changes when `new_owner` owns it already. INVALID_ARGUMENT for a
+  // new owner that is empty, longer than 256 bytes or holds control characters;
+  // RESOURCE_EXHAUSTED when it holds max_sessions_per_client; the errors of Get; with a store,
+  // the error of writing the owner.
+  absl::StatusOr<std::shared_ptr<Session>> Transfer(
+      absl::string_view id, std::string new_owner, absl::string_view by = "",
+      absl::FunctionRef<absl::Status(const Session&)> allowed =
+          [](const Session&) { return absl::OkStatus(); }) ABSL_LOCKS_EXCLUDED(mu_);
 
   // NOT_FOUND for an unknown id (INVALID_ARGUMENT for an empty one), UNAVAILABLE after
   // Shutdown. Counts as activity.

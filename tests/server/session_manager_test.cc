@@ -308,6 +308,17 @@ TEST_F(SessionManagerRestoreTest, AHandedOverSessionKeepsItsNewOwnerAfterARestar
     EXPECT_EQ((*handed)->points_received(), 2000u) << "its points stay";
     // Handing it to its owner changes nothing and records nothing.
     ASSERT_TRUE(manager.Transfer(stored[1], "bob").ok());
+    // The caller's right is checked against the owner of the moment: a client that still
+    // thinks the session is alice's cannot take it from bob.
+    const absl::Status stale = manager
+                                   .Transfer(stored[1], "carol", "", [](const Session& current) {
+                                     return current.owner() == "alice"
+                                                ? absl::OkStatus()
+                                                : absl::PermissionDeniedError("not alice's");
+                                   })
+                                   .status();
+    EXPECT_TRUE(absl::IsPermissionDenied(stale)) << stale;
+    EXPECT_EQ(manager.Get(stored[1]).value()->owner(), "bob");
     // Bob may hold two sessions; alice's second would be his third.
     ASSERT_TRUE(manager.Create(SmallConfig(), "bob's own", "", "bob").ok());
     const absl::Status full = manager.Transfer(stored[0], "bob").status();

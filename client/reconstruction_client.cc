@@ -13,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "client/grpc_status.h"
 #include "client/proto_conversion.h"
+#include "core/status_macros.h"
 #include "proto/packing.h"
 
 namespace neuralmesh::client {
@@ -85,6 +86,23 @@ class ReconstructionClient::OpenCall {
   grpc::ClientContext& context_;
 };
 
+template <typename Request, typename Response>
+absl::StatusOr<Response> ReconstructionClient::UnaryCall(
+    grpc::Status (v1::ReconstructionService::Stub::*method)(grpc::ClientContext*, const Request&,
+                                                           Response*),
+    const Request& request, const char* name, const UnaryCallOptions& options) {
+  grpc::ClientContext context;
+  const OpenCall open(*this, context,
+                      options.runs_after_cancel_calls ? OpenCall::kRunsAfterCancelCalls
+                                                      : OpenCall::kEndedAfterCancelCalls);
+  SetDeadline(context, options.timeout);
+  context.set_wait_for_ready(options.wait_for_ready);
+  Response response;
+  const grpc::Status status = ((*stub_).*method)(&context, request, &response);
+  if (!status.ok()) return FromGrpcStatus(status, name);
+  return response;
+}
+
 absl::StatusOr<std::unique_ptr<ReconstructionClient>> ReconstructionClient::Connect(
     const std::string& address, const ClientOptions& options) {
   if (address.empty()) return absl::InvalidArgumentError("empty server address");
@@ -129,17 +147,12 @@ void ReconstructionClient::SetDeadline(grpc::ClientContext& context, absl::Durat
 absl::StatusOr<v1::Session> ReconstructionClient::CreateSession(const v1::SessionConfig& config,
                                                                 const std::string& name,
                                                                 const TriangleMesh* start_mesh) {
-  grpc::ClientContext context;
-  const OpenCall open(*this, context);
-  SetDeadline(context, options_.call_timeout);
   v1::CreateSessionRequest request;
   *request.mutable_config() = config;
   request.set_name(name);
   if (start_mesh != nullptr) *request.mutable_start_mesh() = ToProto(*start_mesh);
-  v1::Session session;
-  const grpc::Status status = stub_->CreateSession(&context, request, &session);
-  if (!status.ok()) return FromGrpcStatus(status, "CreateSession");
-  return session;
+  return UnaryCall(&v1::ReconstructionService::Stub::CreateSession, request, "CreateSession",
+                   {options_.call_timeout});
 }
 
 absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
@@ -288,16 +301,10 @@ absl::StatusOr<v1::Session> ReconstructionClient::AwaitSession(const std::string
 absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& session_id,
                                                              absl::Duration timeout,
                                                              bool wait_for_ready) {
-  grpc::ClientContext context;
-  const OpenCall open(*this, context);
-  SetDeadline(context, timeout);
-  context.set_wait_for_ready(wait_for_ready);
   v1::GetSessionRequest request;
   request.set_session_id(session_id);
-  v1::Session session;
-  const grpc::Status status = stub_->GetSession(&context, request, &session);
-  if (!status.ok()) return FromGrpcStatus(status, "GetSession");
-  return session;
+  return UnaryCall(&v1::ReconstructionService::Stub::GetSession, request, "GetSession",
+                   {timeout, wait_for_ready});
 }
 
 absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions() {
@@ -311,26 +318,18 @@ absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::AwaitSessions(
 
 absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions(
     absl::Duration timeout, bool wait_for_ready) {
-  grpc::ClientContext context;
-  const OpenCall open(*this, context);
-  SetDeadline(context, timeout);
-  context.set_wait_for_ready(wait_for_ready);
-  v1::ListSessionsResponse response;
-  const grpc::Status status = stub_->ListSessions(&context, v1::ListSessionsRequest(), &response);
-  if (!status.ok()) return FromGrpcStatus(status, "ListSessions");
+  NM_ASSIGN_OR_RETURN(const v1::ListSessionsResponse response,
+                      UnaryCall(&v1::ReconstructionService::Stub::ListSessions,
+                                v1::ListSessionsRequest(), "ListSessions",
+                                {timeout, wait_for_ready}));
   return std::vector<v1::Session>(response.sessions().begin(), response.sessions().end());
 }
 
 absl::StatusOr<v1::Session> ReconstructionClient::Finish(const std::string& session_id) {
-  grpc::ClientContext context;
-  const OpenCall open(*this, context);
-  SetDeadline(context, options_.call_timeout);
   v1::FinishSessionRequest request;
   request.set_session_id(session_id);
-  v1::Session session;
-  const grpc::Status status = stub_->FinishSession(&context, request, &session);
-  if (!status.ok()) return FromGrpcStatus(status, "FinishSession");
-  return session;
+  return UnaryCall(&v1::ReconstructionService::Stub::FinishSession, request, "FinishSession",
+                   {options_.call_timeout});
 }
 
 absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& session_id) {
@@ -339,55 +338,37 @@ absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& sess
 
 absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& session_id,
                                                          absl::Duration timeout) {
-  grpc::ClientContext context;
-  const OpenCall open(*this, context, OpenCall::kRunsAfterCancelCalls);
-  SetDeadline(context, timeout);
   v1::CancelSessionRequest request;
   request.set_session_id(session_id);
-  v1::Session session;
-  const grpc::Status status = stub_->CancelSession(&context, request, &session);
-  if (!status.ok()) return FromGrpcStatus(status, "CancelSession");
-  return session;
+  return UnaryCall(&v1::ReconstructionService::Stub::CancelSession, request, "CancelSession",
+                   {timeout, /*wait_for_ready=*/false, /*runs_after_cancel_calls=*/true});
 }
 
 absl::Status ReconstructionClient::Delete(const std::string& session_id) {
-  grpc::ClientContext context;
-  const OpenCall open(*this, context);
-  SetDeadline(context, options_.call_timeout);
   v1::DeleteSessionRequest request;
   request.set_session_id(session_id);
-  v1::DeleteSessionResponse response;
-  return FromGrpcStatus(stub_->DeleteSession(&context, request, &response), "DeleteSession");
+  return UnaryCall(&v1::ReconstructionService::Stub::DeleteSession, request, "DeleteSession",
+                   {options_.call_timeout})
+      .status();
 }
 
 absl::StatusOr<v1::Session> ReconstructionClient::Transfer(const std::string& session_id,
                                                            const std::string& new_owner) {
-  grpc::ClientContext context;
-  const OpenCall open(*this, context);
-  SetDeadline(context, options_.call_timeout);
   v1::TransferSessionRequest request;
   request.set_session_id(session_id);
   request.set_new_owner(new_owner);
-  v1::Session session;
-  const grpc::Status status = stub_->TransferSession(&context, request, &session);
-  if (!status.ok()) return FromGrpcStatus(status, "TransferSession");
-  return session;
+  return UnaryCall(&v1::ReconstructionService::Stub::TransferSession, request, "TransferSession",
+                   {options_.call_timeout});
 }
 
 absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& session_id,
                                                              v1::MeshVersion version, bool wait,
                                                              absl::Duration timeout) {
-  grpc::ClientContext context;
-  const OpenCall open(*this, context);
-  SetDeadline(context, timeout);
   v1::GetMeshRequest request;
   request.set_session_id(session_id);
   request.set_version(version);
   request.set_wait(wait);
-  v1::MeshUpdate update;
-  const grpc::Status status = stub_->GetMesh(&context, request, &update);
-  if (!status.ok()) return FromGrpcStatus(status, "GetMesh");
-  return update;
+  return UnaryCall(&v1::ReconstructionService::Stub::GetMesh, request, "GetMesh", {timeout});
 }
 
 bool ReconstructionClient::calls_cancelled() const {

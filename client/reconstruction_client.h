@@ -176,6 +176,21 @@ class ReconstructionClient {
   // Registers a call's context for CancelCalls while the call is open.
   class OpenCall;
 
+  // How a unary call is made: its deadline (none when infinite), whether it waits for the
+  // channel to become ready, and whether it goes on after CancelCalls or is ended at once.
+  struct UnaryCallOptions {
+    absl::Duration timeout;
+    bool wait_for_ready = false;
+    bool runs_after_cancel_calls = false;
+  };
+  // Makes the unary call `method` of the stub with `request`; a failure's message names the
+  // call `name` (FromGrpcStatus).
+  template <typename Request, typename Response>
+  absl::StatusOr<Response> UnaryCall(
+      grpc::Status (v1::ReconstructionService::Stub::*method)(grpc::ClientContext*,
+                                                             const Request&, Response*),
+      const Request& request, const char* name, const UnaryCallOptions& options);
+
   absl::StatusOr<v1::Session> GetSession(const std::string& session_id, absl::Duration timeout,
                                          bool wait_for_ready);
   absl::StatusOr<std::vector<v1::Session>> ListSessions(absl::Duration timeout,

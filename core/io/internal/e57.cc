@@ -43,9 +43,6 @@ absl::Status Invalid(absl::string_view what) {
 uint64_t Load64(absl::string_view bytes, size_t at) {
   return LoadScalar<uint64_t>(bytes.data() + at, /*big_endian=*/false);
 }
-uint16_t Load16(absl::string_view bytes, size_t at) {
-  return LoadScalar<uint16_t>(bytes.data() + at, /*big_endian=*/false);
-}
 
 // ---- The XML tree --------------------------------------------------------------------------
 
@@ -106,11 +103,11 @@ struct Field {
   int bits = 0;
   bool single = false;  // Float: 4 bytes each, not 8.
 
-  // The bytes `records` values take in the field's bytestream, or 0 where that is unknown.
-  uint64_t BytesFor(uint64_t records) const {
-    if (kind == Kind::kFloat) return records * (single ? 4 : 8);
-    if (kind == Kind::kInteger) return (records * bits + 7) / 8;
-    return 0;
+  // The bits a value takes in the field's bytestream; 0 for a constant, and for a field that is
+  // not read (a String).
+  int Width() const {
+    if (kind == Kind::kFloat) return single ? 32 : 64;
+    return kind == Kind::kInteger ? bits : 0;
   }
 };
 
@@ -169,7 +166,7 @@ absl::Status CollectFields(const XmlElement& node, absl::string_view scan,
     } else if (*type == "Float") {
       field.kind = Field::Kind::kFloat;
       const std::string* precision = child.Attribute("precision");
-      field.single = precision != nullptr && *precision == "single";
+      field.single = precision != nullptr && absl::EqualsIgnoreCase(*precision, "single");
     }
     fields->push_back(std::move(field));
   }
@@ -178,81 +175,90 @@ absl::Status CollectFields(const XmlElement& node, absl::string_view scan,
 
 // ---- The compressed vector of a scan's points ----------------------------------------------
 
-// The bytestreams of the compressed vector section at physical offset `file_offset`, one per
-// field, each the concatenation of its buffers in the section's data packets; read until every
-// field holds `records` values or the section ends.
-absl::StatusOr<std::vector<std::string>> ReadBytestreams(absl::string_view logical,
-                                                         uint64_t file_offset, uint64_t records,
-                                                         const std::vector<Field>& fields,
-                                                         absl::string_view scan) {
-  std::vector<std::string> streams(fields.size());
-  if (records == 0) return streams;
-  const uint64_t start = E57LogicalOffset(file_offset);
-  if (IsE57Checksum(file_offset) || start > logical.size() ||
-      logical.size() - start < kSectionHeaderSize) {
-    return Invalid(absl::StrCat(scan, "'s points begin at byte ", file_offset,
-                                ", where the file holds no section"));
-  }
-  if (static_cast<uint8_t>(logical[start]) != kCompressedVectorSection) {
-    return Invalid(absl::StrCat(scan, "'s points at byte ", file_offset,
-                                " are not a compressed vector section"));
-  }
-  const uint64_t length = Load64(logical, start + 8);
-  const uint64_t data_offset = Load64(logical, start + 16);
-  if (length > logical.size() - start) {
-    return Invalid(absl::StrCat(scan, "'s section of ", length, " bytes runs past the file"));
-  }
-  const uint64_t end = start + length;
-  uint64_t at = E57LogicalOffset(data_offset);
-  if (IsE57Checksum(data_offset) || at < start + kSectionHeaderSize || at > end) {
-    return Invalid(absl::StrCat(scan, "'s first data packet, at byte ", data_offset,
-                                ", lies outside its section"));
-  }
-  std::vector<uint64_t> needed(fields.size());
-  for (size_t f = 0; f < fields.size(); ++f) needed[f] = fields[f].BytesFor(records);
-  const auto complete = [&] {
-    for (size_t f = 0; f < fields.size(); ++f) {
-      if (streams[f].size() < needed[f]) return false;
+// The data packets of a scan's compressed vector section, read one after another.
+class DataPackets {
+ public:
+  // The section at physical offset `file_offset`, of a prototype of `fields` fields.
+  static absl::StatusOr<DataPackets> Open(const E57LogicalView& file, uint64_t file_offset,
+                                          size_t fields, absl::string_view scan) {
+    const uint64_t start = E57LogicalOffset(file_offset);
+    if (IsE57Checksum(file_offset) || start > file.size() ||
+        file.size() - start < kSectionHeaderSize) {
+      return Invalid(absl::StrCat(scan, "'s points begin at byte ", file_offset,
+                                  ", where the file holds no section"));
     }
-    return true;
-  };
-  while (!complete()) {
-    if (end - at < 4) {
-      return Invalid(absl::StrCat(scan, "'s section ends before its ", records,
-                                  " records (its packets are missing or short)"));
+    if (file.LoadLittleEndian(start, 1) != kCompressedVectorSection) {
+      return Invalid(absl::StrCat(scan, "'s points at byte ", file_offset,
+                                  " are not a compressed vector section"));
     }
-    const uint8_t type = static_cast<uint8_t>(logical[at]);
-    const uint64_t packet_length = uint64_t{Load16(logical, at + 2)} + 1;
-    if (packet_length > end - at) {
-      return Invalid(
-          absl::StrCat(scan, "'s packet at logical byte ", at, " runs past its section"));
+    const uint64_t length = file.LoadLittleEndian(start + 8, 8);
+    const uint64_t data_offset = file.LoadLittleEndian(start + 16, 8);
+    if (length > file.size() - start) {
+      return Invalid(absl::StrCat(scan, "'s section of ", length, " bytes runs past the file"));
     }
-    if (type == kDataPacket) {
-      const size_t count = packet_length >= kDataPacketHeaderSize ? Load16(logical, at + 4) : 0;
-      if (count != fields.size()) {
-        return Invalid(absl::StrCat(scan, "'s data packet holds ", count,
-                                    " bytestreams where its prototype declares ", fields.size(),
+    const uint64_t at = E57LogicalOffset(data_offset);
+    if (IsE57Checksum(data_offset) || at < start + kSectionHeaderSize || at > start + length) {
+      return Invalid(absl::StrCat(scan, "'s first data packet, at byte ", data_offset,
+                                  ", lies outside its section"));
+    }
+    return DataPackets(file, at, start + length, fields, scan);
+  }
+
+  // Reads up to the next data packet (past index and empty ones) and appends its buffer of each
+  // field f to *into[f] where that is not null. INVALID_ARGUMENT at the end of the section, for
+  // a packet that runs past it, of an unknown type, or whose number of buffers is not the
+  // prototype's.
+  absl::Status Next(const std::vector<std::string*>& into) {
+    while (true) {
+      if (end_ - at_ < 4) {
+        return Invalid(absl::StrCat(scan_, "'s section ends before all its records (its packets ",
+                                    "are missing or short)"));
+      }
+      const uint64_t type = file_->LoadLittleEndian(at_, 1);
+      const uint64_t length = file_->LoadLittleEndian(at_ + 2, 2) + 1;
+      if (length > end_ - at_) {
+        return Invalid(
+            absl::StrCat(scan_, "'s packet at logical byte ", at_, " runs past its section"));
+      }
+      const uint64_t packet = at_;
+      at_ += length;
+      if (type == kIndexPacket || type == kEmptyPacket) continue;
+      if (type != kDataPacket) {
+        return Invalid(absl::StrCat(scan_, "'s section holds a packet of unknown type ", type));
+      }
+      const uint64_t count =
+          length >= kDataPacketHeaderSize ? file_->LoadLittleEndian(packet + 4, 2) : 0;
+      if (count != fields_) {
+        return Invalid(absl::StrCat(scan_, "'s data packet holds ", count,
+                                    " bytestreams where its prototype declares ", fields_,
                                     " fields"));
       }
-      uint64_t buffer = at + kDataPacketHeaderSize + 2 * count;
-      if (buffer > at + packet_length) {
-        return Invalid(absl::StrCat(scan, "'s data packet is shorter than its header"));
+      uint64_t buffer = packet + kDataPacketHeaderSize + 2 * count;
+      if (buffer > packet + length) {
+        return Invalid(absl::StrCat(scan_, "'s data packet is shorter than its header"));
       }
       for (size_t f = 0; f < count; ++f) {
-        const uint64_t size = Load16(logical, at + kDataPacketHeaderSize + 2 * f);
-        if (size > at + packet_length - buffer) {
-          return Invalid(absl::StrCat(scan, "'s data packet's buffers run past its end"));
+        const uint64_t size = file_->LoadLittleEndian(packet + kDataPacketHeaderSize + 2 * f, 2);
+        if (size > packet + length - buffer) {
+          return Invalid(absl::StrCat(scan_, "'s data packet's buffers run past its end"));
         }
-        streams[f].append(logical.data() + buffer, size);
+        if (into[f] != nullptr) file_->Append(buffer, size, into[f]);
         buffer += size;
       }
-    } else if (type != kIndexPacket && type != kEmptyPacket) {
-      return Invalid(absl::StrCat(scan, "'s section holds a packet of unknown type ", type));
+      return absl::OkStatus();
     }
-    at += packet_length;
   }
-  return streams;
-}
+
+ private:
+  DataPackets(const E57LogicalView& file, uint64_t at, uint64_t end, size_t fields,
+              absl::string_view scan)
+      : file_(&file), at_(at), end_(end), fields_(fields), scan_(scan) {}
+
+  const E57LogicalView* file_;
+  uint64_t at_, end_;  // The next packet and the section's end, logical.
+  size_t fields_;
+  std::string scan_;
+};
 
 // The integer packed at bit `bit` of `bytes`, `bits` wide, least significant bit first (E57's
 // bitpack codec).
@@ -272,21 +278,44 @@ uint64_t Unpack(absl::string_view bytes, uint64_t bit, int bits) {
   return bits == 64 ? value : value & ((uint64_t{1} << bits) - 1);
 }
 
-// Reads the values of one decoded field, by record.
+// What has arrived of one field's bytestream and is not decoded yet: values from bit
+// `first_bit` of `bytes` on.
+struct FieldStream {
+  std::string bytes;
+  uint64_t first_bit = 0;
+
+  // The number of whole values held.
+  uint64_t Values(const Field& field) const {
+    if (field.Width() == 0) return std::numeric_limits<uint64_t>::max();
+    return (bytes.size() * 8 - first_bit) / field.Width();
+  }
+  // Drops the first `values` values.
+  void Consume(const Field& field, uint64_t values) {
+    first_bit += values * field.Width();
+    bytes.erase(0, first_bit / 8);
+    first_bit %= 8;
+  }
+};
+
+// Reads the values a field's stream holds, by their index among them; `first_record` numbers
+// the first for messages.
 class FieldValues {
  public:
-  FieldValues(const Field& field, absl::string_view bytes) : field_(field), bytes_(bytes) {}
+  FieldValues(const Field& field, const FieldStream& stream, uint64_t first_record)
+      : field_(field), stream_(stream), first_record_(first_record) {}
 
-  absl::StatusOr<double> operator[](uint64_t record) const {
+  absl::StatusOr<double> operator[](uint64_t i) const {
+    const absl::string_view bytes = stream_.bytes;
     if (field_.kind == Field::Kind::kFloat) {
-      if (field_.single) return LoadScalar<float>(bytes_.data() + 4 * record, false);
-      return LoadScalar<double>(bytes_.data() + 8 * record, false);
+      const char* at = bytes.data() + stream_.first_bit / 8;
+      if (field_.single) return LoadScalar<float>(at + 4 * i, false);
+      return LoadScalar<double>(at + 8 * i, false);
     }
     uint64_t packed = 0;
     if (field_.bits > 0) {
-      packed = Unpack(bytes_, record * field_.bits, field_.bits);
+      packed = Unpack(bytes, stream_.first_bit + i * field_.bits, field_.bits);
       if (packed > static_cast<uint64_t>(field_.maximum) - static_cast<uint64_t>(field_.minimum)) {
-        return Invalid(absl::StrCat("record ", record, " of field ", field_.name,
+        return Invalid(absl::StrCat("record ", first_record_ + i, " of field ", field_.name,
                                     " is beyond the field's maximum ", field_.maximum));
       }
     }
@@ -296,7 +325,8 @@ class FieldValues {
 
  private:
   const Field& field_;
-  absl::string_view bytes_;
+  const FieldStream& stream_;
+  uint64_t first_record_;
 };
 
 // ---- One scan ------------------------------------------------------------------------------
@@ -412,7 +442,7 @@ struct Gathered {
   PointsLeftOut left_out;
 };
 
-absl::Status ReadScan(absl::string_view logical, const XmlElement& scan_element,
+absl::Status ReadScan(const E57LogicalView& file, const XmlElement& scan_element,
                       absl::string_view scan, Gathered* out) {
   const XmlElement* points = scan_element.Child("points");
   if (points == nullptr) return Invalid(absl::StrCat(scan, " has no points"));
@@ -452,75 +482,96 @@ absl::Status ReadScan(absl::string_view logical, const XmlElement& scan_element,
   // Every record takes at least one bit of a stream or else its values are all one constant;
   // a count no stream could hold is a damaged header, not a reason to allocate.
   uint64_t bits_per_record = 0;
-  for (const Field& field : fields) {
-    bits_per_record += field.kind == Field::Kind::kFloat ? (field.single ? 32 : 64) : field.bits;
-  }
+  for (const Field& field : fields) bits_per_record += field.Width();
   if (bits_per_record == 0 ? records > (uint64_t{1} << 24)
-                           : records > logical.size() * 8 / bits_per_record) {
+                           : records > file.size() * 8 / bits_per_record) {
     return Invalid(absl::StrCat(scan, " claims ", records, " records, more than the file holds"));
   }
-  NM_ASSIGN_OR_RETURN(const std::vector<std::string> streams,
-                      ReadBytestreams(logical, file_offset, records, fields, scan));
   NM_ASSIGN_OR_RETURN(const Pose pose, ReadPose(scan_element, scan));
   std::array<std::pair<double, double>, 3> color_limits;
   for (int c = 0; colors && c < 3; ++c) {
     NM_ASSIGN_OR_RETURN(color_limits[c], ColorLimits(scan_element, fields[(*colors)[c]], c, scan));
   }
-  const auto values = [&](int f) { return FieldValues(fields[f], streams[f]); };
   out->colored = out->colored && colors.has_value();
   out->with_normals = out->with_normals && normals.has_value();
 
+  // The fields read, whose streams are kept as the packets bring them, decoded as soon as all
+  // of them hold the next records and dropped then: a scan never sits in memory whole.
+  std::vector<int> read(coordinates.begin(), coordinates.end());
+  for (int f : {invalid_state, color_invalid}) {
+    if (f >= 0) read.push_back(f);
+  }
+  if (out->colored) read.insert(read.end(), colors->begin(), colors->end());
+  if (out->with_normals) read.insert(read.end(), normals->begin(), normals->end());
+  std::vector<FieldStream> streams(fields.size());
+  std::vector<std::string*> into(fields.size(), nullptr);
+  for (int f : read) into[f] = &streams[f].bytes;
+  std::optional<DataPackets> packets;
   out->positions.Reserve(out->positions.size() + records);
-  for (uint64_t i = 0; i < records; ++i) {
-    if (invalid_state >= 0) {
-      NM_ASSIGN_OR_RETURN(const double state, values(invalid_state)[i]);
-      if (state != 0) {
-        ++out->left_out.invalid;
-        continue;
+  for (uint64_t done = 0; done < records;) {
+    uint64_t ready = records - done;
+    for (int f : read) ready = std::min(ready, streams[f].Values(fields[f]));
+    if (ready == 0) {
+      if (!packets.has_value()) {
+        NM_ASSIGN_OR_RETURN(packets, DataPackets::Open(file, file_offset, fields.size(), scan));
       }
+      NM_RETURN_IF_ERROR(packets->Next(into));
+      continue;
     }
-    Point3d local;
-    for (int c = 0; c < 3; ++c) {
-      NM_ASSIGN_OR_RETURN(local[c], values(coordinates[c])[i]);
-    }
-    if (!cartesian) {
-      const double range = local[0], azimuth = local[1], elevation = local[2];
-      local = {range * std::cos(elevation) * std::cos(azimuth),
-               range * std::cos(elevation) * std::sin(azimuth), range * std::sin(elevation)};
-    }
-    Point3d p = pose.Rotate(local);
-    for (int c = 0; c < 3; ++c) {
-      p[c] += pose.translation[c];
-      if (!(std::fabs(p[c]) <= std::numeric_limits<float>::max())) {
-        return Invalid(absl::StrCat("point ", i, " of ", scan,
-                                    " is not finite or lies beyond a float's range"));
+    const auto values = [&](int f) { return FieldValues(fields[f], streams[f], done); };
+    for (uint64_t i = 0; i < ready; ++i) {
+      if (invalid_state >= 0) {
+        NM_ASSIGN_OR_RETURN(const double state, values(invalid_state)[i]);
+        if (state != 0) {
+          ++out->left_out.invalid;
+          continue;
+        }
       }
-    }
-    out->positions.Add(p);
-    if (out->colored) {
-      if (color_invalid >= 0) {
-        NM_ASSIGN_OR_RETURN(const double flag, values(color_invalid)[i]);
-        out->colored = flag == 0;
-      }
-      Rgb color;
+      Point3d local;
       for (int c = 0; c < 3; ++c) {
-        NM_ASSIGN_OR_RETURN(const double level, values((*colors)[c])[i]);
-        const auto [low, high] = color_limits[c];
-        color[c] = high > low ? ChannelFromLevel(level - low, high - low) : 0;
+        NM_ASSIGN_OR_RETURN(local[c], values(coordinates[c])[i]);
       }
-      out->colors.push_back(color);
-    }
-    if (out->with_normals) {
-      Point3d n;
+      if (!cartesian) {
+        const double range = local[0], azimuth = local[1], elevation = local[2];
+        local = {range * std::cos(elevation) * std::cos(azimuth),
+                 range * std::cos(elevation) * std::sin(azimuth), range * std::sin(elevation)};
+      }
+      Point3d p = pose.Rotate(local);
       for (int c = 0; c < 3; ++c) {
-        NM_ASSIGN_OR_RETURN(n[c], values((*normals)[c])[i]);
+        p[c] += pose.translation[c];
+        if (!(std::fabs(p[c]) <= std::numeric_limits<float>::max())) {
+          return Invalid(absl::StrCat("point ", done + i, " of ", scan,
+                                      " is not finite or lies beyond a float's range"));
+        }
       }
-      n = pose.Rotate(n);
-      out->normals.emplace_back(NarrowToFloat(n[0]), NarrowToFloat(n[1]), NarrowToFloat(n[2]));
-      out->with_normals = std::isfinite(out->normals.back()[0]) &&
-                          std::isfinite(out->normals.back()[1]) &&
-                          std::isfinite(out->normals.back()[2]);
+      out->positions.Add(p);
+      if (out->colored) {
+        if (color_invalid >= 0) {
+          NM_ASSIGN_OR_RETURN(const double flag, values(color_invalid)[i]);
+          out->colored = flag == 0;
+        }
+        Rgb color;
+        for (int c = 0; c < 3; ++c) {
+          NM_ASSIGN_OR_RETURN(const double level, values((*colors)[c])[i]);
+          const auto [low, high] = color_limits[c];
+          color[c] = high > low ? ChannelFromLevel(level - low, high - low) : 0;
+        }
+        out->colors.push_back(color);
+      }
+      if (out->with_normals) {
+        Point3d n;
+        for (int c = 0; c < 3; ++c) {
+          NM_ASSIGN_OR_RETURN(n[c], values((*normals)[c])[i]);
+        }
+        n = pose.Rotate(n);
+        out->normals.emplace_back(NarrowToFloat(n[0]), NarrowToFloat(n[1]), NarrowToFloat(n[2]));
+        out->with_normals = std::isfinite(out->normals.back()[0]) &&
+                            std::isfinite(out->normals.back()[1]) &&
+                            std::isfinite(out->normals.back()[2]);
+      }
     }
+    for (int f : read) streams[f].Consume(fields[f], ready);
+    done += ready;
   }
   return absl::OkStatus();
 }
@@ -637,16 +688,18 @@ absl::StatusOr<ParsedGeometry> ParseE57(absl::string_view data) {
     return Invalid(absl::StrCat("the header says the file has ", physical_length,
                                 " bytes, but it has ", data.size(), " (truncated?)"));
   }
-  NM_ASSIGN_OR_RETURN(const std::string logical, E57LogicalBytes(data));
+  NM_ASSIGN_OR_RETURN(const E57LogicalView file, E57LogicalView::Open(data));
   const uint64_t xml_start = E57LogicalOffset(xml_offset);
-  if (IsE57Checksum(xml_offset) || xml_start > logical.size() ||
-      xml_length > logical.size() - xml_start) {
+  if (IsE57Checksum(xml_offset) || xml_start > file.size() ||
+      xml_length > file.size() - xml_start) {
     return Invalid("the XML section's offset and length lie beyond the file");
   }
-  absl::StatusOr<XmlElement> parsed =
-      ParseXml(absl::string_view(logical).substr(xml_start, xml_length));
-  if (!parsed.ok())
+  std::string xml;
+  file.Append(xml_start, xml_length, &xml);
+  absl::StatusOr<XmlElement> parsed = ParseXml(xml);
+  if (!parsed.ok()) {
     return Invalid(absl::StrCat("its XML is malformed: ", parsed.status().message()));
+  }
   const XmlElement& root = *parsed;
   if (root.name != "e57Root") {
     return Invalid(absl::StrCat("the XML's root element is <", root.name, ">, not <e57Root>"));
@@ -657,7 +710,7 @@ absl::StatusOr<ParsedGeometry> ParseE57(absl::string_view data) {
   int scans = 0;
   for (const XmlElement& scan_element : data3d->children) {
     const std::string scan = absl::StrCat("scan ", scans++);
-    NM_RETURN_IF_ERROR(ReadScan(logical, scan_element, scan, &gathered));
+    NM_RETURN_IF_ERROR(ReadScan(file, scan_element, scan, &gathered));
   }
   if (scans == 0) return Invalid("the file holds no 3D scans (data3D is empty)");
   if (gathered.positions.size() == 0 && gathered.left_out.invalid > 0) {

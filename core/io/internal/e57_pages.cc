@@ -1,5 +1,6 @@
 #include "core/io/internal/e57_pages.h"
 
+#include <algorithm>
 #include <array>
 
 #include "absl/strings/str_cat.h"
@@ -32,26 +33,40 @@ uint32_t Crc32c(absl::string_view data) {
   return crc ^ 0xFFFFFFFFu;
 }
 
-absl::StatusOr<std::string> E57LogicalBytes(absl::string_view file) {
+absl::StatusOr<E57LogicalView> E57LogicalView::Open(absl::string_view file) {
   if (file.empty() || file.size() % kE57PageSize != 0) {
     return absl::InvalidArgumentError(absl::StrCat("E57: the file's ", file.size(),
                                                    " bytes are not a whole number of ",
                                                    kE57PageSize, "-byte pages (truncated?)"));
   }
-  std::string logical;
-  logical.reserve(file.size() / kE57PageSize * kE57PageDataSize);
   for (uint64_t page = 0; page < file.size() / kE57PageSize; ++page) {
-    const absl::string_view data = file.substr(page * kE57PageSize, kE57PageDataSize);
     std::string expected;
-    AppendChecksum(Crc32c(data), &expected);
+    AppendChecksum(Crc32c(file.substr(page * kE57PageSize, kE57PageDataSize)), &expected);
     if (file.substr(page * kE57PageSize + kE57PageDataSize, 4) != expected) {
       return absl::InvalidArgumentError(absl::StrCat(
           "E57: the checksum of page ", page, " (bytes ", page * kE57PageSize, " to ",
           (page + 1) * kE57PageSize - 1, ") does not match its data: the file is damaged"));
     }
-    logical.append(data.data(), data.size());
   }
-  return logical;
+  return E57LogicalView(file);
+}
+
+void E57LogicalView::Append(uint64_t offset, uint64_t count, std::string* out) const {
+  while (count > 0) {
+    const uint64_t in_page = offset % kE57PageDataSize;
+    const uint64_t n = std::min(count, kE57PageDataSize - in_page);
+    out->append(file_.data() + E57PhysicalOffset(offset), n);
+    offset += n;
+    count -= n;
+  }
+}
+
+uint64_t E57LogicalView::LoadLittleEndian(uint64_t offset, int bytes) const {
+  std::string data;
+  Append(offset, bytes, &data);
+  uint64_t value = 0;
+  for (int b = bytes - 1; b >= 0; --b) value = value << 8 | static_cast<uint8_t>(data[b]);
+  return value;
 }
 
 std::string E57Pages(absl::string_view logical) {

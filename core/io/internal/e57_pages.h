@@ -29,10 +29,27 @@ inline uint64_t E57PhysicalOffset(uint64_t logical) {
 // Whether physical offset `physical` falls on a page's checksum.
 inline bool IsE57Checksum(uint64_t physical) { return physical % kE57PageSize >= kE57PageDataSize; }
 
-// The logical bytes of a whole file, each page's checksum verified. Returns INVALID_ARGUMENT
-// for a file that is not a whole number of pages or a page whose checksum does not match
-// (naming the page: the file is damaged).
-absl::StatusOr<std::string> E57LogicalBytes(absl::string_view file);
+// The logical bytes of a file, read where they lie: copies out of it skip the checksums.
+class E57LogicalView {
+ public:
+  // Checks every page's checksum first. Returns INVALID_ARGUMENT for a file that is not a whole
+  // number of pages or a page whose checksum does not match (naming the page: the file is
+  // damaged).
+  static absl::StatusOr<E57LogicalView> Open(absl::string_view file);
+
+  uint64_t size() const { return size_; }
+  // Appends the logical bytes [offset, offset + count), which must lie within size(), to `out`.
+  void Append(uint64_t offset, uint64_t count, std::string* out) const;
+  // The little-endian integer of `bytes` bytes at `offset` (its bytes within size()).
+  uint64_t LoadLittleEndian(uint64_t offset, int bytes) const;
+
+ private:
+  explicit E57LogicalView(absl::string_view file)
+      : file_(file), size_(file.size() / kE57PageSize * kE57PageDataSize) {}
+
+  absl::string_view file_;
+  uint64_t size_;
+};
 
 // The pages of a file whose logical bytes are `logical`: zero-padded to a whole page, each page
 // followed by its checksum.

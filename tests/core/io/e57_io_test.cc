@@ -279,7 +279,7 @@ TEST(E57IoTest, DamagedAndMalformedFilesAreRefusedWithWhatIsWrong) {
       "the XML has no data3D element",
       "the file holds no 3D scans",
       "record 1 of field cartesianZ is beyond the field's maximum 5",
-      "scan 0's section ends before its 3 records",
+      "scan 0's section ends before all its records",
       "scan 0 has a cartesianY field but no cartesianX",
       "scan 0 has neither cartesian nor spherical coordinates",
       "all 2 points are marked invalid",

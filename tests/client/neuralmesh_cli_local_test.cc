@@ -17,6 +17,7 @@
 #include "core/io/point_cloud_io.h"
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
+#include "tests/testing/e57_file.h"
 #include "tests/testing/las_file.h"
 #include "tests/testing/shapes.h"
 
@@ -637,6 +638,76 @@ TEST_F(LocalCliTest, PtxScansAreReconstructedInTheirRegisteredFrame) {
   const std::string mesh = *dir_ + "/scans.ply";
   const RunResult run = RunNeuralmesh({"reconstruct", path, "-o", mesh, "--vertices", "800"});
   ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "coordinates taken relative to (500000, 4100000, 0)"))
+      << run.out;
+  const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);
+  ASSERT_TRUE(learned.ok()) << learned.status();
+  EXPECT_EQ(learned->positions.size(), 800u);
+  for (const Vec3f& v : learned->positions) {
+    double squared = 0;
+    for (int c = 0; c < 3; ++c) squared += std::pow(learned->origin[c] + v[c] - centre[c], 2);
+    ASSERT_NEAR(std::sqrt(squared), 10.0, 0.3) << "a vertex off the sphere";
+  }
+}
+
+// Two scanner stations of an E57 file, each holding its points as a scanner measures them:
+// range (in 20 bits, steps of 0.1 mm), azimuth and elevation from the station, placed
+// by its pose; a few returns that never came back are marked invalid.
+TEST_F(LocalCliTest, E57ScansInSphericalCoordinatesAreReconstructedWhereTheirPosesPutThem) {
+  const PointCloud unit = ColoredUnitSpherePoints(12000, 8);
+  const double centre[3] = {500123.5, 4100456.25, 80};
+  // Station 0 stands 25 m west of the centre; station 1 30 m east, turned 90 degrees about z.
+  const double stations[2][3] = {{500098.5, 4100456.25, 80}, {500153.5, 4100456.25, 80}};
+  const double turn[2] = {0, M_PI / 2};
+  std::vector<testing::E57Scan> scans(2);
+  for (int s = 0; s < 2; ++s) {
+    std::vector<uint64_t> ranges, states;
+    std::vector<double> azimuths, elevations;
+    const size_t first = s == 0 ? 0 : unit.size() / 2;
+    const size_t last = s == 0 ? unit.size() / 2 : unit.size();
+    for (size_t i = first; i < last; ++i) {
+      double d[3];
+      for (int c = 0; c < 3; ++c) d[c] = centre[c] + 10 * unit.positions[i][c] - stations[s][c];
+      // The station's frame: the registered offset turned back by its rotation.
+      const double x = std::cos(turn[s]) * d[0] + std::sin(turn[s]) * d[1];
+      const double y = -std::sin(turn[s]) * d[0] + std::cos(turn[s]) * d[1];
+      const double range = std::sqrt(x * x + y * y + d[2] * d[2]);
+      ranges.push_back(static_cast<uint64_t>(std::llround(range / 0.0001)));
+      azimuths.push_back(std::atan2(y, x));
+      elevations.push_back(std::asin(d[2] / range));
+      states.push_back(0);
+    }
+    for (int k = 0; k < 25; ++k) {  // No return: no range, a direction only.
+      ranges.push_back(0);
+      azimuths.push_back(0.01 * k);
+      elevations.push_back(0);
+      states.push_back(1);
+    }
+    testing::E57Scan& scan = scans[s];
+    scan.records = ranges.size();
+    scan.fields = {
+        {"<sphericalRange type=\"ScaledInteger\" minimum=\"0\" maximum=\"1000000\" "
+         "scale=\"0.0001\"/>",
+         testing::E57PackBits(ranges, 20)},
+        {"<sphericalAzimuth type=\"Float\"/>", testing::E57Floats(azimuths)},
+        {"<sphericalElevation type=\"Float\"/>", testing::E57Floats(elevations)},
+        {"<sphericalInvalidState type=\"Integer\" minimum=\"0\" maximum=\"2\"/>",
+         testing::E57PackBits(states, 2)}};
+    scan.bytes_per_packet = 16000;
+    scan.elements = absl::StrFormat(
+        "<pose type=\"Structure\"><rotation type=\"Structure\"><w type=\"Float\">%.17g</w>"
+        "<z type=\"Float\">%.17g</z></rotation><translation type=\"Structure\">"
+        "<x type=\"Float\">%.17g</x><y type=\"Float\">%.17g</y><z type=\"Float\">%.17g</z>"
+        "</translation></pose>",
+        std::cos(turn[s] / 2), std::sin(turn[s] / 2), stations[s][0], stations[s][1],
+        stations[s][2]);
+  }
+  const std::string path = *dir_ + "/stations.e57";
+  ASSERT_TRUE(WriteFileContents(path, testing::E57File(scans)).ok());
+  const std::string mesh = *dir_ + "/stations.ply";
+  const RunResult run = RunNeuralmesh({"reconstruct", path, "-o", mesh, "--vertices", "800"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "left out 50 points without a position")) << run.out;
   EXPECT_TRUE(absl::StrContains(run.out, "coordinates taken relative to (500000, 4100000, 0)"))
       << run.out;
   const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);

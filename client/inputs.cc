@@ -14,6 +14,7 @@
 #include "client/file_util.h"
 #include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
+#include "core/io/point_cloud_merge.h"
 #include "core/sampling/mesh_sampler.h"
 #include "core/sampling/point_cloud_sampler.h"
 #include "core/sampling/sample_points.h"
@@ -66,16 +67,24 @@ absl::StatusOr<std::string> UseColors(absl::StatusOr<std::unique_ptr<ColorSource
   return std::string(", with colours");
 }
 
-absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMode mode,
+absl::StatusOr<TargetSpace> LoadTargetSpace(const std::vector<std::string>& inputs,
+                                            SamplingMode mode,
                                             const std::optional<OutlierOptions>& outliers,
                                             const std::optional<PointColorOptions>& colors) {
+  if (inputs.empty()) return absl::InvalidArgumentError("INPUT is required");
+  const std::string& input = inputs.front();
   TargetSpace target;
-  if (outliers.has_value() &&
-      (IsBuiltin(input) || mode == SamplingMode::kArea || mode == SamplingMode::kCurvature)) {
+  if (inputs.size() > 1 && (mode == SamplingMode::kArea || mode == SamplingMode::kCurvature)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--sampling ", ModeName(mode), " samples one mesh; several INPUTs are ",
+                     "point cloud files learned as one (uniform or weighted sampling)"));
+  }
+  if (outliers.has_value() && ((inputs.size() == 1 && IsBuiltin(input)) ||
+                               mode == SamplingMode::kArea || mode == SamplingMode::kCurvature)) {
     return absl::InvalidArgumentError(
         "--remove_outliers applies to point cloud inputs (uniform or weighted sampling)");
   }
-  if (IsBuiltin(input)) {
+  if (inputs.size() == 1 && IsBuiltin(input)) {
     if (mode != SamplingMode::kUniform) {
       return absl::InvalidArgumentError(
           absl::StrCat("--sampling ", ModeName(mode), " does not apply to ", input,
@@ -113,48 +122,96 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::string& input, SamplingMo
     return target;
   }
   PointsLeftOut left_out;
-  NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(input, "INPUT", &left_out));
+  std::string merge_note;
+  NM_ASSIGN_OR_RETURN(PointCloud cloud,
+                      LoadPointClouds(inputs, "INPUT", &left_out, &merge_note));
+  const std::string names = absl::StrJoin(inputs, ", ");
   if (mode == SamplingMode::kWeighted && cloud.weights.empty()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("INPUT '", input, "' has no per-point weights for --sampling weighted"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "INPUT ", QuotedInputs(inputs), " has no per-point weights for --sampling weighted"));
   }
   const size_t points = cloud.size();
-  const std::string notes = absl::StrCat(LeftOutNote(left_out), OriginNote(cloud.origin));
+  const std::string notes =
+      absl::StrCat(merge_note, LeftOutNote(left_out), OriginNote(cloud.origin));
   target.origin = cloud.origin;
   std::string removed_outliers;
   if (outliers.has_value()) {
     absl::StatusOr<size_t> removed = RemoveStatisticalOutliers(cloud, *outliers);
-    if (!removed.ok()) return InFile(removed.status(), "INPUT", input);
+    if (!removed.ok()) return InFile(removed.status(), "INPUT", names);
     removed_outliers = absl::StrCat(", outliers removed: ", *removed);
   }
   std::string with_colors;
   if (colors.has_value() && !cloud.colors.empty()) {
     NM_ASSIGN_OR_RETURN(with_colors,
-                        UseColors(MakePointColorSource(cloud, *colors), input, target));
+                        UseColors(MakePointColorSource(cloud, *colors), names, target));
   }
   auto shared = std::make_shared<const PointCloud>(std::move(cloud));
   absl::StatusOr<std::unique_ptr<Sampler>> sampler = mode == SamplingMode::kWeighted
                                                          ? WeightedPointCloudSampler::Create(shared)
                                                          : UniformPointCloudSampler::Create(shared);
-  if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
+  if (!sampler.ok()) return InFile(sampler.status(), "INPUT", names);
   target.sampler = *std::move(sampler);
-  target.description = absl::StrCat(points, " points of ", input, " (", ModeName(mode), " sampling",
+  target.description = absl::StrCat(points, " points of ", names, " (", ModeName(mode), " sampling",
                                     removed_outliers, with_colors, notes, ")");
   return target;
 }
 
-absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t builtin_points,
-                                               uint64_t seed, PointsLeftOut* left_out) {
-  if (IsBuiltin(input)) {
+absl::StatusOr<PointCloud> LoadPointsForUpload(const std::vector<std::string>& inputs,
+                                               size_t builtin_points, uint64_t seed,
+                                               PointsLeftOut* left_out, std::string* note) {
+  if (inputs.size() == 1 && IsBuiltin(inputs.front())) {
+    if (note != nullptr) note->clear();
     if (builtin_points == 0) return absl::InvalidArgumentError("--points must be > 0");
     if (builtin_points > kMaxBuiltinUploadPoints) {
       return absl::InvalidArgumentError(absl::StrCat(
           "--points must be at most ", kMaxBuiltinUploadPoints, ", not ", builtin_points));
     }
-    NM_ASSIGN_OR_RETURN(const std::unique_ptr<ImplicitSurface> surface, MakeBuiltinSurface(input));
+    NM_ASSIGN_OR_RETURN(const std::unique_ptr<ImplicitSurface> surface,
+                        MakeBuiltinSurface(inputs.front()));
     return SamplePoints(*surface, builtin_points, seed);
   }
-  return LoadPointCloud(input, "INPUT", left_out);
+  return LoadPointClouds(inputs, "INPUT", left_out, note);
+}
+
+absl::StatusOr<PointCloud> LoadPointClouds(const std::vector<std::string>& inputs,
+                                           absl::string_view role, PointsLeftOut* left_out,
+                                           std::string* note) {
+  if (note != nullptr) note->clear();
+  if (inputs.empty()) return absl::InvalidArgumentError(absl::StrCat(role, " is required"));
+  if (inputs.size() == 1) return LoadPointCloud(inputs.front(), role, left_out);
+  std::vector<PointCloud> clouds;
+  PointsLeftOut total;
+  for (const std::string& input : inputs) {
+    if (IsBuiltin(input)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          input, " is a surface: several ", role, "s must all be point cloud files"));
+    }
+    PointsLeftOut one;
+    NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(input, role, &one));
+    total.withheld += one.withheld;
+    total.noise += one.noise;
+    total.invalid += one.invalid;
+    clouds.push_back(std::move(cloud));
+  }
+  // What some files have and another lacks, named by the first that lacks it.
+  std::vector<std::string> dropped;
+  const auto check = [&](const char* what, auto has) {
+    const auto without = std::find_if_not(clouds.begin(), clouds.end(), has);
+    if (without != clouds.end() && std::any_of(clouds.begin(), clouds.end(), has)) {
+      dropped.push_back(
+          absl::StrCat(what, " dropped (", inputs[without - clouds.begin()], " has none)"));
+    }
+  };
+  check("normals", [](const PointCloud& c) { return !c.normals.empty(); });
+  check("weights", [](const PointCloud& c) { return !c.weights.empty(); });
+  check("colours", [](const PointCloud& c) { return !c.colors.empty(); });
+  if (note != nullptr && !dropped.empty()) *note = absl::StrCat("; ", absl::StrJoin(dropped, ", "));
+  if (left_out != nullptr) *left_out = total;
+  return MergePointClouds(std::move(clouds));
+}
+
+std::string QuotedInputs(const std::vector<std::string>& inputs) {
+  return absl::StrCat("'", absl::StrJoin(inputs, "', '"), "'");
 }
 
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role,

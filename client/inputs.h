@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
@@ -42,18 +43,19 @@ struct TargetSpace {
   Origin origin = kNoOrigin;
 };
 
-// The target space of `input`: builtin:NAME (its implicit surface; `mode` must be uniform),
-// a point cloud file (.ply .xyz .ptx .las .pcd .e57 .obj .off .drc .glb; uniform or weighted),
-// or a triangle mesh file for area and curvature sampling. Returns NOT_FOUND for a missing file
-// and INVALID_ARGUMENT for an empty or malformed one, an unknown extension or builtin name, or a
-// sampling mode the input cannot provide; each message names the file.
+// The target space of `inputs`: builtin:NAME (its implicit surface; `mode` must be uniform),
+// point cloud files (.ply .xyz .ptx .las .pcd .e57 .obj .off .drc .glb; uniform or weighted;
+// several are learned as one, LoadPointClouds), or a triangle mesh file for area and curvature
+// sampling. Returns NOT_FOUND for a missing file and INVALID_ARGUMENT for an empty or malformed
+// one, an unknown extension or builtin name, a sampling mode the input cannot provide, or
+// several inputs that are not all point cloud files; each message names the file.
 // With `outliers` set, a point cloud's statistical outliers are removed first
 // (statistical_outliers.h) and the description says how many; INVALID_ARGUMENT for another
 // kind of input. With `colors` set and a point cloud that carries colours (the points left
 // after outlier removal), or a mesh whose vertices do, `colors` of the result is set and the
 // description ends "with colours".
 absl::StatusOr<TargetSpace> LoadTargetSpace(
-    const std::string& input, SamplingMode mode,
+    const std::vector<std::string>& inputs, SamplingMode mode,
     const std::optional<OutlierOptions>& outliers = std::nullopt,
     const std::optional<PointColorOptions>& colors = std::nullopt);
 
@@ -61,19 +63,33 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(
 // limit of points per session (neuralmesh-server --max_points_per_session), 1.6 GB here.
 inline constexpr size_t kMaxBuiltinUploadPoints = size_t{1} << 26;
 
-// The points of `input` for upload: a point cloud file as read, or `builtin_points` samples
-// of a builtin:NAME surface drawn with `seed` (1 to kMaxBuiltinUploadPoints). Errors as
-// LoadTargetSpace.
-// With `left_out`, the points the file marks as not to be used (ReadPointCloud) are counted
-// there.
-absl::StatusOr<PointCloud> LoadPointsForUpload(const std::string& input, size_t builtin_points,
-                                               uint64_t seed, PointsLeftOut* left_out = nullptr);
+// The points of `inputs` for upload: point cloud files as read (LoadPointClouds), or
+// `builtin_points` samples of a builtin:NAME surface drawn with `seed` (1 to
+// kMaxBuiltinUploadPoints). Errors as LoadTargetSpace.
+// With `left_out` and `note`, as LoadPointClouds.
+absl::StatusOr<PointCloud> LoadPointsForUpload(const std::vector<std::string>& inputs,
+                                               size_t builtin_points, uint64_t seed,
+                                               PointsLeftOut* left_out = nullptr,
+                                               std::string* note = nullptr);
 
 // The points of a point cloud file (any extension ReadPointCloud reads). Errors as
 // LoadTargetSpace; `role` names the argument in messages. With `left_out`, as
 // LoadPointsForUpload.
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role,
                                           PointsLeftOut* left_out = nullptr);
+
+// The points of point cloud files as one cloud (MergePointClouds: one after another, each
+// where its origin puts it). Errors as LoadPointCloud, and INVALID_ARGUMENT for a builtin:NAME
+// among several inputs. With `left_out`, the points left out of all the files are counted
+// there; `note` (when not null) is set to "" or to what the merge dropped because a file lacks
+// it: "; normals dropped (b.las has none)".
+absl::StatusOr<PointCloud> LoadPointClouds(const std::vector<std::string>& inputs,
+                                           absl::string_view role,
+                                           PointsLeftOut* left_out = nullptr,
+                                           std::string* note = nullptr);
+
+// The inputs for messages: "'a.las'", "'a.las', 'b.las'".
+std::string QuotedInputs(const std::vector<std::string>& inputs);
 
 // "" when no point was left out; else what to tell the user: "; left out 3 withheld points
 // and 117 classified as noise", "; left out 120 points without a position".

@@ -22,7 +22,8 @@
 namespace neuralmesh::client {
 
 struct LocalReconstructOptions {
-  std::string input;         // A point cloud or mesh file, or builtin:NAME.
+  // A point cloud or mesh file, or builtin:NAME; or several point cloud files, learned as one.
+  std::vector<std::string> inputs;
   std::string output;        // The final mesh; its extension picks the format.
   size_t vertices = 0;       // Final vertex count, > 4.
   std::vector<size_t> lods;  // Milestones below `vertices`, each written beside `output`.
@@ -67,8 +68,9 @@ struct EvalOptions {
 absl::Status RunEval(const EvalOptions& options, std::ostream& out);
 
 struct ConvertOptions {
-  // A mesh or point cloud file, or builtin:NAME for its dense tessellation.
-  std::string input;
+  // A mesh or point cloud file, or builtin:NAME for its dense tessellation; or several point
+  // cloud files, written as one.
+  std::vector<std::string> inputs;
   // Its extension picks the format: a mesh's (kMeshExtensions) or a point cloud's (.ply .xyz
   // .txt .pts .las .pcd .e57 .drc .glb .gltf).
   std::string output;

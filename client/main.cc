@@ -424,7 +424,7 @@ absl::Status RejectFlags(const ParsedArgs& args, const std::vector<std::string>&
 }
 
 absl::Status Reconstruct(const ParsedArgs& args) {
-  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "INPUT"));
+  if (args.positional.empty()) return absl::InvalidArgumentError("missing INPUT");
   NM_ASSIGN_OR_RETURN(const std::vector<size_t> lods,
                       neuralmesh::client::ParseLodList(absl::GetFlag(FLAGS_lod)));
   const bool progress = neuralmesh::client::ShowProgressOnStderr(absl::GetFlag(FLAGS_progress));
@@ -433,7 +433,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
         args, {"output", "sampling", "time_budget", "max_steps", "gltf_draco"},
         "applies to a local reconstruct only (the server picks its own budget; use --out-dir)"));
     neuralmesh::client::RemoteReconstructOptions o;
-    o.input = args.positional[0];
+    o.inputs = args.positional;
     o.server = absl::GetFlag(FLAGS_server);
     o.out_dir = absl::GetFlag(FLAGS_out_dir);
     o.vertices = absl::GetFlag(FLAGS_vertices);
@@ -467,7 +467,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
       "needs --server (a local reconstruct writes -o OUTPUT)"));
   if (!args.Has("vertices")) return absl::InvalidArgumentError("--vertices N is required");
   neuralmesh::client::LocalReconstructOptions o;
-  o.input = args.positional[0];
+  o.inputs = args.positional;
   o.output = absl::GetFlag(FLAGS_output);
   o.vertices = absl::GetFlag(FLAGS_vertices);
   o.lods = lods;
@@ -490,9 +490,9 @@ absl::Status Stats(const ParsedArgs& args) {
 }
 
 absl::Status Convert(const ParsedArgs& args) {
-  NM_RETURN_IF_ERROR(ExpectPositional(args, 1, "INPUT"));
+  if (args.positional.empty()) return absl::InvalidArgumentError("missing INPUT");
   neuralmesh::client::ConvertOptions o;
-  o.input = args.positional[0];
+  o.inputs = args.positional;
   o.output = absl::GetFlag(FLAGS_output);
   NM_ASSIGN_OR_RETURN(o.writing, MeshWritingFromFlags());
   NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
@@ -627,13 +627,14 @@ std::vector<Subcommand> Commands() {
   // clang-format on
   return {
       {"reconstruct",
-       "reconstruct INPUT -o OUTPUT --vertices N [flags]\n"
-       "       neuralmesh reconstruct INPUT --server HOST:PORT --out-dir DIR [--vertices N] "
+       "reconstruct INPUT... -o OUTPUT --vertices N [flags]\n"
+       "       neuralmesh reconstruct INPUT... --server HOST:PORT --out-dir DIR [--vertices N] "
        "[--batch-size K] [--ply] [--glb] [--resume SESSION] [--reconnect_for D]",
        "Learns a mesh of a point cloud, a mesh or a built-in surface, locally or on a server.",
        "Learns a mesh of INPUT: a point cloud (.ply .xyz .txt .pts .ptx .las .pcd .e57 .obj\n"
        ".off .drc .glb .gltf), a triangle mesh with --sampling area|curvature, or\n"
-       "builtin:sphere|torus|genus2.\n"
+       "builtin:sphere|torus|genus2. Several point cloud files (the scans of one site, a file\n"
+       "per station or tile) are learned as one, each where its coordinates put it.\n"
        "Locally it writes OUTPUT and one OUTPUT_lod<N> file per --lod; with --server it\n"
        "uploads the points and saves each mesh the server publishes into --out-dir. Prints\n"
        "the figures of every level.",
@@ -646,7 +647,7 @@ std::vector<Subcommand> Commands() {
        {"json"},
        Stats},
       {"convert",
-       "convert INPUT -o OUTPUT [--gltf_draco] [--remove_outliers] [--quantization_bits B]\n"
+       "convert INPUT... -o OUTPUT [--gltf_draco] [--remove_outliers] [--quantization_bits B]\n"
        "        [--encode_speed S]",
        "Writes a mesh or a point cloud in another format.",
        "Writes INPUT to OUTPUT in the format of its extension, colours included where the\n"
@@ -655,7 +656,7 @@ std::vector<Subcommand> Commands() {
        ".ptx .las .pcd .e57, a file without faces, or anything written to .xyz .txt .pts\n"
        ".las .pcd .e57) go to .ply .xyz .txt .pts .las .pcd .e57 .drc .glb .gltf with their\n"
        "normals and weights (LAS: positions and colours only; E57: no weights), after\n"
-       "--remove_outliers if given.",
+       "--remove_outliers if given. Several point cloud files are written as one.",
        {"output", "gltf_draco", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "quantization_bits", "encode_speed"},
        Convert},

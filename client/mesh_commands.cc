@@ -82,7 +82,7 @@ namespace {
 absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   if (!IsWritablePointCloudExtension(options.output)) {
     return absl::InvalidArgumentError(
-        absl::StrCat("INPUT '", options.input, "' holds points without faces: OUTPUT '",
+        absl::StrCat("INPUT ", QuotedInputs(options.inputs), " holds points without faces: OUTPUT '",
                      options.output, "' must be a point cloud format (", kWritablePointCloudExtensions,
                      ")"));
   }
@@ -93,7 +93,9 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
         "--gltf_draco compresses meshes; points are written to glTF uncompressed (or to .drc)");
   }
   PointsLeftOut left_out;
-  NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(options.input, "INPUT", &left_out));
+  std::string merge_note;
+  NM_ASSIGN_OR_RETURN(PointCloud cloud,
+                      LoadPointClouds(options.inputs, "INPUT", &left_out, &merge_note));
   const size_t read = cloud.size();
   size_t removed = 0;
   if (options.outliers.has_value()) {
@@ -112,7 +114,7 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   if (options.outliers.has_value()) {
     out << " (" << removed << " outliers of " << read << " removed)";
   }
-  out << LeftOutNote(left_out) << OriginNote(cloud.origin) << "\n";
+  out << merge_note << LeftOutNote(left_out) << OriginNote(cloud.origin) << "\n";
   if (!dropped.empty()) {
     out << "note: "
         << (las ? "LAS keeps positions and colours" : "E57 keeps positions, colours and normals")
@@ -131,22 +133,31 @@ absl::Status RunConvert(const ConvertOptions& options, std::ostream& out) {
         "OUTPUT '", options.output, "': unsupported format; use one of ", kMeshExtensions,
         " for meshes, or ", kWritablePointCloudExtensions, " for points"));
   }
-  if (IsBuiltin(options.input) && !mesh_output) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        options.input, " is a surface, not points: convert writes its tessellation to a mesh "
-        "format (", kMeshExtensions, ")"));
-  }
-  if (!IsBuiltin(options.input) &&
-      (!mesh_output || !IsSupportedMeshExtension(options.input))) {
+  if (options.inputs.empty()) return absl::InvalidArgumentError("INPUT is required");
+  const std::string& input = options.inputs.front();
+  if (options.inputs.size() > 1) {
+    if (!IsWritablePointCloudExtension(options.output)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "several INPUTs are written as one point cloud; OUTPUT '", options.output,
+          "' must be a point cloud format (", kWritablePointCloudExtensions, ")"));
+    }
     return ConvertPoints(options, out);
   }
-  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(options.input, "INPUT"));
+  if (IsBuiltin(input) && !mesh_output) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        input, " is a surface, not points: convert writes its tessellation to a mesh "
+        "format (", kMeshExtensions, ")"));
+  }
+  if (!IsBuiltin(input) && (!mesh_output || !IsSupportedMeshExtension(input))) {
+    return ConvertPoints(options, out);
+  }
+  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(input, "INPUT"));
   if (mesh.faces.empty() && IsWritablePointCloudExtension(options.output)) {
     return ConvertPoints(options, out);  // Read again as points: normals and weights too.
   }
   if (options.outliers.has_value()) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "--remove_outliers removes points from point clouds; INPUT '", options.input,
+        "--remove_outliers removes points from point clouds; INPUT '", input,
         "' is a mesh of ", mesh.faces.size(), " faces"));
   }
   NM_RETURN_IF_ERROR(WriteMesh(mesh, options.output, options.writing));

@@ -74,8 +74,10 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   if (options.out_dir.empty()) return absl::InvalidArgumentError("--out-dir DIR is required");
   if (options.batch_size == 0) return absl::InvalidArgumentError("--batch-size must be > 0");
   PointsLeftOut left_out;
-  NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointsForUpload(options.input, options.builtin_points,
-                                                            options.learner.seed, &left_out));
+  std::string merge_note;
+  NM_ASSIGN_OR_RETURN(PointCloud cloud,
+                      LoadPointsForUpload(options.inputs, options.builtin_points,
+                                          options.learner.seed, &left_out, &merge_note));
   const size_t points_read = cloud.size();
   if (!options.colors) cloud.colors.clear();
   const bool outliers_on_server = options.outliers.has_value() && options.outliers_on_server;
@@ -83,9 +85,10 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     NM_ASSIGN_OR_RETURN(const size_t removed, RemoveStatisticalOutliers(cloud, *options.outliers));
     out << "outliers removed: " << removed << " of " << points_read << " points\n";
   }
-  if (const std::string notes = absl::StrCat(LeftOutNote(left_out), OriginNote(cloud.origin));
+  if (const std::string notes =
+          absl::StrCat(merge_note, LeftOutNote(left_out), OriginNote(cloud.origin));
       !notes.empty()) {
-    out << "INPUT '" << options.input << "'" << notes << "\n";
+    out << "INPUT " << QuotedInputs(options.inputs) << notes << "\n";
   }
   std::optional<TriangleMesh> start_mesh;
   if (!options.start_mesh.empty()) {
@@ -130,7 +133,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
 
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ConnectTo(options.server, options.connection));
-  const std::string stem = InputStem(options.input);
+  const std::string stem = InputStem(options.inputs.front());
   // From here on Ctrl-C ends the upload and the watch at once and cancels the session (see
   // `canceller` below), so that the server does not keep learning for nobody.
   InterruptScope interrupt;

@@ -28,7 +28,8 @@ absl::StatusOr<std::unique_ptr<ReconstructionClient>> ConnectTo(const std::strin
                                                                 const ClientOptions& options);
 
 struct RemoteReconstructOptions {
-  std::string input;         // A point cloud file or builtin:NAME.
+  // A point cloud file or builtin:NAME; or several point cloud files, uploaded as one.
+  std::vector<std::string> inputs;
   std::string server;        // host:port.
   std::string out_dir;       // Where the LOD files go.
   size_t vertices = 0;       // Final vertex count; 0: one vertex per 2 points, at most 10000.

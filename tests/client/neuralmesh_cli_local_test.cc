@@ -720,6 +720,93 @@ TEST_F(LocalCliTest, E57ScansInSphericalCoordinatesAreReconstructedWhereTheirPos
   }
 }
 
+// A site in two files, a coloured LAS tile of its western half and an XYZ file of its eastern
+// half, each in its own frame (offsets, scales): learned as one surface, and written as one
+// cloud, the colours dropped because the XYZ file has none.
+TEST_F(LocalCliTest, SeveralPointCloudFilesAreLearnedAndWrittenAsOne) {
+  const PointCloud unit = ColoredUnitSpherePoints(12000, 10);
+  const double centre[3] = {500123.5, 4100456.25, 80};
+  testing::LasLayout layout;
+  layout.format = 2;
+  const double offset[3] = {500100, 4100400, 60};
+  for (int c = 0; c < 3; ++c) {
+    layout.scale[c] = 0.001;
+    layout.offset[c] = offset[c];
+  }
+  std::vector<testing::LasPoint> west;
+  std::string east_xyz;
+  size_t east = 0;
+  for (size_t i = 0; i < unit.size(); ++i) {
+    double p[3];
+    for (int c = 0; c < 3; ++c) p[c] = centre[c] + 10 * unit.positions[i][c];
+    if (unit.positions[i][0] < 0) {
+      testing::LasPoint point{static_cast<int32_t>(std::lround((p[0] - offset[0]) / 0.001)),
+                              static_cast<int32_t>(std::lround((p[1] - offset[1]) / 0.001)),
+                              static_cast<int32_t>(std::lround((p[2] - offset[2]) / 0.001))};
+      point.red = unit.colors[i][0] * 257;
+      point.green = unit.colors[i][1] * 257;
+      point.blue = unit.colors[i][2] * 257;
+      west.push_back(point);
+    } else {
+      absl::StrAppend(&east_xyz, absl::StrFormat("%.4f %.4f %.4f\n", p[0], p[1], p[2]));
+      ++east;
+    }
+  }
+  const std::string las = *dir_ + "/west.las";
+  const std::string xyz = *dir_ + "/east.xyz";
+  std::ofstream(las, std::ios::binary) << testing::LasFile(layout, west);
+  ASSERT_TRUE(WriteFileContents(xyz, east_xyz).ok());
+
+  const std::string mesh = *dir_ + "/site.ply";
+  const RunResult run =
+      RunNeuralmesh({"reconstruct", las, xyz, "-o", mesh, "--vertices", "800"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, absl::StrCat(unit.size(), " points of ", las, ", ", xyz,
+                                                      " (uniform sampling; colours dropped (",
+                                                      xyz, " has none)")))
+      << run.out;
+  const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);
+  ASSERT_TRUE(learned.ok()) << learned.status();
+  EXPECT_EQ(learned->positions.size(), 800u);
+  for (const Vec3f& v : learned->positions) {
+    double squared = 0;
+    for (int c = 0; c < 3; ++c) squared += std::pow(learned->origin[c] + v[c] - centre[c], 2);
+    ASSERT_NEAR(std::sqrt(squared), 10.0, 0.3) << "a vertex off the sphere";
+  }
+
+  const std::string e57 = *dir_ + "/site.e57";
+  const RunResult converted = RunNeuralmesh({"convert", las, xyz, "-o", e57});
+  ASSERT_EQ(converted.exit_code, 0) << converted.Describe();
+  EXPECT_EQ(converted.out,
+            absl::StrCat(e57, ": ", unit.size(), " points; colours dropped (", xyz,
+                         " has none); coordinates taken relative to (500000, 4100000, 0), and "
+                         "put back in the files written\n"));
+  const absl::StatusOr<PointCloud> read = ReadPointCloud(e57);
+  ASSERT_TRUE(read.ok()) << read.status();
+  ASSERT_EQ(read->size(), unit.size());
+  EXPECT_EQ(read->size() - east, west.size());
+  for (size_t i = 0; i < read->size(); ++i) {
+    double squared = 0;
+    for (int c = 0; c < 3; ++c) {
+      squared += std::pow(read->origin[c] + read->positions[i][c] - centre[c], 2);
+    }
+    ASSERT_NEAR(std::sqrt(squared), 10.0, 2e-3) << "point " << i;
+  }
+
+  // Several inputs are points: not a mesh output, not a builtin among them.
+  const RunResult to_obj = RunNeuralmesh({"convert", las, xyz, "-o", *dir_ + "/site.obj"});
+  EXPECT_EQ(to_obj.exit_code, 1);
+  EXPECT_TRUE(absl::StrContains(to_obj.err, "several INPUTs are written as one point cloud"))
+      << to_obj.err;
+  const RunResult with_builtin = RunNeuralmesh(
+      {"reconstruct", las, "builtin:sphere", "-o", *dir_ + "/x.ply", "--vertices", "100"});
+  EXPECT_EQ(with_builtin.exit_code, 1);
+  EXPECT_TRUE(absl::StrContains(with_builtin.err,
+                                "builtin:sphere is a surface: several INPUTs must all be point "
+                                "cloud files"))
+      << with_builtin.err;
+}
+
 TEST_F(LocalCliTest, ClassifiedNoiseInLasScansIsLeftOutAndCounted) {
   const PointCloud unit = ColoredUnitSpherePoints(4000, 9);
   testing::LasLayout layout;

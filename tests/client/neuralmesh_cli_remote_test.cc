@@ -123,7 +123,7 @@ TEST_F(RemoteCliTest, ReconstructWritesIncreasingLodsAndTheFinalMesh) {
 TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
   // The first run: half of the input, then the connection was lost.
   absl::StatusOr<PointCloud> cloud =
-      client::LoadPointsForUpload("builtin:sphere", 4000, LearnerOptions().seed);
+      client::LoadPointsForUpload({"builtin:sphere"}, 4000, LearnerOptions().seed);
   ASSERT_TRUE(cloud.ok()) << cloud.status();
   absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
       client::ReconstructionClient::Connect(server_->address());
@@ -377,17 +377,21 @@ TEST_F(RemoteCliTest, ColouredPointsComeBackAsColouredMeshes) {
 TEST_F(RemoteCliTest, GeoreferencedScansComeBackInTheirCoordinates) {
   const PointCloud unit = ColoredUnitSpherePoints(6000, 8);
   const double centre[3] = {500123.5, 4100456.25, 80};
-  std::string xyz;
-  for (const Vec3f& p : unit.positions) {
-    xyz += absl::StrFormat("%.4f %.4f %.4f\n", centre[0] + p[0], centre[1] + p[1],
-                           centre[2] + p[2]);
+  // The scan in two files, as two stations would leave it; uploaded as one.
+  std::string xyz[2];
+  for (size_t i = 0; i < unit.size(); ++i) {
+    const Vec3f& p = unit.positions[i];
+    xyz[i % 2] += absl::StrFormat("%.4f %.4f %.4f\n", centre[0] + p[0], centre[1] + p[1],
+                                  centre[2] + p[2]);
   }
   const std::string scan = *dir_ + "/utm_scan.xyz";
-  std::ofstream(scan) << xyz;
+  const std::string second = *dir_ + "/utm_scan_2.xyz";
+  std::ofstream(scan) << xyz[0];
+  std::ofstream(second) << xyz[1];
   const std::string out_dir = *dir_ + "/utm";
   const RunResult run =
-      RunNeuralmesh({"reconstruct", scan, "--server", server_->address(), "--out-dir", out_dir,
-                     "--vertices", "500", "--ply"});
+      RunNeuralmesh({"reconstruct", scan, second, "--server", server_->address(), "--out-dir",
+                     out_dir, "--vertices", "500", "--ply"});
   ASSERT_EQ(run.exit_code, 0) << run.Describe();
   EXPECT_TRUE(absl::StrContains(run.out, "coordinates taken relative to (500000, 4100000, 0)"))
       << run.out;
@@ -422,6 +426,7 @@ TEST_F(RemoteCliTest, GeoreferencedScansComeBackInTheirCoordinates) {
   EXPECT_TRUE(std::regex_search(sessions.out,
                                 std::regex("\"origin\": \\[\\s*5e\\+05,\\s*4100000,\\s*0\\s*\\]")))
       << sessions.out;
+  EXPECT_TRUE(absl::StrContains(sessions.out, "\"points_taken\": 6000")) << sessions.out;
 }
 
 TEST_F(RemoteCliTest, SessionsListsTheFinishedSession) {
@@ -469,7 +474,7 @@ TEST_F(RemoteCliTest, SessionCommandsGetFinishCancelTransferAndDelete) {
   EXPECT_THAT(too_early.err, ::testing::HasSubstr("has published no mesh yet"));
   EXPECT_FALSE(std::filesystem::exists(out + "/early.ply"));
 
-  absl::StatusOr<PointCloud> cloud = client::LoadPointsForUpload("builtin:sphere", 4000, 5);
+  absl::StatusOr<PointCloud> cloud = client::LoadPointsForUpload({"builtin:sphere"}, 4000, 5);
   ASSERT_TRUE(cloud.ok()) << cloud.status();
   ASSERT_TRUE((*service)->UploadPoints(id, *cloud, 1000).ok());
   const RunResult latest = RunNeuralmesh(

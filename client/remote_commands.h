@@ -50,8 +50,8 @@ struct RemoteReconstructOptions {
   // (client/reconnecting_calls.h); zero: the first lost connection ends the command.
   absl::Duration reconnect_for = ReconnectOptions().give_up_after;
   // Set: no new session; the upload into this one, which still takes points, goes on from the
-  // points it has taken (Session.points_taken). The input and its flags must be those of the
-  // first run; the session keeps the configuration it was created with.
+  // points it has taken (Session.points_taken). The inputs (in the same order) and their flags
+  // must be those of the first run; the session keeps the configuration it was created with.
   std::string resume_session;
   // A mesh file for a new session to learn on from (CreateSessionRequest.start_mesh); empty:
   // learner.initial_mesh.
@@ -60,10 +60,10 @@ struct RemoteReconstructOptions {
 
 // Creates a session (or takes up `resume_session`), watches it while the input streams up in
 // batches, finishes it and writes every LOD milestone (<stem>_lod<N>.drc) and the final mesh
-// (<stem>.drc) into out_dir, printing each update's figures on `out`. Returns OK only when the
-// final mesh arrived; otherwise the first error. A lost connection is ridden out for
-// `reconnect_for` (notices on `err`): the upload goes on from the points the session has
-// taken. When the upload fails the session is cancelled, except when the connection stayed
+// (<stem>.drc; the stem of the first input) into out_dir, printing each update's figures on
+// `out`. Returns OK only when the final mesh arrived; otherwise the first error. A lost
+// connection is ridden out for `reconnect_for` (notices on `err`): the upload goes on from the
+// points the session has taken. When the upload fails the session is cancelled, except when the connection stayed
 // lost (UNAVAILABLE): the session keeps its points and the message says how to resume. A
 // first SIGINT or SIGTERM cancels the session and returns CANCELLED.
 absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::ostream& out,

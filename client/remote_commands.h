@@ -63,9 +63,9 @@ struct RemoteReconstructOptions {
 // (<stem>.drc; the stem of the first input) into out_dir, printing each update's figures on
 // `out`. Returns OK only when the final mesh arrived; otherwise the first error. A lost
 // connection is ridden out for `reconnect_for` (notices on `err`): the upload goes on from the
-// points the session has taken. When the upload fails the session is cancelled, except when the connection stayed
-// lost (UNAVAILABLE): the session keeps its points and the message says how to resume. A
-// first SIGINT or SIGTERM cancels the session and returns CANCELLED.
+// points the session has taken. When the upload fails the session is cancelled, except when
+// the connection stayed lost (UNAVAILABLE): the session keeps its points and the message says
+// how to resume. A first SIGINT or SIGTERM cancels the session and returns CANCELLED.
 absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::ostream& out,
                                   std::ostream& err);
 

@@ -7,6 +7,7 @@
 // check: each input is parsed as it is and, when it is a whole number of pages, once more with
 // its checksums recomputed, so that mutations reach the XML, the sections and the packets.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -29,25 +30,15 @@ void CheckWrittenAgain(const ParsedGeometry& parsed) {
   const absl::StatusOr<ParsedGeometry> reread = neuralmesh::io_internal::ParseE57(written);
   FUZZ_CHECK(reread.ok(), "the writer's output does not parse: %s",
              reread.status().ToString().c_str());
-  FUZZ_CHECK(reread->positions.size() == parsed.positions.size(), "%zu points, then %zu",
-             parsed.positions.size(), reread->positions.size());
-  FUZZ_CHECK(reread->colors == parsed.colors, "colours change when written and read back");
-  FUZZ_CHECK(reread->normals == parsed.normals, "normals change when written and read back");
+  std::array<double, 3> scale;
   for (int c = 0; c < 3; ++c) {
     double farthest = 0;
     for (const auto& p : parsed.positions) farthest = std::max<double>(farthest, std::fabs(p[c]));
-    const double scale = neuralmesh::io_internal::IntegerScaleKeepingFloats(farthest);
-    for (size_t i = 0; i < parsed.positions.size(); ++i) {
-      const double before = parsed.origin[c] + double{parsed.positions[i][c]};
-      const double after = reread->origin[c] + double{reread->positions[i][c]};
-      const double local =
-          std::max(std::fabs(parsed.positions[i][c]), std::fabs(reread->positions[i][c]));
-      const double tolerance = 0.5001 * scale + local * std::ldexp(1.0, -23);
-      FUZZ_CHECK(std::fabs(after - before) <= tolerance,
-                 "point %zu moved by %g on axis %d when written (scale %g)", i, after - before, c,
-                 scale);
-    }
+    scale[c] = neuralmesh::io_internal::IntegerScaleKeepingFloats(farthest);
   }
+  neuralmesh::fuzz::CheckPositionsWithinScale(parsed, *reread, scale);
+  FUZZ_CHECK(reread->colors == parsed.colors, "colours change when written and read back");
+  FUZZ_CHECK(reread->normals == parsed.normals, "normals change when written and read back");
 }
 
 void CheckFile(absl::string_view bytes) {

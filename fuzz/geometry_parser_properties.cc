@@ -1,5 +1,6 @@
 #include "fuzz/geometry_parser_properties.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -123,6 +124,25 @@ void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size
              "the report counts %zu + %zu degenerate + %zu invalid faces of %zu", report.faces,
              report.degenerate_faces, report.invalid_faces, triangles.faces.size());
   (void)MeshReportToJson(report);
+}
+
+void CheckPositionsWithinScale(const io_internal::ParsedGeometry& parsed,
+                               const io_internal::ParsedGeometry& reread,
+                               const std::array<double, 3>& scale) {
+  FUZZ_CHECK(reread.positions.size() == parsed.positions.size(), "%zu points, then %zu",
+             parsed.positions.size(), reread.positions.size());
+  for (int c = 0; c < 3; ++c) {
+    for (size_t i = 0; i < parsed.positions.size(); ++i) {
+      const double before = parsed.origin[c] + double{parsed.positions[i][c]};
+      const double after = reread.origin[c] + double{reread.positions[i][c]};
+      const double local =
+          std::max(std::fabs(parsed.positions[i][c]), std::fabs(reread.positions[i][c]));
+      const double tolerance = 0.5001 * scale[c] + local * std::ldexp(1.0, -23);
+      FUZZ_CHECK(std::fabs(after - before) <= tolerance,
+                 "point %zu moved by %g on axis %d when written (scale %g)", i, after - before, c,
+                 scale[c]);
+    }
+  }
 }
 
 }  // namespace neuralmesh::fuzz

@@ -12,6 +12,7 @@
 #define NEURALMESH_FUZZ_GEOMETRY_PARSER_PROPERTIES_H_
 
 #include <cstddef>
+#include <array>
 #include <cstdint>
 #include <functional>
 
@@ -38,6 +39,13 @@ struct GeometryFormat {
 
 // Checks every property above on `data`, aborting through FUZZ_CHECK on the first that fails.
 void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size_t size);
+
+// For the formats of scaled integer coordinates (LAS, E57), whose round trip is not bit for
+// bit: checks that `reread`, `parsed` written and read back, holds as many points, each within
+// half its axis's `scale` (and a float's rounding) of where it was.
+void CheckPositionsWithinScale(const io_internal::ParsedGeometry& parsed,
+                               const io_internal::ParsedGeometry& reread,
+                               const std::array<double, 3>& scale);
 
 }  // namespace neuralmesh::fuzz
 

@@ -610,6 +610,20 @@ TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
 // Two PTX scans of one sphere of radius 10 at a UTM position, each in its scanner's frame: the
 // second scanner stands 30 m east, turned 90 degrees, so its points only meet the first's
 // once its transformation is applied.
+// The mesh at `path` has `vertices` vertices, all within `tolerance` of the sphere of `radius`
+// about `centre` (in the coordinates its origin puts back).
+void ExpectVerticesOnSphere(const std::string& path, size_t vertices, const double centre[3],
+                            double radius, double tolerance) {
+  const absl::StatusOr<TriangleMesh> learned = ReadMesh(path);
+  ASSERT_TRUE(learned.ok()) << learned.status();
+  EXPECT_EQ(learned->positions.size(), vertices);
+  for (const Vec3f& v : learned->positions) {
+    double squared = 0;
+    for (int c = 0; c < 3; ++c) squared += std::pow(learned->origin[c] + v[c] - centre[c], 2);
+    ASSERT_NEAR(std::sqrt(squared), radius, tolerance) << "a vertex off the sphere";
+  }
+}
+
 TEST_F(LocalCliTest, PtxScansAreReconstructedInTheirRegisteredFrame) {
   const PointCloud unit = ColoredUnitSpherePoints(12000, 6);
   const double centre[3] = {500123.5, 4100456.25, 80};
@@ -640,14 +654,7 @@ TEST_F(LocalCliTest, PtxScansAreReconstructedInTheirRegisteredFrame) {
   ASSERT_EQ(run.exit_code, 0) << run.Describe();
   EXPECT_TRUE(absl::StrContains(run.out, "coordinates taken relative to (500000, 4100000, 0)"))
       << run.out;
-  const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);
-  ASSERT_TRUE(learned.ok()) << learned.status();
-  EXPECT_EQ(learned->positions.size(), 800u);
-  for (const Vec3f& v : learned->positions) {
-    double squared = 0;
-    for (int c = 0; c < 3; ++c) squared += std::pow(learned->origin[c] + v[c] - centre[c], 2);
-    ASSERT_NEAR(std::sqrt(squared), 10.0, 0.3) << "a vertex off the sphere";
-  }
+  ExpectVerticesOnSphere(mesh, 800, centre, 10.0, 0.3);
 }
 
 // Two scanner stations of an E57 file, each holding its points as a scanner measures them:
@@ -710,14 +717,7 @@ TEST_F(LocalCliTest, E57ScansInSphericalCoordinatesAreReconstructedWhereTheirPos
   EXPECT_TRUE(absl::StrContains(run.out, "left out 50 points without a position")) << run.out;
   EXPECT_TRUE(absl::StrContains(run.out, "coordinates taken relative to (500000, 4100000, 0)"))
       << run.out;
-  const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);
-  ASSERT_TRUE(learned.ok()) << learned.status();
-  EXPECT_EQ(learned->positions.size(), 800u);
-  for (const Vec3f& v : learned->positions) {
-    double squared = 0;
-    for (int c = 0; c < 3; ++c) squared += std::pow(learned->origin[c] + v[c] - centre[c], 2);
-    ASSERT_NEAR(std::sqrt(squared), 10.0, 0.3) << "a vertex off the sphere";
-  }
+  ExpectVerticesOnSphere(mesh, 800, centre, 10.0, 0.3);
 }
 
 // A site in two files, a coloured LAS tile of its western half and an XYZ file of its eastern
@@ -765,14 +765,7 @@ TEST_F(LocalCliTest, SeveralPointCloudFilesAreLearnedAndWrittenAsOne) {
                                                       " (uniform sampling; colours dropped (",
                                                       xyz, " has none)")))
       << run.out;
-  const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);
-  ASSERT_TRUE(learned.ok()) << learned.status();
-  EXPECT_EQ(learned->positions.size(), 800u);
-  for (const Vec3f& v : learned->positions) {
-    double squared = 0;
-    for (int c = 0; c < 3; ++c) squared += std::pow(learned->origin[c] + v[c] - centre[c], 2);
-    ASSERT_NEAR(std::sqrt(squared), 10.0, 0.3) << "a vertex off the sphere";
-  }
+  ExpectVerticesOnSphere(mesh, 800, centre, 10.0, 0.3);
 
   const std::string e57 = *dir_ + "/site.e57";
   const RunResult converted = RunNeuralmesh({"convert", las, xyz, "-o", e57});

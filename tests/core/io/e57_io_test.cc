@@ -19,21 +19,14 @@
 namespace neuralmesh {
 namespace {
 
+using io_test::ReadCloudFrom;
 using io_test::TempPath;
-using io_test::WriteBytes;
 using testing::E57Field;
 using testing::E57File;
 using testing::E57Floats;
 using testing::E57PackBits;
 using testing::E57Scan;
 using ::testing::HasSubstr;
-
-absl::StatusOr<PointCloud> ReadE57(const std::string& name, const std::string& bytes,
-                                   PointsLeftOut* left_out = nullptr) {
-  const std::string path = TempPath(name);
-  WriteBytes(path, bytes);
-  return ReadPointCloud(path, left_out);
-}
 
 // A ScaledInteger or Integer field whose stored values are `values`, packed as the difference
 // to `minimum` in the bits the range needs.
@@ -96,7 +89,7 @@ TEST(E57IoTest, ScansAreMovedByTheirPosesFromCartesianOrSphericalCoordinates) {
       "<x type=\"Float\">500010</x><y type=\"Float\">4100020</y><z type=\"Float\">5</z>");
   PointsLeftOut left_out;
   const absl::StatusOr<PointCloud> cloud =
-      ReadE57("two_scans.e57", E57File({cartesian, spherical}), &left_out);
+      ReadCloudFrom("two_scans.e57", E57File({cartesian, spherical}), &left_out);
   ASSERT_TRUE(cloud.ok()) << cloud.status();
   EXPECT_EQ(cloud->origin, (Origin{500000, 4100000, 0}));
   ExpectNear(*cloud,
@@ -127,7 +120,7 @@ TEST(E57IoTest, FieldsOfUpToSixtyFourBitsAreUnpackedAcrossWordBoundaries) {
                  {"<cartesianZ type=\"Float\" precision=\"single\"/>",
                   E57Floats(std::vector<float>{0.5f, -1, 2, 3.25f, 4})}};
   scan.bytes_per_packet = 5;
-  const absl::StatusOr<PointCloud> cloud = ReadE57("wide.e57", E57File({scan}));
+  const absl::StatusOr<PointCloud> cloud = ReadCloudFrom("wide.e57", E57File({scan}));
   ASSERT_TRUE(cloud.ok()) << cloud.status();
   std::vector<std::array<double, 3>> expected;
   const float z[] = {0.5f, -1, 2, 3.25f, 4};
@@ -159,7 +152,7 @@ TEST(E57IoTest, ColoursAreScaledFromTheirLimitsAndNormalsTurnedByThePose) {
       "<colorLimits type=\"Structure\"><colorRedMaximum type=\"Integer\">512</colorRedMaximum>"
       "<colorGreenMaximum type=\"Integer\">512</colorGreenMaximum>"
       "<colorBlueMaximum type=\"Integer\">512</colorBlueMaximum></colorLimits>");
-  const absl::StatusOr<PointCloud> cloud = ReadE57("colored.e57", E57File({scan}));
+  const absl::StatusOr<PointCloud> cloud = ReadCloudFrom("colored.e57", E57File({scan}));
   ASSERT_TRUE(cloud.ok()) << cloud.status();
   ExpectNear(*cloud, {{0, 1, 0}, {-1, 0, 0}}, 1e-6);
   EXPECT_EQ(cloud->colors, (std::vector<Rgb>{{255, 255, 0}, {0, 0, 50}}));
@@ -171,7 +164,7 @@ TEST(E57IoTest, ColoursAreScaledFromTheirLimitsAndNormalsTurnedByThePose) {
   // A point whose colour is marked invalid keeps its position; the file's colours are dropped,
   // as they are when one scan has none.
   scan.fields.push_back(IntegerField("isColorInvalid", 0, 1, 1, {0, 1}));
-  const absl::StatusOr<PointCloud> partly = ReadE57("partly_colored.e57", E57File({scan}));
+  const absl::StatusOr<PointCloud> partly = ReadCloudFrom("partly_colored.e57", E57File({scan}));
   ASSERT_TRUE(partly.ok()) << partly.status();
   EXPECT_EQ(partly->size(), 2u);
   EXPECT_TRUE(partly->colors.empty());
@@ -180,7 +173,7 @@ TEST(E57IoTest, ColoursAreScaledFromTheirLimitsAndNormalsTurnedByThePose) {
   plain.fields = {DoubleField("cartesianX", {5}), DoubleField("cartesianY", {5}),
                   DoubleField("cartesianZ", {5})};
   scan.fields.pop_back();
-  const absl::StatusOr<PointCloud> mixed = ReadE57("mixed.e57", E57File({scan, plain}));
+  const absl::StatusOr<PointCloud> mixed = ReadCloudFrom("mixed.e57", E57File({scan, plain}));
   ASSERT_TRUE(mixed.ok()) << mixed.status();
   EXPECT_EQ(mixed->size(), 3u);
   EXPECT_TRUE(mixed->colors.empty());
@@ -233,7 +226,7 @@ E57Scan SmallScan() {
 
 TEST(E57IoTest, DamagedAndMalformedFilesAreRefusedWithWhatIsWrong) {
   const std::string good = E57File({SmallScan()});
-  ASSERT_TRUE(ReadE57("good.e57", good).ok());
+  ASSERT_TRUE(ReadCloudFrom("good.e57", good).ok());
 
   std::string flipped = good;
   flipped[500] ^= 0x10;
@@ -287,7 +280,7 @@ TEST(E57IoTest, DamagedAndMalformedFilesAreRefusedWithWhatIsWrong) {
       "scan 0's data packet holds 3 bytestreams where its prototype declares 4 fields",
   };
   for (size_t k = 0; k < cases.size(); ++k) {
-    const absl::StatusOr<PointCloud> read = ReadE57(cases[k].first + ".e57", cases[k].second);
+    const absl::StatusOr<PointCloud> read = ReadCloudFrom(cases[k].first + ".e57", cases[k].second);
     ASSERT_FALSE(read.ok()) << cases[k].first;
     EXPECT_EQ(read.status().code(), absl::StatusCode::kInvalidArgument) << cases[k].first;
     EXPECT_THAT(std::string(read.status().message()), HasSubstr(messages[k])) << cases[k].first;

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/io/point_cloud_io.h"
 #include "core/point_cloud.h"
 #include "core/random.h"
 #include "core/triangle_mesh.h"
@@ -50,6 +51,14 @@ inline void WriteBytes(const std::string& path, const std::string& bytes) {
   ASSERT_TRUE(out.good()) << "cannot create test file " << path;
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   ASSERT_TRUE(out.good()) << "cannot write test file " << path;
+}
+
+// Writes `bytes` to a temporary file `name` and reads it back as a point cloud.
+inline absl::StatusOr<PointCloud> ReadCloudFrom(const std::string& name, const std::string& bytes,
+                                                PointsLeftOut* left_out = nullptr) {
+  const std::string path = TempPath(name);
+  WriteBytes(path, bytes);
+  return ReadPointCloud(path, left_out);
 }
 
 inline std::string ReadBytes(const std::string& path) {

@@ -21,16 +21,9 @@ namespace {
 
 using io_test::Put;
 using io_test::ReadBytes;
+using io_test::ReadCloudFrom;
 using io_test::TempPath;
-using io_test::WriteBytes;
 using ::testing::HasSubstr;
-
-absl::StatusOr<PointCloud> ReadPcd(const std::string& name, const std::string& bytes,
-                                   PointsLeftOut* left_out = nullptr) {
-  const std::string path = TempPath(name);
-  WriteBytes(path, bytes);
-  return ReadPointCloud(path, left_out);
-}
 
 // LZF as liblzf decodes it, from literal runs and back references to the byte before (runs of
 // one repeated byte), so that both kinds of instruction and long references are exercised.
@@ -121,7 +114,7 @@ TEST(PcdIoTest, ReadsAsciiAsPclWritesItWithEmptyPixelsLeftOut) {
       "0 0 0 4210752 7\n", "1 2 3 ", absl::StrFormat("%.9g", pink_float), " 8\n",
       "nan nan nan 0 0\n\n", "-1.5 0.25 8 65280 1\n", "4 5 6 255 2\n", "7 8 9 16711680 3\n");
   PointsLeftOut left_out;
-  const absl::StatusOr<PointCloud> read = ReadPcd("organized.pcd", pcd, &left_out);
+  const absl::StatusOr<PointCloud> read = ReadCloudFrom("organized.pcd", pcd, &left_out);
   ASSERT_TRUE(read.ok()) << read.status();
   EXPECT_EQ(read->positions,
             (std::vector<Vec3f>{Vec3f(0, 0, 0), Vec3f(1, 2, 3), Vec3f(-1.5f, 0.25f, 8),
@@ -137,7 +130,7 @@ TEST(PcdIoTest, ReadsAsciiAsPclWritesItWithEmptyPixelsLeftOut) {
   const std::string empty =
       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nDATA ascii\n"
       "nan 0 0\n0 inf 0\n";
-  const absl::StatusOr<PointCloud> none = ReadPcd("empty.pcd", empty);
+  const absl::StatusOr<PointCloud> none = ReadCloudFrom("empty.pcd", empty);
   EXPECT_EQ(none.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(none.status().message()),
               HasSubstr("all 2 points lack a position (NaN or infinite x, y or z)"));
@@ -221,7 +214,7 @@ TEST(PcdIoTest, ReadsBinaryRecordsOfMixedTypesAndCompressedColumns) {
   for (const BinaryPoint& p : kBinaryPoints) {
     for (int f = 0; f < 11; ++f) records += FieldBytes(f, p);
   }
-  ExpectBinaryPoints(ReadPcd("binary.pcd", BinaryHeader("binary", 3) + records));
+  ExpectBinaryPoints(ReadCloudFrom("binary.pcd", BinaryHeader("binary", 3) + records));
 
   // binary_compressed: the fields' columns one after another, LZF-compressed behind their
   // compressed and uncompressed sizes.
@@ -235,7 +228,7 @@ TEST(PcdIoTest, ReadsBinaryRecordsOfMixedTypesAndCompressedColumns) {
   Put(static_cast<uint32_t>(compressed.size()), false, &body);
   Put(static_cast<uint32_t>(columns.size()), false, &body);
   body += compressed;
-  ExpectBinaryPoints(ReadPcd("compressed.pcd", BinaryHeader("binary_compressed", 3) + body));
+  ExpectBinaryPoints(ReadCloudFrom("compressed.pcd", BinaryHeader("binary_compressed", 3) + body));
 
   // A long run (a back reference of more than 8 bytes) of a large cloud of one point repeated.
   std::string many_columns;
@@ -249,7 +242,7 @@ TEST(PcdIoTest, ReadsBinaryRecordsOfMixedTypesAndCompressedColumns) {
   Put(static_cast<uint32_t>(packed.size()), false, &many_body);
   Put(static_cast<uint32_t>(many_columns.size()), false, &many_body);
   const absl::StatusOr<PointCloud> repeated =
-      ReadPcd("many.pcd", BinaryHeader("binary_compressed", many) + many_body + packed);
+      ReadCloudFrom("many.pcd", BinaryHeader("binary_compressed", many) + many_body + packed);
   ASSERT_TRUE(repeated.ok()) << repeated.status();
   ASSERT_EQ(repeated->size(), static_cast<size_t>(many));
   EXPECT_EQ(repeated->colors.back(), kBinaryPoints[0].color);
@@ -305,7 +298,7 @@ TEST(PcdIoTest, MalformedFilesAreRefusedWithWhatIsWrong) {
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.what);
-    const absl::StatusOr<PointCloud> read = ReadPcd("bad.pcd", c.bytes);
+    const absl::StatusOr<PointCloud> read = ReadCloudFrom("bad.pcd", c.bytes);
     ASSERT_FALSE(read.ok());
     EXPECT_EQ(read.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_THAT(std::string(read.status().message()), HasSubstr(c.message));

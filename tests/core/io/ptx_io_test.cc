@@ -14,16 +14,8 @@
 namespace neuralmesh {
 namespace {
 
-using io_test::TempPath;
-using io_test::WriteBytes;
+using io_test::ReadCloudFrom;
 using ::testing::HasSubstr;
-
-absl::StatusOr<PointCloud> ReadPtx(const std::string& name, const std::string& text,
-                                   PointsLeftOut* left_out = nullptr) {
-  const std::string path = TempPath(name);
-  WriteBytes(path, text);
-  return ReadPointCloud(path, left_out);
-}
 
 // A scan's header: the grid, the scanner's pose (which readers take from the matrix), and the
 // matrix as PTX writes it, a column a line, the translation last.
@@ -40,7 +32,7 @@ TEST(PtxIoTest, ScansAreMovedIntoTheirRegisteredFrameAndEmptyCellsLeftOut) {
       absl::StrCat(Header(2, 2, kIdentityAt), "1 2 3 0.5\n0 0 0 0.5\n-1.5 0.25 8 0.25\n\n4 5 6 1\n",
                    Header(2, 1, kTurnedAt), "1 2 3 0.5\n10 0 -1 0.75\n");
   PointsLeftOut left_out;
-  const absl::StatusOr<PointCloud> cloud = ReadPtx("two_scans.ptx", ptx, &left_out);
+  const absl::StatusOr<PointCloud> cloud = ReadCloudFrom("two_scans.ptx", ptx, &left_out);
   ASSERT_TRUE(cloud.ok()) << cloud.status();
   EXPECT_EQ(cloud->origin, (Origin{500000, 4100000, 0}));
   const std::vector<Vec3f> expected = {Vec3f(101, 202, 3), Vec3f(98.5f, 200.25f, 8),
@@ -55,7 +47,7 @@ TEST(PtxIoTest, ColoursAreTakenWhenEveryPointHasThem) {
   const std::string identity = "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n";
   const std::string colored = absl::StrCat(Header(1, 3, identity), "1 0 0 0.5 255 0 128\n",
                                            "0 0 0 0.5 0 0 0\n", "0 1 0 0.5 1 2 3\n");
-  const absl::StatusOr<PointCloud> cloud = ReadPtx("colored.ptx", colored);
+  const absl::StatusOr<PointCloud> cloud = ReadCloudFrom("colored.ptx", colored);
   ASSERT_TRUE(cloud.ok()) << cloud.status();
   EXPECT_EQ(cloud->positions, (std::vector<Vec3f>{Vec3f(1, 0, 0), Vec3f(0, 1, 0)}));
   EXPECT_EQ(cloud->colors, (std::vector<Rgb>{{255, 0, 128}, {1, 2, 3}}));
@@ -63,7 +55,7 @@ TEST(PtxIoTest, ColoursAreTakenWhenEveryPointHasThem) {
 
   // A second scan without colours: the file's colours are left out.
   const absl::StatusOr<PointCloud> mixed =
-      ReadPtx("mixed.ptx", absl::StrCat(colored, Header(1, 1, identity), "0 0 1 0.5\n"));
+      ReadCloudFrom("mixed.ptx", absl::StrCat(colored, Header(1, 1, identity), "0 0 1 0.5\n"));
   ASSERT_TRUE(mixed.ok()) << mixed.status();
   EXPECT_EQ(mixed->size(), 3u);
   EXPECT_TRUE(mixed->colors.empty());
@@ -100,7 +92,7 @@ TEST(PtxIoTest, MalformedFilesAreRefusedWithWhatIsWrong) {
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.what);
-    const absl::StatusOr<PointCloud> cloud = ReadPtx("bad.ptx", c.text);
+    const absl::StatusOr<PointCloud> cloud = ReadCloudFrom("bad.ptx", c.text);
     ASSERT_FALSE(cloud.ok());
     EXPECT_EQ(cloud.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_THAT(std::string(cloud.status().message()), HasSubstr(c.message));

@@ -81,7 +81,29 @@ void ExpectSamePoints(const std::string& path, double tolerance) {
   }
 }
 
+// Writes `cloud` to `name` and expects web-e57 to read its points, to `tolerance`, and its
+// colours.
+void ExpectWebE57ReadsWhatIsWritten(const PointCloud& cloud, const std::string& name,
+                                    double tolerance) {
+  const std::string path = TempPath(name);
+  ASSERT_TRUE(WritePointCloud(cloud, path).ok());
+  const std::vector<ReferencePoint> theirs = ReadWithWebE57(path);
+  ASSERT_EQ(theirs.size(), cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(theirs[i].position[c], cloud.origin[c] + cloud.positions[i][c], tolerance)
+          << "point " << i << " axis " << c;
+    }
+    ASSERT_EQ(theirs[i].color.size(), cloud.colors.empty() ? 0u : 3u) << "point " << i;
+    for (size_t c = 0; c < theirs[i].color.size(); ++c) {
+      EXPECT_EQ(theirs[i].color[c], cloud.colors[i][c]) << "point " << i;
+    }
+  }
+  ExpectSamePoints(path, 2e-4);
+}
+
 TEST(E57IndependentReaderTest, WrittenFilesGiveWebE57ThePointsAndColoursWritten) {
+  // A UTM tile of 800 m: scales of 1e-5 m; half of that, and the float's rounding of the points.
   PointCloud cloud = io_test::RandomCloud(20000, 3, /*normals=*/true, /*weights=*/false);
   cloud.origin = {500000, 4100000, 250};
   for (size_t i = 0; i < cloud.size(); ++i) {
@@ -89,33 +111,9 @@ TEST(E57IndependentReaderTest, WrittenFilesGiveWebE57ThePointsAndColoursWritten)
     cloud.colors.push_back(
         {static_cast<uint8_t>(i * 3), static_cast<uint8_t>(i >> 4), static_cast<uint8_t>(i * 11)});
   }
-  const std::string path = TempPath("written.e57");
-  ASSERT_TRUE(WritePointCloud(cloud, path).ok());
-  const std::vector<ReferencePoint> theirs = ReadWithWebE57(path);
-  ASSERT_EQ(theirs.size(), cloud.size());
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    for (int c = 0; c < 3; ++c) {
-      // Half the written scale (1e-5 m), and the float's rounding of the point written.
-      EXPECT_NEAR(theirs[i].position[c], cloud.origin[c] + cloud.positions[i][c], 0.6e-5)
-          << "point " << i << " axis " << c;
-    }
-    ASSERT_EQ(theirs[i].color.size(), 3u);
-    for (int c = 0; c < 3; ++c) EXPECT_EQ(theirs[i].color[c], cloud.colors[i][c]) << i;
-  }
-  ExpectSamePoints(path, 2e-4);
-
+  ExpectWebE57ReadsWhatIsWritten(cloud, "written.e57", 0.6e-5);
   // A unit-sized cloud without colours: scales of 1e-8, fields of about 27 bits.
-  const PointCloud small = io_test::RandomCloud(3000, 4, false, false);
-  const std::string small_path = TempPath("small.e57");
-  ASSERT_TRUE(WritePointCloud(small, small_path).ok());
-  const std::vector<ReferencePoint> small_theirs = ReadWithWebE57(small_path);
-  ASSERT_EQ(small_theirs.size(), small.size());
-  for (size_t i = 0; i < small.size(); ++i) {
-    for (int c = 0; c < 3; ++c) {
-      EXPECT_NEAR(small_theirs[i].position[c], small.positions[i][c], 0.6e-8) << i;
-    }
-    EXPECT_TRUE(small_theirs[i].color.empty());
-  }
+  ExpectWebE57ReadsWhatIsWritten(io_test::RandomCloud(3000, 4, false, false), "small.e57", 0.6e-8);
 }
 
 TEST(E57IndependentReaderTest, BothReadersAgreeOnPosesSphericalCoordinatesAndPackedFields) {

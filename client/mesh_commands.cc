@@ -82,9 +82,9 @@ namespace {
 absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   if (!IsWritablePointCloudExtension(options.output)) {
     return absl::InvalidArgumentError(
-        absl::StrCat("INPUT ", QuotedInputs(options.inputs), " holds points without faces: OUTPUT '",
-                     options.output, "' must be a point cloud format (", kWritablePointCloudExtensions,
-                     ")"));
+        absl::StrCat("INPUT ", QuotedInputs(options.inputs),
+                     " holds points without faces: OUTPUT '", options.output,
+                     "' must be a point cloud format (", kWritablePointCloudExtensions, ")"));
   }
   const bool gltf = absl::EndsWithIgnoreCase(options.output, ".glb") ||
                     absl::EndsWithIgnoreCase(options.output, ".gltf");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 
 #include "core/analysis/mesh_report.h"
@@ -137,7 +138,10 @@ void CheckPositionsWithinScale(const io_internal::ParsedGeometry& parsed,
       const double after = reread.origin[c] + double{reread.positions[i][c]};
       const double local =
           std::max(std::fabs(parsed.positions[i][c]), std::fabs(reread.positions[i][c]));
-      const double tolerance = 0.5001 * scale[c] + local * std::ldexp(1.0, -23);
+      // Half a scale step, and the float's rounding: relative to the coordinate, or for a
+      // subnormal float (a coordinate below 1.2e-38) its absolute step.
+      const double tolerance = 0.5001 * scale[c] + local * std::ldexp(1.0, -23) +
+                               std::numeric_limits<float>::denorm_min();
       FUZZ_CHECK(std::fabs(after - before) <= tolerance,
                  "point %zu moved by %g on axis %d when written (scale %g)", i, after - before, c,
                  scale[c]);

@@ -17,6 +17,9 @@
 #include "proto/packing.h"
 
 namespace neuralmesh::client {
+
+using Stub = v1::ReconstructionService::Stub;
+
 namespace {
 
 // The wire format is little-endian float32; copying the host's floats byte for byte is only
@@ -87,10 +90,10 @@ class ReconstructionClient::OpenCall {
 };
 
 template <typename Request, typename Response>
-absl::StatusOr<Response> ReconstructionClient::UnaryCall(
-    grpc::Status (v1::ReconstructionService::Stub::*method)(grpc::ClientContext*, const Request&,
-                                                           Response*),
-    const Request& request, const char* name, const UnaryCallOptions& options) {
+absl::StatusOr<Response> ReconstructionClient::UnaryCall(StubMethod<Request, Response> method,
+                                                         const Request& request,
+                                                         const char* name,
+                                                         const UnaryCallOptions& options) {
   grpc::ClientContext context;
   const OpenCall open(*this, context,
                       options.runs_after_cancel_calls ? OpenCall::kRunsAfterCancelCalls
@@ -98,7 +101,7 @@ absl::StatusOr<Response> ReconstructionClient::UnaryCall(
   SetDeadline(context, options.timeout);
   context.set_wait_for_ready(options.wait_for_ready);
   Response response;
-  const grpc::Status status = ((*stub_).*method)(&context, request, &response);
+  const grpc::Status status = (stub_.get()->*method)(&context, request, &response);
   if (!status.ok()) return FromGrpcStatus(status, name);
   return response;
 }
@@ -151,8 +154,7 @@ absl::StatusOr<v1::Session> ReconstructionClient::CreateSession(const v1::Sessio
   *request.mutable_config() = config;
   request.set_name(name);
   if (start_mesh != nullptr) *request.mutable_start_mesh() = ToProto(*start_mesh);
-  return UnaryCall(&v1::ReconstructionService::Stub::CreateSession, request, "CreateSession",
-                   {options_.call_timeout});
+  return UnaryCall(&Stub::CreateSession, request, "CreateSession", {options_.call_timeout});
 }
 
 absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
@@ -303,8 +305,7 @@ absl::StatusOr<v1::Session> ReconstructionClient::GetSession(const std::string& 
                                                              bool wait_for_ready) {
   v1::GetSessionRequest request;
   request.set_session_id(session_id);
-  return UnaryCall(&v1::ReconstructionService::Stub::GetSession, request, "GetSession",
-                   {timeout, wait_for_ready});
+  return UnaryCall(&Stub::GetSession, request, "GetSession", {timeout, wait_for_ready});
 }
 
 absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions() {
@@ -319,8 +320,7 @@ absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::AwaitSessions(
 absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions(
     absl::Duration timeout, bool wait_for_ready) {
   NM_ASSIGN_OR_RETURN(const v1::ListSessionsResponse response,
-                      UnaryCall(&v1::ReconstructionService::Stub::ListSessions,
-                                v1::ListSessionsRequest(), "ListSessions",
+                      UnaryCall(&Stub::ListSessions, v1::ListSessionsRequest(), "ListSessions",
                                 {timeout, wait_for_ready}));
   return std::vector<v1::Session>(response.sessions().begin(), response.sessions().end());
 }
@@ -328,8 +328,7 @@ absl::StatusOr<std::vector<v1::Session>> ReconstructionClient::ListSessions(
 absl::StatusOr<v1::Session> ReconstructionClient::Finish(const std::string& session_id) {
   v1::FinishSessionRequest request;
   request.set_session_id(session_id);
-  return UnaryCall(&v1::ReconstructionService::Stub::FinishSession, request, "FinishSession",
-                   {options_.call_timeout});
+  return UnaryCall(&Stub::FinishSession, request, "FinishSession", {options_.call_timeout});
 }
 
 absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& session_id) {
@@ -340,15 +339,14 @@ absl::StatusOr<v1::Session> ReconstructionClient::Cancel(const std::string& sess
                                                          absl::Duration timeout) {
   v1::CancelSessionRequest request;
   request.set_session_id(session_id);
-  return UnaryCall(&v1::ReconstructionService::Stub::CancelSession, request, "CancelSession",
+  return UnaryCall(&Stub::CancelSession, request, "CancelSession",
                    {timeout, /*wait_for_ready=*/false, /*runs_after_cancel_calls=*/true});
 }
 
 absl::Status ReconstructionClient::Delete(const std::string& session_id) {
   v1::DeleteSessionRequest request;
   request.set_session_id(session_id);
-  return UnaryCall(&v1::ReconstructionService::Stub::DeleteSession, request, "DeleteSession",
-                   {options_.call_timeout})
+  return UnaryCall(&Stub::DeleteSession, request, "DeleteSession", {options_.call_timeout})
       .status();
 }
 
@@ -357,8 +355,7 @@ absl::StatusOr<v1::Session> ReconstructionClient::Transfer(const std::string& se
   v1::TransferSessionRequest request;
   request.set_session_id(session_id);
   request.set_new_owner(new_owner);
-  return UnaryCall(&v1::ReconstructionService::Stub::TransferSession, request, "TransferSession",
-                   {options_.call_timeout});
+  return UnaryCall(&Stub::TransferSession, request, "TransferSession", {options_.call_timeout});
 }
 
 absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& session_id,
@@ -368,7 +365,7 @@ absl::StatusOr<v1::MeshUpdate> ReconstructionClient::GetMesh(const std::string& 
   request.set_session_id(session_id);
   request.set_version(version);
   request.set_wait(wait);
-  return UnaryCall(&v1::ReconstructionService::Stub::GetMesh, request, "GetMesh", {timeout});
+  return UnaryCall(&Stub::GetMesh, request, "GetMesh", {timeout});
 }
 
 bool ReconstructionClient::calls_cancelled() const {

@@ -183,13 +183,15 @@ class ReconstructionClient {
     bool wait_for_ready = false;
     bool runs_after_cancel_calls = false;
   };
+  // A unary method of the stub (&Stub::GetSession, ...).
+  template <typename Request, typename Response>
+  using StubMethod = grpc::Status (v1::ReconstructionService::Stub::*)(grpc::ClientContext*,
+                                                                      const Request&, Response*);
   // Makes the unary call `method` of the stub with `request`; a failure's message names the
   // call `name` (FromGrpcStatus).
   template <typename Request, typename Response>
-  absl::StatusOr<Response> UnaryCall(
-      grpc::Status (v1::ReconstructionService::Stub::*method)(grpc::ClientContext*,
-                                                             const Request&, Response*),
-      const Request& request, const char* name, const UnaryCallOptions& options);
+  absl::StatusOr<Response> UnaryCall(StubMethod<Request, Response> method, const Request& request,
+                                     const char* name, const UnaryCallOptions& options);
 
   absl::StatusOr<v1::Session> GetSession(const std::string& session_id, absl::Duration timeout,
                                          bool wait_for_ready);

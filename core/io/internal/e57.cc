@@ -187,12 +187,12 @@ class DataPackets {
       return Invalid(absl::StrCat(scan, "'s points begin at byte ", file_offset,
                                   ", where the file holds no section"));
     }
-    if (file.LoadLittleEndian(start, 1) != kCompressedVectorSection) {
+    if (file.Load<uint8_t>(start) != kCompressedVectorSection) {
       return Invalid(absl::StrCat(scan, "'s points at byte ", file_offset,
                                   " are not a compressed vector section"));
     }
-    const uint64_t length = file.LoadLittleEndian(start + 8, 8);
-    const uint64_t data_offset = file.LoadLittleEndian(start + 16, 8);
+    const uint64_t length = file.Load<uint64_t>(start + 8);
+    const uint64_t data_offset = file.Load<uint64_t>(start + 16);
     if (length > file.size() - start) {
       return Invalid(absl::StrCat(scan, "'s section of ", length, " bytes runs past the file"));
     }
@@ -214,8 +214,8 @@ class DataPackets {
         return Invalid(absl::StrCat(scan_, "'s section ends before all its records (its packets ",
                                     "are missing or short)"));
       }
-      const uint64_t type = file_->LoadLittleEndian(at_, 1);
-      const uint64_t length = file_->LoadLittleEndian(at_ + 2, 2) + 1;
+      const uint64_t type = file_->Load<uint8_t>(at_);
+      const uint64_t length = file_->Load<uint16_t>(at_ + 2) + 1;
       if (length > end_ - at_) {
         return Invalid(
             absl::StrCat(scan_, "'s packet at logical byte ", at_, " runs past its section"));
@@ -227,7 +227,7 @@ class DataPackets {
         return Invalid(absl::StrCat(scan_, "'s section holds a packet of unknown type ", type));
       }
       const uint64_t count =
-          length >= kDataPacketHeaderSize ? file_->LoadLittleEndian(packet + 4, 2) : 0;
+          length >= kDataPacketHeaderSize ? file_->Load<uint16_t>(packet + 4) : 0;
       if (count != fields_) {
         return Invalid(absl::StrCat(scan_, "'s data packet holds ", count,
                                     " bytestreams where its prototype declares ", fields_,
@@ -238,7 +238,7 @@ class DataPackets {
         return Invalid(absl::StrCat(scan_, "'s data packet is shorter than its header"));
       }
       for (size_t f = 0; f < count; ++f) {
-        const uint64_t size = file_->LoadLittleEndian(packet + kDataPacketHeaderSize + 2 * f, 2);
+        const uint64_t size = file_->Load<uint16_t>(packet + kDataPacketHeaderSize + 2 * f);
         if (size > packet + length - buffer) {
           return Invalid(absl::StrCat(scan_, "'s data packet's buffers run past its end"));
         }
@@ -635,7 +635,7 @@ std::string Guid(absl::string_view data, uint64_t salt) {
 
 // The data packets of the section: as many records as fit per packet, a multiple of 64 so that
 // every stream's share ends on a whole 8-byte register.
-std::string DataPackets(const std::vector<WrittenField>& fields, uint64_t records) {
+std::string FormatDataPackets(const std::vector<WrittenField>& fields, uint64_t records) {
   const size_t header = kDataPacketHeaderSize + 2 * fields.size();
   uint64_t bits_per_record = 0;
   for (const WrittenField& field : fields) bits_per_record += field.bits_per_record;
@@ -788,7 +788,7 @@ std::string FormatE57(const GeometryView& points) {
   // The logical layout: the file header, the points' section, the XML.
   std::string section(kSectionHeaderSize, '\0');
   section[0] = static_cast<char>(kCompressedVectorSection);
-  section += DataPackets(fields, count);
+  section += FormatDataPackets(fields, count);
   const uint64_t section_start = kFileHeaderSize;
   const uint64_t section_length = section.size();
   std::string lengths;

@@ -61,14 +61,6 @@ void E57LogicalView::Append(uint64_t offset, uint64_t count, std::string* out) c
   }
 }
 
-uint64_t E57LogicalView::LoadLittleEndian(uint64_t offset, int bytes) const {
-  std::string data;
-  Append(offset, bytes, &data);
-  uint64_t value = 0;
-  for (int b = bytes - 1; b >= 0; --b) value = value << 8 | static_cast<uint8_t>(data[b]);
-  return value;
-}
-
 std::string E57Pages(absl::string_view logical) {
   const uint64_t pages = (logical.size() + kE57PageDataSize - 1) / kE57PageDataSize;
   std::string file;

@@ -10,6 +10,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "core/io/internal/binary.h"
 
 namespace neuralmesh::io_internal {
 
@@ -40,8 +41,13 @@ class E57LogicalView {
   uint64_t size() const { return size_; }
   // Appends the logical bytes [offset, offset + count), which must lie within size(), to `out`.
   void Append(uint64_t offset, uint64_t count, std::string* out) const;
-  // The little-endian integer of `bytes` bytes at `offset` (its bytes within size()).
-  uint64_t LoadLittleEndian(uint64_t offset, int bytes) const;
+  // The little-endian T at `offset` (its bytes within size()).
+  template <typename T>
+  T Load(uint64_t offset) const {
+    std::string bytes;
+    Append(offset, sizeof(T), &bytes);
+    return LoadScalar<T>(bytes.data(), /*big_endian=*/false);
+  }
 
  private:
   explicit E57LogicalView(absl::string_view file)

@@ -188,9 +188,7 @@ absl::StatusOr<PointCloud> LoadPointClouds(const std::vector<std::string>& input
     }
     PointsLeftOut one;
     NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(input, role, &one));
-    total.withheld += one.withheld;
-    total.noise += one.noise;
-    total.invalid += one.invalid;
+    total += one;
     clouds.push_back(std::move(cloud));
   }
   // What some files have and another lacks, named by the first that lacks it.

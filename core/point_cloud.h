@@ -22,6 +22,12 @@ struct PointsLeftOut {
   size_t invalid = 0;
 
   size_t total() const { return withheld + noise + invalid; }
+  PointsLeftOut& operator+=(const PointsLeftOut& other) {
+    withheld += other.withheld;
+    noise += other.noise;
+    invalid += other.invalid;
+    return *this;
+  }
 };
 
 struct PointCloud {

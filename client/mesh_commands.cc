@@ -1,4 +1,9 @@
 // RunStats, RunEval and RunConvert (declared in client/local_commands.h).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/match.h"
@@ -102,13 +107,12 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
     NM_ASSIGN_OR_RETURN(removed, RemoveStatisticalOutliers(cloud, *options.outliers));
   }
   NM_RETURN_IF_ERROR(WritePointCloud(cloud, options.output, options.writing.draco));
-  // What the file holds: LAS has no place for normals and weights, E57 none for weights.
-  const bool las = absl::EndsWithIgnoreCase(options.output, ".las");
-  const bool e57 = absl::EndsWithIgnoreCase(options.output, ".e57");
+  // What the file holds (LAS has no place for normals and weights, E57 none for weights).
+  const WrittenPointAttributes kept = PointAttributesWrittenTo(options.output);
   std::vector<std::string> carried, dropped;
-  if (!cloud.normals.empty()) (las ? dropped : carried).push_back("normals");
-  if (!cloud.weights.empty()) (las || e57 ? dropped : carried).push_back("weights");
-  if (!cloud.colors.empty()) carried.push_back("colours");
+  if (!cloud.normals.empty()) (kept.normals ? carried : dropped).push_back("normals");
+  if (!cloud.weights.empty()) (kept.weights ? carried : dropped).push_back("weights");
+  if (!cloud.colors.empty()) (kept.colors ? carried : dropped).push_back("colours");
   out << options.output << ": " << cloud.size() << " points";
   if (!carried.empty()) out << ", with " << absl::StrJoin(carried, ", ");
   if (options.outliers.has_value()) {
@@ -116,8 +120,16 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   }
   out << merge_note << LeftOutNote(left_out) << OriginNote(cloud.origin) << "\n";
   if (!dropped.empty()) {
-    out << "note: "
-        << (las ? "LAS keeps positions and colours" : "E57 keeps positions, colours and normals")
+    std::vector<std::string> holds = {"positions"};
+    if (kept.colors) holds.push_back("colours");
+    if (kept.normals) holds.push_back("normals");
+    if (kept.weights) holds.push_back("weights");
+    const std::string last = holds.back();
+    holds.pop_back();
+    // The format's name: its extension, "LAS" for .las.
+    const std::string extension = std::filesystem::path(options.output).extension().string();
+    const std::string format = absl::AsciiStrToUpper(extension.substr(1));
+    out << "note: " << format << " keeps " << absl::StrJoin(holds, ", ") << " and " << last
         << "; the " << absl::StrJoin(dropped, " and ") << " were left out\n";
   }
   return absl::OkStatus();

@@ -103,6 +103,15 @@ const char kReadablePointCloudExtensions[] =
 const char kWritablePointCloudExtensions[] =
     ".ply, .xyz, .txt, .pts, .las, .pcd, .e57, .drc, .glb, .gltf";
 
+WrittenPointAttributes PointAttributesWrittenTo(std::string_view path) {
+  const FileFormat format =
+      io_internal::FormatFromPath(absl::string_view(path.data(), path.size()));
+  if (!IsWritable(format)) return {};
+  return {/*normals=*/format != FileFormat::kLas,
+          /*weights=*/format != FileFormat::kLas && format != FileFormat::kE57,
+          /*colors=*/true};
+}
+
 bool IsWritablePointCloudExtension(std::string_view path) {
   return IsWritable(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
 }

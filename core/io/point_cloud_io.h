@@ -27,6 +27,16 @@ bool IsReadablePointCloudExtension(std::string_view path);
 // True when WritePointCloud handles the extension of `path` (kWritablePointCloudExtensions).
 bool IsWritablePointCloudExtension(std::string_view path);
 
+// What WritePointCloud keeps of a cloud besides its positions in the format of `path`: all of
+// it, except in LAS (colours only) and E57 (no weights); nothing for an extension it does not
+// write.
+struct WrittenPointAttributes {
+  bool normals = false;
+  bool weights = false;
+  bool colors = false;
+};
+WrittenPointAttributes PointAttributesWrittenTo(std::string_view path);
+
 // Reads the points at `path`; faces in the file are skipped without being checked:
 //   .ply  ASCII or binary (either byte order): 'vertex' x, y, z of any scalar type; nx, ny, nz
 //         when all present; the first of confidence, weight, quality, intensity, scalar as

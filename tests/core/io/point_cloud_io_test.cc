@@ -120,6 +120,14 @@ TEST(PointCloudIoTest, ExtensionHelpers) {
   for (const char* name : {"e.obj", "f.off", "a.stl", "b.ptx"}) {
     EXPECT_FALSE(IsWritablePointCloudExtension(name)) << name << " should not be writable";
   }
+  const WrittenPointAttributes ply = PointAttributesWrittenTo("a.ply");
+  EXPECT_TRUE(ply.normals && ply.weights && ply.colors);
+  const WrittenPointAttributes las = PointAttributesWrittenTo("b.LAS");
+  EXPECT_TRUE(!las.normals && !las.weights && las.colors);
+  const WrittenPointAttributes e57 = PointAttributesWrittenTo("c.e57");
+  EXPECT_TRUE(e57.normals && !e57.weights && e57.colors);
+  const WrittenPointAttributes ptx = PointAttributesWrittenTo("d.ptx");
+  EXPECT_TRUE(!ptx.normals && !ptx.weights && !ptx.colors) << "PTX is not written";
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -77,6 +77,9 @@ struct ConvertOptions {
   MeshWriteOptions writing;  // Draco settings, glTF compression (meshes only).
   // Set: a point cloud's statistical outliers are removed before it is written.
   std::optional<OutlierOptions> outliers;
+  // With `outliers`, from one .las file to .las: the outliers' records are kept, classified as
+  // noise (ASPRS class 7), instead of removed.
+  bool outliers_as_noise = false;
 };
 
 // Writes INPUT to OUTPUT, colours included where the format holds them. A mesh (a file with
@@ -85,9 +88,12 @@ struct ConvertOptions {
 // or any file written to .xyz/.txt/.pts/.las/.pcd/.e57) are written as a point cloud with their
 // normals, weights and colours where the format holds them, and "OUTPUT: N points" printed
 // (", with normals, weights, colours"; how many outliers went; what LAS or E57 leaves out).
+// One .las INPUT written to .las is copied record by record instead (core/io/las_cleaning.h),
+// its outliers left out or, with outliers_as_noise, classified as noise.
 // INVALID_ARGUMENT for an unknown output extension (before reading INPUT), a mesh format for
 // points that are not a mesh (.obj, .off, .stl), a point format for a builtin surface,
-// --remove_outliers for a mesh, --gltf_draco for points, and the reader's and writer's errors.
+// --remove_outliers for a mesh, --gltf_draco for points, outliers_as_noise for anything but
+// one .las INPUT and a .las OUTPUT, and the reader's and writer's errors.
 absl::Status RunConvert(const ConvertOptions& options, std::ostream& out);
 
 }  // namespace neuralmesh::client

@@ -134,6 +134,10 @@ ABSL_FLAG(int32_t, outlier_passes, neuralmesh::OutlierOptions{}.passes,
           "With --remove_outliers: passes over the cloud, in [1, 16], each judging the points "
           "the one before kept (a few far strays widen the deviation enough to hide milder "
           "ones from the first). The server's filter (--outliers_on_server) makes one.");
+ABSL_FLAG(bool, outliers_as_noise, false,
+          "With --remove_outliers, converting one .las file to .las: keep the outliers' "
+          "records, classified as noise (ASPRS class 7, low point; the readers leave such "
+          "points out), instead of removing them, as PDAL's outlier filter marks them.");
 ABSL_FLAG(bool, outliers_on_server, false,
           "With --remove_outliers and --server: the session removes the outliers as the batches "
           "arrive (SessionConfig.outlier_removal), as for a client that streams a scan, instead "
@@ -496,6 +500,10 @@ absl::Status Convert(const ParsedArgs& args) {
   o.output = absl::GetFlag(FLAGS_output);
   NM_ASSIGN_OR_RETURN(o.writing, MeshWritingFromFlags());
   NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
+  o.outliers_as_noise = absl::GetFlag(FLAGS_outliers_as_noise);
+  if (o.outliers_as_noise && !o.outliers.has_value()) {
+    return absl::InvalidArgumentError("--outliers_as_noise needs --remove_outliers");
+  }
   return neuralmesh::client::RunConvert(o, std::cout);
 }
 
@@ -647,8 +655,8 @@ std::vector<Subcommand> Commands() {
        {"json"},
        Stats},
       {"convert",
-       "convert INPUT... -o OUTPUT [--gltf_draco] [--remove_outliers] [--quantization_bits B]\n"
-       "        [--encode_speed S]",
+       "convert INPUT... -o OUTPUT [--gltf_draco] [--remove_outliers [--outliers_as_noise]]\n"
+       "        [--quantization_bits B] [--encode_speed S]",
        "Writes a mesh or a point cloud in another format.",
        "Writes INPUT to OUTPUT in the format of its extension, colours included where the\n"
        "format holds them. A mesh (a file with faces, or builtin:NAME, its dense reference\n"
@@ -656,9 +664,13 @@ std::vector<Subcommand> Commands() {
        ".ptx .las .pcd .e57, a file without faces, or anything written to .xyz .txt .pts\n"
        ".las .pcd .e57) go to .ply .xyz .txt .pts .las .pcd .e57 .drc .glb .gltf with their\n"
        "normals and weights (LAS: positions and colours only; E57: no weights), after\n"
-       "--remove_outliers if given. Several point cloud files are written as one.",
+       "--remove_outliers if given. One .las file written to .las keeps its records whole\n"
+       "(classes, intensities, times, extra bytes) and its header's scale, offset and\n"
+       "variable-length records (the coordinate system); --outliers_as_noise classifies its\n"
+       "outliers as noise instead of removing them. Several point cloud files are written as\n"
+       "one.",
        {"output", "gltf_draco", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
-        "outlier_passes", "quantization_bits", "encode_speed"},
+        "outlier_passes", "outliers_as_noise", "quantization_bits", "encode_speed"},
        Convert},
       {"eval",
        "eval MESH --reference REF [--json] [--samples N]",

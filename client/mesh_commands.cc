@@ -14,6 +14,8 @@
 #include "core/analysis/geometric_error.h"
 #include "core/analysis/json_writer.h"
 #include "core/analysis/mesh_report.h"
+#include "core/analysis/statistical_outliers.h"
+#include "core/io/las_cleaning.h"
 #include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
 #include "core/status_macros.h"
@@ -97,26 +99,58 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
     return absl::InvalidArgumentError(
         "--gltf_draco compresses meshes; points are written to glTF uncompressed (or to .drc)");
   }
+  // LAS to LAS: the records themselves, with what a PointCloud does not hold.
+  const bool las_records_kept = options.inputs.size() == 1 &&
+                                absl::EndsWithIgnoreCase(options.inputs.front(), ".las") &&
+                                absl::EndsWithIgnoreCase(options.output, ".las");
+  if (options.outliers_as_noise && !las_records_kept) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--outliers_as_noise classifies the outliers of one .las INPUT in a .las OUTPUT; "
+        "INPUT ", QuotedInputs(options.inputs), " to OUTPUT '", options.output,
+        "' can only leave them out"));
+  }
   PointsLeftOut left_out;
   std::string merge_note;
   NM_ASSIGN_OR_RETURN(PointCloud cloud,
                       LoadPointClouds(options.inputs, "INPUT", &left_out, &merge_note));
   const size_t read = cloud.size();
-  size_t removed = 0;
+  std::vector<bool> outlier(cloud.size(), false);
   if (options.outliers.has_value()) {
-    NM_ASSIGN_OR_RETURN(removed, RemoveStatisticalOutliers(cloud, *options.outliers));
+    NM_ASSIGN_OR_RETURN(outlier, FindStatisticalOutliersInPasses(cloud, *options.outliers));
+    cloud = WithoutPoints(cloud, outlier);
   }
-  NM_RETURN_IF_ERROR(WritePointCloud(cloud, options.output, options.writing.draco));
-  // What the file holds (LAS has no place for normals and weights, E57 none for weights).
+  const size_t found = read - cloud.size();
+  size_t written = cloud.size();
+  std::string contents;  // What the file holds besides positions, for the line below.
+  std::vector<std::string> dropped;
   const WrittenPointAttributes kept = PointAttributesWrittenTo(options.output);
-  std::vector<std::string> carried, dropped;
-  if (!cloud.normals.empty()) (kept.normals ? carried : dropped).push_back("normals");
-  if (!cloud.weights.empty()) (kept.weights ? carried : dropped).push_back("weights");
-  if (!cloud.colors.empty()) (kept.colors ? carried : dropped).push_back("colours");
-  out << options.output << ": " << cloud.size() << " points";
-  if (!carried.empty()) out << ", with " << absl::StrJoin(carried, ", ");
+  if (las_records_kept) {
+    NM_RETURN_IF_ERROR(WriteCleanedLas(options.inputs.front(), outlier,
+                                       options.outliers_as_noise
+                                           ? LasOutlierRecords::kClassifiedAsNoise
+                                           : LasOutlierRecords::kLeftOut,
+                                       options.output));
+    contents = absl::StrCat(", each record as in ", options.inputs.front(),
+                            " with every field, and its header's scale, offset and "
+                            "variable-length records");
+    // Classified, the outliers and the records left out on reading stay in the file.
+    if (options.outliers_as_noise) {
+      written = read;
+      left_out = {};
+    }
+  } else {
+    NM_RETURN_IF_ERROR(WritePointCloud(cloud, options.output, options.writing.draco));
+    // What the file holds (LAS has no place for normals and weights, E57 none for weights).
+    std::vector<std::string> carried;
+    if (!cloud.normals.empty()) (kept.normals ? carried : dropped).push_back("normals");
+    if (!cloud.weights.empty()) (kept.weights ? carried : dropped).push_back("weights");
+    if (!cloud.colors.empty()) (kept.colors ? carried : dropped).push_back("colours");
+    if (!carried.empty()) contents = absl::StrCat(", with ", absl::StrJoin(carried, ", "));
+  }
+  out << options.output << ": " << written << " points" << contents;
   if (options.outliers.has_value()) {
-    out << " (" << removed << " outliers of " << read << " removed)";
+    out << " (" << found << " outliers of " << read
+        << (options.outliers_as_noise ? " classified as noise)" : " removed)");
   }
   out << merge_note << LeftOutNote(left_out) << OriginNote(cloud.origin) << "\n";
   if (!dropped.empty()) {

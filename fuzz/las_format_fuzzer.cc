@@ -2,7 +2,8 @@
 // fuzz/geometry_parser_properties.h, and the writer's own: a parsed file written again reads
 // back to the same number of points, each within the written scale (and a float's rounding) of
 // where it was, with the same colours. The generic round trip, bit for bit, does not apply:
-// LAS stores integers.
+// LAS stores integers. A parsed file cleaned of every other point (FormatCleanedLas) reads back
+// to the points kept; with those classified as noise instead, to the same points.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "core/io/internal/las.h"
 #include "fuzz/fuzz_check.h"
@@ -33,6 +35,32 @@ void CheckWrittenAgain(const ParsedGeometry& parsed) {
   FUZZ_CHECK(reread->colors == parsed.colors, "colours change when written and read back");
 }
 
+// The copy keeps the records' integers, so only the origin the reader picks (from the kept
+// points' range) may change the floats: to within their rounding.
+void CheckCleaned(absl::string_view data, const ParsedGeometry& parsed) {
+  if (parsed.positions.empty()) return;  // A file of no points: nothing to clean.
+  std::vector<bool> outliers(parsed.positions.size());
+  ParsedGeometry expected;
+  expected.origin = parsed.origin;
+  for (size_t i = 0; i < outliers.size(); ++i) {
+    outliers[i] = i % 2 == 1;
+    if (!outliers[i]) expected.positions.push_back(parsed.positions[i]);
+  }
+  std::array<double, 3> scale;
+  std::memcpy(scale.data(), data.data() + 131, sizeof scale);
+  for (double& s : scale) s = std::fabs(s);
+  for (const auto records : {neuralmesh::LasOutlierRecords::kLeftOut,
+                             neuralmesh::LasOutlierRecords::kClassifiedAsNoise}) {
+    const absl::StatusOr<std::string> cleaned =
+        neuralmesh::io_internal::FormatCleanedLas(data, outliers, records);
+    FUZZ_CHECK(cleaned.ok(), "cleaning failed: %s", cleaned.status().ToString().c_str());
+    const absl::StatusOr<ParsedGeometry> reread = neuralmesh::io_internal::ParseLas(*cleaned);
+    FUZZ_CHECK(reread.ok(), "the cleaned file does not parse: %s",
+               reread.status().ToString().c_str());
+    neuralmesh::fuzz::CheckPositionsWithinScale(expected, *reread, scale);
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -44,6 +72,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   neuralmesh::fuzz::CheckGeometryParser(las, data, size);
   const absl::StatusOr<ParsedGeometry> parsed = neuralmesh::io_internal::ParseLas(
       absl::string_view(reinterpret_cast<const char*>(data), size));
-  if (parsed.ok()) CheckWrittenAgain(*parsed);
+  if (parsed.ok()) {
+    CheckWrittenAgain(*parsed);
+    CheckCleaned(absl::string_view(reinterpret_cast<const char*>(data), size), *parsed);
+  }
   return 0;
 }

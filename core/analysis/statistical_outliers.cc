@@ -4,10 +4,13 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numeric>
 #include <thread>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "core/analysis/point_kd_tree.h"
+#include "core/status_macros.h"
 
 namespace neuralmesh {
 namespace {
@@ -79,18 +82,37 @@ double OutlierDistanceLimit(absl::Span<const double> mean_distances, double std_
   return mean + std_ratio * deviation;
 }
 
+absl::StatusOr<std::vector<bool>> FindStatisticalOutliersInPasses(const PointCloud& cloud,
+                                                                  const OutlierOptions& options) {
+  if (absl::Status valid = options.Validate(); !valid.ok()) return valid;
+  std::vector<bool> dropped(cloud.size(), false);
+  PointCloud judged = cloud;
+  std::vector<size_t> index_in_cloud(cloud.size());  // Of each point of `judged`.
+  std::iota(index_in_cloud.begin(), index_in_cloud.end(), size_t{0});
+  for (int pass = 0; pass < options.passes; ++pass) {
+    absl::StatusOr<std::vector<bool>> outlier = FindStatisticalOutliers(judged, options);
+    if (!outlier.ok()) return outlier.status();
+    if (std::find(outlier->begin(), outlier->end(), true) == outlier->end()) break;
+    std::vector<size_t> kept_indices;
+    for (size_t i = 0; i < judged.size(); ++i) {
+      if ((*outlier)[i]) {
+        dropped[index_in_cloud[i]] = true;
+      } else {
+        kept_indices.push_back(index_in_cloud[i]);
+      }
+    }
+    judged = WithoutPoints(judged, *outlier);
+    index_in_cloud = std::move(kept_indices);
+  }
+  return dropped;
+}
+
 absl::StatusOr<size_t> RemoveStatisticalOutliers(PointCloud& cloud,
                                                  const OutlierOptions& options) {
-  if (absl::Status valid = options.Validate(); !valid.ok()) return valid;
-  size_t removed = 0;
-  for (int pass = 0; pass < options.passes; ++pass) {
-    absl::StatusOr<std::vector<bool>> outlier = FindStatisticalOutliers(cloud, options);
-    if (!outlier.ok()) return outlier.status();
-    const size_t found = static_cast<size_t>(std::count(outlier->begin(), outlier->end(), true));
-    if (found == 0) break;
-    cloud = WithoutPoints(cloud, *outlier);
-    removed += found;
-  }
+  NM_ASSIGN_OR_RETURN(const std::vector<bool> outlier,
+                      FindStatisticalOutliersInPasses(cloud, options));
+  const size_t removed = static_cast<size_t>(std::count(outlier.begin(), outlier.end(), true));
+  if (removed > 0) cloud = WithoutPoints(cloud, outlier);
   return removed;
 }
 

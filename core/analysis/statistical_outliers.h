@@ -43,9 +43,14 @@ absl::StatusOr<std::vector<bool>> FindStatisticalOutliers(const PointCloud& clou
 // Infinity for fewer than 2 distances.
 double OutlierDistanceLimit(absl::Span<const double> mean_distances, double std_ratio);
 
-// Removes the outliers of `cloud` in up to options.passes passes, each judging the points the
-// one before kept (stopping at a pass that finds none); weights, normals and colours go with
-// their points. Returns how many points went; INVALID_ARGUMENT for invalid options.
+// One flag per point of `cloud`: true for an outlier found in up to options.passes passes,
+// each judging the points the one before kept (stopping at a pass that finds none).
+// INVALID_ARGUMENT for invalid options.
+absl::StatusOr<std::vector<bool>> FindStatisticalOutliersInPasses(const PointCloud& cloud,
+                                                                  const OutlierOptions& options);
+
+// Removes the outliers FindStatisticalOutliersInPasses finds; weights, normals and colours go
+// with their points. Returns how many points went; INVALID_ARGUMENT for invalid options.
 absl::StatusOr<size_t> RemoveStatisticalOutliers(PointCloud& cloud, const OutlierOptions& options);
 
 // `cloud` without the points flagged in `drop` (one flag per point), weights, normals and

@@ -500,6 +500,11 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
        "--outlier_neighbours is 0"},
       {{"convert", xyz, "-o", clean, "--remove_outliers", "--outlier_passes", "17"},
        "--outlier_passes is 17; it must be in [1, 16]"},
+      {{"convert", xyz, "-o", *dir_ + "/points.las", "--outliers_as_noise"},
+       "--outliers_as_noise needs --remove_outliers"},
+      {{"convert", xyz, "-o", *dir_ + "/points.las", "--remove_outliers", "--outliers_as_noise"},
+       "--outliers_as_noise classifies the outliers of one .las INPUT in a .las OUTPUT; INPUT '" +
+           xyz + "' to OUTPUT '" + *dir_ + "/points.las' can only leave them out"},
       {{"reconstruct", xyz, "--server", "127.0.0.1:1", "--remove_outliers", "--outliers_on_server",
         "--outlier_passes", "2"},
        "--outlier_passes: the server's filter makes one pass"},
@@ -800,17 +805,24 @@ TEST_F(LocalCliTest, SeveralPointCloudFilesAreLearnedAndWrittenAsOne) {
       << with_builtin.err;
 }
 
+// LAS records of `count` points of the unit sphere, at the layout's scale (the same on every
+// axis, no offset).
+std::vector<testing::LasPoint> UnitSphereLasPoints(int count, uint64_t seed,
+                                                   const testing::LasLayout& layout) {
+  std::vector<testing::LasPoint> points;
+  for (const Vec3f& p : ColoredUnitSpherePoints(count, seed).positions) {
+    points.push_back({static_cast<int32_t>(std::lround(p[0] / layout.scale[0])),
+                      static_cast<int32_t>(std::lround(p[1] / layout.scale[1])),
+                      static_cast<int32_t>(std::lround(p[2] / layout.scale[2]))});
+  }
+  return points;
+}
+
 TEST_F(LocalCliTest, ClassifiedNoiseInLasScansIsLeftOutAndCounted) {
-  const PointCloud unit = ColoredUnitSpherePoints(4000, 9);
   testing::LasLayout layout;
   layout.format = 1;
   for (double& s : layout.scale) s = 0.0001;
-  std::vector<testing::LasPoint> points;
-  for (const Vec3f& p : unit.positions) {
-    points.push_back({static_cast<int32_t>(std::lround(p[0] / 0.0001)),
-                      static_cast<int32_t>(std::lround(p[1] / 0.0001)),
-                      static_cast<int32_t>(std::lround(p[2] / 0.0001))});
-  }
+  std::vector<testing::LasPoint> points = UnitSphereLasPoints(4000, 9, layout);
   for (int i = 0; i < 40; ++i) {  // Strays 3 to 5 radii out, classified as high noise.
     testing::LasPoint stray{30000 + 500 * i, -50000 + 1000 * i, 40000};
     stray.classification = 18;
@@ -836,6 +848,85 @@ TEST_F(LocalCliTest, ClassifiedNoiseInLasScansIsLeftOutAndCounted) {
   for (const Vec3f& v : learned->positions) {
     ASSERT_NEAR(v.norm(), 1.0f, 0.05f) << "no vertex pulled toward the noise";
   }
+}
+
+// A LAS scan cleaned of its strays and written as LAS keeps what the learner does not read:
+// each record whole (class, intensity, returns, GPS time), the header's scale and offset, its
+// coordinate system. Records classified as noise are left out as on reading.
+TEST_F(LocalCliTest, ALasScanCleanedIntoLasKeepsItsRecordsWhole) {
+  testing::LasLayout layout;
+  layout.version_minor = 4;
+  layout.format = 6;
+  for (double& s : layout.scale) s = 0.00025;
+  layout.vlrs = std::string(54, '\0') + "COMPD_CS[\"a coordinate system\"]";
+  layout.vlrs[2] = 'x';  // The record's user id, so that it is not all zeros.
+  layout.vlrs[20] = static_cast<char>(layout.vlrs.size() - 54);
+  layout.vlr_count = 1;
+  std::vector<testing::LasPoint> points = UnitSphereLasPoints(3000, 4, layout);
+  for (size_t i = 0; i < points.size(); ++i) {
+    points[i].classification = 2;
+    points[i].intensity = static_cast<uint16_t>(i);
+    points[i].gps_time = 4.0e5 + i;
+  }
+  for (int i = 0; i < 3; ++i) {  // Strays 4 radii out, unclassified: outliers.
+    testing::LasPoint stray{16000 + 400 * i, -16000, 0};
+    stray.intensity = 60000;
+    points.insert(points.begin() + 1000 * i + 500, stray);
+  }
+  points[7].classification = 7;  // Low noise.
+  const std::string las = *dir_ + "/scan.las";
+  const std::string source = testing::LasFile(layout, points);
+  std::ofstream(las, std::ios::binary) << source;
+
+  const std::string clean = *dir_ + "/clean.las";
+  const RunResult run = RunNeuralmesh({"convert", las, "-o", clean, "--remove_outliers"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_EQ(run.out, clean + ": 2999 points, each record as in " + las +
+                         " with every field, and its header's scale, offset and "
+                         "variable-length records (3 outliers of 3002 removed); left out 1 "
+                         "point classified as noise\n");
+  const std::string bytes = ReadFileContents(clean).value_or("");
+  ASSERT_EQ(bytes.size(), source.size() - 4 * 30);
+  const size_t first = 375 + layout.vlrs.size();
+  EXPECT_EQ(bytes.substr(375, layout.vlrs.size()), layout.vlrs) << "the coordinate system";
+  EXPECT_EQ(bytes.substr(131, 48), source.substr(131, 48)) << "scale and offset";
+  // The records in order, each as it was: the source's but the strays and the noise.
+  size_t at = first;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (points[i].intensity == 60000 || points[i].classification == 7) continue;
+    ASSERT_LT(at, bytes.size());
+    ASSERT_EQ(bytes.substr(at, 30), source.substr(first + 30 * i, 30)) << "source record " << i;
+    at += 30;
+  }
+  const absl::StatusOr<PointCloud> read = ReadPointCloud(clean);
+  ASSERT_TRUE(read.ok()) << read.status();
+  for (const Vec3f& p : read->positions) ASSERT_NEAR(p.norm(), 1.0f, 1e-3f);
+
+  // Classified as noise instead: every record stays, the strays' with class 7, which the
+  // readers leave out.
+  const std::string marked = *dir_ + "/marked.las";
+  const RunResult mark =
+      RunNeuralmesh({"convert", las, "-o", marked, "--remove_outliers", "--outliers_as_noise"});
+  ASSERT_EQ(mark.exit_code, 0) << mark.Describe();
+  EXPECT_EQ(mark.out, marked + ": 3002 points, each record as in " + las +
+                          " with every field, and its header's scale, offset and "
+                          "variable-length records (3 outliers of 3002 classified as noise)\n");
+  const std::string marked_bytes = ReadFileContents(marked).value_or("");
+  ASSERT_EQ(marked_bytes.size(), source.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const bool noise = points[i].intensity == 60000 || points[i].classification == 7;
+    EXPECT_EQ(marked_bytes[first + 30 * i + 16], noise ? 7 : 2) << "record " << i;
+  }
+  PointsLeftOut left_out;
+  const absl::StatusOr<PointCloud> unmarked = ReadPointCloud(marked, &left_out);
+  ASSERT_TRUE(unmarked.ok()) << unmarked.status();
+  EXPECT_EQ(unmarked->size(), 2999u);
+  EXPECT_EQ(left_out.noise, 4u);
+
+  // Several files, or another format, go through the point cloud: LAS of positions only.
+  const RunResult merged = RunNeuralmesh({"convert", las, clean, "-o", *dir_ + "/both.las"});
+  ASSERT_EQ(merged.exit_code, 0) << merged.Describe();
+  EXPECT_TRUE(absl::StartsWith(merged.out, *dir_ + "/both.las: 6001 points;")) << merged.out;
 }
 
 TEST_F(LocalCliTest, AnInterruptWritesTheMeshLearnedSoFar) {

@@ -30,6 +30,16 @@ void AppendLittleEndian(T value, std::string* out) {
   out->append(bytes, sizeof(T));
 }
 
+// Writes `value` over the sizeof(T) bytes of `out` from `offset` (which must lie within it),
+// in little-endian byte order.
+template <typename T>
+void StoreLittleEndian(T value, size_t offset, std::string* out) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  if (kHostIsBigEndian) std::reverse(bytes, bytes + sizeof(T));
+  std::memcpy(out->data() + offset, bytes, sizeof(T));
+}
+
 }  // namespace neuralmesh::io_internal
 
 #endif  // NEURALMESH_CORE_IO_INTERNAL_BINARY_H_

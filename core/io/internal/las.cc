@@ -10,6 +10,7 @@
 #include "core/io/internal/binary.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
+#include "core/status_macros.h"
 #include "core/rgb.h"
 #include "core/version.h"
 
@@ -30,6 +31,13 @@ constexpr size_t kOffset = 155;      // x, y, z: doubles.
 constexpr size_t kPointCount = 247;  // LAS 1.4: uint64.
 constexpr size_t kLegacyHeaderSize = 227;
 constexpr size_t kHeaderSize14 = 375;
+constexpr size_t kGeneratingSoftware = 58;  // 32 characters.
+constexpr size_t kLegacyByReturn = 111;     // Returns 1-5: uint32 each.
+constexpr size_t kBounds = 179;             // Max x, min x, max y, ...: doubles.
+constexpr size_t kWaveformStart = 227;      // LAS 1.3 and 1.4: uint64.
+constexpr size_t kHeaderSize13 = 235;
+constexpr size_t kEvlrStart = 235;          // LAS 1.4: uint64.
+constexpr size_t kByReturn14 = 255;         // Returns 1-15: uint64 each.
 
 // Format bits that LASzip sets on compressed (LAZ) files.
 constexpr uint8_t kCompressedBits = 0xC0;
@@ -77,26 +85,58 @@ void AppendText(absl::string_view text, size_t size, std::string* out) {
   out->append(size - text.size(), '\0');
 }
 
-}  // namespace
+// The generating software field: this program and its version.
+std::string GeneratingSoftware() { return absl::StrCat("neuralmesh ", NeuralmeshVersion()); }
 
-absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
+// Writes the generating software field of a LAS file's header.
+void SetGeneratingSoftware(std::string* file) {
+  std::string software;
+  AppendText(GeneratingSoftware(), 32, &software);
+  file->replace(kGeneratingSoftware, 32, software);
+}
+
+// The return number of the record at `at`: the low three bits of byte 14 in formats 0-5, the
+// low four in formats 6-10.
+int ReturnNumber(absl::string_view data, size_t at, int format) {
+  return static_cast<uint8_t>(data[at + 14]) & (format >= 6 ? 0x0F : 0x07);
+}
+
+// What the public header block says of the point records, checked against the file.
+struct LasHeader {
+  int minor = 0;  // Version 1.minor.
+  size_t header_size = 0;
+  size_t offset_to_points = 0;
+  uint8_t format = 0;
+  size_t record_length = 0;
+  uint64_t count = 0;
+  Point3d scale, offset;
+
+  size_t points_end() const { return offset_to_points + count * record_length; }
+  size_t record(uint64_t i) const { return offset_to_points + i * record_length; }
+  double Coordinate(absl::string_view data, size_t at, int c) const {
+    return Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
+  }
+};
+
+absl::StatusOr<LasHeader> ReadHeader(absl::string_view data) {
   if (data.size() < kLegacyHeaderSize || data.substr(0, 4) != "LASF") {
     return Invalid(data.size() >= 4 && data.substr(0, 4) == "LASF"
                        ? absl::StrCat("the file ends within its header (", data.size(), " bytes)")
                        : std::string("no LASF signature: not a LAS file"));
   }
+  LasHeader header;
   const int major = static_cast<uint8_t>(data[kVersionMajor]);
-  const int minor = static_cast<uint8_t>(data[kVersionMinor]);
-  if (major != 1 || minor > 4) {
-    return Invalid(absl::StrCat("version ", major, ".", minor, " is not 1.0 to 1.4"));
+  header.minor = static_cast<uint8_t>(data[kVersionMinor]);
+  if (major != 1 || header.minor > 4) {
+    return Invalid(absl::StrCat("version ", major, ".", header.minor, " is not 1.0 to 1.4"));
   }
-  const size_t header_size = Load<uint16_t>(data, kHeaderSize);
-  const size_t offset_to_points = Load<uint32_t>(data, kOffsetToPoints);
+  header.header_size = Load<uint16_t>(data, kHeaderSize);
+  header.offset_to_points = Load<uint32_t>(data, kOffsetToPoints);
   const uint8_t format_byte = static_cast<uint8_t>(data[kPointFormat]);
-  const size_t record_length = Load<uint16_t>(data, kRecordLength);
-  if (header_size < kLegacyHeaderSize || header_size > data.size()) {
-    return Invalid(absl::StrCat("header size ", header_size, " is not between ", kLegacyHeaderSize,
-                                " and the file's ", data.size(), " bytes"));
+  header.record_length = Load<uint16_t>(data, kRecordLength);
+  if (header.header_size < kLegacyHeaderSize || header.header_size > data.size()) {
+    return Invalid(absl::StrCat("header size ", header.header_size, " is not between ",
+                                kLegacyHeaderSize, " and the file's ", data.size(), " bytes"));
   }
   if (format_byte & kCompressedBits) {
     return Invalid(
@@ -106,36 +146,46 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
   if (format_byte > 10) {
     return Invalid(absl::StrCat("point data format ", int{format_byte}, " is not 0 to 10"));
   }
-  const PointFormat format = kFormats[format_byte];
-  if (record_length < format.length) {
-    return Invalid(absl::StrCat("records of ", record_length, " bytes are shorter than format ",
-                                int{format_byte}, "'s ", format.length));
+  header.format = format_byte;
+  if (header.record_length < kFormats[format_byte].length) {
+    return Invalid(absl::StrCat("records of ", header.record_length,
+                                " bytes are shorter than format ", int{format_byte}, "'s ",
+                                kFormats[format_byte].length));
   }
-  uint64_t count = Load<uint32_t>(data, kLegacyPointCount);
-  if (minor >= 4 && header_size >= kHeaderSize14) {
+  header.count = Load<uint32_t>(data, kLegacyPointCount);
+  if (header.minor >= 4 && header.header_size >= kHeaderSize14) {
     const uint64_t count14 = Load<uint64_t>(data, kPointCount);
-    if (count14 != 0) count = count14;
+    if (count14 != 0) header.count = count14;
   }
-  if (offset_to_points < header_size || offset_to_points > data.size() ||
-      count > (data.size() - offset_to_points) / record_length) {
-    return Invalid(absl::StrCat(count, " points of ", record_length, " bytes from byte ",
-                                offset_to_points, " do not fit in the file's ", data.size(),
-                                " bytes"));
+  if (header.offset_to_points < header.header_size || header.offset_to_points > data.size() ||
+      header.count > (data.size() - header.offset_to_points) / header.record_length) {
+    return Invalid(absl::StrCat(header.count, " points of ", header.record_length,
+                                " bytes from byte ", header.offset_to_points,
+                                " do not fit in the file's ", data.size(), " bytes"));
   }
-  Point3d scale, offset;
   for (int c = 0; c < 3; ++c) {
-    scale[c] = Load<double>(data, kScale + 8 * c);
-    offset[c] = Load<double>(data, kOffset + 8 * c);
-    if (!(scale[c] != 0) || !std::isfinite(scale[c]) || !std::isfinite(offset[c])) {
+    header.scale[c] = Load<double>(data, kScale + 8 * c);
+    header.offset[c] = Load<double>(data, kOffset + 8 * c);
+    if (!(header.scale[c] != 0) || !std::isfinite(header.scale[c]) ||
+        !std::isfinite(header.offset[c])) {
       return Invalid(absl::StrCat("the scale and offset of axis ",
-                                  absl::string_view("xyz").substr(c, 1), " (", scale[c], ", ",
-                                  offset[c], ") are not finite numbers and a nonzero scale"));
+                                  absl::string_view("xyz").substr(c, 1), " (", header.scale[c],
+                                  ", ", header.offset[c],
+                                  ") are not finite numbers and a nonzero scale"));
     }
   }
+  return header;
+}
 
-  const auto coordinate = [&](size_t at, int c) {
-    return Load<int32_t>(data, at + 4 * c) * scale[c] + offset[c];
-  };
+}  // namespace
+
+absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
+  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
+  const uint8_t format_byte = header.format;
+  const PointFormat format = kFormats[format_byte];
+  const uint64_t count = header.count;
+  const Point3d& scale = header.scale;
+  const auto coordinate = [&](size_t at, int c) { return header.Coordinate(data, at, c); };
   const auto channel = [&](size_t at, int c) {
     return Load<uint16_t>(data, at + format.rgb + 2 * c);
   };
@@ -143,7 +193,7 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
   // no list of them.
   const auto for_each_usable = [&](auto&& visit) {
     for (uint64_t i = 0; i < count; ++i) {
-      const size_t at = offset_to_points + i * record_length;
+      const size_t at = header.record(i);
       if (Usability(data, at, format_byte) == kUsable && !visit(i, at)) return false;
     }
     return true;
@@ -155,7 +205,7 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
   Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
   uint16_t largest = 0;
   for (uint64_t i = 0; i < count; ++i) {
-    const size_t at = offset_to_points + i * record_length;
+    const size_t at = header.record(i);
     const RecordUsability usability = Usability(data, at, format_byte);
     out.left_out.withheld += usability == kWithheld;
     out.left_out.noise += usability == kNoise;
@@ -251,7 +301,7 @@ absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
   out.push_back(1);
   out.push_back(2);
   AppendText("OTHER", 32, &out);  // System identifier: not a scanner's own file.
-  AppendText(absl::StrCat("neuralmesh ", NeuralmeshVersion()), 32, &out);
+  AppendText(GeneratingSoftware(), 32, &out);
   AppendLittleEndian(uint16_t{0}, &out);  // Creation day of year: not recorded.
   AppendLittleEndian(uint16_t{0}, &out);  // Creation year.
   AppendLittleEndian(static_cast<uint16_t>(kLegacyHeaderSize), &out);
@@ -269,6 +319,89 @@ absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
     AppendLittleEndian(count > 0 ? low[c] : 0.0, &out);
   }
   out += records;
+  return out;
+}
+
+absl::StatusOr<std::string> FormatCleanedLas(absl::string_view data,
+                                             const std::vector<bool>& outliers,
+                                             LasOutlierRecords records) {
+  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
+  // The records ParseLas reads, and of those the outliers.
+  std::vector<size_t> kept, flagged;
+  size_t usable = 0;
+  for (uint64_t i = 0; i < header.count; ++i) {
+    const size_t at = header.record(i);
+    if (Usability(data, at, header.format) != kUsable) {
+      if (records == LasOutlierRecords::kClassifiedAsNoise) kept.push_back(at);
+      continue;
+    }
+    const bool outlier = usable < outliers.size() && outliers[usable];
+    if (outlier) flagged.push_back(at);
+    if (!outlier || records == LasOutlierRecords::kClassifiedAsNoise) kept.push_back(at);
+    ++usable;
+  }
+  if (outliers.size() != usable) {
+    return Invalid(absl::StrCat(outliers.size(), " flags for the file's ", usable,
+                                " points (withheld and noise left out)"));
+  }
+  if (records == LasOutlierRecords::kClassifiedAsNoise) {
+    std::string out(data);
+    for (size_t at : flagged) {
+      if (header.format >= 6) {
+        out[at + 16] = static_cast<char>(kLowNoiseClass);
+      } else {  // The class in the low five bits; the top three are flags.
+        out[at + 15] = static_cast<char>((static_cast<uint8_t>(out[at + 15]) & 0xE0) |
+                                         kLowNoiseClass);
+      }
+    }
+    SetGeneratingSoftware(&out);
+    return out;
+  }
+  if (kept.empty()) return Invalid("no point is kept");
+
+  std::string out(data.data(), header.offset_to_points);
+  out.reserve(data.size());
+  Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
+  uint64_t by_return[16] = {};
+  for (size_t at : kept) {
+    out.append(data.data() + at, header.record_length);
+    for (int c = 0; c < 3; ++c) {
+      low[c] = std::min(low[c], header.Coordinate(data, at, c));
+      high[c] = std::max(high[c], header.Coordinate(data, at, c));
+    }
+    ++by_return[ReturnNumber(data, at, header.format)];
+  }
+  // LAS 1.3's waveform packets and LAS 1.4's extended records, after the points, move up by
+  // the records left out.
+  const size_t removed_bytes = header.points_end() - header.offset_to_points -
+                               kept.size() * header.record_length;
+  out.append(data.data() + header.points_end(), data.size() - header.points_end());
+  const auto move_start = [&](size_t field) {
+    const uint64_t start = Load<uint64_t>(data, field);
+    if (start >= header.points_end()) StoreLittleEndian(start - removed_bytes, field, &out);
+  };
+  if (header.minor >= 3 && header.header_size >= kHeaderSize13) move_start(kWaveformStart);
+  const bool extended_counts = header.minor >= 4 && header.header_size >= kHeaderSize14;
+  if (extended_counts) {
+    move_start(kEvlrStart);
+    StoreLittleEndian<uint64_t>(kept.size(), kPointCount, &out);
+    for (int r = 1; r <= 15; ++r) {
+      StoreLittleEndian<uint64_t>(by_return[r], kByReturn14 + 8 * (r - 1), &out);
+    }
+  }
+  // The legacy counts stay zero where the file left them so (LAS 1.4 with formats 6-10, or
+  // more points than they hold).
+  if (!extended_counts || Load<uint32_t>(data, kLegacyPointCount) != 0) {
+    StoreLittleEndian(static_cast<uint32_t>(kept.size()), kLegacyPointCount, &out);
+    for (int r = 1; r <= 5; ++r) {
+      StoreLittleEndian(static_cast<uint32_t>(by_return[r]), kLegacyByReturn + 4 * (r - 1), &out);
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    StoreLittleEndian(high[c], kBounds + 16 * c, &out);
+    StoreLittleEndian(low[c], kBounds + 16 * c + 8, &out);
+  }
+  SetGeneratingSoftware(&out);
   return out;
 }
 

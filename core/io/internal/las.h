@@ -4,10 +4,12 @@
 #define NEURALMESH_CORE_IO_INTERNAL_LAS_H_
 
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/las_cleaning.h"
 
 namespace neuralmesh::io_internal {
 
@@ -34,6 +36,24 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data);
 // same bytes. Normals and weights have no place in these formats and are not written.
 // Returns INVALID_ARGUMENT for more points than LAS 1.2 counts (2^32 - 1).
 absl::StatusOr<std::string> FormatLas(const GeometryView& points);
+
+// A copy of the LAS file `data` (one ParseLas reads) without its outliers, or with them
+// classified as noise: `outliers` holds one flag per point ParseLas returns, in its order.
+//   kLeftOut: the outliers' records are left out, and so are the withheld and noise records
+//     that ParseLas leaves out. The header's point counts, counts by return and bounds become
+//     those of the kept records, and the starts of what follows the points (LAS 1.3's
+//     waveform packets, LAS 1.4's extended records) move up with it.
+//   kClassifiedAsNoise: every record is kept, the outliers' classified as low noise (ASPRS
+//     class 7), which ParseLas then leaves out; their other flags stay.
+// The rest is kept as it was: each record byte for byte (its intensity, returns, GPS time,
+// extra bytes, ...), the header's version, point format, scale and offset, the
+// variable-length records (the coordinate system among them) and what follows the points;
+// the generating software becomes "neuralmesh VERSION".
+// Returns ParseLas's errors for a malformed file, and INVALID_ARGUMENT when `outliers` has not
+// one flag per point, or every point is an outlier to leave out.
+absl::StatusOr<std::string> FormatCleanedLas(absl::string_view data,
+                                             const std::vector<bool>& outliers,
+                                             LasOutlierRecords records);
 
 }  // namespace neuralmesh::io_internal
 

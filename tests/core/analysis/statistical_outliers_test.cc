@@ -94,6 +94,13 @@ TEST(StatisticalOutliersTest, ASecondPassFindsTheStraysTheFarthestHid) {
     ASSERT_LT(cleaned.positions[i].norm(), 1.01f) << "a stray was kept";
     ASSERT_EQ(cleaned.weights[i], 1.0f) << "weights left their points";
   }
+  // The flags over both passes, by index in the whole cloud: the three strays, the mild one
+  // found by the second pass.
+  const auto flagged = FindStatisticalOutliersInPasses(cloud, options);
+  ASSERT_TRUE(flagged.ok()) << flagged.status();
+  ASSERT_EQ(flagged->size(), cloud.size());
+  EXPECT_EQ(std::count(flagged->begin(), flagged->end(), true), 3);
+  EXPECT_TRUE((*flagged)[20000] && (*flagged)[20001] && (*flagged)[20002]);
 
   options.passes = 1;
   PointCloud once = cloud;

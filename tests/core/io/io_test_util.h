@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/io/internal/binary.h"
 #include "core/io/point_cloud_io.h"
 #include "core/point_cloud.h"
 #include "core/random.h"
@@ -32,6 +33,11 @@ void Put(T value, bool big_endian, std::string* out) {
   out->append(bytes, sizeof(T));
 }
 
+// The little-endian T at `offset` of a binary file's bytes.
+template <typename T>
+T Field(const std::string& bytes, size_t offset) {
+  return io_internal::LoadScalar<T>(bytes.data() + offset, /*big_endian=*/false);
+}
 
 // A path in this test process's temporary directory (tests/testing/temp_dir.h), prefixed with
 // the running test's name.

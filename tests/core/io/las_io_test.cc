@@ -187,13 +187,7 @@ TEST(LasIoTest, MalformedAndCompressedFilesAreRefusedWithWhatIsWrong) {
   EXPECT_TRUE(IsReadablePointCloudExtension("scan.LAS"));
 }
 
-// A field of a LAS file's bytes (little-endian).
-template <typename T>
-T Field(const std::string& bytes, size_t offset) {
-  T value;
-  std::memcpy(&value, bytes.data() + offset, sizeof(T));
-  return value;
-}
+using io_test::Field;
 
 TEST(LasIoTest, WrittenFilesKeepColoursAndGeoreferencedCoordinates) {
   PointCloud cloud;

@@ -1,0 +1,307 @@
+// Cleaning a LAS file without losing what a PointCloud does not hold (WriteCleanedLas,
+// core/io/las_cleaning.h): the kept records byte for byte, the header's version, format, scale
+// and offset, the variable-length records and what follows the points as they were. Outliers
+// left out: the header's point counts, counts by return and bounds those of the kept points,
+// and the starts of the waveform data and extended records moved up with them. Outliers
+// classified as noise: every record kept, theirs with class 7 and their flags.
+#include "core/io/las_cleaning.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
+#include "core/io/point_cloud_io.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/core/io/io_test_util.h"
+#include "tests/testing/las_file.h"
+
+namespace neuralmesh {
+namespace {
+
+using io_test::Field;
+using io_test::ReadBytes;
+using io_test::TempPath;
+using io_test::WriteBytes;
+using ::testing::HasSubstr;
+using testing::LasFile;
+using testing::LasLayout;
+using testing::LasPoint;
+
+// A (extended) variable-length record: its header of 54 (60) bytes, then `payload`.
+std::string VariableLengthRecord(absl::string_view user_id, uint16_t record_id,
+                                 absl::string_view payload, bool extended) {
+  std::string out;
+  io_internal::AppendLittleEndian<uint16_t>(0, &out);  // Reserved.
+  out.append(user_id.data(), user_id.size());
+  out.resize(18, '\0');
+  io_internal::AppendLittleEndian(record_id, &out);
+  if (extended) {
+    io_internal::AppendLittleEndian<uint64_t>(payload.size(), &out);
+  } else {
+    io_internal::AppendLittleEndian<uint16_t>(payload.size(), &out);
+  }
+  out.append("a record the tests made");
+  out.resize(extended ? 60 : 54, '\0');
+  out.append(payload.data(), payload.size());
+  return out;
+}
+
+// Points with every field set to something of its own: intensity, returns, class, GPS time,
+// extra bytes, colour; `left_out` of them classified as noise or withheld.
+std::vector<LasPoint> VariedPoints(int count) {
+  std::vector<LasPoint> points;
+  for (int i = 0; i < count; ++i) {
+    LasPoint p{1000 * i - 3000,
+               70 * i * i,
+               -25 * i,
+               static_cast<uint16_t>(257 * i),
+               7,
+               static_cast<uint16_t>(65535 - i)};
+    p.classification = static_cast<uint8_t>(i % 3 == 0 ? 2 : 5);  // Ground or high vegetation.
+    p.intensity = static_cast<uint16_t>(100 + 31 * i);
+    p.returns = 3;
+    p.return_number = static_cast<uint8_t>(1 + i % 3);
+    p.gps_time = 1.0e8 + 0.25 * i;
+    p.extra = 0xA5000000u + i;
+    points.push_back(p);
+  }
+  return points;
+}
+
+// The byte ranges of the public header block that FormatCleanedLas writes anew: the generating
+// software, the legacy counts and bounds, the starts of the waveform data and of the extended
+// records, the LAS 1.4 counts.
+std::string WithoutRewrittenFields(std::string header) {
+  for (auto [from, to] : {std::pair{58, 90}, {107, 131}, {179, 227}, {227, 243}, {247, 375}}) {
+    if (static_cast<size_t>(from) < header.size()) {
+      std::fill(header.begin() + from, header.begin() + std::min<size_t>(to, header.size()), 0);
+    }
+  }
+  return header;
+}
+
+struct Expected {
+  std::vector<size_t> records;  // Of the source file, in order.
+  size_t record_length;
+  size_t offset_to_points;
+  size_t source_count;
+};
+
+// Checks `out` against `in`, from which it kept expected.records.
+void ExpectRecordsKept(const std::string& in, const std::string& out, const Expected& expected,
+                       size_t header_size) {
+  const size_t kept = expected.records.size();
+  ASSERT_EQ(out.size(), in.size() - (expected.source_count - kept) * expected.record_length);
+  EXPECT_EQ(WithoutRewrittenFields(out.substr(0, header_size)),
+            WithoutRewrittenFields(in.substr(0, header_size)));
+  EXPECT_EQ(out.substr(header_size, expected.offset_to_points - header_size),
+            in.substr(header_size, expected.offset_to_points - header_size))
+      << "the variable-length records";
+  EXPECT_THAT(out.substr(58, 32), HasSubstr("neuralmesh ")) << "generating software";
+  for (size_t k = 0; k < kept; ++k) {
+    EXPECT_EQ(
+        out.substr(expected.offset_to_points + k * expected.record_length, expected.record_length),
+        in.substr(expected.offset_to_points + expected.records[k] * expected.record_length,
+                  expected.record_length))
+        << "record " << k << " (source record " << expected.records[k] << ")";
+  }
+  const size_t out_end = expected.offset_to_points + kept * expected.record_length;
+  const size_t in_end = expected.offset_to_points + expected.source_count * expected.record_length;
+  EXPECT_EQ(out.substr(out_end), in.substr(in_end)) << "what follows the points";
+  // Bounds: the kept records' coordinates, scaled.
+  for (int c = 0; c < 3; ++c) {
+    double low = INFINITY, high = -INFINITY;
+    for (size_t r : expected.records) {
+      const double v =
+          Field<int32_t>(in, expected.offset_to_points + r * expected.record_length + 4 * c) *
+              Field<double>(in, 131 + 8 * c) +
+          Field<double>(in, 155 + 8 * c);
+      low = std::min(low, v);
+      high = std::max(high, v);
+    }
+    EXPECT_EQ(Field<double>(out, 179 + 16 * c), high) << "max of axis " << c;
+    EXPECT_EQ(Field<double>(out, 187 + 16 * c), low) << "min of axis " << c;
+  }
+}
+
+// Writes `in` to a file and cleans it of the points flagged in `outliers` into a new one;
+// returns its bytes.
+std::string Cleaned(const std::string& name, const std::string& in,
+                    const std::vector<bool>& outliers,
+                    LasOutlierRecords records = LasOutlierRecords::kLeftOut) {
+  const std::string source = TempPath(name + ".las");
+  const std::string written = TempPath(name + "_cleaned.las");
+  WriteBytes(source, in);
+  const absl::Status status = WriteCleanedLas(source, outliers, records, written);
+  EXPECT_TRUE(status.ok()) << status;
+  return ReadBytes(written);
+}
+
+TEST(LasCleaningTest, Las14KeepsEveryFieldTheCoordinateSystemAndTheExtendedRecords) {
+  LasLayout layout;
+  layout.version_minor = 4;
+  layout.format = 7;  // Colours and GPS time.
+  layout.record_length = 36 + 4;
+  layout.scale[2] = 0.001;
+  layout.offset[0] = 500000;
+  layout.offset[1] = 4100000;
+  const std::string wkt = "PROJCS[\"WGS 84 / UTM zone 33N\",AUTHORITY[\"EPSG\",\"32633\"]]";
+  layout.vlrs = VariableLengthRecord("LASF_Projection", 2112, wkt, false);
+  layout.vlr_count = 1;
+  layout.after_points = VariableLengthRecord("LASF_Spec", 65535, "waveform packets", true);
+  layout.evlr_count = 1;
+  std::vector<LasPoint> points = VariedPoints(8);
+  points[2].classification = 7;  // Noise: ReadPointCloud leaves it out, and so does the copy.
+  points[5].withheld = true;
+  const std::string in = LasFile(layout, points);
+
+  PointsLeftOut left_out;
+  const absl::StatusOr<PointCloud> read = io_test::ReadCloudFrom("source.las", in, &left_out);
+  ASSERT_TRUE(read.ok()) << read.status();
+  ASSERT_EQ(read->size(), 6u);  // Records 0, 1, 3, 4, 6, 7.
+  const std::string out = Cleaned("las14", in, {false, true, false, false, true, false});
+  ASSERT_FALSE(out.empty());
+  const size_t offset_to_points = 375 + layout.vlrs.size();
+  ExpectRecordsKept(in, out, {{0, 3, 4, 7}, 40, offset_to_points, 8}, 375);
+
+  EXPECT_EQ(Field<uint64_t>(out, 247), 4u) << "point count";
+  EXPECT_EQ(Field<uint32_t>(out, 107), 0u) << "the legacy count stays zero for format 7";
+  // Returns of the kept points 0, 3, 4, 7: 1, 1, 2, 2.
+  EXPECT_EQ(Field<uint64_t>(out, 255), 2u);
+  EXPECT_EQ(Field<uint64_t>(out, 263), 2u);
+  EXPECT_EQ(Field<uint64_t>(out, 271), 0u);
+  const uint64_t evlr_start = Field<uint64_t>(out, 235);
+  EXPECT_EQ(evlr_start, offset_to_points + 4 * 40);
+  EXPECT_EQ(out.substr(evlr_start), layout.after_points);
+  EXPECT_EQ(Field<uint32_t>(out, 243), 1u);
+
+  // Read back: the kept points, where they were, with their colours.
+  const absl::StatusOr<PointCloud> reread = io_test::ReadCloudFrom("kept.las", out);
+  ASSERT_TRUE(reread.ok()) << reread.status();
+  EXPECT_EQ(reread->origin, read->origin);
+  ASSERT_EQ(reread->size(), 4u);
+  const std::vector<size_t> kept_points = {0, 2, 3, 5};
+  for (size_t k = 0; k < kept_points.size(); ++k) {
+    EXPECT_EQ(reread->positions[k], read->positions[kept_points[k]]) << k;
+    EXPECT_EQ(reread->colors[k], read->colors[kept_points[k]]) << k;
+  }
+}
+
+TEST(LasCleaningTest, Las12AndLas13CountAgainAndMoveTheWaveformData) {
+  for (const int minor : {2, 3}) {
+    SCOPED_TRACE(::testing::Message() << "LAS 1." << minor);
+    LasLayout layout;
+    layout.version_minor = minor;
+    layout.format = 1;  // GPS time, no colour.
+    if (minor == 3) layout.after_points = "waveform packets, 29 bytes.";
+    const std::vector<LasPoint> points = VariedPoints(5);
+    const std::string in = LasFile(layout, points);
+    const size_t header_size = minor == 3 ? 235 : 227;
+    const std::string out =
+        Cleaned(absl::StrCat("las1", minor), in, {true, false, false, false, true});
+    ASSERT_FALSE(out.empty());
+    ExpectRecordsKept(in, out, {{1, 2, 3}, 28, header_size, 5}, header_size);
+    EXPECT_EQ(Field<uint32_t>(out, 107), 3u) << "point count";
+    // Returns of points 1, 2, 3: 2, 3, 1.
+    for (int r = 1; r <= 5; ++r) {
+      EXPECT_EQ(Field<uint32_t>(out, 111 + 4 * (r - 1)), r <= 3 ? 1u : 0u) << "return " << r;
+    }
+    if (minor == 3) {
+      const uint64_t waveform_start = Field<uint64_t>(out, 227);
+      EXPECT_EQ(waveform_start, header_size + 3 * 28);
+      EXPECT_EQ(out.substr(waveform_start), layout.after_points);
+    }
+  }
+}
+
+TEST(LasCleaningTest, OutliersClassifiedAsNoiseKeepEveryRecordAndTheirFlags) {
+  for (const int format : {3, 8}) {  // The two record families: class in byte 15, or 16.
+    SCOPED_TRACE(::testing::Message() << "format " << format);
+    LasLayout layout;
+    layout.version_minor = format >= 6 ? 4 : 2;
+    layout.format = format;
+    std::vector<LasPoint> points = VariedPoints(6);
+    points[1].withheld = true;  // Withheld: kept as it is, not one of the points to flag.
+    points[3].classification = 18;
+    const std::string in = LasFile(layout, points);
+    // The points read: 0, 2, 4, 5; outliers 2 and 5.
+    const std::string out = Cleaned(absl::StrCat("noise", format), in, {false, true, false, true},
+                                    LasOutlierRecords::kClassifiedAsNoise);
+    ASSERT_EQ(out.size(), in.size());
+    const size_t header_size = format >= 6 ? 375 : 227;
+    const size_t length = testing::kLasRecordLength[format];
+    EXPECT_EQ(WithoutRewrittenFields(out.substr(0, header_size)),
+              WithoutRewrittenFields(in.substr(0, header_size)));
+    EXPECT_EQ(out.substr(107, 24), in.substr(107, 24)) << "the counts stay";
+    EXPECT_EQ(out.substr(179, 48), in.substr(179, 48)) << "the bounds stay";
+    for (size_t i = 0; i < points.size(); ++i) {
+      std::string expected = in.substr(header_size + i * length, length);
+      if (i == 2 || i == 5) {
+        if (format >= 6) {
+          expected[16] = 7;
+        } else {
+          expected[15] = static_cast<char>(7);
+        }
+      }
+      EXPECT_EQ(out.substr(header_size + i * length, length), expected) << "record " << i;
+    }
+    // Read again, the outliers are left out as noise.
+    PointsLeftOut left_out;
+    const absl::StatusOr<PointCloud> reread = io_test::ReadCloudFrom("noise.las", out, &left_out);
+    ASSERT_TRUE(reread.ok()) << reread.status();
+    EXPECT_EQ(reread->size(), 2u);
+    EXPECT_EQ(left_out.noise, 3u);
+    EXPECT_EQ(left_out.withheld, 1u);
+  }
+  // Format 1's flags (synthetic, key point, withheld) share the class's byte and stay.
+  LasLayout layout;
+  layout.format = 1;
+  std::vector<LasPoint> points = VariedPoints(3);
+  std::string in = LasFile(layout, points);
+  in[227 + 28 + 15] = static_cast<char>(0x60 | 5);  // Point 1: synthetic and key point, class 5.
+  const std::string out =
+      Cleaned("flags", in, {false, true, false}, LasOutlierRecords::kClassifiedAsNoise);
+  EXPECT_EQ(static_cast<uint8_t>(out[227 + 28 + 15]), 0x60 | 7);
+}
+
+TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
+  LasLayout layout;
+  std::vector<LasPoint> points = VariedPoints(4);
+  points[1].classification = 18;  // High noise: not one of the points to flag.
+  const std::string source = TempPath("source.las");
+  WriteBytes(source, LasFile(layout, points));
+  const std::string written = TempPath("written.las");
+
+  absl::Status status =
+      WriteCleanedLas(source, {true, true, true, true}, LasOutlierRecords::kLeftOut, written);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()),
+              HasSubstr("4 flags for the file's 3 points (withheld and noise left out)"));
+  EXPECT_THAT(std::string(status.message()), HasSubstr("source.las"));
+
+  status = WriteCleanedLas(source, {true, true, true}, LasOutlierRecords::kLeftOut, written);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), HasSubstr("no point is kept"));
+
+  const std::string text = TempPath("points.xyz");
+  WriteBytes(text, "0 0 0\n1 1 1\n");
+  status = WriteCleanedLas(text, {false, false}, LasOutlierRecords::kLeftOut, written);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), HasSubstr("is not a .las file"));
+
+  const std::string fake = TempPath("fake.las");
+  WriteBytes(fake, std::string(300, 'x'));
+  status = WriteCleanedLas(fake, {false}, LasOutlierRecords::kClassifiedAsNoise, written);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), HasSubstr("no LASF signature"));
+
+  status = WriteCleanedLas(TempPath("missing.las"), {false}, LasOutlierRecords::kLeftOut, written);
+  EXPECT_EQ(status.code(), absl::StatusCode::kNotFound);
+}
+
+}  // namespace
+}  // namespace neuralmesh

@@ -70,7 +70,8 @@ absl::StatusOr<std::string> UseColors(absl::StatusOr<std::unique_ptr<ColorSource
 absl::StatusOr<TargetSpace> LoadTargetSpace(const std::vector<std::string>& inputs,
                                             SamplingMode mode,
                                             const std::optional<OutlierOptions>& outliers,
-                                            const std::optional<PointColorOptions>& colors) {
+                                            const std::optional<PointColorOptions>& colors,
+                                            const PointSelection& selection) {
   if (inputs.empty()) return absl::InvalidArgumentError("INPUT is required");
   const std::string& input = inputs.front();
   TargetSpace target;
@@ -124,7 +125,7 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::vector<std::string>& inpu
   PointsLeftOut left_out;
   std::string merge_note;
   NM_ASSIGN_OR_RETURN(PointCloud cloud,
-                      LoadPointClouds(inputs, "INPUT", &left_out, &merge_note));
+                      LoadPointClouds(inputs, "INPUT", &left_out, &merge_note, selection));
   const std::string names = absl::StrJoin(inputs, ", ");
   if (mode == SamplingMode::kWeighted && cloud.weights.empty()) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -158,7 +159,8 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::vector<std::string>& inpu
 
 absl::StatusOr<PointCloud> LoadPointsForUpload(const std::vector<std::string>& inputs,
                                                size_t builtin_points, uint64_t seed,
-                                               PointsLeftOut* left_out, std::string* note) {
+                                               PointsLeftOut* left_out, std::string* note,
+                                               const PointSelection& selection) {
   if (inputs.size() == 1 && IsBuiltin(inputs.front())) {
     if (note != nullptr) note->clear();
     if (builtin_points == 0) return absl::InvalidArgumentError("--points must be > 0");
@@ -170,15 +172,15 @@ absl::StatusOr<PointCloud> LoadPointsForUpload(const std::vector<std::string>& i
                         MakeBuiltinSurface(inputs.front()));
     return SamplePoints(*surface, builtin_points, seed);
   }
-  return LoadPointClouds(inputs, "INPUT", left_out, note);
+  return LoadPointClouds(inputs, "INPUT", left_out, note, selection);
 }
 
 absl::StatusOr<PointCloud> LoadPointClouds(const std::vector<std::string>& inputs,
                                            absl::string_view role, PointsLeftOut* left_out,
-                                           std::string* note) {
+                                           std::string* note, const PointSelection& selection) {
   if (note != nullptr) note->clear();
   if (inputs.empty()) return absl::InvalidArgumentError(absl::StrCat(role, " is required"));
-  if (inputs.size() == 1) return LoadPointCloud(inputs.front(), role, left_out);
+  if (inputs.size() == 1) return LoadPointCloud(inputs.front(), role, left_out, selection);
   std::vector<PointCloud> clouds;
   PointsLeftOut total;
   for (const std::string& input : inputs) {
@@ -187,7 +189,7 @@ absl::StatusOr<PointCloud> LoadPointClouds(const std::vector<std::string>& input
           input, " is a surface: several ", role, "s must all be point cloud files"));
     }
     PointsLeftOut one;
-    NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(input, role, &one));
+    NM_ASSIGN_OR_RETURN(PointCloud cloud, LoadPointCloud(input, role, &one, selection));
     total += one;
     clouds.push_back(std::move(cloud));
   }
@@ -213,9 +215,10 @@ std::string QuotedInputs(const std::vector<std::string>& inputs) {
 }
 
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role,
-                                          PointsLeftOut* left_out) {
+                                          PointsLeftOut* left_out,
+                                          const PointSelection& selection) {
   NM_RETURN_IF_ERROR(CheckInputFile(input, role));
-  absl::StatusOr<PointCloud> cloud = ReadPointCloud(input, left_out);
+  absl::StatusOr<PointCloud> cloud = ReadPointCloud(input, left_out, selection);
   if (!cloud.ok()) return InFile(cloud.status(), role, input);
   return cloud;
 }
@@ -231,6 +234,7 @@ std::string LeftOutNote(const PointsLeftOut& left_out) {
   add(left_out.withheld, " withheld", "");
   add(left_out.noise, "", " classified as noise");
   add(left_out.invalid, "", " without a position");
+  add(left_out.other_class, "", " of other classes");
   if (parts.empty()) return "";
   const std::string last = parts.back();
   parts.pop_back();

@@ -15,6 +15,7 @@
 #include "absl/strings/string_view.h"
 #include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
+#include "core/io/point_selection.h"
 #include "core/point_cloud.h"
 #include "core/sampling/sampler.h"
 #include "core/triangle_mesh.h"
@@ -53,11 +54,12 @@ struct TargetSpace {
 // (statistical_outliers.h) and the description says how many; INVALID_ARGUMENT for another
 // kind of input. With `colors` set and a point cloud that carries colours (the points left
 // after outlier removal), or a mesh whose vertices do, `colors` of the result is set and the
-// description ends "with colours".
+// description ends "with colours". Point cloud files are read with `selection`.
 absl::StatusOr<TargetSpace> LoadTargetSpace(
     const std::vector<std::string>& inputs, SamplingMode mode,
     const std::optional<OutlierOptions>& outliers = std::nullopt,
-    const std::optional<PointColorOptions>& colors = std::nullopt);
+    const std::optional<PointColorOptions>& colors = std::nullopt,
+    const PointSelection& selection = {});
 
 // The most points LoadPointsForUpload samples from a builtin surface: the server's default
 // limit of points per session (neuralmesh-server --max_points_per_session), 1.6 GB here.
@@ -66,33 +68,37 @@ inline constexpr size_t kMaxBuiltinUploadPoints = size_t{1} << 26;
 // The points of `inputs` for upload: point cloud files as read (LoadPointClouds), or
 // `builtin_points` samples of a builtin:NAME surface drawn with `seed` (1 to
 // kMaxBuiltinUploadPoints). Errors as LoadTargetSpace.
-// With `left_out` and `note`, as LoadPointClouds.
+// With `left_out`, `note` and `selection`, as LoadPointClouds.
 absl::StatusOr<PointCloud> LoadPointsForUpload(const std::vector<std::string>& inputs,
                                                size_t builtin_points, uint64_t seed,
                                                PointsLeftOut* left_out = nullptr,
-                                               std::string* note = nullptr);
+                                               std::string* note = nullptr,
+                                               const PointSelection& selection = {});
 
-// The points of a point cloud file (any extension ReadPointCloud reads). Errors as
-// LoadTargetSpace; `role` names the argument in messages. With `left_out`, as
+// The points of a point cloud file (any extension ReadPointCloud reads, with `selection`).
+// Errors as LoadTargetSpace; `role` names the argument in messages. With `left_out`, as
 // LoadPointsForUpload.
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role,
-                                          PointsLeftOut* left_out = nullptr);
+                                          PointsLeftOut* left_out = nullptr,
+                                          const PointSelection& selection = {});
 
 // The points of point cloud files as one cloud (MergePointClouds: one after another, each
 // where its origin puts it). Errors as LoadPointCloud, and INVALID_ARGUMENT for a builtin:NAME
 // among several inputs. With `left_out`, the points left out of all the files are counted
 // there; `note` (when not null) is set to "" or to what the merge dropped because a file lacks
-// it: "; normals dropped (b.las has none)".
+// it: "; normals dropped (b.las has none)". Each file is read with `selection`.
 absl::StatusOr<PointCloud> LoadPointClouds(const std::vector<std::string>& inputs,
                                            absl::string_view role,
                                            PointsLeftOut* left_out = nullptr,
-                                           std::string* note = nullptr);
+                                           std::string* note = nullptr,
+                                           const PointSelection& selection = {});
 
 // The inputs for messages: "'a.las'", "'a.las', 'b.las'".
 std::string QuotedInputs(const std::vector<std::string>& inputs);
 
 // "" when no point was left out; else what to tell the user: "; left out 3 withheld points
-// and 117 classified as noise", "; left out 120 points without a position".
+// and 117 classified as noise", "; left out 120 points without a position", "; left out 5000
+// points of other classes".
 std::string LeftOutNote(const PointsLeftOut& left_out);
 
 // "" for a zero origin; else (georeferenced data) what to tell the user: "; coordinates taken

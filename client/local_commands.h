@@ -16,6 +16,7 @@
 #include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
+#include "core/io/point_selection.h"
 #include "core/io/mesh_io.h"
 #include "core/learning/learner_options.h"
 
@@ -32,6 +33,7 @@ struct LocalReconstructOptions {
   std::string start_mesh;
   SamplingMode sampling = SamplingMode::kUniform;
   std::optional<OutlierOptions> outliers;  // Set: remove a point cloud's outliers first.
+  PointSelection selection;                // Which points of a LAS file are read.
   // Set: when the input carries colours, every mesh written gets them (color_source.h).
   std::optional<PointColorOptions> colors = PointColorOptions{};
   absl::Duration time_budget = absl::InfiniteDuration();  // For the whole run.
@@ -77,6 +79,7 @@ struct ConvertOptions {
   MeshWriteOptions writing;  // Draco settings, glTF compression (meshes only).
   // Set: a point cloud's statistical outliers are removed before it is written.
   std::optional<OutlierOptions> outliers;
+  PointSelection selection;  // Which points of a LAS file are read (and, LAS to LAS, kept).
   // With `outliers`, from one .las file to .las: the outliers' records are kept, classified as
   // noise (ASPRS class 7), instead of removed.
   bool outliers_as_noise = false;

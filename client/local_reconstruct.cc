@@ -79,7 +79,7 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
                                  start_mesh.has_value() ? start_mesh->positions.size() : 0));
   NM_ASSIGN_OR_RETURN(const TargetSpace target,
                       LoadTargetSpace(options.inputs, options.sampling, options.outliers,
-                                      options.colors));
+                                      options.colors, options.selection));
   if (start_mesh.has_value()) {
     NM_RETURN_IF_ERROR(MoveStartMesh(target.origin, options.start_mesh, &*start_mesh));
   }

@@ -1,6 +1,7 @@
 // neuralmesh: Neural Meshes surface reconstruction (Ivrissimtzis, Jeong, Seidel) on the
 // command line, locally or through a neuralmesh-server. This file holds the flags and the
 // dispatch only; the commands live in the neuralmesh_client library.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <iostream>
@@ -14,6 +15,7 @@
 #include "absl/flags/flag.h"
 #include "absl/status/status.h"
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
 #include "client/command_line.h"
@@ -29,6 +31,7 @@
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/io/file_contents.h"
+#include "core/io/point_selection.h"
 #include "core/learning/learner_options.h"
 #include "core/status_macros.h"
 #include "core/version.h"
@@ -118,6 +121,10 @@ ABSL_FLAG(std::string, start_mesh, "",
           "mesh is sent exactly (CreateSessionRequest.start_mesh); not with --resume.");
 
 // Input clean-up.
+ABSL_FLAG(std::string, las_classes, "",
+          "The ASPRS classes whose points are read from LAS files, as numbers and ranges "
+          "(2 ground, 6 building: '2,6'; '1-6,9'), or 'all'. Unset: every class but noise (7, "
+          "low point; 18, high noise). Withheld points are never read.");
 ABSL_FLAG(bool, remove_outliers, false,
           "Remove a point cloud's statistical outliers before learning, upload or convert: "
           "points whose "
@@ -293,6 +300,27 @@ absl::StatusOr<neuralmesh::LearnerOptions> LearnerFromFlags() {
 }
 
 // Unset without --remove_outliers; checked here so that a bad value is named by its flag.
+// Unset without --las_classes; refused when no input is a LAS file, where it would select
+// nothing.
+absl::StatusOr<neuralmesh::PointSelection> SelectionFromFlags(
+    const std::vector<std::string>& inputs) {
+  neuralmesh::PointSelection selection;
+  const std::string classes = absl::GetFlag(FLAGS_las_classes);
+  if (classes.empty()) return selection;
+  absl::StatusOr<neuralmesh::LasClasses> parsed = neuralmesh::ParseLasClasses(classes);
+  if (!parsed.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("--las_classes: ", parsed.status().message()));
+  }
+  if (std::none_of(inputs.begin(), inputs.end(), [](const std::string& input) {
+        return absl::EndsWithIgnoreCase(input, ".las");
+      })) {
+    return absl::InvalidArgumentError(
+        "--las_classes selects the points of LAS files by class; no INPUT is a .las file");
+  }
+  selection.las_classes = *parsed;
+  return selection;
+}
+
 absl::StatusOr<std::optional<neuralmesh::OutlierOptions>> OutliersFromFlags() {
   if (!absl::GetFlag(FLAGS_remove_outliers)) return std::nullopt;
   neuralmesh::OutlierOptions o;
@@ -444,6 +472,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     o.lods = lods;
     NM_ASSIGN_OR_RETURN(o.learner, LearnerFromFlags());
     NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
+    NM_ASSIGN_OR_RETURN(o.selection, SelectionFromFlags(o.inputs));
     o.outliers_on_server = absl::GetFlag(FLAGS_outliers_on_server);
     NM_ASSIGN_OR_RETURN(o.colors, ColorsFromFlags());
     if (o.outliers_on_server && !o.outliers.has_value()) {
@@ -477,6 +506,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
   o.lods = lods;
   NM_ASSIGN_OR_RETURN(o.learner, LearnerFromFlags());
   NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
+  NM_ASSIGN_OR_RETURN(o.selection, SelectionFromFlags(o.inputs));
   NM_ASSIGN_OR_RETURN(o.sampling,
                       neuralmesh::client::ParseSamplingMode(absl::GetFlag(FLAGS_sampling)));
   o.start_mesh = absl::GetFlag(FLAGS_start_mesh);
@@ -500,6 +530,7 @@ absl::Status Convert(const ParsedArgs& args) {
   o.output = absl::GetFlag(FLAGS_output);
   NM_ASSIGN_OR_RETURN(o.writing, MeshWritingFromFlags());
   NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
+  NM_ASSIGN_OR_RETURN(o.selection, SelectionFromFlags(o.inputs));
   o.outliers_as_noise = absl::GetFlag(FLAGS_outliers_as_noise);
   if (o.outliers_as_noise && !o.outliers.has_value()) {
     return absl::InvalidArgumentError("--outliers_as_noise needs --remove_outliers");
@@ -628,7 +659,7 @@ std::vector<Subcommand> Commands() {
       "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
       "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
-      "start_mesh", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
+      "start_mesh", "las_classes", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
       "outlier_passes", "outliers_on_server", "colors", "color_neighbours", "sampling",
       "time_budget", "max_steps", "quantization_bits", "encode_speed", "gltf_draco", "progress",
       "server", "out-dir", "batch-size", "points", "ply", "glb", "resume", "reconnect_for"};
@@ -669,7 +700,8 @@ std::vector<Subcommand> Commands() {
        "variable-length records (the coordinate system); --outliers_as_noise classifies its\n"
        "outliers as noise instead of removing them. Several point cloud files are written as\n"
        "one.",
-       {"output", "gltf_draco", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
+       {"output", "gltf_draco", "las_classes", "remove_outliers", "outlier_neighbours",
+        "outlier_std_ratio",
         "outlier_passes", "outliers_as_noise", "quantization_bits", "encode_speed"},
        Convert},
       {"eval",

@@ -112,7 +112,8 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   PointsLeftOut left_out;
   std::string merge_note;
   NM_ASSIGN_OR_RETURN(PointCloud cloud,
-                      LoadPointClouds(options.inputs, "INPUT", &left_out, &merge_note));
+                      LoadPointClouds(options.inputs, "INPUT", &left_out, &merge_note,
+                                      options.selection));
   const size_t read = cloud.size();
   std::vector<bool> outlier(cloud.size(), false);
   if (options.outliers.has_value()) {
@@ -129,7 +130,7 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
                                        options.outliers_as_noise
                                            ? LasOutlierRecords::kClassifiedAsNoise
                                            : LasOutlierRecords::kLeftOut,
-                                       options.output));
+                                       options.output, options.selection));
     contents = absl::StrCat(", each record as in ", options.inputs.front(),
                             " with every field, and its header's scale, offset and "
                             "variable-length records");

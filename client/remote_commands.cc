@@ -77,7 +77,8 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   std::string merge_note;
   NM_ASSIGN_OR_RETURN(PointCloud cloud,
                       LoadPointsForUpload(options.inputs, options.builtin_points,
-                                          options.learner.seed, &left_out, &merge_note));
+                                          options.learner.seed, &left_out, &merge_note,
+                                          options.selection));
   const size_t points_read = cloud.size();
   if (!options.colors) cloud.colors.clear();
   const bool outliers_on_server = options.outliers.has_value() && options.outliers_on_server;

@@ -19,6 +19,7 @@
 #include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
+#include "core/io/point_selection.h"
 #include "core/learning/learner_options.h"
 
 namespace neuralmesh::client {
@@ -37,6 +38,7 @@ struct RemoteReconstructOptions {
   LearnerOptions learner;
   std::optional<OutlierOptions> outliers;  // Set: remove the points' outliers before upload,
   bool outliers_on_server = false;         // or, when this is set, the session as they arrive.
+  PointSelection selection;                // Which points of a LAS file are uploaded.
   // Set: upload the points' colours, which the session paints its meshes with, blending
   // `neighbours` points (SessionConfig.color_neighbours).
   std::optional<PointColorOptions> colors = PointColorOptions{};

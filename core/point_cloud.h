@@ -20,12 +20,14 @@ struct PointsLeftOut {
   size_t withheld = 0;
   size_t noise = 0;
   size_t invalid = 0;
+  size_t other_class = 0;  // Of a class the reader was not asked for (PointSelection).
 
-  size_t total() const { return withheld + noise + invalid; }
+  size_t total() const { return withheld + noise + invalid + other_class; }
   PointsLeftOut& operator+=(const PointsLeftOut& other) {
     withheld += other.withheld;
     noise += other.noise;
     invalid += other.invalid;
+    other_class += other.other_class;
     return *this;
   }
 };

@@ -3,13 +3,15 @@
 // back to the same number of points, each within the written scale (and a float's rounding) of
 // where it was, with the same colours. The generic round trip, bit for bit, does not apply:
 // LAS stores integers. A parsed file cleaned of every other point (FormatCleanedLas) reads back
-// to the points kept; with those classified as noise instead, to the same points.
+// to the points kept; with those classified as noise instead, to the same points; both with
+// the default classes and with some asked for.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,7 +39,8 @@ void CheckWrittenAgain(const ParsedGeometry& parsed) {
 
 // The copy keeps the records' integers, so only the origin the reader picks (from the kept
 // points' range) may change the floats: to within their rounding.
-void CheckCleaned(absl::string_view data, const ParsedGeometry& parsed) {
+void CheckCleaned(absl::string_view data, const ParsedGeometry& parsed,
+                  const std::optional<neuralmesh::LasClasses>& classes) {
   if (parsed.positions.empty()) return;  // A file of no points: nothing to clean.
   std::vector<bool> outliers(parsed.positions.size());
   ParsedGeometry expected;
@@ -52,9 +55,10 @@ void CheckCleaned(absl::string_view data, const ParsedGeometry& parsed) {
   for (const auto records : {neuralmesh::LasOutlierRecords::kLeftOut,
                              neuralmesh::LasOutlierRecords::kClassifiedAsNoise}) {
     const absl::StatusOr<std::string> cleaned =
-        neuralmesh::io_internal::FormatCleanedLas(data, outliers, records);
+        neuralmesh::io_internal::FormatCleanedLas(data, outliers, records, classes);
     FUZZ_CHECK(cleaned.ok(), "cleaning failed: %s", cleaned.status().ToString().c_str());
-    const absl::StatusOr<ParsedGeometry> reread = neuralmesh::io_internal::ParseLas(*cleaned);
+    const absl::StatusOr<ParsedGeometry> reread =
+        neuralmesh::io_internal::ParseLas(*cleaned, classes);
     FUZZ_CHECK(reread.ok(), "the cleaned file does not parse: %s",
                reread.status().ToString().c_str());
     neuralmesh::fuzz::CheckPositionsWithinScale(expected, *reread, scale);
@@ -70,11 +74,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       },
       nullptr, /*skips_faces=*/false};
   neuralmesh::fuzz::CheckGeometryParser(las, data, size);
-  const absl::StatusOr<ParsedGeometry> parsed = neuralmesh::io_internal::ParseLas(
-      absl::string_view(reinterpret_cast<const char*>(data), size));
+  const absl::string_view bytes(reinterpret_cast<const char*>(data), size);
+  const absl::StatusOr<ParsedGeometry> parsed = neuralmesh::io_internal::ParseLas(bytes);
   if (parsed.ok()) {
     CheckWrittenAgain(*parsed);
-    CheckCleaned(absl::string_view(reinterpret_cast<const char*>(data), size), *parsed);
+    CheckCleaned(bytes, *parsed, std::nullopt);
   }
+  // Ground, and a class the input picks (its last byte, often a record's).
+  neuralmesh::LasClasses classes;
+  classes.set(2).set(size > 0 ? data[size - 1] : 0);
+  const absl::StatusOr<ParsedGeometry> selected =
+      neuralmesh::io_internal::ParseLas(bytes, classes);
+  if (selected.ok()) CheckCleaned(bytes, *selected, classes);
   return 0;
 }

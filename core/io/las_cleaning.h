@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "core/io/point_selection.h"
 
 namespace neuralmesh {
 
@@ -19,14 +20,16 @@ enum class LasOutlierRecords {
 
 // Writes to `path` the LAS file at `source` without its outliers, or with them classified as
 // noise (internal/las.h, FormatCleanedLas): `outliers` holds one flag per point ReadPointCloud
-// reads from `source`, in its order. Every other record is copied byte for byte, and the
+// reads from `source` with `selection`, in its order; with kLeftOut, the records it does not
+// read are left out too. Every other record is copied byte for byte, and the
 // header keeps its version, point format, scale, offset and variable-length records; with
 // kLeftOut its counts and bounds become the kept points'.
 // Returns NOT_FOUND when `source` cannot be read; INVALID_ARGUMENT when it is not a LAS file
 // ReadPointCloud reads, or `outliers` has not one flag per point, or flags every point to
 // leave out; otherwise the status of the write.
 absl::Status WriteCleanedLas(const std::string& source, const std::vector<bool>& outliers,
-                             LasOutlierRecords records, const std::string& path);
+                             LasOutlierRecords records, const std::string& path,
+                             const PointSelection& selection = {});
 
 }  // namespace neuralmesh
 

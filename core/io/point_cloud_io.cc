@@ -43,7 +43,8 @@ absl::Status UnsupportedExtension(const std::string& path, const char* supported
 }
 
 absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view data,
-                                           const std::string& path, PointsLeftOut* left_out) {
+                                           const std::string& path, PointsLeftOut* left_out,
+                                           const PointSelection& selection) {
   *left_out = {};
   absl::StatusOr<io_internal::ParsedGeometry> parsed;
   switch (format) {
@@ -54,7 +55,7 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
       parsed = io_internal::ParseXyz(data);
       break;
     case FileFormat::kLas:
-      parsed = io_internal::ParseLas(data);
+      parsed = io_internal::ParseLas(data, selection.las_classes);
       break;
     case FileFormat::kPcd:
       parsed = io_internal::ParsePcd(data);
@@ -116,7 +117,8 @@ bool IsWritablePointCloudExtension(std::string_view path) {
   return IsWritable(io_internal::FormatFromPath(absl::string_view(path.data(), path.size())));
 }
 
-absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, PointsLeftOut* left_out) {
+absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, PointsLeftOut* left_out,
+                                          const PointSelection& selection) {
   const FileFormat format = io_internal::FormatFromPath(path);
   if (!IsReadable(format)) {
     return UnsupportedExtension(path, kReadablePointCloudExtensions);
@@ -124,7 +126,7 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, PointsLeftOut
   NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
   PointsLeftOut ignored;
   absl::StatusOr<PointCloud> cloud =
-      ParsePointCloud(format, data, path, left_out != nullptr ? left_out : &ignored);
+      ParsePointCloud(format, data, path, left_out != nullptr ? left_out : &ignored, selection);
   if (!cloud.ok()) return io_internal::WithPath(cloud.status(), path);
   if (cloud->empty()) {
     return absl::InvalidArgumentError(absl::StrCat("'", path, "' contains no points"));

@@ -10,6 +10,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/io/draco_codec.h"
+#include "core/io/point_selection.h"
 #include "core/point_cloud.h"
 
 namespace neuralmesh {
@@ -47,8 +48,9 @@ WrittenPointAttributes PointAttributesWrittenTo(std::string_view path);
 //         them; empty grid cells (0 0 0) left out and counted in `left_out`; see
 //         internal/ptx.h.
 //   .las  LAS 1.0-1.4 point records of formats 0-10, with colours where the format has them;
-//         withheld points and those classified as noise (classes 7 and 18) are left out, and
-//         counted in `left_out` when it is given.
+//         withheld points are left out, and so are those of classes outside
+//         selection.las_classes or, without them, those classified as noise (classes 7 and
+//         18); all counted in `left_out` when it is given.
 //   .pcd  PCL's Point Cloud Data (ascii, binary, binary_compressed): x y z, normal_x normal_y
 //         normal_z, rgb or rgba, confidence/weight/quality as weights; points without a
 //         position (NaN) left out and counted in `left_out`; see internal/pcd.h.
@@ -69,7 +71,8 @@ WrittenPointAttributes PointAttributesWrittenTo(std::string_view path);
 // malformed content (the message gives the line or byte offset and what was expected), or a
 // cloud that fails ValidatePointCloud (e.g. negative weights).
 absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,
-                                          PointsLeftOut* left_out = nullptr);
+                                          PointsLeftOut* left_out = nullptr,
+                                          const PointSelection& selection = {});
 
 // Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
 // nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"

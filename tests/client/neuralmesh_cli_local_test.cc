@@ -15,6 +15,7 @@
 #include "core/io/file_contents.h"
 #include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
+#include "core/random.h"
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
 #include "tests/testing/e57_file.h"
@@ -612,9 +613,6 @@ TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
 
 // A scan whose noise is classified (and one point withheld): reconstruct and convert leave
 // those points out and say how many.
-// Two PTX scans of one sphere of radius 10 at a UTM position, each in its scanner's frame: the
-// second scanner stands 30 m east, turned 90 degrees, so its points only meet the first's
-// once its transformation is applied.
 // The mesh at `path` has `vertices` vertices, all within `tolerance` of the sphere of `radius`
 // about `centre` (in the coordinates its origin puts back).
 void ExpectVerticesOnSphere(const std::string& path, size_t vertices, const double centre[3],
@@ -629,6 +627,9 @@ void ExpectVerticesOnSphere(const std::string& path, size_t vertices, const doub
   }
 }
 
+// Two PTX scans of one sphere of radius 10 at a UTM position, each in its scanner's frame: the
+// second scanner stands 30 m east, turned 90 degrees, so its points only meet the first's
+// once its transformation is applied.
 TEST_F(LocalCliTest, PtxScansAreReconstructedInTheirRegisteredFrame) {
   const PointCloud unit = ColoredUnitSpherePoints(12000, 6);
   const double centre[3] = {500123.5, 4100456.25, 80};
@@ -927,6 +928,66 @@ TEST_F(LocalCliTest, ALasScanCleanedIntoLasKeepsItsRecordsWhole) {
   const RunResult merged = RunNeuralmesh({"convert", las, clean, "-o", *dir_ + "/both.las"});
   ASSERT_EQ(merged.exit_code, 0) << merged.Describe();
   EXPECT_TRUE(absl::StartsWith(merged.out, *dir_ + "/both.las: 6001 points;")) << merged.out;
+}
+
+// A classified scan: a building (class 6, a unit sphere) above the ground (class 2, a square
+// 3 m below). --las_classes 6 learns the building alone; --las_classes 2 converts the ground
+// alone, LAS to LAS with its records whole.
+TEST_F(LocalCliTest, LasClassesChooseWhichPointsAreLearnedAndConverted) {
+  testing::LasLayout layout;
+  layout.format = 1;
+  for (double& s : layout.scale) s = 0.0001;
+  std::vector<testing::LasPoint> points = UnitSphereLasPoints(3000, 6, layout);
+  for (testing::LasPoint& p : points) p.classification = 6;
+  Random rng(3);
+  for (int i = 0; i < 3000; ++i) {
+    testing::LasPoint ground{static_cast<int32_t>(std::lround((6 * rng.NextDouble() - 3) / 0.0001)),
+                             static_cast<int32_t>(std::lround((6 * rng.NextDouble() - 3) / 0.0001)),
+                             -30000};
+    ground.classification = 2;
+    points.push_back(ground);
+  }
+  const std::string las = *dir_ + "/classified_site.las";
+  std::ofstream(las, std::ios::binary) << testing::LasFile(layout, points);
+
+  const std::string mesh = *dir_ + "/building.ply";
+  const RunResult run = RunNeuralmesh(
+      {"reconstruct", las, "-o", mesh, "--vertices", "300", "--las_classes", "6"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "3000 points of " + las +
+                                             " (uniform sampling; left out 3000 points of "
+                                             "other classes)"))
+      << run.out;
+  const double centre[3] = {0, 0, 0};
+  ExpectVerticesOnSphere(mesh, 300, centre, 1.0, 0.05);
+
+  const std::string ground = *dir_ + "/ground.las";
+  const RunResult convert =
+      RunNeuralmesh({"convert", las, "-o", ground, "--las_classes", "2"});
+  ASSERT_EQ(convert.exit_code, 0) << convert.Describe();
+  EXPECT_TRUE(absl::StartsWith(convert.out, ground + ": 3000 points, each record as in "))
+      << convert.out;
+  const absl::StatusOr<PointCloud> read = ReadPointCloud(ground);
+  ASSERT_TRUE(read.ok()) << read.status();
+  ASSERT_EQ(read->size(), 3000u);
+  for (const Vec3f& p : read->positions) ASSERT_FLOAT_EQ(p[2], -3.0f);
+
+  const RunResult not_las = RunNeuralmesh(
+      {"convert", ground, "-o", *dir_ + "/ground.xyz", "--las_classes", "2"});
+  ASSERT_EQ(not_las.exit_code, 0) << "a LAS input: " << not_las.Describe();
+  const RunResult refused = RunNeuralmesh(
+      {"reconstruct", *dir_ + "/ground.xyz", "-o", mesh, "--vertices", "100", "--las_classes",
+       "2"});
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_TRUE(absl::StrContains(refused.err,
+                                "--las_classes selects the points of LAS files by class; no "
+                                "INPUT is a .las file"))
+      << refused.Describe();
+  const RunResult bad = RunNeuralmesh({"convert", las, "-o", ground, "--las_classes", "2,ground"});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_TRUE(absl::StrContains(
+      bad.err, "--las_classes: LAS classes '2,ground': 'ground' is not a class from 0 to 255"))
+      << bad.Describe();
 }
 
 TEST_F(LocalCliTest, AnInterruptWritesTheMeshLearnedSoFar) {

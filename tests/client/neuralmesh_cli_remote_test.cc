@@ -27,6 +27,7 @@
 #include "tests/client/subprocess.h"
 #include "tests/client/tcp_proxy.h"
 #include "tests/client/test_server.h"
+#include "tests/testing/las_file.h"
 #include "tests/testing/shapes.h"
 
 namespace neuralmesh::testing {
@@ -307,6 +308,35 @@ TEST_F(RemoteCliTest, RemoveOutliersFiltersTheUpload) {
   const double hausdorff = HausdorffToTheUnitSphere(*dir_ + "/filtered/sphere_and_stray.drc");
   EXPECT_GE(hausdorff, 0);
   EXPECT_LT(hausdorff, 0.05) << "a spike toward the stray point is left";
+}
+
+// --las_classes uploads the points of the classes asked for only: the building (class 6, a unit
+// sphere), not the ground under it (class 2, 3 m below).
+TEST_F(RemoteCliTest, LasClassesChooseThePointsUploaded) {
+  testing::LasLayout layout;
+  layout.format = 1;
+  for (double& s : layout.scale) s = 0.0001;
+  std::vector<testing::LasPoint> points;
+  for (const Vec3f& p : ColoredUnitSpherePoints(4000, 12).positions) {
+    testing::LasPoint building{static_cast<int32_t>(std::lround(p[0] / 0.0001)),
+                               static_cast<int32_t>(std::lround(p[1] / 0.0001)),
+                               static_cast<int32_t>(std::lround(p[2] / 0.0001))};
+    building.classification = 6;
+    points.push_back(building);
+    testing::LasPoint ground{building.x * 3, building.y * 3, -30000};
+    ground.classification = 2;
+    points.push_back(ground);
+  }
+  const std::string las = *dir_ + "/site.las";
+  std::ofstream(las, std::ios::binary) << testing::LasFile(layout, points);
+  const RunResult run = RunNeuralmesh({"reconstruct", las, "--server", server_->address(),
+                                       "--out-dir", *dir_ + "/building", "--vertices", "400",
+                                       "--las_classes", "6"});
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(run.out, "left out 4000 points of other classes")) << run.out;
+  const double hausdorff = HausdorffToTheUnitSphere(*dir_ + "/building/site.drc");
+  EXPECT_GE(hausdorff, 0);
+  EXPECT_LT(hausdorff, 0.05) << "the ground was learned too";
 }
 
 // --outliers_on_server leaves the stray to the session, which holds it back as the batches

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "absl/strings/str_cat.h"
@@ -63,17 +64,20 @@ absl::Status Invalid(absl::string_view message) {
 constexpr int kLowNoiseClass = 7;
 constexpr int kHighNoiseClass = 18;
 
-enum RecordUsability { kUsable, kWithheld, kNoise };
+enum RecordUsability { kUsable, kWithheld, kNoise, kOtherClass };
 
 // Whether the record at `at` is to be used: the withheld flag (the specification: to be
-// treated as deleted) and the noise classes leave it out. Formats 0-5 hold the class in the
-// low five bits of byte 15 and the withheld flag in its top bit; formats 6-10 the flag in bit
-// 2 of byte 15 and the class in byte 16.
-RecordUsability Usability(absl::string_view data, size_t at, int format) {
+// treated as deleted) leaves it out, and so does its class: one outside `classes`, or without
+// them a noise class. Formats 0-5 hold the class in the low five bits of byte 15 and the
+// withheld flag in its top bit; formats 6-10 the flag in bit 2 of byte 15 and the class in
+// byte 16.
+RecordUsability Usability(absl::string_view data, size_t at, int format,
+                          const std::optional<LasClasses>& classes) {
   const uint8_t flags = static_cast<uint8_t>(data[at + 15]);
   const bool extended = format >= 6;
   if (extended ? (flags & 0x04) != 0 : (flags & 0x80) != 0) return kWithheld;
   const int classification = extended ? static_cast<uint8_t>(data[at + 16]) : flags & 0x1F;
+  if (classes.has_value()) return (*classes)[classification] ? kUsable : kOtherClass;
   return classification == kLowNoiseClass || classification == kHighNoiseClass ? kNoise
                                                                                 : kUsable;
 }
@@ -179,7 +183,8 @@ absl::StatusOr<LasHeader> ReadHeader(absl::string_view data) {
 
 }  // namespace
 
-absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
+absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
+                                         const std::optional<LasClasses>& classes) {
   NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
   const uint8_t format_byte = header.format;
   const PointFormat format = kFormats[format_byte];
@@ -194,7 +199,7 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
   const auto for_each_usable = [&](auto&& visit) {
     for (uint64_t i = 0; i < count; ++i) {
       const size_t at = header.record(i);
-      if (Usability(data, at, format_byte) == kUsable && !visit(i, at)) return false;
+      if (Usability(data, at, format_byte, classes) == kUsable && !visit(i, at)) return false;
     }
     return true;
   };
@@ -206,9 +211,10 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
   uint16_t largest = 0;
   for (uint64_t i = 0; i < count; ++i) {
     const size_t at = header.record(i);
-    const RecordUsability usability = Usability(data, at, format_byte);
+    const RecordUsability usability = Usability(data, at, format_byte, classes);
     out.left_out.withheld += usability == kWithheld;
     out.left_out.noise += usability == kNoise;
+    out.left_out.other_class += usability == kOtherClass;
     if (usability != kUsable) continue;
     for (int c = 0; c < 3; ++c) {
       low[c] = std::min(low[c], coordinate(at, c));
@@ -218,8 +224,11 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data) {
   }
   const size_t kept = count - out.left_out.total();
   if (kept == 0 && count > 0) {
-    return Invalid(absl::StrCat("all ", count, " points are withheld (", out.left_out.withheld,
-                                ") or classified as noise (", out.left_out.noise, ")"));
+    return Invalid(absl::StrCat(
+        "all ", count, " points are withheld (", out.left_out.withheld, ") or ",
+        classes.has_value()
+            ? absl::StrCat("of classes not asked for (", out.left_out.other_class, ")")
+            : absl::StrCat("classified as noise (", out.left_out.noise, ")")));
   }
   if (kept > 0) {
     const Point3d step = {std::fabs(scale[0]), std::fabs(scale[1]), std::fabs(scale[2])};
@@ -324,14 +333,15 @@ absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
 
 absl::StatusOr<std::string> FormatCleanedLas(absl::string_view data,
                                              const std::vector<bool>& outliers,
-                                             LasOutlierRecords records) {
+                                             LasOutlierRecords records,
+                                             const std::optional<LasClasses>& classes) {
   NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
   // The records ParseLas reads, and of those the outliers.
   std::vector<size_t> kept, flagged;
   size_t usable = 0;
   for (uint64_t i = 0; i < header.count; ++i) {
     const size_t at = header.record(i);
-    if (Usability(data, at, header.format) != kUsable) {
+    if (Usability(data, at, header.format, classes) != kUsable) {
       if (records == LasOutlierRecords::kClassifiedAsNoise) kept.push_back(at);
       continue;
     }
@@ -342,7 +352,7 @@ absl::StatusOr<std::string> FormatCleanedLas(absl::string_view data,
   }
   if (outliers.size() != usable) {
     return Invalid(absl::StrCat(outliers.size(), " flags for the file's ", usable,
-                                " points (withheld and noise left out)"));
+                                " points (withheld, noise or other classes left out)"));
   }
   if (records == LasOutlierRecords::kClassifiedAsNoise) {
     std::string out(data);

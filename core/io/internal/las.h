@@ -3,6 +3,7 @@
 #ifndef NEURALMESH_CORE_IO_INTERNAL_LAS_H_
 #define NEURALMESH_CORE_IO_INTERNAL_LAS_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,12 +11,14 @@
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
 #include "core/io/las_cleaning.h"
+#include "core/io/point_selection.h"
 
 namespace neuralmesh::io_internal {
 
 // Parses a LAS file: the positions of its point records (integer X, Y, Z times the header's
-// scale, plus its offset; withheld records and those classified as noise, ASPRS classes 7 and
-// 18, left out and counted in ParsedGeometry::left_out) and, for the formats that carry them
+// scale, plus its offset; withheld records left out, and those of the classes outside
+// `classes`, or without them those classified as noise, ASPRS classes 7 and 18; all counted
+// in ParsedGeometry::left_out) and, for the formats that carry them
 // (2, 3, 5, 7, 8, 10), their colours (16-bit channels scaled to 8 bits, or taken as they are
 // when no channel of the file exceeds 255, as some writers store 8-bit values). Positions are
 // floats, relative to ParsedGeometry::origin where the file's coordinates are too far from 0
@@ -24,8 +27,9 @@ namespace neuralmesh::io_internal {
 // Returns INVALID_ARGUMENT saying what is wrong for a file without the "LASF" signature, a
 // header or records that run past the end of the file, a compressed (LAZ) file, a point
 // format above 10, a record shorter than its format, a zero or non-finite scale, or a point
-// count that does not fit the file, or points that are all withheld or noise.
-absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data);
+// count that does not fit the file, or points that are all left out.
+absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
+                                        const std::optional<LasClasses>& classes = std::nullopt);
 
 // Formats points as a LAS 1.2 file of point format 0, or 2 with their colours (8-bit levels
 // times 257 in the 16-bit channels), without variable-length records. The header's offset is
@@ -38,22 +42,24 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data);
 absl::StatusOr<std::string> FormatLas(const GeometryView& points);
 
 // A copy of the LAS file `data` (one ParseLas reads) without its outliers, or with them
-// classified as noise: `outliers` holds one flag per point ParseLas returns, in its order.
-//   kLeftOut: the outliers' records are left out, and so are the withheld and noise records
-//     that ParseLas leaves out. The header's point counts, counts by return and bounds become
-//     those of the kept records, and the starts of what follows the points (LAS 1.3's
-//     waveform packets, LAS 1.4's extended records) move up with it.
+// classified as noise: `outliers` holds one flag per point ParseLas returns with `classes`, in
+// its order.
+//   kLeftOut: the outliers' records are left out, and so are the withheld, noise and other
+//     classes' records that ParseLas leaves out. The header's point counts, counts by return
+//     and bounds become those of the kept records, and the starts of what follows the points
+//     (LAS 1.3's waveform packets, LAS 1.4's extended records) move up with it.
 //   kClassifiedAsNoise: every record is kept, the outliers' classified as low noise (ASPRS
-//     class 7), which ParseLas then leaves out; their other flags stay.
+//     class 7), which ParseLas then leaves out (unless `classes` holds 7); their other flags
+//     stay.
 // The rest is kept as it was: each record byte for byte (its intensity, returns, GPS time,
 // extra bytes, ...), the header's version, point format, scale and offset, the
 // variable-length records (the coordinate system among them) and what follows the points;
 // the generating software becomes "neuralmesh VERSION".
 // Returns ParseLas's errors for a malformed file, and INVALID_ARGUMENT when `outliers` has not
 // one flag per point, or every point is an outlier to leave out.
-absl::StatusOr<std::string> FormatCleanedLas(absl::string_view data,
-                                             const std::vector<bool>& outliers,
-                                             LasOutlierRecords records);
+absl::StatusOr<std::string> FormatCleanedLas(
+    absl::string_view data, const std::vector<bool>& outliers, LasOutlierRecords records,
+    const std::optional<LasClasses>& classes = std::nullopt);
 
 }  // namespace neuralmesh::io_internal
 

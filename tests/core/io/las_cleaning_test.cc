@@ -268,6 +268,41 @@ TEST(LasCleaningTest, OutliersClassifiedAsNoiseKeepEveryRecordAndTheirFlags) {
   EXPECT_EQ(static_cast<uint8_t>(out[227 + 28 + 15]), 0x60 | 7);
 }
 
+// With classes asked for, the flags are for the points of those classes; left out, the
+// records of other classes go too; classified as noise, they stay as they were.
+TEST(LasCleaningTest, TheClassesAskedForChooseThePointsAndTheRecordsKept) {
+  LasLayout layout;
+  layout.format = 1;
+  std::vector<LasPoint> points = VariedPoints(6);  // Classes 2, 5, 5, 2, 5, 5.
+  const std::string in = LasFile(layout, points);
+  const std::string source = TempPath("classes.las");
+  WriteBytes(source, in);
+  PointSelection vegetation;
+  vegetation.las_classes = LasClasses().set(5);
+  const std::string written = TempPath("vegetation.las");
+  // Points 1, 2, 4, 5 are read; 4 is an outlier.
+  ASSERT_TRUE(WriteCleanedLas(source, {false, false, true, false}, LasOutlierRecords::kLeftOut,
+                              written, vegetation)
+                  .ok());
+  std::string out = ReadBytes(written);
+  ExpectRecordsKept(in, out, {{1, 2, 5}, 28, 227, 6}, 227);
+
+  ASSERT_TRUE(WriteCleanedLas(source, {false, false, true, false},
+                              LasOutlierRecords::kClassifiedAsNoise, written, vegetation)
+                  .ok());
+  out = ReadBytes(written);
+  ASSERT_EQ(out.size(), in.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_EQ(out[227 + 28 * i + 15], i == 4 ? 7 : in[227 + 28 * i + 15]) << "record " << i;
+  }
+
+  const absl::Status status =
+      WriteCleanedLas(source, {false, false, false, false, false, false},
+                      LasOutlierRecords::kLeftOut, written, vegetation);
+  EXPECT_THAT(std::string(status.message()),
+              HasSubstr("6 flags for the file's 4 points (withheld, noise or other classes"));
+}
+
 TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
   LasLayout layout;
   std::vector<LasPoint> points = VariedPoints(4);
@@ -280,7 +315,8 @@ TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
       WriteCleanedLas(source, {true, true, true, true}, LasOutlierRecords::kLeftOut, written);
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()),
-              HasSubstr("4 flags for the file's 3 points (withheld and noise left out)"));
+              HasSubstr("4 flags for the file's 3 points (withheld, noise or other classes "
+                        "left out)"));
   EXPECT_THAT(std::string(status.message()), HasSubstr("source.las"));
 
   status = WriteCleanedLas(source, {true, true, true}, LasOutlierRecords::kLeftOut, written);

@@ -66,6 +66,52 @@ TEST(LasIoTest, ReadsThePositionsAndColoursOfEveryPointFormat) {
   EXPECT_EQ(cloud->colors, (std::vector<Rgb>{{255, 0, 128}, {1, 2, 3}}));
 }
 
+// Classes asked for (PointSelection): only their points are read, noise classes among them
+// when asked for; the others are counted apart from noise; withheld points stay out.
+TEST(LasIoTest, OnlyThePointsOfTheClassesAskedForAreRead) {
+  for (const int format : {1, 6}) {
+    SCOPED_TRACE(::testing::Message() << "format " << format);
+    LasLayout layout;
+    layout.version_minor = format >= 6 ? 4 : 2;
+    layout.format = format;
+    std::vector<LasPoint> points;
+    for (int c : {2, 6, 7, 2, 18, 6, 5, 2}) {
+      LasPoint p{100 * c, static_cast<int32_t>(points.size()), 0};
+      p.classification = static_cast<uint8_t>(c);
+      points.push_back(p);
+    }
+    points[3].withheld = true;
+    const std::string path = TempPath(absl::StrCat("classes", format, ".las"));
+    WriteBytes(path, LasFile(layout, points));
+
+    PointSelection ground_and_low_noise;
+    ground_and_low_noise.las_classes = LasClasses().set(2).set(7);
+    PointsLeftOut left_out;
+    absl::StatusOr<PointCloud> cloud = ReadPointCloud(path, &left_out, ground_and_low_noise);
+    ASSERT_TRUE(cloud.ok()) << cloud.status();
+    ASSERT_EQ(cloud->size(), 3u);  // Points 0, 2 and 7.
+    EXPECT_FLOAT_EQ(cloud->positions[0][1], 0.0f);
+    EXPECT_FLOAT_EQ(cloud->positions[1][0], 7.0f) << "low noise, asked for";
+    EXPECT_FLOAT_EQ(cloud->positions[2][1], 0.07f);
+    EXPECT_EQ(left_out.withheld, 1u);
+    EXPECT_EQ(left_out.other_class, 4u);
+    EXPECT_EQ(left_out.noise, 0u) << "with classes asked for, noise is a class like another";
+
+    PointSelection all;
+    all.las_classes = LasClasses().set();
+    cloud = ReadPointCloud(path, &left_out, all);
+    ASSERT_TRUE(cloud.ok()) << cloud.status();
+    EXPECT_EQ(cloud->size(), 7u) << "every point but the withheld one";
+
+    PointSelection water;
+    water.las_classes = LasClasses().set(9);
+    cloud = ReadPointCloud(path, &left_out, water);
+    EXPECT_EQ(cloud.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(std::string(cloud.status().message()),
+                HasSubstr("all 8 points are withheld (1) or of classes not asked for (7)"));
+  }
+}
+
 // UTM coordinates at millimetre resolution: a float holds 500,000 m to about 3 cm (and
 // 4,100,000 m to 25 cm), so x and y are taken relative to the origin (the minimum rounded down
 // to 1,000 m) and keep their millimetres; z, near 0, stays as it is.

@@ -59,14 +59,19 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
 absl::Status RunStats(const std::string& mesh, bool json, std::ostream& out);
 
 struct EvalOptions {
-  std::string mesh;       // The reconstruction.
-  std::string reference;  // A mesh file, or builtin:NAME for its implicit surface.
-  size_t samples = 0;     // Samples per surface; 0: GeometricErrorOptions' default.
+  std::string mesh;  // The reconstruction.
+  // A mesh file, builtin:NAME for its implicit surface, or a point cloud file (a scan: the
+  // points the mesh was learned from).
+  std::string reference;
+  size_t samples = 0;  // Samples per surface; 0: GeometricErrorOptions' default.
   uint64_t seed = 1;
   bool json = false;
+  PointSelection selection;  // Which points of a LAS reference are read.
 };
 
-// Prints the geometric error of MESH against REFERENCE (core/analysis/geometric_error.h).
+// Prints the geometric error of MESH against REFERENCE (core/analysis/geometric_error.h):
+// ComputeGeometricError for a surface, ComputeErrorAgainstPoints for points (a point cloud
+// format, or a file without faces), each distance also in the files' units.
 absl::Status RunEval(const EvalOptions& options, std::ostream& out);
 
 struct ConvertOptions {

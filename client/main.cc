@@ -547,6 +547,7 @@ absl::Status Eval(const ParsedArgs& args) {
   o.samples = absl::GetFlag(FLAGS_samples);
   o.seed = absl::GetFlag(FLAGS_seed);
   o.json = absl::GetFlag(FLAGS_json);
+  NM_ASSIGN_OR_RETURN(o.selection, SelectionFromFlags({o.reference}));
   return neuralmesh::client::RunEval(o, std::cout);
 }
 
@@ -708,8 +709,10 @@ std::vector<Subcommand> Commands() {
        "eval MESH --reference REF [--json] [--samples N]",
        "Prints the geometric error of a mesh against a reference surface.",
        "Prints the geometric error (Chamfer, Hausdorff, normal consistency) of MESH against\n"
-       "REF, a mesh file or builtin:NAME (its dense reference tessellation).",
-       {"reference", "json", "samples", "seed"},
+       "REF, a mesh file or builtin:NAME (its dense reference tessellation), or against the\n"
+       "points of a scan (a point cloud file, or one without faces): each point's distance to\n"
+       "MESH, and MESH's distance to the nearest point.",
+       {"reference", "json", "samples", "seed", "las_classes"},
        Eval},
       {"watch",
        "watch SESSION --server HOST:PORT --out-dir DIR [--ply] [--glb] [--reconnect_for D]",

@@ -1,9 +1,11 @@
 // RunStats, RunEval and RunConvert (declared in client/local_commands.h).
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/strip.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/match.h"
@@ -33,35 +35,32 @@ absl::Status RunStats(const std::string& mesh_path, bool json, std::ostream& out
   return absl::OkStatus();
 }
 
-absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
-  NM_ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(options.mesh, "MESH"));
-  NM_ASSIGN_OR_RETURN(const TriangleMesh reference, LoadMesh(options.reference, "--reference"));
-  // Georeferenced files may have been read relative to different origins.
-  if (const absl::Status moved = MoveOrigin(reference.origin, &mesh); !moved.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("MESH '", options.mesh,
-                                                   "' against --reference '", options.reference,
-                                                   "': ", moved.message()));
-  }
-  GeometricErrorOptions error_options;
-  if (options.samples > 0) error_options.samples = options.samples;
-  error_options.seed = options.seed;
-  NM_RETURN_IF_ERROR(error_options.Validate());
-  absl::StatusOr<GeometricError> computed = ComputeGeometricError(mesh, reference, error_options);
-  if (!computed.ok()) {  // Names the two files: the error speaks of "the reconstruction".
-    return absl::Status(computed.status().code(),
-                        absl::StrCat("MESH '", options.mesh, "' against --reference '",
-                                     options.reference, "': ", computed.status().message()));
-  }
-  const GeometricError& error = *computed;
+namespace {
+
+// Whether RunEval compares with points: a point cloud format, or a mesh format whose file
+// holds no faces.
+absl::StatusOr<bool> ReferenceIsPoints(const std::string& reference) {
+  if (IsBuiltin(reference) || !IsReadablePointCloudExtension(reference)) return false;
+  if (!IsSupportedMeshExtension(reference)) return true;
+  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(reference, "--reference"));
+  return mesh.faces.empty();
+}
+
+// The error's figures, as text or JSON. `against` names what was compared with: "the
+// reference's bounding-box diagonal" or "the points' ...".
+absl::Status PrintGeometricError(const EvalOptions& options, const GeometricError& error,
+                                 size_t samples, size_t points, std::ostream& out) {
+  const bool has_normals = !std::isnan(error.normal_consistency);
   if (options.json) {
     JsonWriter json(2);
     json.BeginObject();
     json.Key("mesh").String(options.mesh);
     json.Key("reference").String(options.reference);
-    json.Key("samples").Uint(error_options.samples);
+    if (points > 0) json.Key("reference_points").Uint(points);
+    json.Key("samples").Uint(samples);
     json.Key("chamfer_l1").Double(error.chamfer_l1);
     json.Key("hausdorff").Double(error.hausdorff);
-    json.Key("normal_consistency").Double(error.normal_consistency);
+    if (has_normals) json.Key("normal_consistency").Double(error.normal_consistency);
     json.Key("accuracy").Double(error.accuracy);
     json.Key("completeness").Double(error.completeness);
     json.Key("diagonal").Double(error.diagonal);
@@ -70,17 +69,70 @@ absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
     out << text << "\n";
     return absl::OkStatus();
   }
-  out << absl::StrFormat(
-      "%s against %s (%d samples per surface; distances relative to the reference's\n"
-      "bounding-box diagonal %.6g)\n"
-      "  chamfer_l1          %.6g\n"
-      "  hausdorff           %.6g\n"
-      "  normal_consistency  %.6f\n"
-      "  accuracy            %.6g  (reconstruction -> reference)\n"
-      "  completeness        %.6g  (reference -> reconstruction)\n",
-      options.mesh, options.reference, error_options.samples, error.diagonal, error.chamfer_l1,
-      error.hausdorff, error.normal_consistency, error.accuracy, error.completeness);
+  const char* other = points > 0 ? "points" : "reference";
+  if (points > 0) {
+    out << absl::StrFormat(
+        "%s against the %d points of %s (each point to the mesh; %d samples of the mesh to\n"
+        "their nearest points)\n",
+        options.mesh, points, options.reference, samples);
+  } else {
+    out << absl::StrFormat("%s against %s (%d samples per surface)\n", options.mesh,
+                           options.reference, samples);
+  }
+  // Each distance relative to the diagonal and in the files' units (metres for most scans).
+  out << absl::StrFormat("  %-18s  %-12s  %-12s  (%s bounding-box diagonal: %.6g)\n", "",
+                         "/ diagonal", "distance", points > 0 ? "the points'" : "the reference's",
+                         error.diagonal);
+  const auto line = [&](const char* name, double value, const std::string& what) {
+    const std::string row = absl::StrFormat("  %-18s  %-12.6g  %-12.6g%s", name, value,
+                                            value * error.diagonal, what);
+    out << absl::StripTrailingAsciiWhitespace(row) << "\n";
+  };
+  line("chamfer_l1", error.chamfer_l1, "");
+  line("hausdorff", error.hausdorff, "");
+  if (has_normals) out << absl::StrFormat("  normal_consistency  %.6f\n", error.normal_consistency);
+  line("accuracy", error.accuracy, absl::StrCat("  (reconstruction -> ", other, ")"));
+  line("completeness", error.completeness, absl::StrCat("  (", other, " -> reconstruction)"));
   return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
+  NM_ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(options.mesh, "MESH"));
+  NM_ASSIGN_OR_RETURN(const bool against_points, ReferenceIsPoints(options.reference));
+  GeometricErrorOptions error_options;
+  if (options.samples > 0) error_options.samples = options.samples;
+  error_options.seed = options.seed;
+  NM_RETURN_IF_ERROR(error_options.Validate());
+  const auto named = [&](const absl::Status& status) {
+    return absl::Status(status.code(),
+                        absl::StrCat("MESH '", options.mesh, "' against --reference '",
+                                     options.reference, "': ", status.message()));
+  };
+  absl::StatusOr<GeometricError> error;
+  size_t points = 0;
+  if (against_points) {
+    NM_ASSIGN_OR_RETURN(const PointCloud cloud,
+                        LoadPointClouds({options.reference}, "--reference", nullptr, nullptr,
+                                        options.selection));
+    // Georeferenced files may have been read relative to different origins.
+    if (const absl::Status moved = MoveOrigin(cloud.origin, &mesh); !moved.ok()) {
+      return named(moved);
+    }
+    points = cloud.size();
+    error = ComputeErrorAgainstPoints(mesh, cloud, error_options);
+  } else {
+    NM_ASSIGN_OR_RETURN(const TriangleMesh reference,
+                        LoadMesh(options.reference, "--reference"));
+    if (const absl::Status moved = MoveOrigin(reference.origin, &mesh); !moved.ok()) {
+      return named(moved);
+    }
+    error = ComputeGeometricError(mesh, reference, error_options);
+  }
+  // The error speaks of "the reconstruction": the message names the two files.
+  if (!error.ok()) return named(error.status());
+  return PrintGeometricError(options, *error, error_options.samples, points, out);
 }
 
 namespace {

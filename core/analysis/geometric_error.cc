@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <thread>
@@ -9,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "core/analysis/point_kd_tree.h"
 #include "core/analysis/triangle_tree.h"
 #include "core/bounding_box.h"
 #include "core/random.h"
@@ -255,6 +258,106 @@ absl::StatusOr<GeometricError> ComputeGeometricError(const TriangleMesh& reconst
         (to_reference.mean_normal_agreement + to_reconstruction.mean_normal_agreement) /
         static_cast<double>(voting_sides);
   }
+  return error;
+}
+
+absl::StatusOr<GeometricError> ComputeErrorAgainstPoints(const TriangleMesh& reconstruction,
+                                                         const PointCloud& points,
+                                                         const GeometricErrorOptions& options) {
+  NM_RETURN_IF_ERROR(options.Validate());
+  NM_RETURN_IF_ERROR(CheckMesh(reconstruction, "reconstruction"));
+  if (points.empty()) return absl::InvalidArgumentError("there are no points to compare with");
+  std::vector<Vec3> queries(points.size());
+  BoundingBox box;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Vec3f& p = points.positions[i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      return absl::InvalidArgumentError(absl::StrCat("point ", i, " is not finite"));
+    }
+    queries[i] = ToVec3(p);
+    box.Extend(queries[i]);
+  }
+  const double diagonal = box.diagonal();
+  if (!(diagonal > 0.0)) {
+    return absl::InvalidArgumentError("the points' bounding box has zero diagonal");
+  }
+  Surface surface;
+  NM_RETURN_IF_ERROR(
+      PrepareSurface(reconstruction, options.samples, options.seed, "reconstruction", surface));
+  const bool normals = !points.normals.empty();
+
+  // Points to the reconstruction: exact, every one.
+  TriangleTree::BatchOptions batch;
+  batch.threads = options.threads;
+  double max_distance = 0.0, to_mesh_sum = 0.0, normal_sum = 0.0;
+  size_t normal_count = 0;
+  const std::vector<TriangleTree::ClosestPointResult> closest =
+      surface.tree->ClosestPoints(queries, batch);
+  for (size_t i = 0; i < closest.size(); ++i) {
+    max_distance = std::max(max_distance, closest[i].distance);
+    to_mesh_sum += closest[i].distance;
+    const Vec3& n = surface.geometry.normals[closest[i].face];
+    if (normals && n.sqrnorm() > 0.0 && points.normals[i].sqrnorm() > 0.0f) {
+      normal_sum += std::abs(ToVec3(points.normals[i]).normalized().dot(n));
+      ++normal_count;
+    }
+  }
+  const double points_agreement = normal_count > 0 ? normal_sum / normal_count : 0.0;
+  const size_t points_voted = normal_count;
+
+  // The reconstruction's samples and vertices to their nearest point.
+  const PointKdTree tree(points.positions, 0, static_cast<uint32_t>(points.size()));
+  const QueryPoints& query = surface.query;
+  const size_t samples = query.samples.size();
+  std::vector<double> distance(samples + query.vertices.size());
+  std::vector<uint32_t> nearest(samples);
+  size_t threads = options.threads > 0 ? static_cast<size_t>(options.threads)
+                                       : std::max(1u, std::thread::hardware_concurrency());
+  threads = std::min(threads, std::max<size_t>(1, distance.size() / 4096));
+  auto measure = [&](size_t first, size_t last) {
+    NeighbourHeap heap;
+    for (size_t i = first; i < last; ++i) {
+      const Vec3& q = i < samples ? query.samples[i] : query.vertices[i - samples];
+      tree.Search(points.positions, Vec3f(q[0], q[1], q[2]), UINT32_MAX, 1, &heap);
+      const uint32_t index = heap.top().second;
+      heap.pop();
+      distance[i] = (ToVec3(points.positions[index]) - q).norm();
+      if (i < samples) nearest[i] = index;
+    }
+  };
+  std::vector<std::thread> workers;
+  for (size_t t = 1; t < threads; ++t) {
+    workers.emplace_back(measure, distance.size() * t / threads,
+                         distance.size() * (t + 1) / threads);
+  }
+  measure(0, distance.size() / threads);
+  for (std::thread& worker : workers) worker.join();
+  double to_points_sum = 0.0;
+  normal_sum = 0.0;
+  normal_count = 0;
+  for (size_t i = 0; i < distance.size(); ++i) {
+    max_distance = std::max(max_distance, distance[i]);
+    if (i >= samples) continue;
+    to_points_sum += distance[i];
+    const Vec3f& n = normals ? points.normals[nearest[i]] : Vec3f(0, 0, 0);
+    if (n.sqrnorm() > 0.0f && query.normals[i].sqrnorm() > 0.0) {
+      normal_sum += std::abs(query.normals[i].dot(ToVec3(n).normalized()));
+      ++normal_count;
+    }
+  }
+
+  GeometricError error;
+  error.diagonal = diagonal;
+  error.accuracy = to_points_sum / static_cast<double>(samples) / diagonal;
+  error.completeness = to_mesh_sum / static_cast<double>(points.size()) / diagonal;
+  error.chamfer_l1 = 0.5 * (error.accuracy + error.completeness);
+  error.hausdorff = max_distance / diagonal;
+  const size_t voting_sides = (points_voted > 0 ? 1 : 0) + (normal_count > 0 ? 1 : 0);
+  error.normal_consistency =
+      voting_sides == 0
+          ? std::numeric_limits<double>::quiet_NaN()
+          : (points_agreement + (normal_count > 0 ? normal_sum / normal_count : 0.0)) /
+                static_cast<double>(voting_sides);
   return error;
 }
 

@@ -1,5 +1,6 @@
-// Geometric error of a reconstruction against a reference surface: Chamfer (L1), Hausdorff
-// and normal consistency, normalised by the diagonal of the reference's bounding box.
+// Geometric error of a reconstruction against a reference surface, or against the points it was
+// learned from: Chamfer (L1), Hausdorff and normal consistency, normalised by the diagonal of
+// the reference's bounding box.
 //
 //   1. Sample each surface area-uniformly (pick a triangle with probability proportional to
 //      its area, then a uniform point in it), deterministically from the seed.
@@ -28,6 +29,7 @@
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
 #include "core/mesh.h"
+#include "core/point_cloud.h"
 #include "core/triangle_mesh.h"
 
 namespace neuralmesh {
@@ -63,6 +65,25 @@ struct GeometricError {
 absl::StatusOr<GeometricError> ComputeGeometricError(const TriangleMesh& reconstruction,
                                                      const TriangleMesh& reference,
                                                      const GeometricErrorOptions& options = {});
+
+// Compares `reconstruction` with the points it was learned from, for scans that have no
+// reference surface (the points and the mesh in one frame):
+//   completeness = mean over every point of its exact distance to the reconstruction / diag,
+//   accuracy = mean over the reconstruction's area-uniform samples of the distance to the
+//     nearest point / diag (surface where the points have none: a bridged hole, a bulge; the
+//     points' spacing sets its floor),
+//   chamfer_l1 = (accuracy + completeness) / 2,
+//   hausdorff = the largest distance either way / diag, also over every vertex,
+//   normal_consistency = mean over both sides of |n . n'|, the points' normals against the
+//     closest triangle's and the samples' against their nearest point's, when the points carry
+//     normals; NaN otherwise,
+// diag being the diagonal of the points' bounding box. O((n + s + v) log) for n points and s
+// samples.
+// Returns INVALID_ARGUMENT as ComputeGeometricError for the reconstruction, and for no points,
+// a non-finite point or points whose bounding box has zero diagonal.
+absl::StatusOr<GeometricError> ComputeErrorAgainstPoints(const TriangleMesh& reconstruction,
+                                                         const PointCloud& points,
+                                                         const GeometricErrorOptions& options = {});
 
 // The exact (unnormalised) distance from each of `points` to the surface of `mesh`, in the
 // order of `points`, over `threads` threads (0: one per hardware thread).

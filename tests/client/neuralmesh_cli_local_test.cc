@@ -569,6 +569,14 @@ TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
   ASSERT_TRUE(learned.ok()) << learned.status();
   EXPECT_FALSE(learned->colors.empty());
   expect_on_sphere(*learned);
+  // Against the scan's points, in the scan's frame: the mesh lies within its edges' sag.
+  const RunResult fit = RunNeuralmesh({"eval", mesh, "--reference", las, "--json"});
+  ASSERT_EQ(fit.exit_code, 0) << fit.Describe();
+  double completeness = 0, diagonal = 0;
+  ASSERT_TRUE(absl::SimpleAtod(JsonValue(fit.out, "completeness"), &completeness)) << fit.out;
+  ASSERT_TRUE(absl::SimpleAtod(JsonValue(fit.out, "diagonal"), &diagonal)) << fit.out;
+  EXPECT_NEAR(diagonal, 20 * std::sqrt(3.0), 0.1) << fit.out;
+  EXPECT_LT(completeness * diagonal, 0.15) << fit.out;
   // The mesh in Draco, whose metadata keep another origin 400 m away.
   TriangleMesh moved = *learned;
   ASSERT_TRUE(MoveOrigin({500100, 4100400, 0}, &moved).ok());
@@ -960,6 +968,32 @@ TEST_F(LocalCliTest, LasClassesChooseWhichPointsAreLearnedAndConverted) {
       << run.out;
   const double centre[3] = {0, 0, 0};
   ExpectVerticesOnSphere(mesh, 300, centre, 1.0, 0.05);
+  // Against the building's points, the mesh fits; against all of them, the ground is far off.
+  const RunResult fits = RunNeuralmesh(
+      {"eval", mesh, "--reference", las, "--las_classes", "6", "--json", "--samples", "20000"});
+  ASSERT_EQ(fits.exit_code, 0) << fits.Describe();
+  EXPECT_EQ(JsonValue(fits.out, "reference_points"), "3000") << fits.out;
+  double completeness = 0, hausdorff = 0, diagonal = 0;
+  ASSERT_TRUE(absl::SimpleAtod(JsonValue(fits.out, "completeness"), &completeness)) << fits.out;
+  ASSERT_TRUE(absl::SimpleAtod(JsonValue(fits.out, "hausdorff"), &hausdorff)) << fits.out;
+  ASSERT_TRUE(absl::SimpleAtod(JsonValue(fits.out, "diagonal"), &diagonal)) << fits.out;
+  EXPECT_NEAR(diagonal, 2 * std::sqrt(3.0), 0.05);
+  EXPECT_LT(completeness * diagonal, 0.03) << "the building's points lie on its mesh";
+  EXPECT_LT(hausdorff * diagonal, 0.15);
+  const RunResult off = RunNeuralmesh({"eval", mesh, "--reference", las, "--samples", "20000"});
+  ASSERT_EQ(off.exit_code, 0) << off.Describe();
+  EXPECT_TRUE(absl::StrContains(off.out, "against the 6000 points of " + las)) << off.out;
+  EXPECT_FALSE(absl::StrContains(off.out, "normal_consistency")) << "points without normals";
+  // The ground's half of the points lies 2 to 4 from the sphere.
+  const std::smatch row = [&] {
+    std::smatch m;
+    std::regex_search(off.out, m,
+                      std::regex("completeness +[0-9.e+-]+ +([0-9.e+-]+) +\\(points -> "
+                                 "reconstruction\\)"));
+    return m;
+  }();
+  ASSERT_FALSE(row.empty()) << off.out;
+  EXPECT_GT(std::stod(row[1]), 1.0) << off.out;
 
   const std::string ground = *dir_ + "/ground.las";
   const RunResult convert =

@@ -133,6 +133,62 @@ TEST(GeometricErrorTest, RejectsInvalidInput) {
       << "more samples than the bound must be refused, not allocated";
 }
 
+// The points of a unit sphere (with their normals) against meshes of it: the mesh itself fits
+// them to its tessellation; a sphere 0.1 larger is that far from every point; where the points
+// miss a cap, accuracy (mesh to points) sees the mesh over no data and completeness does not.
+TEST(GeometricErrorTest, AgainstPointsMeasuresBothWaysInThePointsFrame) {
+  PointCloud points = testing::ColoredUnitSpherePoints(20000, 5);
+  for (const Vec3f& p : points.positions) points.normals.push_back(p);
+  const TriangleMesh sphere = Icosphere(5);
+  absl::StatusOr<GeometricError> error = ComputeErrorAgainstPoints(sphere, points, FewSamples());
+  ASSERT_TRUE(error.ok()) << error.status();
+  const double diagonal = error->diagonal;
+  EXPECT_NEAR(diagonal, 2 * std::sqrt(3.0), 0.02) << "the points' box";
+  // Icosphere(5): edges of about 0.04, chords 1e-4 to 2e-4 inside the sphere.
+  EXPECT_LT(error->completeness * diagonal, 3e-4);
+  // A sample's nearest point: within the spacing of 20,000 points (about 0.025).
+  EXPECT_LT(error->accuracy * diagonal, 0.015);
+  // The widest gap between 20,000 random points, about sqrt(log n / n) across: 0.05.
+  EXPECT_LT(error->hausdorff * diagonal, 0.08);
+  EXPECT_GT(error->normal_consistency, 0.99);
+
+  const TriangleMesh larger = Icosphere(5, 1.1);
+  error = ComputeErrorAgainstPoints(larger, points, FewSamples());
+  ASSERT_TRUE(error.ok()) << error.status();
+  EXPECT_NEAR(error->completeness * diagonal, 0.1, 0.002);
+  EXPECT_NEAR(error->hausdorff * diagonal, 0.1, 0.04);
+
+  PointCloud capless;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (points.positions[i][2] > 0.5f) continue;
+    capless.positions.push_back(points.positions[i]);
+  }
+  error = ComputeErrorAgainstPoints(sphere, capless, FewSamples());
+  ASSERT_TRUE(error.ok()) << error.status();
+  const double capless_diagonal = error->diagonal;
+  EXPECT_LT(error->completeness * capless_diagonal, 3e-4) << "every point is on the mesh";
+  // A quarter of the sphere's area lies above z = 0.5, its samples up to 1 from the points
+  // (the pole to the circle at z = 0.5), 0.25 on average over that cap.
+  EXPECT_GT(error->accuracy * capless_diagonal, 0.04);
+  EXPECT_NEAR(error->hausdorff * capless_diagonal, 1.0, 0.02);
+  EXPECT_TRUE(std::isnan(error->normal_consistency)) << "no normals, no consistency";
+
+  const auto code = [](const absl::StatusOr<GeometricError>& r) { return r.status().code(); };
+  EXPECT_EQ(code(ComputeErrorAgainstPoints(sphere, PointCloud())),
+            absl::StatusCode::kInvalidArgument);
+  PointCloud one_place;
+  one_place.positions.assign(3, Vec3f(1, 2, 3));
+  EXPECT_EQ(code(ComputeErrorAgainstPoints(sphere, one_place)),
+            absl::StatusCode::kInvalidArgument);
+  PointCloud nan = capless;
+  nan.positions[7][1] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(code(ComputeErrorAgainstPoints(sphere, nan)), absl::StatusCode::kInvalidArgument);
+  TriangleMesh no_faces = sphere;
+  no_faces.faces.clear();
+  EXPECT_EQ(code(ComputeErrorAgainstPoints(no_faces, points)),
+            absl::StatusCode::kInvalidArgument);
+}
+
 TEST(GeometricErrorTest, DistancesToMeshAreExact) {
   const TriangleMesh patch = GridPatch(4, 4);  // [0,1]^2 at z = 0.
   const std::vector<Vec3> points = {Vec3(0.5, 0.5, 0.25), Vec3(0.3, 0.7, -2.0), Vec3(2.0, 0.5, 0.0),

@@ -16,6 +16,7 @@
 #include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
+#include "core/io/point_cloud_io.h"
 #include "core/io/point_selection.h"
 #include "core/io/mesh_io.h"
 #include "core/learning/learner_options.h"
@@ -85,6 +86,7 @@ struct ConvertOptions {
   // Set: a point cloud's statistical outliers are removed before it is written.
   std::optional<OutlierOptions> outliers;
   PointSelection selection;  // Which points of a LAS file are read (and, LAS to LAS, kept).
+  PcdData pcd_data = PcdData::kBinary;  // How a .pcd OUTPUT stores its points.
   // With `outliers`, from one .las file to .las: the outliers' records are kept, classified as
   // noise (ASPRS class 7), instead of removed.
   bool outliers_as_noise = false;

@@ -120,6 +120,11 @@ ABSL_FLAG(std::string, start_mesh, "",
           "area. --initial_mesh disc still keeps its longest border open. With --server the "
           "mesh is sent exactly (CreateSessionRequest.start_mesh); not with --resume.");
 
+ABSL_FLAG(std::string, pcd_data, "binary",
+          "How convert stores the points of a .pcd OUTPUT (its DATA line): binary (point "
+          "records), binary_compressed (field by field, LZF-compressed, as PCL keeps maps) or "
+          "ascii.");
+
 // Input clean-up.
 ABSL_FLAG(std::string, las_classes, "",
           "The ASPRS classes whose points are read from LAS files, as numbers and ranges "
@@ -532,6 +537,18 @@ absl::Status Convert(const ParsedArgs& args) {
   NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
   NM_ASSIGN_OR_RETURN(o.selection, SelectionFromFlags(o.inputs));
   o.outliers_as_noise = absl::GetFlag(FLAGS_outliers_as_noise);
+  const std::string pcd_data = absl::GetFlag(FLAGS_pcd_data);
+  if (pcd_data == "binary_compressed") {
+    o.pcd_data = neuralmesh::PcdData::kBinaryCompressed;
+  } else if (pcd_data == "ascii") {
+    o.pcd_data = neuralmesh::PcdData::kAscii;
+  } else if (pcd_data != "binary") {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--pcd_data is '", pcd_data, "'; it must be binary, binary_compressed or ascii"));
+  }
+  if (args.Has("pcd_data") && !absl::EndsWithIgnoreCase(o.output, ".pcd")) {
+    return absl::InvalidArgumentError("--pcd_data applies to a .pcd OUTPUT");
+  }
   if (o.outliers_as_noise && !o.outliers.has_value()) {
     return absl::InvalidArgumentError("--outliers_as_noise needs --remove_outliers");
   }
@@ -688,7 +705,7 @@ std::vector<Subcommand> Commands() {
        Stats},
       {"convert",
        "convert INPUT... -o OUTPUT [--gltf_draco] [--remove_outliers [--outliers_as_noise]]\n"
-       "        [--quantization_bits B] [--encode_speed S]",
+       "        [--las_classes C] [--pcd_data D] [--quantization_bits B] [--encode_speed S]",
        "Writes a mesh or a point cloud in another format.",
        "Writes INPUT to OUTPUT in the format of its extension, colours included where the\n"
        "format holds them. A mesh (a file with faces, or builtin:NAME, its dense reference\n"
@@ -701,8 +718,8 @@ std::vector<Subcommand> Commands() {
        "variable-length records (the coordinate system); --outliers_as_noise classifies its\n"
        "outliers as noise instead of removing them. Several point cloud files are written as\n"
        "one.",
-       {"output", "gltf_draco", "las_classes", "remove_outliers", "outlier_neighbours",
-        "outlier_std_ratio",
+       {"output", "gltf_draco", "pcd_data", "las_classes", "remove_outliers",
+        "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "outliers_as_noise", "quantization_bits", "encode_speed"},
        Convert},
       {"eval",

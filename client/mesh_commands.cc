@@ -192,7 +192,8 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
       left_out = {};
     }
   } else {
-    NM_RETURN_IF_ERROR(WritePointCloud(cloud, options.output, options.writing.draco));
+    NM_RETURN_IF_ERROR(
+        WritePointCloud(cloud, options.output, {options.writing.draco, options.pcd_data}));
     // What the file holds (LAS has no place for normals and weights, E57 none for weights).
     std::vector<std::string> carried;
     if (!cloud.normals.empty()) (kept.normals ? carried : dropped).push_back("normals");

@@ -6,7 +6,8 @@
 //  - a file that parses with its faces also parses without them, to the same points (point
 //    clouds are read with FaceHandling::kSkip, meshes with kRead);
 //  - the format's writer output parses back to the same positions, faces and (where the
-//    format holds them) normals and weights, bit for bit;
+//    format holds them) normals and weights, bit for bit (a NaN normal or weight may come back
+//    as another NaN: text holds no NaN's payload);
 //  - a parsed mesh can be reported on (`neuralmesh stats`), however broken its connectivity.
 #ifndef NEURALMESH_FUZZ_GEOMETRY_PARSER_PROPERTIES_H_
 #define NEURALMESH_FUZZ_GEOMETRY_PARSER_PROPERTIES_H_

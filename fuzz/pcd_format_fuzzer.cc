@@ -1,6 +1,7 @@
 // The PCD parser and writer (core/io/internal/pcd.h) against the properties of
 // fuzz/geometry_parser_properties.h: ascii, binary and LZF-compressed (binary_compressed)
-// data, headers of every field type.
+// data, headers of every field type; what is parsed is written back in each of the three
+// kinds of data (LzfCompress included) and must read back bit for bit.
 #include <cstddef>
 #include <cstdint>
 
@@ -8,11 +9,18 @@
 #include "fuzz/geometry_parser_properties.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const neuralmesh::fuzz::GeometryFormat pcd{
-      [](absl::string_view bytes, neuralmesh::io_internal::FaceHandling) {
-        return neuralmesh::io_internal::ParsePcd(bytes);
-      },
-      neuralmesh::io_internal::FormatPcd, /*skips_faces=*/false};
-  neuralmesh::fuzz::CheckGeometryParser(pcd, data, size);
+  for (const neuralmesh::PcdData kind :
+       {neuralmesh::PcdData::kBinary, neuralmesh::PcdData::kBinaryCompressed,
+        neuralmesh::PcdData::kAscii}) {
+    const neuralmesh::fuzz::GeometryFormat pcd{
+        [](absl::string_view bytes, neuralmesh::io_internal::FaceHandling) {
+          return neuralmesh::io_internal::ParsePcd(bytes);
+        },
+        [kind](const neuralmesh::io_internal::GeometryView& geometry) {
+          return neuralmesh::io_internal::FormatPcd(geometry, kind);
+        },
+        /*skips_faces=*/false};
+    neuralmesh::fuzz::CheckGeometryParser(pcd, data, size);
+  }
   return 0;
 }

@@ -136,7 +136,7 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, PointsLeftOut
 }
 
 absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
-                             const DracoOptions& draco) {
+                             const PointCloudWriteOptions& options) {
   const FileFormat format = io_internal::FormatFromPath(path);
   if (!IsWritable(format)) {
     return UnsupportedExtension(path, kWritablePointCloudExtensions);
@@ -152,7 +152,7 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
   } else if (format == FileFormat::kXyz) {
     data = io_internal::FormatXyz(view);
   } else if (format == FileFormat::kPcd) {
-    data = io_internal::FormatPcd(view);
+    data = io_internal::FormatPcd(view, options.pcd);
   } else if (format == FileFormat::kE57) {
     data = io_internal::FormatE57(view);
   } else if (format == FileFormat::kLas) {
@@ -166,7 +166,7 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
     if (!formatted.ok()) return io_internal::CannotWrite(path, formatted.status());
     data = *std::move(formatted);
   } else {
-    absl::StatusOr<std::string> encoded = EncodePointCloud(cloud, draco);
+    absl::StatusOr<std::string> encoded = EncodePointCloud(cloud, options.draco);
     if (!encoded.ok()) return io_internal::CannotWrite(path, encoded.status());
     data = *std::move(encoded);
   }

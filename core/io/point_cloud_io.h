@@ -38,6 +38,18 @@ struct WrittenPointAttributes {
 };
 WrittenPointAttributes PointAttributesWrittenTo(std::string_view path);
 
+// How WritePointCloud stores the points of a PCD file (its DATA line).
+enum class PcdData {
+  kBinary,            // Point records, as in memory: the fastest to read and write.
+  kBinaryCompressed,  // Field by field, LZF-compressed: smaller, as PCL's maps are kept.
+  kAscii,             // Text lines.
+};
+
+struct PointCloudWriteOptions {
+  DracoOptions draco;               // .drc: quantization and speed.
+  PcdData pcd = PcdData::kBinary;  // .pcd.
+};
+
 // Reads the points at `path`; faces in the file are skipped without being checked:
 //   .ply  ASCII or binary (either byte order): 'vertex' x, y, z of any scalar type; nx, ny, nz
 //         when all present; the first of confidence, weight, quality, intensity, scalar as
@@ -77,19 +89,18 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,
 // Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
 // nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"
 // text for .xyz/.txt/.pts (a header comment names the columns), LAS 1.2 of point format 0 or
-// 2 (with colours; no normals or weights: internal/las.h), binary PCD (x y z, normal_x
-// normal_y normal_z, rgb, confidence as present), E57 of one scan (scaled integer
-// coordinates, colours, normals; no weights: internal/e57.h), .drc encoded with `draco`, or
-// glTF 2.0 POINTS (.glb, or .gltf with its buffer embedded) with COLOR_0, NORMAL (unit length)
-// and _WEIGHT attributes as present. The positions are written with cloud.origin put back
-// (PLY and PCD doubles, exact text, the LAS and E57 offsets, a glTF node's translation, Draco
-// metadata).
+// 2 (with colours; no normals or weights: internal/las.h), PCD (x y z, normal_x normal_y
+// normal_z, rgb, confidence as present; options.pcd picks binary, binary_compressed or ascii
+// data), E57 of one scan (scaled integer coordinates, colours, normals; no weights:
+// internal/e57.h), .drc encoded with options.draco, or glTF 2.0 POINTS (.glb, or .gltf with
+// its buffer embedded) with COLOR_0, NORMAL (unit length) and _WEIGHT attributes as present.
+// The positions are written with cloud.origin put back (PLY and PCD doubles, exact text, the
+// LAS and E57 offsets, a glTF node's translation, Draco metadata).
 // Returns INVALID_ARGUMENT for an unsupported extension, an empty cloud, a cloud that fails
-// ValidatePointCloud, more points than LAS counts, or invalid `draco` options; otherwise the
-// status of the write ("cannot
-// write 'path': reason").
+// ValidatePointCloud, more points than LAS counts, or invalid Draco options; otherwise the
+// status of the write ("cannot write 'path': reason").
 absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
-                             const DracoOptions& draco = {});
+                             const PointCloudWriteOptions& options = {});
 
 }  // namespace neuralmesh
 

@@ -16,6 +16,7 @@
 #include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
 #include "core/random.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
 #include "tests/testing/e57_file.h"
@@ -394,9 +395,16 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   const std::string xyz = *dir_ + "/points.xyz";
   const std::string glb = *dir_ + "/points.glb";
   const std::string pcd = *dir_ + "/points.pcd";
-  for (const auto& [from, to] : {std::pair{ply, xyz}, {xyz, glb}, {glb, pcd}}) {
+  const std::string compressed = *dir_ + "/compressed.pcd";
+  const std::string ascii = *dir_ + "/ascii.pcd";
+  const std::pair<std::string, std::string> steps[] = {
+      {ply, xyz}, {xyz, glb}, {glb, pcd}, {pcd, compressed}, {compressed, ascii}};
+  for (const auto& [from, to] : steps) {
     SCOPED_TRACE(to);
-    const RunResult converted = RunNeuralmesh({"convert", from, "-o", to});
+    std::vector<std::string> args = {"convert", from, "-o", to};
+    if (to == compressed) args.insert(args.end(), {"--pcd_data", "binary_compressed"});
+    if (to == ascii) args.insert(args.end(), {"--pcd_data", "ascii"});
+    const RunResult converted = RunNeuralmesh(args);
     ASSERT_EQ(converted.exit_code, 0) << converted.Describe();
     EXPECT_EQ(converted.out, to + ": 5000 points, with normals, weights, colours\n");
     const absl::StatusOr<PointCloud> kept = ReadPointCloud(to);
@@ -406,6 +414,9 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
     EXPECT_EQ(kept->weights, cloud.weights);
     EXPECT_EQ(kept->colors, cloud.colors);
   }
+  EXPECT_THAT(ReadFileContents(compressed).value_or(""),
+              ::testing::HasSubstr("\nDATA binary_compressed\n"));
+  EXPECT_THAT(ReadFileContents(ascii).value_or(""), ::testing::HasSubstr("\nDATA ascii\n"));
 
   const std::string drc = *dir_ + "/points.drc";
   const RunResult to_drc = RunNeuralmesh({"convert", xyz, "-o", drc});
@@ -503,6 +514,10 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
        "--outlier_passes is 17; it must be in [1, 16]"},
       {{"convert", xyz, "-o", *dir_ + "/points.las", "--outliers_as_noise"},
        "--outliers_as_noise needs --remove_outliers"},
+      {{"convert", xyz, "-o", clean, "--pcd_data", "ascii"},
+       "--pcd_data applies to a .pcd OUTPUT"},
+      {{"convert", xyz, "-o", *dir_ + "/points.pcd", "--pcd_data", "text"},
+       "--pcd_data is 'text'; it must be binary, binary_compressed or ascii"},
       {{"convert", xyz, "-o", *dir_ + "/points.las", "--remove_outliers", "--outliers_as_noise"},
        "--outliers_as_noise classifies the outliers of one .las INPUT in a .las OUTPUT; INPUT '" +
            xyz + "' to OUTPUT '" + *dir_ + "/points.las' can only leave them out"},

@@ -49,6 +49,8 @@ struct GeometryView {
 // Appends position `i` of `geometry` as the binary formats hold it (PLY, PCD), little-endian:
 // three floats, or with an origin three doubles with the origin put back.
 void AppendPosition(const GeometryView& geometry, size_t i, std::string* out);
+// Coordinate `c` of that position.
+void AppendPositionCoordinate(const GeometryView& geometry, size_t i, int c, std::string* out);
 
 }  // namespace neuralmesh::io_internal
 

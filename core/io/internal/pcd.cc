@@ -14,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "core/io/internal/binary.h"
+#include "core/io/internal/lzf.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/status_macros.h"
@@ -182,42 +183,6 @@ absl::StatusOr<PcdHeader> ParseHeader(absl::string_view data) {
     return Invalid("POINTS ", *points, " is not WIDTH ", *width, " x HEIGHT ", h);
   }
   return header;
-}
-
-// LZF (liblzf's format, as PCL writes it): `in` decompressed into exactly `out->size()` bytes.
-absl::Status LzfDecompress(absl::string_view in, std::string* out) {
-  size_t ip = 0, op = 0;
-  const size_t out_size = out->size();
-  const auto corrupt = [&](absl::string_view what) {
-    return Invalid("the compressed points are corrupt at byte ", ip, " of ", in.size(), ": ", what);
-  };
-  while (ip < in.size()) {
-    const unsigned ctrl = static_cast<uint8_t>(in[ip++]);
-    if (ctrl < 32) {  // A literal run of ctrl + 1 bytes.
-      const size_t length = ctrl + 1;
-      if (length > in.size() - ip) return corrupt("a literal run reaches past the end");
-      if (length > out_size - op) return corrupt("more bytes than the header states");
-      std::memcpy(out->data() + op, in.data() + ip, length);
-      ip += length;
-      op += length;
-      continue;
-    }
-    size_t length = ctrl >> 5;  // A back reference of length + 2 bytes.
-    if (ip >= in.size()) return corrupt("a back reference is cut off");
-    if (length == 7) {
-      length += static_cast<uint8_t>(in[ip++]);
-      if (ip >= in.size()) return corrupt("a back reference is cut off");
-    }
-    const size_t distance = ((ctrl & 0x1F) << 8) + static_cast<uint8_t>(in[ip++]) + 1;
-    length += 2;
-    if (distance > op) return corrupt("a back reference points before the start");
-    if (length > out_size - op) return corrupt("more bytes than the header states");
-    for (size_t k = 0; k < length; ++k, ++op) (*out)[op] = (*out)[op - distance];
-  }
-  if (op != out_size) {
-    return Invalid("the compressed points give ", op, " bytes; the header states ", out_size);
-  }
-  return absl::OkStatus();
 }
 
 // A value of `field` stored at `p`, little-endian.
@@ -448,7 +413,9 @@ absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data) {
       return Invalid(compressed, " compressed bytes cannot hold ", size);
     }
     std::string columns(size, '\0');
-    NM_RETURN_IF_ERROR(LzfDecompress(body.substr(8, compressed), &columns));
+    if (const absl::Status lzf = LzfDecompress(body.substr(8, compressed), &columns); !lzf.ok()) {
+      return Invalid(lzf.message());
+    }
     // Field by field: all points' values of the first field, then of the second, ...
     ReadBinary(
         header, roles,
@@ -462,12 +429,13 @@ absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data) {
   return out;
 }
 
-std::string FormatPcd(const GeometryView& geometry) {
+std::string FormatPcd(const GeometryView& geometry, PcdData data) {
   const bool doubles = geometry.has_origin();
   const size_t n = geometry.positions.size();
   const bool normals = !geometry.normals.empty();
   const bool colors = !geometry.colors.empty();
   const bool weights = !geometry.weights.empty();
+  const bool ascii = data == PcdData::kAscii;
   std::string fields = "x y z", sizes = doubles ? "8 8 8" : "4 4 4", types = "F F F",
               counts = "1 1 1";
   const auto add = [&](absl::string_view name, absl::string_view size, absl::string_view type) {
@@ -479,24 +447,69 @@ std::string FormatPcd(const GeometryView& geometry) {
   if (normals) {
     for (const char* name : {"normal_x", "normal_y", "normal_z"}) add(name, "4", "F");
   }
-  if (colors) add("rgb", "4", "F");
+  if (colors) add("rgb", "4", ascii ? "U" : "F");
   if (weights) add("confidence", "4", "F");
+  const char* kind = ascii ? "ascii" : data == PcdData::kBinary ? "binary" : "binary_compressed";
   std::string out =
       absl::StrCat("# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS ", fields,
                    "\nSIZE ", sizes, "\nTYPE ", types, "\nCOUNT ", counts, "\nWIDTH ", n,
-                   "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS ", n, "\nDATA binary\n");
-  for (size_t i = 0; i < n; ++i) {
-    AppendPosition(geometry, i, &out);
-    if (normals) {
-      for (int c = 0; c < 3; ++c) AppendLittleEndian(geometry.normals[i][c], &out);
+                   "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS ", n, "\nDATA ", kind, "\n");
+  const auto packed_rgb = [&](size_t i) {
+    const Rgb& rgb = geometry.colors[i];
+    return uint32_t{rgb[0]} << 16 | uint32_t{rgb[1]} << 8 | uint32_t{rgb[2]};
+  };
+  if (ascii) {
+    for (size_t i = 0; i < n; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        if (c > 0) out.push_back(' ');
+        AppendCoordinate(geometry.positions[i][c], geometry.origin[c], &out);
+      }
+      if (normals) {
+        for (int c = 0; c < 3; ++c) {
+          out.push_back(' ');
+          AppendFloat(geometry.normals[i][c], &out);
+        }
+      }
+      if (colors) absl::StrAppend(&out, " ", packed_rgb(i));
+      if (weights) {
+        out.push_back(' ');
+        AppendFloat(geometry.weights[i], &out);
+      }
+      out.push_back('\n');
     }
-    if (colors) {
-      const Rgb& rgb = geometry.colors[i];
-      AppendLittleEndian(uint32_t{rgb[0]} << 16 | uint32_t{rgb[1]} << 8 | uint32_t{rgb[2]}, &out);
-    }
-    if (weights) AppendLittleEndian(geometry.weights[i], &out);
+    return out;
   }
-  return out;
+  // The values of field `f` of every point, appended to `records` (the point's record when
+  // called point by point, the column when field by field).
+  const auto append_field = [&](int f, size_t i, std::string* records) {
+    if (f < 3) {
+      AppendPositionCoordinate(geometry, i, f, records);
+    } else if (f < 6) {
+      AppendLittleEndian(geometry.normals[i][f - 3], records);
+    } else if (f == 6) {
+      AppendLittleEndian(packed_rgb(i), records);
+    } else {
+      AppendLittleEndian(geometry.weights[i], records);
+    }
+  };
+  std::vector<int> written = {0, 1, 2};
+  if (normals) written.insert(written.end(), {3, 4, 5});
+  if (colors) written.push_back(6);
+  if (weights) written.push_back(7);
+  if (data == PcdData::kBinary) {
+    for (size_t i = 0; i < n; ++i) {
+      for (int f : written) append_field(f, i, &out);
+    }
+    return out;
+  }
+  std::string columns;
+  for (int f : written) {
+    for (size_t i = 0; i < n; ++i) append_field(f, i, &columns);
+  }
+  const std::string compressed = LzfCompress(columns);
+  AppendLittleEndian(static_cast<uint32_t>(compressed.size()), &out);
+  AppendLittleEndian(static_cast<uint32_t>(columns.size()), &out);
+  return out + compressed;
 }
 
 }  // namespace neuralmesh::io_internal

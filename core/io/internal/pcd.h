@@ -9,6 +9,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/point_cloud_io.h"
 
 namespace neuralmesh::io_internal {
 
@@ -27,11 +28,14 @@ namespace neuralmesh::io_internal {
 // their stated size, or a file whose points all lack a position.
 absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data);
 
-// Formats points as a binary PCD 0.7 file that PCL and Open3D read: FIELDS x y z (float, or
-// double with geometry.origin added when the origin is not zero, as PLY does: PCD has no
-// offset), then normal_x normal_y normal_z, rgb (PCL's packed float) and confidence as
-// present; WIDTH the points, HEIGHT 1 (unorganized). Faces are not written.
-std::string FormatPcd(const GeometryView& geometry);
+// Formats points as a PCD 0.7 file that PCL and Open3D read: FIELDS x y z (float, or double
+// with geometry.origin added when the origin is not zero, as PLY does: PCD has no offset),
+// then normal_x normal_y normal_z, rgb (PCL's packed colour: a float's bits in binary data, the
+// integer in ASCII, as PCL 1.9 and later write it) and confidence as present; WIDTH the
+// points, HEIGHT 1 (unorganized). `data` is the DATA line: binary records, the same values
+// field by field and LZF-compressed (binary_compressed), or ASCII lines with floats in as few
+// digits as give them back. Faces are not written.
+std::string FormatPcd(const GeometryView& geometry, PcdData data = PcdData::kBinary);
 
 }  // namespace neuralmesh::io_internal
 

@@ -94,7 +94,7 @@ TEST(ColorIoTest, PointColorsSurvivePlyXyzAndDraco) {
     draco.position_quantization_bits = 16;
     draco.encode_speed = speed;
     const std::string drc = TempPath("colored_points.drc");
-    ASSERT_TRUE(WritePointCloud(cloud, drc, draco).ok());
+    ASSERT_TRUE(WritePointCloud(cloud, drc, {draco}).ok());
     const absl::StatusOr<PointCloud> decoded = ReadPointCloud(drc);
     ASSERT_TRUE(decoded.ok()) << decoded.status();
     ExpectSameColorsByPosition(cloud.positions, cloud.colors, decoded->positions, decoded->colors,

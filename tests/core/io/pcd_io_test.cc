@@ -100,6 +100,48 @@ TEST(PcdIoTest, WrittenCloudsComeBackWithNormalsColoursAndWeights) {
   EXPECT_EQ(placed->positions, utm.positions);
 }
 
+// binary_compressed and ascii data give the same points back, georeferenced ones too; the
+// compressed file of a smooth cloud is smaller than the binary one; ascii colours are PCL's
+// packed integers.
+TEST(PcdIoTest, CompressedAndAsciiDataComeBackAsBinaryDoes) {
+  PointCloud cloud = io_test::RandomCloud(3000, 4, /*normals=*/true, /*weights=*/true);
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    cloud.colors.push_back({static_cast<uint8_t>(i), 200, 7});
+    cloud.weights[i] = 1.0f;  // Constant columns, as a scan's often are: they compress.
+  }
+  PointCloud utm = cloud;
+  utm.origin = {500000, 4100000, 0};
+  for (Vec3f& p : utm.positions) p += Vec3f(500, 500, 0);  // The reader's origin stays.
+  const std::string binary = TempPath("binary.pcd");
+  ASSERT_TRUE(WritePointCloud(cloud, binary).ok());
+  for (const PcdData kind : {PcdData::kBinaryCompressed, PcdData::kAscii}) {
+    const bool ascii = kind == PcdData::kAscii;
+    SCOPED_TRACE(ascii ? "ascii" : "binary_compressed");
+    for (const PointCloud* written : {&cloud, &utm}) {
+      const std::string path = TempPath(ascii ? "cloud_ascii.pcd" : "cloud_compressed.pcd");
+      PointCloudWriteOptions options;
+      options.pcd = kind;
+      ASSERT_TRUE(WritePointCloud(*written, path, options).ok());
+      const std::string bytes = ReadBytes(path);
+      EXPECT_THAT(bytes, HasSubstr(ascii ? "\nDATA ascii\n" : "\nDATA binary_compressed\n"));
+      const absl::StatusOr<PointCloud> read = ReadPointCloud(path);
+      ASSERT_TRUE(read.ok()) << read.status();
+      EXPECT_EQ(read->origin, written->origin);
+      EXPECT_EQ(read->positions, written->positions);
+      EXPECT_EQ(read->normals, written->normals);
+      EXPECT_EQ(read->weights, written->weights);
+      EXPECT_EQ(read->colors, written->colors);
+      if (written == &cloud && !ascii) {
+        EXPECT_LT(bytes.size(), ReadBytes(binary).size() * 9 / 10);
+      }
+      if (written == &cloud && ascii) {
+        EXPECT_THAT(bytes, HasSubstr("TYPE F F F F F F U F\n"));
+        EXPECT_THAT(bytes, HasSubstr(absl::StrCat(" ", Packed({1, 200, 7}), " 1\n")));
+      }
+    }
+  }
+}
+
 TEST(PcdIoTest, ReadsAsciiAsPclWritesItWithEmptyPixelsLeftOut) {
   // An organized 3 x 2 cloud: rgb as the packed integer (PCL since 1.9) or as the float whose
   // bits it is (older files); one pixel without a position; intensity skipped.

@@ -461,7 +461,7 @@ TEST(PointCloudIoTest, WriteRejectsInvalidCloudsAndReportsIoFailures) {
   EXPECT_THAT(std::string(missing_dir.message()), HasSubstr("cannot write")) << missing_dir;
   DracoOptions bad;
   bad.position_quantization_bits = 0;
-  const absl::Status bad_options = WritePointCloud(kThree, TempPath("bad.drc"), bad);
+  const absl::Status bad_options = WritePointCloud(kThree, TempPath("bad.drc"), {bad});
   EXPECT_EQ(bad_options.code(), absl::StatusCode::kInvalidArgument) << bad_options;
   EXPECT_THAT(std::string(bad_options.message()), HasSubstr("position_quantization_bits"))
       << "the message should name the bad option";

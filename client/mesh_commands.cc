@@ -1,6 +1,7 @@
 // RunStats, RunEval and RunConvert (declared in client/local_commands.h).
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,17 +38,8 @@ absl::Status RunStats(const std::string& mesh_path, bool json, std::ostream& out
 
 namespace {
 
-// Whether RunEval compares with points: a point cloud format, or a mesh format whose file
-// holds no faces.
-absl::StatusOr<bool> ReferenceIsPoints(const std::string& reference) {
-  if (IsBuiltin(reference) || !IsReadablePointCloudExtension(reference)) return false;
-  if (!IsSupportedMeshExtension(reference)) return true;
-  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(reference, "--reference"));
-  return mesh.faces.empty();
-}
-
-// The error's figures, as text or JSON. `against` names what was compared with: "the
-// reference's bounding-box diagonal" or "the points' ...".
+// The error's figures, as text or JSON; `points` is the count of the reference's points when
+// it was a point cloud, else 0.
 absl::Status PrintGeometricError(const EvalOptions& options, const GeometricError& error,
                                  size_t samples, size_t points, std::ostream& out) {
   const bool has_normals = !std::isnan(error.normal_consistency);
@@ -100,7 +92,14 @@ absl::Status PrintGeometricError(const EvalOptions& options, const GeometricErro
 
 absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
   NM_ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(options.mesh, "MESH"));
-  NM_ASSIGN_OR_RETURN(const bool against_points, ReferenceIsPoints(options.reference));
+  // A surface (builtin:NAME, a mesh file with faces), or points: a point cloud format, or a
+  // mesh format whose file holds no faces.
+  std::optional<TriangleMesh> reference;
+  const std::string& name = options.reference;
+  if (IsBuiltin(name) || !IsReadablePointCloudExtension(name) || IsSupportedMeshExtension(name)) {
+    NM_ASSIGN_OR_RETURN(reference, LoadMesh(name, "--reference"));
+    if (reference->faces.empty() && IsReadablePointCloudExtension(name)) reference.reset();
+  }
   GeometricErrorOptions error_options;
   if (options.samples > 0) error_options.samples = options.samples;
   error_options.seed = options.seed;
@@ -112,7 +111,7 @@ absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
   };
   absl::StatusOr<GeometricError> error;
   size_t points = 0;
-  if (against_points) {
+  if (!reference.has_value()) {
     NM_ASSIGN_OR_RETURN(const PointCloud cloud,
                         LoadPointClouds({options.reference}, "--reference", nullptr, nullptr,
                                         options.selection));
@@ -123,12 +122,10 @@ absl::Status RunEval(const EvalOptions& options, std::ostream& out) {
     points = cloud.size();
     error = ComputeErrorAgainstPoints(mesh, cloud, error_options);
   } else {
-    NM_ASSIGN_OR_RETURN(const TriangleMesh reference,
-                        LoadMesh(options.reference, "--reference"));
-    if (const absl::Status moved = MoveOrigin(reference.origin, &mesh); !moved.ok()) {
+    if (const absl::Status moved = MoveOrigin(reference->origin, &mesh); !moved.ok()) {
       return named(moved);
     }
-    error = ComputeGeometricError(mesh, reference, error_options);
+    error = ComputeGeometricError(mesh, *reference, error_options);
   }
   // The error speaks of "the reconstruction": the message names the two files.
   if (!error.ok()) return named(error.status());

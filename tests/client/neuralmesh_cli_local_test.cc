@@ -179,6 +179,18 @@ TEST_F(LocalCliTest, EvalAgainstTheBuiltinSphereGivesASmallChamferDistance) {
   // about 0.3% of it.
   EXPECT_GT(chamfer, 0.0) << eval.out;
   EXPECT_LT(chamfer, 0.01) << "the 500-vertex sphere is far from the unit sphere:\n" << eval.out;
+
+  // Against points in a mesh format (a PLY without faces, with normals): the points' figures.
+  PointCloud points = ColoredUnitSpherePoints(4000, 21);
+  points.normals = points.positions;
+  const std::string ply = *dir_ + "/sphere_points.ply";
+  ASSERT_TRUE(WritePointCloud(points, ply).ok());
+  const RunResult against_points = RunNeuralmesh({"eval", *output_, "--reference", ply});
+  ASSERT_EQ(against_points.exit_code, 0) << against_points.Describe();
+  EXPECT_TRUE(absl::StrContains(against_points.out, "against the 4000 points of " + ply))
+      << against_points.out;
+  EXPECT_TRUE(absl::StrContains(against_points.out, "normal_consistency  0.9"))
+      << "the points' normals agree with the mesh's:\n" << against_points.out;
 }
 
 TEST_F(LocalCliTest, TheSameSeedGivesByteIdenticalFiles) {

@@ -287,7 +287,8 @@ class PointSink {
     Point3d p;
     for (int c = 0; c < 3; ++c) p[c] = value(roles_.position[c]);
     for (int c = 0; c < 3; ++c) {
-      if (!(std::fabs(p[c]) <= std::numeric_limits<float>::max())) {
+      // Text may hold the largest float as a decimal a little beyond it ("3.4028235e+38").
+      if (!std::isfinite(NarrowToFloat(p[c]))) {
         ++out_->left_out.invalid;
         return;
       }

@@ -59,9 +59,13 @@ bool ParseFloat(absl::string_view token, float* value) {
 }
 
 float NarrowToFloat(double value) {
-  constexpr double kMax = std::numeric_limits<float>::max();
-  if (value > kMax) return std::numeric_limits<float>::infinity();
-  if (value < -kMax) return -std::numeric_limits<float>::infinity();
+  constexpr float kMax = std::numeric_limits<float>::max();
+  // Halfway from the largest float to 2^128: ties round to even, which is 2^128, infinite.
+  constexpr double kOverflow = 0x1.ffffffp+127;
+  if (value >= kOverflow) return std::numeric_limits<float>::infinity();
+  if (value <= -kOverflow) return -std::numeric_limits<float>::infinity();
+  if (value > kMax) return kMax;
+  if (value < -kMax) return -kMax;
   return static_cast<float>(value);
 }
 

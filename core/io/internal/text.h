@@ -46,8 +46,10 @@ bool ParseDouble(absl::string_view token, double* value);
 // As ParseDouble, then NarrowToFloat.
 bool ParseFloat(absl::string_view token, float* value);
 
-// Rounds to float; values beyond the float range become infinite (a plain cast would be
-// undefined behavior).
+// Rounds to the nearest float, as a cast does: values that round beyond the largest float
+// become infinite (a plain cast of them would be undefined behavior), and those between it and
+// the halfway point to 2^128 become the largest float, as the text "3.4028235e+38" that prints
+// it must.
 float NarrowToFloat(double value);
 // Parses the whole token as a base-10 integer.
 bool ParseInt64(absl::string_view token, int64_t* value);

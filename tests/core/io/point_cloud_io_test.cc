@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -18,6 +19,7 @@ namespace {
 
 using io_test::ExpectSameCloud;
 using io_test::Put;
+using io_test::ReadBytes;
 using io_test::TempPath;
 using io_test::WriteBytes;
 using ::testing::HasSubstr;
@@ -333,6 +335,33 @@ TEST(XyzCloudTest, WrittenNormalsThatCouldBeColoursReadBackAsNormals) {
   ASSERT_TRUE(headless.ok()) << headless.status();
   EXPECT_TRUE(headless->normals.empty()) << "without a header they read as colours";
   EXPECT_EQ(headless->colors.size(), 3u);
+}
+
+// The largest float prints as "3.4028235e+38", which as a double lies beyond it: read back, it
+// is the largest float again, not infinity (and the point is not dropped). Subnormals and -0
+// come back too. Found by pcd_format_fuzzer writing ASCII PCD.
+TEST(XyzCloudTest, TextGivesBackTheExtremeFloats) {
+  constexpr float kMax = std::numeric_limits<float>::max();
+  constexpr float kTiny = std::numeric_limits<float>::denorm_min();
+  PointCloud cloud;
+  cloud.positions = {Vec3f(kMax, 1, 2), Vec3f(-kMax, 0, -0.0f), Vec3f(kTiny, -kTiny, 5)};
+  for (const char* name : {"extremes.xyz", "extremes.pcd"}) {
+    SCOPED_TRACE(name);
+    const std::string path = TempPath(name);
+    PointCloudWriteOptions options;
+    options.pcd = PcdData::kAscii;
+    ASSERT_TRUE(WritePointCloud(cloud, path, options).ok());
+    EXPECT_THAT(ReadBytes(path), HasSubstr("3.4028235e+38"));
+    const absl::StatusOr<PointCloud> read = ReadPointCloud(path);
+    ASSERT_TRUE(read.ok()) << read.status();
+    ASSERT_EQ(read->size(), 3u);
+    for (size_t i = 0; i < 3; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(std::signbit(read->positions[i][c]), std::signbit(cloud.positions[i][c]));
+        EXPECT_EQ(read->positions[i][c], cloud.positions[i][c]) << i << " " << c;
+      }
+    }
+  }
 }
 
 TEST(XyzCloudTest, MalformedFilesAreRejectedWithAReason) {

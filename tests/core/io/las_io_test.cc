@@ -112,9 +112,6 @@ TEST(LasIoTest, OnlyThePointsOfTheClassesAskedForAreRead) {
   }
 }
 
-// UTM coordinates at millimetre resolution: a float holds 500,000 m to about 3 cm (and
-// 4,100,000 m to 25 cm), so x and y are taken relative to the origin (the minimum rounded down
-// to 1,000 m) and keep their millimetres; z, near 0, stays as it is.
 // Withheld points (to be treated as deleted) and those classified as noise (class 7, low
 // point; 18, high noise) are left out and counted, in both record families; they do not move
 // the origin. A file of nothing else says so.
@@ -156,6 +153,9 @@ TEST(LasIoTest, WithheldAndNoisePointsAreLeftOutAndCounted) {
   }
 }
 
+// UTM coordinates at millimetre resolution: a float holds 500,000 m to about 3 cm (and
+// 4,100,000 m to 25 cm), so x and y are taken relative to the origin (the minimum rounded down
+// to 1,000 m) and keep their millimetres; z, near 0, stays as it is.
 TEST(LasIoTest, GeoreferencedCoordinatesKeepTheirResolutionRelativeToAnOrigin) {
   LasLayout layout;
   layout.version_minor = 4;

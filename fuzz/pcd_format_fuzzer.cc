@@ -17,7 +17,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
           return neuralmesh::io_internal::ParsePcd(bytes);
         },
         [kind](const neuralmesh::io_internal::GeometryView& geometry) {
-          return neuralmesh::io_internal::FormatPcd(geometry, kind);
+          return neuralmesh::io_internal::FormatPcd(geometry, kind).value();
         },
         /*skips_faces=*/false};
     neuralmesh::fuzz::CheckGeometryParser(pcd, data, size);

@@ -152,7 +152,9 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
   } else if (format == FileFormat::kXyz) {
     data = io_internal::FormatXyz(view);
   } else if (format == FileFormat::kPcd) {
-    data = io_internal::FormatPcd(view, options.pcd);
+    absl::StatusOr<std::string> formatted = io_internal::FormatPcd(view, options.pcd);
+    if (!formatted.ok()) return io_internal::CannotWrite(path, formatted.status());
+    data = *std::move(formatted);
   } else if (format == FileFormat::kE57) {
     data = io_internal::FormatE57(view);
   } else if (format == FileFormat::kLas) {

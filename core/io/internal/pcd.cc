@@ -430,7 +430,7 @@ absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data) {
   return out;
 }
 
-std::string FormatPcd(const GeometryView& geometry, PcdData data) {
+absl::StatusOr<std::string> FormatPcd(const GeometryView& geometry, PcdData data) {
   const bool doubles = geometry.has_origin();
   const size_t n = geometry.positions.size();
   const bool normals = !geometry.normals.empty();
@@ -502,6 +502,14 @@ std::string FormatPcd(const GeometryView& geometry, PcdData data) {
       for (int f : written) append_field(f, i, &out);
     }
     return out;
+  }
+  const uint64_t record_bytes = (doubles ? 24 : 12) + (normals ? 12 : 0) + (colors ? 4 : 0) +
+                                (weights ? 4 : 0);
+  // The compressed size may exceed the data's by a 32nd.
+  const uint64_t largest = uint64_t{n} * record_bytes * 33 / 32 + 1;
+  if (largest > std::numeric_limits<uint32_t>::max()) {
+    return Invalid(n, " points of ", record_bytes, " bytes are more than binary_compressed data ",
+                   "holds (sizes of 32 bits); write them as binary");
   }
   std::string columns;
   for (int f : written) {

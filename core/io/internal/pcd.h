@@ -35,7 +35,10 @@ absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data);
 // points, HEIGHT 1 (unorganized). `data` is the DATA line: binary records, the same values
 // field by field and LZF-compressed (binary_compressed), or ASCII lines with floats in as few
 // digits as give them back. Faces are not written.
-std::string FormatPcd(const GeometryView& geometry, PcdData data = PcdData::kBinary);
+// Returns INVALID_ARGUMENT for binary_compressed data of 4 GiB or more, whose sizes PCD
+// stores in 32 bits.
+absl::StatusOr<std::string> FormatPcd(const GeometryView& geometry,
+                                      PcdData data = PcdData::kBinary);
 
 }  // namespace neuralmesh::io_internal
 

@@ -203,7 +203,9 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
     out << " (" << found << " outliers of " << read
         << (options.outliers_as_noise ? " classified as noise)" : " removed)");
   }
-  out << merge_note << LeftOutNote(left_out) << OriginNote(cloud.origin) << "\n";
+  // Copied LAS records keep the file's own coordinates: no origin was taken or put back.
+  out << merge_note << LeftOutNote(left_out)
+      << (las_records_kept ? std::string() : OriginNote(cloud.origin)) << "\n";
   if (!dropped.empty()) {
     std::vector<std::string> holds = {"positions"};
     if (kept.colors) holds.push_back("colours");

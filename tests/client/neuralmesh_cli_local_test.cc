@@ -626,6 +626,13 @@ TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
   const absl::StatusOr<PointCloud> converted = ReadPointCloud(*dir_ + "/scan.xyz");
   ASSERT_TRUE(converted.ok()) << converted.status();
   EXPECT_EQ(converted->origin, (std::array<double, 3>{500000, 4100000, 0}));
+  // LAS to LAS copies the records, in the file's own coordinates: no origin to speak of.
+  const std::string copy = *dir_ + "/scan_copy.las";
+  const RunResult copied = RunNeuralmesh({"convert", las, "-o", copy});
+  ASSERT_EQ(copied.exit_code, 0) << copied.Describe();
+  EXPECT_EQ(copied.out, copy + ": 20000 points, each record as in " + las +
+                            " with every field, and its header's scale, offset and "
+                            "variable-length records\n");
 
   // eval compares files read relative to different origins in one frame: the mesh against
   // itself in Draco.

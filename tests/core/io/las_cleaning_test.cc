@@ -50,8 +50,8 @@ std::string VariableLengthRecord(absl::string_view user_id, uint16_t record_id,
   return out;
 }
 
-// Points with every field set to something of its own: intensity, returns, class, GPS time,
-// extra bytes, colour; `left_out` of them classified as noise or withheld.
+// Points with every field set to something of its own: intensity, returns, class (2 or 5), GPS
+// time, extra bytes, colour.
 std::vector<LasPoint> VariedPoints(int count) {
   std::vector<LasPoint> points;
   for (int i = 0; i < count; ++i) {

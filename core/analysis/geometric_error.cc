@@ -14,6 +14,7 @@
 #include "core/analysis/point_kd_tree.h"
 #include "core/analysis/triangle_tree.h"
 #include "core/bounding_box.h"
+#include "core/parallel_ranges.h"
 #include "core/random.h"
 #include "core/status_macros.h"
 
@@ -311,10 +312,7 @@ absl::StatusOr<GeometricError> ComputeErrorAgainstPoints(const TriangleMesh& rec
   const size_t samples = query.samples.size();
   std::vector<double> distance(samples + query.vertices.size());
   std::vector<uint32_t> nearest(samples);
-  size_t threads = options.threads > 0 ? static_cast<size_t>(options.threads)
-                                       : std::max(1u, std::thread::hardware_concurrency());
-  threads = std::min(threads, std::max<size_t>(1, distance.size() / 4096));
-  auto measure = [&](size_t first, size_t last) {
+  ForEachRange(distance.size(), options.threads, 4096, [&](size_t first, size_t last) {
     NeighbourHeap heap;
     for (size_t i = first; i < last; ++i) {
       const Vec3& q = i < samples ? query.samples[i] : query.vertices[i - samples];
@@ -324,14 +322,7 @@ absl::StatusOr<GeometricError> ComputeErrorAgainstPoints(const TriangleMesh& rec
       distance[i] = (ToVec3(points.positions[index]) - q).norm();
       if (i < samples) nearest[i] = index;
     }
-  };
-  std::vector<std::thread> workers;
-  for (size_t t = 1; t < threads; ++t) {
-    workers.emplace_back(measure, distance.size() * t / threads,
-                         distance.size() * (t + 1) / threads);
-  }
-  measure(0, distance.size() / threads);
-  for (std::thread& worker : workers) worker.join();
+  });
   double to_points_sum = 0.0;
   normal_sum = 0.0;
   normal_count = 0;

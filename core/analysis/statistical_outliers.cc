@@ -5,11 +5,11 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
-#include <thread>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "core/analysis/point_kd_tree.h"
+#include "core/parallel_ranges.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh {
@@ -48,22 +48,13 @@ absl::StatusOr<std::vector<bool>> FindStatisticalOutliers(const PointCloud& clou
   if (n <= k) return outlier;
   const PointKdTree tree(cloud.positions, 0, static_cast<uint32_t>(n));
   std::vector<double> mean_distance(n);
-  size_t threads = options.threads > 0 ? static_cast<size_t>(options.threads)
-                                       : std::max(1u, std::thread::hardware_concurrency());
-  threads = std::min(threads, std::max<size_t>(1, n / 4096));
-  auto measure = [&](size_t first, size_t last) {
+  ForEachRange(n, options.threads, 4096, [&](size_t first, size_t last) {
     NeighbourHeap heap;
     for (size_t i = first; i < last; ++i) {
       tree.Search(cloud.positions, cloud.positions[i], static_cast<uint32_t>(i), k, &heap);
       mean_distance[i] = MeanDistance(heap);
     }
-  };
-  std::vector<std::thread> workers;
-  for (size_t t = 1; t < threads; ++t) {
-    workers.emplace_back(measure, n * t / threads, n * (t + 1) / threads);
-  }
-  measure(0, n / threads);
-  for (std::thread& worker : workers) worker.join();
+  });
 
   const double limit = OutlierDistanceLimit(mean_distance, options.std_ratio);
   for (size_t i = 0; i < n; ++i) outlier[i] = mean_distance[i] > limit;

@@ -376,8 +376,9 @@ absl::StatusOr<std::string> FormatCleanedLas(absl::string_view data,
   for (size_t at : kept) {
     out.append(data.data() + at, header.record_length);
     for (int c = 0; c < 3; ++c) {
-      low[c] = std::min(low[c], header.Coordinate(data, at, c));
-      high[c] = std::max(high[c], header.Coordinate(data, at, c));
+      const double coordinate = header.Coordinate(data, at, c);
+      low[c] = std::min(low[c], coordinate);
+      high[c] = std::max(high[c], coordinate);
     }
     ++by_return[ReturnNumber(data, at, header.format)];
   }

@@ -439,17 +439,20 @@ absl::StatusOr<std::string> FormatPcd(const GeometryView& geometry, PcdData data
   const bool ascii = data == PcdData::kAscii;
   std::string fields = "x y z", sizes = doubles ? "8 8 8" : "4 4 4", types = "F F F",
               counts = "1 1 1";
-  const auto add = [&](absl::string_view name, absl::string_view size, absl::string_view type) {
+  uint64_t record_bytes = doubles ? 24 : 12;
+  // Another field of 4 bytes.
+  const auto add = [&](absl::string_view name, absl::string_view type) {
     absl::StrAppend(&fields, " ", name);
-    absl::StrAppend(&sizes, " ", size);
+    absl::StrAppend(&sizes, " 4");
     absl::StrAppend(&types, " ", type);
     absl::StrAppend(&counts, " 1");
+    record_bytes += 4;
   };
   if (normals) {
-    for (const char* name : {"normal_x", "normal_y", "normal_z"}) add(name, "4", "F");
+    for (const char* name : {"normal_x", "normal_y", "normal_z"}) add(name, "F");
   }
-  if (colors) add("rgb", "4", ascii ? "U" : "F");
-  if (weights) add("confidence", "4", "F");
+  if (colors) add("rgb", ascii ? "U" : "F");
+  if (weights) add("confidence", "F");
   const char* kind = ascii ? "ascii" : data == PcdData::kBinary ? "binary" : "binary_compressed";
   std::string out =
       absl::StrCat("# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS ", fields,
@@ -503,8 +506,6 @@ absl::StatusOr<std::string> FormatPcd(const GeometryView& geometry, PcdData data
     }
     return out;
   }
-  const uint64_t record_bytes = (doubles ? 24 : 12) + (normals ? 12 : 0) + (colors ? 4 : 0) +
-                                (weights ? 4 : 0);
   // The compressed size may exceed the data's by a 32nd.
   const uint64_t largest = uint64_t{n} * record_bytes * 33 / 32 + 1;
   if (largest > std::numeric_limits<uint32_t>::max()) {

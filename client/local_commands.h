@@ -98,12 +98,14 @@ struct ConvertOptions {
 // or any file written to .xyz/.txt/.pts/.las/.pcd/.e57) are written as a point cloud with their
 // normals, weights and colours where the format holds them, and "OUTPUT: N points" printed
 // (", with normals, weights, colours"; how many outliers went; what LAS or E57 leaves out).
-// One .las INPUT written to .las is copied record by record instead (core/io/las_cleaning.h),
-// its outliers left out or, with outliers_as_noise, classified as noise.
+// .las INPUTs written to .las are copied record by record instead (core/io/las_cleaning.h),
+// their outliers left out or, with outliers_as_noise, classified as noise; several whose
+// records cannot share one file (another point format, coordinate system, ...) are written as
+// points, and the line says why.
 // INVALID_ARGUMENT for an unknown output extension (before reading INPUT), a mesh format for
 // points that are not a mesh (.obj, .off, .stl), a point format for a builtin surface,
 // --remove_outliers for a mesh, --gltf_draco for points, outliers_as_noise for anything but
-// one .las INPUT and a .las OUTPUT, and the reader's and writer's errors.
+// .las INPUTs whose records share a .las OUTPUT, and the reader's and writer's errors.
 absl::Status RunConvert(const ConvertOptions& options, std::ostream& out);
 
 }  // namespace neuralmesh::client

@@ -147,7 +147,7 @@ ABSL_FLAG(int32_t, outlier_passes, neuralmesh::OutlierOptions{}.passes,
           "the one before kept (a few far strays widen the deviation enough to hide milder "
           "ones from the first). The server's filter (--outliers_on_server) makes one.");
 ABSL_FLAG(bool, outliers_as_noise, false,
-          "With --remove_outliers, converting one .las file to .las: keep the outliers' "
+          "With --remove_outliers, converting .las files to .las: keep the outliers' "
           "records, classified as noise (ASPRS class 7, low point; the readers leave such "
           "points out), instead of removing them, as PDAL's outlier filter marks them.");
 ABSL_FLAG(bool, outliers_on_server, false,
@@ -713,11 +713,12 @@ std::vector<Subcommand> Commands() {
        ".ptx .las .pcd .e57, a file without faces, or anything written to .xyz .txt .pts\n"
        ".las .pcd .e57) go to .ply .xyz .txt .pts .las .pcd .e57 .drc .glb .gltf with their\n"
        "normals and weights (LAS: positions and colours only; E57: no weights), after\n"
-       "--remove_outliers if given. One .las file written to .las keeps its records whole\n"
-       "(classes, intensities, times, extra bytes) and its header's scale, offset and\n"
-       "variable-length records (the coordinate system); --outliers_as_noise classifies its\n"
-       "outliers as noise instead of removing them. Several point cloud files are written as\n"
-       "one.",
+       "--remove_outliers if given. Several point cloud files are written as one. .las files\n"
+       "written to .las keep their records whole (classes, intensities, times, extra bytes)\n"
+       "and the first file's offset and variable-length records (the coordinate system);\n"
+       "tiles are joined so when they share the version, point format, coordinate system and\n"
+       "extra bytes. --outliers_as_noise classifies the outliers as noise instead of\n"
+       "removing them.",
        {"output", "gltf_draco", "pcd_data", "las_classes", "remove_outliers",
         "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "outliers_as_noise", "quantization_bits", "encode_speed"},

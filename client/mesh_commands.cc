@@ -1,4 +1,5 @@
 // RunStats, RunEval and RunConvert (declared in client/local_commands.h).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -149,12 +150,13 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
         "--gltf_draco compresses meshes; points are written to glTF uncompressed (or to .drc)");
   }
   // LAS to LAS: the records themselves, with what a PointCloud does not hold.
-  const bool las_records_kept = options.inputs.size() == 1 &&
-                                absl::EndsWithIgnoreCase(options.inputs.front(), ".las") &&
-                                absl::EndsWithIgnoreCase(options.output, ".las");
-  if (options.outliers_as_noise && !las_records_kept) {
+  const bool las_to_las =
+      absl::EndsWithIgnoreCase(options.output, ".las") &&
+      std::all_of(options.inputs.begin(), options.inputs.end(),
+                  [](const std::string& input) { return absl::EndsWithIgnoreCase(input, ".las"); });
+  if (options.outliers_as_noise && !las_to_las) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "--outliers_as_noise classifies the outliers of one .las INPUT in a .las OUTPUT; "
+        "--outliers_as_noise classifies the outliers of .las INPUTs in a .las OUTPUT; "
         "INPUT ", QuotedInputs(options.inputs), " to OUTPUT '", options.output,
         "' can only leave them out"));
   }
@@ -174,15 +176,36 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   std::string contents;  // What the file holds besides positions, for the line below.
   std::vector<std::string> dropped;
   const WrittenPointAttributes kept = PointAttributesWrittenTo(options.output);
+  // Several LAS files whose records cannot share one file (another point format, coordinate
+  // system, ...) are written as points, saying why.
+  bool las_records_kept = false;
+  std::string not_joined;
+  if (las_to_las) {
+    const absl::Status joined = WriteCleanedLas(
+        options.inputs, outlier,
+        options.outliers_as_noise ? LasOutlierRecords::kClassifiedAsNoise
+                                  : LasOutlierRecords::kLeftOut,
+        options.output, options.selection);
+    las_records_kept = joined.ok();
+    if (absl::IsFailedPrecondition(joined)) {
+      if (options.outliers_as_noise) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "--outliers_as_noise: the records of INPUT ", QuotedInputs(options.inputs),
+            " cannot be put in one file: ", joined.message()));
+      }
+      not_joined = absl::StrCat("; the records could not be kept whole: ", joined.message());
+    } else {
+      NM_RETURN_IF_ERROR(joined);
+    }
+  }
   if (las_records_kept) {
-    NM_RETURN_IF_ERROR(WriteCleanedLas(options.inputs.front(), outlier,
-                                       options.outliers_as_noise
-                                           ? LasOutlierRecords::kClassifiedAsNoise
-                                           : LasOutlierRecords::kLeftOut,
-                                       options.output, options.selection));
-    contents = absl::StrCat(", each record as in ", options.inputs.front(),
-                            " with every field, and its header's scale, offset and "
-                            "variable-length records");
+    contents = options.inputs.size() == 1
+                   ? absl::StrCat(", each record as in ", options.inputs.front(),
+                                  " with every field, and its header's scale, offset and "
+                                  "variable-length records")
+                   : absl::StrCat(", each record as in its INPUT with every field, and the "
+                                  "header's offset and variable-length records of ",
+                                  options.inputs.front());
     // Classified, the outliers and the records left out on reading stay in the file.
     if (options.outliers_as_noise) {
       written = read;
@@ -205,7 +228,7 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   }
   // Copied LAS records keep the file's own coordinates: no origin was taken or put back.
   out << merge_note << LeftOutNote(left_out)
-      << (las_records_kept ? std::string() : OriginNote(cloud.origin)) << "\n";
+      << (las_records_kept ? std::string() : OriginNote(cloud.origin)) << not_joined << "\n";
   if (!dropped.empty()) {
     std::vector<std::string> holds = {"positions"};
     if (kept.colors) holds.push_back("colours");

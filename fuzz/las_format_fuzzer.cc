@@ -56,7 +56,7 @@ void CheckCleaned(absl::string_view data, const ParsedGeometry& parsed,
   for (const auto records : {neuralmesh::LasOutlierRecords::kLeftOut,
                              neuralmesh::LasOutlierRecords::kClassifiedAsNoise}) {
     const absl::StatusOr<std::string> cleaned =
-        neuralmesh::io_internal::FormatCleanedLas(data, outliers, records, classes);
+        neuralmesh::io_internal::FormatCleanedLas({{"fuzz.las", data}}, outliers, records, classes);
     FUZZ_CHECK(cleaned.ok(), "cleaning failed: %s", cleaned.status().ToString().c_str());
     const absl::StatusOr<ParsedGeometry> reread =
         neuralmesh::io_internal::ParseLas(*cleaned, classes);

@@ -1,6 +1,7 @@
-// Cleaning a LAS file of its outliers without losing what a PointCloud does not hold: the
+// Cleaning LAS files of their outliers without losing what a PointCloud does not hold: the
 // records are copied, not read and written again, so each keeps its class, intensity,
 // returns, GPS time and extra bytes, and the file its scale, offset and coordinate system.
+// Several files (the tiles of a survey) are joined into one the same way.
 #ifndef NEURALMESH_CORE_IO_LAS_CLEANING_H_
 #define NEURALMESH_CORE_IO_LAS_CLEANING_H_
 
@@ -18,18 +19,21 @@ enum class LasOutlierRecords {
   kClassifiedAsNoise,  // Kept, as low noise (ASPRS class 7), which the readers leave out.
 };
 
-// Writes to `path` the LAS file at `source` without its outliers, or with them classified as
-// noise (internal/las.h, FormatCleanedLas): `outliers` holds one flag per point ReadPointCloud
-// reads from `source` with `selection`, in its order; with kLeftOut, the records it does not
-// read are left out too. Every other record is copied byte for byte, and the
-// header keeps its version, point format, scale, offset and variable-length records; with
-// kLeftOut its counts and bounds become the kept points'.
-// Returns NOT_FOUND when `source` cannot be read; INVALID_ARGUMENT when it is not a LAS file
+// Writes to `path` the LAS files at `sources`, one after another, without their outliers, or
+// with them classified as noise (internal/las.h, FormatCleanedLas): `outliers` holds one flag
+// per point ReadPointCloud reads from the sources with `selection`, file after file, in their
+// order; with kLeftOut, the records it does not read are left out too. Every other record is
+// copied byte for byte (but for its coordinates, put on the finest scale, when the files'
+// scales or offsets differ), and the header keeps the first file's version, point format,
+// offset and variable-length records; its counts and bounds become the records written.
+// Returns NOT_FOUND when a source cannot be read; INVALID_ARGUMENT when one is not a LAS file
 // ReadPointCloud reads, or `outliers` has not one flag per point, or flags every point to
-// leave out; otherwise the status of the write.
-absl::Status WriteCleanedLas(const std::string& source, const std::vector<bool>& outliers,
-                             LasOutlierRecords records, const std::string& path,
-                             const PointSelection& selection = {});
+// leave out; FAILED_PRECONDITION, saying why, when the records of several files cannot be put
+// in one file (another version, point format, record length, coordinate system, extra bytes
+// than the first's, ...: FormatCleanedLas); otherwise the status of the write.
+absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
+                             const std::vector<bool>& outliers, LasOutlierRecords records,
+                             const std::string& path, const PointSelection& selection = {});
 
 }  // namespace neuralmesh
 

@@ -531,7 +531,7 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
       {{"convert", xyz, "-o", *dir_ + "/points.pcd", "--pcd_data", "text"},
        "--pcd_data is 'text'; it must be binary, binary_compressed or ascii"},
       {{"convert", xyz, "-o", *dir_ + "/points.las", "--remove_outliers", "--outliers_as_noise"},
-       "--outliers_as_noise classifies the outliers of one .las INPUT in a .las OUTPUT; INPUT '" +
+       "--outliers_as_noise classifies the outliers of .las INPUTs in a .las OUTPUT; INPUT '" +
            xyz + "' to OUTPUT '" + *dir_ + "/points.las' can only leave them out"},
       {{"reconstruct", xyz, "--server", "127.0.0.1:1", "--remove_outliers", "--outliers_on_server",
         "--outlier_passes", "2"},
@@ -966,10 +966,41 @@ TEST_F(LocalCliTest, ALasScanCleanedIntoLasKeepsItsRecordsWhole) {
   EXPECT_EQ(unmarked->size(), 2999u);
   EXPECT_EQ(left_out.noise, 4u);
 
-  // Several files, or another format, go through the point cloud: LAS of positions only.
-  const RunResult merged = RunNeuralmesh({"convert", las, clean, "-o", *dir_ + "/both.las"});
-  ASSERT_EQ(merged.exit_code, 0) << merged.Describe();
-  EXPECT_TRUE(absl::StartsWith(merged.out, *dir_ + "/both.las: 6001 points;")) << merged.out;
+  // Two tiles joined: one file of both tiles' records, each whole, after the first's header.
+  const std::string both = *dir_ + "/both.las";
+  const RunResult joined = RunNeuralmesh({"convert", las, clean, "-o", both});
+  ASSERT_EQ(joined.exit_code, 0) << joined.Describe();
+  EXPECT_EQ(joined.out, both + ": 6001 points, each record as in its INPUT with every field, "
+                               "and the header's offset and variable-length records of " +
+                            las + "; left out 1 point classified as noise\n");
+  const std::string both_bytes = ReadFileContents(both).value_or("");
+  ASSERT_EQ(both_bytes.size(), first + 6001 * 30);
+  EXPECT_EQ(both_bytes.substr(375, layout.vlrs.size()), layout.vlrs) << "the coordinate system";
+  EXPECT_EQ(both_bytes.substr(first + 3002 * 30), bytes.substr(first)) << "the second tile";
+  EXPECT_EQ(both_bytes.substr(first + 7 * 30, 30), source.substr(first + 8 * 30, 30))
+      << "the first tile, its noise left out";
+
+  // Tiles of another point format go through the point cloud (LAS 1.2 of positions), saying
+  // why; --outliers_as_noise, which needs their records, is refused.
+  testing::LasLayout other;
+  other.version_minor = 4;
+  other.format = 1;
+  const std::string tile = *dir_ + "/tile.las";
+  std::ofstream(tile, std::ios::binary) << testing::LasFile(other, {{0, 0, 100}, {0, 100, 0}});
+  const RunResult mixed = RunNeuralmesh({"convert", las, tile, "-o", *dir_ + "/mixed.las"});
+  ASSERT_EQ(mixed.exit_code, 0) << mixed.Describe();
+  EXPECT_THAT(mixed.out, ::testing::HasSubstr("3004 points"));
+  EXPECT_THAT(mixed.out,
+              ::testing::HasSubstr("; the records could not be kept whole: '" + tile +
+                                   "' has point format 1 (records of 28 bytes) and '" + las +
+                                   "' format 6 (30)\n"));
+  const RunResult refused = RunNeuralmesh({"convert", las, tile, "-o", *dir_ + "/mixed.las",
+                                           "--remove_outliers", "--outliers_as_noise"});
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_THAT(refused.err,
+              ::testing::HasSubstr("--outliers_as_noise: the records of INPUT '" + las + "', '" +
+                                   tile + "' cannot be put in one file: '" + tile +
+                                   "' has point format 1"));
 }
 
 // A classified scan: a building (class 6, a unit sphere) above the ground (class 2, a square

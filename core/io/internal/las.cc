@@ -3,12 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "core/io/internal/binary.h"
+#include "core/io/internal/file_util.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/status_macros.h"
@@ -24,6 +28,7 @@ constexpr size_t kVersionMajor = 24;
 constexpr size_t kVersionMinor = 25;
 constexpr size_t kHeaderSize = 94;
 constexpr size_t kOffsetToPoints = 96;
+constexpr size_t kVlrCount = 100;
 constexpr size_t kPointFormat = 104;
 constexpr size_t kRecordLength = 105;
 constexpr size_t kLegacyPointCount = 107;
@@ -181,6 +186,70 @@ absl::StatusOr<LasHeader> ReadHeader(absl::string_view data) {
   return header;
 }
 
+// The variable-length records that say how the point records are to be read: the coordinate
+// system (user "LASF_Projection") and the extra bytes' description ("LASF_Spec", record 4),
+// each as its user, record id and payload.
+std::string InterpretingRecords(absl::string_view data, const LasHeader& header) {
+  constexpr size_t kVlrHeaderSize = 54;
+  std::string out;
+  size_t at = header.header_size;
+  const uint32_t count = Load<uint32_t>(data, kVlrCount);
+  for (uint32_t i = 0; i < count && at + kVlrHeaderSize <= header.offset_to_points; ++i) {
+    absl::string_view user = data.substr(at + 2, 16);
+    user = user.substr(0, user.find('\0'));
+    const uint16_t id = Load<uint16_t>(data, at + 18);
+    const size_t length = Load<uint16_t>(data, at + 20);
+    if (at + kVlrHeaderSize + length > header.offset_to_points) break;
+    if (user == "LASF_Projection" || (user == "LASF_Spec" && id == 4)) {
+      absl::StrAppend(&out, data.substr(at + 2, 18), data.substr(at + kVlrHeaderSize, length));
+    }
+    at += kVlrHeaderSize + length;
+  }
+  return out;
+}
+
+// OK when the records of the files can follow one another in one file of the first's header:
+// the same version, point format and record length, the same coordinate system and extra
+// bytes, the same data after the points (extended records), and no waveform packets, to which
+// records point by their place in their own file. Otherwise FAILED_PRECONDITION saying why.
+absl::Status CheckJoinable(const std::vector<LasSource>& sources,
+                           const std::vector<LasHeader>& headers) {
+  const LasHeader& first = headers.front();
+  const std::string a = absl::StrCat("'", sources.front().name, "'");
+  const absl::string_view first_after = sources.front().data.substr(first.points_end());
+  for (size_t s = 1; s < sources.size(); ++s) {
+    const LasHeader& header = headers[s];
+    const std::string b = absl::StrCat("'", sources[s].name, "'");
+    const absl::string_view data = sources[s].data;
+    if (header.minor != first.minor) {
+      return absl::FailedPreconditionError(absl::StrCat(b, " is LAS 1.", header.minor, " and ",
+                                                        a, " LAS 1.", first.minor));
+    }
+    if (header.format != first.format || header.record_length != first.record_length) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          b, " has point format ", int{header.format}, " (records of ", header.record_length,
+          " bytes) and ", a, " format ", int{first.format}, " (", first.record_length, ")"));
+    }
+    if (InterpretingRecords(data, header) != InterpretingRecords(sources.front().data, first)) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("the coordinate systems or extra bytes of ", b, " and ", a, " differ"));
+    }
+    if (data.substr(header.points_end()) != first_after) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "what follows the points of ", b, " and ", a, " (extended records) differs"));
+    }
+  }
+  constexpr int kWaveformFormats[] = {4, 5, 9, 10};
+  if (sources.size() > 1 &&
+      std::find(std::begin(kWaveformFormats), std::end(kWaveformFormats), first.format) !=
+          std::end(kWaveformFormats)) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "the records of point format ", int{first.format},
+        " point into their own file's waveform data"));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
@@ -331,86 +400,129 @@ absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
   return out;
 }
 
-absl::StatusOr<std::string> FormatCleanedLas(absl::string_view data,
+absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sources,
                                              const std::vector<bool>& outliers,
                                              LasOutlierRecords records,
                                              const std::optional<LasClasses>& classes) {
-  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
-  // The records ParseLas reads, and of those the outliers.
-  std::vector<size_t> kept, flagged;
-  size_t usable = 0;
-  for (uint64_t i = 0; i < header.count; ++i) {
-    const size_t at = header.record(i);
-    if (Usability(data, at, header.format, classes) != kUsable) {
-      if (records == LasOutlierRecords::kClassifiedAsNoise) kept.push_back(at);
-      continue;
+  if (sources.empty()) return Invalid("no file to clean");
+  std::vector<LasHeader> headers;
+  for (const LasSource& source : sources) {
+    absl::StatusOr<LasHeader> header = ReadHeader(source.data);
+    if (!header.ok()) return WithPath(header.status(), source.name);
+    headers.push_back(*header);
+  }
+  NM_RETURN_IF_ERROR(CheckJoinable(sources, headers));
+  const LasHeader& first = headers.front();
+  // Each axis's finest scale among the files, so that no record loses resolution, from the
+  // first file's offset.
+  Point3d scale = first.scale;
+  for (const LasHeader& header : headers) {
+    for (int c = 0; c < 3; ++c) {
+      if (std::fabs(header.scale[c]) < std::fabs(scale[c])) scale[c] = header.scale[c];
     }
-    const bool outlier = usable < outliers.size() && outliers[usable];
-    if (outlier) flagged.push_back(at);
-    if (!outlier || records == LasOutlierRecords::kClassifiedAsNoise) kept.push_back(at);
-    ++usable;
   }
-  if (outliers.size() != usable) {
-    return Invalid(absl::StrCat(outliers.size(), " flags for the file's ", usable,
-                                " points (withheld, noise or other classes left out)"));
-  }
-  if (records == LasOutlierRecords::kClassifiedAsNoise) {
-    std::string out(data);
-    for (size_t at : flagged) {
-      if (header.format >= 6) {
-        out[at + 16] = static_cast<char>(kLowNoiseClass);
-      } else {  // The class in the low five bits; the top three are flags.
-        out[at + 15] = static_cast<char>((static_cast<uint8_t>(out[at + 15]) & 0xE0) |
-                                         kLowNoiseClass);
-      }
-    }
-    SetGeneratingSoftware(&out);
-    return out;
-  }
-  if (kept.empty()) return Invalid("no point is kept");
+  const bool as_noise = records == LasOutlierRecords::kClassifiedAsNoise;
 
-  std::string out(data.data(), header.offset_to_points);
-  out.reserve(data.size());
+  std::string out(sources.front().data.substr(0, first.offset_to_points));
   Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
   uint64_t by_return[16] = {};
-  for (size_t at : kept) {
-    out.append(data.data() + at, header.record_length);
-    for (int c = 0; c < 3; ++c) {
-      const double coordinate = header.Coordinate(data, at, c);
-      low[c] = std::min(low[c], coordinate);
-      high[c] = std::max(high[c], coordinate);
+  uint64_t written = 0;
+  size_t usable = 0;  // The points ParseLas reads, over every file.
+  for (size_t s = 0; s < sources.size(); ++s) {
+    const absl::string_view data = sources[s].data;
+    const LasHeader& header = headers[s];
+    const bool same_grid = header.scale == scale && header.offset == first.offset;
+    for (uint64_t i = 0; i < header.count; ++i) {
+      const size_t at = header.record(i);
+      bool outlier = false;
+      if (Usability(data, at, header.format, classes) == kUsable) {
+        outlier = usable < outliers.size() && outliers[usable];
+        ++usable;
+        if (outlier && !as_noise) continue;
+      } else if (!as_noise) {
+        continue;
+      }
+      const size_t put = out.size();
+      out.append(data.data() + at, header.record_length);
+      if (outlier) {
+        if (header.format >= 6) {
+          out[put + 16] = static_cast<char>(kLowNoiseClass);
+        } else {  // The class in the low five bits; the top three are flags.
+          out[put + 15] = static_cast<char>((static_cast<uint8_t>(out[put + 15]) & 0xE0) |
+                                            kLowNoiseClass);
+        }
+      }
+      for (int c = 0; c < 3; ++c) {
+        double coordinate = header.Coordinate(data, at, c);
+        if (!same_grid) {  // Onto the joined file's scale and offset.
+          const double stored = std::round((coordinate - first.offset[c]) / scale[c]);
+          if (!(stored >= std::numeric_limits<int32_t>::min() &&
+                stored <= std::numeric_limits<int32_t>::max())) {
+            return absl::FailedPreconditionError(absl::StrCat(
+                "the coordinates of '", sources[s].name, "' do not fit LAS's 32-bit integers at '",
+                sources.front().name, "''s offset and the scale ", scale[c], " of axis ",
+                absl::string_view("xyz").substr(c, 1)));
+          }
+          StoreLittleEndian(static_cast<int32_t>(stored), put + 4 * c, &out);
+          coordinate = stored * scale[c] + first.offset[c];
+        }
+        low[c] = std::min(low[c], coordinate);
+        high[c] = std::max(high[c], coordinate);
+      }
+      ++by_return[ReturnNumber(data, at, header.format)];
+      ++written;
     }
-    ++by_return[ReturnNumber(data, at, header.format)];
   }
-  // LAS 1.3's waveform packets and LAS 1.4's extended records, after the points, move up by
-  // the records left out.
-  const size_t removed_bytes = header.points_end() - header.offset_to_points -
-                               kept.size() * header.record_length;
-  out.append(data.data() + header.points_end(), data.size() - header.points_end());
+  std::vector<std::string> names;
+  for (const LasSource& source : sources) names.push_back(absl::StrCat("'", source.name, "'"));
+  if (outliers.size() != usable) {
+    return Invalid(absl::StrCat(outliers.size(), " flags for the ", usable, " points read from ",
+                                absl::StrJoin(names, ", "),
+                                " (withheld, noise or other classes left out)"));
+  }
+  if (written == 0 && !as_noise) {
+    return Invalid(absl::StrCat("no point of ", absl::StrJoin(names, ", "), " is kept"));
+  }
+  const bool extended_counts = first.minor >= 4 && first.header_size >= kHeaderSize14;
+  constexpr uint64_t kLegacyMax = std::numeric_limits<uint32_t>::max();
+  if (!extended_counts && written > kLegacyMax) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        written, " points are more than LAS 1.", first.minor, " counts (", kLegacyMax, ")"));
+  }
+
+  // LAS 1.3's waveform packets and LAS 1.4's extended records, after the points, move with
+  // their end.
+  const absl::string_view first_data = sources.front().data;
+  const size_t points_end = out.size();
+  out.append(first_data.data() + first.points_end(), first_data.size() - first.points_end());
   const auto move_start = [&](size_t field) {
-    const uint64_t start = Load<uint64_t>(data, field);
-    if (start >= header.points_end()) StoreLittleEndian(start - removed_bytes, field, &out);
+    const uint64_t start = Load<uint64_t>(first_data, field);
+    if (start >= first.points_end()) {
+      StoreLittleEndian<uint64_t>(start - first.points_end() + points_end, field, &out);
+    }
   };
-  if (header.minor >= 3 && header.header_size >= kHeaderSize13) move_start(kWaveformStart);
-  const bool extended_counts = header.minor >= 4 && header.header_size >= kHeaderSize14;
+  if (first.minor >= 3 && first.header_size >= kHeaderSize13) move_start(kWaveformStart);
   if (extended_counts) {
     move_start(kEvlrStart);
-    StoreLittleEndian<uint64_t>(kept.size(), kPointCount, &out);
+    StoreLittleEndian<uint64_t>(written, kPointCount, &out);
     for (int r = 1; r <= 15; ++r) {
       StoreLittleEndian<uint64_t>(by_return[r], kByReturn14 + 8 * (r - 1), &out);
     }
   }
   // The legacy counts stay zero where the file left them so (LAS 1.4 with formats 6-10, or
-  // more points than they hold).
-  if (!extended_counts || Load<uint32_t>(data, kLegacyPointCount) != 0) {
-    StoreLittleEndian(static_cast<uint32_t>(kept.size()), kLegacyPointCount, &out);
+  // more points than they hold), and become so beyond what they hold.
+  if (!extended_counts || Load<uint32_t>(first_data, kLegacyPointCount) != 0) {
+    const bool fits = written <= kLegacyMax;
+    StoreLittleEndian(static_cast<uint32_t>(fits ? written : 0), kLegacyPointCount, &out);
     for (int r = 1; r <= 5; ++r) {
-      StoreLittleEndian(static_cast<uint32_t>(by_return[r]), kLegacyByReturn + 4 * (r - 1), &out);
+      StoreLittleEndian(static_cast<uint32_t>(fits ? by_return[r] : 0),
+                        kLegacyByReturn + 4 * (r - 1), &out);
     }
   }
   for (int c = 0; c < 3; ++c) {
-    StoreLittleEndian(high[c], kBounds + 16 * c, &out);
-    StoreLittleEndian(low[c], kBounds + 16 * c + 8, &out);
+    StoreLittleEndian(scale[c], kScale + 8 * c, &out);
+    StoreLittleEndian(written > 0 ? high[c] : 0.0, kBounds + 16 * c, &out);
+    StoreLittleEndian(written > 0 ? low[c] : 0.0, kBounds + 16 * c + 8, &out);
   }
   SetGeneratingSoftware(&out);
   return out;

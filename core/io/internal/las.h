@@ -41,25 +41,37 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
 // Returns INVALID_ARGUMENT for more points than LAS 1.2 counts (2^32 - 1).
 absl::StatusOr<std::string> FormatLas(const GeometryView& points);
 
-// A copy of the LAS file `data` (one ParseLas reads) without its outliers, or with them
-// classified as noise: `outliers` holds one flag per point ParseLas returns with `classes`, in
-// its order.
+// A LAS file's bytes, and the name by which messages speak of it.
+struct LasSource {
+  std::string name;
+  absl::string_view data;
+};
+
+// The LAS files `sources` (ParseLas reads each) as one file without their outliers, or with
+// them classified as noise: `outliers` holds one flag per point ParseLas returns with
+// `classes`, file after file, in their order.
 //   kLeftOut: the outliers' records are left out, and so are the withheld, noise and other
-//     classes' records that ParseLas leaves out. The header's point counts, counts by return
-//     and bounds become those of the kept records, and the starts of what follows the points
-//     (LAS 1.3's waveform packets, LAS 1.4's extended records) move up with it.
+//     classes' records that ParseLas leaves out.
 //   kClassifiedAsNoise: every record is kept, the outliers' classified as low noise (ASPRS
 //     class 7), which ParseLas then leaves out (unless `classes` holds 7); their other flags
 //     stay.
-// The rest is kept as it was: each record byte for byte (its intensity, returns, GPS time,
-// extra bytes, ...), the header's version, point format, scale and offset, the
-// variable-length records (the coordinate system among them) and what follows the points;
+// Each record is kept byte for byte (its intensity, returns, GPS time, extra bytes, ...) but
+// for its coordinates when several files have different scales or offsets: the file then has
+// each axis's finest scale among them and the first file's offset. The first file gives the
+// rest: the header's version, point format and offset, the variable-length records (the
+// coordinate system among them) and what follows the points. The header's point counts,
+// counts by return and bounds become those of the records written, the starts of what follows
+// the points (LAS 1.3's waveform packets, LAS 1.4's extended records) move with their end, and
 // the generating software becomes "neuralmesh VERSION".
-// Returns ParseLas's errors for a malformed file, and INVALID_ARGUMENT when `outliers` has not
-// one flag per point, or every point is an outlier to leave out.
+// Returns ParseLas's errors for a malformed file, named; INVALID_ARGUMENT when `outliers` has
+// not one flag per point, or every point is an outlier to leave out; FAILED_PRECONDITION,
+// saying why, when the records of several files cannot be put in one file: another version,
+// point format, record length, coordinate system, extra bytes or extended records than the
+// first's, records that point to waveform data, coordinates that do not fit 32 bits at the
+// joined scale and offset, or more points than the version counts.
 absl::StatusOr<std::string> FormatCleanedLas(
-    absl::string_view data, const std::vector<bool>& outliers, LasOutlierRecords records,
-    const std::optional<LasClasses>& classes = std::nullopt);
+    const std::vector<LasSource>& sources, const std::vector<bool>& outliers,
+    LasOutlierRecords records, const std::optional<LasClasses>& classes = std::nullopt);
 
 }  // namespace neuralmesh::io_internal
 

@@ -3,12 +3,16 @@
 // and offset, the variable-length records and what follows the points as they were. Outliers
 // left out: the header's point counts, counts by return and bounds those of the kept points,
 // and the starts of the waveform data and extended records moved up with them. Outliers
-// classified as noise: every record kept, theirs with class 7 and their flags.
+// classified as noise: every record kept, theirs with class 7 and their flags. Tiles joined
+// into one file, on the finest scale, or refused saying why.
 #include "core/io/las_cleaning.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -136,7 +140,7 @@ std::string Cleaned(const std::string& name, const std::string& in,
   const std::string source = TempPath(name + ".las");
   const std::string written = TempPath(name + "_cleaned.las");
   WriteBytes(source, in);
-  const absl::Status status = WriteCleanedLas(source, outliers, records, written);
+  const absl::Status status = WriteCleanedLas({source}, outliers, records, written);
   EXPECT_TRUE(status.ok()) << status;
   return ReadBytes(written);
 }
@@ -281,13 +285,13 @@ TEST(LasCleaningTest, TheClassesAskedForChooseThePointsAndTheRecordsKept) {
   vegetation.las_classes = LasClasses().set(5);
   const std::string written = TempPath("vegetation.las");
   // Points 1, 2, 4, 5 are read; 4 is an outlier.
-  ASSERT_TRUE(WriteCleanedLas(source, {false, false, true, false}, LasOutlierRecords::kLeftOut,
+  ASSERT_TRUE(WriteCleanedLas({source}, {false, false, true, false}, LasOutlierRecords::kLeftOut,
                               written, vegetation)
                   .ok());
   std::string out = ReadBytes(written);
   ExpectRecordsKept(in, out, {{1, 2, 5}, 28, 227, 6}, 227);
 
-  ASSERT_TRUE(WriteCleanedLas(source, {false, false, true, false},
+  ASSERT_TRUE(WriteCleanedLas({source}, {false, false, true, false},
                               LasOutlierRecords::kClassifiedAsNoise, written, vegetation)
                   .ok());
   out = ReadBytes(written);
@@ -297,10 +301,134 @@ TEST(LasCleaningTest, TheClassesAskedForChooseThePointsAndTheRecordsKept) {
   }
 
   const absl::Status status =
-      WriteCleanedLas(source, {false, false, false, false, false, false},
+      WriteCleanedLas({source}, {false, false, false, false, false, false},
                       LasOutlierRecords::kLeftOut, written, vegetation);
   EXPECT_THAT(std::string(status.message()),
-              HasSubstr("6 flags for the file's 4 points (withheld, noise or other classes"));
+              HasSubstr("6 flags for the 4 points read from '" + source +
+                        "' (withheld, noise or other classes"));
+}
+
+// A survey's tiles joined: every record whole and in order, after the first tile's header and
+// coordinate system; a tile on another scale and offset is put on the finest scale, every
+// coordinate kept.
+TEST(LasCleaningTest, TilesJoinIntoOneFileOnTheFinestScale) {
+  const std::string crs =
+      VariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM zone 32N\"]", false);
+  LasLayout a;
+  a.format = 3;
+  a.vlrs = crs;
+  a.vlr_count = 1;
+  a.offset[0] = 500000;
+  a.offset[1] = 4000000;
+  LasLayout b = a;
+  for (double& s : b.scale) s = 0.001;
+  b.offset[0] = 500100;
+  const std::vector<LasPoint> points_a = VariedPoints(5);
+  std::vector<LasPoint> points_b = VariedPoints(4);
+  points_b[2].withheld = true;
+  const std::string in_a = LasFile(a, points_a), in_b = LasFile(b, points_b);
+  const std::string tile_a = TempPath("tile_a.las"), tile_b = TempPath("tile_b.las");
+  WriteBytes(tile_a, in_a);
+  WriteBytes(tile_b, in_b);
+  const size_t length = testing::kLasRecordLength[3];
+  const size_t first = 227 + crs.size();
+
+  for (const auto records : {LasOutlierRecords::kLeftOut, LasOutlierRecords::kClassifiedAsNoise}) {
+    const bool as_noise = records == LasOutlierRecords::kClassifiedAsNoise;
+    SCOPED_TRACE(as_noise ? "classified as noise" : "left out");
+    // The points read: a's 5, then b's 0, 1 and 3; the outliers a's 1 and b's 3.
+    const std::string written = TempPath("joined.las");
+    const absl::Status status = WriteCleanedLas(
+        {tile_a, tile_b}, {false, true, false, false, false, false, false, true}, records,
+        written);
+    ASSERT_TRUE(status.ok()) << status;
+    const std::string out = ReadBytes(written);
+    // (tile, record) of each record written.
+    std::vector<std::pair<int, size_t>> expected;
+    for (size_t i = 0; i < 5; ++i) {
+      if (as_noise || i != 1) expected.push_back({0, i});
+    }
+    for (size_t i = 0; i < 4; ++i) {
+      if (as_noise || (i != 2 && i != 3)) expected.push_back({1, i});
+    }
+    ASSERT_EQ(out.size(), first + expected.size() * length);
+    EXPECT_EQ(out.substr(227, crs.size()), crs) << "the coordinate system";
+    EXPECT_EQ(Field<uint32_t>(out, 107), expected.size());
+    uint32_t first_returns = 0;
+    std::array<double, 3> low = {INFINITY, INFINITY, INFINITY};
+    std::array<double, 3> high = {-INFINITY, -INFINITY, -INFINITY};
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(Field<double>(out, 131 + 8 * c), 0.001) << "the finest scale, axis " << c;
+      EXPECT_EQ(Field<double>(out, 155 + 8 * c), a.offset[c]) << "a's offset, axis " << c;
+    }
+    for (size_t k = 0; k < expected.size(); ++k) {
+      const auto [tile, i] = expected[k];
+      const std::string& in = tile == 0 ? in_a : in_b;
+      const LasPoint& p = (tile == 0 ? points_a : points_b)[i];
+      const size_t at = first + k * length;
+      std::string source = in.substr(first + i * length, length);
+      if (as_noise && ((tile == 0 && i == 1) || (tile == 1 && i == 3))) {
+        source[15] = static_cast<char>(7);
+      }
+      EXPECT_EQ(out.substr(at + 12, length - 12), source.substr(12)) << "record " << k;
+      // On the scale of 0.001 from a's offset: a's integers times 10, b's moved by 100 m in x.
+      const int32_t x = tile == 0 ? 10 * p.x : p.x + 100000;
+      const int32_t y = tile == 0 ? 10 * p.y : p.y;
+      const int32_t z = tile == 0 ? 10 * p.z : p.z;
+      EXPECT_EQ(Field<int32_t>(out, at), x) << "record " << k;
+      EXPECT_EQ(Field<int32_t>(out, at + 4), y) << "record " << k;
+      EXPECT_EQ(Field<int32_t>(out, at + 8), z) << "record " << k;
+      first_returns += p.return_number == 1;
+      const int32_t stored[3] = {x, y, z};
+      for (int c = 0; c < 3; ++c) {
+        const double v = stored[c] * 0.001 + a.offset[c];
+        low[c] = std::min(low[c], v);
+        high[c] = std::max(high[c], v);
+      }
+    }
+    EXPECT_EQ(Field<uint32_t>(out, 111), first_returns) << "first returns";
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(Field<double>(out, 179 + 16 * c), high[c]) << "max of axis " << c;
+      EXPECT_EQ(Field<double>(out, 187 + 16 * c), low[c]) << "min of axis " << c;
+    }
+  }
+}
+
+// Tiles whose records cannot share one file are refused, saying which and why.
+TEST(LasCleaningTest, TilesThatCannotShareAFileAreRefusedSayingWhy) {
+  const auto joined = [](const LasLayout& a, const LasLayout& b) {
+    const std::string tile_a = TempPath("refused_a.las"), tile_b = TempPath("refused_b.las");
+    WriteBytes(tile_a, LasFile(a, VariedPoints(2)));
+    WriteBytes(tile_b, LasFile(b, VariedPoints(2)));
+    return WriteCleanedLas({tile_a, tile_b}, std::vector<bool>(4, false),
+                           LasOutlierRecords::kLeftOut, TempPath("refused.las"));
+  };
+  const auto expect_refused = [](const absl::Status& status, absl::string_view why) {
+    EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition) << status;
+    EXPECT_THAT(std::string(status.message()), HasSubstr(std::string(why)));
+  };
+  LasLayout a;
+  a.format = 1;
+  LasLayout b = a;
+  b.format = 3;
+  expect_refused(joined(a, b), "refused_b.las' has point format 3 (records of 34 bytes) and '");
+  b = a;
+  b.version_minor = 4;
+  expect_refused(joined(a, b), "refused_b.las' is LAS 1.4 and '");
+  b = a;
+  b.vlrs = VariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM zone 33N\"]", false);
+  b.vlr_count = 1;
+  expect_refused(joined(a, b), "the coordinate systems or extra bytes of '");
+  // Another kind of record (a description of the tile, say) does not matter.
+  b.vlrs = VariableLengthRecord("tile_notes", 1, "tile 2", false);
+  EXPECT_TRUE(joined(a, b).ok());
+  b = a;
+  b.offset[0] = 1.0e6;
+  for (double& s : b.scale) s = 1e-4;
+  expect_refused(joined(a, b), "do not fit LAS's 32-bit integers");
+  a.format = b.format = 4;
+  b = a;
+  expect_refused(joined(a, b), "point into their own file's waveform data");
 }
 
 TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
@@ -312,30 +440,31 @@ TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
   const std::string written = TempPath("written.las");
 
   absl::Status status =
-      WriteCleanedLas(source, {true, true, true, true}, LasOutlierRecords::kLeftOut, written);
+      WriteCleanedLas({source}, {true, true, true, true}, LasOutlierRecords::kLeftOut, written);
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()),
-              HasSubstr("4 flags for the file's 3 points (withheld, noise or other classes "
-                        "left out)"));
+              HasSubstr("4 flags for the 3 points read from '" + source +
+                        "' (withheld, noise or other classes left out)"));
   EXPECT_THAT(std::string(status.message()), HasSubstr("source.las"));
 
-  status = WriteCleanedLas(source, {true, true, true}, LasOutlierRecords::kLeftOut, written);
+  status = WriteCleanedLas({source}, {true, true, true}, LasOutlierRecords::kLeftOut, written);
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_THAT(std::string(status.message()), HasSubstr("no point is kept"));
+  EXPECT_THAT(std::string(status.message()), HasSubstr("no point of '" + source + "' is kept"));
 
   const std::string text = TempPath("points.xyz");
   WriteBytes(text, "0 0 0\n1 1 1\n");
-  status = WriteCleanedLas(text, {false, false}, LasOutlierRecords::kLeftOut, written);
+  status = WriteCleanedLas({text}, {false, false}, LasOutlierRecords::kLeftOut, written);
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()), HasSubstr("is not a .las file"));
 
   const std::string fake = TempPath("fake.las");
   WriteBytes(fake, std::string(300, 'x'));
-  status = WriteCleanedLas(fake, {false}, LasOutlierRecords::kClassifiedAsNoise, written);
+  status = WriteCleanedLas({fake}, {false}, LasOutlierRecords::kClassifiedAsNoise, written);
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()), HasSubstr("no LASF signature"));
 
-  status = WriteCleanedLas(TempPath("missing.las"), {false}, LasOutlierRecords::kLeftOut, written);
+  status =
+      WriteCleanedLas({TempPath("missing.las")}, {false}, LasOutlierRecords::kLeftOut, written);
   EXPECT_EQ(status.code(), absl::StatusCode::kNotFound);
 }
 

@@ -18,6 +18,10 @@ JOBS=${JOBS:-$(nproc)}
 generator=()
 command -v ninja >/dev/null 2>&1 && generator=(-G Ninja)
 
+phase() {  # phase MESSAGE: what starts now, and the seconds since the script began
+  echo "==> $1 (at ${SECONDS} s)" >&2
+}
+
 configure() {  # configure DIR [CMAKE ARGS...]; keeps an existing build's generator
   local dir=$1
   shift
@@ -28,15 +32,15 @@ configure() {  # configure DIR [CMAKE ARGS...]; keeps an existing build's genera
   fi
 }
 
-echo "==> Building into ${BUILD_DIR}/" >&2
+phase "Building into ${BUILD_DIR}/"
 configure "${BUILD_DIR}"
 cmake --build "${BUILD_DIR}" -j "${JOBS}"
 
-echo "==> Running the test suites" >&2
+phase "Running the test suites"
 (cd "${BUILD_DIR}" && ctest --output-on-failure -j "${JOBS}" --timeout 900)
 
 if [[ "${SKIP_TSAN:-0}" != 1 ]]; then
-  echo "==> Running the concurrency tests under ThreadSanitizer (${TSAN_BUILD_DIR}/)" >&2
+  phase "Running the concurrency tests under ThreadSanitizer (${TSAN_BUILD_DIR}/)"
   configure "${TSAN_BUILD_DIR}" -DNEURALMESH_CORE_ONLY=ON -DNEURALMESH_TSAN=ON \
     -DNEURALMESH_BUILD_BENCH=OFF
   tsan_tests=$(cd tests && find core -name '*concurrent*_test.cc' -exec basename {} .cc \;)
@@ -46,9 +50,10 @@ if [[ "${SKIP_TSAN:-0}" != 1 ]]; then
 fi
 
 if [[ "${SKIP_ASAN:-0}" != 1 ]]; then
-  echo "==> Running the core tests under AddressSanitizer and UBSan (${ASAN_BUILD_DIR}/)" >&2
+  phase "Running the core tests under AddressSanitizer and UBSan (${ASAN_BUILD_DIR}/)"
   configure "${ASAN_BUILD_DIR}" -DNEURALMESH_CORE_ONLY=ON -DNEURALMESH_SANITIZE=ON \
     -DNEURALMESH_BUILD_BENCH=OFF
   cmake --build "${ASAN_BUILD_DIR}" -j "${JOBS}"
   (cd "${ASAN_BUILD_DIR}" && ctest --output-on-failure -j "${JOBS}" -LE acceptance --timeout 900)
 fi
+phase "All passed"

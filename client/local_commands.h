@@ -80,7 +80,7 @@ struct ConvertOptions {
   // cloud files, written as one.
   std::vector<std::string> inputs;
   // Its extension picks the format: a mesh's (kMeshExtensions) or a point cloud's (.ply .xyz
-  // .txt .pts .las .pcd .e57 .drc .glb .gltf).
+  // .txt .pts .ptx .las .pcd .e57 .drc .glb .gltf).
   std::string output;
   MeshWriteOptions writing;  // Draco settings, glTF compression (meshes only).
   // Set: a point cloud's statistical outliers are removed before it is written.
@@ -95,9 +95,10 @@ struct ConvertOptions {
 // Writes INPUT to OUTPUT, colours included where the format holds them. A mesh (a file with
 // faces, or builtin:NAME) is written as a mesh, and "OUTPUT: V vertices, F faces" printed
 // (", with colours"). Points (a .xyz/.txt/.pts/.ptx/.las/.pcd/.e57 file, a file without faces,
-// or any file written to .xyz/.txt/.pts/.las/.pcd/.e57) are written as a point cloud with their
-// normals, weights and colours where the format holds them, and "OUTPUT: N points" printed
-// (", with normals, weights, colours"; how many outliers went; what LAS or E57 leaves out).
+// or any file written to .xyz/.txt/.pts/.ptx/.las/.pcd/.e57) are written as a point cloud with
+// their normals, weights and colours where the format holds them, and "OUTPUT: N points"
+// printed (", with normals, weights, colours"; how many outliers went; what LAS, PTX or E57
+// leaves out).
 // .las INPUTs written to .las are copied record by record instead (core/io/las_cleaning.h),
 // their outliers left out or, with outliers_as_noise, classified as noise; several whose
 // records cannot share one file (another point format, coordinate system, ...) are written as

@@ -46,7 +46,7 @@ ABSL_FLAG(std::string, output, "",
           "Local reconstruct: the mesh to write; the extension picks the format (.ply .obj .off "
           ".stl .drc .glb .gltf). LOD files go beside it as <stem>_lod<N><ext>. get: where the "
           "session's mesh goes. convert: the file written (a mesh's format, or a point cloud's: "
-          ".ply .xyz .txt .pts .las .pcd .e57 .drc .glb .gltf).");
+          ".ply .xyz .txt .pts .ptx .las .pcd .e57 .drc .glb .gltf).");
 ABSL_FLAG(uint64_t, vertices, 0,
           "Vertex count of the final mesh (met exactly). Required for a local reconstruct; with "
           "--server, 0 means one vertex per 2 points, at most 10000.");
@@ -711,14 +711,14 @@ std::vector<Subcommand> Commands() {
        "format holds them. A mesh (a file with faces, or builtin:NAME, its dense reference\n"
        "tessellation) goes to .ply .obj .off .stl .drc .glb .gltf; points (.xyz .txt .pts\n"
        ".ptx .las .pcd .e57, a file without faces, or anything written to .xyz .txt .pts\n"
-       ".las .pcd .e57) go to .ply .xyz .txt .pts .las .pcd .e57 .drc .glb .gltf with their\n"
-       "normals and weights (LAS: positions and colours only; E57: no weights), after\n"
-       "--remove_outliers if given. Several point cloud files are written as one. .las files\n"
-       "written to .las keep their records whole (classes, intensities, times, extra bytes)\n"
-       "and the first file's offset and variable-length records (the coordinate system);\n"
-       "tiles are joined so when they share the version, point format, coordinate system and\n"
-       "extra bytes. --outliers_as_noise classifies the outliers as noise instead of\n"
-       "removing them.",
+       ".ptx .las .pcd .e57) go to .ply .xyz .txt .pts .ptx .las .pcd .e57 .drc .glb .gltf\n"
+       "with their normals and weights (LAS, PTX: positions and colours only; E57: no\n"
+       "weights), after --remove_outliers if given. Several point cloud files are written as\n"
+       "one. .las files written to .las keep their records whole (classes, intensities,\n"
+       "times, extra bytes) and the first file's offset and variable-length records (the\n"
+       "coordinate system); tiles are joined so when they share the version, point format,\n"
+       "coordinate system and extra bytes. --outliers_as_noise classifies the outliers as\n"
+       "noise instead of removing them.",
        {"output", "gltf_draco", "pcd_data", "las_classes", "remove_outliers",
         "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "outliers_as_noise", "quantization_bits", "encode_speed"},

@@ -3,8 +3,9 @@
 // back to the same number of points, each within the written scale (and a float's rounding) of
 // where it was, with the same colours. The generic round trip, bit for bit, does not apply:
 // LAS stores integers. A parsed file cleaned of every other point (FormatCleanedLas) reads back
-// to the points kept; with those classified as noise instead, to the same points; both with
-// the default classes and with some asked for.
+// to the points kept; with those classified as noise instead, to the same points; joined
+// with itself as a second tile, to the points kept twice; all with the default classes and
+// with some asked for.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -56,7 +57,8 @@ void CheckCleaned(absl::string_view data, const ParsedGeometry& parsed,
   for (const auto records : {neuralmesh::LasOutlierRecords::kLeftOut,
                              neuralmesh::LasOutlierRecords::kClassifiedAsNoise}) {
     const absl::StatusOr<std::string> cleaned =
-        neuralmesh::io_internal::FormatCleanedLas({{"fuzz.las", data}}, outliers, records, classes);
+        neuralmesh::io_internal::FormatCleanedLas({{"fuzz.las", data}}, outliers, records,
+                                                  classes);
     FUZZ_CHECK(cleaned.ok(), "cleaning failed: %s", cleaned.status().ToString().c_str());
     const absl::StatusOr<ParsedGeometry> reread =
         neuralmesh::io_internal::ParseLas(*cleaned, classes);
@@ -68,6 +70,29 @@ void CheckCleaned(absl::string_view data, const ParsedGeometry& parsed,
                                                                                    : expected,
         *reread, scale);
   }
+
+  // The file joined with itself, as two tiles: the kept points twice; refused only for the
+  // formats whose records point into their file's waveform data.
+  std::vector<bool> twice = outliers;
+  twice.insert(twice.end(), outliers.begin(), outliers.end());
+  const absl::StatusOr<std::string> joined = neuralmesh::io_internal::FormatCleanedLas(
+      {{"a.las", data}, {"b.las", data}}, twice, neuralmesh::LasOutlierRecords::kLeftOut,
+      classes);
+  const int format = static_cast<uint8_t>(data[104]);
+  if (format == 4 || format == 5 || format == 9 || format == 10) {
+    FUZZ_CHECK(absl::IsFailedPrecondition(joined.status()),
+               "tiles of waveform format %d joined: %s", format,
+               joined.status().ToString().c_str());
+    return;
+  }
+  FUZZ_CHECK(joined.ok(), "joining failed: %s", joined.status().ToString().c_str());
+  const absl::StatusOr<ParsedGeometry> reread = neuralmesh::io_internal::ParseLas(*joined, classes);
+  FUZZ_CHECK(reread.ok(), "the joined file does not parse: %s",
+             reread.status().ToString().c_str());
+  ParsedGeometry both = expected;
+  both.positions.insert(both.positions.end(), expected.positions.begin(),
+                        expected.positions.end());
+  neuralmesh::fuzz::CheckPositionsWithinScale(both, *reread, scale);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
-// The PTX parser (core/io/internal/ptx.h) against the properties of
-// fuzz/geometry_parser_properties.h. PTX has no writer here: the project reads scans from it.
+// The PTX parser and writer (core/io/internal/ptx.h) against the properties of
+// fuzz/geometry_parser_properties.h: a parsed file written again (one scan, the points in
+// their registered frame) reads back to the same points and colours.
 #include <cstddef>
 #include <cstdint>
 
@@ -11,7 +12,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       [](absl::string_view text, neuralmesh::io_internal::FaceHandling) {
         return neuralmesh::io_internal::ParsePtx(text);
       },
-      nullptr, /*skips_faces=*/false};
+      neuralmesh::io_internal::FormatPtx, /*skips_faces=*/false,
+      /*writes_normals_and_weights=*/false};
   neuralmesh::fuzz::CheckGeometryParser(ptx, data, size);
   return 0;
 }

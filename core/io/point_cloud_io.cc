@@ -29,8 +29,8 @@ bool IsReadable(FileFormat format) {
 
 bool IsWritable(FileFormat format) {
   return format == FileFormat::kPly || format == FileFormat::kXyz ||
-         format == FileFormat::kLas || format == FileFormat::kPcd || format == FileFormat::kE57 ||
-         format == FileFormat::kDraco || format == FileFormat::kGltf;
+         format == FileFormat::kPtx || format == FileFormat::kLas || format == FileFormat::kPcd ||
+         format == FileFormat::kE57 || format == FileFormat::kDraco || format == FileFormat::kGltf;
 }
 
 absl::Status UnsupportedExtension(const std::string& path, const char* supported) {
@@ -102,14 +102,15 @@ bool IsReadablePointCloudExtension(std::string_view path) {
 const char kReadablePointCloudExtensions[] =
     ".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .e57, .obj, .off, .drc, .glb, .gltf";
 const char kWritablePointCloudExtensions[] =
-    ".ply, .xyz, .txt, .pts, .las, .pcd, .e57, .drc, .glb, .gltf";
+    ".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .e57, .drc, .glb, .gltf";
 
 WrittenPointAttributes PointAttributesWrittenTo(std::string_view path) {
   const FileFormat format =
       io_internal::FormatFromPath(absl::string_view(path.data(), path.size()));
   if (!IsWritable(format)) return {};
-  return {/*normals=*/format != FileFormat::kLas,
-          /*weights=*/format != FileFormat::kLas && format != FileFormat::kE57,
+  const bool positions_and_colors = format == FileFormat::kLas || format == FileFormat::kPtx;
+  return {/*normals=*/!positions_and_colors,
+          /*weights=*/!positions_and_colors && format != FileFormat::kE57,
           /*colors=*/true};
 }
 
@@ -151,6 +152,8 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
     data = io_internal::FormatPly(view);
   } else if (format == FileFormat::kXyz) {
     data = io_internal::FormatXyz(view);
+  } else if (format == FileFormat::kPtx) {
+    data = io_internal::FormatPtx(view);
   } else if (format == FileFormat::kPcd) {
     absl::StatusOr<std::string> formatted = io_internal::FormatPcd(view, options.pcd);
     if (!formatted.ok()) return io_internal::CannotWrite(path, formatted.status());

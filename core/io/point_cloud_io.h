@@ -18,8 +18,8 @@ namespace neuralmesh {
 // The extensions ReadPointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .ptx, .las,
 // .pcd, .e57, .obj, .off, .drc, .glb, .gltf".
 extern const char kReadablePointCloudExtensions[];
-// The extensions WritePointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .las, .pcd,
-// .e57, .drc, .glb, .gltf".
+// The extensions WritePointCloud handles, for messages: ".ply, .xyz, .txt, .pts, .ptx, .las,
+// .pcd, .e57, .drc, .glb, .gltf".
 extern const char kWritablePointCloudExtensions[];
 
 // True when ReadPointCloud handles the extension of `path` (kReadablePointCloudExtensions).
@@ -29,8 +29,8 @@ bool IsReadablePointCloudExtension(std::string_view path);
 bool IsWritablePointCloudExtension(std::string_view path);
 
 // What WritePointCloud keeps of a cloud besides its positions in the format of `path`: all of
-// it, except in LAS (colours only) and E57 (no weights); nothing for an extension it does not
-// write.
+// it, except in LAS and PTX (colours only) and E57 (no weights); nothing for an extension it
+// does not write.
 struct WrittenPointAttributes {
   bool normals = false;
   bool weights = false;
@@ -88,14 +88,15 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,
 
 // Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
 // nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"
-// text for .xyz/.txt/.pts (a header comment names the columns), LAS 1.2 of point format 0 or
-// 2 (with colours; no normals or weights: internal/las.h), PCD (x y z, normal_x normal_y
-// normal_z, rgb, confidence as present; options.pcd picks binary, binary_compressed or ascii
-// data), E57 of one scan (scaled integer coordinates, colours, normals; no weights:
+// text for .xyz/.txt/.pts (a header comment names the columns), PTX of one scan ("x y z
+// intensity [r g b]", intensity 0.5; no normals or weights: internal/ptx.h), LAS 1.2 of point
+// format 0 or 2 (with colours; no normals or weights: internal/las.h), PCD (x y z, normal_x
+// normal_y normal_z, rgb, confidence as present; options.pcd picks binary, binary_compressed
+// or ascii data), E57 of one scan (scaled integer coordinates, colours, normals; no weights:
 // internal/e57.h), .drc encoded with options.draco, or glTF 2.0 POINTS (.glb, or .gltf with
 // its buffer embedded) with COLOR_0, NORMAL (unit length) and _WEIGHT attributes as present.
-// The positions are written with cloud.origin put back (PLY and PCD doubles, exact text, the
-// LAS and E57 offsets, a glTF node's translation, Draco metadata).
+// The positions are written with cloud.origin put back (PLY and PCD doubles, exact text (XYZ,
+// PTX), the LAS and E57 offsets, a glTF node's translation, Draco metadata).
 // Returns INVALID_ARGUMENT for an unsupported extension, an empty cloud, a cloud that fails
 // ValidatePointCloud, more points than LAS counts, or invalid Draco options; otherwise the
 // status of the write ("cannot write 'path': reason").

@@ -453,6 +453,16 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   EXPECT_EQ(read->colors, cloud.colors);
   EXPECT_TRUE(read->normals.empty());
 
+  const std::string ptx = *dir_ + "/points.ptx";
+  const RunResult to_ptx = RunNeuralmesh({"convert", pcd, "-o", ptx});
+  ASSERT_EQ(to_ptx.exit_code, 0) << to_ptx.Describe();
+  EXPECT_EQ(to_ptx.out, ptx + ": 5000 points, with colours\nnote: PTX keeps positions and "
+                             "colours; the normals and weights were left out\n");
+  read = ReadPointCloud(ptx);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->positions, cloud.positions);
+  EXPECT_EQ(read->colors, cloud.colors);
+
   const std::string e57 = *dir_ + "/points.e57";
   const RunResult to_e57 = RunNeuralmesh({"convert", pcd, "-o", e57});
   ASSERT_EQ(to_e57.exit_code, 0) << to_e57.Describe();
@@ -514,7 +524,7 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
   const Refused refused[] = {
       {{"convert", xyz, "-o", *dir_ + "/points.obj"},
        "holds points without faces: OUTPUT '" + *dir_ + "/points.obj' must be a point cloud "
-       "format (.ply, .xyz, .txt, .pts, .las, .pcd, .e57, .drc, .glb, .gltf)"},
+       "format (.ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .e57, .drc, .glb, .gltf)"},
       {{"convert", "builtin:torus", "-o", *dir_ + "/torus.xyz"},
        "builtin:torus is a surface, not points"},
       {{"convert", xyz, "-o", glb, "--gltf_draco"}, "--gltf_draco compresses meshes"},

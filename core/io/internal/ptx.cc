@@ -1,12 +1,15 @@
 #include "core/io/internal/ptx.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/rgb.h"
@@ -153,6 +156,41 @@ absl::StatusOr<ParsedGeometry> ParsePtx(absl::string_view data) {
   }
   positions.MoveTo(&out);
   if (colored) out.colors = std::move(colors);
+  return out;
+}
+
+std::string FormatPtx(const GeometryView& points) {
+  const bool colored = !points.colors.empty();
+  // A point at (0, 0, 0) would read as an empty cell: the scan's frame then starts at an
+  // integer x left of every point.
+  double lowest_x = INFINITY;
+  bool at_zero = false;
+  for (const Vec3f& p : points.positions) {
+    const double x = points.origin[0] + p[0];
+    lowest_x = std::min(lowest_x, x);
+    at_zero = at_zero || (x == 0 && points.origin[1] + p[1] == 0 && points.origin[2] + p[2] == 0);
+  }
+  const double frame_x = at_zero ? std::floor(lowest_x) - 1 : 0;
+  const std::string x = absl::StrFormat("%.0f", frame_x);
+
+  std::string out;
+  out.reserve(points.positions.size() * (colored ? 48 : 36) + 128);
+  absl::StrAppend(&out, points.positions.size(), "\n1\n");  // Columns of one row.
+  absl::StrAppend(&out, x, " 0 0\n1 0 0\n0 1 0\n0 0 1\n");  // The scanner and its axes.
+  absl::StrAppend(&out, "1 0 0 0\n0 1 0 0\n0 0 1 0\n", x, " 0 0 1\n");  // Column by column.
+  const Point3d frame_origin = {points.origin[0] - frame_x, points.origin[1], points.origin[2]};
+  for (size_t i = 0; i < points.positions.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      AppendCoordinate(points.positions[i][c], frame_origin[c], &out);
+      out += ' ';
+    }
+    out += "0.5";
+    if (colored) {
+      const Rgb& rgb = points.colors[i];
+      absl::StrAppend(&out, " ", int{rgb[0]}, " ", int{rgb[1]}, " ", int{rgb[2]});
+    }
+    out += '\n';
+  }
   return out;
 }
 

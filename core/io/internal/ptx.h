@@ -4,6 +4,8 @@
 #ifndef NEURALMESH_CORE_IO_INTERNAL_PTX_H_
 #define NEURALMESH_CORE_IO_INTERNAL_PTX_H_
 
+#include <string>
+
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
@@ -22,6 +24,17 @@ namespace neuralmesh::io_internal {
 // is not a number, a scan that ends before its columns x rows points, or a file whose points
 // are all empty cells.
 absl::StatusOr<ParsedGeometry> ParsePtx(absl::string_view data);
+
+// Formats points as a PTX file of one scan: as many columns as points, of one row each,
+// "x y z intensity" per point, or "x y z intensity r g b" with colours (0-255 levels). The
+// coordinates are written as AppendCoordinate writes them (text.h), the origin put back. The
+// intensity, which the points do not carry, is 0.5 throughout. The scanner stands at the
+// registered frame's origin with its axes, and the transformation is the identity, but for a
+// cloud with a point at (0, 0, 0), which PTX reserves for an empty cell of the grid: the
+// scan's own frame then starts at an integer x left of every point (the scanner's position and
+// the transformation's translation), so that no point lies at its origin. Normals and weights
+// have no place in PTX and are not written.
+std::string FormatPtx(const GeometryView& points);
 
 }  // namespace neuralmesh::io_internal
 

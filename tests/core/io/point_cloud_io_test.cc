@@ -86,6 +86,10 @@ TEST_P(CloudRoundTripTest, WriteThenReadGivesTheSameCloud) {
     }
     EXPECT_EQ(read->normals, e57 ? cloud.normals : std::vector<Vec3f>{});
     EXPECT_TRUE(read->weights.empty());
+  } else if (std::string(extension) == ".ptx") {  // Exact text; no normals or weights.
+    EXPECT_EQ(read->positions, cloud.positions);
+    EXPECT_TRUE(read->normals.empty());
+    EXPECT_TRUE(read->weights.empty());
   } else if (std::string(extension) == ".drc") {
     ExpectSameCloud(cloud, *read,
                     io_test::QuantizationTolerance(io_test::BoundingCubeRange(cloud.positions), 11),
@@ -97,8 +101,8 @@ TEST_P(CloudRoundTripTest, WriteThenReadGivesTheSameCloud) {
 
 INSTANTIATE_TEST_SUITE_P(AllWritableFormats, CloudRoundTripTest,
                          ::testing::Combine(::testing::Values(".ply", ".xyz", ".txt", ".pts",
-                                                              ".las", ".pcd", ".e57", ".drc",
-                                                              ".glb", ".gltf"),
+                                                              ".ptx", ".las", ".pcd", ".e57",
+                                                              ".drc", ".glb", ".gltf"),
                                             ::testing::Bool(), ::testing::Bool()),
                          [](const auto& info) {
                            return std::string(std::get<0>(info.param) + 1) +
@@ -116,10 +120,11 @@ TEST(PointCloudIoTest, ExtensionHelpers) {
     EXPECT_FALSE(IsReadablePointCloudExtension(name)) << name << " should not be readable";
   }
   for (const char* name :
-       {"a.ply", "b.xyz", "c.txt", "d.pts", "g.DRC", "h.las", "i.glb", "j.PCD", "k.e57"}) {
+       {"a.ply", "b.xyz", "c.txt", "d.pts", "g.DRC", "h.las", "i.glb", "j.PCD", "k.e57",
+        "l.Ptx"}) {
     EXPECT_TRUE(IsWritablePointCloudExtension(name)) << name << " should be writable";
   }
-  for (const char* name : {"e.obj", "f.off", "a.stl", "b.ptx"}) {
+  for (const char* name : {"e.obj", "f.off", "a.stl"}) {
     EXPECT_FALSE(IsWritablePointCloudExtension(name)) << name << " should not be writable";
   }
   const WrittenPointAttributes ply = PointAttributesWrittenTo("a.ply");
@@ -129,7 +134,7 @@ TEST(PointCloudIoTest, ExtensionHelpers) {
   const WrittenPointAttributes e57 = PointAttributesWrittenTo("c.e57");
   EXPECT_TRUE(e57.normals && !e57.weights && e57.colors);
   const WrittenPointAttributes ptx = PointAttributesWrittenTo("d.ptx");
-  EXPECT_TRUE(!ptx.normals && !ptx.weights && !ptx.colors) << "PTX is not written";
+  EXPECT_TRUE(!ptx.normals && !ptx.weights && ptx.colors);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -453,7 +458,7 @@ TEST(PointCloudIoTest, MissingFileUnsupportedExtensionAndEmptyFile) {
   const absl::Status obj = WritePointCloud(kThree, TempPath("cloud.obj"));
   EXPECT_EQ(obj.code(), absl::StatusCode::kInvalidArgument) << obj;
   EXPECT_THAT(std::string(obj.message()),
-              HasSubstr(".ply, .xyz, .txt, .pts, .las, .pcd, .e57, .drc, .glb, .gltf"))
+              HasSubstr(".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .e57, .drc, .glb, .gltf"))
       << "the message should list the writable extensions";
 
   for (const char* name : {"empty.ply", "empty.xyz", "empty.obj", "empty.off", "empty.drc"}) {

@@ -424,6 +424,9 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
   const bool as_noise = records == LasOutlierRecords::kClassifiedAsNoise;
 
   std::string out(sources.front().data.substr(0, first.offset_to_points));
+  size_t total_size = 0;
+  for (const LasSource& source : sources) total_size += source.data.size();
+  out.reserve(total_size);
   Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
   uint64_t by_return[16] = {};
   uint64_t written = 0;
@@ -459,9 +462,9 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
           if (!(stored >= std::numeric_limits<int32_t>::min() &&
                 stored <= std::numeric_limits<int32_t>::max())) {
             return absl::FailedPreconditionError(absl::StrCat(
-                "the coordinates of '", sources[s].name, "' do not fit LAS's 32-bit integers at '",
-                sources.front().name, "''s offset and the scale ", scale[c], " of axis ",
-                absl::string_view("xyz").substr(c, 1)));
+                "the coordinates of '", sources[s].name,
+                "' do not fit LAS's 32-bit integers at the offset of '", sources.front().name,
+                "' and the scale ", scale[c], " of axis ", absl::string_view("xyz").substr(c, 1)));
           }
           StoreLittleEndian(static_cast<int32_t>(stored), put + 4 * c, &out);
           coordinate = stored * scale[c] + first.offset[c];

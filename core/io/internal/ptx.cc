@@ -1,6 +1,5 @@
 #include "core/io/internal/ptx.h"
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -9,7 +8,6 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/rgb.h"
@@ -63,6 +61,19 @@ absl::StatusOr<uint64_t> ReadCount(LineCursor* cursor, absl::string_view what,
                                   ", one non-negative integer, not ", Quoted((*tokens)[0])));
   }
   return static_cast<uint64_t>(value);
+}
+
+// Whether AppendCoordinate writes every coordinate of `p` as zero (no digit but 0), which PTX
+// reads as an empty cell. Only a coordinate within a float's rounding of -origin can be, so
+// the others are not written to find out.
+bool WrittenAsZero(const Vec3f& p, const Point3d& origin, std::string* text) {
+  for (int c = 0; c < 3; ++c) {
+    if (std::fabs(origin[c] + p[c]) > std::fabs(origin[c]) * 1e-6) return false;
+    text->clear();
+    AppendCoordinate(p[c], origin[c], text);
+    if (text->find_first_of("123456789") != std::string::npos) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -160,36 +171,46 @@ absl::StatusOr<ParsedGeometry> ParsePtx(absl::string_view data) {
 }
 
 std::string FormatPtx(const GeometryView& points) {
+  const size_t count = points.positions.size();
   const bool colored = !points.colors.empty();
-  // A point at (0, 0, 0) would read as an empty cell: the scan's frame then starts at an
-  // integer x left of every point.
-  double lowest_x = INFINITY;
-  bool at_zero = false;
-  for (const Vec3f& p : points.positions) {
-    const double x = points.origin[0] + p[0];
-    lowest_x = std::min(lowest_x, x);
-    at_zero = at_zero || (x == 0 && points.origin[1] + p[1] == 0 && points.origin[2] + p[2] == 0);
+  // The points that would read as empty cells go to scans of their own.
+  std::vector<bool> at_zero(count);
+  std::string text;
+  for (size_t i = 0; i < count; ++i) {
+    at_zero[i] = WrittenAsZero(points.positions[i], points.origin, &text);
   }
-  const double frame_x = at_zero ? std::floor(lowest_x) - 1 : 0;
-  const std::string x = absl::StrFormat("%.0f", frame_x);
-
   std::string out;
-  out.reserve(points.positions.size() * (colored ? 48 : 36) + 128);
-  absl::StrAppend(&out, points.positions.size(), "\n1\n");  // Columns of one row.
-  absl::StrAppend(&out, x, " 0 0\n1 0 0\n0 1 0\n0 0 1\n");  // The scanner and its axes.
-  absl::StrAppend(&out, "1 0 0 0\n0 1 0 0\n0 0 1 0\n", x, " 0 0 1\n");  // Column by column.
-  const Point3d frame_origin = {points.origin[0] - frame_x, points.origin[1], points.origin[2]};
-  for (size_t i = 0; i < points.positions.size(); ++i) {
-    for (int c = 0; c < 3; ++c) {
-      AppendCoordinate(points.positions[i][c], frame_origin[c], &out);
-      out += ' ';
+  out.reserve(count * (colored ? 48 : 36) + 160);
+  // A scan's header: its columns of one row, the scanner at the frame's origin with its axes,
+  // and the transformation, column by column: for points at zero, a translation by 1 in x,
+  // from which they lie at -1.
+  const auto append_header = [&out](size_t columns, bool for_zero) {
+    const char* translation = for_zero ? "1" : "0";
+    absl::StrAppend(&out, columns, "\n1\n", translation, " 0 0\n1 0 0\n0 1 0\n0 0 1\n",
+                    "1 0 0 0\n0 1 0 0\n0 0 1 0\n", translation, " 0 0 1\n");
+  };
+  if (count == 0) append_header(0, false);  // A file holds one scan at least.
+  for (size_t begin = 0; begin < count;) {
+    size_t end = begin;
+    while (end < count && at_zero[end] == at_zero[begin]) ++end;
+    append_header(end - begin, at_zero[begin]);
+    for (size_t i = begin; i < end; ++i) {
+      if (at_zero[i]) {
+        out += "-1 0 0 ";
+      } else {
+        for (int c = 0; c < 3; ++c) {
+          AppendCoordinate(points.positions[i][c], points.origin[c], &out);
+          out += ' ';
+        }
+      }
+      out += "0.5";
+      if (colored) {
+        const Rgb& rgb = points.colors[i];
+        absl::StrAppend(&out, " ", int{rgb[0]}, " ", int{rgb[1]}, " ", int{rgb[2]});
+      }
+      out += '\n';
     }
-    out += "0.5";
-    if (colored) {
-      const Rgb& rgb = points.colors[i];
-      absl::StrAppend(&out, " ", int{rgb[0]}, " ", int{rgb[1]}, " ", int{rgb[2]});
-    }
-    out += '\n';
+    begin = end;
   }
   return out;
 }

@@ -29,11 +29,11 @@ absl::StatusOr<ParsedGeometry> ParsePtx(absl::string_view data);
 // "x y z intensity" per point, or "x y z intensity r g b" with colours (0-255 levels). The
 // coordinates are written as AppendCoordinate writes them (text.h), the origin put back. The
 // intensity, which the points do not carry, is 0.5 throughout. The scanner stands at the
-// registered frame's origin with its axes, and the transformation is the identity, but for a
-// cloud with a point at (0, 0, 0), which PTX reserves for an empty cell of the grid: the
-// scan's own frame then starts at an integer x left of every point (the scanner's position and
-// the transformation's translation), so that no point lies at its origin. Normals and weights
-// have no place in PTX and are not written.
+// registered frame's origin with its axes, and the transformation is the identity. A point at
+// (0, 0, 0), which PTX reserves for an empty cell of the grid, goes instead to a scan of its
+// own (with those next to it), translated by 1 in x, in which it lies at (-1, 0, 0); so the
+// points read back in their order. Normals and weights have no place in PTX and are not
+// written.
 std::string FormatPtx(const GeometryView& points);
 
 }  // namespace neuralmesh::io_internal

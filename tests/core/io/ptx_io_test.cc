@@ -93,20 +93,19 @@ TEST(PtxIoTest, WrittenCloudsReadBackToTheSamePointsAndColours) {
   EXPECT_EQ(read->colors, cloud.colors);
 }
 
-// PTX reserves (0, 0, 0) for an empty cell of its grid: a cloud with a point there is written
-// in a scan frame that starts at an integer x left of every point, and reads back whole.
-TEST(PtxIoTest, APointAtZeroMovesTheScansFrameSoThatItIsKept) {
+// PTX reserves (0, 0, 0) for an empty cell of its grid: a point there is written in a scan of
+// its own, translated by 1 in x, where it lies at (-1, 0, 0); the points read back whole and
+// in their order.
+TEST(PtxIoTest, APointAtZeroIsWrittenInAScanOfItsOwnSoThatItIsKept) {
   PointCloud cloud;
-  cloud.positions = {Vec3f(0, 0, 0), Vec3f(2.5f, 1, 0), Vec3f(-3.25f, 0, 1)};
+  cloud.positions = {Vec3f(2.5f, 1, 0), Vec3f(0, 0, 0), Vec3f(-3.25f, 0, 1)};
   const std::string path = TempPath("at_zero.ptx");
   ASSERT_TRUE(WritePointCloud(cloud, path).ok());
-  const std::string text = io_test::ReadBytes(path);
-  // The scanner at x = -5 (floor(-3.25) - 1), and the translation too; the points relative to
-  // it.
-  EXPECT_TRUE(absl::StartsWith(text, "3\n1\n-5 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n"
-                                     "0 1 0 0\n0 0 1 0\n-5 0 0 1\n5 0 0 0.5\n7.5 1 0 0.5\n"
-                                     "1.75 0 1 0.5\n"))
-      << text;
+  const std::string axes = "1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n";
+  EXPECT_EQ(io_test::ReadBytes(path),
+            "1\n1\n0 0 0\n" + axes + "0 0 0 1\n2.5 1 0 0.5\n" +  //
+                "1\n1\n1 0 0\n" + axes + "1 0 0 1\n-1 0 0 0.5\n" +    //
+                "1\n1\n0 0 0\n" + axes + "0 0 0 1\n-3.25 0 1 0.5\n");
   PointsLeftOut left_out;
   const absl::StatusOr<PointCloud> read = ReadPointCloud(path, &left_out);
   ASSERT_TRUE(read.ok()) << read.status();

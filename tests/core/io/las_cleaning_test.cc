@@ -394,6 +394,51 @@ TEST(LasCleaningTest, TilesJoinIntoOneFileOnTheFinestScale) {
   }
 }
 
+// LAS 1.4 tiles joined: the records of both, then the extended records once, their start moved
+// past all the records; the 64-bit counts summed, the legacy ones left zero. Tiles whose
+// extended records differ are refused.
+TEST(LasCleaningTest, Las14TilesJoinWithTheirExtendedRecordsOnceAfterThePoints) {
+  LasLayout layout;
+  layout.version_minor = 4;
+  layout.format = 7;
+  layout.record_length = 36 + 4;
+  layout.vlrs = VariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM 33N\"]", false);
+  layout.vlr_count = 1;
+  layout.after_points = VariableLengthRecord("tile_notes", 1, "a survey's notes", true);
+  layout.evlr_count = 1;
+  const std::string in_a = LasFile(layout, VariedPoints(3));
+  const std::string in_b = LasFile(layout, VariedPoints(4));
+  const std::string tile_a = TempPath("tile14_a.las"), tile_b = TempPath("tile14_b.las");
+  WriteBytes(tile_a, in_a);
+  WriteBytes(tile_b, in_b);
+  const std::string written = TempPath("joined14.las");
+  const absl::Status status = WriteCleanedLas({tile_a, tile_b}, std::vector<bool>(7, false),
+                                              LasOutlierRecords::kLeftOut, written);
+  ASSERT_TRUE(status.ok()) << status;
+  const std::string out = ReadBytes(written);
+  const size_t first = 375 + layout.vlrs.size();
+  ASSERT_EQ(out.size(), first + 7 * 40 + layout.after_points.size());
+  EXPECT_EQ(out.substr(first, 3 * 40), in_a.substr(first, 3 * 40)) << "a's records";
+  EXPECT_EQ(out.substr(first + 3 * 40, 4 * 40), in_b.substr(first, 4 * 40)) << "b's records";
+  const uint64_t evlr_start = Field<uint64_t>(out, 235);
+  EXPECT_EQ(evlr_start, first + 7 * 40);
+  EXPECT_EQ(out.substr(evlr_start), layout.after_points);
+  EXPECT_EQ(Field<uint64_t>(out, 247), 7u) << "point count";
+  EXPECT_EQ(Field<uint32_t>(out, 107), 0u) << "the legacy count stays zero";
+  // Return numbers (VariedPoints): 1, 2, 3 in a, then 1, 2, 3, 1 in b.
+  EXPECT_EQ(Field<uint64_t>(out, 255), 3u) << "first returns";
+  EXPECT_EQ(Field<uint64_t>(out, 263), 2u) << "second returns";
+  EXPECT_EQ(Field<uint64_t>(out, 271), 2u) << "third returns";
+
+  LasLayout other = layout;
+  other.after_points = VariableLengthRecord("tile_notes", 1, "another survey's", true);
+  WriteBytes(tile_b, LasFile(other, VariedPoints(4)));
+  const absl::Status refused = WriteCleanedLas({tile_a, tile_b}, std::vector<bool>(7, false),
+                                               LasOutlierRecords::kLeftOut, written);
+  EXPECT_EQ(refused.code(), absl::StatusCode::kFailedPrecondition) << refused;
+  EXPECT_THAT(std::string(refused.message()), HasSubstr("what follows the points of '"));
+}
+
 // Tiles whose records cannot share one file are refused, saying which and why.
 TEST(LasCleaningTest, TilesThatCannotShareAFileAreRefusedSayingWhy) {
   const auto joined = [](const LasLayout& a, const LasLayout& b) {

@@ -26,6 +26,8 @@ struct HttpRequest {
   // Set by HttpServer: the client sent a certificate that the TLS context's client CAs signed
   // (TlsServerContext::Create).
   bool client_certificate = false;
+  // And that certificate's common name (empty without one).
+  std::string client_common_name;
 };
 
 // Parses a request head: the request line and the header lines, each ending in CRLF (or LF),

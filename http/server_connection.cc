@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <climits>
+#include <string>
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
@@ -69,6 +70,23 @@ bool ServerConnection::client_certificate_verified() const {
   if (certificate == nullptr) return false;
   X509_free(certificate);
   return SSL_get_verify_result(tls_) == X509_V_OK;
+}
+
+std::string ServerConnection::client_common_name() const {
+  if (!client_certificate_verified()) return "";
+  X509* certificate = SSL_get1_peer_certificate(tls_);
+  std::string name;
+  const X509_NAME* subject = X509_get_subject_name(certificate);
+  const int at = X509_NAME_get_index_by_NID(subject, NID_commonName, -1);
+  if (at >= 0) {
+    const ASN1_STRING* text = X509_NAME_ENTRY_get_data(X509_NAME_get_entry(subject, at));
+    unsigned char* utf8 = nullptr;
+    const int length = ASN1_STRING_to_UTF8(&utf8, text);
+    if (length > 0) name.assign(reinterpret_cast<const char*>(utf8), length);
+    OPENSSL_free(utf8);
+  }
+  X509_free(certificate);
+  return name;
 }
 
 absl::Status ServerConnection::AcceptTls(const TlsServerContext& context) {

@@ -7,6 +7,7 @@
 #define NEURALMESH_HTTP_SERVER_CONNECTION_H_
 
 #include <cstddef>
+#include <string>
 
 #include "absl/status/status.h"
 #include "absl/strings/string_view.h"
@@ -38,6 +39,10 @@ class ServerConnection {
   // Whether the client sent, in the handshake of AcceptTls, a certificate that the context's
   // client CAs signed (false without TLS or without client CAs).
   bool client_certificate_verified() const;
+
+  // The common name of that verified certificate's subject (its first, as gRPC takes it);
+  // empty without one, or when it has none.
+  std::string client_common_name() const;
 
   // Up to `size` bytes; 0 when the peer closed, the read deadline passed or the connection
   // failed.

@@ -45,6 +45,13 @@ void ClientCertificateIdentity::ReplaceRoles(ClientRoles roles) {
   roles_ = std::move(roles);
 }
 
+std::optional<AccessRole> ClientCertificateIdentity::RoleOf(
+    absl::string_view common_name) const {
+  absl::MutexLock lock(&mu_);
+  if (auto it = roles_.find(common_name); it != roles_.end()) return it->second;
+  return others_;
+}
+
 grpc::Status ClientCertificateIdentity::Process(const InputMetadata& /*auth_metadata*/,
                                                 grpc::AuthContext* context,
                                                 OutputMetadata* /*consumed_auth_metadata*/,
@@ -56,11 +63,7 @@ grpc::Status ClientCertificateIdentity::Process(const InputMetadata& /*auth_meta
                         "the client certificate has no common name to name its client by");
   }
   const absl::string_view name(names.front().data(), names.front().size());
-  std::optional<AccessRole> role = others_;
-  {
-    absl::MutexLock lock(&mu_);
-    if (auto it = roles_.find(name); it != roles_.end()) role = it->second;
-  }
+  const std::optional<AccessRole> role = RoleOf(name);
   if (!role.has_value()) {
     return grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
                         absl::StrCat("the client certificate's common name \"", name,

@@ -43,13 +43,16 @@ class ClientCertificateIdentity : public grpc::AuthMetadataProcessor {
   // Replaces the roles by common name for calls that start from now on (SIGHUP).
   void ReplaceRoles(ClientRoles roles) ABSL_LOCKS_EXCLUDED(mu_);
 
+  // The role of a certificate with this common name; none when it has none (refused).
+  std::optional<AccessRole> RoleOf(absl::string_view common_name) const ABSL_LOCKS_EXCLUDED(mu_);
+
   bool IsBlocking() const override { return false; }
   grpc::Status Process(const InputMetadata& auth_metadata, grpc::AuthContext* context,
                        OutputMetadata* consumed_auth_metadata,
                        OutputMetadata* response_metadata) override ABSL_LOCKS_EXCLUDED(mu_);
 
  private:
-  absl::Mutex mu_;
+  mutable absl::Mutex mu_;
   ClientRoles roles_ ABSL_GUARDED_BY(mu_);
   const std::optional<AccessRole> others_;
 };

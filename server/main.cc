@@ -120,8 +120,10 @@ ABSL_FLAG(bool, metrics_tls, false,
 ABSL_FLAG(bool, metrics_client_certificate, false,
           "With --metrics_tls and --tls_client_ca_file: /metrics answers only clients that "
           "present a certificate the client CAs signed (403 otherwise; Prometheus: "
-          "tls_config.cert_file and key_file); /healthz stays open to probes without one. "
-          "SIGHUP reads the CAs again with the certificate.");
+          "tls_config.cert_file and key_file), and with --client_roles_file or "
+          "--client_certificate_role only those whose certificate's common name has a role; "
+          "/healthz stays open to probes without one. SIGHUP reads the CAs again with the "
+          "certificate, and the roles.");
 ABSL_FLAG(std::string, metrics_token_file, "",
           "File holding a token (16 or more letters, digits or -._~) that /metrics asks for "
           "as 'Authorization: Bearer TOKEN' (401 otherwise; Prometheus: authorization."

@@ -89,6 +89,13 @@ http::HttpResponse AnswerMetricsRequest(const http::HttpRequest& request,
                                 "/metrics needs a client certificate signed by the server's "
                                 "client CA (--tls_client_ca_file)");
     }
+    if (sources.require_client_certificate && sources.client_role &&
+        !sources.client_role(request.client_common_name).has_value()) {
+      return http::TextResponse(
+          403, absl::StrCat("the client certificate's common name \"",
+                            request.client_common_name,
+                            "\" has no role on this server (--client_roles_file)"));
+    }
     if (sources.access != nullptr && !sources.access->Admits(request)) {
       return http::BearerChallenge(
           "neuralmesh metrics",

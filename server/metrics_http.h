@@ -11,13 +11,16 @@
 // methods 405 (http/http_server.h). With a token (--metrics_token_file), /metrics answers only
 // requests that bring it ("Authorization: Bearer TOKEN"; 401 otherwise), and with client
 // certificates (--metrics_client_certificate) only clients that present one the server's
-// client CAs signed (403 otherwise); /healthz and / stay open to probes, as they tell nothing
-// but whether the server serves.
+// client CAs signed, and where clients have roles by their certificates' common names
+// (--client_roles_file, --client_certificate_role), one whose name has a role (403
+// otherwise); /healthz and / stay open to probes, as they tell nothing but whether the server
+// serves.
 #ifndef NEURALMESH_SERVER_METRICS_HTTP_H_
 #define NEURALMESH_SERVER_METRICS_HTTP_H_
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -25,7 +28,9 @@
 #include "absl/status/status.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
+#include "absl/strings/string_view.h"
 #include "http/http_message.h"
+#include "server/access_tokens.h"
 #include "server/server_metrics.h"
 #include "server/session_manager.h"
 
@@ -60,6 +65,9 @@ struct MetricsSources {
   // Whether /metrics needs a verified client certificate (http::HttpRequest::
   // client_certificate) besides what `access` asks.
   bool require_client_certificate = false;
+  // With it: the role of a certificate's common name (null: any certificate will do); a
+  // client whose name has none is refused.
+  std::function<std::optional<AccessRole>(absl::string_view common_name)> client_role;
 };
 
 // The /metrics page's text.

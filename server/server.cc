@@ -194,6 +194,12 @@ absl::StatusOr<std::unique_ptr<ReconstructionServer>> ReconstructionServer::Star
       sources.access = server->metrics_access_;
     }
     sources.require_client_certificate = options.metrics_client_certificate;
+    // Where clients have roles by their certificates, the page follows them, as renewed.
+    if (std::shared_ptr<ClientCertificateIdentity> identity = server->certificate_identity_) {
+      sources.client_role = [identity](absl::string_view common_name) {
+        return identity->RoleOf(common_name);
+      };
+    }
     std::string host =
         options.metrics_host.empty() ? HostOf(options.address) : options.metrics_host;
     if (host.empty()) host = "127.0.0.1";  // In-process only: no network the server listens on.

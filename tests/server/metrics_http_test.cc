@@ -368,6 +368,45 @@ TEST(MetricsHttpTest, WithClientCertificatesOnlyAClientOfTheClientCaReadsTheMetr
   EXPECT_THAT(status.message(), HasSubstr("it needs metrics_tls and client CAs"));
 }
 
+// With client roles by certificate (--client_roles_file), /metrics answers only clients whose
+// certificate's common name has a role, as the roles stand after a renewal (SIGHUP).
+TEST(MetricsHttpTest, WithClientRolesOnlyACommonNameWithARoleReadsTheMetrics) {
+  absl::StatusOr<neuralmesh::testing::TestCertificates> certificates =
+      neuralmesh::testing::MakeTestCertificates(neuralmesh::testing::MakeTempDir("metrics_roles"));
+  ASSERT_TRUE(certificates.ok()) << certificates.status();
+  ServerOptions options;
+  options.security.tls.certificate_chain = certificates->server_chain;
+  options.security.tls.private_key = certificates->server_key;
+  options.security.tls.client_ca_certificates = certificates->ca;
+  options.security.client_roles = {{"neuralmesh-test-client", AccessRole::kReader}};
+  options.metrics_tls = true;
+  options.metrics_client_certificate = true;
+  std::unique_ptr<ReconstructionServer> server = StartWithMetrics(options);
+  ASSERT_NE(server, nullptr);
+  HttpsTarget client;
+  client.port = server->metrics_port();
+  client.ca = certificates->ca;
+  client.client_chain = certificates->client_chain;
+  client.client_key = certificates->client_key;
+  HttpsTarget second = client;
+  second.client_chain = certificates->second_client_chain;
+  second.client_key = certificates->second_client_key;
+
+  std::string error;
+  EXPECT_EQ(HttpsGet(client, "/metrics", "", &error).status, 200) << error;
+  const HttpReply refused = HttpsGet(second, "/metrics", "", &error);
+  EXPECT_EQ(refused.status, 403) << error;
+  EXPECT_EQ(refused.body,
+            "the client certificate's common name \"neuralmesh-test-second_client\" has no role "
+            "on this server (--client_roles_file)\n");
+  EXPECT_EQ(HttpsGet(second, "/healthz").status, 200) << "probes need no role";
+
+  ASSERT_TRUE(
+      server->ReplaceClientRoles({{"neuralmesh-test-second_client", AccessRole::kUser}}).ok());
+  EXPECT_EQ(HttpsGet(second, "/metrics", "", &error).status, 200) << error;
+  EXPECT_EQ(HttpsGet(client, "/metrics").status, 403);
+}
+
 TEST(MetricsHttpTest, TlsAndATokenNeedAMetricsPageAndTlsNeedsACertificate) {
   ServerOptions options;
   options.address = "127.0.0.1:0";

@@ -65,6 +65,18 @@ std::unique_ptr<ReconstructionServer> StartWithMetrics(ServerOptions options = {
   return server;
 }
 
+// A server whose metrics page speaks HTTPS and asks for a client certificate of the client
+// CA (--metrics_tls, --metrics_client_certificate).
+ServerOptions MetricsForClientCertificates(const neuralmesh::testing::TestCertificates& tls) {
+  ServerOptions options;
+  options.security.tls.certificate_chain = tls.server_chain;
+  options.security.tls.private_key = tls.server_key;
+  options.security.tls.client_ca_certificates = tls.ca;
+  options.metrics_tls = true;
+  options.metrics_client_certificate = true;
+  return options;
+}
+
 TEST(MetricsHttpTest, CountsASessionsWorkAndTheCallsByStatus) {
   std::unique_ptr<ReconstructionServer> server = StartWithMetrics();
   ASSERT_NE(server, nullptr);
@@ -320,12 +332,7 @@ TEST(MetricsHttpTest, WithClientCertificatesOnlyAClientOfTheClientCaReadsTheMetr
   absl::StatusOr<neuralmesh::testing::TestCertificates> certificates =
       neuralmesh::testing::MakeTestCertificates(neuralmesh::testing::MakeTempDir("metrics_mtls"));
   ASSERT_TRUE(certificates.ok()) << certificates.status();
-  ServerOptions options;
-  options.security.tls.certificate_chain = certificates->server_chain;
-  options.security.tls.private_key = certificates->server_key;
-  options.security.tls.client_ca_certificates = certificates->ca;
-  options.metrics_tls = true;
-  options.metrics_client_certificate = true;
+  ServerOptions options = MetricsForClientCertificates(*certificates);
   std::unique_ptr<ReconstructionServer> server = StartWithMetrics(options);
   ASSERT_NE(server, nullptr);
   HttpsTarget target;
@@ -374,13 +381,8 @@ TEST(MetricsHttpTest, WithClientRolesOnlyACommonNameWithARoleReadsTheMetrics) {
   absl::StatusOr<neuralmesh::testing::TestCertificates> certificates =
       neuralmesh::testing::MakeTestCertificates(neuralmesh::testing::MakeTempDir("metrics_roles"));
   ASSERT_TRUE(certificates.ok()) << certificates.status();
-  ServerOptions options;
-  options.security.tls.certificate_chain = certificates->server_chain;
-  options.security.tls.private_key = certificates->server_key;
-  options.security.tls.client_ca_certificates = certificates->ca;
+  ServerOptions options = MetricsForClientCertificates(*certificates);
   options.security.client_roles = {{"neuralmesh-test-client", AccessRole::kReader}};
-  options.metrics_tls = true;
-  options.metrics_client_certificate = true;
   std::unique_ptr<ReconstructionServer> server = StartWithMetrics(options);
   ASSERT_NE(server, nullptr);
   HttpsTarget client;

@@ -235,7 +235,9 @@ void HttpServer::Serve(int fd, absl::Time read_deadline) {
         Respond(connection, response, true);
       } else {
         request->client_certificate = connection.client_certificate_verified();
-        request->client_common_name = connection.client_common_name();
+        if (request->client_certificate) {
+          request->client_common_name = connection.client_common_name();
+        }
         Respond(connection, handler_(*request), request->method == "GET");
       }
     } else if (absl::IsResourceExhausted(head.status())) {

@@ -73,11 +73,14 @@ bool ServerConnection::client_certificate_verified() const {
 }
 
 std::string ServerConnection::client_common_name() const {
-  if (!client_certificate_verified()) return "";
+  if (tls_ == nullptr) return "";
   X509* certificate = SSL_get1_peer_certificate(tls_);
+  if (certificate == nullptr) return "";
   std::string name;
   const X509_NAME* subject = X509_get_subject_name(certificate);
-  const int at = X509_NAME_get_index_by_NID(subject, NID_commonName, -1);
+  const int at = SSL_get_verify_result(tls_) == X509_V_OK
+                     ? X509_NAME_get_index_by_NID(subject, NID_commonName, -1)
+                     : -1;
   if (at >= 0) {
     const ASN1_STRING* text = X509_NAME_ENTRY_get_data(X509_NAME_get_entry(subject, at));
     unsigned char* utf8 = nullptr;

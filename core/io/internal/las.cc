@@ -217,6 +217,7 @@ absl::Status CheckJoinable(const std::vector<LasSource>& sources,
   const LasHeader& first = headers.front();
   const std::string a = absl::StrCat("'", sources.front().name, "'");
   const absl::string_view first_after = sources.front().data.substr(first.points_end());
+  const std::string first_interpreting = InterpretingRecords(sources.front().data, first);
   for (size_t s = 1; s < sources.size(); ++s) {
     const LasHeader& header = headers[s];
     const std::string b = absl::StrCat("'", sources[s].name, "'");
@@ -230,7 +231,7 @@ absl::Status CheckJoinable(const std::vector<LasSource>& sources,
           b, " has point format ", int{header.format}, " (records of ", header.record_length,
           " bytes) and ", a, " format ", int{first.format}, " (", first.record_length, ")"));
     }
-    if (InterpretingRecords(data, header) != InterpretingRecords(sources.front().data, first)) {
+    if (InterpretingRecords(data, header) != first_interpreting) {
       return absl::FailedPreconditionError(
           absl::StrCat("the coordinate systems or extra bytes of ", b, " and ", a, " differ"));
     }
@@ -476,15 +477,17 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
       ++written;
     }
   }
-  std::vector<std::string> names;
-  for (const LasSource& source : sources) names.push_back(absl::StrCat("'", source.name, "'"));
+  const auto names = [&sources] {
+    return absl::StrJoin(sources, ", ", [](std::string* out, const LasSource& source) {
+      absl::StrAppend(out, "'", source.name, "'");
+    });
+  };
   if (outliers.size() != usable) {
     return Invalid(absl::StrCat(outliers.size(), " flags for the ", usable, " points read from ",
-                                absl::StrJoin(names, ", "),
-                                " (withheld, noise or other classes left out)"));
+                                names(), " (withheld, noise or other classes left out)"));
   }
   if (written == 0 && !as_noise) {
-    return Invalid(absl::StrCat("no point of ", absl::StrJoin(names, ", "), " is kept"));
+    return Invalid(absl::StrCat("no point of ", names(), " is kept"));
   }
   const bool extended_counts = first.minor >= 4 && first.header_size >= kHeaderSize14;
   constexpr uint64_t kLegacyMax = std::numeric_limits<uint32_t>::max();

@@ -513,6 +513,7 @@ absl::StatusOr<std::string> FormatPcd(const GeometryView& geometry, PcdData data
                    "holds (sizes of 32 bits); write them as binary");
   }
   std::string columns;
+  columns.reserve(n * record_bytes);
   for (int f : written) {
     for (size_t i = 0; i < n; ++i) append_field(f, i, &columns);
   }

@@ -80,33 +80,34 @@ struct ConvertOptions {
   // cloud files, written as one.
   std::vector<std::string> inputs;
   // Its extension picks the format: a mesh's (kMeshExtensions) or a point cloud's (.ply .xyz
-  // .txt .pts .ptx .las .pcd .e57 .drc .glb .gltf).
+  // .txt .pts .ptx .las .laz .pcd .e57 .drc .glb .gltf).
   std::string output;
   MeshWriteOptions writing;  // Draco settings, glTF compression (meshes only).
   // Set: a point cloud's statistical outliers are removed before it is written.
   std::optional<OutlierOptions> outliers;
   PointSelection selection;  // Which points of a LAS file are read (and, LAS to LAS, kept).
   PcdData pcd_data = PcdData::kBinary;  // How a .pcd OUTPUT stores its points.
-  // With `outliers`, from one .las file to .las: the outliers' records are kept, classified as
-  // noise (ASPRS class 7), instead of removed.
+  // With `outliers`, from LAS files (.las, .laz) to LAS: the outliers' records are kept,
+  // classified as noise (ASPRS class 7), instead of removed.
   bool outliers_as_noise = false;
 };
 
 // Writes INPUT to OUTPUT, colours included where the format holds them. A mesh (a file with
 // faces, or builtin:NAME) is written as a mesh, and "OUTPUT: V vertices, F faces" printed
-// (", with colours"). Points (a .xyz/.txt/.pts/.ptx/.las/.pcd/.e57 file, a file without faces,
-// or any file written to .xyz/.txt/.pts/.ptx/.las/.pcd/.e57) are written as a point cloud with
-// their normals, weights and colours where the format holds them, and "OUTPUT: N points"
-// printed (", with normals, weights, colours"; how many outliers went; what LAS, PTX or E57
-// leaves out).
-// .las INPUTs written to .las are copied record by record instead (core/io/las_cleaning.h),
-// their outliers left out or, with outliers_as_noise, classified as noise; several whose
-// records cannot share one file (another point format, coordinate system, ...) are written as
-// points, and the line says why.
+// (", with colours"). Points (a .xyz/.txt/.pts/.ptx/.las/.laz/.pcd/.e57 file, a file without
+// faces, or any file written to .xyz/.txt/.pts/.ptx/.las/.laz/.pcd/.e57) are written as a point
+// cloud with their normals, weights and colours where the format holds them, and "OUTPUT: N
+// points" printed (", with normals, weights, colours"; how many outliers went; what LAS, PTX or
+// E57 leaves out).
+// LAS INPUTs (.las, .laz) written to LAS are copied record by record instead
+// (core/io/las_cleaning.h), their outliers left out or, with outliers_as_noise, classified as
+// noise; several whose records cannot share one file (another point format, coordinate system,
+// ...) are written as points, and the line says why (so are records of formats 4-10 written to
+// .laz).
 // INVALID_ARGUMENT for an unknown output extension (before reading INPUT), a mesh format for
 // points that are not a mesh (.obj, .off, .stl), a point format for a builtin surface,
 // --remove_outliers for a mesh, --gltf_draco for points, outliers_as_noise for anything but
-// .las INPUTs whose records share a .las OUTPUT, and the reader's and writer's errors.
+// LAS INPUTs whose records share a LAS OUTPUT, and the reader's and writer's errors.
 absl::Status RunConvert(const ConvertOptions& options, std::ostream& out);
 
 }  // namespace neuralmesh::client

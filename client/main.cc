@@ -31,6 +31,7 @@
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/draco_codec.h"
 #include "core/io/file_contents.h"
+#include "core/io/las_cleaning.h"
 #include "core/io/point_selection.h"
 #include "core/learning/learner_options.h"
 #include "core/status_macros.h"
@@ -46,7 +47,7 @@ ABSL_FLAG(std::string, output, "",
           "Local reconstruct: the mesh to write; the extension picks the format (.ply .obj .off "
           ".stl .drc .glb .gltf). LOD files go beside it as <stem>_lod<N><ext>. get: where the "
           "session's mesh goes. convert: the file written (a mesh's format, or a point cloud's: "
-          ".ply .xyz .txt .pts .ptx .las .pcd .e57 .drc .glb .gltf).");
+          ".ply .xyz .txt .pts .ptx .las .laz .pcd .e57 .drc .glb .gltf).");
 ABSL_FLAG(uint64_t, vertices, 0,
           "Vertex count of the final mesh (met exactly). Required for a local reconstruct; with "
           "--server, 0 means one vertex per 2 points, at most 10000.");
@@ -147,7 +148,7 @@ ABSL_FLAG(int32_t, outlier_passes, neuralmesh::OutlierOptions{}.passes,
           "the one before kept (a few far strays widen the deviation enough to hide milder "
           "ones from the first). The server's filter (--outliers_on_server) makes one.");
 ABSL_FLAG(bool, outliers_as_noise, false,
-          "With --remove_outliers, converting .las files to .las: keep the outliers' "
+          "With --remove_outliers, converting .las/.laz files to .las/.laz: keep the outliers' "
           "records, classified as noise (ASPRS class 7, low point; the readers leave such "
           "points out), instead of removing them, as PDAL's outlier filter marks them.");
 ABSL_FLAG(bool, outliers_on_server, false,
@@ -316,11 +317,10 @@ absl::StatusOr<neuralmesh::PointSelection> SelectionFromFlags(
   if (!parsed.ok()) {
     return absl::InvalidArgumentError(absl::StrCat("--las_classes: ", parsed.status().message()));
   }
-  if (std::none_of(inputs.begin(), inputs.end(), [](const std::string& input) {
-        return absl::EndsWithIgnoreCase(input, ".las");
-      })) {
+  if (std::none_of(inputs.begin(), inputs.end(), neuralmesh::IsLasPath)) {
     return absl::InvalidArgumentError(
-        "--las_classes selects the points of LAS files by class; no INPUT is a .las file");
+        "--las_classes selects the points of LAS files by class; no INPUT is a .las or .laz "
+        "file");
   }
   selection.las_classes = *parsed;
   return selection;
@@ -688,8 +688,8 @@ std::vector<Subcommand> Commands() {
        "       neuralmesh reconstruct INPUT... --server HOST:PORT --out-dir DIR [--vertices N] "
        "[--batch-size K] [--ply] [--glb] [--resume SESSION] [--reconnect_for D]",
        "Learns a mesh of a point cloud, a mesh or a built-in surface, locally or on a server.",
-       "Learns a mesh of INPUT: a point cloud (.ply .xyz .txt .pts .ptx .las .pcd .e57 .obj\n"
-       ".off .drc .glb .gltf), a triangle mesh with --sampling area|curvature, or\n"
+       "Learns a mesh of INPUT: a point cloud (.ply .xyz .txt .pts .ptx .las .laz .pcd .e57\n"
+       ".obj .off .drc .glb .gltf), a triangle mesh with --sampling area|curvature, or\n"
        "builtin:sphere|torus|genus2. Several point cloud files (the scans of one site, a file\n"
        "per station or tile) are learned as one, each where its coordinates put it.\n"
        "Locally it writes OUTPUT and one OUTPUT_lod<N> file per --lod; with --server it\n"
@@ -710,15 +710,16 @@ std::vector<Subcommand> Commands() {
        "Writes INPUT to OUTPUT in the format of its extension, colours included where the\n"
        "format holds them. A mesh (a file with faces, or builtin:NAME, its dense reference\n"
        "tessellation) goes to .ply .obj .off .stl .drc .glb .gltf; points (.xyz .txt .pts\n"
-       ".ptx .las .pcd .e57, a file without faces, or anything written to .xyz .txt .pts\n"
-       ".ptx .las .pcd .e57) go to .ply .xyz .txt .pts .ptx .las .pcd .e57 .drc .glb .gltf\n"
-       "with their normals and weights (LAS, PTX: positions and colours only; E57: no\n"
-       "weights), after --remove_outliers if given. Several point cloud files are written as\n"
-       "one. .las files written to .las keep their records whole (classes, intensities,\n"
-       "times, extra bytes) and the first file's offset and variable-length records (the\n"
-       "coordinate system); tiles are joined so when they share the version, point format,\n"
-       "coordinate system and extra bytes. --outliers_as_noise classifies the outliers as\n"
-       "noise instead of removing them.",
+       ".ptx .las .laz .pcd .e57, a file without faces, or anything written to .xyz .txt\n"
+       ".pts .ptx .las .laz .pcd .e57) go to .ply .xyz .txt .pts .ptx .las .laz .pcd .e57\n"
+       ".drc .glb .gltf with their normals and weights (LAS, PTX: positions and colours\n"
+       "only; E57: no weights), after --remove_outliers if given. Several point cloud files\n"
+       "are written as one. LAS files (.las, or .laz compressed by LASzip) written to .las or\n"
+       ".laz keep their records whole (classes, intensities, times, extra bytes) and the\n"
+       "first file's offset and variable-length records (the coordinate system); tiles are\n"
+       "joined so when they share the version, point format, coordinate system and extra\n"
+       "bytes (and, for .laz, a point format of 0 to 3). --outliers_as_noise classifies the\n"
+       "outliers as noise instead of removing them.",
        {"output", "gltf_draco", "pcd_data", "las_classes", "remove_outliers",
         "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "outliers_as_noise", "quantization_bits", "encode_speed"},

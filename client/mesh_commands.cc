@@ -149,14 +149,12 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
     return absl::InvalidArgumentError(
         "--gltf_draco compresses meshes; points are written to glTF uncompressed (or to .drc)");
   }
-  // LAS to LAS: the records themselves, with what a PointCloud does not hold.
-  const bool las_to_las =
-      absl::EndsWithIgnoreCase(options.output, ".las") &&
-      std::all_of(options.inputs.begin(), options.inputs.end(),
-                  [](const std::string& input) { return absl::EndsWithIgnoreCase(input, ".las"); });
+  // LAS to LAS (.las or .laz): the records themselves, with what a PointCloud does not hold.
+  const bool las_to_las = IsLasPath(options.output) &&
+                          std::all_of(options.inputs.begin(), options.inputs.end(), IsLasPath);
   if (options.outliers_as_noise && !las_to_las) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "--outliers_as_noise classifies the outliers of .las INPUTs in a .las OUTPUT; "
+        "--outliers_as_noise classifies the outliers of .las/.laz INPUTs in a .las/.laz OUTPUT; "
         "INPUT ", QuotedInputs(options.inputs), " to OUTPUT '", options.output,
         "' can only leave them out"));
   }

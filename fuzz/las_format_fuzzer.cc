@@ -5,7 +5,8 @@
 // LAS stores integers. A parsed file cleaned of every other point (FormatCleanedLas) reads back
 // to the points kept; with those classified as noise instead, to the same points; joined
 // with itself as a second tile, to the points kept twice; all with the default classes and
-// with some asked for.
+// with some asked for. A LAZ input is read as the LAS file it compresses, and cleaned as that
+// (laz_format_fuzzer checks the codec itself).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "core/io/internal/las.h"
+#include "core/io/internal/laz.h"
 #include "fuzz/fuzz_check.h"
 #include "fuzz/geometry_parser_properties.h"
 
@@ -104,7 +106,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       },
       nullptr, /*skips_faces=*/false};
   neuralmesh::fuzz::CheckGeometryParser(las, data, size);
-  const absl::string_view bytes(reinterpret_cast<const char*>(data), size);
+  absl::string_view bytes(reinterpret_cast<const char*>(data), size);
+  std::string decompressed;
+  if (neuralmesh::io_internal::IsLaz(bytes)) {
+    absl::StatusOr<std::string> las = neuralmesh::io_internal::DecompressLaz(bytes);
+    if (!las.ok()) return 0;  // ParseLas refuses it as well, checked above.
+    decompressed = *std::move(las);
+    bytes = decompressed;
+  }
   const absl::StatusOr<ParsedGeometry> parsed = neuralmesh::io_internal::ParseLas(bytes);
   if (parsed.ok()) {
     CheckWrittenAgain(*parsed);

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package that building, testing and running neuralmesh needs, the
 # live viewer's three.js from the npm registry into client/web/node_modules, and the tests'
-# independent E57 reader (web-e57) into tests/tools/node_modules (`npm ci`, the versions pinned
-# by each folder's package-lock.json).
+# independent E57 and LAZ readers (web-e57, laz-perf) into tests/tools/node_modules (`npm ci`,
+# the versions pinned by each folder's package-lock.json).
 # Idempotent: when everything is already installed it only checks and returns.
 #
 # Usage: scripts/install-deps.sh [EXTRA_PACKAGE...]
@@ -51,7 +51,7 @@ else
 fi
 
 # npm packages, once per change of a lock file: three.js for the viewer (client/web), and the
-# independent readers the tests check written files with (tests/tools: web-e57).
+# independent readers the tests check written files with (tests/tools: web-e57, laz-perf).
 root="$(cd "$(dirname "$0")/.." && pwd)"
 for dir in client/web tests/tools; do
   lock="${root}/${dir}/package-lock.json"

@@ -5,9 +5,14 @@
 #include "core/io/file_contents.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/las.h"
+#include "core/io/internal/laz.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh {
+
+bool IsLasPath(const std::string& path) {
+  return io_internal::FormatFromPath(path) == io_internal::FileFormat::kLas;
+}
 
 absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
                              const std::vector<bool>& outliers, LasOutlierRecords records,
@@ -15,18 +20,27 @@ absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
   std::vector<std::string> contents;
   contents.reserve(sources.size());
   for (const std::string& source : sources) {
-    if (io_internal::FormatFromPath(source) != io_internal::FileFormat::kLas) {
-      return absl::InvalidArgumentError(absl::StrCat("'", source, "' is not a .las file"));
+    if (!IsLasPath(source)) {
+      return absl::InvalidArgumentError(absl::StrCat("'", source, "' is not a .las or .laz file"));
     }
-    NM_ASSIGN_OR_RETURN(contents.emplace_back(), ReadFileContents(source));
+    std::string& data = contents.emplace_back();
+    NM_ASSIGN_OR_RETURN(data, ReadFileContents(source));
+    if (io_internal::IsLaz(data)) {
+      absl::StatusOr<std::string> decompressed = io_internal::DecompressLaz(data);
+      if (!decompressed.ok()) return io_internal::WithPath(decompressed.status(), source);
+      data = *std::move(decompressed);
+    }
   }
   std::vector<io_internal::LasSource> files;
   for (size_t i = 0; i < sources.size(); ++i) {
     files.push_back({sources[i], contents[i]});
   }
   NM_ASSIGN_OR_RETURN(
-      const std::string cleaned,
+      std::string cleaned,
       io_internal::FormatCleanedLas(files, outliers, records, selection.las_classes));
+  if (io_internal::LowercaseExtension(path) == ".laz") {
+    NM_ASSIGN_OR_RETURN(cleaned, io_internal::CompressLas(cleaned));
+  }
   return WriteFileContents(path, cleaned);
 }
 

@@ -19,6 +19,10 @@ enum class LasOutlierRecords {
   kClassifiedAsNoise,  // Kept, as low noise (ASPRS class 7), which the readers leave out.
 };
 
+// Whether `path` names a LAS file: .las, or .laz for one compressed by LASzip
+// (internal/laz.h).
+bool IsLasPath(const std::string& path);
+
 // Writes to `path` the LAS files at `sources`, one after another, without their outliers, or
 // with them classified as noise (internal/las.h, FormatCleanedLas): `outliers` holds one flag
 // per point ReadPointCloud reads from the sources with `selection`, file after file, in their
@@ -30,7 +34,10 @@ enum class LasOutlierRecords {
 // ReadPointCloud reads, or `outliers` has not one flag per point, or flags every point to
 // leave out; FAILED_PRECONDITION, saying why, when the records of several files cannot be put
 // in one file (another version, point format, record length, coordinate system, extra bytes
-// than the first's, ...: FormatCleanedLas); otherwise the status of the write.
+// than the first's, ...: FormatCleanedLas) or when `path` is .laz and the records' point format
+// is not one LAZ is written in here (4 to 10); otherwise the status of the write.
+// Sources may be LAZ (.laz), read as the LAS files they compress; a .laz `path` is written as
+// LAZ (internal/laz.h).
 absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
                              const std::vector<bool>& outliers, LasOutlierRecords records,
                              const std::string& path, const PointSelection& selection = {});

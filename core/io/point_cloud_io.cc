@@ -10,6 +10,7 @@
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/geometry_data.h"
 #include "core/io/internal/las.h"
+#include "core/io/internal/laz.h"
 #include "core/io/internal/obj.h"
 #include "core/io/internal/off.h"
 #include "core/io/internal/pcd.h"
@@ -100,9 +101,9 @@ bool IsReadablePointCloudExtension(std::string_view path) {
 }
 
 const char kReadablePointCloudExtensions[] =
-    ".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .e57, .obj, .off, .drc, .glb, .gltf";
+    ".ply, .xyz, .txt, .pts, .ptx, .las, .laz, .pcd, .e57, .obj, .off, .drc, .glb, .gltf";
 const char kWritablePointCloudExtensions[] =
-    ".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .e57, .drc, .glb, .gltf";
+    ".ply, .xyz, .txt, .pts, .ptx, .las, .laz, .pcd, .e57, .drc, .glb, .gltf";
 
 WrittenPointAttributes PointAttributesWrittenTo(std::string_view path) {
   const FileFormat format =
@@ -162,6 +163,9 @@ absl::Status WritePointCloud(const PointCloud& cloud, const std::string& path,
     data = io_internal::FormatE57(view);
   } else if (format == FileFormat::kLas) {
     absl::StatusOr<std::string> formatted = io_internal::FormatLas(view);
+    if (formatted.ok() && io_internal::LowercaseExtension(path) == ".laz") {
+      formatted = io_internal::CompressLas(*formatted);
+    }
     if (!formatted.ok()) return io_internal::CannotWrite(path, formatted.status());
     data = *std::move(formatted);
   } else if (format == FileFormat::kGltf) {

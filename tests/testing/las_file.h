@@ -45,6 +45,25 @@ inline constexpr int kLasRecordLength[] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 5
 inline constexpr int kLasRgbOffset[] = {0, 0, 20, 28, 0, 28, 0, 30, 30, 0, 30};
 inline constexpr int kLasGpsTimeOffset[] = {0, 20, 0, 20, 20, 20, 22, 22, 22, 22, 22};
 
+// A (extended) variable-length record: its header of 54 (60) bytes, then `payload`.
+inline std::string LasVariableLengthRecord(const std::string& user_id, uint16_t record_id,
+                                           const std::string& payload, bool extended) {
+  std::string out;
+  io_internal::AppendLittleEndian<uint16_t>(0, &out);  // Reserved.
+  out.append(user_id);
+  out.resize(18, '\0');
+  io_internal::AppendLittleEndian(record_id, &out);
+  if (extended) {
+    io_internal::AppendLittleEndian<uint64_t>(payload.size(), &out);
+  } else {
+    io_internal::AppendLittleEndian<uint16_t>(payload.size(), &out);
+  }
+  out.append("a record the tests made");
+  out.resize(extended ? 60 : 54, '\0');
+  out.append(payload);
+  return out;
+}
+
 // A LAS file as the specification lays it out: the public header block (227 bytes for 1.2,
 // 235 for 1.3, 375 for 1.4), the layout's variable-length records, the point records and the
 // layout's bytes after them.

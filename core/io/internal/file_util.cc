@@ -22,7 +22,7 @@ FileFormat FormatFromPath(absl::string_view path) {
   if (extension == ".drc") return FileFormat::kDraco;
   if (extension == ".glb" || extension == ".gltf") return FileFormat::kGltf;
   if (extension == ".xyz" || extension == ".txt" || extension == ".pts") return FileFormat::kXyz;
-  if (extension == ".las") return FileFormat::kLas;
+  if (extension == ".las" || extension == ".laz") return FileFormat::kLas;
   if (extension == ".pcd") return FileFormat::kPcd;
   if (extension == ".ptx") return FileFormat::kPtx;
   if (extension == ".e57") return FileFormat::kE57;

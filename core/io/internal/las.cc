@@ -13,6 +13,8 @@
 #include "absl/strings/str_join.h"
 #include "core/io/internal/binary.h"
 #include "core/io/internal/file_util.h"
+#include "core/io/internal/las_layout.h"
+#include "core/io/internal/laz.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
 #include "core/status_macros.h"
@@ -22,31 +24,7 @@
 namespace neuralmesh::io_internal {
 namespace {
 
-// Offsets in the public header block (LAS 1.4, Table 3; earlier versions share the first 227
-// bytes).
-constexpr size_t kVersionMajor = 24;
-constexpr size_t kVersionMinor = 25;
-constexpr size_t kHeaderSize = 94;
-constexpr size_t kOffsetToPoints = 96;
-constexpr size_t kVlrCount = 100;
-constexpr size_t kPointFormat = 104;
-constexpr size_t kRecordLength = 105;
-constexpr size_t kLegacyPointCount = 107;
-constexpr size_t kScale = 131;       // x, y, z: doubles.
-constexpr size_t kOffset = 155;      // x, y, z: doubles.
-constexpr size_t kPointCount = 247;  // LAS 1.4: uint64.
-constexpr size_t kLegacyHeaderSize = 227;
-constexpr size_t kHeaderSize14 = 375;
-constexpr size_t kGeneratingSoftware = 58;  // 32 characters.
-constexpr size_t kLegacyByReturn = 111;     // Returns 1-5: uint32 each.
-constexpr size_t kBounds = 179;             // Max x, min x, max y, ...: doubles.
-constexpr size_t kWaveformStart = 227;      // LAS 1.3 and 1.4: uint64.
-constexpr size_t kHeaderSize13 = 235;
-constexpr size_t kEvlrStart = 235;          // LAS 1.4: uint64.
-constexpr size_t kByReturn14 = 255;         // Returns 1-15: uint64 each.
-
-// Format bits that LASzip sets on compressed (LAZ) files.
-constexpr uint8_t kCompressedBits = 0xC0;
+using namespace las_layout;  // NOLINT: the header's field offsets.
 
 // The shortest record of each point format, and where its red channel is (0: no colour).
 struct PointFormat {
@@ -148,9 +126,7 @@ absl::StatusOr<LasHeader> ReadHeader(absl::string_view data) {
                                 kLegacyHeaderSize, " and the file's ", data.size(), " bytes"));
   }
   if (format_byte & kCompressedBits) {
-    return Invalid(
-        "the points are compressed (LAZ); decompress them first (laszip, pdal "
-        "translate) or write them as .las");
+    return Invalid("the points are compressed (LAZ); DecompressLaz reads them");
   }
   if (format_byte > 10) {
     return Invalid(absl::StrCat("point data format ", int{format_byte}, " is not 0 to 10"));
@@ -190,18 +166,18 @@ absl::StatusOr<LasHeader> ReadHeader(absl::string_view data) {
 // system (user "LASF_Projection") and the extra bytes' description ("LASF_Spec", record 4),
 // each as its user, record id and payload.
 std::string InterpretingRecords(absl::string_view data, const LasHeader& header) {
-  constexpr size_t kVlrHeaderSize = 54;
   std::string out;
   size_t at = header.header_size;
   const uint32_t count = Load<uint32_t>(data, kVlrCount);
   for (uint32_t i = 0; i < count && at + kVlrHeaderSize <= header.offset_to_points; ++i) {
-    absl::string_view user = data.substr(at + 2, 16);
+    absl::string_view user = data.substr(at + kVlrUser, 16);
     user = user.substr(0, user.find('\0'));
-    const uint16_t id = Load<uint16_t>(data, at + 18);
-    const size_t length = Load<uint16_t>(data, at + 20);
+    const uint16_t id = Load<uint16_t>(data, at + kVlrRecordId);
+    const size_t length = Load<uint16_t>(data, at + kVlrLength);
     if (at + kVlrHeaderSize + length > header.offset_to_points) break;
     if (user == "LASF_Projection" || (user == "LASF_Spec" && id == 4)) {
-      absl::StrAppend(&out, data.substr(at + 2, 18), data.substr(at + kVlrHeaderSize, length));
+      absl::StrAppend(&out, data.substr(at + kVlrUser, 18),
+                      data.substr(at + kVlrHeaderSize, length));
     }
     at += kVlrHeaderSize + length;
   }
@@ -255,6 +231,10 @@ absl::Status CheckJoinable(const std::vector<LasSource>& sources,
 
 absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
                                          const std::optional<LasClasses>& classes) {
+  if (IsLaz(data)) {
+    NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(data));
+    return ParseLas(las, classes);
+  }
   NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
   const uint8_t format_byte = header.format;
   const PointFormat format = kFormats[format_byte];

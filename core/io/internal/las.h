@@ -24,9 +24,9 @@ namespace neuralmesh::io_internal {
 // floats, relative to ParsedGeometry::origin where the file's coordinates are too far from 0
 // for a float to keep its resolution, the scale (georeferenced data such as UTM:
 // OriginKeepingResolution in position_collector.h).
+// A LAZ file (laz.h) is read as the LAS file it compresses, with DecompressLaz's errors.
 // Returns INVALID_ARGUMENT saying what is wrong for a file without the "LASF" signature, a
-// header or records that run past the end of the file, a compressed (LAZ) file, a point
-// format above 10, a record shorter than its format, a zero or non-finite scale, or a point
+// header or records that run past the end of the file, a point format above 10, a record shorter than its format, a zero or non-finite scale, or a point
 // count that does not fit the file, or points that are all left out.
 absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
                                         const std::optional<LasClasses>& classes = std::nullopt);

@@ -5,7 +5,6 @@
 // to 64 bits split across packets) must give both readers the same points.
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -33,19 +32,13 @@ struct ReferencePoint {
 
 // What web-e57 reads from `path`; fails the test when it cannot run or refuses the file.
 std::vector<ReferencePoint> ReadWithWebE57(const std::string& path) {
-  const std::string command = "node tests/tools/e57_reader.mjs '" + path + "' XYZ 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  EXPECT_NE(pipe, nullptr) << command;
-  if (pipe == nullptr) return {};
-  std::string output;
-  char buffer[65536];
-  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) output.append(buffer, n);
-  const int status = pclose(pipe);
-  EXPECT_EQ(status, 0) << "web-e57 (npm ci in tests/tools: scripts/install-deps.sh) failed: "
-                       << output.substr(0, 2000);
-  if (status != 0) return {};
+  const io_test::CommandResult run =
+      io_test::RunCommand("node tests/tools/e57_reader.mjs '" + path + "' XYZ 2>&1");
+  EXPECT_EQ(run.status, 0) << "web-e57 (npm ci in tests/tools: scripts/install-deps.sh) failed: "
+                           << run.output.substr(0, 2000);
+  if (run.status != 0) return {};
   std::vector<ReferencePoint> points;
-  for (absl::string_view line : absl::StrSplit(output, '\n', absl::SkipWhitespace())) {
+  for (absl::string_view line : absl::StrSplit(run.output, '\n', absl::SkipWhitespace())) {
     const std::vector<absl::string_view> tokens = absl::StrSplit(line, ' ', absl::SkipEmpty());
     ReferencePoint point;
     EXPECT_TRUE(tokens.size() == 3 || tokens.size() == 6) << line;

@@ -3,11 +3,12 @@
 #ifndef NEURALMESH_TESTS_CORE_IO_IO_TEST_UTIL_H_
 #define NEURALMESH_TESTS_CORE_IO_IO_TEST_UTIL_H_
 
-#include <cstring>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <string>
@@ -31,6 +32,23 @@ void Put(T value, bool big_endian, std::string* out) {
   const bool host_big = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
   if (big_endian != host_big) std::reverse(bytes, bytes + sizeof(T));
   out->append(bytes, sizeof(T));
+}
+
+// What a shell command printed on its standard output, and its exit status; for the independent
+// readers of tests/tools (the tests run from the repository's root).
+struct CommandResult {
+  int status = -1;
+  std::string output;
+};
+
+inline CommandResult RunCommand(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[65536];
+  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) result.output.append(buffer, n);
+  result.status = pclose(pipe);
+  return result;
 }
 
 // The little-endian T at `offset` of a binary file's bytes.
@@ -218,4 +236,3 @@ inline PointCloud RandomCloud(int n, uint64_t seed, bool normals, bool weights) 
 }  // namespace neuralmesh::io_test
 
 #endif  // NEURALMESH_TESTS_CORE_IO_IO_TEST_UTIL_H_
-

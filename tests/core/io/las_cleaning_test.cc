@@ -32,27 +32,9 @@ using io_test::TempPath;
 using io_test::WriteBytes;
 using ::testing::HasSubstr;
 using testing::LasFile;
+using testing::LasVariableLengthRecord;
 using testing::LasLayout;
 using testing::LasPoint;
-
-// A (extended) variable-length record: its header of 54 (60) bytes, then `payload`.
-std::string VariableLengthRecord(absl::string_view user_id, uint16_t record_id,
-                                 absl::string_view payload, bool extended) {
-  std::string out;
-  io_internal::AppendLittleEndian<uint16_t>(0, &out);  // Reserved.
-  out.append(user_id.data(), user_id.size());
-  out.resize(18, '\0');
-  io_internal::AppendLittleEndian(record_id, &out);
-  if (extended) {
-    io_internal::AppendLittleEndian<uint64_t>(payload.size(), &out);
-  } else {
-    io_internal::AppendLittleEndian<uint16_t>(payload.size(), &out);
-  }
-  out.append("a record the tests made");
-  out.resize(extended ? 60 : 54, '\0');
-  out.append(payload.data(), payload.size());
-  return out;
-}
 
 // Points with every field set to something of its own: intensity, returns, class (2 or 5), GPS
 // time, extra bytes, colour.
@@ -154,9 +136,9 @@ TEST(LasCleaningTest, Las14KeepsEveryFieldTheCoordinateSystemAndTheExtendedRecor
   layout.offset[0] = 500000;
   layout.offset[1] = 4100000;
   const std::string wkt = "PROJCS[\"WGS 84 / UTM zone 33N\",AUTHORITY[\"EPSG\",\"32633\"]]";
-  layout.vlrs = VariableLengthRecord("LASF_Projection", 2112, wkt, false);
+  layout.vlrs = LasVariableLengthRecord("LASF_Projection", 2112, wkt, false);
   layout.vlr_count = 1;
-  layout.after_points = VariableLengthRecord("LASF_Spec", 65535, "waveform packets", true);
+  layout.after_points = LasVariableLengthRecord("LASF_Spec", 65535, "waveform packets", true);
   layout.evlr_count = 1;
   std::vector<LasPoint> points = VariedPoints(8);
   points[2].classification = 7;  // Noise: ReadPointCloud leaves it out, and so does the copy.
@@ -313,7 +295,7 @@ TEST(LasCleaningTest, TheClassesAskedForChooseThePointsAndTheRecordsKept) {
 // coordinate kept.
 TEST(LasCleaningTest, TilesJoinIntoOneFileOnTheFinestScale) {
   const std::string crs =
-      VariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM zone 32N\"]", false);
+      LasVariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM zone 32N\"]", false);
   LasLayout a;
   a.format = 3;
   a.vlrs = crs;
@@ -402,9 +384,9 @@ TEST(LasCleaningTest, Las14TilesJoinWithTheirExtendedRecordsOnceAfterThePoints) 
   layout.version_minor = 4;
   layout.format = 7;
   layout.record_length = 36 + 4;
-  layout.vlrs = VariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM 33N\"]", false);
+  layout.vlrs = LasVariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM 33N\"]", false);
   layout.vlr_count = 1;
-  layout.after_points = VariableLengthRecord("tile_notes", 1, "a survey's notes", true);
+  layout.after_points = LasVariableLengthRecord("tile_notes", 1, "a survey's notes", true);
   layout.evlr_count = 1;
   const std::string in_a = LasFile(layout, VariedPoints(3));
   const std::string in_b = LasFile(layout, VariedPoints(4));
@@ -431,7 +413,7 @@ TEST(LasCleaningTest, Las14TilesJoinWithTheirExtendedRecordsOnceAfterThePoints) 
   EXPECT_EQ(Field<uint64_t>(out, 271), 2u) << "third returns";
 
   LasLayout other = layout;
-  other.after_points = VariableLengthRecord("tile_notes", 1, "another survey's", true);
+  other.after_points = LasVariableLengthRecord("tile_notes", 1, "another survey's", true);
   WriteBytes(tile_b, LasFile(other, VariedPoints(4)));
   const absl::Status refused = WriteCleanedLas({tile_a, tile_b}, std::vector<bool>(7, false),
                                                LasOutlierRecords::kLeftOut, written);
@@ -461,11 +443,11 @@ TEST(LasCleaningTest, TilesThatCannotShareAFileAreRefusedSayingWhy) {
   b.version_minor = 4;
   expect_refused(joined(a, b), "refused_b.las' is LAS 1.4 and '");
   b = a;
-  b.vlrs = VariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM zone 33N\"]", false);
+  b.vlrs = LasVariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM zone 33N\"]", false);
   b.vlr_count = 1;
   expect_refused(joined(a, b), "the coordinate systems or extra bytes of '");
   // Another kind of record (a description of the tile, say) does not matter.
-  b.vlrs = VariableLengthRecord("tile_notes", 1, "tile 2", false);
+  b.vlrs = LasVariableLengthRecord("tile_notes", 1, "tile 2", false);
   EXPECT_TRUE(joined(a, b).ok());
   b = a;
   b.offset[0] = 1.0e6;
@@ -500,7 +482,7 @@ TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
   WriteBytes(text, "0 0 0\n1 1 1\n");
   status = WriteCleanedLas({text}, {false, false}, LasOutlierRecords::kLeftOut, written);
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_THAT(std::string(status.message()), HasSubstr("is not a .las file"));
+  EXPECT_THAT(std::string(status.message()), HasSubstr("is not a .las or .laz file"));
 
   const std::string fake = TempPath("fake.las");
   WriteBytes(fake, std::string(300, 'x'));

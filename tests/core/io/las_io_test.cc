@@ -1,6 +1,6 @@
 // LAS point clouds (core/io/internal/las.h) through ReadPointCloud: every point format, with
 // and without colours, LAS 1.2 and 1.4 headers, georeferenced coordinates moved to an origin,
-// and malformed or compressed files refused with what is wrong.
+// and malformed files refused with what is wrong (LAZ: laz_test.cc).
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -188,7 +188,7 @@ TEST(LasIoTest, GeoreferencedCoordinatesKeepTheirResolutionRelativeToAnOrigin) {
   EXPECT_FLOAT_EQ(near_zero->positions[0][0], -50.0f);
 }
 
-TEST(LasIoTest, MalformedAndCompressedFilesAreRefusedWithWhatIsWrong) {
+TEST(LasIoTest, MalformedFilesAreRefusedWithWhatIsWrong) {
   LasLayout layout;
   layout.format = 3;
   const std::string good = LasFile(layout, kPoints);
@@ -215,7 +215,7 @@ TEST(LasIoTest, MalformedAndCompressedFilesAreRefusedWithWhatIsWrong) {
       {"truncated header", good.substr(0, 100), "the file ends within its header (100 bytes)"},
       {"truncated points", good.substr(0, good.size() - 1),
        "3 points of 34 bytes from byte 227 do not fit in the file's 328 bytes"},
-      {"LAZ", laz, "the points are compressed (LAZ)"},
+      {"LAZ bits without LASzip's record", laz, "LAZ: no LASzip record"},
       {"format 11", format11, "point data format 11 is not 0 to 10"},
       {"short records", short_records, "records of 20 bytes are shorter than format 3's 34"},
       {"too many points", too_many, "4 points of 34 bytes"},

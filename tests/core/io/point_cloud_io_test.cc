@@ -451,14 +451,14 @@ TEST(PointCloudIoTest, MissingFileUnsupportedExtensionAndEmptyFile) {
   const absl::StatusOr<PointCloud> stl = ReadPointCloud(TempPath("part.stl"));
   EXPECT_EQ(stl.status().code(), absl::StatusCode::kInvalidArgument) << stl.status();
   EXPECT_THAT(std::string(stl.status().message()),
-              HasSubstr(".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .e57, .obj, .off, .drc, .glb, "
+              HasSubstr(".ply, .xyz, .txt, .pts, .ptx, .las, .laz, .pcd, .e57, .obj, .off, .drc, .glb, "
                         ".gltf"))
       << "the message should list the readable extensions";
 
   const absl::Status obj = WritePointCloud(kThree, TempPath("cloud.obj"));
   EXPECT_EQ(obj.code(), absl::StatusCode::kInvalidArgument) << obj;
   EXPECT_THAT(std::string(obj.message()),
-              HasSubstr(".ply, .xyz, .txt, .pts, .ptx, .las, .pcd, .e57, .drc, .glb, .gltf"))
+              HasSubstr(".ply, .xyz, .txt, .pts, .ptx, .las, .laz, .pcd, .e57, .drc, .glb, .gltf"))
       << "the message should list the writable extensions";
 
   for (const char* name : {"empty.ply", "empty.xyz", "empty.obj", "empty.off", "empty.drc"}) {

@@ -1,0 +1,46 @@
+// LASzip-compressed LAS files (.laz): the same header and records as LAS, the records coded in
+// chunks (50,000 records by default) by LASzip's arithmetic coder, described by a variable-length
+// record (user "laszip encoded", record 22204), with a table of the chunks' sizes after them.
+// Point formats 0 to 3 (LAS 1.0-1.4), LASzip's item coders of version 2: what LASzip 2 and 3,
+// LAStools, PDAL and laz-perf write for these formats. LAS 1.4's formats 6 to 10, whose records
+// LASzip 3 codes in layers, and the waveform formats 4 and 5 are refused, saying so.
+#ifndef NEURALMESH_CORE_IO_INTERNAL_LAZ_H_
+#define NEURALMESH_CORE_IO_INTERNAL_LAZ_H_
+
+#include <cstdint>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+
+namespace neuralmesh::io_internal {
+
+// Whether `data` starts as a LAS file whose point format carries LASzip's compression bits.
+bool IsLaz(absl::string_view data);
+
+// The LAS file that `laz` holds compressed: its header (the point format without the
+// compression bits, one variable-length record fewer, the offsets to the points and to the
+// extended records moved), its other variable-length records, its records byte for byte, and
+// what follows them (LAS 1.4's extended records).
+// Returns INVALID_ARGUMENT saying what is wrong for a file that is not LAZ, a missing or
+// malformed LASzip record, a chunk table or chunks that do not fit the file or decode to
+// another number of records than the header counts, or records whose decompressed size would
+// exceed 4,096 times the compressed data (a corrupt count), and for what LASzip writes that is
+// not read here, saying so: formats 4 to 10 (the layered compressor of LASzip 3 among them) and
+// LASzip 1's compression (one stream, item coders of version 1).
+absl::StatusOr<std::string> DecompressLaz(absl::string_view laz);
+
+struct LazWriteOptions {
+  // Records per chunk; each chunk starts afresh, so a reader can start at any chunk.
+  uint32_t chunk_size = 50000;
+};
+
+// `las` compressed as LAZ: what DecompressLaz turns back into `las`, byte for byte.
+// Returns INVALID_ARGUMENT for a malformed LAS file (a header, records or variable-length
+// records that do not fit it) or a chunk size of 0; FAILED_PRECONDITION for point formats 4 to
+// 10, which are not written as LAZ here.
+absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOptions& options = {});
+
+}  // namespace neuralmesh::io_internal
+
+#endif  // NEURALMESH_CORE_IO_INTERNAL_LAZ_H_

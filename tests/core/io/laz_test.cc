@@ -1,0 +1,483 @@
+// LASzip-compressed LAS (core/io/internal/laz.h and its coders): the arithmetic and integer
+// coders decode what they encoded, LAS files of every point format 0-3 come back from LAZ byte
+// for byte (extra bytes, several chunks, LAS 1.4 with extended records, random records among
+// scan-like ones), scans compress, ReadPointCloud and WritePointCloud take .laz, and malformed,
+// truncated or corrupt files are refused or decoded without reading out of bounds.
+// (laz_independent_reader_test.cc checks the files against laz-perf, LASzip's own decoder.)
+#include "core/io/internal/laz.h"
+
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/io/internal/laz_arithmetic_coder.h"
+#include "core/io/internal/laz_integer_coder.h"
+#include "core/io/las_cleaning.h"
+#include "core/io/point_cloud_io.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/core/io/io_test_util.h"
+#include "tests/testing/las_file.h"
+#include "tests/testing/las_scan.h"
+
+namespace neuralmesh {
+namespace {
+
+using io_internal::CompressLas;
+using io_internal::DecompressLaz;
+using io_internal::LazWriteOptions;
+using io_internal::laz::ArithmeticDecoder;
+using io_internal::laz::ArithmeticEncoder;
+using io_internal::laz::BitModel;
+using io_internal::laz::IntegerCoder;
+using io_internal::laz::SymbolModel;
+using io_test::TempPath;
+using io_test::WriteBytes;
+using ::testing::HasSubstr;
+using testing::LasScan;
+using testing::ScanLasFile;
+
+// One coding operation of a random sequence: a bit of one of three models, a symbol of one of
+// several alphabets, or raw bits, a short or an int.
+struct Operation {
+  int kind;   // 0 bit, 1 symbol, 2 raw bits, 3 short, 4 int.
+  int model;  // Which bit or symbol model; the bit count for raw bits.
+  uint32_t value;
+};
+
+TEST(LazCoderTest, ArithmeticCodingDecodesWhatWasEncoded) {
+  const std::vector<uint32_t> alphabets = {2, 3, 17, 64, 256, 516, 2048};
+  std::mt19937 random(7);
+  std::vector<Operation> operations;
+  for (int i = 0; i < 200000; ++i) {
+    Operation op{static_cast<int>(random() % 5), 0, 0};
+    if (op.kind == 0) {
+      op.model = random() % 3;
+      // Skewed bits, so that the models adapt far from one half.
+      op.value = random() % 100 < 10u * (op.model + 1) ? 1 : 0;
+    } else if (op.kind == 1) {
+      op.model = random() % alphabets.size();
+      // Small symbols mostly, as residuals are.
+      const uint32_t n = alphabets[op.model];
+      op.value = random() % 4 == 0 ? random() % n : random() % std::min<uint32_t>(n, 4);
+    } else if (op.kind == 2) {
+      op.model = 1 + random() % 32;
+      op.value = op.model == 32 ? random() : random() & ((1u << op.model) - 1);
+    } else {
+      op.value = op.kind == 3 ? random() & 0xFFFF : random();
+    }
+    operations.push_back(op);
+  }
+  std::string coded = "prefix";
+  {
+    std::vector<BitModel> bits(3);
+    std::vector<SymbolModel> symbols;
+    for (uint32_t n : alphabets) symbols.emplace_back(n);
+    ArithmeticEncoder encoder(&coded);
+    for (const Operation& op : operations) {
+      switch (op.kind) {
+        case 0:
+          encoder.EncodeBit(bits[op.model], op.value);
+          break;
+        case 1:
+          encoder.EncodeSymbol(symbols[op.model], op.value);
+          break;
+        case 2:
+          encoder.WriteBits(op.model, op.value);
+          break;
+        case 3:
+          encoder.WriteShort(static_cast<uint16_t>(op.value));
+          break;
+        default:
+          encoder.WriteInt(op.value);
+          break;
+      }
+    }
+    encoder.Done();
+  }
+  EXPECT_EQ(coded.substr(0, 6), "prefix");
+  std::vector<BitModel> bits(3);
+  std::vector<SymbolModel> symbols;
+  for (uint32_t n : alphabets) symbols.emplace_back(n);
+  ArithmeticDecoder decoder(absl::string_view(coded).substr(6));
+  for (size_t i = 0; i < operations.size(); ++i) {
+    const Operation& op = operations[i];
+    uint32_t value = 0;
+    switch (op.kind) {
+      case 0:
+        value = decoder.DecodeBit(bits[op.model]);
+        break;
+      case 1:
+        value = decoder.DecodeSymbol(symbols[op.model]);
+        break;
+      case 2:
+        value = decoder.ReadBits(op.model);
+        break;
+      case 3:
+        value = decoder.ReadShort();
+        break;
+      default:
+        value = decoder.ReadInt();
+        break;
+    }
+    ASSERT_EQ(value, op.value) << "operation " << i << " of kind " << op.kind;
+  }
+  // It ends where the stream does, as LASzip's readers of chunk after chunk require.
+  EXPECT_EQ(decoder.consumed(), coded.size() - 6);
+  EXPECT_EQ(decoder.overrun(), 0u);
+}
+
+TEST(LazCoderTest, IntegersOfEveryMagnitudeComeBack) {
+  std::mt19937 random(11);
+  constexpr int32_t kMin = std::numeric_limits<int32_t>::min();
+  constexpr int32_t kMax = std::numeric_limits<int32_t>::max();
+  struct Value {
+    int32_t predicted, real;
+    uint32_t context;
+  };
+  for (const uint32_t bits : {16u, 32u}) {
+    SCOPED_TRACE(absl::StrCat(bits, " bits"));
+    std::vector<Value> values;
+    const std::vector<int32_t> extremes = bits == 32
+                                              ? std::vector<int32_t>{kMin, kMax, 0, -1, 1, kMin + 1}
+                                              : std::vector<int32_t>{0, 65535, 1, 32768, 32767};
+    for (int i = 0; i < 50000; ++i) {
+      Value v{0, 0, static_cast<uint32_t>(random() % 3)};
+      const auto draw = [&]() -> int32_t {
+        if (random() % 10 == 0) return extremes[random() % extremes.size()];
+        const int32_t near = static_cast<int32_t>(random() % 2000) - 1000;
+        return bits == 32 ? static_cast<int32_t>(random()) >> (random() % 32)
+                          : static_cast<int32_t>((30000 + near) & 0xFFFF);
+      };
+      v.predicted = draw();
+      v.real = random() % 2 == 0 ? draw() : static_cast<int32_t>(v.predicted + random() % 5);
+      if (bits == 16) v.real &= 0xFFFF;
+      values.push_back(v);
+    }
+    std::string coded;
+    {
+      ArithmeticEncoder encoder(&coded);
+      IntegerCoder coder(bits, 3);
+      for (const Value& v : values) coder.Compress(encoder, v.predicted, v.real, v.context);
+      encoder.Done();
+    }
+    ArithmeticDecoder decoder(coded);
+    IntegerCoder coder(bits, 3);
+    for (size_t i = 0; i < values.size(); ++i) {
+      ASSERT_EQ(coder.Decompress(decoder, values[i].predicted, values[i].context), values[i].real)
+          << "value " << i << " predicted " << values[i].predicted;
+    }
+  }
+}
+
+// `las` through LAZ (chunks of `chunk_size`) and back: the same bytes. Returns the LAZ file.
+std::string ExpectSameThroughLaz(const std::string& las, uint32_t chunk_size = 50000) {
+  const absl::StatusOr<std::string> laz = CompressLas(las, {chunk_size});
+  EXPECT_TRUE(laz.ok()) << laz.status();
+  if (!laz.ok()) return {};
+  const absl::StatusOr<std::string> back = DecompressLaz(*laz);
+  EXPECT_TRUE(back.ok()) << back.status();
+  EXPECT_TRUE(back.ok() && *back == las)
+      << "sizes " << las.size() << " and " << (back.ok() ? back->size() : 0);
+  return *laz;
+}
+
+TEST(LazTest, EveryPointFormatComesBackByteForByte) {
+  for (int format = 0; format <= 3; ++format) {
+    for (const int extra : {0, 3}) {
+      for (const uint32_t chunk_size : {50000u, 1000u, 1u}) {
+        SCOPED_TRACE(
+            absl::StrCat("format ", format, ", ", extra, " extra bytes, chunks of ", chunk_size));
+        LasScan scan;
+        scan.format = format;
+        scan.extra_bytes = extra;
+        scan.records = 2500;
+        scan.random_every = 97;
+        scan.seed = format * 10 + extra;
+        const std::string laz = ExpectSameThroughLaz(ScanLasFile(scan), chunk_size);
+        EXPECT_EQ(io_test::Field<uint8_t>(laz, 104), format | 0x80);
+      }
+    }
+  }
+  for (const size_t records : {0, 1, 2}) {
+    SCOPED_TRACE(absl::StrCat(records, " records"));
+    LasScan scan;
+    scan.format = 3;
+    scan.records = records;
+    ExpectSameThroughLaz(ScanLasFile(scan));
+  }
+}
+
+TEST(LazTest, Las14FilesKeepTheirRecordsAndExtendedRecords) {
+  LasScan scan = testing::Las14Scan(/*format=*/1, 3000);
+  scan.extra_bytes = 2;
+  const std::string laz = ExpectSameThroughLaz(ScanLasFile(scan), 1000);
+  // The extended records follow the chunk table, where the header says they start.
+  EXPECT_EQ(laz.substr(io_test::Field<uint64_t>(laz, 235)), scan.after_points);
+}
+
+TEST(LazTest, ScansCompressToAFractionOfTheirSize) {
+  LasScan scan;
+  scan.format = 3;
+  scan.records = 100000;
+  const std::string las = ScanLasFile(scan);
+  const absl::StatusOr<std::string> laz = CompressLas(las);
+  ASSERT_TRUE(laz.ok()) << laz.status();
+  const double ratio = static_cast<double>(laz->size()) / las.size();
+  std::printf("100,000 scan records of format 3: %zu bytes as LAS, %zu as LAZ (%.3f)\n", las.size(),
+              laz->size(), ratio);
+  EXPECT_LT(ratio, 0.25);
+}
+
+TEST(LazTest, ReadAndWrittenAsPointCloudsLikeLas) {
+  LasScan scan;
+  scan.format = 2;
+  scan.records = 5000;
+  const std::string las = ScanLasFile(scan);
+  const absl::StatusOr<std::string> laz = CompressLas(las);
+  ASSERT_TRUE(laz.ok()) << laz.status();
+  const std::string las_path = TempPath("scan.las"), laz_path = TempPath("scan.LAZ");
+  WriteBytes(las_path, las);
+  WriteBytes(laz_path, *laz);
+  const absl::StatusOr<PointCloud> from_las = ReadPointCloud(las_path);
+  const absl::StatusOr<PointCloud> from_laz = ReadPointCloud(laz_path);
+  ASSERT_TRUE(from_las.ok()) << from_las.status();
+  ASSERT_TRUE(from_laz.ok()) << from_laz.status();
+  EXPECT_EQ(from_laz->positions, from_las->positions);
+  EXPECT_EQ(from_laz->colors, from_las->colors);
+  EXPECT_EQ(from_laz->origin, from_las->origin);
+
+  const std::string written = TempPath("written.laz");
+  ASSERT_TRUE(WritePointCloud(*from_las, written).ok());
+  EXPECT_TRUE(io_internal::IsLaz(io_test::ReadBytes(written)));
+  const absl::StatusOr<PointCloud> back = ReadPointCloud(written);
+  ASSERT_TRUE(back.ok()) << back.status();
+  ASSERT_EQ(back->size(), from_las->size());
+  EXPECT_EQ(back->colors, from_las->colors);
+  for (size_t i = 0; i < back->size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(back->origin[c] + back->positions[i][c],
+                  from_las->origin[c] + from_las->positions[i][c], 1e-3)
+          << "point " << i;
+    }
+  }
+  EXPECT_TRUE(IsReadablePointCloudExtension("tile.laz"));
+  EXPECT_TRUE(IsWritablePointCloudExtension("tile.laz"));
+}
+
+TEST(LazTest, CleanedLasFilesAreReadFromAndWrittenToLaz) {
+  LasScan scan;
+  scan.format = 1;
+  scan.records = 4000;
+  const std::string las = ScanLasFile(scan);
+  const std::string las_path = TempPath("tile.las"), laz_path = TempPath("tile.laz");
+  WriteBytes(las_path, las);
+  WriteBytes(laz_path, *CompressLas(las));
+  const absl::StatusOr<PointCloud> cloud = ReadPointCloud(las_path);
+  ASSERT_TRUE(cloud.ok()) << cloud.status();
+  std::vector<bool> outliers(cloud->size(), false);
+  for (size_t i = 0; i < outliers.size(); i += 10) outliers[i] = true;
+  const std::string from_las = TempPath("clean.las"), from_laz = TempPath("clean.laz");
+  ASSERT_TRUE(
+      WriteCleanedLas({las_path}, outliers, LasOutlierRecords::kClassifiedAsNoise, from_las).ok());
+  ASSERT_TRUE(
+      WriteCleanedLas({laz_path}, outliers, LasOutlierRecords::kClassifiedAsNoise, from_laz).ok());
+  const std::string written = io_test::ReadBytes(from_laz);
+  ASSERT_TRUE(io_internal::IsLaz(written));
+  const absl::StatusOr<std::string> back = DecompressLaz(written);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_TRUE(*back == io_test::ReadBytes(from_las));
+
+  // LAS 1.4's formats are not written as LAZ: the records go to the point writers instead.
+  testing::LasLayout layout;
+  layout.version_minor = 4;
+  layout.format = 6;
+  const std::string format6 = TempPath("format6.las");
+  WriteBytes(format6, testing::LasFile(layout, {{1, 2, 3}, {4, 5, 6}}));
+  const absl::Status status =
+      WriteCleanedLas({format6}, {false, false}, LasOutlierRecords::kLeftOut, TempPath("6.laz"));
+  EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition) << status;
+  EXPECT_THAT(std::string(status.message()), HasSubstr("writing point format 6"));
+}
+
+// Overwrites the little-endian value at `at`.
+template <typename T>
+std::string With(std::string bytes, size_t at, T value) {
+  std::memcpy(&bytes[at], &value, sizeof value);
+  return bytes;
+}
+
+// The chunk table of `laz` (our writer's: chunks of `chunk_size`, the table's offset after the
+// LASzip record) written again as LASzip writes it for chunks of varying size: the chunk size
+// 2^32 - 1 in the LASzip record and each chunk's record count in the table.
+std::string WithVariableChunks(const std::string& laz, uint32_t chunk_size, uint64_t records) {
+  constexpr size_t kChunkSize = 227 + 54 + 12;
+  const uint32_t offset_to_points = io_test::Field<uint32_t>(laz, 96);
+  const int64_t table_at = io_test::Field<int64_t>(laz, offset_to_points);
+  const uint32_t chunks = io_test::Field<uint32_t>(laz, table_at + 4);
+  // Our table's chunk sizes.
+  ArithmeticDecoder decoder(absl::string_view(laz).substr(table_at + 8));
+  IntegerCoder sizes(32, 2);
+  std::vector<uint32_t> bytes;
+  for (uint32_t i = 0; i < chunks; ++i) {
+    bytes.push_back(static_cast<uint32_t>(
+        sizes.Decompress(decoder, static_cast<int32_t>(i > 0 ? bytes.back() : 0), 1)));
+  }
+  std::string out = With<uint32_t>(laz.substr(0, table_at + 8), kChunkSize, 0xFFFFFFFFu);
+  ArithmeticEncoder encoder(&out);
+  IntegerCoder table(32, 2);
+  uint32_t last_count = 0, last_size = 0;
+  for (uint32_t i = 0; i < chunks; ++i) {
+    const uint32_t count =
+        static_cast<uint32_t>(std::min<uint64_t>(chunk_size, records - uint64_t{i} * chunk_size));
+    table.Compress(encoder, static_cast<int32_t>(last_count), static_cast<int32_t>(count), 0);
+    table.Compress(encoder, static_cast<int32_t>(last_size), static_cast<int32_t>(bytes[i]), 1);
+    last_count = count;
+    last_size = bytes[i];
+  }
+  encoder.Done();
+  return out;
+}
+
+TEST(LazTest, ChunksOfVaryingSizeAndATableOffsetAtTheEndAreRead) {
+  LasScan scan;
+  scan.format = 2;
+  scan.records = 2600;
+  const std::string las = ScanLasFile(scan);
+  const std::string laz = *CompressLas(las, {1000});
+  const absl::StatusOr<std::string> varying = DecompressLaz(WithVariableChunks(laz, 1000, 2600));
+  ASSERT_TRUE(varying.ok()) << varying.status();
+  EXPECT_TRUE(*varying == las);
+
+  // A writer that cannot seek back leaves -1 where the table's offset goes and puts the offset
+  // in the file's last 8 bytes.
+  const uint32_t offset_to_points = io_test::Field<uint32_t>(laz, 96);
+  const int64_t table_at = io_test::Field<int64_t>(laz, offset_to_points);
+  std::string streamed = With<int64_t>(laz, offset_to_points, -1);
+  streamed.append(reinterpret_cast<const char*>(&table_at), 8);
+  const absl::StatusOr<std::string> from_end = DecompressLaz(streamed);
+  ASSERT_TRUE(from_end.ok()) << from_end.status();
+  EXPECT_TRUE(*from_end == las);
+}
+
+TEST(LazTest, MalformedFilesAreRefusedWithWhatIsWrong) {
+  LasScan scan;
+  scan.format = 1;
+  scan.records = 3000;
+  const std::string las = ScanLasFile(scan);
+  const std::string laz = *CompressLas(las, {1000});
+  // The LASzip record follows the header (227 bytes): 54 bytes of record header, then its
+  // payload: compressor, coder, version, options, chunk size, ..., items from byte 34.
+  constexpr size_t kPayload = 227 + 54;
+  const uint32_t offset_to_points = io_test::Field<uint32_t>(laz, 96);
+  const int64_t table_at = io_test::Field<int64_t>(laz, offset_to_points);
+  struct Case {
+    const char* what;
+    std::string bytes;
+    absl::StatusCode code;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"no LASzip record", With<uint32_t>(laz, 100, 0), absl::StatusCode::kInvalidArgument,
+       "no LASzip record"},
+      {"layered compressor", With<uint16_t>(laz, kPayload, 3), absl::StatusCode::kInvalidArgument,
+       "compressed in layers (LASzip 3, LAS 1.4 formats 6 to 10)"},
+      {"format 6", With<uint8_t>(laz, 104, 6 | 0x80), absl::StatusCode::kInvalidArgument,
+       "point format 6 is compressed in layers"},
+      {"format 5", With<uint8_t>(laz, 104, 5 | 0x80), absl::StatusCode::kInvalidArgument,
+       "point format 5 (waveform packets)"},
+      {"LASzip 1's items", With<uint16_t>(laz, kPayload + 34 + 4, 1),
+       absl::StatusCode::kInvalidArgument, "compressed as LASzip 1 did"},
+      {"LASzip 1's stream", With<uint16_t>(laz, kPayload, 1), absl::StatusCode::kInvalidArgument,
+       "compressed as LASzip 1 did"},
+      {"items of another format", With<uint8_t>(laz, 104, 0 | 0x80),
+       absl::StatusCode::kInvalidArgument, "do not code point format 0 in records of 28 bytes"},
+      {"chunk table outside the file", With<int64_t>(laz, offset_to_points, int64_t{1} << 40),
+       absl::StatusCode::kInvalidArgument, "the chunk table's offset 1099511627776 is not within"},
+      {"chunk table version", With<uint32_t>(laz, table_at, 7), absl::StatusCode::kInvalidArgument,
+       "chunk table version 7 is not 0"},
+      {"fewer records than counted", With<uint32_t>(laz, 107, 4000),
+       absl::StatusCode::kInvalidArgument, "hold 3000 of the header's 4000 records"},
+      {"a corrupt count", With<uint32_t>(laz, 107, 4000000000u), absl::StatusCode::kInvalidArgument,
+       "the point count is corrupt"},
+      {"zero chunk size", With<uint32_t>(laz, kPayload + 12, 0), absl::StatusCode::kInvalidArgument,
+       "chunk size is 0"},
+      {"truncated chunks", laz.substr(0, offset_to_points + 400),
+       absl::StatusCode::kInvalidArgument, "is not within the points' data"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    const absl::StatusOr<std::string> back = DecompressLaz(c.bytes);
+    ASSERT_FALSE(back.ok());
+    EXPECT_EQ(back.status().code(), c.code) << back.status();
+    EXPECT_THAT(std::string(back.status().message()), HasSubstr(c.message));
+  }
+  // Through ReadPointCloud, named.
+  const std::string path = TempPath("layered.laz");
+  WriteBytes(path, With<uint8_t>(laz, 104, 7 | 0x80));
+  const absl::StatusOr<PointCloud> cloud = ReadPointCloud(path);
+  ASSERT_FALSE(cloud.ok());
+  EXPECT_THAT(std::string(cloud.status().message()), HasSubstr("layered.laz"));
+  EXPECT_THAT(std::string(cloud.status().message()), HasSubstr("decompress it first"));
+}
+
+TEST(LazTest, CorruptChunksDecodeWithoutReadingOutOfBounds) {
+  LasScan scan;
+  scan.format = 3;
+  scan.extra_bytes = 1;
+  scan.records = 2000;
+  const std::string las = ScanLasFile(scan);
+  const std::string laz = *CompressLas(las, {500});
+  const uint32_t offset_to_points = io_test::Field<uint32_t>(laz, 96);
+  std::mt19937 random(3);
+  int refused = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    std::string corrupt = laz;
+    // A few bytes of the chunks changed: the file is refused, or its records come out wrong;
+    // AddressSanitizer checks that no read leaves the file.
+    for (int k = 0; k < 3; ++k) {
+      corrupt[offset_to_points + 8 + random() % (laz.size() - offset_to_points - 40)] ^=
+          static_cast<char>(1 + random() % 255);
+    }
+    const absl::StatusOr<std::string> back = DecompressLaz(corrupt);
+    if (back.ok()) {
+      EXPECT_EQ(back->size(), las.size());
+    } else {
+      ++refused;
+      EXPECT_EQ(back.status().code(), absl::StatusCode::kInvalidArgument) << back.status();
+    }
+  }
+  // Garbage decodes to wide residuals, whose raw bits run past the chunk's end: most
+  // corruptions are noticed so.
+  EXPECT_GT(refused, 150);
+  for (size_t end = 300; end < laz.size(); end += 997) {
+    EXPECT_FALSE(DecompressLaz(laz.substr(0, end)).ok()) << "truncated at " << end;
+  }
+}
+
+TEST(LazTest, CompressingRefusesWhatItDoesNotWrite) {
+  testing::LasLayout layout;
+  layout.format = 6;
+  layout.version_minor = 4;
+  const std::string format6 = testing::LasFile(layout, {{1, 2, 3}});
+  const absl::StatusOr<std::string> laz = CompressLas(format6);
+  ASSERT_FALSE(laz.ok());
+  EXPECT_EQ(laz.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(std::string(laz.status().message()),
+              HasSubstr("writing point format 6 is not supported (formats 0 to 3 are)"));
+  LasScan scan;
+  scan.records = 10;
+  const std::string compressed = *CompressLas(ScanLasFile(scan));
+  EXPECT_THAT(std::string(CompressLas(compressed).status().message()),
+              HasSubstr("compressed already"));
+  EXPECT_THAT(std::string(CompressLas(ScanLasFile(scan), {0}).status().message()),
+              HasSubstr("a chunk size of 0"));
+}
+
+}  // namespace
+}  // namespace neuralmesh

@@ -1,5 +1,7 @@
 #include "core/io/internal/laz_arithmetic_coder.h"
 
+#include <algorithm>
+
 namespace neuralmesh::io_internal::laz {
 namespace {
 
@@ -63,10 +65,30 @@ void SymbolModel::Update() {
     distribution_[k] = (scale * sum) >> (31 - kSymbolLengthShift);
     sum += counts_[k];
   }
+  if (!decoder_table_.empty()) FillDecoderTable();
   update_cycle_ = (5 * update_cycle_) >> 2;
   const uint32_t max_cycle = (symbols + 6) << 3;
   if (update_cycle_ > max_cycle) update_cycle_ = max_cycle;
   symbols_until_update_ = update_cycle_;
+}
+
+void SymbolModel::KeepDecoderTable() {
+  uint32_t table_bits = 3;
+  while (symbols() > (1u << (table_bits + 2))) ++table_bits;
+  decoder_table_.assign((size_t{1} << table_bits) + 2, 0);
+  table_shift_ = kSymbolLengthShift - table_bits;
+  FillDecoderTable();
+}
+
+void SymbolModel::FillDecoderTable() {
+  const uint32_t table_size = static_cast<uint32_t>(decoder_table_.size()) - 2;
+  uint32_t s = 0;
+  for (uint32_t k = 0; k < symbols(); ++k) {
+    const uint32_t w = distribution_[k] >> table_shift_;
+    while (s < w) decoder_table_[++s] = k - 1;
+  }
+  decoder_table_[0] = 0;
+  while (s <= table_size) decoder_table_[++s] = symbols() - 1;
 }
 
 void ArithmeticEncoder::EncodeBit(BitModel& model, uint32_t bit) {
@@ -191,21 +213,45 @@ uint32_t ArithmeticDecoder::DecodeBit(BitModel& model) {
 }
 
 uint32_t ArithmeticDecoder::DecodeSymbol(SymbolModel& model) {
-  // Bisection for the symbol whose scaled interval holds the value.
+  // The symbol whose scaled interval holds the value, by bisection: over the symbols the
+  // decoder table leaves, or over all of them for small models.
+  if (model.decoder_table_.empty() && model.symbols() > 16) model.KeepDecoderTable();
+  const std::vector<uint32_t>& distribution = model.distribution_;
+  const uint32_t last = model.symbols() - 1;
   uint32_t symbol = 0, x = 0, y = length_;
-  uint32_t n = model.symbols();
   length_ >>= kSymbolLengthShift;
-  uint32_t k = n >> 1;
-  do {
-    const uint32_t z = length_ * model.distribution_[k];
-    if (z > value_) {
-      n = k;
-      y = z;
-    } else {
-      symbol = k;
-      x = z;
+  if (!model.decoder_table_.empty()) {
+    // value_ < length_ before the shift, so the scaled value is below 2^15 + 2^6 and its entry
+    // at most the table's size.
+    const uint32_t scaled = value_ / length_;
+    const size_t entry =
+        std::min<size_t>(scaled >> model.table_shift_, model.decoder_table_.size() - 2);
+    symbol = model.decoder_table_[entry];
+    uint32_t n = model.decoder_table_[entry + 1] + 1;
+    while (n > symbol + 1) {
+      const uint32_t k = (symbol + n) >> 1;
+      if (distribution[k] > scaled) {
+        n = k;
+      } else {
+        symbol = k;
+      }
     }
-  } while ((k = (symbol + n) >> 1) != symbol);
+    x = distribution[symbol] * length_;
+    if (symbol != last) y = distribution[symbol + 1] * length_;
+  } else {
+    uint32_t n = last + 1;
+    uint32_t k = n >> 1;
+    do {
+      const uint32_t z = length_ * distribution[k];
+      if (z > value_) {
+        n = k;
+        y = z;
+      } else {
+        symbol = k;
+        x = z;
+      }
+    } while ((k = (symbol + n) >> 1) != symbol);
+  }
   value_ -= x;
   length_ = y - x;
   if (length_ < kMinLength) Renormalize();

@@ -43,9 +43,16 @@ class SymbolModel {
   friend class ArithmeticDecoder;
   void Count(uint32_t symbol);
   void Update();
+  // Starts keeping the decoder's table (models of more than 16 symbols that are decoded).
+  void KeepDecoderTable();
+  void FillDecoderTable();
 
   std::vector<uint32_t> distribution_;  // Cumulative, scaled to 2^15.
   std::vector<uint32_t> counts_;
+  // For decoding: the first symbol whose interval can hold each 2^table_shift_ of the scaled
+  // value, and one entry past the last, so that a search looks at a few symbols only.
+  std::vector<uint32_t> decoder_table_;
+  uint32_t table_shift_ = 0;
   uint32_t total_count_ = 0;
   uint32_t update_cycle_ = 0;
   uint32_t symbols_until_update_ = 0;

@@ -99,7 +99,9 @@ struct ConvertOptions {
 // cloud with their normals, weights and colours where the format holds them, and "OUTPUT: N
 // points" printed (", with normals, weights, colours"; how many outliers went; what LAS, PTX or
 // E57 leaves out).
-// LAS INPUTs (.las, .laz) written to LAS are copied record by record instead
+// One LAS INPUT (.las, .laz) written to LAS without `outliers` or `selection.las_classes` is
+// copied whole, every record and the header ("OUTPUT: N records of INPUT, ..."; CopyLas).
+// Other LAS INPUTs written to LAS are copied record by record instead
 // (core/io/las_cleaning.h), their outliers left out or, with outliers_as_noise, classified as
 // noise; several whose records cannot share one file (another point format, coordinate system,
 // ...) are written as points, and the line says why (so are records of formats 4-10 written to

@@ -714,12 +714,13 @@ std::vector<Subcommand> Commands() {
        ".pts .ptx .las .laz .pcd .e57) go to .ply .xyz .txt .pts .ptx .las .laz .pcd .e57\n"
        ".drc .glb .gltf with their normals and weights (LAS, PTX: positions and colours\n"
        "only; E57: no weights), after --remove_outliers if given. Several point cloud files\n"
-       "are written as one. LAS files (.las, or .laz compressed by LASzip) written to .las or\n"
-       ".laz keep their records whole (classes, intensities, times, extra bytes) and the\n"
-       "first file's offset and variable-length records (the coordinate system); tiles are\n"
-       "joined so when they share the version, point format, coordinate system and extra\n"
-       "bytes (and, for .laz, a point format of 0 to 3). --outliers_as_noise classifies the\n"
-       "outliers as noise instead of removing them.",
+       "are written as one. One LAS file (.las, or .laz compressed by LASzip) written to .las\n"
+       "or .laz with nothing to remove or select is copied whole, every record and the\n"
+       "header. LAS files written to LAS otherwise keep their records whole (classes,\n"
+       "intensities, times, extra bytes) and the first file's offset and variable-length\n"
+       "records (the coordinate system); tiles are joined so when they share the version,\n"
+       "point format, coordinate system and extra bytes (and, for .laz, a point format of 0\n"
+       "to 3). --outliers_as_noise classifies the outliers as noise instead of removing them.",
        {"output", "gltf_draco", "pcd_data", "las_classes", "remove_outliers",
         "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "outliers_as_noise", "quantization_bits", "encode_speed"},

@@ -158,6 +158,20 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
         "INPUT ", QuotedInputs(options.inputs), " to OUTPUT '", options.output,
         "' can only leave them out"));
   }
+  // One LAS file with nothing to remove or select: every record as it is, compressed or not.
+  // Records that LAZ is not written in here (FAILED_PRECONDITION) go the points' way below,
+  // which says why.
+  if (las_to_las && options.inputs.size() == 1 && !options.outliers.has_value() &&
+      !options.selection.las_classes.has_value()) {
+    const absl::StatusOr<LasCopy> copy = CopyLas(options.inputs.front(), options.output);
+    if (copy.ok()) {
+      out << options.output << ": " << copy->records << " records of " << options.inputs.front()
+          << ", every one and the header as they were (" << copy->read_bytes << " bytes to "
+          << copy->written_bytes << ")\n";
+      return absl::OkStatus();
+    }
+    if (!absl::IsFailedPrecondition(copy.status())) return copy.status();
+  }
   PointsLeftOut left_out;
   std::string merge_note;
   NM_ASSIGN_OR_RETURN(PointCloud cloud,

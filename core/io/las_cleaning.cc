@@ -14,6 +14,31 @@ bool IsLasPath(const std::string& path) {
   return io_internal::FormatFromPath(path) == io_internal::FileFormat::kLas;
 }
 
+absl::StatusOr<LasCopy> CopyLas(const std::string& source, const std::string& path) {
+  for (const std::string* file : {&source, &path}) {
+    if (!IsLasPath(*file)) {
+      return absl::InvalidArgumentError(absl::StrCat("'", *file, "' is not a .las or .laz file"));
+    }
+  }
+  NM_ASSIGN_OR_RETURN(std::string data, ReadFileContents(source));
+  LasCopy copy;
+  copy.read_bytes = data.size();
+  if (io_internal::IsLaz(data)) {
+    absl::StatusOr<std::string> decompressed = io_internal::DecompressLaz(data);
+    if (!decompressed.ok()) return io_internal::WithPath(decompressed.status(), source);
+    data = *std::move(decompressed);
+  }
+  const absl::StatusOr<uint64_t> records = io_internal::LasRecordCount(data);
+  if (!records.ok()) return io_internal::WithPath(records.status(), source);
+  copy.records = *records;
+  if (io_internal::LowercaseExtension(path) == ".laz") {
+    NM_ASSIGN_OR_RETURN(data, io_internal::CompressLas(data));
+  }
+  copy.written_bytes = data.size();
+  NM_RETURN_IF_ERROR(WriteFileContents(path, data));
+  return copy;
+}
+
 absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
                              const std::vector<bool>& outliers, LasOutlierRecords records,
                              const std::string& path, const PointSelection& selection) {

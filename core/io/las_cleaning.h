@@ -1,14 +1,18 @@
 // Cleaning LAS files of their outliers without losing what a PointCloud does not hold: the
 // records are copied, not read and written again, so each keeps its class, intensity,
 // returns, GPS time and extra bytes, and the file its scale, offset and coordinate system.
-// Several files (the tiles of a survey) are joined into one the same way.
+// Several files (the tiles of a survey) are joined into one the same way, and one file with
+// nothing to remove is copied whole, compressed (LAZ) or not.
 #ifndef NEURALMESH_CORE_IO_LAS_CLEANING_H_
 #define NEURALMESH_CORE_IO_LAS_CLEANING_H_
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "core/io/point_selection.h"
 
 namespace neuralmesh {
@@ -22,6 +26,23 @@ enum class LasOutlierRecords {
 // Whether `path` names a LAS file: .las, or .laz for one compressed by LASzip
 // (internal/laz.h).
 bool IsLasPath(const std::string& path);
+
+// What CopyLas copied: the records, and the file's bytes before and after.
+struct LasCopy {
+  uint64_t records = 0;
+  size_t read_bytes = 0;
+  size_t written_bytes = 0;
+};
+
+// Writes the LAS or LAZ file at `source` to `path` as LAS or LAZ by its extension (as laszip
+// does): every record byte for byte, noise and withheld ones too, and the header and
+// variable-length records as they were (but the compression: its point format bits, LASzip's
+// record and the offsets that move with it; internal/laz.h).
+// Returns NOT_FOUND when `source` cannot be read; INVALID_ARGUMENT when either path is not
+// .las or .laz, or the source is malformed (ParseLas's and DecompressLaz's errors, named);
+// FAILED_PRECONDITION for records of point formats 4 to 10 to a .laz `path`, which are not
+// written as LAZ here; otherwise the status of the write.
+absl::StatusOr<LasCopy> CopyLas(const std::string& source, const std::string& path);
 
 // Writes to `path` the LAS files at `sources`, one after another, without their outliers, or
 // with them classified as noise (internal/las.h, FormatCleanedLas): `outliers` holds one flag

@@ -312,6 +312,11 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
   return out;
 }
 
+absl::StatusOr<uint64_t> LasRecordCount(absl::string_view data) {
+  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
+  return header.count;
+}
+
 absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
   const size_t count = points.positions.size();
   if (count > std::numeric_limits<uint32_t>::max()) {

@@ -26,10 +26,15 @@ namespace neuralmesh::io_internal {
 // OriginKeepingResolution in position_collector.h).
 // A LAZ file (laz.h) is read as the LAS file it compresses, with DecompressLaz's errors.
 // Returns INVALID_ARGUMENT saying what is wrong for a file without the "LASF" signature, a
-// header or records that run past the end of the file, a point format above 10, a record shorter than its format, a zero or non-finite scale, or a point
-// count that does not fit the file, or points that are all left out.
+// header or records that run past the end of the file, a point format above 10, a record
+// shorter than its format, a zero or non-finite scale, or a point count that does not fit the
+// file, or points that are all left out.
 absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
                                         const std::optional<LasClasses>& classes = std::nullopt);
+
+// The number of point records of an uncompressed LAS file, after ParseLas's checks of its
+// header (and its errors but the last).
+absl::StatusOr<uint64_t> LasRecordCount(absl::string_view data);
 
 // Formats points as a LAS 1.2 file of point format 0, or 2 with their colours (8-bit levels
 // times 257 in the 16-bit channels), without variable-length records. The header's offset is

@@ -458,6 +458,45 @@ TEST(LasCleaningTest, TilesThatCannotShareAFileAreRefusedSayingWhy) {
   expect_refused(joined(a, b), "point into their own file's waveform data");
 }
 
+TEST(LasCleaningTest, CopiesKeepEveryRecordCompressedOrNot) {
+  LasLayout layout;
+  layout.version_minor = 3;
+  layout.format = 3;
+  std::vector<LasPoint> points;
+  for (int i = 0; i < 500; ++i) {
+    LasPoint p{i * 13, -i * 7, i % 50};
+    p.classification = i % 25 == 0 ? 7 : 2;  // Noise and withheld records are copied too.
+    p.withheld = i % 40 == 1;
+    p.gps_time = 1000 + 0.01 * i;
+    p.red = static_cast<uint16_t>(i * 100);
+    points.push_back(p);
+  }
+  const std::string source = TempPath("tile.las");
+  WriteBytes(source, LasFile(layout, points));
+  const std::string laz = TempPath("tile.laz"), back = TempPath("back.las");
+  const absl::StatusOr<LasCopy> compressed = CopyLas(source, laz);
+  ASSERT_TRUE(compressed.ok()) << compressed.status();
+  EXPECT_EQ(compressed->records, 500u);
+  EXPECT_EQ(compressed->read_bytes, ReadBytes(source).size());
+  EXPECT_EQ(compressed->written_bytes, ReadBytes(laz).size());
+  EXPECT_LT(compressed->written_bytes, compressed->read_bytes / 2);
+  ASSERT_TRUE(CopyLas(laz, back).ok());
+  EXPECT_TRUE(ReadBytes(back) == ReadBytes(source));
+  const std::string again = TempPath("again.laz");
+  ASSERT_TRUE(CopyLas(laz, again).ok());
+  EXPECT_TRUE(ReadBytes(again) == ReadBytes(laz));
+
+  layout.version_minor = 4;
+  layout.format = 6;
+  const std::string format6 = TempPath("format6.las");
+  WriteBytes(format6, LasFile(layout, points));
+  EXPECT_EQ(CopyLas(format6, TempPath("format6.laz")).status().code(),
+            absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(CopyLas(TempPath("missing.las"), back).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(std::string(CopyLas(source, TempPath("tile.xyz")).status().message()),
+              HasSubstr("is not a .las or .laz file"));
+}
+
 TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
   LasLayout layout;
   std::vector<LasPoint> points = VariedPoints(4);

@@ -1,5 +1,5 @@
-// Reads a LAZ file with laz-perf (LASzip's decoder compiled to WebAssembly), a LAZ reader
-// independent of neuralmesh, for neuralmesh's LAZ tests. Writes every decompressed point record,
+// Reads a LAZ file with laz-perf (the LASzip-compatible codec PDAL uses, compiled to
+// WebAssembly), a LAZ reader independent of neuralmesh, for neuralmesh's LAZ tests. Writes every decompressed point record,
 // in file order, concatenated (LENGTH bytes each) to OUT, and prints one line "FORMAT LENGTH
 // COUNT": the point data format as laz-perf reports it (without the compression bit 0x80), the
 // record length and the point count. Exits 1 with the reader's error on stderr when it refuses

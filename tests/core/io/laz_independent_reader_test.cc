@@ -1,8 +1,8 @@
-// LAZ files read by an independent decoder: laz-perf, LASzip's decoder compiled to WebAssembly
-// (tests/tools/laz_reader.mjs, installed from npm by scripts/install-deps.sh). The LAZ files
-// neuralmesh writes must give laz-perf every record of the LAS file they compress, byte for
-// byte: each point format 0-3, extra bytes, several chunks, random records among scan-like
-// ones, LAS 1.4, and the files WritePointCloud writes.
+// LAZ files read by an independent decoder: laz-perf, the LASzip-compatible codec PDAL uses,
+// compiled to WebAssembly (tests/tools/laz_reader.mjs, installed from npm by
+// scripts/install-deps.sh). The LAZ files neuralmesh writes must give laz-perf every record of
+// the LAS file they compress, byte for byte: each point format 0-3, extra bytes, several
+// chunks, random records among scan-like ones, LAS 1.4, and the files WritePointCloud writes.
 #include <string>
 
 #include "absl/strings/str_cat.h"

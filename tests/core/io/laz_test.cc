@@ -3,7 +3,7 @@
 // for byte (extra bytes, several chunks, LAS 1.4 with extended records, random records among
 // scan-like ones), scans compress, ReadPointCloud and WritePointCloud take .laz, and malformed,
 // truncated or corrupt files are refused or decoded without reading out of bounds.
-// (laz_independent_reader_test.cc checks the files against laz-perf, LASzip's own decoder.)
+// (laz_independent_reader_test.cc checks the files against laz-perf, an independent decoder.)
 #include "core/io/internal/laz.h"
 
 #include <cstdint>

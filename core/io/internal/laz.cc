@@ -40,8 +40,15 @@ constexpr uint16_t kItemVersion = 2;
 constexpr uint64_t kMaxExpansion = 4096;
 
 // Bytes past the end of a chunk that its decoder may read: the encoder ends a chunk with zeros
-// enough for none.
+// enough for none. A corrupt chunk decodes to wide residuals whose raw bits run past its end
+// within a few records; decoding checks every kOverrunCheck records, so that a chunk that
+// claims more records than its bytes can hold costs about as much as its bytes.
 constexpr size_t kOverrunAllowed = 4;
+constexpr uint64_t kOverrunCheck = 256;
+
+// Scans compress to a tenth of their size or so; the output is reserved for at most this many
+// times the compressed data, and grows chunk by chunk past it (a corrupt count).
+constexpr uint64_t kReservedExpansion = 64;
 
 template <typename T>
 T Load(absl::string_view data, size_t offset) {
@@ -340,6 +347,7 @@ absl::Status DecodeChunk(absl::string_view chunk, uint64_t count, RecordCoder& c
   laz::ArithmeticDecoder decoder(chunk.substr(record_length));
   for (uint64_t i = 1; i < count; ++i) {
     coder.Decode(decoder, out + i * record_length);
+    if (i % kOverrunCheck == 0 && decoder.overrun() > kOverrunAllowed) break;
   }
   if (decoder.overrun() > kOverrunAllowed) {
     return Invalid(absl::StrCat(name(), " ends ", decoder.overrun(), " bytes before its ", count,
@@ -391,22 +399,21 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz) {
 
   const size_t laszip_size = laszip->end() - laszip->at;
   std::string las;
-  las.reserve(header.offset_to_points + header.count * header.record_length);
+  las.reserve(header.offset_to_points +
+              std::min(header.count * header.record_length,
+                       kReservedExpansion * compressed + (uint64_t{1} << 20)));
   absl::StrAppend(&las, laz.substr(0, laszip->at));
   absl::StrAppend(&las, laz.substr(laszip->end(), header.offset_to_points - laszip->end()));
   las[kPointFormat] = static_cast<char>(header.format());
   SetUint32(header.vlr_count - 1, kVlrCount, &las);
   SetUint32(static_cast<uint32_t>(header.offset_to_points - laszip_size), kOffsetToPoints, &las);
-  const size_t points_at = las.size();
-  las.resize(points_at + header.count * header.record_length);
   RecordCoder coder(header.format(), header.record_length);
-  uint64_t record = 0;
   for (size_t i = 0; i < chunks.size(); ++i) {
-    NM_RETURN_IF_ERROR(DecodeChunk(
-        laz.substr(chunks[i].at, chunks[i].size), chunks[i].count, coder, header.record_length,
-        reinterpret_cast<uint8_t*>(&las[points_at + record * header.record_length]), i,
-        chunks.size()));
-    record += chunks[i].count;
+    const size_t chunk_at = las.size();
+    las.resize(chunk_at + chunks[i].count * header.record_length);
+    NM_RETURN_IF_ERROR(DecodeChunk(laz.substr(chunks[i].at, chunks[i].size), chunks[i].count, coder,
+                                   header.record_length, reinterpret_cast<uint8_t*>(&las[chunk_at]),
+                                   i, chunks.size()));
   }
   if (header.evlr_start != 0 && points_end < laz.size()) {
     SetUint64(las.size(), kEvlrStart, &las);

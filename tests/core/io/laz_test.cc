@@ -407,6 +407,13 @@ TEST(LazTest, MalformedFilesAreRefusedWithWhatIsWrong) {
        "the point count is corrupt"},
       {"zero chunk size", With<uint32_t>(laz, kPayload + 12, 0), absl::StatusCode::kInvalidArgument,
        "chunk size is 0"},
+      // Chunks of 1,000 records said to hold 50,000 each: the first runs out of bytes.
+      {
+          "chunks that claim more records than they hold",
+          With<uint32_t>(With<uint32_t>(laz, kPayload + 12, 50000), 107, 150000),
+          absl::StatusCode::kInvalidArgument,
+          "chunk 1 of 3 ends",
+      },
       {"truncated chunks", laz.substr(0, offset_to_points + 400),
        absl::StatusCode::kInvalidArgument, "is not within the points' data"},
   };

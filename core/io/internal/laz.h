@@ -23,11 +23,12 @@ bool IsLaz(absl::string_view data);
 // extended records moved), its other variable-length records, its records byte for byte, and
 // what follows them (LAS 1.4's extended records).
 // Returns INVALID_ARGUMENT saying what is wrong for a file that is not LAZ, a missing or
-// malformed LASzip record, a chunk table or chunks that do not fit the file or decode to
-// another number of records than the header counts, or records whose decompressed size would
-// exceed 4,096 times the compressed data (a corrupt count), and for what LASzip writes that is
-// not read here, saying so: formats 4 to 10 (the layered compressor of LASzip 3 among them) and
-// LASzip 1's compression (one stream, item coders of version 1).
+// malformed LASzip record, a chunk table or chunks that do not fit the file or list another
+// number of records than the header counts, a chunk whose bytes run out before its records are
+// decoded (truncated or corrupt), or records whose decompressed size would exceed 4,096 times
+// the compressed data (a corrupt count); and for what LASzip writes that is not read here,
+// saying so: formats 4 to 10 (the layered compressor of LASzip 3 among them) and LASzip 1's
+// compression (one stream, item coders of version 1).
 absl::StatusOr<std::string> DecompressLaz(absl::string_view laz);
 
 struct LazWriteOptions {

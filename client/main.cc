@@ -719,8 +719,9 @@ std::vector<Subcommand> Commands() {
        "header. LAS files written to LAS otherwise keep their records whole (classes,\n"
        "intensities, times, extra bytes) and the first file's offset and variable-length\n"
        "records (the coordinate system); tiles are joined so when they share the version,\n"
-       "point format, coordinate system and extra bytes (and, for .laz, a point format of 0\n"
-       "to 3). --outliers_as_noise classifies the outliers as noise instead of removing them.",
+       "point format, coordinate system and extra bytes (and, for .laz, a point format\n"
+       "without waveforms: 0 to 3 or 6 to 8). --outliers_as_noise classifies the outliers\n"
+       "as noise instead of removing them.",
        {"output", "gltf_draco", "pcd_data", "las_classes", "remove_outliers",
         "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "outliers_as_noise", "quantization_bits", "encode_speed"},

@@ -23,8 +23,8 @@ bool Finite(const Vec3f& v) {
 
 template <typename T>
 bool BitwiseEqual(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(),
-                                                           a.size() * sizeof(T)) == 0);
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 // Floats (or vectors of them) equal bit for bit, except that a NaN equals any NaN: a text
@@ -137,9 +137,8 @@ void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size
     const absl::StatusOr<ParsedGeometry> reread = format.parse(written, FaceHandling::kRead);
     FUZZ_CHECK(reread.ok(), "the writer's output does not parse: %s",
                reread.status().ToString().c_str());
-    const bool same = format.writes_normals_and_weights
-                          ? SamePoints(*mesh, *reread)
-                          : SamePlacedPositions(*mesh, *reread);
+    const bool same = format.writes_normals_and_weights ? SamePoints(*mesh, *reread)
+                                                        : SamePlacedPositions(*mesh, *reread);
     FUZZ_CHECK(same, "points change when written and read back");
     FUZZ_CHECK(BitwiseEqual(mesh->colors, reread->colors),
                "colours change when written and read back (%zu, then %zu)", mesh->colors.size(),
@@ -156,10 +155,10 @@ void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size
   FUZZ_CHECK(report.vertices + report.isolated_vertices == triangles.positions.size(),
              "the report counts %zu + %zu isolated vertices of %zu", report.vertices,
              report.isolated_vertices, triangles.positions.size());
-  FUZZ_CHECK(report.faces + report.degenerate_faces == triangles.faces.size() &&
-                 report.invalid_faces == 0,
-             "the report counts %zu + %zu degenerate + %zu invalid faces of %zu", report.faces,
-             report.degenerate_faces, report.invalid_faces, triangles.faces.size());
+  FUZZ_CHECK(
+      report.faces + report.degenerate_faces == triangles.faces.size() && report.invalid_faces == 0,
+      "the report counts %zu + %zu degenerate + %zu invalid faces of %zu", report.faces,
+      report.degenerate_faces, report.invalid_faces, triangles.faces.size());
   (void)MeshReportToJson(report);
 }
 
@@ -174,10 +173,13 @@ void CheckPositionsWithinScale(const io_internal::ParsedGeometry& parsed,
       const double after = reread.origin[c] + double{reread.positions[i][c]};
       const double local =
           std::max(std::fabs(parsed.positions[i][c]), std::fabs(reread.positions[i][c]));
-      // Half a scale step, and the float's rounding: relative to the coordinate, or for a
-      // subnormal float (a coordinate below 1.2e-38) its absolute step.
+      // Half a scale step, the float's rounding (relative to the coordinate, or for a
+      // subnormal float, one below 1.2e-38, its absolute step), and the rounding of the
+      // coordinate in double precision on either side (a step finer than the scale where the
+      // scale is finer than the double's resolution, as 1e-10 at 500,000).
       const double tolerance = 0.5001 * scale[c] + local * std::ldexp(1.0, -23) +
-                               std::numeric_limits<float>::denorm_min();
+                               std::numeric_limits<float>::denorm_min() +
+                               std::max(std::fabs(before), std::fabs(after)) * std::ldexp(1.0, -52);
       FUZZ_CHECK(std::fabs(after - before) <= tolerance,
                  "point %zu moved by %g on axis %d when written (scale %g)", i, after - before, c,
                  scale[c]);

@@ -1,9 +1,10 @@
 // The LAZ codec (core/io/internal/laz.h): any input is decompressed or refused without a crash
 // or a read out of bounds, and what decompresses compresses again to a file that decompresses
 // to the same bytes: the LAS file that a LAZ file holds is one CompressLas writes exactly (for
-// the point formats it writes, 0 to 3, and a LAS 1.4 header whose extended records start after
-// the points or nowhere). The coders' round trip is checked on the records the input decodes
-// to, which random inputs make as wild as records get.
+// the point formats it writes, 0 to 3 and 6 to 8, and a LAS 1.4 header whose extended records
+// start after the points or nowhere). The coders' round trip is checked on the records the
+// input decodes to, which random inputs make as wild as records get, in item versions 3 and 4
+// for the layered formats 6 to 8.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -43,8 +44,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FUZZ_CHECK(!neuralmesh::io_internal::IsLaz(*las), "the decompressed file says it is LAZ");
   if (!ExtendedRecordsPlaced(*las)) return 0;
   for (const uint32_t chunk_size : {50000u, 3u}) {
+    const uint16_t version = chunk_size == 3 ? 4 : 3;
     const absl::StatusOr<std::string> laz =
-        neuralmesh::io_internal::CompressLas(*las, {chunk_size});
+        neuralmesh::io_internal::CompressLas(*las, {chunk_size, version});
     FUZZ_CHECK(laz.ok(), "what decompressed does not compress: %s",
                laz.status().ToString().c_str());
     const absl::StatusOr<std::string> again = neuralmesh::io_internal::DecompressLaz(*laz);

@@ -1,8 +1,9 @@
-// LAS files whose records look like an airborne scan, every field of formats 0 to 3 in use:
-// pulses along flight lines with first and last returns, intensities, classes, scan angles and
-// directions, edge flags, point sources, GPS times in interleaved sequences, colours (grey and
-// not) and extra bytes; optionally with records of random bytes among them, the extremes a
-// coder must also take. For the LAZ codec's tests (core/io/internal/laz.h).
+// LAS files whose records look like an airborne scan, every field of formats 0 to 3 and 6 to 8
+// in use: pulses along flight lines with first and last returns, intensities, classes (and
+// LAS 1.4's classification flags), scan angles and directions, edge flags, point sources, GPS
+// times in interleaved sequences, the scanner channels of a multi-beam system, colours (grey
+// and not), near infrared and extra bytes; optionally with records of random bytes among them,
+// the extremes a coder must also take. For the LAZ codec's tests (core/io/internal/laz.h).
 #ifndef NEURALMESH_TESTS_TESTING_LAS_SCAN_H_
 #define NEURALMESH_TESTS_TESTING_LAS_SCAN_H_
 
@@ -18,9 +19,11 @@
 namespace neuralmesh::testing {
 
 struct LasScan {
-  int version_minor = 2;
-  int format = 0;       // 0 to 3.
-  int extra_bytes = 0;  // After the format's fields.
+  int version_minor = 2;  // 4 for formats 6 to 8 whatever it says.
+  int format = 0;         // 0 to 3, 6 to 8.
+  int extra_bytes = 0;    // After the format's fields.
+  // Formats 6-8: the pulses of this many scanner channels (1 to 4) take turns, three by three.
+  int scanner_channels = 1;
   size_t records = 0;
   // One record in this many is random bytes (0: none).
   size_t random_every = 0;
@@ -49,7 +52,7 @@ inline LasScan Las14Scan(int format, size_t records) {
 
 inline std::string ScanLasFile(const LasScan& scan) {
   LasLayout layout;
-  layout.version_minor = scan.version_minor;
+  layout.version_minor = scan.format >= 6 ? 4 : scan.version_minor;
   layout.format = scan.format;
   const int length = kLasRecordLength[scan.format] + scan.extra_bytes;
   layout.record_length = length;
@@ -91,10 +94,25 @@ inline std::string ScanLasFile(const LasScan& scan) {
     io_internal::AppendLittleEndian(z, &fields);
     io_internal::AppendLittleEndian(intensity, &fields);
     const bool edge = along == 0 || along == 1499;
-    fields += static_cast<char>(return_number | returns << 3 | (line % 2) << 6 | edge << 7);
-    fields += static_cast<char>(random() % 50 == 0 ? 7 : return_number == returns ? 2 : 1);
-    fields += static_cast<char>(static_cast<int8_t>(-20 + static_cast<int>(along * 40 / 1500)));
-    fields += static_cast<char>(random() % 200 == 0 ? 5 : 0);
+    const char classification = random() % 50 == 0 ? 7 : return_number == returns ? 2 : 1;
+    const char user_data = random() % 200 == 0 ? 5 : 0;
+    const int angle = -20 + static_cast<int>(along * 40 / 1500);
+    if (scan.format >= 6) {
+      // Returns in 4 bits each; classification flags (an overlap now and then), the channel,
+      // the scan direction and the edge; the class; the user data; the angle in 0.006 degrees.
+      const int channel = static_cast<int>(pulse / 3 % scan.scanner_channels);
+      fields += static_cast<char>(return_number | returns << 4);
+      fields += static_cast<char>((random() % 100 == 0 ? 8 : 0) | channel << 4 | (line % 2) << 6 |
+                                  edge << 7);
+      fields += classification;
+      fields += user_data;
+      io_internal::AppendLittleEndian(static_cast<int16_t>(angle * 167 + pulse % 5), &fields);
+    } else {
+      fields += static_cast<char>(return_number | returns << 3 | (line % 2) << 6 | edge << 7);
+      fields += classification;
+      fields += static_cast<char>(static_cast<int8_t>(angle));
+      fields += user_data;
+    }
     io_internal::AppendLittleEndian(static_cast<uint16_t>(1 + line), &fields);
     std::memcpy(record, fields.data(), fields.size());
     if (kLasGpsTimeOffset[scan.format] != 0) {
@@ -116,6 +134,11 @@ inline std::string ScanLasFile(const LasScan& scan) {
         io_internal::AppendLittleEndian(channel, &bytes);
       }
       std::memcpy(record + kLasRgbOffset[scan.format], bytes.data(), 6);
+    }
+    if (scan.format == 8) {  // The near infrared, after the colour.
+      std::string bytes;
+      io_internal::AppendLittleEndian(static_cast<uint16_t>(20000 + z * 3 + random() % 64), &bytes);
+      std::memcpy(record + kLasRgbOffset[scan.format] + 6, bytes.data(), 2);
     }
     for (int k = 0; k < scan.extra_bytes; ++k) {
       record[kLasRecordLength[scan.format] + k] = static_cast<char>((pulse >> (2 * k)) & 0xFF);

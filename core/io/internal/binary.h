@@ -1,4 +1,4 @@
-// Fixed-width little- and big-endian scalars for the binary formats (PLY, STL).
+// Fixed-width little- and big-endian scalars for the binary formats (PLY, STL, LAS).
 #ifndef NEURALMESH_CORE_IO_INTERNAL_BINARY_H_
 #define NEURALMESH_CORE_IO_INTERNAL_BINARY_H_
 
@@ -38,6 +38,16 @@ void StoreLittleEndian(T value, size_t offset, std::string* out) {
   std::memcpy(bytes, &value, sizeof(T));
   if (kHostIsBigEndian) std::reverse(bytes, bytes + sizeof(T));
   std::memcpy(out->data() + offset, bytes, sizeof(T));
+}
+
+// Writes `value` in little-endian byte order to the sizeof(T) bytes at `p` (no alignment
+// needed).
+template <typename T>
+void StoreLittleEndian(T value, void* p) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  if (kHostIsBigEndian) std::reverse(bytes, bytes + sizeof(T));
+  std::memcpy(p, bytes, sizeof(T));
 }
 
 }  // namespace neuralmesh::io_internal

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <memory>
+#include <optional>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -12,6 +14,7 @@
 #include "core/io/internal/laz_arithmetic_coder.h"
 #include "core/io/internal/laz_integer_coder.h"
 #include "core/io/internal/laz_items.h"
+#include "core/io/internal/laz_layered_items.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::io_internal {
@@ -32,8 +35,18 @@ constexpr uint16_t kCompressorPointwiseChunked = 2;  // Formats 0-5.
 constexpr uint16_t kCompressorLayeredChunked = 3;    // Formats 6-10 (LASzip 3).
 constexpr uint32_t kVariableChunkSize = 0xFFFFFFFFu;
 
-enum ItemType : uint16_t { kByte = 0, kPoint10 = 6, kGpsTime11 = 7, kRgb12 = 8 };
-constexpr uint16_t kItemVersion = 2;
+enum ItemType : uint16_t {
+  kByte = 0,
+  kPoint10 = 6,
+  kGpsTime11 = 7,
+  kRgb12 = 8,
+  kPoint14 = 10,
+  kRgb14 = 11,
+  kRgbNir14 = 12,
+  kByte14 = 14
+};
+// The item version of formats 0-3 (those of formats 6-8 are 3 or 4).
+constexpr uint16_t kPointwiseVersion = 2;
 
 // Decompressed records above this many times the bytes that code them are a corrupt count:
 // even constant records take some bits each.
@@ -148,38 +161,106 @@ absl::StatusOr<std::vector<Vlr>> ReadVlrs(absl::string_view data, const Header& 
   return vlrs;
 }
 
-// The items of a record of point format 0 to 3 with `extra` bytes after its fields.
-std::vector<Item> ItemsOf(int format, size_t extra) {
-  std::vector<Item> items = {{kPoint10, laz::Point10Coder::kSize, kItemVersion}};
-  if (format == 1 || format == 3) {
-    items.push_back({kGpsTime11, laz::GpsTime11Coder::kSize, kItemVersion});
+// The record lengths of formats 0 to 8 without extra bytes (4 and 5 are not coded here).
+constexpr size_t kBaseLength[] = {20, 28, 26, 34, 57, 63, 30, 36, 38};
+
+bool IsLayered(int format) { return format >= 6; }
+
+// The items of a record of point format 0 to 3 or 6 to 8 with `extra` bytes after its fields,
+// in item `version` (2 for formats 0-3, 3 or 4 for 6-8).
+std::vector<Item> ItemsOf(int format, size_t extra, uint16_t version) {
+  std::vector<Item> items;
+  const uint16_t extra_size = static_cast<uint16_t>(extra);
+  if (IsLayered(format)) {
+    items.push_back({kPoint14, laz::Point14Coder::kSize, version});
+    if (format == 7) items.push_back({kRgb14, 6, version});
+    if (format == 8) items.push_back({kRgbNir14, 8, version});
+    if (extra > 0) items.push_back({kByte14, extra_size, version});
+    return items;
   }
-  if (format == 2 || format == 3) {
-    items.push_back({kRgb12, laz::Rgb12Coder::kSize, kItemVersion});
-  }
-  if (extra > 0) items.push_back({kByte, static_cast<uint16_t>(extra), kItemVersion});
+  items.push_back({kPoint10, laz::Point10Coder::kSize, version});
+  if (format == 1 || format == 3) items.push_back({kGpsTime11, laz::GpsTimeCoder::kSize, version});
+  if (format == 2 || format == 3) items.push_back({kRgb12, laz::Rgb12Coder::kSize, version});
+  if (extra > 0) items.push_back({kByte, extra_size, version});
   return items;
 }
 
-// The record lengths of formats 0 to 3 without extra bytes.
-constexpr size_t kBaseLength[] = {20, 28, 26, 34};
-
-// Codes whole records of format 0 to 3, item after item.
-class RecordCoder {
+// Codes the records of one chunk: its first record raw, the others coded.
+class ChunkCoder {
  public:
-  RecordCoder(int format, size_t record_length)
-      : gps_time_(format == 1 || format == 3),
+  virtual ~ChunkCoder() = default;
+  // Appends the chunk of the `count` records at `records` to `out`.
+  virtual void Encode(const uint8_t* records, uint64_t count, std::string* out) = 0;
+  // Decodes `chunk` into `count` records at `out`; `name` names the chunk for messages.
+  virtual absl::Status Decode(absl::string_view chunk, uint64_t count, uint8_t* out,
+                              absl::string_view name) = 0;
+
+ protected:
+  explicit ChunkCoder(size_t record_length) : record_length_(record_length) {}
+
+  // Copies the chunk's first record to `out`.
+  absl::Status DecodeFirst(absl::string_view chunk, uint8_t* out, absl::string_view name) const {
+    if (chunk.size() < record_length_) {
+      return Invalid(absl::StrCat(name, " has ", chunk.size(),
+                                  " bytes, fewer than its first raw record's ", record_length_));
+    }
+    std::memcpy(out, chunk.data(), record_length_);
+    return absl::OkStatus();
+  }
+
+  // Decodes records 1 to count - 1 with `decode_record`, stopping early once `overrun` says
+  // the coded bytes ran out.
+  template <typename DecodeRecord, typename Overrun>
+  absl::Status DecodeRest(uint64_t count, uint8_t* out, absl::string_view name,
+                          DecodeRecord decode_record, Overrun overrun) const {
+    for (uint64_t i = 1; i < count; ++i) {
+      decode_record(out + i * record_length_);
+      if (i % kOverrunCheck == 0 && overrun() > kOverrunAllowed) break;
+    }
+    if (overrun() > kOverrunAllowed) {
+      return Invalid(absl::StrCat(name, " ends ", overrun(), " bytes before its ", count,
+                                  " records are decoded: the file is truncated or corrupt"));
+    }
+    return absl::OkStatus();
+  }
+
+  size_t record_length_;
+};
+
+// Formats 0 to 3: the items after one another in one stream (item version 2).
+class PointwiseChunkCoder : public ChunkCoder {
+ public:
+  PointwiseChunkCoder(int format, size_t record_length)
+      : ChunkCoder(record_length),
+        gps_time_(format == 1 || format == 3),
         rgb_(format == 2 || format == 3),
         bytes_(record_length - kBaseLength[format]) {}
 
-  void Reset(const uint8_t* first) {
-    Apply(first, [](auto& coder, const uint8_t* item) { coder.Reset(item); });
+  void Encode(const uint8_t* records, uint64_t count, std::string* out) override {
+    out->append(reinterpret_cast<const char*>(records), record_length_);
+    if (count == 1) return;
+    Apply(records, [](auto& coder, const uint8_t* item) { coder.Reset(item); });
+    laz::ArithmeticEncoder encoder(out);
+    for (uint64_t i = 1; i < count; ++i) {
+      Apply(records + i * record_length_,
+            [&](auto& coder, const uint8_t* item) { coder.Encode(encoder, item); });
+    }
+    encoder.Done();
   }
-  void Encode(laz::ArithmeticEncoder& encoder, const uint8_t* record) {
-    Apply(record, [&](auto& coder, const uint8_t* item) { coder.Encode(encoder, item); });
-  }
-  void Decode(laz::ArithmeticDecoder& decoder, uint8_t* record) {
-    Apply(record, [&](auto& coder, uint8_t* item) { coder.Decode(decoder, item); });
+
+  absl::Status Decode(absl::string_view chunk, uint64_t count, uint8_t* out,
+                      absl::string_view name) override {
+    NM_RETURN_IF_ERROR(DecodeFirst(chunk, out, name));
+    if (count == 1) return absl::OkStatus();
+    Apply(static_cast<const uint8_t*>(out),
+          [](auto& coder, const uint8_t* item) { coder.Reset(item); });
+    laz::ArithmeticDecoder decoder(chunk.substr(record_length_));
+    return DecodeRest(
+        count, out, name,
+        [&](uint8_t* record) {
+          Apply(record, [&](auto& coder, uint8_t* item) { coder.Decode(decoder, item); });
+        },
+        [&] { return decoder.overrun(); });
   }
 
  private:
@@ -190,7 +271,7 @@ class RecordCoder {
     at += laz::Point10Coder::kSize;
     if (gps_time_) {
       function(gps_time_coder_, record + at);
-      at += laz::GpsTime11Coder::kSize;
+      at += laz::GpsTimeCoder::kSize;
     }
     if (rgb_) {
       function(rgb_coder_, record + at);
@@ -201,10 +282,114 @@ class RecordCoder {
 
   bool gps_time_, rgb_;
   laz::Point10Coder point_;
-  laz::GpsTime11Coder gps_time_coder_;
+  laz::GpsTimeCoder gps_time_coder_{2};
   laz::Rgb12Coder rgb_coder_;
   laz::BytesCoder bytes_;
 };
+
+// Formats 6 to 8 (item versions 3 and 4): after the first record, the number of records, the
+// size of every item's every layer, then the layers' bytes, all in item order.
+class LayeredChunkCoder : public ChunkCoder {
+ public:
+  LayeredChunkCoder(int format, size_t record_length, uint16_t version)
+      : ChunkCoder(record_length), point_(version) {
+    if (format == 7 || format == 8) rgb_.emplace(/*near_infrared=*/format == 8, version);
+    const size_t extra = record_length - kBaseLength[format];
+    if (extra > 0) bytes_.emplace(extra, version);
+  }
+
+  void Encode(const uint8_t* records, uint64_t count, std::string* out) override {
+    out->append(reinterpret_cast<const char*>(records), record_length_);
+    uint32_t channel = 0;
+    point_.StartEncoding(records, channel);
+    if (rgb_) rgb_->StartEncoding(records + rgb_at(), channel);
+    if (bytes_) bytes_->StartEncoding(records + bytes_at(), channel);
+    for (uint64_t i = 1; i < count; ++i) {
+      const uint8_t* record = records + i * record_length_;
+      channel = 0;  // As LASzip passes it on (laz_layered_items.h).
+      point_.Encode(record, channel);
+      if (rgb_) rgb_->Encode(record + rgb_at(), channel);
+      if (bytes_) bytes_->Encode(record + bytes_at(), channel);
+    }
+    std::vector<std::string> layers;
+    ForEachLayers([&](laz::Layers& item_layers) { item_layers.FinishEncoding(&layers); });
+    AppendLittleEndian(static_cast<uint32_t>(count), out);
+    for (const std::string& layer : layers) {
+      AppendLittleEndian(static_cast<uint32_t>(layer.size()), out);
+    }
+    for (const std::string& layer : layers) out->append(layer);
+  }
+
+  absl::Status Decode(absl::string_view chunk, uint64_t count, uint8_t* out,
+                      absl::string_view name) override {
+    NM_RETURN_IF_ERROR(DecodeFirst(chunk, out, name));
+    if (count == 1) return absl::OkStatus();
+    size_t layer_count = 0;
+    ForEachLayers([&](laz::Layers& item_layers) { layer_count += item_layers.count(); });
+    // The number of records (which LASzip does not read either), then the layers' sizes.
+    size_t at = record_length_ + 4;
+    if (chunk.size() < at + 4 * layer_count) {
+      return Invalid(absl::StrCat(name, " ends within the sizes of its ", layer_count, " layers"));
+    }
+    std::vector<absl::string_view> layers(layer_count);
+    size_t layer_at = at + 4 * layer_count;
+    for (absl::string_view& layer : layers) {
+      const uint32_t size = Load<uint32_t>(chunk, at);
+      at += 4;
+      if (size > chunk.size() - layer_at) {
+        return Invalid(absl::StrCat(name, "'s layers run past its end (", chunk.size(), " bytes)"));
+      }
+      layer = chunk.substr(layer_at, size);
+      layer_at += size;
+    }
+    if (layers[0].empty()) {
+      return Invalid(absl::StrCat(name, " has no layer of returns, X and Y"));
+    }
+    uint32_t channel = 0;
+    const absl::string_view* item_layers = layers.data();
+    point_.StartDecoding(out, channel, item_layers);
+    item_layers += point_.layers().count();
+    if (rgb_) {
+      rgb_->StartDecoding(out + rgb_at(), channel, item_layers);
+      item_layers += rgb_->layers().count();
+    }
+    if (bytes_) bytes_->StartDecoding(out + bytes_at(), channel, item_layers);
+    return DecodeRest(
+        count, out, name,
+        [&](uint8_t* record) {
+          channel = 0;
+          point_.Decode(record, channel);
+          if (rgb_) rgb_->Decode(record + rgb_at(), channel);
+          if (bytes_) bytes_->Decode(record + bytes_at(), channel);
+        },
+        [&] {
+          size_t most = 0;
+          ForEachLayers(
+              [&](laz::Layers& item_layers) { most = std::max(most, item_layers.overrun()); });
+          return most;
+        });
+  }
+
+ private:
+  size_t rgb_at() const { return laz::Point14Coder::kSize; }
+  size_t bytes_at() const { return rgb_at() + (rgb_ ? rgb_->size() : 0); }
+
+  template <typename Function>
+  void ForEachLayers(Function function) {
+    function(point_.layers());
+    if (rgb_) function(rgb_->layers());
+    if (bytes_) function(bytes_->layers());
+  }
+
+  laz::Point14Coder point_;
+  std::optional<laz::Rgb14Coder> rgb_;
+  std::optional<laz::Bytes14Coder> bytes_;
+};
+
+std::unique_ptr<ChunkCoder> MakeChunkCoder(int format, size_t record_length, uint16_t version) {
+  if (IsLayered(format)) return std::make_unique<LayeredChunkCoder>(format, record_length, version);
+  return std::make_unique<PointwiseChunkCoder>(format, record_length);
+}
 
 // Where a chunk's bytes are and how many records it holds.
 struct Chunk {
@@ -279,8 +464,14 @@ absl::StatusOr<std::vector<Chunk>> ReadChunkTable(absl::string_view laz, const H
   return chunks;
 }
 
-// Checks the LASzip record against the header and returns its chunk size.
-absl::StatusOr<uint32_t> CheckLaszipRecord(absl::string_view payload, const Header& header) {
+// What the LASzip record says of the chunks.
+struct Compression {
+  uint32_t chunk_size = 0;
+  uint16_t item_version = 0;
+};
+
+// Checks the LASzip record against the header.
+absl::StatusOr<Compression> CheckLaszipRecord(absl::string_view payload, const Header& header) {
   if (payload.size() < kLaszipFixedSize) {
     return Invalid(absl::StrCat("the LASzip record has ", payload.size(), " bytes, not ",
                                 kLaszipFixedSize, " or more"));
@@ -299,21 +490,23 @@ absl::StatusOr<uint32_t> CheckLaszipRecord(absl::string_view payload, const Head
     items[i] = {Load<uint16_t>(payload, at), Load<uint16_t>(payload, at + 2),
                 Load<uint16_t>(payload, at + 4)};
   }
-  if (compressor == kCompressorLayeredChunked || header.format() >= 6) {
-    return Invalid(absl::StrCat(
-        "point format ", header.format(),
-        " is compressed in layers (LASzip 3, LAS 1.4 formats 6 to 10), which is not read here; "
-        "decompress it first (laszip, pdal translate)"));
-  }
-  if (header.format() >= 4) {
-    return Invalid(absl::StrCat("point format ", header.format(),
+  const int format = header.format();
+  if (format == 4 || format == 5 || format == 9 || format == 10) {
+    return Invalid(absl::StrCat("point format ", format,
                                 " (waveform packets) is not read here; decompress it first "
                                 "(laszip, pdal translate)"));
   }
-  if (compressor != kCompressorPointwise && compressor != kCompressorPointwiseChunked) {
+  if (format > 10) return Invalid(absl::StrCat("point format ", format, " is not 0 to 10"));
+  if (compressor != kCompressorPointwise && compressor != kCompressorPointwiseChunked &&
+      compressor != kCompressorLayeredChunked) {
     return Invalid(absl::StrCat("compressor ", compressor, " is not 1, 2 or 3"));
   }
   if (coder != 0) return Invalid(absl::StrCat("coder ", coder, " is not 0 (arithmetic)"));
+  if ((compressor == kCompressorLayeredChunked) != IsLayered(format)) {
+    return Invalid(absl::StrCat("compressor ", compressor, " does not code point format ", format,
+                                ": formats 6 to 10 are compressed in layers (compressor 3), "
+                                "formats 0 to 5 are not"));
+  }
   const bool laszip1 =
       compressor == kCompressorPointwise ||
       std::any_of(items.begin(), items.end(), [](const Item& item) { return item.version == 1; });
@@ -322,38 +515,17 @@ absl::StatusOr<uint32_t> CheckLaszipRecord(absl::string_view payload, const Head
         "the records are compressed as LASzip 1 did (one stream, or item coders of version 1), "
         "which is not read here; compress the file again with a newer laszip");
   }
-  if (header.record_length < kBaseLength[header.format()] ||
-      items != ItemsOf(header.format(), header.record_length - kBaseLength[header.format()])) {
+  const uint16_t version = items.empty() ? 0 : items[0].version;
+  const bool known_version =
+      IsLayered(format) ? version == 3 || version == 4 : version == kPointwiseVersion;
+  if (header.record_length < kBaseLength[format] || !known_version ||
+      items != ItemsOf(format, header.record_length - kBaseLength[format], version)) {
     return Invalid(absl::StrCat("the LASzip record's items (", ItemsText(items),
-                                ") do not code point format ", header.format(), " in records of ",
+                                ") do not code point format ", format, " in records of ",
                                 header.record_length, " bytes"));
   }
   if (chunk_size == 0) return Invalid("the LASzip record's chunk size is 0");
-  return chunk_size;
-}
-
-// Decodes `chunk` (its first record raw, then the coded rest) into `count` records at `out`;
-// the chunk is number `index` (from 0) of `chunks`, for messages.
-absl::Status DecodeChunk(absl::string_view chunk, uint64_t count, RecordCoder& coder,
-                         size_t record_length, uint8_t* out, size_t index, size_t chunks) {
-  const auto name = [&] { return absl::StrCat("chunk ", index + 1, " of ", chunks); };
-  if (chunk.size() < record_length) {
-    return Invalid(absl::StrCat(name(), " has ", chunk.size(),
-                                " bytes, fewer than its first raw record's ", record_length));
-  }
-  std::memcpy(out, chunk.data(), record_length);
-  if (count == 1) return absl::OkStatus();
-  coder.Reset(out);
-  laz::ArithmeticDecoder decoder(chunk.substr(record_length));
-  for (uint64_t i = 1; i < count; ++i) {
-    coder.Decode(decoder, out + i * record_length);
-    if (i % kOverrunCheck == 0 && decoder.overrun() > kOverrunAllowed) break;
-  }
-  if (decoder.overrun() > kOverrunAllowed) {
-    return Invalid(absl::StrCat(name(), " ends ", decoder.overrun(), " bytes before its ", count,
-                                " records are decoded: the file is truncated or corrupt"));
-  }
-  return absl::OkStatus();
+  return Compression{chunk_size, version};
 }
 
 void SetUint32(uint32_t value, size_t at, std::string* out) { StoreLittleEndian(value, at, out); }
@@ -381,7 +553,7 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz) {
         "no LASzip record (user \"laszip encoded\", record 22204) says how the "
         "points are compressed");
   }
-  NM_ASSIGN_OR_RETURN(const uint32_t chunk_size, CheckLaszipRecord(laszip->payload, header));
+  NM_ASSIGN_OR_RETURN(const Compression compression, CheckLaszipRecord(laszip->payload, header));
   const size_t points_end =
       header.evlr_start > header.offset_to_points && header.evlr_start <= laz.size()
           ? static_cast<size_t>(header.evlr_start)
@@ -394,7 +566,7 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz) {
   }
   std::vector<Chunk> chunks;
   if (header.count > 0) {
-    NM_ASSIGN_OR_RETURN(chunks, ReadChunkTable(laz, header, chunk_size));
+    NM_ASSIGN_OR_RETURN(chunks, ReadChunkTable(laz, header, compression.chunk_size));
   }
 
   const size_t laszip_size = laszip->end() - laszip->at;
@@ -407,13 +579,14 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz) {
   las[kPointFormat] = static_cast<char>(header.format());
   SetUint32(header.vlr_count - 1, kVlrCount, &las);
   SetUint32(static_cast<uint32_t>(header.offset_to_points - laszip_size), kOffsetToPoints, &las);
-  RecordCoder coder(header.format(), header.record_length);
+  const std::unique_ptr<ChunkCoder> coder =
+      MakeChunkCoder(header.format(), header.record_length, compression.item_version);
   for (size_t i = 0; i < chunks.size(); ++i) {
     const size_t chunk_at = las.size();
     las.resize(chunk_at + chunks[i].count * header.record_length);
-    NM_RETURN_IF_ERROR(DecodeChunk(laz.substr(chunks[i].at, chunks[i].size), chunks[i].count, coder,
-                                   header.record_length, reinterpret_cast<uint8_t*>(&las[chunk_at]),
-                                   i, chunks.size()));
+    NM_RETURN_IF_ERROR(coder->Decode(laz.substr(chunks[i].at, chunks[i].size), chunks[i].count,
+                                     reinterpret_cast<uint8_t*>(&las[chunk_at]),
+                                     absl::StrCat("chunk ", i + 1, " of ", chunks.size())));
   }
   if (header.evlr_start != 0 && points_end < laz.size()) {
     SetUint64(las.size(), kEvlrStart, &las);
@@ -427,10 +600,11 @@ absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOpt
   if ((header.format_byte & kCompressedBits) != 0) {
     return absl::InvalidArgumentError("LAS: the points are compressed already (LAZ)");
   }
-  if (header.format_byte > 3) {
+  if (header.format_byte > 8 || header.format_byte == 4 || header.format_byte == 5) {
     return absl::FailedPreconditionError(
         absl::StrCat("LAZ: writing point format ", int{header.format_byte},
-                     " is not supported (formats 0 to 3 are); write .las"));
+                     " (waveform packets) is not supported (formats 0 to 3 and 6 to 8 are); "
+                     "write .las"));
   }
   const int format = header.format_byte;
   if (header.record_length < kBaseLength[format]) {
@@ -444,12 +618,19 @@ absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOpt
         header.offset_to_points, " do not fit in the file's ", las.size(), " bytes"));
   }
   if (options.chunk_size == 0) return absl::InvalidArgumentError("LAZ: a chunk size of 0");
+  if (options.layered_version != 3 && options.layered_version != 4) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("LAZ: item version ", options.layered_version, " is not 3 or 4"));
+  }
   NM_ASSIGN_OR_RETURN(const std::vector<Vlr> vlrs, ReadVlrs(las, header, "LAS"));
   const size_t vlrs_end = vlrs.empty() ? header.header_size : vlrs.back().end();
   const size_t points_end = header.offset_to_points + header.count * header.record_length;
 
   // The LASzip record, after the others (padding before the points stays after it).
-  const std::vector<Item> items = ItemsOf(format, header.record_length - kBaseLength[format]);
+  const bool layered = IsLayered(format);
+  const uint16_t version = layered ? options.layered_version : kPointwiseVersion;
+  const std::vector<Item> items =
+      ItemsOf(format, header.record_length - kBaseLength[format], version);
   std::string record(kVlrHeaderSize, '\0');
   record.replace(kVlrUser, kLaszipUser.size(), kLaszipUser.data(), kLaszipUser.size());
   StoreLittleEndian(kLaszipRecordId, kVlrRecordId, &record);
@@ -457,9 +638,10 @@ absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOpt
                     kVlrLength, &record);
   constexpr absl::string_view kDescription = "LAZ written by neuralmesh";
   record.replace(kVlrLength + 2, kDescription.size(), kDescription.data(), kDescription.size());
-  AppendLittleEndian(kCompressorPointwiseChunked, &record);
+  AppendLittleEndian(layered ? kCompressorLayeredChunked : kCompressorPointwiseChunked, &record);
   AppendLittleEndian(uint16_t{0}, &record);  // The arithmetic coder.
-  record.append({2, 2, 0, 0});               // Version 2.2, revision 0.
+  // The LASzip version whose format this is: 2.2 (revision 0), or 3.4 (revision 3).
+  record.append(layered ? std::string({3, 4, 3, 0}) : std::string({2, 2, 0, 0}));
   AppendLittleEndian(uint32_t{0}, &record);  // Options.
   AppendLittleEndian(options.chunk_size, &record);
   AppendLittleEndian(int64_t{-1}, &record);  // No special extended records.
@@ -482,21 +664,12 @@ absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOpt
   laz.append(8, '\0');
 
   const uint8_t* records = reinterpret_cast<const uint8_t*>(las.data() + header.offset_to_points);
-  RecordCoder coder(format, header.record_length);
+  const std::unique_ptr<ChunkCoder> coder = MakeChunkCoder(format, header.record_length, version);
   std::vector<uint32_t> chunk_sizes;
   for (uint64_t first = 0; first < header.count; first += options.chunk_size) {
     const uint64_t end = std::min<uint64_t>(header.count, first + options.chunk_size);
     const size_t chunk_at = laz.size();
-    const uint8_t* record_at = records + first * header.record_length;
-    laz.append(reinterpret_cast<const char*>(record_at), header.record_length);
-    if (end - first > 1) {
-      coder.Reset(record_at);
-      laz::ArithmeticEncoder encoder(&laz);
-      for (uint64_t i = first + 1; i < end; ++i) {
-        coder.Encode(encoder, records + i * header.record_length);
-      }
-      encoder.Done();
-    }
+    coder->Encode(records + first * header.record_length, end - first, &laz);
     chunk_sizes.push_back(static_cast<uint32_t>(laz.size() - chunk_at));
   }
 

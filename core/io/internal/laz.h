@@ -2,8 +2,9 @@
 // chunks (50,000 records by default) by LASzip's arithmetic coder, described by a variable-length
 // record (user "laszip encoded", record 22204), with a table of the chunks' sizes after them.
 // Point formats 0 to 3 (LAS 1.0-1.4), LASzip's item coders of version 2: what LASzip 2 and 3,
-// LAStools, PDAL and laz-perf write for these formats. LAS 1.4's formats 6 to 10, whose records
-// LASzip 3 codes in layers, and the waveform formats 4 and 5 are refused, saying so.
+// LAStools, PDAL and laz-perf write for these formats. LAS 1.4's formats 6 to 8, whose records
+// LASzip 3 codes in layers with item coders of version 3 or 4 (laz_layered_items.h). The
+// waveform formats 4, 5, 9 and 10 are refused, saying so.
 #ifndef NEURALMESH_CORE_IO_INTERNAL_LAZ_H_
 #define NEURALMESH_CORE_IO_INTERNAL_LAZ_H_
 
@@ -26,20 +27,24 @@ bool IsLaz(absl::string_view data);
 // malformed LASzip record, a chunk table or chunks that do not fit the file or list another
 // number of records than the header counts, a chunk whose bytes run out before its records are
 // decoded (truncated or corrupt), or records whose decompressed size would exceed 4,096 times
-// the compressed data (a corrupt count); and for what LASzip writes that is not read here,
-// saying so: formats 4 to 10 (the layered compressor of LASzip 3 among them) and LASzip 1's
-// compression (one stream, item coders of version 1).
+// the compressed data (a corrupt count), a layered chunk whose layers do not fit it or lack
+// the layer of returns, X and Y; and for what LASzip writes that is not read here, saying so:
+// the waveform formats 4, 5, 9 and 10 and LASzip 1's compression (one stream, item coders of
+// version 1).
 absl::StatusOr<std::string> DecompressLaz(absl::string_view laz);
 
 struct LazWriteOptions {
   // Records per chunk; each chunk starts afresh, so a reader can start at any chunk.
   uint32_t chunk_size = 50000;
+  // The item version of formats 6 to 8: 3 (LASzip 3, laz-perf) or 4 (newer LASzip).
+  uint16_t layered_version = 3;
 };
 
 // `las` compressed as LAZ: what DecompressLaz turns back into `las`, byte for byte.
 // Returns INVALID_ARGUMENT for a malformed LAS file (a header, records or variable-length
-// records that do not fit it) or a chunk size of 0; FAILED_PRECONDITION for point formats 4 to
-// 10, which are not written as LAZ here.
+// records that do not fit it), a chunk size of 0 or an item version other than 3 or 4;
+// FAILED_PRECONDITION for the waveform formats 4, 5, 9 and 10, which are not written as LAZ
+// here.
 absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOptions& options = {});
 
 }  // namespace neuralmesh::io_internal

@@ -22,13 +22,6 @@ void Store64(uint64_t value, uint8_t* p) {
   Store32(static_cast<uint32_t>(value >> 32), p + 4);
 }
 
-// A model of 256 symbols in `slot`, made on first use and reset with the others at a chunk's
-// start.
-SymbolModel& ModelIn(std::optional<SymbolModel>& slot) {
-  if (!slot.has_value()) slot.emplace(256);
-  return *slot;
-}
-
 // Which of 16 contexts the return r of n returns codes its X, Y and intensity in, and which of
 // 8 its Z: first, intermediate and last returns apart, and contexts of their own for the
 // combinations that badly written files hold (r or n of 0, r above n).
@@ -56,6 +49,11 @@ constexpr size_t kIntensity = 12, kFlags = 14, kClass = 15, kScanAngle = 16, kUs
                  kPointSource = 18;
 
 }  // namespace
+
+SymbolModel& ModelIn(std::optional<SymbolModel>& slot, uint32_t symbols) {
+  if (!slot.has_value()) slot.emplace(symbols);
+  return *slot;
+}
 
 void StreamingMedian5::Add(int32_t v) {
   std::array<int32_t, 5>& x = values_;
@@ -215,13 +213,14 @@ namespace {
 
 // The GPS time's multiplier symbols: the difference from the last time as a multiple of the
 // last difference, 1 to 499 (500 for any larger), -1 to -9 as 501 to 509 (510 for any
-// smaller) and 0; then a time unchanged, a time coded in full (a new sequence), and a switch
-// to one of the three other sequences.
+// smaller) and 0; then a time unchanged (version 2 only), a time coded in full (a new
+// sequence), and a switch to one of the three other sequences. After a difference of 0 the
+// symbols are, in the same order: unchanged (version 2), a difference of 32 bits, in full,
+// a switch.
 constexpr int32_t kMultiMax = 500;
 constexpr int32_t kMultiMin = -10;
 constexpr uint32_t kMultiUnchanged = kMultiMax - kMultiMin + 1;  // 511
-constexpr uint32_t kMultiCodeFull = kMultiMax - kMultiMin + 2;   // 512
-constexpr uint32_t kMultiSymbols = kMultiMax - kMultiMin + 6;    // 516
+constexpr uint32_t kMultiSymbols = kMultiMax - kMultiMin + 6;    // 516 (515 in version 3)
 
 // Whether `difference` fits 32 bits, and then it as an int32_t.
 bool Fits32(int64_t difference) { return difference == static_cast<int32_t>(difference); }
@@ -233,26 +232,31 @@ int32_t Times(int32_t multiplier, int32_t difference) {
 
 }  // namespace
 
-GpsTime11Coder::GpsTime11Coder() : multiplier_(kMultiSymbols) {}
+GpsTimeCoder::GpsTimeCoder(int version)
+    : unchanged_symbols_(version == 2 ? 1 : 0),
+      multiplier_(kMultiSymbols - 1 + unchanged_symbols_),
+      zero_difference_(5 + unchanged_symbols_) {}
 
-void GpsTime11Coder::Reset(const uint8_t* first) {
+int64_t GpsTimeCoder::LoadTime(const uint8_t* item) { return static_cast<int64_t>(Load64(item)); }
+
+void GpsTimeCoder::Reset(int64_t first) {
   multiplier_.Reset();
   zero_difference_.Reset();
   difference_.Reset();
   last_ = next_ = 0;
-  last_time_ = {static_cast<int64_t>(Load64(first)), 0, 0, 0};
+  last_time_ = {first, 0, 0, 0};
   last_difference_.fill(0);
   extreme_count_.fill(0);
 }
 
-void GpsTime11Coder::CountExtreme(int32_t difference) {
+void GpsTimeCoder::CountExtreme(int32_t difference) {
   if (++extreme_count_[last_] > 3) {
     last_difference_[last_] = difference;
     extreme_count_[last_] = 0;
   }
 }
 
-void GpsTime11Coder::EncodeNewSequence(ArithmeticEncoder& encoder, int64_t time) {
+void GpsTimeCoder::EncodeNewSequence(ArithmeticEncoder& encoder, int64_t time) {
   const uint64_t bits = static_cast<uint64_t>(time);
   difference_.Compress(encoder,
                        static_cast<int32_t>(static_cast<uint64_t>(last_time_[last_]) >> 32),
@@ -265,7 +269,7 @@ void GpsTime11Coder::EncodeNewSequence(ArithmeticEncoder& encoder, int64_t time)
   last_time_[last_] = time;
 }
 
-void GpsTime11Coder::DecodeNewSequence(ArithmeticDecoder& decoder) {
+void GpsTimeCoder::DecodeNewSequence(ArithmeticDecoder& decoder) {
   const uint32_t high = static_cast<uint32_t>(difference_.Decompress(
       decoder, static_cast<int32_t>(static_cast<uint64_t>(last_time_[last_]) >> 32), 8));
   const uint64_t bits = (uint64_t{high} << 32) | decoder.ReadInt();
@@ -276,14 +280,17 @@ void GpsTime11Coder::DecodeNewSequence(ArithmeticDecoder& decoder) {
   extreme_count_[last_] = 0;
 }
 
-void GpsTime11Coder::Encode(ArithmeticEncoder& encoder, const uint8_t* item) {
+void GpsTimeCoder::Encode(ArithmeticEncoder& encoder, const uint8_t* item) {
   EncodeTime(encoder, static_cast<int64_t>(Load64(item)));
 }
 
-void GpsTime11Coder::EncodeTime(ArithmeticEncoder& encoder, int64_t time) {
+void GpsTimeCoder::EncodeTime(ArithmeticEncoder& encoder, int64_t time) {
   const bool after_zero = last_difference_[last_] == 0;
   SymbolModel& model = after_zero ? zero_difference_ : multiplier_;
-  if (time == last_time_[last_]) {
+  // The symbols of a difference of 32 bits after a zero one, and of a time coded in full.
+  const uint32_t fits = unchanged_symbols_;
+  const uint32_t in_full = after_zero ? fits + 1 : kMultiUnchanged + unchanged_symbols_;
+  if (unchanged_symbols_ != 0 && time == last_time_[last_]) {
     encoder.EncodeSymbol(model, after_zero ? 0 : kMultiUnchanged);
     return;
   }
@@ -295,19 +302,19 @@ void GpsTime11Coder::EncodeTime(ArithmeticEncoder& encoder, int64_t time) {
       const int64_t other = static_cast<int64_t>(
           static_cast<uint64_t>(time) - static_cast<uint64_t>(last_time_[(last_ + i) & 3]));
       if (Fits32(other)) {
-        encoder.EncodeSymbol(model, after_zero ? i + 2 : kMultiCodeFull + i);
+        encoder.EncodeSymbol(model, in_full + i);
         last_ = (last_ + i) & 3;
         EncodeTime(encoder, time);
         return;
       }
     }
-    encoder.EncodeSymbol(model, after_zero ? 2 : kMultiCodeFull);
+    encoder.EncodeSymbol(model, in_full);
     EncodeNewSequence(encoder, time);
     return;
   }
   const int32_t difference = static_cast<int32_t>(difference64);
   if (after_zero) {
-    encoder.EncodeSymbol(model, 1);
+    encoder.EncodeSymbol(model, fits);
     difference_.Compress(encoder, 0, difference, 0);
     last_difference_[last_] = difference;
     extreme_count_[last_] = 0;
@@ -350,26 +357,27 @@ void GpsTime11Coder::EncodeTime(ArithmeticEncoder& encoder, int64_t time) {
   last_time_[last_] = time;
 }
 
-void GpsTime11Coder::Decode(ArithmeticDecoder& decoder, uint8_t* item) {
+void GpsTimeCoder::Decode(ArithmeticDecoder& decoder, uint8_t* item) {
   Store64(static_cast<uint64_t>(DecodeTime(decoder)), item);
 }
 
-int64_t GpsTime11Coder::DecodeTime(ArithmeticDecoder& decoder) {
+int64_t GpsTimeCoder::DecodeTime(ArithmeticDecoder& decoder) {
   // Sequence switches are at most three in a row in a valid stream; more are corrupt data,
   // decoded as the time unchanged.
+  const uint32_t in_full = kMultiUnchanged + unchanged_symbols_;
   for (int switches = 0; switches < 4; ++switches) {
     if (last_difference_[last_] == 0) {
       const uint32_t symbol = decoder.DecodeSymbol(zero_difference_);
-      if (symbol == 1) {
+      if (symbol == unchanged_symbols_) {
         last_difference_[last_] = difference_.Decompress(decoder, 0, 0);
         last_time_[last_] =
             static_cast<int64_t>(static_cast<uint64_t>(last_time_[last_]) +
                                  static_cast<uint64_t>(int64_t{last_difference_[last_]}));
         extreme_count_[last_] = 0;
-      } else if (symbol == 2) {
+      } else if (symbol == unchanged_symbols_ + 1) {
         DecodeNewSequence(decoder);
-      } else if (symbol > 2) {
-        last_ = (last_ + symbol - 2) & 3;
+      } else if (symbol > unchanged_symbols_ + 1) {
+        last_ = (last_ + symbol - unchanged_symbols_ - 1) & 3;
         continue;
       }
       return last_time_[last_];
@@ -397,13 +405,13 @@ int64_t GpsTime11Coder::DecodeTime(ArithmeticDecoder& decoder) {
         difference = difference_.Decompress(decoder, Times(kMultiMin, last), 6);
         CountExtreme(difference);
       }
-    } else if (symbol == kMultiUnchanged) {
+    } else if (symbol < in_full) {  // Unchanged (version 2).
       return last_time_[last_];
-    } else if (symbol == kMultiCodeFull) {
+    } else if (symbol == in_full) {
       DecodeNewSequence(decoder);
       return last_time_[last_];
     } else {
-      last_ = (last_ + symbol - kMultiCodeFull) & 3;
+      last_ = (last_ + symbol - in_full) & 3;
       continue;
     }
     last_time_[last_] = static_cast<int64_t>(static_cast<uint64_t>(last_time_[last_]) +
@@ -413,90 +421,104 @@ int64_t GpsTime11Coder::DecodeTime(ArithmeticDecoder& decoder) {
   return last_time_[last_];
 }
 
-Rgb12Coder::Rgb12Coder() : differences_(6, SymbolModel(256)) {}
+RgbModels::RgbModels() : differences(6, SymbolModel(256)) {}
 
-void Rgb12Coder::Reset(const uint8_t* first) {
-  changed_bytes_.Reset();
-  for (SymbolModel& model : differences_) model.Reset();
-  for (int c = 0; c < 3; ++c) last_[c] = Load16(first + 2 * c);
+void RgbModels::Reset() {
+  changed_bytes.Reset();
+  for (SymbolModel& model : differences) model.Reset();
 }
 
-void Rgb12Coder::Encode(ArithmeticEncoder& encoder, const uint8_t* item) {
-  uint16_t rgb[3];
-  for (int c = 0; c < 3; ++c) rgb[c] = Load16(item + 2 * c);
+uint32_t EncodeRgb(ArithmeticEncoder& encoder, RgbModels& models,
+                   const std::array<uint16_t, 3>& last, const std::array<uint16_t, 3>& rgb) {
   uint32_t changed = 0;
   for (int c = 0; c < 3; ++c) {
-    changed |= uint32_t{(last_[c] & 0x00FF) != (rgb[c] & 0x00FF)} << (2 * c);
-    changed |= uint32_t{(last_[c] & 0xFF00) != (rgb[c] & 0xFF00)} << (2 * c + 1);
+    changed |= uint32_t{(last[c] & 0x00FF) != (rgb[c] & 0x00FF)} << (2 * c);
+    changed |= uint32_t{(last[c] & 0xFF00) != (rgb[c] & 0xFF00)} << (2 * c + 1);
   }
   const bool colored = rgb[0] != rgb[1] || rgb[0] != rgb[2];
   changed |= uint32_t{colored} << 6;
-  encoder.EncodeSymbol(changed_bytes_, changed);
+  encoder.EncodeSymbol(models.changed_bytes, changed);
   // Each byte's change from the last record; green's and blue's predicted by red's.
+  std::vector<SymbolModel>& differences = models.differences;
   int32_t low = 0, high = 0;
   if (changed & 1) {
-    low = (rgb[0] & 0xFF) - (last_[0] & 0xFF);
-    encoder.EncodeSymbol(differences_[0], static_cast<uint8_t>(low));
+    low = (rgb[0] & 0xFF) - (last[0] & 0xFF);
+    encoder.EncodeSymbol(differences[0], static_cast<uint8_t>(low));
   }
   if (changed & 2) {
-    high = (rgb[0] >> 8) - (last_[0] >> 8);
-    encoder.EncodeSymbol(differences_[1], static_cast<uint8_t>(high));
+    high = (rgb[0] >> 8) - (last[0] >> 8);
+    encoder.EncodeSymbol(differences[1], static_cast<uint8_t>(high));
   }
   if (colored) {
     if (changed & 4) {
-      const int32_t corrector = (rgb[1] & 0xFF) - Clamp8(low + (last_[1] & 0xFF));
-      encoder.EncodeSymbol(differences_[2], static_cast<uint8_t>(corrector));
+      const int32_t corrector = (rgb[1] & 0xFF) - Clamp8(low + (last[1] & 0xFF));
+      encoder.EncodeSymbol(differences[2], static_cast<uint8_t>(corrector));
     }
     if (changed & 16) {
-      low = (low + (rgb[1] & 0xFF) - (last_[1] & 0xFF)) / 2;
-      const int32_t corrector = (rgb[2] & 0xFF) - Clamp8(low + (last_[2] & 0xFF));
-      encoder.EncodeSymbol(differences_[4], static_cast<uint8_t>(corrector));
+      low = (low + (rgb[1] & 0xFF) - (last[1] & 0xFF)) / 2;
+      const int32_t corrector = (rgb[2] & 0xFF) - Clamp8(low + (last[2] & 0xFF));
+      encoder.EncodeSymbol(differences[4], static_cast<uint8_t>(corrector));
     }
     if (changed & 8) {
-      const int32_t corrector = (rgb[1] >> 8) - Clamp8(high + (last_[1] >> 8));
-      encoder.EncodeSymbol(differences_[3], static_cast<uint8_t>(corrector));
+      const int32_t corrector = (rgb[1] >> 8) - Clamp8(high + (last[1] >> 8));
+      encoder.EncodeSymbol(differences[3], static_cast<uint8_t>(corrector));
     }
     if (changed & 32) {
-      high = (high + (rgb[1] >> 8) - (last_[1] >> 8)) / 2;
-      const int32_t corrector = (rgb[2] >> 8) - Clamp8(high + (last_[2] >> 8));
-      encoder.EncodeSymbol(differences_[5], static_cast<uint8_t>(corrector));
+      high = (high + (rgb[1] >> 8) - (last[1] >> 8)) / 2;
+      const int32_t corrector = (rgb[2] >> 8) - Clamp8(high + (last[2] >> 8));
+      encoder.EncodeSymbol(differences[5], static_cast<uint8_t>(corrector));
     }
   }
-  for (int c = 0; c < 3; ++c) last_[c] = rgb[c];
+  return changed;
 }
 
-void Rgb12Coder::Decode(ArithmeticDecoder& decoder, uint8_t* item) {
-  const uint32_t changed = decoder.DecodeSymbol(changed_bytes_);
-  uint16_t rgb[3];
+std::array<uint16_t, 3> DecodeRgb(ArithmeticDecoder& decoder, RgbModels& models,
+                                  const std::array<uint16_t, 3>& last) {
+  const uint32_t changed = decoder.DecodeSymbol(models.changed_bytes);
+  std::array<uint16_t, 3> rgb;
   auto decode_byte = [&](int model, int32_t predicted) {
-    return static_cast<uint8_t>(decoder.DecodeSymbol(differences_[model]) + predicted);
+    return static_cast<uint8_t>(decoder.DecodeSymbol(models.differences[model]) + predicted);
   };
-  rgb[0] = changed & 1 ? decode_byte(0, last_[0] & 0xFF) : last_[0] & 0xFF;
-  rgb[0] |= (changed & 2 ? decode_byte(1, last_[0] >> 8) : last_[0] >> 8) << 8;
+  rgb[0] = changed & 1 ? decode_byte(0, last[0] & 0xFF) : last[0] & 0xFF;
+  rgb[0] |= (changed & 2 ? decode_byte(1, last[0] >> 8) : last[0] >> 8) << 8;
   if (changed & 64) {
-    int32_t low = (rgb[0] & 0xFF) - (last_[0] & 0xFF);
-    rgb[1] = changed & 4 ? decode_byte(2, Clamp8(low + (last_[1] & 0xFF))) : last_[1] & 0xFF;
+    int32_t low = (rgb[0] & 0xFF) - (last[0] & 0xFF);
+    rgb[1] = changed & 4 ? decode_byte(2, Clamp8(low + (last[1] & 0xFF))) : last[1] & 0xFF;
     if (changed & 16) {
-      low = (low + (rgb[1] & 0xFF) - (last_[1] & 0xFF)) / 2;
-      rgb[2] = decode_byte(4, Clamp8(low + (last_[2] & 0xFF)));
+      low = (low + (rgb[1] & 0xFF) - (last[1] & 0xFF)) / 2;
+      rgb[2] = decode_byte(4, Clamp8(low + (last[2] & 0xFF)));
     } else {
-      rgb[2] = last_[2] & 0xFF;
+      rgb[2] = last[2] & 0xFF;
     }
-    int32_t high = (rgb[0] >> 8) - (last_[0] >> 8);
-    rgb[1] |= (changed & 8 ? decode_byte(3, Clamp8(high + (last_[1] >> 8))) : last_[1] >> 8) << 8;
+    int32_t high = (rgb[0] >> 8) - (last[0] >> 8);
+    rgb[1] |= (changed & 8 ? decode_byte(3, Clamp8(high + (last[1] >> 8))) : last[1] >> 8) << 8;
     if (changed & 32) {
-      high = (high + (rgb[1] >> 8) - (last_[1] >> 8)) / 2;
-      rgb[2] |= decode_byte(5, Clamp8(high + (last_[2] >> 8))) << 8;
+      high = (high + (rgb[1] >> 8) - (last[1] >> 8)) / 2;
+      rgb[2] |= decode_byte(5, Clamp8(high + (last[2] >> 8))) << 8;
     } else {
-      rgb[2] |= last_[2] & 0xFF00;
+      rgb[2] |= last[2] & 0xFF00;
     }
   } else {
     rgb[1] = rgb[2] = rgb[0];
   }
-  for (int c = 0; c < 3; ++c) {
-    last_[c] = rgb[c];
-    Store16(rgb[c], item + 2 * c);
-  }
+  return rgb;
+}
+
+void Rgb12Coder::Reset(const uint8_t* first) {
+  models_.Reset();
+  for (int c = 0; c < 3; ++c) last_[c] = Load16(first + 2 * c);
+}
+
+void Rgb12Coder::Encode(ArithmeticEncoder& encoder, const uint8_t* item) {
+  std::array<uint16_t, 3> rgb;
+  for (int c = 0; c < 3; ++c) rgb[c] = Load16(item + 2 * c);
+  EncodeRgb(encoder, models_, last_, rgb);
+  last_ = rgb;
+}
+
+void Rgb12Coder::Decode(ArithmeticDecoder& decoder, uint8_t* item) {
+  last_ = DecodeRgb(decoder, models_, last_);
+  for (int c = 0; c < 3; ++c) Store16(last_[c], item + 2 * c);
 }
 
 BytesCoder::BytesCoder(size_t count) : models_(count, SymbolModel(256)), last_(count) {}

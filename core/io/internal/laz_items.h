@@ -2,7 +2,8 @@
 // 20 bytes every record starts with (POINT10), the GPS time (GPSTIME11), the colour (RGB12)
 // and the extra bytes (BYTE). Each predicts its fields from the records before it in the chunk
 // and codes what the prediction missed; Reset starts a chunk from its first record, which the
-// chunk holds raw. Decode is Encode's exact inverse, as in LASzip.
+// chunk holds raw. Decode is Encode's exact inverse, as in LASzip. The GPS time's and the
+// colour's coding serve the layered coders of formats 6 to 8 too (laz_layered_items.h).
 #ifndef NEURALMESH_CORE_IO_INTERNAL_LAZ_ITEMS_H_
 #define NEURALMESH_CORE_IO_INTERNAL_LAZ_ITEMS_H_
 
@@ -15,6 +16,10 @@
 #include "core/io/internal/laz_integer_coder.h"
 
 namespace neuralmesh::io_internal::laz {
+
+// The model in `slot`, of `symbols` symbols, made on first use; a coder resets the models it
+// made at a chunk's start.
+SymbolModel& ModelIn(std::optional<SymbolModel>& slot, uint32_t symbols = 256);
 
 // The median of the last five values added (three at first, zeros before any).
 class StreamingMedian5 {
@@ -56,26 +61,34 @@ class Point10Coder {
 };
 
 // The GPS time, a double coded through its bits as an integer, in up to four interleaved
-// sequences (several scanners or flight lines).
-class GpsTime11Coder {
+// sequences (several scanners or flight lines). Version 2 (GPSTIME11) codes every record's
+// time, an unchanged one too; version 3 (a layer of POINT14) only the times that changed, with
+// one symbol fewer.
+class GpsTimeCoder {
  public:
   static constexpr size_t kSize = 8;
-  GpsTime11Coder();
-  void Reset(const uint8_t* first);
+  explicit GpsTimeCoder(int version);
+  void Reset(const uint8_t* first) { Reset(LoadTime(first)); }
+  void Reset(int64_t first);
   void Encode(ArithmeticEncoder& encoder, const uint8_t* item);
   void Decode(ArithmeticDecoder& decoder, uint8_t* item);
-
- private:
+  // The time's bits; version 3 codes only a time other than the last one.
   void EncodeTime(ArithmeticEncoder& encoder, int64_t time);
   int64_t DecodeTime(ArithmeticDecoder& decoder);
+
+ private:
+  static int64_t LoadTime(const uint8_t* item);
   // Starts a new sequence at `time`, coded in full.
   void EncodeNewSequence(ArithmeticEncoder& encoder, int64_t time);
   void DecodeNewSequence(ArithmeticDecoder& decoder);
   // Counts a difference far from the last one; the fourth in a row becomes the new one.
   void CountExtreme(int32_t difference);
 
+  // 1 where an unchanged time has a symbol of its own (version 2), else 0: the symbols of the
+  // cases after it are this much higher.
+  uint32_t unchanged_symbols_;
   SymbolModel multiplier_;
-  SymbolModel zero_difference_{6};
+  SymbolModel zero_difference_;
   IntegerCoder difference_{32, 9};
   uint32_t last_ = 0, next_ = 0;
   std::array<int64_t, 4> last_time_{};
@@ -83,19 +96,29 @@ class GpsTime11Coder {
   std::array<int32_t, 4> extreme_count_{};
 };
 
-// Red, green and blue, 16 bits each, coded byte by byte, green and blue predicted from red's
-// change.
+// Red, green and blue, 16 bits each, coded byte by byte as their change from `last`, green and
+// blue predicted from red's change. RGB12 codes a record's colour so; RGB14 too, in a layer.
+struct RgbModels {
+  RgbModels();
+  void Reset();
+  SymbolModel changed_bytes{128};
+  std::vector<SymbolModel> differences;  // Red low, red high, green low, high, blue low, high.
+};
+// Returns which bytes changed (0: the colour is `last`).
+uint32_t EncodeRgb(ArithmeticEncoder& encoder, RgbModels& models,
+                   const std::array<uint16_t, 3>& last, const std::array<uint16_t, 3>& rgb);
+std::array<uint16_t, 3> DecodeRgb(ArithmeticDecoder& decoder, RgbModels& models,
+                                  const std::array<uint16_t, 3>& last);
+
 class Rgb12Coder {
  public:
   static constexpr size_t kSize = 6;
-  Rgb12Coder();
   void Reset(const uint8_t* first);
   void Encode(ArithmeticEncoder& encoder, const uint8_t* item);
   void Decode(ArithmeticDecoder& decoder, uint8_t* item);
 
  private:
-  SymbolModel changed_bytes_{128};
-  std::vector<SymbolModel> differences_;  // Red low, red high, green low, high, blue low, high.
+  RgbModels models_;
   std::array<uint16_t, 3> last_{};
 };
 

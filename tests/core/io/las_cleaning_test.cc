@@ -32,9 +32,9 @@ using io_test::TempPath;
 using io_test::WriteBytes;
 using ::testing::HasSubstr;
 using testing::LasFile;
-using testing::LasVariableLengthRecord;
 using testing::LasLayout;
 using testing::LasPoint;
+using testing::LasVariableLengthRecord;
 
 // Points with every field set to something of its own: intensity, returns, class (2 or 5), GPS
 // time, extra bytes, colour.
@@ -282,9 +282,8 @@ TEST(LasCleaningTest, TheClassesAskedForChooseThePointsAndTheRecordsKept) {
     EXPECT_EQ(out[227 + 28 * i + 15], i == 4 ? 7 : in[227 + 28 * i + 15]) << "record " << i;
   }
 
-  const absl::Status status =
-      WriteCleanedLas({source}, {false, false, false, false, false, false},
-                      LasOutlierRecords::kLeftOut, written, vegetation);
+  const absl::Status status = WriteCleanedLas({source}, {false, false, false, false, false, false},
+                                              LasOutlierRecords::kLeftOut, written, vegetation);
   EXPECT_THAT(std::string(status.message()),
               HasSubstr("6 flags for the 4 points read from '" + source +
                         "' (withheld, noise or other classes"));
@@ -321,8 +320,7 @@ TEST(LasCleaningTest, TilesJoinIntoOneFileOnTheFinestScale) {
     // The points read: a's 5, then b's 0, 1 and 3; the outliers a's 1 and b's 3.
     const std::string written = TempPath("joined.las");
     const absl::Status status = WriteCleanedLas(
-        {tile_a, tile_b}, {false, true, false, false, false, false, false, true}, records,
-        written);
+        {tile_a, tile_b}, {false, true, false, false, false, false, false, true}, records, written);
     ASSERT_TRUE(status.ok()) << status;
     const std::string out = ReadBytes(written);
     // (tile, record) of each record written.
@@ -486,11 +484,18 @@ TEST(LasCleaningTest, CopiesKeepEveryRecordCompressedOrNot) {
   ASSERT_TRUE(CopyLas(laz, again).ok());
   EXPECT_TRUE(ReadBytes(again) == ReadBytes(laz));
 
+  // LAS 1.4's formats are copied so too; waveform records are not written as LAZ.
   layout.version_minor = 4;
   layout.format = 6;
-  const std::string format6 = TempPath("format6.las");
+  const std::string format6 = TempPath("format6.las"), format6_laz = TempPath("format6.laz");
   WriteBytes(format6, LasFile(layout, points));
-  EXPECT_EQ(CopyLas(format6, TempPath("format6.laz")).status().code(),
+  ASSERT_TRUE(CopyLas(format6, format6_laz).ok());
+  ASSERT_TRUE(CopyLas(format6_laz, back).ok());
+  EXPECT_TRUE(ReadBytes(back) == ReadBytes(format6));
+  layout.format = 9;
+  const std::string format9 = TempPath("format9.las");
+  WriteBytes(format9, LasFile(layout, points));
+  EXPECT_EQ(CopyLas(format9, TempPath("format9.laz")).status().code(),
             absl::StatusCode::kFailedPrecondition);
   EXPECT_EQ(CopyLas(TempPath("missing.las"), back).status().code(), absl::StatusCode::kNotFound);
   EXPECT_THAT(std::string(CopyLas(source, TempPath("tile.xyz")).status().message()),

@@ -1,8 +1,9 @@
 // LAZ files read by an independent decoder: laz-perf, the LASzip-compatible codec PDAL uses,
 // compiled to WebAssembly (tests/tools/laz_reader.mjs, installed from npm by
 // scripts/install-deps.sh). The LAZ files neuralmesh writes must give laz-perf every record of
-// the LAS file they compress, byte for byte: each point format 0-3, extra bytes, several
-// chunks, random records among scan-like ones, LAS 1.4, and the files WritePointCloud writes.
+// the LAS file they compress, byte for byte: each point format 0-3 and 6-8, extra bytes,
+// several chunks, scanner channels, random records among scan-like ones, LAS 1.4, and the files
+// WritePointCloud writes.
 #include <string>
 
 #include "absl/strings/str_cat.h"
@@ -77,6 +78,22 @@ TEST(LazIndependentReaderTest, LazPerfReadsEveryRecordOfEachPointFormat) {
         scan.seed = 100 + format;
         ExpectLazPerfReadsTheRecords(scan, chunk_size);
       }
+    }
+  }
+}
+
+TEST(LazIndependentReaderTest, LazPerfReadsEveryRecordOfLas14PointFormats) {
+  for (int format = 6; format <= 8; ++format) {
+    for (const int channels : {1, 4}) {
+      SCOPED_TRACE(absl::StrCat("format ", format, ", ", channels, " scanner channels"));
+      LasScan scan;
+      scan.format = format;
+      scan.scanner_channels = channels;
+      scan.extra_bytes = format == 7 ? 0 : 2;
+      scan.records = 3000;
+      scan.random_every = 61;
+      scan.seed = 200 + format * 10 + channels;
+      ExpectLazPerfReadsTheRecords(scan, format == 8 ? 50000 : 700);
     }
   }
 }

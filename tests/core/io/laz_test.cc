@@ -175,9 +175,18 @@ TEST(LazCoderTest, IntegersOfEveryMagnitudeComeBack) {
   }
 }
 
-// `las` through LAZ (chunks of `chunk_size`) and back: the same bytes. Returns the LAZ file.
-std::string ExpectSameThroughLaz(const std::string& las, uint32_t chunk_size = 50000) {
-  const absl::StatusOr<std::string> laz = CompressLas(las, {chunk_size});
+// Overwrites the little-endian value at `at`.
+template <typename T>
+std::string With(std::string bytes, size_t at, T value) {
+  std::memcpy(&bytes[at], &value, sizeof value);
+  return bytes;
+}
+
+// `las` through LAZ (chunks of `chunk_size`, formats 6-8 in item `version`) and back: the same
+// bytes. Returns the LAZ file.
+std::string ExpectSameThroughLaz(const std::string& las, uint32_t chunk_size = 50000,
+                                 uint16_t version = 3) {
+  const absl::StatusOr<std::string> laz = CompressLas(las, {chunk_size, version});
   EXPECT_TRUE(laz.ok()) << laz.status();
   if (!laz.ok()) return {};
   const absl::StatusOr<std::string> back = DecompressLaz(*laz);
@@ -211,6 +220,76 @@ TEST(LazTest, EveryPointFormatComesBackByteForByte) {
     scan.records = records;
     ExpectSameThroughLaz(ScanLasFile(scan));
   }
+}
+
+TEST(LazTest, Las14PointFormatsComeBackByteForByte) {
+  for (int format = 6; format <= 8; ++format) {
+    for (const int channels : {1, 3}) {
+      for (const int extra : {0, 3}) {
+        for (const uint32_t chunk_size : {50000u, 700u, 1u}) {
+          for (const uint16_t version : {3, 4}) {
+            SCOPED_TRACE(absl::StrCat("format ", format, ", ", channels, " scanner channels, ",
+                                      extra, " extra bytes, chunks of ", chunk_size, ", version ",
+                                      version));
+            LasScan scan;
+            scan.format = format;
+            scan.scanner_channels = channels;
+            scan.extra_bytes = extra;
+            scan.records = 2500;
+            scan.random_every = 89;
+            scan.seed = format * 10 + channels + extra;
+            const std::string laz = ExpectSameThroughLaz(ScanLasFile(scan), chunk_size, version);
+            EXPECT_EQ(io_test::Field<uint8_t>(laz, 104), format | 0x80);
+          }
+        }
+      }
+    }
+  }
+  for (const size_t records : {0, 1, 2}) {
+    SCOPED_TRACE(absl::StrCat(records, " records"));
+    LasScan scan;
+    scan.format = 8;
+    scan.records = records;
+    ExpectSameThroughLaz(ScanLasFile(scan));
+  }
+  // LAS 1.4's records of a scan with variable-length records before them and extended ones
+  // after.
+  LasScan scan = testing::Las14Scan(/*format=*/7, 3000);
+  scan.scanner_channels = 2;
+  const std::string laz = ExpectSameThroughLaz(ScanLasFile(scan), 1000);
+  EXPECT_EQ(laz.substr(io_test::Field<uint64_t>(laz, 235)), scan.after_points);
+}
+
+TEST(LazTest, ItemVersionsThreeAndFourDifferWhereScannerChannelsSwitch) {
+  // The LASzip record's items follow the LAS 1.4 header (375 bytes), the record's header (54)
+  // and its fixed fields (34): POINT14's and RGB14's versions.
+  constexpr size_t kVersions[] = {375 + 54 + 34 + 4, 375 + 54 + 34 + 6 + 4};
+  for (const int channels : {1, 3}) {
+    SCOPED_TRACE(absl::StrCat(channels, " scanner channels"));
+    LasScan scan;
+    scan.format = 7;
+    scan.scanner_channels = channels;
+    scan.records = 3000;
+    const std::string las = ScanLasFile(scan);
+    const std::string version3 = ExpectSameThroughLaz(las, 1000, 3);
+    std::string version4 = ExpectSameThroughLaz(las, 1000, 4);
+    for (const size_t at : kVersions) {
+      EXPECT_EQ(io_test::Field<uint16_t>(version3, at), 3);
+      EXPECT_EQ(io_test::Field<uint16_t>(version4, at), 4);
+      version4 = With<uint16_t>(version4, at, 3);
+    }
+    // One scanner: the same records coded alike. Several: version 4 codes the colours of every
+    // channel apart, where version 3 mixes them (and is then read as other colours).
+    if (channels == 1) {
+      EXPECT_TRUE(version4 == version3);
+    } else {
+      EXPECT_FALSE(version4 == version3);
+      const absl::StatusOr<std::string> misread = DecompressLaz(version4);
+      EXPECT_TRUE(!misread.ok() || *misread != las);
+    }
+  }
+  EXPECT_EQ(CompressLas(ScanLasFile(LasScan{}), {50000, 5}).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 TEST(LazTest, Las14FilesKeepTheirRecordsAndExtendedRecords) {
@@ -293,23 +372,16 @@ TEST(LazTest, CleanedLasFilesAreReadFromAndWrittenToLaz) {
   ASSERT_TRUE(back.ok()) << back.status();
   EXPECT_TRUE(*back == io_test::ReadBytes(from_las));
 
-  // LAS 1.4's formats are not written as LAZ: the records go to the point writers instead.
+  // Waveform records are not written as LAZ: the records go to the point writers instead.
   testing::LasLayout layout;
   layout.version_minor = 4;
-  layout.format = 6;
-  const std::string format6 = TempPath("format6.las");
-  WriteBytes(format6, testing::LasFile(layout, {{1, 2, 3}, {4, 5, 6}}));
+  layout.format = 9;
+  const std::string format9 = TempPath("format9.las");
+  WriteBytes(format9, testing::LasFile(layout, {{1, 2, 3}, {4, 5, 6}}));
   const absl::Status status =
-      WriteCleanedLas({format6}, {false, false}, LasOutlierRecords::kLeftOut, TempPath("6.laz"));
+      WriteCleanedLas({format9}, {false, false}, LasOutlierRecords::kLeftOut, TempPath("9.laz"));
   EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition) << status;
-  EXPECT_THAT(std::string(status.message()), HasSubstr("writing point format 6"));
-}
-
-// Overwrites the little-endian value at `at`.
-template <typename T>
-std::string With(std::string bytes, size_t at, T value) {
-  std::memcpy(&bytes[at], &value, sizeof value);
-  return bytes;
+  EXPECT_THAT(std::string(status.message()), HasSubstr("writing point format 9"));
 }
 
 // The chunk table of `laz` (our writer's: chunks of `chunk_size`, the table's offset after the
@@ -386,9 +458,9 @@ TEST(LazTest, MalformedFilesAreRefusedWithWhatIsWrong) {
       {"no LASzip record", With<uint32_t>(laz, 100, 0), absl::StatusCode::kInvalidArgument,
        "no LASzip record"},
       {"layered compressor", With<uint16_t>(laz, kPayload, 3), absl::StatusCode::kInvalidArgument,
-       "compressed in layers (LASzip 3, LAS 1.4 formats 6 to 10)"},
+       "compressor 3 does not code point format 1"},
       {"format 6", With<uint8_t>(laz, 104, 6 | 0x80), absl::StatusCode::kInvalidArgument,
-       "point format 6 is compressed in layers"},
+       "compressor 2 does not code point format 6"},
       {"format 5", With<uint8_t>(laz, 104, 5 | 0x80), absl::StatusCode::kInvalidArgument,
        "point format 5 (waveform packets)"},
       {"LASzip 1's items", With<uint16_t>(laz, kPayload + 34 + 4, 1),
@@ -425,12 +497,60 @@ TEST(LazTest, MalformedFilesAreRefusedWithWhatIsWrong) {
     EXPECT_THAT(std::string(back.status().message()), HasSubstr(c.message));
   }
   // Through ReadPointCloud, named.
-  const std::string path = TempPath("layered.laz");
-  WriteBytes(path, With<uint8_t>(laz, 104, 7 | 0x80));
+  const std::string path = TempPath("waveform.laz");
+  WriteBytes(path, With<uint8_t>(laz, 104, 9 | 0x80));
   const absl::StatusOr<PointCloud> cloud = ReadPointCloud(path);
   ASSERT_FALSE(cloud.ok());
-  EXPECT_THAT(std::string(cloud.status().message()), HasSubstr("layered.laz"));
+  EXPECT_THAT(std::string(cloud.status().message()), HasSubstr("waveform.laz"));
   EXPECT_THAT(std::string(cloud.status().message()), HasSubstr("decompress it first"));
+}
+
+TEST(LazTest, MalformedLayersAreRefusedWithWhatIsWrong) {
+  LasScan scan;
+  scan.format = 7;
+  scan.records = 3000;
+  const std::string las = ScanLasFile(scan);
+  const std::string laz = *CompressLas(las, {1000});
+  // The LASzip record follows the LAS 1.4 header (375 bytes) and its record header (54).
+  constexpr size_t kPayload = 375 + 54;
+  ASSERT_EQ(io_test::Field<uint16_t>(laz, kPayload), 3);  // Layered.
+  // The first chunk: its first record raw (36 bytes), the number of records, the sizes of 10
+  // layers (9 of POINT14, 1 of RGB14), then their bytes.
+  const size_t chunk = io_test::Field<uint32_t>(laz, 96) + 8;
+  const size_t sizes = chunk + 36 + 4;
+  EXPECT_EQ(io_test::Field<uint32_t>(laz, chunk + 36), 1000u);
+  size_t layers = 0;
+  for (int i = 0; i < 10; ++i) layers += io_test::Field<uint32_t>(laz, sizes + 4 * i);
+  EXPECT_GT(io_test::Field<uint32_t>(laz, sizes), 40u);  // Returns, X and Y.
+  ASSERT_TRUE(DecompressLaz(laz).ok());
+  struct Case {
+    const char* what;
+    std::string bytes;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"a layer past the chunk's end", With<uint32_t>(laz, sizes + 4, 1u << 30),
+       "chunk 1 of 3's layers run past its end"},
+      {"no layer of returns and X, Y", With<uint32_t>(laz, sizes, 0),
+       "chunk 1 of 3 has no layer of returns, X and Y"},
+      {"item version 5", With<uint16_t>(laz, kPayload + 34 + 4, 5),
+       "do not code point format 7 in records of 36 bytes"},
+      {"format 9", With<uint8_t>(laz, 104, 9 | 0x80), "point format 9 (waveform packets)"},
+      {"a layer cut short", With<uint32_t>(laz, sizes, 20), "chunk 1 of 3 ends"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    const absl::StatusOr<std::string> back = DecompressLaz(c.bytes);
+    ASSERT_FALSE(back.ok());
+    EXPECT_EQ(back.status().code(), absl::StatusCode::kInvalidArgument) << back.status();
+    EXPECT_THAT(std::string(back.status().message()), HasSubstr(c.message));
+  }
+  // A layer's bytes garbled: refused as running out, or decoded to other records, never read
+  // out of bounds (AddressSanitizer).
+  std::string garbled = laz;
+  for (size_t i = sizes + 40; i < sizes + 40 + layers; i += 7) garbled[i] = static_cast<char>(i);
+  const absl::StatusOr<std::string> back = DecompressLaz(garbled);
+  EXPECT_TRUE(!back.ok() || *back != las);
 }
 
 TEST(LazTest, CorruptChunksDecodeWithoutReadingOutOfBounds) {
@@ -469,14 +589,15 @@ TEST(LazTest, CorruptChunksDecodeWithoutReadingOutOfBounds) {
 
 TEST(LazTest, CompressingRefusesWhatItDoesNotWrite) {
   testing::LasLayout layout;
-  layout.format = 6;
+  layout.format = 10;
   layout.version_minor = 4;
-  const std::string format6 = testing::LasFile(layout, {{1, 2, 3}});
-  const absl::StatusOr<std::string> laz = CompressLas(format6);
+  const std::string format10 = testing::LasFile(layout, {{1, 2, 3}});
+  const absl::StatusOr<std::string> laz = CompressLas(format10);
   ASSERT_FALSE(laz.ok());
   EXPECT_EQ(laz.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(std::string(laz.status().message()),
-              HasSubstr("writing point format 6 is not supported (formats 0 to 3 are)"));
+              HasSubstr("writing point format 10 (waveform packets) is not supported (formats 0 "
+                        "to 3 and 6 to 8 are)"));
   LasScan scan;
   scan.records = 10;
   const std::string compressed = *CompressLas(ScanLasFile(scan));

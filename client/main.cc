@@ -717,11 +717,11 @@ std::vector<Subcommand> Commands() {
        "are written as one. One LAS file (.las, or .laz compressed by LASzip) written to .las\n"
        "or .laz with nothing to remove or select is copied whole, every record and the\n"
        "header. LAS files written to LAS otherwise keep their records whole (classes,\n"
-       "intensities, times, extra bytes) and the first file's offset and variable-length\n"
-       "records (the coordinate system); tiles are joined so when they share the version,\n"
-       "point format, coordinate system and extra bytes (and, for .laz, a point format\n"
-       "without waveforms: 0 to 3 or 6 to 8). --outliers_as_noise classifies the outliers\n"
-       "as noise instead of removing them.",
+       "intensities, times, extra bytes) and the offset and variable-length records (the\n"
+       "coordinate system) of the first file of the highest LAS version; tiles are joined so\n"
+       "when they share the coordinate system and extra bytes and hold no waveforms, those\n"
+       "of other point formats in the format that holds every field of theirs.\n"
+       "--outliers_as_noise classifies the outliers as noise instead of removing them.",
        {"output", "gltf_draco", "pcd_data", "las_classes", "remove_outliers",
         "outlier_neighbours", "outlier_std_ratio",
         "outlier_passes", "outliers_as_noise", "quantization_bits", "encode_speed"},

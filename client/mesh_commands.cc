@@ -188,16 +188,17 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
   std::string contents;  // What the file holds besides positions, for the line below.
   std::vector<std::string> dropped;
   const WrittenPointAttributes kept = PointAttributesWrittenTo(options.output);
-  // Several LAS files whose records cannot share one file (another point format, coordinate
-  // system, ...) are written as points, saying why.
+  // Several LAS files whose records cannot share one file (another coordinate system, extra
+  // bytes, ...) are written as points, saying why.
   bool las_records_kept = false;
   std::string not_joined;
+  LasJoin join;
   if (las_to_las) {
     const absl::Status joined = WriteCleanedLas(
         options.inputs, outlier,
         options.outliers_as_noise ? LasOutlierRecords::kClassifiedAsNoise
                                   : LasOutlierRecords::kLeftOut,
-        options.output, options.selection);
+        options.output, options.selection, &join);
     las_records_kept = joined.ok();
     if (absl::IsFailedPrecondition(joined)) {
       if (options.outliers_as_noise) {
@@ -215,9 +216,13 @@ absl::Status ConvertPoints(const ConvertOptions& options, std::ostream& out) {
                    ? absl::StrCat(", each record as in ", options.inputs.front(),
                                   " with every field, and its header's scale, offset and "
                                   "variable-length records")
-                   : absl::StrCat(", each record as in its INPUT with every field, and the "
-                                  "header's offset and variable-length records of ",
-                                  options.inputs.front());
+                   : absl::StrCat(", each record as in its INPUT with every field",
+                                  join.converted ? absl::StrCat(", in point format ",
+                                                                join.point_format, " of LAS 1.",
+                                                                join.version_minor)
+                                                 : std::string(),
+                                  ", and the header's offset and variable-length records of ",
+                                  options.inputs[join.header_source]);
     // Classified, the outliers and the records left out on reading stay in the file.
     if (options.outliers_as_noise) {
       written = read;

@@ -5,8 +5,9 @@
 // LAS stores integers. A parsed file cleaned of every other point (FormatCleanedLas) reads back
 // to the points kept; with those classified as noise instead, to the same points; joined
 // with itself as a second tile, to the points kept twice; all with the default classes and
-// with some asked for. A LAZ input is read as the LAS file it compresses, and cleaned as that
-// (laz_format_fuzzer checks the codec itself).
+// with some asked for; joined with a tile of another format (its points written by the writer),
+// to the points kept and the tile's, or refused. A LAZ input is read as the LAS file it
+// compresses, and cleaned as that (laz_format_fuzzer checks the codec itself).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -95,6 +96,26 @@ void CheckCleaned(absl::string_view data, const ParsedGeometry& parsed,
   both.positions.insert(both.positions.end(), expected.positions.begin(),
                         expected.positions.end());
   neuralmesh::fuzz::CheckPositionsWithinScale(both, *reread, scale);
+  if (classes.has_value()) return;
+
+  // Joined with a tile of LAS 1.2's format 0 or 2 (its points as FormatLas writes them): the
+  // records converted into the format that holds both's fields, every point read again, or
+  // refused where the coordinates do not fit one grid.
+  const GeometryView view{parsed.positions, {}, {}, {}, parsed.colors, parsed.origin};
+  const absl::StatusOr<std::string> tile = neuralmesh::io_internal::FormatLas(view);
+  FUZZ_CHECK(tile.ok(), "the writer failed: %s", tile.status().ToString().c_str());
+  std::vector<bool> kept(outliers.size() + parsed.positions.size(), false);
+  std::copy(outliers.begin(), outliers.end(), kept.begin());
+  const absl::StatusOr<std::string> mixed = neuralmesh::io_internal::FormatCleanedLas(
+      {{"a.las", data}, {"tile.las", *tile}}, kept, neuralmesh::LasOutlierRecords::kLeftOut);
+  if (absl::IsFailedPrecondition(mixed.status())) return;
+  FUZZ_CHECK(mixed.ok(), "joining another format failed: %s", mixed.status().ToString().c_str());
+  const absl::StatusOr<ParsedGeometry> mixed_read = neuralmesh::io_internal::ParseLas(*mixed);
+  FUZZ_CHECK(mixed_read.ok(), "the file joined with another format does not parse: %s",
+             mixed_read.status().ToString().c_str());
+  FUZZ_CHECK(mixed_read->positions.size() == expected.positions.size() + parsed.positions.size(),
+             "%zu points read from the file joined with another format, not %zu + %zu",
+             mixed_read->positions.size(), expected.positions.size(), parsed.positions.size());
 }
 
 }  // namespace

@@ -59,7 +59,8 @@ absl::StatusOr<LasCopy> CopyLas(const std::string& source, const std::string& pa
 
 absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
                              const std::vector<bool>& outliers, LasOutlierRecords records,
-                             const std::string& path, const PointSelection& selection) {
+                             const std::string& path, const PointSelection& selection,
+                             LasJoin* join) {
   std::vector<std::string> contents;
   contents.reserve(sources.size());
   for (const std::string& source : sources) {
@@ -70,8 +71,9 @@ absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
   for (size_t i = 0; i < sources.size(); ++i) {
     files.push_back({sources[i], contents[i]});
   }
-  NM_ASSIGN_OR_RETURN(std::string cleaned, io_internal::FormatCleanedLas(files, outliers, records,
-                                                                         selection.las_classes));
+  NM_ASSIGN_OR_RETURN(
+      std::string cleaned,
+      io_internal::FormatCleanedLas(files, outliers, records, selection.las_classes, join));
   return WriteLas(path, std::move(cleaned)).status();
 }
 

@@ -990,27 +990,40 @@ TEST_F(LocalCliTest, ALasScanCleanedIntoLasKeepsItsRecordsWhole) {
   EXPECT_EQ(both_bytes.substr(first + 7 * 30, 30), source.substr(first + 8 * 30, 30))
       << "the first tile, its noise left out";
 
-  // Tiles of another point format go through the point cloud (LAS 1.2 of positions), saying
-  // why; --outliers_as_noise, which needs their records, is refused.
-  testing::LasLayout other;
-  other.version_minor = 4;
+  // A tile of another point format joins them in the one that holds both's fields.
+  testing::LasLayout other = layout;
   other.format = 1;
   const std::string tile = *dir_ + "/tile.las";
   std::ofstream(tile, std::ios::binary) << testing::LasFile(other, {{0, 0, 100}, {0, 100, 0}});
-  const RunResult mixed = RunNeuralmesh({"convert", las, tile, "-o", *dir_ + "/mixed.las"});
+  const std::string mixed_path = *dir_ + "/mixed.las";
+  const RunResult mixed = RunNeuralmesh({"convert", las, tile, "-o", mixed_path});
   ASSERT_EQ(mixed.exit_code, 0) << mixed.Describe();
-  EXPECT_THAT(mixed.out, ::testing::HasSubstr("3004 points"));
-  EXPECT_THAT(mixed.out,
-              ::testing::HasSubstr("; the records could not be kept whole: '" + tile +
-                                   "' has point format 1 (records of 28 bytes) and '" + las +
-                                   "' format 6 (30)\n"));
-  const RunResult refused = RunNeuralmesh({"convert", las, tile, "-o", *dir_ + "/mixed.las",
-                                           "--remove_outliers", "--outliers_as_noise"});
+  EXPECT_EQ(mixed.out, mixed_path +
+                           ": 3004 points, each record as in its INPUT with every "
+                           "field, in point format 6 of LAS 1.4, and the header's offset "
+                           "and variable-length records of " +
+                           las + "; left out 1 point classified as noise\n");
+  const std::string mixed_bytes = ReadFileContents(mixed_path).value_or("");
+  ASSERT_EQ(mixed_bytes.size(), first + 3004 * 30);
+  EXPECT_EQ(mixed_bytes[104], 6);
+
+  // Tiles in other coordinate systems go through the point cloud (LAS 1.2 of positions),
+  // saying why; --outliers_as_noise, which needs their records, is refused.
+  other.vlrs =
+      testing::LasVariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"another zone\"]", false);
+  std::ofstream(tile, std::ios::binary) << testing::LasFile(other, {{0, 0, 100}, {0, 100, 0}});
+  const RunResult apart = RunNeuralmesh({"convert", las, tile, "-o", mixed_path});
+  ASSERT_EQ(apart.exit_code, 0) << apart.Describe();
+  EXPECT_THAT(apart.out, ::testing::HasSubstr("3004 points"));
+  EXPECT_THAT(apart.out, ::testing::HasSubstr("; the records could not be kept whole: the "
+                                              "coordinate systems or extra bytes of '" +
+                                              tile + "' and '" + las + "' differ\n"));
+  const RunResult refused = RunNeuralmesh(
+      {"convert", las, tile, "-o", mixed_path, "--remove_outliers", "--outliers_as_noise"});
   EXPECT_NE(refused.exit_code, 0);
   EXPECT_THAT(refused.err,
               ::testing::HasSubstr("--outliers_as_noise: the records of INPUT '" + las + "', '" +
-                                   tile + "' cannot be put in one file: '" + tile +
-                                   "' has point format 1"));
+                                   tile + "' cannot be put in one file: the coordinate systems"));
 }
 
 // A classified scan: a building (class 6, a unit sphere) above the ground (class 2, a square

@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -17,8 +18,8 @@
 #include "core/io/internal/laz.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
-#include "core/status_macros.h"
 #include "core/rgb.h"
+#include "core/status_macros.h"
 #include "core/version.h"
 
 namespace neuralmesh::io_internal {
@@ -61,8 +62,7 @@ RecordUsability Usability(absl::string_view data, size_t at, int format,
   if (extended ? (flags & 0x04) != 0 : (flags & 0x80) != 0) return kWithheld;
   const int classification = extended ? static_cast<uint8_t>(data[at + 16]) : flags & 0x1F;
   if (classes.has_value()) return (*classes)[classification] ? kUsable : kOtherClass;
-  return classification == kLowNoiseClass || classification == kHighNoiseClass ? kNoise
-                                                                                : kUsable;
+  return classification == kLowNoiseClass || classification == kHighNoiseClass ? kNoise : kUsable;
 }
 
 // A fixed-size text field of the header, padded with zeros.
@@ -153,10 +153,9 @@ absl::StatusOr<LasHeader> ReadHeader(absl::string_view data) {
     header.offset[c] = Load<double>(data, kOffset + 8 * c);
     if (!(header.scale[c] != 0) || !std::isfinite(header.scale[c]) ||
         !std::isfinite(header.offset[c])) {
-      return Invalid(absl::StrCat("the scale and offset of axis ",
-                                  absl::string_view("xyz").substr(c, 1), " (", header.scale[c],
-                                  ", ", header.offset[c],
-                                  ") are not finite numbers and a nonzero scale"));
+      return Invalid(absl::StrCat(
+          "the scale and offset of axis ", absl::string_view("xyz").substr(c, 1), " (",
+          header.scale[c], ", ", header.offset[c], ") are not finite numbers and a nonzero scale"));
     }
   }
   return header;
@@ -184,53 +183,176 @@ std::string InterpretingRecords(absl::string_view data, const LasHeader& header)
   return out;
 }
 
-// OK when the records of the files can follow one another in one file of the first's header:
-// the same version, point format and record length, the same coordinate system and extra
-// bytes, the same data after the points (extended records), and no waveform packets, to which
-// records point by their place in their own file. Otherwise FAILED_PRECONDITION saying why.
-absl::Status CheckJoinable(const std::vector<LasSource>& sources,
-                           const std::vector<LasHeader>& headers) {
+bool IsWaveformFormat(int format) { return format == 4 || format == 5 || format >= 9; }
+bool HasGpsTime(int format) { return format != 0 && format != 2; }
+
+// How the records of several files are put in one: in the header of the first file of the
+// highest version among them (its variable-length records, offset and what follows its points),
+// as records of the point format that holds every field any of them holds.
+struct JoinLayout {
+  size_t base = 0;  // The file whose header the joined file takes.
+  uint8_t format = 0;
+  size_t record_length = 0;
+  size_t extra_bytes = 0;  // After the format's fields, in every file alike.
+  // Whether the GPS times are adjusted standard GPS time (the header's global encoding bit 0),
+  // when a file holds them.
+  std::optional<bool> standard_gps_time;
+};
+
+// The layout of the files' records joined: formats 0 to 3 go to the one of 0 to 3 with a GPS
+// time if one has it and a colour if one has it; with any of formats 6 to 8 among them, to the
+// one of 6 to 8 with a colour (and 8 a near infrared) if one has it. FAILED_PRECONDITION saying
+// why when they cannot share one file: other extra bytes or coordinate systems than the
+// first's, other data after the points (extended records), GPS times of another kind (GPS week
+// time or adjusted standard GPS time), or waveform packets, to which records point by their
+// place in their own file.
+absl::StatusOr<JoinLayout> PlanJoin(const std::vector<LasSource>& sources,
+                                    const std::vector<LasHeader>& headers) {
   const LasHeader& first = headers.front();
   const std::string a = absl::StrCat("'", sources.front().name, "'");
+  JoinLayout join;
+  join.extra_bytes = first.record_length - kFormats[first.format].length;
   const absl::string_view first_after = sources.front().data.substr(first.points_end());
   const std::string first_interpreting = InterpretingRecords(sources.front().data, first);
-  for (size_t s = 1; s < sources.size(); ++s) {
+  bool extended = false, gps_time = false, rgb = false, near_infrared = false;
+  // The kind of GPS time of the first file that holds one, and that file.
+  std::optional<std::pair<bool, size_t>> time_kind;
+  for (size_t s = 0; s < sources.size(); ++s) {
     const LasHeader& header = headers[s];
     const std::string b = absl::StrCat("'", sources[s].name, "'");
     const absl::string_view data = sources[s].data;
-    if (header.minor != first.minor) {
-      return absl::FailedPreconditionError(absl::StrCat(b, " is LAS 1.", header.minor, " and ",
-                                                        a, " LAS 1.", first.minor));
+    if (sources.size() > 1 && IsWaveformFormat(header.format)) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("the records of ", b, " (point format ", int{header.format},
+                       ") point into their own file's waveform data"));
     }
-    if (header.format != first.format || header.record_length != first.record_length) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          b, " has point format ", int{header.format}, " (records of ", header.record_length,
-          " bytes) and ", a, " format ", int{first.format}, " (", first.record_length, ")"));
+    const size_t extra = header.record_length - kFormats[header.format].length;
+    if (extra != join.extra_bytes) {
+      return absl::FailedPreconditionError(
+          absl::StrCat(b, " has ", extra, " extra bytes a record and ", a, " ", join.extra_bytes));
     }
     if (InterpretingRecords(data, header) != first_interpreting) {
       return absl::FailedPreconditionError(
           absl::StrCat("the coordinate systems or extra bytes of ", b, " and ", a, " differ"));
     }
     if (data.substr(header.points_end()) != first_after) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "what follows the points of ", b, " and ", a, " (extended records) differs"));
+      return absl::FailedPreconditionError(absl::StrCat("what follows the points of ", b, " and ",
+                                                        a, " (extended records) differs"));
     }
+    if (HasGpsTime(header.format)) {
+      const bool standard = (Load<uint16_t>(data, kGlobalEncoding) & 1) != 0;
+      if (!time_kind.has_value()) {
+        time_kind = {standard, s};
+      } else if (time_kind->first != standard) {
+        const auto kind = [](bool standard) {
+          return standard ? "adjusted standard GPS time" : "GPS week time";
+        };
+        return absl::FailedPreconditionError(absl::StrCat(b, " holds ", kind(standard), " and '",
+                                                          sources[time_kind->second].name, "' ",
+                                                          kind(!standard)));
+      }
+    }
+    if (header.minor > headers[join.base].minor) join.base = s;
+    extended = extended || header.format >= 6;
+    gps_time = gps_time || HasGpsTime(header.format);
+    rgb = rgb || kFormats[header.format].rgb != 0;
+    near_infrared = near_infrared || header.format == 8;
   }
-  constexpr int kWaveformFormats[] = {4, 5, 9, 10};
-  if (sources.size() > 1 &&
-      std::find(std::begin(kWaveformFormats), std::end(kWaveformFormats), first.format) !=
-          std::end(kWaveformFormats)) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        "the records of point format ", int{first.format},
-        " point into their own file's waveform data"));
+  if (sources.size() == 1) {
+    join.format = first.format;
+  } else if (extended) {
+    join.format = near_infrared ? 8 : rgb ? 7 : 6;
+  } else {
+    join.format = static_cast<uint8_t>((gps_time ? 1 : 0) + (rgb ? 2 : 0));
   }
-  return absl::OkStatus();
+  join.record_length = kFormats[join.format].length + join.extra_bytes;
+  if (time_kind.has_value()) join.standard_gps_time = time_kind->first;
+  return join;
+}
+
+// The fields of a point record of formats 0-3 and 6-8.
+struct LasRecordFields {
+  std::string xyz_intensity;  // 14 bytes, as stored.
+  int return_number = 0, returns = 0;
+  bool scan_direction = false, edge = false;
+  // Synthetic, key point, withheld, overlap (LAS 1.4's order; the last only in formats 6-10).
+  int classification_flags = 0;
+  int scanner_channel = 0;
+  int classification = 0;
+  int user_data = 0;
+  int16_t scan_angle = 0;  // In 0.006 degrees.
+  std::string point_source = std::string(2, '\0');
+  std::string gps_time = std::string(8, '\0');
+  std::string rgb = std::string(6, '\0');
+  std::string near_infrared = std::string(2, '\0');
+};
+
+LasRecordFields ReadRecordFields(absl::string_view record, int format) {
+  LasRecordFields f;
+  f.xyz_intensity = std::string(record.substr(0, 14));
+  const uint8_t returns = static_cast<uint8_t>(record[14]),
+                flags = static_cast<uint8_t>(record[15]);
+  if (format >= 6) {
+    f.return_number = returns & 0x0F;
+    f.returns = returns >> 4;
+    f.classification_flags = flags & 0x0F;
+    f.scanner_channel = (flags >> 4) & 3;
+    f.scan_direction = (flags >> 6) & 1;
+    f.edge = flags >> 7;
+    f.classification = static_cast<uint8_t>(record[16]);
+    f.user_data = static_cast<uint8_t>(record[17]);
+    f.scan_angle = Load<int16_t>(record, 18);
+    f.point_source = std::string(record.substr(20, 2));
+    f.gps_time = std::string(record.substr(22, 8));
+    if (format == 8) f.near_infrared = std::string(record.substr(36, 2));
+  } else {
+    f.return_number = returns & 0x07;
+    f.returns = (returns >> 3) & 0x07;
+    f.scan_direction = (returns >> 6) & 1;
+    f.edge = returns >> 7;
+    f.classification = flags & 0x1F;
+    f.classification_flags = flags >> 5;
+    // The scan angle rank in whole degrees, from -90 to 90.
+    f.scan_angle = static_cast<int16_t>(std::lround(static_cast<int8_t>(record[16]) / 0.006));
+    f.user_data = static_cast<uint8_t>(record[17]);
+    f.point_source = std::string(record.substr(18, 2));
+    if (HasGpsTime(format)) f.gps_time = std::string(record.substr(20, 8));
+  }
+  if (kFormats[format].rgb != 0) f.rgb = std::string(record.substr(kFormats[format].rgb, 6));
+  return f;
+}
+
+// Appends the fields as a record of `format`, one that holds each field the record they were
+// read from holds (PlanJoin's), but for its extra bytes.
+void AppendRecordFields(const LasRecordFields& f, int format, std::string* out) {
+  *out += f.xyz_intensity;
+  if (format >= 6) {
+    *out += static_cast<char>(f.return_number | f.returns << 4);
+    *out += static_cast<char>(f.classification_flags | f.scanner_channel << 4 |
+                              f.scan_direction << 6 | f.edge << 7);
+    *out += static_cast<char>(f.classification);
+    *out += static_cast<char>(f.user_data);
+    AppendLittleEndian(f.scan_angle, out);
+    *out += f.point_source;
+    *out += f.gps_time;
+    if (format >= 7) *out += f.rgb;
+    if (format == 8) *out += f.near_infrared;
+  } else {  // From formats 0 to 3, whose fields fit.
+    *out +=
+        static_cast<char>(f.return_number | f.returns << 3 | f.scan_direction << 6 | f.edge << 7);
+    *out += static_cast<char>(f.classification | f.classification_flags << 5);
+    *out += static_cast<char>(static_cast<int8_t>(std::lround(f.scan_angle * 0.006)));
+    *out += static_cast<char>(f.user_data);
+    *out += f.point_source;
+    if (HasGpsTime(format)) *out += f.gps_time;
+    if (kFormats[format].rgb != 0) *out += f.rgb;
+  }
 }
 
 }  // namespace
 
 absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
-                                         const std::optional<LasClasses>& classes) {
+                                        const std::optional<LasClasses>& classes) {
   if (IsLaz(data)) {
     NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(data));
     return ParseLas(las, classes);
@@ -274,11 +396,11 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
   }
   const size_t kept = count - out.left_out.total();
   if (kept == 0 && count > 0) {
-    return Invalid(absl::StrCat(
-        "all ", count, " points are withheld (", out.left_out.withheld, ") or ",
-        classes.has_value()
-            ? absl::StrCat("of classes not asked for (", out.left_out.other_class, ")")
-            : absl::StrCat("classified as noise (", out.left_out.noise, ")")));
+    return Invalid(
+        absl::StrCat("all ", count, " points are withheld (", out.left_out.withheld, ") or ",
+                     classes.has_value()
+                         ? absl::StrCat("of classes not asked for (", out.left_out.other_class, ")")
+                         : absl::StrCat("classified as noise (", out.left_out.noise, ")")));
   }
   if (kept > 0) {
     const Point3d step = {std::fabs(scale[0]), std::fabs(scale[1]), std::fabs(scale[2])};
@@ -338,19 +460,18 @@ absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
   Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
   for (size_t i = 0; i < count; ++i) {
     for (int c = 0; c < 3; ++c) {
-      const int32_t stored =
-          static_cast<int32_t>(std::llround(points.positions[i][c] / scale[c]));
+      const int32_t stored = static_cast<int32_t>(std::llround(points.positions[i][c] / scale[c]));
       AppendLittleEndian(stored, &records);
       const double coordinate = stored * scale[c] + points.origin[c];
       low[c] = std::min(low[c], coordinate);
       high[c] = std::max(high[c], coordinate);
     }
-    AppendLittleEndian(uint16_t{0}, &records);  // Intensity.
+    AppendLittleEndian(uint16_t{0}, &records);         // Intensity.
     records.push_back(static_cast<char>(1 | 1 << 3));  // Return 1 of 1.
-    records.push_back('\0');  // Class 0: created, never classified.
-    records.push_back('\0');  // Scan angle rank.
-    records.push_back('\0');  // User data.
-    AppendLittleEndian(uint16_t{0}, &records);  // Point source.
+    records.push_back('\0');                           // Class 0: created, never classified.
+    records.push_back('\0');                           // Scan angle rank.
+    records.push_back('\0');                           // User data.
+    AppendLittleEndian(uint16_t{0}, &records);         // Point source.
     if (colored) {
       for (uint8_t level : points.colors[i]) {
         AppendLittleEndian(static_cast<uint16_t>(level * 257), &records);
@@ -370,7 +491,7 @@ absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
   AppendLittleEndian(uint16_t{0}, &out);  // Creation year.
   AppendLittleEndian(static_cast<uint16_t>(kLegacyHeaderSize), &out);
   AppendLittleEndian(static_cast<uint32_t>(kLegacyHeaderSize), &out);  // Offset to the points.
-  AppendLittleEndian(uint32_t{0}, &out);  // Variable-length records.
+  AppendLittleEndian(uint32_t{0}, &out);                               // Variable-length records.
   out.push_back(static_cast<char>(format));
   AppendLittleEndian(record_length, &out);
   AppendLittleEndian(static_cast<uint32_t>(count), &out);
@@ -389,7 +510,8 @@ absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
 absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sources,
                                              const std::vector<bool>& outliers,
                                              LasOutlierRecords records,
-                                             const std::optional<LasClasses>& classes) {
+                                             const std::optional<LasClasses>& classes,
+                                             LasJoin* joined) {
   if (sources.empty()) return Invalid("no file to clean");
   std::vector<LasHeader> headers;
   for (const LasSource& source : sources) {
@@ -397,8 +519,8 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
     if (!header.ok()) return WithPath(header.status(), source.name);
     headers.push_back(*header);
   }
-  NM_RETURN_IF_ERROR(CheckJoinable(sources, headers));
-  const LasHeader& first = headers.front();
+  NM_ASSIGN_OR_RETURN(const JoinLayout join, PlanJoin(sources, headers));
+  const LasHeader& first = headers[join.base];
   // Each axis's finest scale among the files, so that no record loses resolution, from the
   // first file's offset.
   Point3d scale = first.scale;
@@ -409,7 +531,15 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
   }
   const bool as_noise = records == LasOutlierRecords::kClassifiedAsNoise;
 
-  std::string out(sources.front().data.substr(0, first.offset_to_points));
+  const absl::string_view first_data = sources[join.base].data;
+  std::string out(first_data.substr(0, first.offset_to_points));
+  out[kPointFormat] = static_cast<char>(join.format);
+  if (join.standard_gps_time.has_value()) {  // Of the files' times, whichever file has them.
+    const uint16_t encoding = Load<uint16_t>(out, kGlobalEncoding);
+    StoreLittleEndian(static_cast<uint16_t>((encoding & ~1u) | *join.standard_gps_time),
+                      kGlobalEncoding, &out);
+  }
+  StoreLittleEndian(static_cast<uint16_t>(join.record_length), kRecordLength, &out);
   size_t total_size = 0;
   for (const LasSource& source : sources) total_size += source.data.size();
   out.reserve(total_size);
@@ -432,13 +562,19 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
         continue;
       }
       const size_t put = out.size();
-      out.append(data.data() + at, header.record_length);
+      if (header.format == join.format) {
+        out.append(data.data() + at, header.record_length);
+      } else {
+        const absl::string_view record = data.substr(at, header.record_length);
+        AppendRecordFields(ReadRecordFields(record, header.format), join.format, &out);
+        absl::StrAppend(&out, record.substr(record.size() - join.extra_bytes));
+      }
       if (outlier) {
-        if (header.format >= 6) {
+        if (join.format >= 6) {
           out[put + 16] = static_cast<char>(kLowNoiseClass);
         } else {  // The class in the low five bits; the top three are flags.
-          out[put + 15] = static_cast<char>((static_cast<uint8_t>(out[put + 15]) & 0xE0) |
-                                            kLowNoiseClass);
+          out[put + 15] =
+              static_cast<char>((static_cast<uint8_t>(out[put + 15]) & 0xE0) | kLowNoiseClass);
         }
       }
       for (int c = 0; c < 3; ++c) {
@@ -449,7 +585,7 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
                 stored <= std::numeric_limits<int32_t>::max())) {
             return absl::FailedPreconditionError(absl::StrCat(
                 "the coordinates of '", sources[s].name,
-                "' do not fit LAS's 32-bit integers at the offset of '", sources.front().name,
+                "' do not fit LAS's 32-bit integers at the offset of '", sources[join.base].name,
                 "' and the scale ", scale[c], " of axis ", absl::string_view("xyz").substr(c, 1)));
           }
           StoreLittleEndian(static_cast<int32_t>(stored), put + 4 * c, &out);
@@ -458,7 +594,7 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
         low[c] = std::min(low[c], coordinate);
         high[c] = std::max(high[c], coordinate);
       }
-      ++by_return[ReturnNumber(data, at, header.format)];
+      ++by_return[ReturnNumber(out, put, join.format)];
       ++written;
     }
   }
@@ -477,13 +613,12 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
   const bool extended_counts = first.minor >= 4 && first.header_size >= kHeaderSize14;
   constexpr uint64_t kLegacyMax = std::numeric_limits<uint32_t>::max();
   if (!extended_counts && written > kLegacyMax) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        written, " points are more than LAS 1.", first.minor, " counts (", kLegacyMax, ")"));
+    return absl::FailedPreconditionError(absl::StrCat(written, " points are more than LAS 1.",
+                                                      first.minor, " counts (", kLegacyMax, ")"));
   }
 
   // LAS 1.3's waveform packets and LAS 1.4's extended records, after the points, move with
   // their end.
-  const absl::string_view first_data = sources.front().data;
   const size_t points_end = out.size();
   out.append(first_data.data() + first.points_end(), first_data.size() - first.points_end());
   const auto move_start = [&](size_t field) {
@@ -501,9 +636,10 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
     }
   }
   // The legacy counts stay zero where the file left them so (LAS 1.4 with formats 6-10, or
-  // more points than they hold), and become so beyond what they hold.
+  // more points than they hold), and become so beyond what they hold or for records joined
+  // into formats 6-10.
   if (!extended_counts || Load<uint32_t>(first_data, kLegacyPointCount) != 0) {
-    const bool fits = written <= kLegacyMax;
+    const bool fits = written <= kLegacyMax && join.format < 6;
     StoreLittleEndian(static_cast<uint32_t>(fits ? written : 0), kLegacyPointCount, &out);
     for (int r = 1; r <= 5; ++r) {
       StoreLittleEndian(static_cast<uint32_t>(fits ? by_return[r] : 0),
@@ -516,6 +652,11 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
     StoreLittleEndian(written > 0 ? low[c] : 0.0, kBounds + 16 * c + 8, &out);
   }
   SetGeneratingSoftware(&out);
+  if (joined != nullptr) {
+    *joined = {join.base, first.minor, join.format,
+               std::any_of(headers.begin(), headers.end(),
+                           [&](const LasHeader& header) { return header.format != join.format; })};
+  }
   return out;
 }
 

@@ -62,21 +62,29 @@ struct LasSource {
 //     stay.
 // Each record is kept byte for byte (its intensity, returns, GPS time, extra bytes, ...) but
 // for its coordinates when several files have different scales or offsets: the file then has
-// each axis's finest scale among them and the first file's offset. The first file gives the
-// rest: the header's version, point format and offset, the variable-length records (the
-// coordinate system among them) and what follows the points. The header's point counts,
-// counts by return and bounds become those of the records written, the starts of what follows
-// the points (LAS 1.3's waveform packets, LAS 1.4's extended records) move with their end, and
-// the generating software becomes "neuralmesh VERSION".
+// each axis's finest scale among them and the offset of the file whose header it takes, the
+// first of the highest LAS version. That file gives the rest: the header's version and offset,
+// the variable-length records (the coordinate system among them) and what follows the points.
+// Files of different point formats are joined in the format that holds every field any of
+// them holds: formats 0-3 in the one of 0-3 with a GPS time and a colour where one has them,
+// with any of formats 6-8 among them in the one of 6-8 with a colour (8: a near infrared)
+// where one has it. Their records' fields move into it as they are (LAS 1.4's 4-bit returns,
+// 8-bit classes and classification flags take the legacy ones; the scan angle rank in degrees
+// becomes the angle in 0.006 degrees), the fields a record lacks zero, its extra bytes after
+// them. The header's point counts, counts by return and bounds become those of the records
+// written, the starts of what follows the points (LAS 1.3's waveform packets, LAS 1.4's
+// extended records) move with their end, and the generating software becomes "neuralmesh
+// VERSION". `join`, when given, says how the files were joined.
 // Returns ParseLas's errors for a malformed file, named; INVALID_ARGUMENT when `outliers` has
 // not one flag per point, or every point is an outlier to leave out; FAILED_PRECONDITION,
-// saying why, when the records of several files cannot be put in one file: another version,
-// point format, record length, coordinate system, extra bytes or extended records than the
-// first's, records that point to waveform data, coordinates that do not fit 32 bits at the
-// joined scale and offset, or more points than the version counts.
+// saying why, when the records of several files cannot be put in one file: other extra bytes,
+// coordinate system or extended records than the first's, records that point to waveform
+// data, coordinates that do not fit 32 bits at the joined scale and offset, or more points
+// than the version counts.
 absl::StatusOr<std::string> FormatCleanedLas(
     const std::vector<LasSource>& sources, const std::vector<bool>& outliers,
-    LasOutlierRecords records, const std::optional<LasClasses>& classes = std::nullopt);
+    LasOutlierRecords records, const std::optional<LasClasses>& classes = std::nullopt,
+    LasJoin* join = nullptr);
 
 }  // namespace neuralmesh::io_internal
 

@@ -9,6 +9,7 @@
 
 namespace neuralmesh::io_internal::las_layout {
 
+constexpr size_t kGlobalEncoding = 6;  // uint16; bit 0: GPS times are adjusted standard time.
 constexpr size_t kVersionMajor = 24;
 constexpr size_t kVersionMinor = 25;
 constexpr size_t kGeneratingSoftware = 58;  // 32 characters.

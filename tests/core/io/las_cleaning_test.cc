@@ -436,10 +436,8 @@ TEST(LasCleaningTest, TilesThatCannotShareAFileAreRefusedSayingWhy) {
   a.format = 1;
   LasLayout b = a;
   b.format = 3;
-  expect_refused(joined(a, b), "refused_b.las' has point format 3 (records of 34 bytes) and '");
-  b = a;
-  b.version_minor = 4;
-  expect_refused(joined(a, b), "refused_b.las' is LAS 1.4 and '");
+  b.record_length = 34 + 4;
+  expect_refused(joined(a, b), "refused_b.las' has 4 extra bytes a record and '");
   b = a;
   b.vlrs = LasVariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM zone 33N\"]", false);
   b.vlr_count = 1;
@@ -451,9 +449,118 @@ TEST(LasCleaningTest, TilesThatCannotShareAFileAreRefusedSayingWhy) {
   b.offset[0] = 1.0e6;
   for (double& s : b.scale) s = 1e-4;
   expect_refused(joined(a, b), "do not fit LAS's 32-bit integers");
-  a.format = b.format = 4;
+  a.format = 4;
   b = a;
-  expect_refused(joined(a, b), "point into their own file's waveform data");
+  expect_refused(joined(a, b),
+                 "refused_a.las' (point format 4) point into their own file's "
+                 "waveform data");
+}
+
+// Tiles of other LAS versions and point formats are joined in the header of the first of the
+// highest version, in the point format that holds every field of theirs.
+TEST(LasCleaningTest, TilesOfOtherVersionsAndFormatsJoinInAFormatHoldingEveryField) {
+  const std::vector<LasPoint> points = VariedPoints(3);
+  // The tiles, each of `points`; the joined file, and how they were joined.
+  const auto join = [&](const std::vector<std::string>& tiles, LasJoin* how) {
+    const std::string written = TempPath("joined_formats.las");
+    const absl::Status status = WriteCleanedLas(tiles, std::vector<bool>(3 * tiles.size(), false),
+                                                LasOutlierRecords::kLeftOut, written, {}, how);
+    EXPECT_TRUE(status.ok()) << status;
+    return ReadBytes(written);
+  };
+  LasLayout gps, colour, extended;
+  gps.format = 1;
+  colour.format = 2;
+  extended.version_minor = 4;
+  extended.format = 6;
+  extended.vlrs = LasVariableLengthRecord("tile_notes", 1, "LAS 1.4 tile", false);
+  extended.vlr_count = 1;
+  const std::string gps_tile = TempPath("gps.las"), colour_tile = TempPath("colour.las"),
+                    extended_tile = TempPath("extended.las");
+  WriteBytes(gps_tile, LasFile(gps, points));
+  // The colour tile's scan angle rank: 25 degrees.
+  std::string colour_bytes = LasFile(colour, points);
+  for (size_t i = 0; i < 3; ++i) colour_bytes[227 + 26 * i + 16] = 25;
+  WriteBytes(colour_tile, colour_bytes);
+  WriteBytes(extended_tile, LasFile(extended, points));
+
+  // LAS 1.2's formats 1 (GPS time) and 2 (colour): format 3, the fields a tile lacks zero.
+  LasJoin how;
+  const std::string legacy = join({gps_tile, colour_tile}, &how);
+  EXPECT_EQ(how.point_format, 3);
+  EXPECT_EQ(how.version_minor, 2);
+  EXPECT_EQ(how.header_source, 0u);
+  EXPECT_TRUE(how.converted);
+  ASSERT_EQ(legacy.size(), 227 + 6 * 34u);
+  EXPECT_EQ(legacy[104], 3);
+  EXPECT_EQ(Field<uint16_t>(legacy, 105), 34);
+  for (size_t i = 0; i < 6; ++i) {
+    SCOPED_TRACE(absl::StrCat("record ", i));
+    const LasPoint& p = points[i % 3];
+    const size_t at = 227 + 34 * i;
+    EXPECT_EQ(Field<int32_t>(legacy, at), p.x);
+    EXPECT_EQ(Field<uint16_t>(legacy, at + 12), p.intensity);
+    EXPECT_EQ(legacy[at + 14] & 7, p.return_number);
+    EXPECT_EQ(legacy[at + 15] & 0x1F, p.classification);
+    EXPECT_EQ(legacy[at + 16], i < 3 ? 0 : 25) << "scan angle rank";
+    EXPECT_EQ(Field<double>(legacy, at + 20), i < 3 ? p.gps_time : 0.0);
+    EXPECT_EQ(Field<uint16_t>(legacy, at + 28), i < 3 ? 0 : p.red);
+    EXPECT_EQ(Field<uint16_t>(legacy, at + 32), i < 3 ? 0 : p.blue);
+  }
+
+  // With LAS 1.4's format 6 among them: format 7, in the LAS 1.4 tile's header and with its
+  // variable-length records; the legacy returns, classes and scan angles as LAS 1.4 holds them.
+  const std::string joined = join({colour_tile, extended_tile}, &how);
+  EXPECT_EQ(how.point_format, 7);
+  EXPECT_EQ(how.version_minor, 4);
+  EXPECT_EQ(how.header_source, 1u);
+  const std::string extended_bytes = ReadBytes(extended_tile);
+  const size_t first = 375 + extended.vlrs.size();
+  ASSERT_EQ(joined.size(), first + 6 * 36);
+  EXPECT_EQ(joined.substr(375, extended.vlrs.size()), extended.vlrs);
+  EXPECT_EQ(joined[104], 7);
+  EXPECT_EQ(Field<uint64_t>(joined, 247), 6u);
+  EXPECT_EQ(Field<uint32_t>(joined, 107), 0u) << "no legacy count for format 7";
+  for (size_t i = 0; i < 6; ++i) {
+    SCOPED_TRACE(absl::StrCat("record ", i));
+    const LasPoint& p = points[i % 3];
+    const size_t at = first + 36 * i;
+    EXPECT_EQ(Field<int32_t>(joined, at + 4), p.y);
+    EXPECT_EQ(joined[at + 14], static_cast<char>(p.return_number | p.returns << 4));
+    EXPECT_EQ(joined[at + 16], static_cast<char>(p.classification));
+    // 25 degrees in steps of 0.006 degrees.
+    EXPECT_EQ(Field<int16_t>(joined, at + 18), i < 3 ? 4167 : 0);
+    EXPECT_EQ(Field<double>(joined, at + 22), i < 3 ? 0.0 : p.gps_time);
+    EXPECT_EQ(Field<uint16_t>(joined, at + 30), i < 3 ? p.red : 0);
+  }
+  // The LAS 1.4 tile's records but for the colour they gain: byte for byte.
+  EXPECT_EQ(joined.substr(first + 3 * 36, 30), extended_bytes.substr(first, 30));
+  const absl::StatusOr<PointCloud> read = ReadPointCloud(TempPath("joined_formats.las"));
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->size(), 6u);
+  EXPECT_EQ(read->colors.size(), 6u);
+
+  // Tiles of one format: no record converted.
+  join({gps_tile, gps_tile}, &how);
+  EXPECT_FALSE(how.converted);
+  EXPECT_EQ(how.point_format, 1);
+
+  // GPS times are of one kind in a file (the header's global encoding, bit 0: adjusted
+  // standard GPS time, else GPS week time): the joined header says the kind of the tile that
+  // has them; tiles of both kinds are refused.
+  std::string standard_bytes = LasFile(gps, points);
+  standard_bytes[6] = 1;
+  const std::string standard_tile = TempPath("standard_time.las");
+  WriteBytes(standard_tile, standard_bytes);
+  EXPECT_EQ(join({colour_tile, standard_tile}, &how)[6], 1);
+  EXPECT_EQ(how.header_source, 0u);
+  const absl::Status mixed_times =
+      WriteCleanedLas({gps_tile, standard_tile}, std::vector<bool>(6, false),
+                      LasOutlierRecords::kLeftOut, TempPath("mixed_times.las"));
+  EXPECT_EQ(mixed_times.code(), absl::StatusCode::kFailedPrecondition) << mixed_times;
+  EXPECT_THAT(std::string(mixed_times.message()),
+              HasSubstr("standard_time.las' holds adjusted standard GPS time and '" + gps_tile +
+                        "' GPS week time"));
 }
 
 TEST(LasCleaningTest, CopiesKeepEveryRecordCompressedOrNot) {

@@ -6,7 +6,7 @@
 // byte for byte.
 //
 //   build/bin/laz-bench [--records=2000000] [--format=3] [--scanner_channels=1]
-//                       [--chunk_size=50000] [--repeats=3]
+//                       [--chunk_size=50000] [--threads=1] [--repeats=3]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -23,6 +23,7 @@ ABSL_FLAG(int, format, 3, "LAS point format, 0 to 3 or 6 to 8.");
 ABSL_FLAG(int, scanner_channels, 1, "Formats 6-8: scanner channels taking turns, 1 to 4.");
 ABSL_FLAG(uint32_t, chunk_size, 50000, "Records per LAZ chunk.");
 ABSL_FLAG(int, repeats, 3, "Runs of each direction; the fastest is printed.");
+ABSL_FLAG(int, threads, 1, "Threads coding chunks; 0 for one per hardware thread.");
 
 namespace neuralmesh {
 namespace {
@@ -55,14 +56,19 @@ int Run() {
   const std::string las = testing::ScanLasFile(scan);
   const int repeats = std::max(1, absl::GetFlag(FLAGS_repeats));
   absl::StatusOr<std::string> laz;
-  const double compress = BestSeconds(
-      repeats, [&] { laz = io_internal::CompressLas(las, {absl::GetFlag(FLAGS_chunk_size)}); });
+  const double compress = BestSeconds(repeats, [&] {
+    io_internal::LazWriteOptions options;
+    options.chunk_size = absl::GetFlag(FLAGS_chunk_size);
+    options.threads = absl::GetFlag(FLAGS_threads);
+    laz = io_internal::CompressLas(las, options);
+  });
   if (!laz.ok()) {
     std::fprintf(stderr, "compressing failed: %s\n", laz.status().ToString().c_str());
     return 1;
   }
   absl::StatusOr<std::string> back;
-  const double decompress = BestSeconds(repeats, [&] { back = io_internal::DecompressLaz(*laz); });
+  const double decompress = BestSeconds(
+      repeats, [&] { back = io_internal::DecompressLaz(*laz, {absl::GetFlag(FLAGS_threads)}); });
   if (!back.ok() || *back != las) {
     std::fprintf(stderr, "the records did not come back: %s\n",
                  back.ok() ? "different bytes" : back.status().ToString().c_str());

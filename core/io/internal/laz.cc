@@ -4,6 +4,7 @@
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <thread>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -15,6 +16,7 @@
 #include "core/io/internal/laz_integer_coder.h"
 #include "core/io/internal/laz_items.h"
 #include "core/io/internal/laz_layered_items.h"
+#include "core/parallel_ranges.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::io_internal {
@@ -60,8 +62,17 @@ constexpr size_t kOverrunAllowed = 4;
 constexpr uint64_t kOverrunCheck = 256;
 
 // Scans compress to a tenth of their size or so; the output is reserved for at most this many
-// times the compressed data, and grows chunk by chunk past it (a corrupt count).
+// times the compressed data, and grows wave by wave of chunks past it (a corrupt count).
 constexpr uint64_t kReservedExpansion = 64;
+
+// Chunks are coded in waves of this many per thread: each thread codes a run of consecutive
+// chunks (independent by design), with coders of its own.
+constexpr size_t kChunksPerThread = 4;
+
+size_t ThreadCount(int threads) {
+  return threads > 0 ? static_cast<size_t>(threads)
+                     : std::max(1u, std::thread::hardware_concurrency());
+}
 
 template <typename T>
 T Load(absl::string_view data, size_t offset) {
@@ -538,7 +549,7 @@ bool IsLaz(absl::string_view data) {
          (static_cast<uint8_t>(data[kPointFormat]) & kCompressedBits) != 0;
 }
 
-absl::StatusOr<std::string> DecompressLaz(absl::string_view laz) {
+absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOptions& options) {
   NM_ASSIGN_OR_RETURN(const Header header, ReadHeader(laz, "LAZ"));
   if ((header.format_byte & kCompressedBits) == 0) {
     return Invalid("the point format carries no compression bits: a LAS file, not LAZ");
@@ -579,14 +590,27 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz) {
   las[kPointFormat] = static_cast<char>(header.format());
   SetUint32(header.vlr_count - 1, kVlrCount, &las);
   SetUint32(static_cast<uint32_t>(header.offset_to_points - laszip_size), kOffsetToPoints, &las);
-  const std::unique_ptr<ChunkCoder> coder =
-      MakeChunkCoder(header.format(), header.record_length, compression.item_version);
-  for (size_t i = 0; i < chunks.size(); ++i) {
-    const size_t chunk_at = las.size();
-    las.resize(chunk_at + chunks[i].count * header.record_length);
-    NM_RETURN_IF_ERROR(coder->Decode(laz.substr(chunks[i].at, chunks[i].size), chunks[i].count,
-                                     reinterpret_cast<uint8_t*>(&las[chunk_at]),
-                                     absl::StrCat("chunk ", i + 1, " of ", chunks.size())));
+  // The chunks in waves of a few per thread, each thread decoding a run of them with coders
+  // of its own; the output grows wave by wave.
+  const size_t wave = kChunksPerThread * ThreadCount(options.threads);
+  std::vector<absl::Status> statuses(chunks.size());
+  for (size_t begin = 0; begin < chunks.size(); begin += wave) {
+    const size_t end = std::min(chunks.size(), begin + wave);
+    std::vector<size_t> chunk_at(end - begin);
+    for (size_t i = begin; i < end; ++i) {
+      chunk_at[i - begin] = las.size();
+      las.resize(las.size() + chunks[i].count * header.record_length);
+    }
+    ForEachRange(end - begin, options.threads, 1, [&](size_t first, size_t last) {
+      const std::unique_ptr<ChunkCoder> coder =
+          MakeChunkCoder(header.format(), header.record_length, compression.item_version);
+      for (size_t i = begin + first; i < begin + last; ++i) {
+        statuses[i] = coder->Decode(laz.substr(chunks[i].at, chunks[i].size), chunks[i].count,
+                                    reinterpret_cast<uint8_t*>(&las[chunk_at[i - begin]]),
+                                    absl::StrCat("chunk ", i + 1, " of ", chunks.size()));
+      }
+    });
+    for (size_t i = begin; i < end; ++i) NM_RETURN_IF_ERROR(statuses[i]);
   }
   if (header.evlr_start != 0 && points_end < laz.size()) {
     SetUint64(las.size(), kEvlrStart, &las);
@@ -664,13 +688,29 @@ absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOpt
   laz.append(8, '\0');
 
   const uint8_t* records = reinterpret_cast<const uint8_t*>(las.data() + header.offset_to_points);
-  const std::unique_ptr<ChunkCoder> coder = MakeChunkCoder(format, header.record_length, version);
+  // The chunks in waves of a few per thread, each coded into a string of its own by the thread
+  // that takes it, then appended in order.
+  const uint64_t chunk_count = (header.count + options.chunk_size - 1) / options.chunk_size;
+  const size_t wave = kChunksPerThread * ThreadCount(options.threads);
   std::vector<uint32_t> chunk_sizes;
-  for (uint64_t first = 0; first < header.count; first += options.chunk_size) {
-    const uint64_t end = std::min<uint64_t>(header.count, first + options.chunk_size);
-    const size_t chunk_at = laz.size();
-    coder->Encode(records + first * header.record_length, end - first, &laz);
-    chunk_sizes.push_back(static_cast<uint32_t>(laz.size() - chunk_at));
+  std::vector<std::string> coded(std::min<uint64_t>(wave, chunk_count));
+  for (uint64_t begin = 0; begin < chunk_count; begin += wave) {
+    const uint64_t end = std::min<uint64_t>(chunk_count, begin + wave);
+    ForEachRange(end - begin, options.threads, 1, [&](size_t first, size_t last) {
+      const std::unique_ptr<ChunkCoder> coder =
+          MakeChunkCoder(format, header.record_length, version);
+      for (uint64_t i = begin + first; i < begin + last; ++i) {
+        const uint64_t from = i * options.chunk_size;
+        const uint64_t to = std::min<uint64_t>(header.count, from + options.chunk_size);
+        std::string& chunk = coded[i - begin];
+        chunk.clear();
+        coder->Encode(records + from * header.record_length, to - from, &chunk);
+      }
+    });
+    for (uint64_t i = begin; i < end; ++i) {
+      chunk_sizes.push_back(static_cast<uint32_t>(coded[i - begin].size()));
+      laz += coded[i - begin];
+    }
   }
 
   SetUint64(laz.size(), table_offset_at, &laz);

@@ -19,6 +19,12 @@ namespace neuralmesh::io_internal {
 // Whether `data` starts as a LAS file whose point format carries LASzip's compression bits.
 bool IsLaz(absl::string_view data);
 
+struct LazReadOptions {
+  // Threads decoding chunks (each on its own): 0 for one per hardware thread. The output is
+  // the same.
+  int threads = 0;
+};
+
 // The LAS file that `laz` holds compressed: its header (the point format without the
 // compression bits, one variable-length record fewer, the offsets to the points and to the
 // extended records moved), its other variable-length records, its records byte for byte, and
@@ -31,13 +37,17 @@ bool IsLaz(absl::string_view data);
 // the layer of returns, X and Y; and for what LASzip writes that is not read here, saying so:
 // the waveform formats 4, 5, 9 and 10 and LASzip 1's compression (one stream, item coders of
 // version 1).
-absl::StatusOr<std::string> DecompressLaz(absl::string_view laz);
+absl::StatusOr<std::string> DecompressLaz(absl::string_view laz,
+                                          const LazReadOptions& options = {});
 
 struct LazWriteOptions {
   // Records per chunk; each chunk starts afresh, so a reader can start at any chunk.
   uint32_t chunk_size = 50000;
   // The item version of formats 6 to 8: 3 (LASzip 3, laz-perf) or 4 (newer LASzip).
   uint16_t layered_version = 3;
+  // Threads coding chunks (each on its own): 0 for one per hardware thread. The output is the
+  // same.
+  int threads = 0;
 };
 
 // `las` compressed as LAZ: what DecompressLaz turns back into `las`, byte for byte.

@@ -260,6 +260,40 @@ TEST(LazTest, Las14PointFormatsComeBackByteForByte) {
   EXPECT_EQ(laz.substr(io_test::Field<uint64_t>(laz, 235)), scan.after_points);
 }
 
+TEST(LazTest, ChunksAreCodedAlikeOnAnyNumberOfThreads) {
+  for (const int format : {1, 8}) {
+    SCOPED_TRACE(absl::StrCat("format ", format));
+    LasScan scan;
+    scan.format = format;
+    scan.scanner_channels = format == 8 ? 2 : 1;
+    scan.records = 20000;
+    scan.random_every = 101;
+    const std::string las = ScanLasFile(scan);
+    LazWriteOptions options;
+    options.chunk_size = 900;  // 23 chunks: several waves of chunks on every thread count.
+    options.threads = 1;
+    const absl::StatusOr<std::string> one = CompressLas(las, options);
+    ASSERT_TRUE(one.ok()) << one.status();
+    for (const int threads : {2, 3, 0}) {
+      options.threads = threads;
+      const absl::StatusOr<std::string> laz = CompressLas(las, options);
+      ASSERT_TRUE(laz.ok()) << laz.status();
+      EXPECT_TRUE(*laz == *one) << threads << " threads";
+      const absl::StatusOr<std::string> back = DecompressLaz(*one, {threads});
+      ASSERT_TRUE(back.ok()) << back.status();
+      EXPECT_TRUE(*back == las) << threads << " threads";
+    }
+    // A corrupt chunk is named alike: the first in the file's order.
+    std::string corrupt = *one;
+    const size_t points = io_test::Field<uint32_t>(corrupt, 96) + 8;
+    for (size_t i = points + 5000; i < points + 60000; i += 3) corrupt[i] = static_cast<char>(i);
+    const absl::StatusOr<std::string> serial = DecompressLaz(corrupt, {1});
+    const absl::StatusOr<std::string> parallel = DecompressLaz(corrupt, {3});
+    EXPECT_FALSE(serial.ok());
+    EXPECT_EQ(serial.status(), parallel.status());
+  }
+}
+
 TEST(LazTest, ItemVersionsThreeAndFourDifferWhereScannerChannelsSwitch) {
   // The LASzip record's items follow the LAS 1.4 header (375 bytes), the record's header (54)
   // and its fixed fields (34): POINT14's and RGB14's versions.

@@ -35,11 +35,6 @@ constexpr uint8_t kReturnLevel[8][8] = {{0, 1, 2, 3, 4, 5, 6, 7}, {1, 0, 1, 2, 3
                                         {4, 3, 2, 1, 0, 1, 2, 3}, {5, 4, 3, 2, 1, 0, 1, 2},
                                         {6, 5, 4, 3, 2, 1, 0, 1}, {7, 6, 5, 4, 3, 2, 1, 0}};
 
-// The context of Y from X's bit length k (even values, 20 and above alike), and of Z from
-// their mean; plus 1 for single returns.
-uint32_t YContext(uint32_t k, bool single) { return (single ? 1 : 0) + (k < 20 ? k & ~1u : 20); }
-uint32_t ZContext(uint32_t k, bool single) { return (single ? 1 : 0) + (k < 18 ? k & ~1u : 18); }
-
 uint8_t Clamp8(int32_t value) {
   return static_cast<uint8_t>(value <= 0 ? 0 : value >= 255 ? 255 : value);
 }

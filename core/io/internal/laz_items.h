@@ -21,6 +21,15 @@ namespace neuralmesh::io_internal::laz {
 // made at a chunk's start.
 SymbolModel& ModelIn(std::optional<SymbolModel>& slot, uint32_t symbols = 256);
 
+// The context of Y from X's bit length k (even values, 20 and above alike), and of Z from
+// their mean; plus 1 for single returns. POINT10 and POINT14 alike.
+inline uint32_t YContext(uint32_t k, bool single) {
+  return (single ? 1 : 0) + (k < 20 ? k & ~1u : 20);
+}
+inline uint32_t ZContext(uint32_t k, bool single) {
+  return (single ? 1 : 0) + (k < 18 ? k & ~1u : 18);
+}
+
 // The median of the last five values added (three at first, zeros before any).
 class StreamingMedian5 {
  public:

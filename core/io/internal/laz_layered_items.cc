@@ -40,10 +40,6 @@ uint32_t ReturnLevel(uint32_t n, uint32_t r) {
 // Single (3), first (1), last (2) or intermediate (0) return.
 uint32_t ReturnKind(uint32_t n, uint32_t r) { return (r == 1 ? 1 : 0) + (r >= n ? 2 : 0); }
 
-// The contexts of Y from X's bit length k, and of Z from their mean, as in laz_items.cc.
-uint32_t YContext(uint32_t k, bool single) { return (single ? 1 : 0) + (k < 20 ? k & ~1u : 20); }
-uint32_t ZContext(uint32_t k, bool single) { return (single ? 1 : 0) + (k < 18 ? k & ~1u : 18); }
-
 enum Point14Layer : size_t {
   kReturnsXY,
   kZ,
@@ -369,6 +365,13 @@ void Point14Coder::Decode(uint8_t* item, uint32_t& channel) {
 }
 
 struct Rgb14Coder::Channel {
+  void Reset(const std::array<uint16_t, 4>& first) {
+    rgb.Reset();
+    nir_changed.Reset();
+    for (SymbolModel& model : nir) model.Reset();
+    last = first;
+  }
+
   RgbModels rgb;
   SymbolModel nir_changed{4};
   std::vector<SymbolModel> nir = std::vector<SymbolModel>(2, SymbolModel(256));  // Low, high.
@@ -376,18 +379,8 @@ struct Rgb14Coder::Channel {
 };
 
 Rgb14Coder::Rgb14Coder(bool near_infrared, int version)
-    : near_infrared_(near_infrared), version_(version), layers_(near_infrared ? 2 : 1) {}
+    : near_infrared_(near_infrared), layers_(near_infrared ? 2 : 1), channels_(version) {}
 Rgb14Coder::~Rgb14Coder() = default;
-
-void Rgb14Coder::StartChannel(uint32_t channel, const std::array<uint16_t, 4>& last) {
-  if (channels_[channel] == nullptr) channels_[channel] = std::make_unique<Channel>();
-  Channel& c = *channels_[channel];
-  c.rgb.Reset();
-  c.nir_changed.Reset();
-  for (SymbolModel& model : c.nir) model.Reset();
-  c.last = last;
-  in_chunk_[channel] = true;
-}
 
 namespace {
 
@@ -401,36 +394,18 @@ std::array<uint16_t, 4> LoadColor(const uint8_t* item, size_t size) {
 
 void Rgb14Coder::StartEncoding(const uint8_t* first, uint32_t channel) {
   layers_.StartEncoding();
-  in_chunk_.fill(false);
-  current_ = channel;
-  StartChannel(channel, LoadColor(first, size()));
+  channels_.Start(channel, LoadColor(first, size()));
 }
 
 void Rgb14Coder::StartDecoding(const uint8_t* first, uint32_t channel,
                                const absl::string_view* layers) {
   layers_.StartDecoding(layers);
-  in_chunk_.fill(false);
-  current_ = channel;
-  StartChannel(channel, LoadColor(first, size()));
-}
-
-Rgb14Coder::Channel& Rgb14Coder::Switch(uint32_t channel) {
-  Channel* predictor = channels_[current_].get();
-  if (channel != current_) {
-    current_ = channel;
-    if (!in_chunk_[channel]) {
-      StartChannel(channel, predictor->last);
-      predictor = channels_[channel].get();
-    } else if (version_ >= 4) {
-      predictor = channels_[channel].get();
-    }
-  }
-  return *predictor;
+  channels_.Start(channel, LoadColor(first, size()));
 }
 
 void Rgb14Coder::Encode(const uint8_t* item, uint32_t channel) {
-  Channel& predictor = Switch(channel);
-  Channel& c = *channels_[current_];
+  Channel& predictor = channels_.Switch(channel);
+  Channel& c = channels_.models();
   const std::array<uint16_t, 4> color = LoadColor(item, size());
   const std::array<uint16_t, 3> last_rgb = {predictor.last[0], predictor.last[1],
                                             predictor.last[2]};
@@ -443,8 +418,9 @@ void Rgb14Coder::Encode(const uint8_t* item, uint32_t channel) {
                              (uint32_t{(last & 0xFF00) != (nir & 0xFF00)} << 1);
     ArithmeticEncoder& encoder = layers_.encoder(1);
     encoder.EncodeSymbol(c.nir_changed, changed);
-    if (changed & 1)
+    if (changed & 1) {
       encoder.EncodeSymbol(c.nir[0], static_cast<uint8_t>((nir & 0xFF) - (last & 0xFF)));
+    }
     if (changed & 2) encoder.EncodeSymbol(c.nir[1], static_cast<uint8_t>((nir >> 8) - (last >> 8)));
     if (changed != 0) layers_.MarkChanged(1);
   }
@@ -452,8 +428,8 @@ void Rgb14Coder::Encode(const uint8_t* item, uint32_t channel) {
 }
 
 void Rgb14Coder::Decode(uint8_t* item, uint32_t channel) {
-  Channel& predictor = Switch(channel);
-  Channel& c = *channels_[current_];
+  Channel& predictor = channels_.Switch(channel);
+  Channel& c = channels_.models();
   if (layers_.present(0)) {
     const std::array<uint16_t, 3> rgb = DecodeRgb(
         layers_.decoder(0), c.rgb, {predictor.last[0], predictor.last[1], predictor.last[2]});
@@ -475,57 +451,34 @@ void Rgb14Coder::Decode(uint8_t* item, uint32_t channel) {
 }
 
 struct Bytes14Coder::Channel {
+  void Reset(const std::vector<uint8_t>& first) {
+    if (models.size() != first.size()) models.assign(first.size(), SymbolModel(256));
+    for (SymbolModel& model : models) model.Reset();
+    last = first;
+  }
+
   std::vector<SymbolModel> models;
   std::vector<uint8_t> last;
 };
 
 Bytes14Coder::Bytes14Coder(size_t count, int version)
-    : count_(count), version_(version), layers_(count) {}
+    : count_(count), layers_(count), channels_(version) {}
 Bytes14Coder::~Bytes14Coder() = default;
-
-void Bytes14Coder::StartChannel(uint32_t channel, const std::vector<uint8_t>& last) {
-  if (channels_[channel] == nullptr) {
-    channels_[channel] = std::make_unique<Channel>();
-    channels_[channel]->models.assign(count_, SymbolModel(256));
-  }
-  Channel& c = *channels_[channel];
-  for (SymbolModel& model : c.models) model.Reset();
-  c.last = last;
-  in_chunk_[channel] = true;
-}
 
 void Bytes14Coder::StartEncoding(const uint8_t* first, uint32_t channel) {
   layers_.StartEncoding();
-  in_chunk_.fill(false);
-  current_ = channel;
-  StartChannel(channel, std::vector<uint8_t>(first, first + count_));
+  channels_.Start(channel, std::vector<uint8_t>(first, first + count_));
 }
 
 void Bytes14Coder::StartDecoding(const uint8_t* first, uint32_t channel,
                                  const absl::string_view* layers) {
   layers_.StartDecoding(layers);
-  in_chunk_.fill(false);
-  current_ = channel;
-  StartChannel(channel, std::vector<uint8_t>(first, first + count_));
-}
-
-Bytes14Coder::Channel& Bytes14Coder::Switch(uint32_t channel) {
-  Channel* predictor = channels_[current_].get();
-  if (channel != current_) {
-    current_ = channel;
-    if (!in_chunk_[channel]) {
-      StartChannel(channel, predictor->last);
-      predictor = channels_[channel].get();
-    } else if (version_ >= 4) {
-      predictor = channels_[channel].get();
-    }
-  }
-  return *predictor;
+  channels_.Start(channel, std::vector<uint8_t>(first, first + count_));
 }
 
 void Bytes14Coder::Encode(const uint8_t* item, uint32_t channel) {
-  Channel& predictor = Switch(channel);
-  Channel& c = *channels_[current_];
+  Channel& predictor = channels_.Switch(channel);
+  Channel& c = channels_.models();
   for (size_t i = 0; i < count_; ++i) {
     const uint8_t difference = static_cast<uint8_t>(item[i] - predictor.last[i]);
     layers_.encoder(i).EncodeSymbol(c.models[i], difference);
@@ -537,8 +490,8 @@ void Bytes14Coder::Encode(const uint8_t* item, uint32_t channel) {
 }
 
 void Bytes14Coder::Decode(uint8_t* item, uint32_t channel) {
-  Channel& predictor = Switch(channel);
-  Channel& c = *channels_[current_];
+  Channel& predictor = channels_.Switch(channel);
+  Channel& c = channels_.models();
   for (size_t i = 0; i < count_; ++i) {
     if (layers_.present(i)) {
       predictor.last[i] =

@@ -112,6 +112,51 @@ class Point14Coder {
   uint32_t current_ = 0;
 };
 
+// The models and last values of an item after POINT14, one set per scanner channel, switched
+// as LASzip switches them (above). `Channel` holds `Last last` and has Reset(last), which resets
+// its models and takes those last values; it may be incomplete here.
+template <typename Channel, typename Last>
+class ChannelContexts {
+ public:
+  explicit ChannelContexts(int version) : version_(version) {}
+
+  // A chunk starts in `channel` with `first`'s values; the other channels are unseen.
+  void Start(uint32_t channel, const Last& first) {
+    in_chunk_.fill(false);
+    current_ = channel;
+    StartChannel(channel, first);
+  }
+  // Switches to `channel` for a record and returns the channel whose last values the record is
+  // predicted from and stored as: at a switch to a channel seen before in the chunk, the one
+  // left in version 3. models() codes it.
+  Channel& Switch(uint32_t channel) {
+    Channel* predictor = channels_[current_].get();
+    if (channel != current_) {
+      current_ = channel;
+      if (!in_chunk_[channel]) {
+        StartChannel(channel, predictor->last);
+        predictor = channels_[channel].get();
+      } else if (version_ >= 4) {
+        predictor = channels_[channel].get();
+      }
+    }
+    return *predictor;
+  }
+  Channel& models() { return *channels_[current_]; }
+
+ private:
+  void StartChannel(uint32_t channel, const Last& last) {
+    if (channels_[channel] == nullptr) channels_[channel] = std::make_unique<Channel>();
+    channels_[channel]->Reset(last);
+    in_chunk_[channel] = true;
+  }
+
+  int version_;
+  std::array<std::unique_ptr<Channel>, 4> channels_;
+  std::array<bool, 4> in_chunk_{};
+  uint32_t current_ = 0;
+};
+
 // RGB14 (red, green and blue in one layer) or RGBNIR14 (and the near infrared in a second).
 class Rgb14Coder {
  public:
@@ -128,16 +173,10 @@ class Rgb14Coder {
 
  private:
   struct Channel;
-  // The channel whose last record `channel`'s record is predicted from, after a switch.
-  Channel& Switch(uint32_t channel);
-  void StartChannel(uint32_t channel, const std::array<uint16_t, 4>& last);
 
   bool near_infrared_;
-  int version_;
   Layers layers_;
-  std::array<std::unique_ptr<Channel>, 4> channels_;
-  std::array<bool, 4> in_chunk_{};
-  uint32_t current_ = 0;
+  ChannelContexts<Channel, std::array<uint16_t, 4>> channels_;  // Red, green, blue, infrared.
 };
 
 // BYTE14: each extra byte in a layer of its own, coded as its change from the last record's.
@@ -155,15 +194,10 @@ class Bytes14Coder {
 
  private:
   struct Channel;
-  Channel& Switch(uint32_t channel);
-  void StartChannel(uint32_t channel, const std::vector<uint8_t>& last);
 
   size_t count_;
-  int version_;
   Layers layers_;
-  std::array<std::unique_ptr<Channel>, 4> channels_;
-  std::array<bool, 4> in_chunk_{};
-  uint32_t current_ = 0;
+  ChannelContexts<Channel, std::vector<uint8_t>> channels_;
 };
 
 }  // namespace neuralmesh::io_internal::laz

@@ -37,7 +37,10 @@ uint32_t ReturnLevel(uint32_t n, uint32_t r) {
   return std::min<uint32_t>(static_cast<uint32_t>(std::abs(static_cast<int>(n - r))), 7);
 }
 
-// Single (3), first (1), last (2) or intermediate (0) return.
+// Single (3), first (1), last (2) or intermediate (0) return. LASzip's sources number first
+// and last both ways round (its version 3 reader as here; its version 4 writer and laz-perf
+// the other way): the numbering only names the intensity's contexts, alike on both sides, so
+// the bytes are the same.
 uint32_t ReturnKind(uint32_t n, uint32_t r) { return (r == 1 ? 1 : 0) + (r >= n ? 2 : 0); }
 
 enum Point14Layer : size_t {

@@ -17,7 +17,7 @@
 // predict that one record from, and store it as, the last record of the channel they leave.
 // Version 4 (newer LASzip) fixes both: POINT14 passes every record's own channel on, and a
 // switch predicts from the new channel's last record. Versions 3 and 4 are read and written;
-// version 3 is what laz-perf and LASzip before 3.4 read.
+// every LAZ reader reads version 3, only newer LASzip version 4 (laz-perf reads it as 3).
 //
 // One instance either encodes or decodes. A chunk starts with its first record, which the chunk
 // holds raw (Start*); the others are coded one by one; encoding ends with the layers' bytes.

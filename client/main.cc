@@ -697,10 +697,13 @@ std::vector<Subcommand> Commands() {
        "the figures of every level.",
        WithConnectionFlags(reconstruct), Reconstruct},
       {"stats",
-       "stats MESH [--json]",
-       "Prints the mesh report of a mesh.",
+       "stats MESH|POINTS [--json]",
+       "Prints the mesh report of a mesh, or what a point cloud file holds.",
        "Prints the mesh report of MESH (a mesh file or builtin:NAME): counts, valences, genus,\n"
-       "boundaries, manifoldness.",
+       "boundaries, manifoldness. For POINTS, a point cloud file (.xyz .txt .pts .ptx .las\n"
+       ".laz .pcd .e57): the points read and left out, where they lie and what they carry;\n"
+       "for LAS and LAZ also the version, point format, records, scale, offset, coordinate\n"
+       "system, GPS time, classes and, for LAZ, the compression.",
        {"json"},
        Stats},
       {"convert",

@@ -1,17 +1,19 @@
 // RunStats, RunEval and RunConvert (declared in client/local_commands.h).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/ascii.h"
-#include "absl/strings/strip.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "absl/strings/match.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/strip.h"
 #include "client/builtin_shapes.h"
 #include "client/inputs.h"
 #include "client/local_commands.h"
@@ -20,13 +22,135 @@
 #include "core/analysis/mesh_report.h"
 #include "core/analysis/statistical_outliers.h"
 #include "core/io/las_cleaning.h"
+#include "core/io/las_description.h"
 #include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh::client {
 
+namespace {
+
+// The report of a point cloud file (one ReadPointCloud reads that is no mesh file): the points
+// read and left out, where they lie, what they carry; and for LAS and LAZ the header, the
+// classes and the compression (LasDescription).
+absl::Status PrintPointCloudStats(const std::string& path, bool json, std::ostream& out) {
+  PointsLeftOut left_out;
+  NM_ASSIGN_OR_RETURN(const PointCloud cloud, LoadPointCloud(path, "FILE", &left_out, {}));
+  std::optional<LasDescription> las;
+  if (IsLasPath(path)) {
+    NM_ASSIGN_OR_RETURN(las, DescribeLasFile(path));
+  }
+  std::array<double, 3> low = {INFINITY, INFINITY, INFINITY};
+  std::array<double, 3> high = {-INFINITY, -INFINITY, -INFINITY};
+  for (const Vec3f& p : cloud.positions) {
+    for (int c = 0; c < 3; ++c) {
+      low[c] = std::min(low[c], cloud.origin[c] + double{p[c]});
+      high[c] = std::max(high[c], cloud.origin[c] + double{p[c]});
+    }
+  }
+  std::vector<std::string> carried;
+  if (!cloud.colors.empty()) carried.push_back("colours");
+  if (!cloud.normals.empty()) carried.push_back("normals");
+  if (!cloud.weights.empty()) carried.push_back("weights");
+  // Classes with records, "2: 1500" (JSON: {"2": 1500}).
+  std::vector<std::pair<int, uint64_t>> classes;
+  if (las.has_value()) {
+    for (int c = 0; c < 256; ++c) {
+      if (las->records_by_class[c] > 0) classes.push_back({c, las->records_by_class[c]});
+    }
+  }
+  if (json) {
+    JsonWriter writer(2);
+    writer.BeginObject();
+    writer.Key("file").String(path);
+    writer.Key("points").Uint(cloud.size());
+    writer.Key("left_out").BeginObject();
+    writer.Key("withheld").Uint(left_out.withheld);
+    writer.Key("noise").Uint(left_out.noise);
+    writer.Key("invalid").Uint(left_out.invalid);
+    writer.EndObject();
+    if (!cloud.empty()) {
+      writer.Key("min").BeginArray();
+      for (const double v : low) writer.Double(v);
+      writer.EndArray();
+      writer.Key("max").BeginArray();
+      for (const double v : high) writer.Double(v);
+      writer.EndArray();
+    }
+    writer.Key("colors").Bool(!cloud.colors.empty());
+    writer.Key("normals").Bool(!cloud.normals.empty());
+    writer.Key("weights").Bool(!cloud.weights.empty());
+    if (las.has_value()) {
+      writer.Key("las").BeginObject();
+      writer.Key("version").String(absl::StrCat("1.", las->version_minor));
+      writer.Key("point_format").Int(las->point_format);
+      writer.Key("record_length").Uint(las->record_length);
+      writer.Key("extra_bytes").Uint(las->extra_bytes);
+      writer.Key("records").Uint(las->records);
+      writer.Key("withheld").Uint(las->withheld);
+      writer.Key("classes").BeginObject();
+      for (const auto& [c, count] : classes) writer.Key(absl::StrCat(c)).Uint(count);
+      writer.EndObject();
+      writer.Key("scale").BeginArray();
+      for (const double v : las->scale) writer.Double(v);
+      writer.EndArray();
+      writer.Key("offset").BeginArray();
+      for (const double v : las->offset) writer.Double(v);
+      writer.EndArray();
+      writer.Key("coordinate_system").String(las->coordinate_system);
+      writer.Key("gps_time").String(las->standard_gps_time ? "adjusted standard" : "week");
+      writer.Key("variable_length_records").Uint(las->variable_length_records);
+      writer.Key("generating_software").String(las->generating_software);
+      writer.Key("file_bytes").Uint(las->file_bytes);
+      if (!las->compression.empty()) writer.Key("compression").String(las->compression);
+      writer.EndObject();
+    }
+    writer.EndObject();
+    NM_ASSIGN_OR_RETURN(const std::string text, writer.Finish());
+    out << text << "\n";
+    return absl::OkStatus();
+  }
+  out << path << "\n";
+  if (las.has_value()) {
+    out << absl::StrFormat("  LAS 1.%d, point format %d: %d records of %d bytes (%d extra)\n",
+                           las->version_minor, las->point_format, las->records, las->record_length,
+                           las->extra_bytes);
+    if (!las->compression.empty()) {
+      out << absl::StrFormat("  LAZ: %s; %d bytes\n", las->compression, las->file_bytes);
+    }
+    out << absl::StrFormat("  scale %.17g %.17g %.17g, offset %.17g %.17g %.17g\n", las->scale[0],
+                           las->scale[1], las->scale[2], las->offset[0], las->offset[1],
+                           las->offset[2]);
+    out << "  coordinate system: "
+        << (las->coordinate_system.empty() ? "none"
+                                           : absl::StrCat(las->coordinate_system, " record"))
+        << "; GPS time: " << (las->standard_gps_time ? "adjusted standard" : "week") << "\n";
+    out << "  classes: "
+        << absl::StrJoin(classes, ", ",
+                         [](std::string* text, const std::pair<int, uint64_t>& c) {
+                           absl::StrAppend(text, c.first, ": ", c.second);
+                         })
+        << (las->withheld > 0 ? absl::StrCat(" (", las->withheld, " withheld)") : "") << "\n";
+    if (!las->generating_software.empty()) {
+      out << "  written by " << las->generating_software << "\n";
+    }
+  }
+  out << "  " << cloud.size() << " points read" << LeftOutNote(left_out) << "\n";
+  if (!cloud.empty()) {
+    out << absl::StrFormat("  from (%.15g, %.15g, %.15g) to (%.15g, %.15g, %.15g)\n", low[0],
+                           low[1], low[2], high[0], high[1], high[2]);
+  }
+  out << "  with " << (carried.empty() ? "positions only" : absl::StrJoin(carried, ", ")) << "\n";
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::Status RunStats(const std::string& mesh_path, bool json, std::ostream& out) {
+  if (!IsSupportedMeshExtension(mesh_path) && IsReadablePointCloudExtension(mesh_path)) {
+    return PrintPointCloudStats(mesh_path, json, out);
+  }
   NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(mesh_path, "MESH"));
   const MeshReport report = ComputeMeshReport(mesh);
   if (json) {

@@ -168,6 +168,66 @@ TEST_F(LocalCliTest, StatsPrintsTextByDefault) {
   EXPECT_TRUE(absl::StrContains(stats.out, "100")) << stats.out;
 }
 
+// `stats` of a point cloud file: the points read and left out, their box, what they carry; for
+// LAS and LAZ what the header, the records and the compression say.
+TEST_F(LocalCliTest, StatsDescribesPointCloudFilesAndLazCompression) {
+  testing::LasLayout layout;
+  layout.version_minor = 4;
+  layout.format = 7;
+  layout.vlrs = testing::LasVariableLengthRecord("LASF_Projection", 2112, "PROJCS[\"UTM 32N\"]",
+                                                 /*extended=*/false);
+  layout.vlr_count = 1;
+  std::vector<testing::LasPoint> points;
+  for (int i = 0; i < 10; ++i) {
+    testing::LasPoint p{100 * i, 200, -300 * i};
+    p.classification = static_cast<uint8_t>(i < 7 ? 2 : 6);
+    p.withheld = i == 9;
+    p.red = 4000;
+    points.push_back(p);
+  }
+  points[3].classification = 7;  // Noise.
+  const std::string las = *dir_ + "/described.las", laz = *dir_ + "/described.laz";
+  std::ofstream(las, std::ios::binary) << testing::LasFile(layout, points);
+  ASSERT_EQ(RunNeuralmesh({"convert", las, "-o", laz}).exit_code, 0);
+
+  const RunResult text = RunNeuralmesh({"stats", laz});
+  ASSERT_EQ(text.exit_code, 0) << text.Describe();
+  EXPECT_EQ(text.out,
+            laz +
+                "\n"
+                "  LAS 1.4, point format 7: 10 records of 36 bytes (0 extra)\n"
+                "  LAZ: LASzip 3.4 (revision 3), layered chunks, item version 3, 1 chunk of "
+                "up to 50000 records; " +
+                std::to_string(ReadFileContents(laz).value_or("").size()) +
+                " bytes\n"
+                "  scale 0.01 0.01 0.01, offset 0 0 0\n"
+                "  coordinate system: WKT record; GPS time: week\n"
+                "  classes: 2: 6, 6: 3, 7: 1 (1 withheld)\n"
+                "  8 points read; left out 1 withheld point and 1 classified as noise\n"
+                "  from (0, 2, -24) to (8, 2, 0)\n"
+                "  with colours\n")
+      << text.Describe();
+  const RunResult json = RunNeuralmesh({"stats", las, "--json"});
+  ASSERT_EQ(json.exit_code, 0) << json.Describe();
+  EXPECT_EQ(JsonValue(json.out, "points"), "8") << json.out;
+  EXPECT_EQ(JsonValue(json.out, "point_format"), "7") << json.out;
+  EXPECT_EQ(JsonValue(json.out, "coordinate_system"), "\"WKT\"") << json.out;
+  EXPECT_EQ(JsonValue(json.out, "6"), "3") << json.out;
+  EXPECT_EQ(JsonValue(json.out, "compression"), "") << "a LAS file is not compressed";
+
+  // Other point cloud files: their points, box and attributes.
+  const std::string xyz = *dir_ + "/described.xyz";
+  std::ofstream(xyz) << "0 0 0\n1 2 3\n";
+  const RunResult plain = RunNeuralmesh({"stats", xyz});
+  ASSERT_EQ(plain.exit_code, 0) << plain.Describe();
+  EXPECT_EQ(plain.out, xyz +
+                           "\n  2 points read\n  from (0, 0, 0) to (1, 2, 3)\n  with positions "
+                           "only\n");
+  const RunResult missing = RunNeuralmesh({"stats", *dir_ + "/missing.laz"});
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_THAT(missing.err, ::testing::HasSubstr("missing.laz"));
+}
+
 TEST_F(LocalCliTest, EvalAgainstTheBuiltinSphereGivesASmallChamferDistance) {
   ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
   const RunResult eval = RunNeuralmesh(

@@ -434,6 +434,48 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
   return out;
 }
 
+absl::StatusOr<LasDescription> DescribeLas(absl::string_view data) {
+  if (IsLaz(data)) {
+    NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(data));
+    return DescribeLas(las);
+  }
+  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
+  LasDescription out;
+  out.version_minor = header.minor;
+  out.point_format = header.format;
+  out.record_length = header.record_length;
+  out.extra_bytes = header.record_length - kFormats[header.format].length;
+  out.records = header.count;
+  out.scale = header.scale;
+  out.offset = header.offset;
+  absl::string_view software = data.substr(kGeneratingSoftware, 32);
+  out.generating_software = std::string(software.substr(0, software.find('\0')));
+  out.standard_gps_time = (Load<uint16_t>(data, kGlobalEncoding) & 1) != 0;
+  out.variable_length_records = Load<uint32_t>(data, kVlrCount);
+  size_t at = header.header_size;
+  for (uint32_t i = 0;
+       i < out.variable_length_records && at + kVlrHeaderSize <= header.offset_to_points; ++i) {
+    absl::string_view user = data.substr(at + kVlrUser, 16);
+    user = user.substr(0, user.find('\0'));
+    const uint16_t id = Load<uint16_t>(data, at + kVlrRecordId);
+    if (user == "LASF_Projection" && id == 2112) {
+      out.coordinate_system = "WKT";
+    } else if (user == "LASF_Projection" && id == 34735 && out.coordinate_system.empty()) {
+      out.coordinate_system = "GeoTIFF";
+    }
+    at += kVlrHeaderSize + Load<uint16_t>(data, at + kVlrLength);
+  }
+  out.records_by_class.assign(256, 0);
+  const bool extended = header.format >= 6;
+  for (uint64_t i = 0; i < header.count; ++i) {
+    const size_t record = header.record(i);
+    const uint8_t flags = static_cast<uint8_t>(data[record + 15]);
+    out.withheld += extended ? (flags & 0x04) != 0 : (flags & 0x80) != 0;
+    ++out.records_by_class[extended ? static_cast<uint8_t>(data[record + 16]) : flags & 0x1F];
+  }
+  return out;
+}
+
 absl::StatusOr<uint64_t> LasRecordCount(absl::string_view data) {
   NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
   return header.count;

@@ -11,6 +11,7 @@
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
 #include "core/io/las_cleaning.h"
+#include "core/io/las_description.h"
 #include "core/io/point_selection.h"
 
 namespace neuralmesh::io_internal {
@@ -35,6 +36,10 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
 // The number of point records of an uncompressed LAS file, after ParseLas's checks of its
 // header (and its errors but the last).
 absl::StatusOr<uint64_t> LasRecordCount(absl::string_view data);
+
+// Describes a LAS file (a LAZ file: the LAS file it holds, without `compression`), with
+// ParseLas's errors for a malformed one.
+absl::StatusOr<LasDescription> DescribeLas(absl::string_view data);
 
 // Formats points as a LAS 1.2 file of point format 0, or 2 with their colours (8-bit levels
 // times 257 in the 16-bit channels), without variable-length records. The header's offset is

@@ -619,6 +619,33 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOp
   return las;
 }
 
+absl::StatusOr<std::string> DescribeLazCompression(absl::string_view laz) {
+  NM_ASSIGN_OR_RETURN(const Header header, ReadHeader(laz, "LAZ"));
+  if ((header.format_byte & kCompressedBits) == 0) {
+    return Invalid("the point format carries no compression bits: a LAS file, not LAZ");
+  }
+  NM_ASSIGN_OR_RETURN(const std::vector<Vlr> vlrs, ReadVlrs(laz, header, "LAZ"));
+  const auto laszip = std::find_if(vlrs.begin(), vlrs.end(), [](const Vlr& vlr) {
+    return vlr.user == kLaszipUser && vlr.id == kLaszipRecordId;
+  });
+  if (laszip == vlrs.end()) return Invalid("no LASzip record says how the points are compressed");
+  NM_ASSIGN_OR_RETURN(const Compression compression, CheckLaszipRecord(laszip->payload, header));
+  std::vector<Chunk> chunks;
+  if (header.count > 0) {
+    NM_ASSIGN_OR_RETURN(chunks, ReadChunkTable(laz, header, compression.chunk_size));
+  }
+  const absl::string_view payload = laszip->payload;
+  return absl::StrCat(
+      "LASzip ", static_cast<uint8_t>(payload[4]), ".", static_cast<uint8_t>(payload[5]),
+      " (revision ", Load<uint16_t>(payload, 6), "), ",
+      Load<uint16_t>(payload, 0) == kCompressorLayeredChunked ? "layered" : "pointwise",
+      " chunks, item version ", compression.item_version, ", ", chunks.size(),
+      chunks.size() == 1 ? " chunk of " : " chunks of ",
+      compression.chunk_size == kVariableChunkSize
+          ? std::string("varying size")
+          : absl::StrCat("up to ", compression.chunk_size, " records"));
+}
+
 absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOptions& options) {
   NM_ASSIGN_OR_RETURN(const Header header, ReadHeader(las, "LAS"));
   if ((header.format_byte & kCompressedBits) != 0) {

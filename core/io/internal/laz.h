@@ -40,6 +40,12 @@ struct LazReadOptions {
 absl::StatusOr<std::string> DecompressLaz(absl::string_view laz,
                                           const LazReadOptions& options = {});
 
+// How `laz` is compressed, for reports (`neuralmesh stats`): the LASzip version that wrote it,
+// the compressor, the item version and the chunks, as "LASzip 3.4 (revision 3), layered chunks,
+// item version 3, 3 chunks of up to 50000 records". DecompressLaz's errors for a file it does
+// not read.
+absl::StatusOr<std::string> DescribeLazCompression(absl::string_view laz);
+
 struct LazWriteOptions {
   // Records per chunk; each chunk starts afresh, so a reader can start at any chunk.
   uint32_t chunk_size = 50000;

@@ -56,8 +56,9 @@ struct LocalReconstructOptions {
 absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::ostream& out,
                                  std::ostream& err);
 
-// Prints the mesh report of MESH (a mesh file or builtin:NAME), or for a point cloud file what
-// it holds (and a LAS or LAZ file's description), as text or JSON.
+// Prints the mesh report of MESH (a mesh file or builtin:NAME), or for a point cloud file (a
+// mesh format's too when it holds no faces) what it holds (and a LAS or LAZ file's
+// description), as text or JSON.
 absl::Status RunStats(const std::string& mesh, bool json, std::ostream& out);
 
 struct EvalOptions {

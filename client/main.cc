@@ -701,9 +701,10 @@ std::vector<Subcommand> Commands() {
        "Prints the mesh report of a mesh, or what a point cloud file holds.",
        "Prints the mesh report of MESH (a mesh file or builtin:NAME): counts, valences, genus,\n"
        "boundaries, manifoldness. For POINTS, a point cloud file (.xyz .txt .pts .ptx .las\n"
-       ".laz .pcd .e57): the points read and left out, where they lie and what they carry;\n"
-       "for LAS and LAZ also the version, point format, records, scale, offset, coordinate\n"
-       "system, GPS time, classes and, for LAZ, the compression.",
+       ".laz .pcd .e57, or a mesh format without faces): the points read and left out, where\n"
+       "they lie and what they carry; for LAS and LAZ also the version, point format,\n"
+       "records, scale, offset, coordinate system, GPS time, classes and, for LAZ, the\n"
+       "compression.",
        {"json"},
        Stats},
       {"convert",

@@ -152,6 +152,10 @@ absl::Status RunStats(const std::string& mesh_path, bool json, std::ostream& out
     return PrintPointCloudStats(mesh_path, json, out);
   }
   NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(mesh_path, "MESH"));
+  // Points in a mesh format (a PLY of a scan): the point cloud's report.
+  if (mesh.faces.empty() && IsReadablePointCloudExtension(mesh_path)) {
+    return PrintPointCloudStats(mesh_path, json, out);
+  }
   const MeshReport report = ComputeMeshReport(mesh);
   if (json) {
     out << MeshReportToJson(report, 2) << "\n";

@@ -223,6 +223,16 @@ TEST_F(LocalCliTest, StatsDescribesPointCloudFilesAndLazCompression) {
   EXPECT_EQ(plain.out, xyz +
                            "\n  2 points read\n  from (0, 0, 0) to (1, 2, 3)\n  with positions "
                            "only\n");
+  // Points in a mesh format: the same report.
+  const std::string ply = *dir_ + "/described_points.ply";
+  PointCloud two;
+  two.positions = {{0, 0, 0}, {1, 2, 3}};
+  ASSERT_TRUE(WritePointCloud(two, ply).ok());
+  const RunResult ply_stats = RunNeuralmesh({"stats", ply});
+  ASSERT_EQ(ply_stats.exit_code, 0) << ply_stats.Describe();
+  EXPECT_EQ(ply_stats.out, ply +
+                               "\n  2 points read\n  from (0, 0, 0) to (1, 2, 3)\n  with "
+                               "positions only\n");
   const RunResult missing = RunNeuralmesh({"stats", *dir_ + "/missing.laz"});
   EXPECT_NE(missing.exit_code, 0);
   EXPECT_THAT(missing.err, ::testing::HasSubstr("missing.laz"));

@@ -549,22 +549,42 @@ bool IsLaz(absl::string_view data) {
          (static_cast<uint8_t>(data[kPointFormat]) & kCompressedBits) != 0;
 }
 
-absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOptions& options) {
-  NM_ASSIGN_OR_RETURN(const Header header, ReadHeader(laz, "LAZ"));
-  if ((header.format_byte & kCompressedBits) == 0) {
+namespace {
+
+// A LAZ file's header and its LASzip record (the last, if several), checked.
+struct LazHeader {
+  Header header;
+  Vlr laszip;
+  Compression compression;
+};
+
+absl::StatusOr<LazHeader> ReadLazHeader(absl::string_view laz) {
+  LazHeader out;
+  NM_ASSIGN_OR_RETURN(out.header, ReadHeader(laz, "LAZ"));
+  if ((out.header.format_byte & kCompressedBits) == 0) {
     return Invalid("the point format carries no compression bits: a LAS file, not LAZ");
   }
-  NM_ASSIGN_OR_RETURN(const std::vector<Vlr> vlrs, ReadVlrs(laz, header, "LAZ"));
-  const Vlr* laszip = nullptr;
-  for (const Vlr& vlr : vlrs) {
-    if (vlr.user == kLaszipUser && vlr.id == kLaszipRecordId) laszip = &vlr;
-  }
-  if (laszip == nullptr) {
+  NM_ASSIGN_OR_RETURN(const std::vector<Vlr> vlrs, ReadVlrs(laz, out.header, "LAZ"));
+  const auto laszip = std::find_if(vlrs.rbegin(), vlrs.rend(), [](const Vlr& vlr) {
+    return vlr.user == kLaszipUser && vlr.id == kLaszipRecordId;
+  });
+  if (laszip == vlrs.rend()) {
     return Invalid(
         "no LASzip record (user \"laszip encoded\", record 22204) says how the "
         "points are compressed");
   }
-  NM_ASSIGN_OR_RETURN(const Compression compression, CheckLaszipRecord(laszip->payload, header));
+  out.laszip = *laszip;
+  NM_ASSIGN_OR_RETURN(out.compression, CheckLaszipRecord(out.laszip.payload, out.header));
+  return out;
+}
+
+}  // namespace
+
+absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOptions& options) {
+  NM_ASSIGN_OR_RETURN(const LazHeader laz_header, ReadLazHeader(laz));
+  const Header& header = laz_header.header;
+  const Vlr* laszip = &laz_header.laszip;
+  const Compression& compression = laz_header.compression;
   const size_t points_end =
       header.evlr_start > header.offset_to_points && header.evlr_start <= laz.size()
           ? static_cast<size_t>(header.evlr_start)
@@ -620,21 +640,14 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOp
 }
 
 absl::StatusOr<std::string> DescribeLazCompression(absl::string_view laz) {
-  NM_ASSIGN_OR_RETURN(const Header header, ReadHeader(laz, "LAZ"));
-  if ((header.format_byte & kCompressedBits) == 0) {
-    return Invalid("the point format carries no compression bits: a LAS file, not LAZ");
-  }
-  NM_ASSIGN_OR_RETURN(const std::vector<Vlr> vlrs, ReadVlrs(laz, header, "LAZ"));
-  const auto laszip = std::find_if(vlrs.begin(), vlrs.end(), [](const Vlr& vlr) {
-    return vlr.user == kLaszipUser && vlr.id == kLaszipRecordId;
-  });
-  if (laszip == vlrs.end()) return Invalid("no LASzip record says how the points are compressed");
-  NM_ASSIGN_OR_RETURN(const Compression compression, CheckLaszipRecord(laszip->payload, header));
+  NM_ASSIGN_OR_RETURN(const LazHeader laz_header, ReadLazHeader(laz));
+  const Header& header = laz_header.header;
+  const Compression& compression = laz_header.compression;
   std::vector<Chunk> chunks;
   if (header.count > 0) {
     NM_ASSIGN_OR_RETURN(chunks, ReadChunkTable(laz, header, compression.chunk_size));
   }
-  const absl::string_view payload = laszip->payload;
+  const absl::string_view payload = laz_header.laszip.payload;
   return absl::StrCat(
       "LASzip ", static_cast<uint8_t>(payload[4]), ".", static_cast<uint8_t>(payload[5]),
       " (revision ", Load<uint16_t>(payload, 6), "), ",

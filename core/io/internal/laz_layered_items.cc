@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <utility>
 
 #include "core/io/internal/binary.h"
 
@@ -72,7 +73,7 @@ void Layers::StartEncoding() {
 void Layers::FinishEncoding(std::vector<std::string>* layers) {
   for (size_t i = 0; i < count(); ++i) {
     encoders_[i]->Done();
-    layers->push_back(changed_[i] ? bytes_[i] : std::string());
+    layers->push_back(changed_[i] ? std::move(bytes_[i]) : std::string());
   }
 }
 

@@ -109,7 +109,7 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
   bool header_printed = false;
   StopReason reason = StopReason::kTargetReached;
   // A run whose mesh stops growing (too few points, all in one place) ends instead of spinning.
-  GrowthWatch growth(options.learner.c_vs, learner->num_vertices(), 0);
+  GrowthWatch growth(LongestSplitInterval(options.learner), learner->num_vertices(), 0);
   absl::Status stalled;
   for (size_t i = 0; i < targets.size(); ++i) {
     StopCriteria stop;

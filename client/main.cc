@@ -70,6 +70,14 @@ ABSL_FLAG(int32_t, c_vs, kLearnerDefaults.c_vs,
 ABSL_FLAG(double, c_ec, kLearnerDefaults.c_ec,
           "C_ec (Section 2.2): the half-edge collapse step runs every C_ec * v Basic Steps, > 0 "
           "(v counted as at least C_vs, not in the paper).");
+ABSL_FLAG(uint64_t, early_phase_vertices, kLearnerDefaults.early_phase_vertices,
+          "The paper's early phase (Section 4, its David model): until the mesh first has this "
+          "many vertices, Steps 2 and 3 run with --early_c_vs and --early_c_ec. 0: none; the "
+          "paper's David setting is 10000.");
+ABSL_FLAG(int32_t, early_c_vs, kLearnerDefaults.early_c_vs,
+          "C_vs of the early phase (--early_phase_vertices), >= 1.");
+ABSL_FLAG(double, early_c_ec, kLearnerDefaults.early_c_ec,
+          "C_ec of the early phase (--early_phase_vertices), > 0.");
 ABSL_FLAG(double, alpha_sc, kLearnerDefaults.alpha_sc,
           "alpha_sc (Section 2.2, Eq. 4): signal counter decay, in (0, 1).");
 ABSL_FLAG(double, alpha_r, kLearnerDefaults.alpha_r,
@@ -288,6 +296,9 @@ absl::StatusOr<neuralmesh::LearnerOptions> LearnerFromFlags() {
   o.c_l = absl::GetFlag(FLAGS_c_l);
   o.c_vs = absl::GetFlag(FLAGS_c_vs);
   o.c_ec = absl::GetFlag(FLAGS_c_ec);
+  o.early_phase_vertices = absl::GetFlag(FLAGS_early_phase_vertices);
+  o.early_c_vs = absl::GetFlag(FLAGS_early_c_vs);
+  o.early_c_ec = absl::GetFlag(FLAGS_early_c_ec);
   o.alpha_sc = absl::GetFlag(FLAGS_alpha_sc);
   o.remove_triangles = absl::GetFlag(FLAGS_remove_triangles);
   o.alpha_r = absl::GetFlag(FLAGS_alpha_r);
@@ -673,9 +684,9 @@ std::vector<Subcommand> Commands() {
   // clang-format off
   const std::vector<std::string> reconstruct = {
       "output", "vertices", "lod", "seed", "alpha_w", "alpha_l", "c_l", "c_vs", "c_ec",
-      "alpha_sc", "alpha_r", "alpha_m", "remove_triangles", "merge_boundaries",
-      "splits_per_step", "close_small_holes", "max_closed_hole_vertices",
-      "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
+      "early_phase_vertices", "early_c_vs", "early_c_ec", "alpha_sc", "alpha_r", "alpha_m",
+      "remove_triangles", "merge_boundaries", "splits_per_step", "close_small_holes",
+      "max_closed_hole_vertices", "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
       "start_mesh", "las_classes", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
       "outlier_passes", "outliers_on_server", "colors", "color_neighbours", "sampling",

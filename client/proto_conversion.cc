@@ -10,6 +10,9 @@ v1::LearnerOptions ToProto(const LearnerOptions& options) {
   proto.mutable_c_l()->set_value(options.c_l);
   proto.mutable_c_vs()->set_value(options.c_vs);
   proto.mutable_c_ec()->set_value(options.c_ec);
+  proto.mutable_early_phase_vertices()->set_value(options.early_phase_vertices);
+  proto.mutable_early_c_vs()->set_value(options.early_c_vs);
+  proto.mutable_early_c_ec()->set_value(options.early_c_ec);
   proto.mutable_alpha_sc()->set_value(options.alpha_sc);
   proto.mutable_remove_triangles()->set_value(options.remove_triangles);
   proto.mutable_alpha_r()->set_value(options.alpha_r);

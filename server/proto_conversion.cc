@@ -43,6 +43,9 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
   if (l.has_c_l()) o.c_l = l.c_l().value();
   if (l.has_c_vs()) o.c_vs = l.c_vs().value();
   if (l.has_c_ec()) o.c_ec = l.c_ec().value();
+  if (l.has_early_phase_vertices()) o.early_phase_vertices = l.early_phase_vertices().value();
+  if (l.has_early_c_vs()) o.early_c_vs = l.early_c_vs().value();
+  if (l.has_early_c_ec()) o.early_c_ec = l.early_c_ec().value();
   if (l.has_alpha_sc()) o.alpha_sc = l.alpha_sc().value();
   if (l.has_remove_triangles()) o.remove_triangles = l.remove_triangles().value();
   if (l.has_alpha_r()) o.alpha_r = l.alpha_r().value();
@@ -149,6 +152,9 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
   l.mutable_c_l()->set_value(o.c_l);
   l.mutable_c_vs()->set_value(o.c_vs);
   l.mutable_c_ec()->set_value(o.c_ec);
+  l.mutable_early_phase_vertices()->set_value(o.early_phase_vertices);
+  l.mutable_early_c_vs()->set_value(o.early_c_vs);
+  l.mutable_early_c_ec()->set_value(o.early_c_ec);
   l.mutable_alpha_sc()->set_value(o.alpha_sc);
   l.mutable_remove_triangles()->set_value(o.remove_triangles);
   l.mutable_alpha_r()->set_value(o.alpha_r);

@@ -605,7 +605,7 @@ SliceResult Session::RunSlice(absl::Time deadline) {
         return {SliceResult::kDone};
       }
       learner_ = *std::move(learner);
-      growth_.emplace(config_.learner.c_vs, learner_->num_vertices(), 0);
+      growth_.emplace(LongestSplitInterval(config_.learner), learner_->num_vertices(), 0);
       {
         absl::MutexLock lock(&mu_);
         if (state_ == v1::SESSION_STATE_COLLECTING) state_ = v1::SESSION_STATE_LEARNING;

@@ -18,8 +18,9 @@ class GrowthWatch {
   // learning counts as stalled; normal growth makes one every few splits.
   static constexpr uint64_t kStallSplits = 2000;
 
-  // For a learner with parameter C_vs = `c_vs` (> 0), starting now with `vertices` vertices
-  // after `basic_steps` steps.
+  // For a learner that splits every `c_vs` (> 0) Basic Steps, or less often
+  // (LongestSplitInterval in learner_options.h), starting now with `vertices` vertices after
+  // `basic_steps` steps.
   GrowthWatch(int c_vs, size_t vertices, uint64_t basic_steps);
 
   // Records the learner's state; FAILED_PRECONDITION saying so once the mesh has not grown past

@@ -86,6 +86,7 @@ class Learner::Impl {
       mesh_.property(spared_until_, v) = 0;
     }
     live_vertices_ = mesh_.n_vertices();
+    early_phase_ = live_vertices_ < options_.early_phase_vertices;
     next_connectivity_step_ = ConnectivityInterval();
   }
   // A start mesh comes in any vertex order: renumbered as after every Step 3.
@@ -149,7 +150,7 @@ class Learner::Impl {
     counters_.RecordWin(winner, step_);
     mesh_.property(active_, w) = true;
 
-    if (step_ % static_cast<uint64_t>(options_.c_vs) == 0) {
+    if (step_ % static_cast<uint64_t>(SplitInterval()) == 0) {
       Clock::time_point t2;
       if (timings_on_) t2 = Clock::now();  // Every split is timed: they are rare.
       for (int i = 0; i < options_.splits_per_step; ++i) {
@@ -217,11 +218,16 @@ class Learner::Impl {
   LearnerTimings timings() const { return timings_; }
 
  private:
-  // C_ec * v Basic Steps, with v at least C_vs (learner_options.h).
+  // C_vs, or in the early phase its own (learner_options.h).
+  int SplitInterval() const { return early_phase_ ? options_.early_c_vs : options_.c_vs; }
+
+  // C_ec * v Basic Steps, with v at least C_vs, or in the early phase its own C_ec and C_vs
+  // (learner_options.h).
   uint64_t ConnectivityInterval() const {
+    const double c_ec = early_phase_ ? options_.early_c_ec : options_.c_ec;
     const double v =
-        std::max(static_cast<double>(live_vertices_), static_cast<double>(options_.c_vs));
-    return static_cast<uint64_t>(std::ceil(options_.c_ec * v));
+        std::max(static_cast<double>(live_vertices_), static_cast<double>(SplitInterval()));
+    return static_cast<uint64_t>(std::ceil(c_ec * v));
   }
 
   // Step 2: split the most active vertex, or the largest cell next to it (see
@@ -235,6 +241,7 @@ class Learner::Impl {
     const Mesh::VertexHandle v0 = SplitVertex(mesh_, rings_, v);
     if (!v0.is_valid()) return;
     ++live_vertices_;
+    if (live_vertices_ >= options_.early_phase_vertices) early_phase_ = false;
     ++progress_.splits;
     // Every ring the split changed (v, v0, the two cut neighbours, the neighbours v0 took
     // over) belongs to v0 or one of its neighbours. Each is read again at once, while the
@@ -415,6 +422,8 @@ class Learner::Impl {
   uint64_t step_ = 0;
   uint64_t next_connectivity_step_ = 0;
   size_t live_vertices_ = 0;
+  // Until the mesh first has early_phase_vertices vertices (learner_options.h).
+  bool early_phase_ = false;
   size_t deleted_faces_ = 0;
   LearnerProgress progress_;
   bool timings_on_ = false;

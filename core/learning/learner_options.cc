@@ -1,5 +1,6 @@
 #include "core/learning/learner_options.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
@@ -39,6 +40,12 @@ absl::Status LearnerOptions::Validate() const {
   if (c_vs < 1 || c_vs > 1000000) return OutOfRange("c_vs", c_vs, "[1, 1000000]");
   if (!(c_ec > 0 && c_ec <= 1e6)) return OutOfRange("c_ec", c_ec, "(0, 1e6]");
   if (!(alpha_sc > 0 && alpha_sc < 1)) return OutOfRange("alpha_sc", alpha_sc, "(0, 1)");
+  if (early_c_vs < 1 || early_c_vs > 1000000) {
+    return OutOfRange("early_c_vs", early_c_vs, "[1, 1000000]");
+  }
+  if (!(early_c_ec > 0 && early_c_ec <= 1e6)) {
+    return OutOfRange("early_c_ec", early_c_ec, "(0, 1e6]");
+  }
   if (!(alpha_r > 0 && std::isfinite(alpha_r))) return OutOfRange("alpha_r", alpha_r, "(0, inf)");
   if (!(alpha_m > 0 && std::isfinite(alpha_m))) return OutOfRange("alpha_m", alpha_m, "(0, inf)");
   if (sewn_strip_grace_calls < 0 || sewn_strip_grace_calls > 1000) {
@@ -57,6 +64,11 @@ absl::Status LearnerOptions::Validate() const {
     return OutOfRange("splits_per_step", splits_per_step, "[1, 1000]");
   }
   return absl::OkStatus();
+}
+
+int LongestSplitInterval(const LearnerOptions& options) {
+  return options.early_phase_vertices > 0 ? std::max(options.c_vs, options.early_c_vs)
+                                          : options.c_vs;
 }
 
 }  // namespace neuralmesh

@@ -59,6 +59,16 @@ struct LearnerOptions {
   // valences. (Not an option.)
   double c_ec = 10;
   double alpha_sc = 0.95;  // alpha_sc, Section 2.2 / Eq. 4: signal counter decay, (0, 1).
+  // An early phase with other C_vs and C_ec (Section 4): "For the David model in particular,
+  // up to the 10k vertex we used C_vs = 500, C_ec = 8. This way the neural mesh learned faster
+  // the concavities of the model and we were able to recover the correct topology at an early
+  // stage." Until the mesh first has early_phase_vertices vertices, Steps 2 and 3 run every
+  // early_c_vs and early_c_ec * v Basic Steps; from then on every c_vs and c_ec * v, even if
+  // collapses take the mesh below that count again. 0, the paper's setting for its other
+  // models, has no early phase; 10000 with the defaults below is its David setting.
+  uint64_t early_phase_vertices = 0;
+  int early_c_vs = 500;   // C_vs of the early phase, >= 1 (the paper's David: 500).
+  double early_c_ec = 8;  // C_ec of the early phase, > 0 (the paper's David: 8).
   // Where Step 2 splits (vertex_split.h, LargestCellNear). The paper splits the vertex with the
   // highest signal counter and relies on high-valence vertices having larger restricted Voronoi
   // cells (Section 3.1). With alpha_sc = 0.95 the counter remembers about 20 Basic Steps, so at
@@ -127,6 +137,10 @@ struct LearnerOptions {
   // Returns INVALID_ARGUMENT naming the first parameter out of its range.
   absl::Status Validate() const;
 };
+
+// The most Basic Steps between two of Step 2's splits in any phase of learning: c_vs, or
+// early_c_vs when there is an early phase and it is larger (GrowthWatch's unit of patience).
+int LongestSplitInterval(const LearnerOptions& options);
 
 }  // namespace neuralmesh
 

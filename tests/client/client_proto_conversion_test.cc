@@ -13,6 +13,9 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   options.c_l = 3;
   options.c_vs = 50;
   options.c_ec = 7.5;
+  options.early_phase_vertices = 10000;
+  options.early_c_vs = 400;
+  options.early_c_ec = 6.5;
   options.alpha_sc = 0.9;
   options.remove_triangles = false;
   options.alpha_r = 6;
@@ -34,6 +37,11 @@ TEST(ClientProtoConversionTest, SetsEveryLearnerField) {
   EXPECT_EQ(proto.c_l().value(), 3);
   EXPECT_EQ(proto.c_vs().value(), 50);
   EXPECT_EQ(proto.c_ec().value(), 7.5);
+  EXPECT_EQ(proto.early_phase_vertices().value(), 10000u);
+  EXPECT_EQ(proto.early_c_vs().value(), 400);
+  EXPECT_EQ(proto.early_c_ec().value(), 6.5);
+  ASSERT_TRUE(ToProto(LearnerOptions{}).has_early_phase_vertices())
+      << "0 (no early phase) must be sent, not left unset";
   EXPECT_EQ(proto.alpha_sc().value(), 0.9);
   ASSERT_TRUE(proto.has_remove_triangles()) << "false must be sent, not left unset";
   EXPECT_FALSE(proto.remove_triangles().value());

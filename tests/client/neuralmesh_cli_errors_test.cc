@@ -83,6 +83,10 @@ TEST_F(CliErrorsTest, LearnerParameterOutOfRange) {
       {"reconstruct", "builtin:sphere", "-o", Output(), "--vertices", "100", "--alpha_w", "2"});
   EXPECT_TRUE(absl::StrContains(err, "alpha_w")) << err;
   EXPECT_FALSE(std::filesystem::exists(Output())) << "nothing may be written";
+  const std::string early =
+      ExpectFailure({"reconstruct", "builtin:sphere", "-o", Output(), "--vertices", "100",
+                     "--early_phase_vertices", "1000", "--early_c_ec", "0"});
+  EXPECT_TRUE(absl::StrContains(early, "early_c_ec")) << early;
 }
 
 TEST_F(CliErrorsTest, NonNumericFlagValue) {

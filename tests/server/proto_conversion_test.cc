@@ -125,6 +125,9 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_FALSE(config->outlier_removal.has_value()) << "unset: every point is accepted";
   EXPECT_FALSE(SessionConfigToProto(*config).has_outlier_removal());
   EXPECT_EQ(config->colors.neighbours, PointColorOptions().neighbours);
+  EXPECT_EQ(config->learner.early_phase_vertices, 0u) << "no early phase by default";
+  EXPECT_EQ(config->learner.early_c_vs, 500) << "the paper's David setting";
+  EXPECT_EQ(config->learner.early_c_ec, 8);
 
   proto.mutable_learner()->mutable_alpha_l()->set_value(0);  // A valid zero, not "unset".
   proto.mutable_learner()->mutable_remove_triangles()->set_value(false);
@@ -133,6 +136,9 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   proto.mutable_learner()->mutable_min_merged_loop_vertices()->set_value(3);
   proto.mutable_learner()->mutable_cut_inactive_faces()->set_value(false);
   proto.mutable_learner()->set_initial_mesh(v1::INITIAL_MESH_DISC);
+  proto.mutable_learner()->mutable_early_phase_vertices()->set_value(10000);
+  proto.mutable_learner()->mutable_early_c_vs()->set_value(400);
+  proto.mutable_learner()->mutable_early_c_ec()->set_value(6.5);
   proto.mutable_refresh_interval_ms()->set_value(0);
   proto.mutable_draco()->mutable_position_quantization_bits()->set_value(14);
   proto.mutable_outlier_removal()->mutable_std_ratio()->set_value(2.5);
@@ -148,6 +154,9 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(config->learner.min_merged_loop_vertices, 3);
   EXPECT_FALSE(config->learner.cut_inactive_faces);
   EXPECT_EQ(config->learner.initial_mesh, InitialMesh::kDisc);
+  EXPECT_EQ(config->learner.early_phase_vertices, 10000u);
+  EXPECT_EQ(config->learner.early_c_vs, 400);
+  EXPECT_EQ(config->learner.early_c_ec, 6.5);
   EXPECT_EQ(config->refresh_interval, absl::ZeroDuration()) << "0 turns refreshes off";
   EXPECT_EQ(config->draco.position_quantization_bits, 14);
   ASSERT_TRUE(config->outlier_removal.has_value()) << "an empty message turns it on";
@@ -167,6 +176,9 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(again->learner.min_merged_loop_vertices, 3);
   EXPECT_FALSE(again->learner.cut_inactive_faces);
   EXPECT_EQ(again->learner.initial_mesh, InitialMesh::kDisc);
+  EXPECT_EQ(again->learner.early_phase_vertices, 10000u);
+  EXPECT_EQ(again->learner.early_c_vs, 400);
+  EXPECT_EQ(again->learner.early_c_ec, 6.5);
   EXPECT_EQ(again->draco.position_quantization_bits, 14);
   EXPECT_TRUE(echo.outlier_removal().has_neighbours());
   ASSERT_TRUE(again->outlier_removal.has_value());

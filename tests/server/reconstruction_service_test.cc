@@ -117,6 +117,11 @@ TEST_F(ReconstructionServiceTest, InvalidOptionsAreInvalidArgumentNamingTheField
   }
   {
     v1::CreateSessionRequest r = CreateRequest(100);
+    r.mutable_config()->mutable_learner()->mutable_early_c_vs()->set_value(0);
+    cases.push_back({"early_c_vs = 0", r, "early_c_vs"});
+  }
+  {
+    v1::CreateSessionRequest r = CreateRequest(100);
     r.mutable_config()->add_lod_milestones(50);
     r.mutable_config()->add_lod_milestones(20);
     cases.push_back({"milestones decreasing", r, "lod_milestones"});

@@ -15,6 +15,7 @@
 #include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
 #include "core/io/point_cloud_merge.h"
+#include "core/sampling/las_file_sampler.h"
 #include "core/sampling/mesh_sampler.h"
 #include "core/sampling/point_cloud_sampler.h"
 #include "core/sampling/sample_points.h"
@@ -154,6 +155,45 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::vector<std::string>& inpu
   target.sampler = *std::move(sampler);
   target.description = absl::StrCat(points, " points of ", names, " (", ModeName(mode), " sampling",
                                     removed_outliers, with_colors, notes, ")");
+  return target;
+}
+
+absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string>& inputs,
+                                                   SamplingMode mode, bool remove_outliers,
+                                                   const PointSelection& selection) {
+  if (inputs.size() != 1) {
+    return absl::InvalidArgumentError(
+        "--off_core samples one LAS file where it lies; several INPUTs are read whole and "
+        "learned as one without it");
+  }
+  const std::string& input = inputs.front();
+  if (IsBuiltin(input) ||
+      !(absl::EndsWithIgnoreCase(input, ".las") || absl::EndsWithIgnoreCase(input, ".laz"))) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--off_core samples LAS files (.las) where they lie; INPUT '", input,
+                     "' is read whole without it"));
+  }
+  if (mode != SamplingMode::kUniform) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--off_core samples uniformly, not by --sampling ", ModeName(mode)));
+  }
+  if (remove_outliers) {
+    return absl::InvalidArgumentError(
+        "--remove_outliers judges every point against its neighbours, so it reads the file "
+        "whole: not with --off_core");
+  }
+  NM_RETURN_IF_ERROR(CheckInputFile(input, "INPUT"));
+  absl::StatusOr<std::unique_ptr<LasFileSampler>> sampler =
+      LasFileSampler::Open(input, selection.las_classes);
+  if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
+  TargetSpace target;
+  target.origin = (*sampler)->origin();
+  target.description = absl::StrFormat(
+      "the %d records of %s, sampled where they lie (off-core; %.1f%% of them points to read%s%s)",
+      (*sampler)->records(), input, 100 * (*sampler)->kept_share(),
+      (*sampler)->has_colors() ? "; colours are not painted off-core" : "",
+      OriginNote(target.origin));
+  target.sampler = *std::move(sampler);
   return target;
 }
 

@@ -61,6 +61,16 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(
     const std::optional<PointColorOptions>& colors = std::nullopt,
     const PointSelection& selection = {});
 
+// The target space of `inputs` sampled off-core (--off_core, LasFileSampler): the records of
+// one uncompressed LAS file read where they lie, `selection`'s classes. Returns
+// INVALID_ARGUMENT, saying why, for other inputs (several, builtin:NAME, another format), a
+// sampling mode other than uniform, or outlier removal (which needs every point in memory);
+// LasFileSampler's errors. Colours are not painted off-core: the description says so when the
+// file carries them.
+absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string>& inputs,
+                                                   SamplingMode mode, bool remove_outliers,
+                                                   const PointSelection& selection = {});
+
 // The most points LoadPointsForUpload samples from a builtin surface: the server's default
 // limit of points per session (neuralmesh-server --max_points_per_session), 1.6 GB here.
 inline constexpr size_t kMaxBuiltinUploadPoints = size_t{1} << 26;

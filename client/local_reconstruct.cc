@@ -78,8 +78,11 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
                       LodTargets(options.lods, options.vertices,
                                  start_mesh.has_value() ? start_mesh->positions.size() : 0));
   NM_ASSIGN_OR_RETURN(const TargetSpace target,
-                      LoadTargetSpace(options.inputs, options.sampling, options.outliers,
-                                      options.colors, options.selection));
+                      options.off_core
+                          ? LoadOffCoreTargetSpace(options.inputs, options.sampling,
+                                                   options.outliers.has_value(), options.selection)
+                          : LoadTargetSpace(options.inputs, options.sampling, options.outliers,
+                                            options.colors, options.selection));
   if (start_mesh.has_value()) {
     NM_RETURN_IF_ERROR(MoveStartMesh(target.origin, options.start_mesh, &*start_mesh));
   }

@@ -129,6 +129,13 @@ ABSL_FLAG(std::string, start_mesh, "",
           "area. --initial_mesh disc still keeps its longest border open. With --server the "
           "mesh is sent exactly (CreateSessionRequest.start_mesh); not with --resume.");
 
+ABSL_FLAG(bool, off_core, false,
+          "Sample the one uncompressed LAS file INPUT where it lies, mapped into memory, instead "
+          "of reading it: learning starts at once whatever the file's size, and memory holds "
+          "the mesh, not the points (the paper's off-core learning of 28 million points, "
+          "Section 4.1). Uniform sampling; no --remove_outliers; colours are not painted. Local "
+          "only.");
+
 ABSL_FLAG(std::string, pcd_data, "binary",
           "How convert stores the points of a .pcd OUTPUT (its DATA line): binary (point "
           "records), binary_compressed (field by field, LZF-compressed, as PCL keeps maps) or "
@@ -480,6 +487,9 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     NM_RETURN_IF_ERROR(RejectFlags(
         args, {"output", "sampling", "time_budget", "max_steps", "gltf_draco"},
         "applies to a local reconstruct only (the server picks its own budget; use --out-dir)"));
+    NM_RETURN_IF_ERROR(RejectFlags(
+        args, {"off_core"},
+        "samples a local file where it lies; a server learns the points uploaded to it"));
     neuralmesh::client::RemoteReconstructOptions o;
     o.inputs = args.positional;
     o.server = absl::GetFlag(FLAGS_server);
@@ -526,6 +536,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
   NM_ASSIGN_OR_RETURN(o.sampling,
                       neuralmesh::client::ParseSamplingMode(absl::GetFlag(FLAGS_sampling)));
   o.start_mesh = absl::GetFlag(FLAGS_start_mesh);
+  o.off_core = absl::GetFlag(FLAGS_off_core);
   NM_ASSIGN_OR_RETURN(o.colors, ColorsFromFlags());
   o.time_budget = absl::GetFlag(FLAGS_time_budget);
   o.max_steps = absl::GetFlag(FLAGS_max_steps);
@@ -688,7 +699,7 @@ std::vector<Subcommand> Commands() {
       "remove_triangles", "merge_boundaries", "splits_per_step", "close_small_holes",
       "max_closed_hole_vertices", "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
       "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
-      "start_mesh", "las_classes", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
+      "start_mesh", "off_core", "las_classes", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
       "outlier_passes", "outliers_on_server", "colors", "color_neighbours", "sampling",
       "time_budget", "max_steps", "quantization_bits", "encode_speed", "gltf_draco", "progress",
       "server", "out-dir", "batch-size", "points", "ply", "glb", "resume", "reconnect_for"};

@@ -627,7 +627,12 @@ TEST_F(LocalCliTest, ConvertWritesPointCloudsWithWhatEachFormatHolds) {
 // (500123.5, 4100456.25, 80). The mesh is learned relative to the origin the reader chose,
 // written in the scan's coordinates (PLY doubles) and lies on the sphere; both commands say
 // where that origin is. STL, which holds only floats, stays relative to it, and says so.
-TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
+// The centre of the sphere of GeoreferencedSphereLas.
+constexpr double kSphereScanCentre[3] = {500123.5, 4100456.25, 80};
+
+// A LAS 1.4 file of format 7 at `path`: 20,000 coloured points of a sphere of radius 10 m
+// centred at kSphereScanCentre, in UTM millimetres.
+void WriteGeoreferencedSphereLas(const std::string& path) {
   const PointCloud unit = ColoredUnitSpherePoints(20000, 5);
   testing::LasLayout layout;
   layout.version_minor = 4;
@@ -635,22 +640,26 @@ TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
   for (double& s : layout.scale) s = 0.001;
   layout.offset[0] = 500000;
   layout.offset[1] = 4100000;
-  const double centre[3] = {500123.5, 4100456.25, 80};
   std::vector<testing::LasPoint> points;
   for (size_t i = 0; i < unit.size(); ++i) {
     testing::LasPoint p{};
     int32_t* fields[3] = {&p.x, &p.y, &p.z};
     for (int c = 0; c < 3; ++c) {
-      *fields[c] = static_cast<int32_t>(
-          std::lround((centre[c] + 10.0 * unit.positions[i][c] - layout.offset[c]) / 0.001));
+      *fields[c] = static_cast<int32_t>(std::lround(
+          (kSphereScanCentre[c] + 10.0 * unit.positions[i][c] - layout.offset[c]) / 0.001));
     }
     p.red = unit.colors[i][0] * 257;
     p.green = unit.colors[i][1] * 257;
     p.blue = unit.colors[i][2] * 257;
     points.push_back(p);
   }
+  std::ofstream(path, std::ios::binary) << testing::LasFile(layout, points);
+}
+
+TEST_F(LocalCliTest, GeoreferencedLasScansAreReconstructedRelativeToAnOrigin) {
+  const double* centre = kSphereScanCentre;
   const std::string las = *dir_ + "/scan.las";
-  std::ofstream(las, std::ios::binary) << testing::LasFile(layout, points);
+  WriteGeoreferencedSphereLas(las);
 
   const std::string mesh = *dir_ + "/scan.ply";
   const RunResult run = RunNeuralmesh({"reconstruct", las, "-o", mesh, "--vertices", "1000"});
@@ -939,6 +948,71 @@ std::vector<testing::LasPoint> UnitSphereLasPoints(int count, uint64_t seed,
                       static_cast<int32_t>(std::lround(p[2] / layout.scale[2]))});
   }
   return points;
+}
+
+// --off_core: the scan sampled where it lies instead of read. The mesh lies on the sphere in
+// the scan's coordinates, a seed gives the same file again, and what cannot be sampled so is
+// refused, saying why.
+TEST_F(LocalCliTest, OffCoreLearnsALasScanWhereItLies) {
+  const std::string las = *dir_ + "/scan.las";
+  WriteGeoreferencedSphereLas(las);
+  const std::string mesh = *dir_ + "/off_core.ply";
+  const std::vector<std::string> learn = {"reconstruct", las,    "-o",        mesh,
+                                          "--vertices",  "1000", "--off_core"};
+  const RunResult run = RunNeuralmesh(learn);
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_TRUE(absl::StrContains(
+      run.out, absl::StrCat("learning the 20000 records of ", las,
+                            ", sampled where they lie (off-core; 100.0% of them points to read; "
+                            "colours are not painted off-core; coordinates taken relative to "
+                            "(500000, 4100000, 0), and put back in the files written)")))
+      << run.out;
+  const absl::StatusOr<TriangleMesh> learned = ReadMesh(mesh);
+  ASSERT_TRUE(learned.ok()) << learned.status();
+  EXPECT_EQ(learned->origin, (std::array<double, 3>{500000, 4100000, 0}));
+  EXPECT_TRUE(learned->colors.empty());
+  EXPECT_EQ(learned->positions.size(), 1000u);
+  for (const Vec3f& v : learned->positions) {
+    double squared = 0;
+    for (int c = 0; c < 3; ++c) {
+      squared += std::pow(learned->origin[c] + v[c] - kSphereScanCentre[c], 2);
+    }
+    ASSERT_NEAR(std::sqrt(squared), 10.0, 0.25) << "a vertex off the sphere";
+  }
+  const RunResult stats = RunNeuralmesh({"stats", mesh, "--json"});
+  EXPECT_EQ(JsonValue(stats.out, "genus"), "0") << stats.out;
+  EXPECT_EQ(JsonValue(stats.out, "boundary_loops"), "0") << stats.out;
+  std::vector<std::string> again = learn;
+  again[3] = *dir_ + "/off_core_again.ply";
+  ASSERT_EQ(RunNeuralmesh(again).exit_code, 0);
+  EXPECT_EQ(ReadWholeFile(mesh), ReadWholeFile(again[3])) << "the same seed, the same mesh";
+
+  const std::string laz = *dir_ + "/scan.laz";
+  const std::string xyz = *dir_ + "/scan.xyz";
+  ASSERT_EQ(RunNeuralmesh({"convert", las, "-o", laz}).exit_code, 0);
+  ASSERT_EQ(RunNeuralmesh({"convert", las, "-o", xyz}).exit_code, 0);
+  const std::string out = *dir_ + "/refused.ply";
+  const std::vector<std::pair<std::vector<std::string>, std::string>> refused = {
+      {{las, las}, "several INPUTs are read whole"},
+      {{xyz}, "INPUT '" + xyz + "' is read whole without it"},
+      {{laz}, "cannot be read one at a time"},
+      {{las, "--remove_outliers"}, "not with --off_core"},
+      {{las, "--sampling", "weighted"}, "samples uniformly, not by --sampling weighted"},
+  };
+  for (const auto& [args, why] : refused) {
+    std::vector<std::string> command = {"reconstruct", "-o",  out,
+                                        "--vertices",  "100", "--off_core"};
+    command.insert(command.begin() + 1, args.begin(), args.end());
+    const RunResult result = RunNeuralmesh(command);
+    EXPECT_NE(result.exit_code, 0) << result.Describe();
+    EXPECT_TRUE(absl::StrContains(result.err, why)) << result.Describe();
+  }
+  EXPECT_FALSE(std::filesystem::exists(out)) << "nothing may be written";
+  const RunResult remote = RunNeuralmesh(
+      {"reconstruct", las, "--server", "127.0.0.1:1", "--out-dir", *dir_, "--off_core"});
+  EXPECT_NE(remote.exit_code, 0) << remote.Describe();
+  EXPECT_TRUE(absl::StrContains(remote.err, "--off_core samples a local file where it lies"))
+      << remote.Describe();
 }
 
 TEST_F(LocalCliTest, ClassifiedNoiseInLasScansIsLeftOutAndCounted) {
@@ -1302,6 +1376,7 @@ TEST(LocalCliHelpTest, HelpDocumentsEveryReconstructFlag) {
                            "--sampling",
                            "--initial_mesh",
                            "--start_mesh",
+                           "--off_core",
                            "--remove_outliers",
                            "--outlier_neighbours",
                            "--outlier_std_ratio",

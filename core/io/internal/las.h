@@ -10,6 +10,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/position_collector.h"
 #include "core/io/las_cleaning.h"
 #include "core/io/las_description.h"
 #include "core/io/point_selection.h"
@@ -32,6 +33,44 @@ namespace neuralmesh::io_internal {
 // file, or points that are all left out.
 absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
                                         const std::optional<LasClasses>& classes = std::nullopt);
+
+// The point records of an uncompressed LAS file, read one at a time where they lie: for
+// sampling a file without reading it whole (core/sampling/las_file_sampler.h). Holds a view
+// of the file's bytes, which must outlive it.
+class LasRecords {
+ public:
+  // ParseLas's checks of the header, and its errors for a malformed one (a LAZ file's records
+  // are compressed: INVALID_ARGUMENT). `classes` as ParseLas's.
+  static absl::StatusOr<LasRecords> Create(absl::string_view data,
+                                           const std::optional<LasClasses>& classes);
+
+  uint64_t size() const { return count_; }
+  // Whether ParseLas reads record i (< size()): not withheld, and of a class in `classes`, or
+  // without them of no noise class.
+  bool Kept(uint64_t i) const;
+  // Record i's coordinates in the file's frame: its integers times the scale, plus the offset.
+  Point3d Position(uint64_t i) const;
+  // Where record i's bytes are (to start loading them).
+  const char* Address(uint64_t i) const { return data_.data() + first_ + i * length_; }
+  // Whether the records' point format carries colours.
+  bool has_colors() const;
+  // Each axis's scale, made positive: the coordinates' resolution.
+  Point3d Resolution() const;
+  // The smallest and largest coordinates the header states, which a writer may leave stale.
+  Point3d header_low() const { return header_low_; }
+  Point3d header_high() const { return header_high_; }
+
+ private:
+  LasRecords() = default;
+
+  absl::string_view data_;
+  std::optional<LasClasses> classes_;
+  uint64_t count_ = 0;
+  size_t first_ = 0;
+  size_t length_ = 0;
+  int format_ = 0;
+  Point3d scale_, offset_, header_low_, header_high_;
+};
 
 // The number of point records of an uncompressed LAS file, after ParseLas's checks of its
 // header (and its errors but the last).

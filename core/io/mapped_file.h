@@ -1,0 +1,40 @@
+// A file mapped into memory read-only: its bytes are read from the page cache (or the disk)
+// when touched, not copied, so a file larger than memory can be read where it lies (off-core
+// sampling: core/sampling/las_file_sampler.h).
+#ifndef NEURALMESH_CORE_IO_MAPPED_FILE_H_
+#define NEURALMESH_CORE_IO_MAPPED_FILE_H_
+
+#include <cstddef>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+
+namespace neuralmesh {
+
+class MappedFile {
+ public:
+  // Maps the whole file at `path`, advised for random access. Returns NOT_FOUND ("cannot open
+  // 'path': reason") when it cannot be opened, mapped or is not a regular file, and
+  // INVALID_ARGUMENT when it is empty (ReadFileContents's messages).
+  static absl::StatusOr<MappedFile> Open(const std::string& path);
+
+  MappedFile(MappedFile&& other) noexcept;
+  MappedFile& operator=(MappedFile&& other) noexcept;
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  ~MappedFile();
+
+  // The file's bytes, valid while this object lives.
+  absl::string_view data() const { return absl::string_view(data_, size_); }
+
+ private:
+  MappedFile(const char* data, size_t size) : data_(data), size_(size) {}
+
+  const char* data_ = nullptr;
+  size_t size_ = 0;
+};
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_IO_MAPPED_FILE_H_

@@ -1,0 +1,202 @@
+#include "core/sampling/las_file_sampler.h"
+
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "core/io/internal/las.h"
+#include "core/io/internal/las_layout.h"
+#include "core/io/internal/laz.h"
+#include "core/random.h"
+#include "gtest/gtest.h"
+#include "tests/testing/las_file.h"
+#include "tests/testing/temp_dir.h"
+
+namespace neuralmesh {
+namespace {
+
+// A scan line in UTM millimetres: record i at x = 500000 + i / 100 (so a sample names its
+// record), y = 4100000 + (i % 7), z = 80; every 10th record withheld, every 7th (not withheld)
+// classified as low noise (7), every 5th else as building (6), the rest ground (2).
+testing::LasLayout Layout() {
+  testing::LasLayout layout;
+  layout.version_minor = 4;
+  layout.format = 6;
+  for (double& s : layout.scale) s = 0.001;
+  layout.offset[0] = 500000;
+  layout.offset[1] = 4100000;
+  return layout;
+}
+
+std::vector<testing::LasPoint> ScanLine(int n) {
+  std::vector<testing::LasPoint> points;
+  for (int i = 0; i < n; ++i) {
+    testing::LasPoint p{};
+    p.x = 10 * i;
+    p.y = 1000 * (i % 7);
+    p.z = 80000;
+    p.withheld = i % 10 == 0;
+    p.classification = i % 7 == 0 ? 7 : i % 5 == 0 ? 6 : 2;
+    points.push_back(p);
+  }
+  return points;
+}
+
+std::string Write(const std::string& name, const std::string& bytes) {
+  const std::string path = testing::ProcessTempDir() + "/" + name;
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
+}
+
+std::unique_ptr<LasFileSampler> Open(const std::string& path,
+                                     const std::optional<LasClasses>& classes = std::nullopt) {
+  absl::StatusOr<std::unique_ptr<LasFileSampler>> sampler = LasFileSampler::Open(path, classes);
+  EXPECT_TRUE(sampler.ok()) << sampler.status();
+  return sampler.ok() ? *std::move(sampler) : nullptr;
+}
+
+// The record a sample of ScanLine came from, relative to `origin`.
+int RecordOf(const Vec3& sample, const Origin& origin) {
+  return static_cast<int>(std::lround((sample[0] + origin[0] - 500000) * 100));
+}
+
+TEST(LasFileSamplerTest, DrawsEveryKeptRecordAlikeAndNoOther) {
+  const std::vector<testing::LasPoint> points = ScanLine(300);
+  const std::string path = Write("line.las", testing::LasFile(Layout(), points));
+  for (bool buildings_only : {false, true}) {
+    std::optional<LasClasses> classes;
+    if (buildings_only) {
+      classes.emplace();
+      (*classes)[6] = true;
+    }
+    auto sampler = Open(path, classes);
+    ASSERT_NE(sampler, nullptr);
+    EXPECT_EQ(sampler->records(), 300u);
+    const auto kept = [&](int i) {
+      const testing::LasPoint& p = points[i];
+      return !p.withheld && (buildings_only ? p.classification == 6 : p.classification != 7);
+    };
+    int kept_count = 0;
+    for (int i = 0; i < 300; ++i) kept_count += kept(i);
+    EXPECT_NEAR(sampler->kept_share(), kept_count / 300.0, 0.03);
+
+    const int draws = 200000;
+    Random rng(3);
+    std::map<int, int> counts;
+    for (int d = 0; d < draws; ++d) ++counts[RecordOf(sampler->Sample(rng), sampler->origin())];
+    EXPECT_EQ(counts.size(), static_cast<size_t>(kept_count)) << "no sample off the records";
+    const double expected = static_cast<double>(draws) / kept_count;
+    for (int i = 0; i < 300; ++i) {
+      if (kept(i)) {
+        EXPECT_NEAR(counts[i], expected, 0.2 * expected) << "record " << i;
+      } else {
+        EXPECT_EQ(counts[i], 0) << "record " << i << " is left out when the file is read";
+      }
+    }
+  }
+}
+
+TEST(LasFileSamplerTest, SamplesAreTheRecordsAsReadingTheFileGivesThem) {
+  const std::string bytes = testing::LasFile(Layout(), ScanLine(5000));
+  const std::string path = Write("georeferenced.las", bytes);
+  auto sampler = Open(path);
+  ASSERT_NE(sampler, nullptr);
+  absl::StatusOr<io_internal::ParsedGeometry> parsed = io_internal::ParseLas(bytes);
+  ASSERT_TRUE(parsed.ok()) << parsed.status();
+  EXPECT_EQ(sampler->origin(), parsed->origin) << "the same origin as the file read whole";
+  EXPECT_NE(sampler->origin(), kNoOrigin) << "UTM coordinates need one";
+  // The header's bounds: every record's, the ones left out too (record 0 is withheld).
+  BoundingBox read;
+  for (const Vec3f& p : parsed->positions) read.Extend(Vec3(p));
+  const Vec3 all_min = Vec3(500000, 4100000, 80) - Vec3(sampler->origin().data());
+  const Vec3 all_max = Vec3(500049.99, 4100006, 80) - Vec3(sampler->origin().data());
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_LE(sampler->Bounds().min[c], read.min[c] + 1e-5) << "axis " << c;  // Floats.
+    EXPECT_GE(sampler->Bounds().max[c], read.max[c] - 1e-5) << "axis " << c;
+    EXPECT_NEAR(sampler->Bounds().min[c], all_min[c], 1e-6) << "axis " << c;
+    EXPECT_NEAR(sampler->Bounds().max[c], all_max[c], 1e-6) << "axis " << c;
+  }
+  // Each sample is a record's coordinates, exactly: integers times the scale plus the offset.
+  Random rng(5);
+  for (int d = 0; d < 1000; ++d) {
+    const Vec3 s = sampler->Sample(rng);
+    const int i = RecordOf(s, sampler->origin());
+    ASSERT_GE(i, 0);
+    ASSERT_LT(i, 5000);
+    EXPECT_EQ(s[0] + sampler->origin()[0], 10 * i * 0.001 + 500000);
+    EXPECT_EQ(s[1] + sampler->origin()[1], 1000 * (i % 7) * 0.001 + 4100000);
+    EXPECT_EQ(s[2] + sampler->origin()[2], 80000 * 0.001);
+  }
+}
+
+TEST(LasFileSamplerTest, ASeedGivesTheSameSamplesAndPrefetchingChangesNothing) {
+  const std::string path = Write("seeded.las", testing::LasFile(Layout(), ScanLine(1000)));
+  auto sampler = Open(path);
+  ASSERT_NE(sampler, nullptr);
+  Random a(9), b(9);
+  for (int d = 0; d < 500; ++d) {
+    sampler->PrefetchSample(a);
+    const Vec3 first = sampler->Sample(a);
+    EXPECT_EQ(first, sampler->Sample(b)) << "draw " << d;
+  }
+}
+
+TEST(LasFileSamplerTest, StaleHeaderBoundsAreNotTrusted) {
+  std::string bytes = testing::LasFile(Layout(), ScanLine(5000));
+  absl::StatusOr<io_internal::ParsedGeometry> parsed = io_internal::ParseLas(bytes);
+  ASSERT_TRUE(parsed.ok()) << parsed.status();
+  const double data_diagonal = 5000 * 0.01;  // Nearly all of it along x.
+  // Bounds left zero, as some writers leave them; then bounds a thousand times too large.
+  for (double stated : {0.0, 1e9}) {
+    for (int k = 0; k < 6; ++k) {
+      io_internal::StoreLittleEndian(k % 2 == 0 ? stated : -stated,
+                                     io_internal::las_layout::kBounds + 8 * k, &bytes);
+    }
+    auto sampler = Open(Write("stale.las", bytes));
+    ASSERT_NE(sampler, nullptr);
+    EXPECT_EQ(sampler->origin(), parsed->origin) << "header bounds " << stated;
+    EXPECT_LT(sampler->Bounds().diagonal(), 1.01 * data_diagonal) << "header bounds " << stated;
+    EXPECT_GT(sampler->Bounds().diagonal(), 0.9 * data_diagonal) << "header bounds " << stated;
+  }
+}
+
+TEST(LasFileSamplerTest, RefusesWhatCannotBeSampledWhereItLies) {
+  const auto expect_refused = [](const std::string& path, absl::StatusCode code,
+                                 const std::string& words) {
+    absl::StatusOr<std::unique_ptr<LasFileSampler>> sampler = LasFileSampler::Open(path);
+    ASSERT_FALSE(sampler.ok()) << path;
+    EXPECT_EQ(sampler.status().code(), code) << sampler.status();
+    EXPECT_TRUE(absl::StrContains(sampler.status().message(), words)) << sampler.status();
+  };
+  expect_refused(testing::ProcessTempDir() + "/missing.las", absl::StatusCode::kNotFound,
+                 "cannot open");
+  expect_refused(Write("empty.las", ""), absl::StatusCode::kInvalidArgument, "is empty");
+  expect_refused(Write("text.las", "x y z\n1 2 3\n"), absl::StatusCode::kInvalidArgument,
+                 "no LASF signature");
+  const std::string las = testing::LasFile(Layout(), ScanLine(1000));
+  absl::StatusOr<std::string> laz = io_internal::CompressLas(las);
+  ASSERT_TRUE(laz.ok()) << laz.status();
+  expect_refused(Write("line.laz", *laz), absl::StatusCode::kInvalidArgument,
+                 "cannot be read one at a time");
+  expect_refused(Write("none.las", testing::LasFile(Layout(), {})),
+                 absl::StatusCode::kInvalidArgument, "no point records");
+  // Every record withheld, then one in 400 kept: each sample would read hundreds of records.
+  std::vector<testing::LasPoint> points = ScanLine(4000);
+  for (testing::LasPoint& p : points) p.withheld = true;
+  expect_refused(Write("withheld.las", testing::LasFile(Layout(), points)),
+                 absl::StatusCode::kInvalidArgument, "0 of 4096 records drawn");
+  for (size_t i = 0; i < points.size(); i += 400) points[i].withheld = false;
+  expect_refused(Write("sparse.las", testing::LasFile(Layout(), points)),
+                 absl::StatusCode::kInvalidArgument, "read it whole");
+  for (size_t i = 0; i < points.size(); i += 20) points[i].withheld = false;  // One in 20.
+  for (testing::LasPoint& p : points) p.classification = 2;
+  EXPECT_TRUE(LasFileSampler::Open(Write("enough.las", testing::LasFile(Layout(), points))).ok())
+      << "5% kept: about 20 records a sample";
+}
+
+}  // namespace
+}  // namespace neuralmesh

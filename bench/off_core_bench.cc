@@ -1,6 +1,7 @@
-// Off-core sampling (core/sampling/las_file_sampler.h, `neuralmesh reconstruct --off_core`)
-// against reading the file whole: a LAS file of --points points of a torus (radius 10 m and
-// 4 m, in UTM millimetres) is written, then learned to --vertices vertices both ways, with the
+// Off-core sampling (core/sampling/off_core_sampler.h, `neuralmesh reconstruct --off_core`)
+// against reading the file whole: a LAS file (or with --format=ply a binary PLY file of
+// doubles) of --points points of a torus (radius 10 m and 4 m, in UTM coordinates) is written,
+// then learned to --vertices vertices both ways, with the
 // paper's parameters on one thread. Prints for each way the time until learning starts (the
 // file opened, or read and its sampler built), until the first coarse mesh (1,000 vertices)
 // and until the last, and the memory the process holds then: anonymous (its own allocations:
@@ -8,9 +9,11 @@
 // The file is in the page cache when both start (it has just been written): off-core reading
 // from a disk costs a read per sample that misses the cache, which this does not measure.
 //
-//   build/bin/off-core-bench [--points=20000000] [--vertices=20000] [--file=PATH] [--keep]
+//   build/bin/off-core-bench [--points=20000000] [--vertices=20000] [--format=las|ply]
+//                            [--file=PATH] [--keep]
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -21,12 +24,13 @@
 #include "core/learning/learner.h"
 #include "core/random.h"
 #include "core/sampling/implicit_surfaces.h"
-#include "core/sampling/las_file_sampler.h"
+#include "core/sampling/off_core_sampler.h"
 #include "core/sampling/point_cloud_sampler.h"
 
 ABSL_FLAG(size_t, points, 20000000, "Points of the LAS file.");
 ABSL_FLAG(size_t, vertices, 20000, "Vertices to learn each way.");
-ABSL_FLAG(std::string, file, "/tmp/off-core-bench.las", "Where the LAS file is written.");
+ABSL_FLAG(std::string, format, "las", "The file's format: las or ply.");
+ABSL_FLAG(std::string, file, "", "Where the file is written; /tmp/off-core-bench.FORMAT if empty.");
 ABSL_FLAG(bool, keep, false, "Keep the LAS file afterwards.");
 
 namespace neuralmesh {
@@ -76,9 +80,12 @@ bool LearnAndPrint(const char* way, const Sampler& target, double opened, size_t
 int Run() {
   const size_t n = absl::GetFlag(FLAGS_points);
   const size_t vertices = absl::GetFlag(FLAGS_vertices);
-  const std::string path = absl::GetFlag(FLAGS_file);
-  if (n < 1000 || vertices <= 1000) {
-    std::fprintf(stderr, "--points must be at least 1000 and --vertices above 1000\n");
+  const std::string format = absl::GetFlag(FLAGS_format);
+  const std::string path = absl::GetFlag(FLAGS_file).empty() ? "/tmp/off-core-bench." + format
+                                                             : absl::GetFlag(FLAGS_file);
+  if (n < 1000 || vertices <= 1000 || (format != "las" && format != "ply")) {
+    std::fprintf(stderr,
+                 "--points must be at least 1000, --vertices above 1000, --format las or ply\n");
     return 1;
   }
   {
@@ -100,14 +107,15 @@ int Run() {
   std::printf(
       "%zu points of a torus in %s (%.0f MB), learned to %zu vertices; memory held "
       "at the end, RssAnon %.0f MB before either\n\n",
-      n, path.c_str(), n * 20.0 / 1e6, vertices, StatusMegabytes("RssAnon"));
+      n, path.c_str(), static_cast<double>(std::filesystem::file_size(path)) / 1e6, vertices,
+      StatusMegabytes("RssAnon"));
   std::printf("%-12s %10s %12s %12s %14s %14s\n", "way", "ready s", "1K vertices s", "last s",
               "anonymous MB", "file MB");
 
   bool ok = true;
   {
     const Clock::time_point start = Clock::now();
-    absl::StatusOr<std::unique_ptr<LasFileSampler>> sampler = LasFileSampler::Open(path);
+    absl::StatusOr<std::unique_ptr<OffCoreSampler>> sampler = OffCoreSampler::Open(path);
     if (!sampler.ok()) {
       std::fprintf(stderr, "%s\n", sampler.status().ToString().c_str());
       return 1;
@@ -139,7 +147,8 @@ int Run() {
 int main(int argc, char** argv) {
   neuralmesh::ParseBenchFlags(
       argc, argv,
-      "Off-core sampling of a LAS file against reading it whole.\n"
-      "  build/bin/off-core-bench [--points=20000000] [--vertices=20000] [--file=PATH] [--keep]");
+      "Off-core sampling of a LAS or PLY file against reading it whole.\n"
+      "  build/bin/off-core-bench [--points=20000000] [--vertices=20000] [--format=las|ply]\n"
+      "                           [--file=PATH] [--keep]");
   return neuralmesh::Run();
 }

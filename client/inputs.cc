@@ -15,8 +15,8 @@
 #include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
 #include "core/io/point_cloud_merge.h"
-#include "core/sampling/las_file_sampler.h"
 #include "core/sampling/mesh_sampler.h"
+#include "core/sampling/off_core_sampler.h"
 #include "core/sampling/point_cloud_sampler.h"
 #include "core/sampling/sample_points.h"
 #include "core/status_macros.h"
@@ -163,15 +163,17 @@ absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string
                                                    const PointSelection& selection) {
   if (inputs.size() != 1) {
     return absl::InvalidArgumentError(
-        "--off_core samples one LAS file where it lies; several INPUTs are read whole and "
-        "learned as one without it");
+        "--off_core samples one file where it lies; several INPUTs are read whole and learned "
+        "as one without it");
   }
   const std::string& input = inputs.front();
   if (IsBuiltin(input) ||
-      !(absl::EndsWithIgnoreCase(input, ".las") || absl::EndsWithIgnoreCase(input, ".laz"))) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--off_core samples LAS files (.las) where they lie; INPUT '", input,
-                     "' is read whole without it"));
+      !(absl::EndsWithIgnoreCase(input, ".las") || absl::EndsWithIgnoreCase(input, ".laz") ||
+        absl::EndsWithIgnoreCase(input, ".ply"))) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--off_core samples uncompressed LAS (.las) and binary PLY (.ply) files where they lie; "
+        "INPUT '",
+        input, "' is read whole without it"));
   }
   if (mode != SamplingMode::kUniform) {
     return absl::InvalidArgumentError(
@@ -183,8 +185,8 @@ absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string
         "whole: not with --off_core");
   }
   NM_RETURN_IF_ERROR(CheckInputFile(input, "INPUT"));
-  absl::StatusOr<std::unique_ptr<LasFileSampler>> sampler =
-      LasFileSampler::Open(input, selection.las_classes);
+  absl::StatusOr<std::unique_ptr<OffCoreSampler>> sampler =
+      OffCoreSampler::Open(input, selection.las_classes);
   if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
   TargetSpace target;
   target.origin = (*sampler)->origin();

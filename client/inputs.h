@@ -61,11 +61,12 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(
     const std::optional<PointColorOptions>& colors = std::nullopt,
     const PointSelection& selection = {});
 
-// The target space of `inputs` sampled off-core (--off_core, LasFileSampler): the records of
-// one uncompressed LAS file read where they lie, `selection`'s classes. Returns
+// The target space of `inputs` sampled off-core (--off_core, OffCoreSampler): the records of
+// one uncompressed LAS or binary PLY file read where they lie, a LAS file's with `selection`'s
+// classes. Returns
 // INVALID_ARGUMENT, saying why, for other inputs (several, builtin:NAME, another format), a
 // sampling mode other than uniform, or outlier removal (which needs every point in memory);
-// LasFileSampler's errors. Colours are not painted off-core: the description says so when the
+// OffCoreSampler's errors. Colours are not painted off-core: the description says so when the
 // file carries them.
 absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string>& inputs,
                                                    SamplingMode mode, bool remove_outliers,

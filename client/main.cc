@@ -130,11 +130,11 @@ ABSL_FLAG(std::string, start_mesh, "",
           "mesh is sent exactly (CreateSessionRequest.start_mesh); not with --resume.");
 
 ABSL_FLAG(bool, off_core, false,
-          "Sample the one uncompressed LAS file INPUT where it lies, mapped into memory, instead "
-          "of reading it: learning starts at once whatever the file's size, and memory holds "
-          "the mesh, not the points (the paper's off-core learning of 28 million points, "
-          "Section 4.1). Uniform sampling; no --remove_outliers; colours are not painted. Local "
-          "only.");
+          "Sample the one INPUT, an uncompressed LAS or a binary PLY file, where it lies, mapped "
+          "into memory, instead of reading it: learning starts at once whatever the file's "
+          "size, and memory holds the mesh, not the points (the paper's off-core learning of "
+          "28 million points, Section 4.1). Uniform sampling; no --remove_outliers; colours "
+          "are not painted. Local only.");
 
 ABSL_FLAG(std::string, pcd_data, "binary",
           "How convert stores the points of a .pcd OUTPUT (its DATA line): binary (point "

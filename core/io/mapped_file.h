@@ -1,6 +1,6 @@
 // A file mapped into memory read-only: its bytes are read from the page cache (or the disk)
 // when touched, not copied, so a file larger than memory can be read where it lies (off-core
-// sampling: core/sampling/las_file_sampler.h).
+// sampling: core/sampling/off_core_sampler.h).
 #ifndef NEURALMESH_CORE_IO_MAPPED_FILE_H_
 #define NEURALMESH_CORE_IO_MAPPED_FILE_H_
 

@@ -953,7 +953,7 @@ std::vector<testing::LasPoint> UnitSphereLasPoints(int count, uint64_t seed,
 // --off_core: the scan sampled where it lies instead of read. The mesh lies on the sphere in
 // the scan's coordinates, a seed gives the same file again, and what cannot be sampled so is
 // refused, saying why.
-TEST_F(LocalCliTest, OffCoreLearnsALasScanWhereItLies) {
+TEST_F(LocalCliTest, OffCoreLearnsALasOrPlyScanWhereItLies) {
   const std::string las = *dir_ + "/scan.las";
   WriteGeoreferencedSphereLas(las);
   const std::string mesh = *dir_ + "/off_core.ply";
@@ -986,6 +986,27 @@ TEST_F(LocalCliTest, OffCoreLearnsALasScanWhereItLies) {
   again[3] = *dir_ + "/off_core_again.ply";
   ASSERT_EQ(RunNeuralmesh(again).exit_code, 0);
   EXPECT_EQ(ReadWholeFile(mesh), ReadWholeFile(again[3])) << "the same seed, the same mesh";
+
+  // The scan as binary PLY (doubles, as georeferenced points are written): the same sphere.
+  const std::string ply = *dir_ + "/scan.ply";
+  ASSERT_EQ(RunNeuralmesh({"convert", las, "-o", ply}).exit_code, 0);
+  std::vector<std::string> from_ply = learn;
+  from_ply[1] = ply;
+  from_ply[3] = *dir_ + "/off_core_ply.obj";
+  const RunResult ply_run = RunNeuralmesh(from_ply);
+  ASSERT_EQ(ply_run.exit_code, 0) << ply_run.Describe();
+  EXPECT_TRUE(absl::StrContains(ply_run.out, "learning the 20000 records of " + ply))
+      << ply_run.out;
+  const absl::StatusOr<TriangleMesh> from_ply_mesh = ReadMesh(from_ply[3]);
+  ASSERT_TRUE(from_ply_mesh.ok()) << from_ply_mesh.status();
+  EXPECT_EQ(from_ply_mesh->origin, learned->origin);
+  for (const Vec3f& v : from_ply_mesh->positions) {
+    double squared = 0;
+    for (int c = 0; c < 3; ++c) {
+      squared += std::pow(from_ply_mesh->origin[c] + v[c] - kSphereScanCentre[c], 2);
+    }
+    ASSERT_NEAR(std::sqrt(squared), 10.0, 0.25) << "a vertex off the sphere";
+  }
 
   const std::string laz = *dir_ + "/scan.laz";
   const std::string xyz = *dir_ + "/scan.xyz";

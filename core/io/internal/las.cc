@@ -476,21 +476,21 @@ absl::StatusOr<LasDescription> DescribeLas(absl::string_view data) {
   return out;
 }
 
-absl::StatusOr<LasRecords> LasRecords::Create(absl::string_view data,
-                                              const std::optional<LasClasses>& classes) {
+absl::StatusOr<std::unique_ptr<LasRecords>> LasRecords::Create(
+    absl::string_view data, const std::optional<LasClasses>& classes) {
   NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
-  LasRecords records;
-  records.data_ = data;
-  records.classes_ = classes;
-  records.count_ = header.count;
-  records.first_ = header.offset_to_points;
-  records.length_ = header.record_length;
-  records.format_ = header.format;
-  records.scale_ = header.scale;
-  records.offset_ = header.offset;
+  std::unique_ptr<LasRecords> records(new LasRecords());
+  records->data_ = data;
+  records->classes_ = classes;
+  records->count_ = header.count;
+  records->first_ = header.offset_to_points;
+  records->length_ = header.record_length;
+  records->format_ = header.format;
+  records->scale_ = header.scale;
+  records->offset_ = header.offset;
   for (int c = 0; c < 3; ++c) {
-    records.header_high_[c] = Load<double>(data, kBounds + 16 * c);
-    records.header_low_[c] = Load<double>(data, kBounds + 16 * c + 8);
+    records->header_high_[c] = Load<double>(data, kBounds + 16 * c);
+    records->header_low_[c] = Load<double>(data, kBounds + 16 * c + 8);
   }
   return records;
 }
@@ -508,8 +508,8 @@ Point3d LasRecords::Position(uint64_t i) const {
 
 bool LasRecords::has_colors() const { return kFormats[format_].rgb != 0; }
 
-Point3d LasRecords::Resolution() const {
-  return {std::fabs(scale_[0]), std::fabs(scale_[1]), std::fabs(scale_[2])};
+std::optional<Point3d> LasRecords::Resolution() const {
+  return Point3d{std::fabs(scale_[0]), std::fabs(scale_[1]), std::fabs(scale_[2])};
 }
 
 absl::StatusOr<uint64_t> LasRecordCount(absl::string_view data) {

@@ -3,13 +3,16 @@
 #ifndef NEURALMESH_CORE_IO_INTERNAL_LAS_H_
 #define NEURALMESH_CORE_IO_INTERNAL_LAS_H_
 
+#include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/point_records.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/las_cleaning.h"
 #include "core/io/las_description.h"
@@ -35,30 +38,29 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
                                         const std::optional<LasClasses>& classes = std::nullopt);
 
 // The point records of an uncompressed LAS file, read one at a time where they lie: for
-// sampling a file without reading it whole (core/sampling/las_file_sampler.h). Holds a view
+// sampling a file without reading it whole (core/sampling/off_core_sampler.h). Holds a view
 // of the file's bytes, which must outlive it.
-class LasRecords {
+class LasRecords final : public PointRecords {
  public:
   // ParseLas's checks of the header, and its errors for a malformed one (a LAZ file's records
   // are compressed: INVALID_ARGUMENT). `classes` as ParseLas's.
-  static absl::StatusOr<LasRecords> Create(absl::string_view data,
-                                           const std::optional<LasClasses>& classes);
+  static absl::StatusOr<std::unique_ptr<LasRecords>> Create(
+      absl::string_view data, const std::optional<LasClasses>& classes);
 
-  uint64_t size() const { return count_; }
-  // Whether ParseLas reads record i (< size()): not withheld, and of a class in `classes`, or
-  // without them of no noise class.
-  bool Kept(uint64_t i) const;
-  // Record i's coordinates in the file's frame: its integers times the scale, plus the offset.
-  Point3d Position(uint64_t i) const;
-  // Where record i's bytes are (to start loading them).
-  const char* Address(uint64_t i) const { return data_.data() + first_ + i * length_; }
-  // Whether the records' point format carries colours.
-  bool has_colors() const;
-  // Each axis's scale, made positive: the coordinates' resolution.
-  Point3d Resolution() const;
-  // The smallest and largest coordinates the header states, which a writer may leave stale.
-  Point3d header_low() const { return header_low_; }
-  Point3d header_high() const { return header_high_; }
+  uint64_t size() const override { return count_; }
+  // Whether ParseLas reads record i: not withheld, and of a class in `classes`, or without
+  // them of no noise class.
+  bool Kept(uint64_t i) const override;
+  // Its integers times the scale, plus the offset.
+  Point3d Position(uint64_t i) const override;
+  const char* Address(uint64_t i) const override { return data_.data() + first_ + i * length_; }
+  bool has_colors() const override;
+  // Each axis's scale, made positive.
+  std::optional<Point3d> Resolution() const override;
+  // The header's.
+  std::optional<std::pair<Point3d, Point3d>> StatedBounds() const override {
+    return std::make_pair(header_low_, header_high_);
+  }
 
  private:
   LasRecords() = default;

@@ -270,6 +270,21 @@ absl::StatusOr<std::vector<Role>> VertexRoles(const PlyElement& element, bool* h
   return roles;
 }
 
+}  // namespace
+
+absl::StatusOr<PlyVertexLayout> FindPlyVertexLayout(const PlyElement& vertex) {
+  bool has_normals = false, has_weights = false;
+  PlyVertexLayout layout;
+  NM_ASSIGN_OR_RETURN(const std::vector<Role> roles,
+                      VertexRoles(vertex, &has_normals, &has_weights, &layout.has_colors));
+  for (size_t i = 0; i < roles.size(); ++i) {
+    if (roles[i] >= kX && roles[i] <= kZ) layout.axes[roles[i] - kX] = static_cast<int>(i);
+  }
+  return layout;
+}
+
+namespace {
+
 template <typename Body>
 absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry* out) {
   if (element.count > kMaxVertices) {

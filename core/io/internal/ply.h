@@ -7,6 +7,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/ply_header.h"
 
 namespace neuralmesh::io_internal {
 
@@ -21,6 +22,14 @@ namespace neuralmesh::io_internal {
 // what was expected, for a malformed header, a count larger than the remaining data could
 // hold, missing or malformed values, non-finite coordinates or out-of-range face indices.
 absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces);
+
+// Which properties of the 'vertex' element ParsePly reads as x, y and z (their indices), and
+// whether it reads colours from it. INVALID_ARGUMENT "line N: ..." when x, y or z is missing.
+struct PlyVertexLayout {
+  int axes[3] = {-1, -1, -1};
+  bool has_colors = false;
+};
+absl::StatusOr<PlyVertexLayout> FindPlyVertexLayout(const PlyElement& vertex);
 
 // Formats `geometry` as binary little-endian PLY: float x, y, z (double, with geometry.origin
 // added, when the origin is not zero), then float nx, ny, nz, a float

@@ -48,6 +48,20 @@ Point3d OriginKeepingResolution(const Point3d& low, const Point3d& high, const P
   return origin;
 }
 
+Point3d OriginOfUnstatedResolution(const Point3d& low, const Point3d& high) {
+  double side = 0;
+  for (int c = 0; c < 3; ++c) side = std::max(side, high[c] - low[c]);
+  // Points that a float cannot tell apart where they are (a box smaller than a float's step,
+  // or a single point) take the step of that box: the same whether their doubles or the
+  // floats they became are read, so that what is written reads back alike.
+  Point3d step;
+  for (int c = 0; c < 3; ++c) {
+    const double far = std::max(std::fabs(low[c]), std::fabs(high[c]));
+    step[c] = std::max(side, far / kFloatSteps) / kUnstatedStepsPerSide;
+  }
+  return OriginKeepingResolution(low, high, step);
+}
+
 void PositionCollector::MoveTo(ParsedGeometry* out) {
   Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
   for (const Point3d& p : positions_) {
@@ -57,19 +71,7 @@ void PositionCollector::MoveTo(ParsedGeometry* out) {
     }
   }
   out->origin = {0, 0, 0};
-  if (!positions_.empty()) {
-    double side = 0;
-    for (int c = 0; c < 3; ++c) side = std::max(side, high[c] - low[c]);
-    // Points that a float cannot tell apart where they are (a box smaller than a float's step,
-    // or a single point) take the step of that box: the same whether their doubles or the
-    // floats they became are read, so that what is written reads back alike.
-    Point3d step;
-    for (int c = 0; c < 3; ++c) {
-      const double far = std::max(std::fabs(low[c]), std::fabs(high[c]));
-      step[c] = std::max(side, far / kFloatSteps) / kUnstatedStepsPerSide;
-    }
-    out->origin = OriginKeepingResolution(low, high, step);
-  }
+  if (!positions_.empty()) out->origin = OriginOfUnstatedResolution(low, high);
   out->positions.resize(positions_.size());
   for (size_t i = 0; i < positions_.size(); ++i) {
     for (int c = 0; c < 3; ++c) {

@@ -29,6 +29,10 @@ Point3d OriginKeepingResolution(const Point3d& low, const Point3d& high, const P
 // hold, a float keeping 24 bits. 0.001 for an axis that is zero everywhere.
 double IntegerScaleKeepingFloats(double farthest);
 
+// OriginKeepingResolution for points in the box `low`-`high` of a file that states no
+// resolution (PositionCollector::MoveTo's rule, below).
+Point3d OriginOfUnstatedResolution(const Point3d& low, const Point3d& high);
+
 class PositionCollector {
  public:
   PositionCollector() = default;

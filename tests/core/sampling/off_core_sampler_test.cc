@@ -1,7 +1,9 @@
-#include "core/sampling/las_file_sampler.h"
+#include "core/sampling/off_core_sampler.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <string>
@@ -11,6 +13,7 @@
 #include "core/io/internal/las.h"
 #include "core/io/internal/las_layout.h"
 #include "core/io/internal/laz.h"
+#include "core/io/internal/ply.h"
 #include "core/random.h"
 #include "gtest/gtest.h"
 #include "tests/testing/las_file.h"
@@ -52,9 +55,9 @@ std::string Write(const std::string& name, const std::string& bytes) {
   return path;
 }
 
-std::unique_ptr<LasFileSampler> Open(const std::string& path,
+std::unique_ptr<OffCoreSampler> Open(const std::string& path,
                                      const std::optional<LasClasses>& classes = std::nullopt) {
-  absl::StatusOr<std::unique_ptr<LasFileSampler>> sampler = LasFileSampler::Open(path, classes);
+  absl::StatusOr<std::unique_ptr<OffCoreSampler>> sampler = OffCoreSampler::Open(path, classes);
   EXPECT_TRUE(sampler.ok()) << sampler.status();
   return sampler.ok() ? *std::move(sampler) : nullptr;
 }
@@ -64,7 +67,7 @@ int RecordOf(const Vec3& sample, const Origin& origin) {
   return static_cast<int>(std::lround((sample[0] + origin[0] - 500000) * 100));
 }
 
-TEST(LasFileSamplerTest, DrawsEveryKeptRecordAlikeAndNoOther) {
+TEST(OffCoreSamplerTest, DrawsEveryKeptRecordAlikeAndNoOther) {
   const std::vector<testing::LasPoint> points = ScanLine(300);
   const std::string path = Write("line.las", testing::LasFile(Layout(), points));
   for (bool buildings_only : {false, true}) {
@@ -100,7 +103,7 @@ TEST(LasFileSamplerTest, DrawsEveryKeptRecordAlikeAndNoOther) {
   }
 }
 
-TEST(LasFileSamplerTest, SamplesAreTheRecordsAsReadingTheFileGivesThem) {
+TEST(OffCoreSamplerTest, SamplesAreTheRecordsAsReadingTheFileGivesThem) {
   const std::string bytes = testing::LasFile(Layout(), ScanLine(5000));
   const std::string path = Write("georeferenced.las", bytes);
   auto sampler = Open(path);
@@ -133,7 +136,7 @@ TEST(LasFileSamplerTest, SamplesAreTheRecordsAsReadingTheFileGivesThem) {
   }
 }
 
-TEST(LasFileSamplerTest, ASeedGivesTheSameSamplesAndPrefetchingChangesNothing) {
+TEST(OffCoreSamplerTest, ASeedGivesTheSameSamplesAndPrefetchingChangesNothing) {
   const std::string path = Write("seeded.las", testing::LasFile(Layout(), ScanLine(1000)));
   auto sampler = Open(path);
   ASSERT_NE(sampler, nullptr);
@@ -145,7 +148,7 @@ TEST(LasFileSamplerTest, ASeedGivesTheSameSamplesAndPrefetchingChangesNothing) {
   }
 }
 
-TEST(LasFileSamplerTest, StaleHeaderBoundsAreNotTrusted) {
+TEST(OffCoreSamplerTest, StaleHeaderBoundsAreNotTrusted) {
   std::string bytes = testing::LasFile(Layout(), ScanLine(5000));
   absl::StatusOr<io_internal::ParsedGeometry> parsed = io_internal::ParseLas(bytes);
   ASSERT_TRUE(parsed.ok()) << parsed.status();
@@ -164,10 +167,10 @@ TEST(LasFileSamplerTest, StaleHeaderBoundsAreNotTrusted) {
   }
 }
 
-TEST(LasFileSamplerTest, RefusesWhatCannotBeSampledWhereItLies) {
+TEST(OffCoreSamplerTest, RefusesWhatCannotBeSampledWhereItLies) {
   const auto expect_refused = [](const std::string& path, absl::StatusCode code,
                                  const std::string& words) {
-    absl::StatusOr<std::unique_ptr<LasFileSampler>> sampler = LasFileSampler::Open(path);
+    absl::StatusOr<std::unique_ptr<OffCoreSampler>> sampler = OffCoreSampler::Open(path);
     ASSERT_FALSE(sampler.ok()) << path;
     EXPECT_EQ(sampler.status().code(), code) << sampler.status();
     EXPECT_TRUE(absl::StrContains(sampler.status().message(), words)) << sampler.status();
@@ -176,7 +179,7 @@ TEST(LasFileSamplerTest, RefusesWhatCannotBeSampledWhereItLies) {
                  "cannot open");
   expect_refused(Write("empty.las", ""), absl::StatusCode::kInvalidArgument, "is empty");
   expect_refused(Write("text.las", "x y z\n1 2 3\n"), absl::StatusCode::kInvalidArgument,
-                 "no LASF signature");
+                 "neither LAS nor PLY");
   const std::string las = testing::LasFile(Layout(), ScanLine(1000));
   absl::StatusOr<std::string> laz = io_internal::CompressLas(las);
   ASSERT_TRUE(laz.ok()) << laz.status();
@@ -194,8 +197,110 @@ TEST(LasFileSamplerTest, RefusesWhatCannotBeSampledWhereItLies) {
                  absl::StatusCode::kInvalidArgument, "read it whole");
   for (size_t i = 0; i < points.size(); i += 20) points[i].withheld = false;  // One in 20.
   for (testing::LasPoint& p : points) p.classification = 2;
-  EXPECT_TRUE(LasFileSampler::Open(Write("enough.las", testing::LasFile(Layout(), points))).ok())
+  EXPECT_TRUE(OffCoreSampler::Open(Write("enough.las", testing::LasFile(Layout(), points))).ok())
       << "5% kept: about 20 records a sample";
+}
+
+// A binary PLY file: a 'camera' element of one 5-byte record before the vertices, each vertex
+// `red`, x, y, z (doubles, or floats), `green`, `blue`, and an empty face list after them.
+// Vertex i lies at (500000 + i / 100, 4100000 + (i % 7), 80) in doubles, or (i / 100, i % 7,
+// 80) in floats.
+std::string PlyFile(int n, bool doubles, bool big_endian, const std::string& vertex_extra = "") {
+  std::string out = "ply\nformat ";
+  out += big_endian ? "binary_big_endian" : "binary_little_endian";
+  out += " 1.0\nelement camera 1\nproperty float a\nproperty uchar b\n";
+  out += "element vertex " + std::to_string(n) + "\nproperty uchar red\n";
+  for (const char* axis : {"x", "y", "z"}) {
+    out += std::string("property ") + (doubles ? "double " : "float ") + axis + "\n";
+  }
+  out += "property uchar green\nproperty uchar blue\n" + vertex_extra;
+  out += "element face 0\nproperty list uchar int vertex_indices\nend_header\n";
+  out.append(5, '\x7f');
+  const auto append = [&](auto value) {
+    char bytes[sizeof(value)];
+    std::memcpy(bytes, &value, sizeof(value));
+    if (big_endian) std::reverse(bytes, bytes + sizeof(value));
+    out.append(bytes, sizeof(value));
+  };
+  for (int i = 0; i < n; ++i) {
+    out += static_cast<char>(i);
+    const double p[3] = {(doubles ? 500000 : 0) + i / 100.0, (doubles ? 4100000 : 0) + i % 7, 80};
+    for (double c : p) doubles ? append(c) : append(static_cast<float>(c));
+    out += "\x01\x02";
+  }
+  return out;
+}
+
+TEST(OffCoreSamplerTest, PlyVerticesAreSampledAsParsePlyReadsThem) {
+  for (bool doubles : {true, false}) {
+    for (bool big_endian : {false, true}) {
+      const std::string bytes = PlyFile(3000, doubles, big_endian);
+      auto sampler = Open(Write("scan.ply", bytes));
+      ASSERT_NE(sampler, nullptr);
+      EXPECT_EQ(sampler->records(), 3000u);
+      EXPECT_TRUE(sampler->has_colors());
+      absl::StatusOr<io_internal::ParsedGeometry> parsed =
+          io_internal::ParsePly(bytes, io_internal::FaceHandling::kSkip);
+      ASSERT_TRUE(parsed.ok()) << parsed.status();
+      EXPECT_EQ(sampler->origin(), parsed->origin) << "doubles " << doubles;
+      EXPECT_EQ(sampler->origin() != kNoOrigin, doubles) << "UTM doubles need an origin";
+      Random rng(2);
+      for (int d = 0; d < 1000; ++d) {
+        const Vec3 s = sampler->Sample(rng) + Vec3(sampler->origin().data());
+        const int i = static_cast<int>(std::lround((s[0] - (doubles ? 500000 : 0)) * 100));
+        ASSERT_GE(i, 0);
+        ASSERT_LT(i, 3000);
+        const double x = (doubles ? 500000 : 0) + i / 100.0;
+        EXPECT_EQ(s[0], doubles ? x : static_cast<double>(static_cast<float>(x))) << i;
+        EXPECT_EQ(s[1], (doubles ? 4100000 : 0) + i % 7) << i;
+        EXPECT_EQ(s[2], 80) << i;
+      }
+    }
+  }
+  // A vertex with a coordinate that is not a number (which ParsePly refuses the file for) is
+  // never drawn.
+  std::string bytes = PlyFile(100, true, false);
+  const double nan = std::nan("");
+  const size_t first_vertex = bytes.find("end_header\n") + 11 + 5;
+  std::memcpy(&bytes[first_vertex + 27 * 50 + 1], &nan, sizeof(nan));
+  absl::StatusOr<io_internal::ParsedGeometry> refused =
+      io_internal::ParsePly(bytes, io_internal::FaceHandling::kSkip);
+  ASSERT_FALSE(refused.ok()) << "vertex 50's x is not a number";
+  auto sampler = Open(Write("nan.ply", bytes));
+  ASSERT_NE(sampler, nullptr);
+  Random rng(4);
+  for (int d = 0; d < 20000; ++d) {
+    const Vec3 s = sampler->Sample(rng);
+    ASSERT_TRUE(std::isfinite(s[0])) << "draw " << d;
+  }
+}
+
+TEST(OffCoreSamplerTest, PlyFilesWithoutRecordsOfOneSizeAreRefusedSayingWhy) {
+  const auto expect_refused = [](const std::string& name, const std::string& bytes,
+                                 const std::string& words) {
+    absl::StatusOr<std::unique_ptr<OffCoreSampler>> sampler =
+        OffCoreSampler::Open(Write(name, bytes));
+    ASSERT_FALSE(sampler.ok()) << name;
+    EXPECT_EQ(sampler.status().code(), absl::StatusCode::kInvalidArgument) << sampler.status();
+    EXPECT_TRUE(absl::StrContains(sampler.status().message(), words)) << sampler.status();
+  };
+  expect_refused("ascii.ply",
+                 "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float "
+                 "y\nproperty float z\nend_header\n1 2 3\n",
+                 "ASCII");
+  expect_refused("list.ply", PlyFile(10, true, false, "property list uchar int tags\n"),
+                 "element 'vertex' has the list property 'tags'");
+  const std::string whole = PlyFile(10, true, false);
+  expect_refused("cut.ply", whole.substr(0, whole.size() - 1), "do not fit");
+  expect_refused("no_vertex.ply",
+                 "ply\nformat binary_little_endian 1.0\nelement point 1\nproperty float x\n"
+                 "end_header\n1234",
+                 "no 'vertex' element");
+  expect_refused("no_z.ply",
+                 "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n"
+                 "property float y\nend_header\n12345678",
+                 "no scalar property 'z'");
+  expect_refused("no_vertices.ply", PlyFile(0, true, false), "no point records");
 }
 
 }  // namespace

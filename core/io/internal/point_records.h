@@ -1,0 +1,39 @@
+// The point records of a file whose records all have one size, read one at a time where they
+// lie in the file's bytes instead of parsed all at once: what off-core sampling reads
+// (core/sampling/off_core_sampler.h). LAS files (las.h) and binary PLY files
+// (ply_vertex_records.h) have such records.
+#ifndef NEURALMESH_CORE_IO_INTERNAL_POINT_RECORDS_H_
+#define NEURALMESH_CORE_IO_INTERNAL_POINT_RECORDS_H_
+
+#include <cstdint>
+#include <optional>
+#include <utility>
+
+#include "core/io/internal/position_collector.h"
+
+namespace neuralmesh::io_internal {
+
+class PointRecords {
+ public:
+  virtual ~PointRecords() = default;
+
+  virtual uint64_t size() const = 0;
+  // Whether reading the file whole would take record i (< size()) as a point.
+  virtual bool Kept(uint64_t i) const = 0;
+  // Record i's coordinates in the file's frame.
+  virtual Point3d Position(uint64_t i) const = 0;
+  // Where record i's bytes are (to start loading them).
+  virtual const char* Address(uint64_t i) const = 0;
+  // Whether the records carry colours.
+  virtual bool has_colors() const = 0;
+  // The coordinates' resolution per axis (a LAS file's scale), or nothing where the file
+  // states none.
+  virtual std::optional<Point3d> Resolution() const = 0;
+  // The smallest and largest coordinates the file states (a LAS header's, which a writer may
+  // leave stale), or nothing.
+  virtual std::optional<std::pair<Point3d, Point3d>> StatedBounds() const = 0;
+};
+
+}  // namespace neuralmesh::io_internal
+
+#endif  // NEURALMESH_CORE_IO_INTERNAL_POINT_RECORDS_H_

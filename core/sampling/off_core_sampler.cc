@@ -1,0 +1,124 @@
+#include "core/sampling/off_core_sampler.h"
+
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/io/internal/las.h"
+#include "core/io/internal/laz.h"
+#include "core/io/internal/ply_vertex_records.h"
+#include "core/io/internal/position_collector.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh {
+namespace {
+
+using io_internal::Point3d;
+
+// Seeds the probe's draws: the same file gives the same probe.
+constexpr uint64_t kProbeSeed = 0x6c61735f70726f62;
+
+Vec3 ToVec3(const Point3d& p) { return Vec3(p[0], p[1], p[2]); }
+Point3d ToPoint3d(const Vec3& v) { return {v[0], v[1], v[2]}; }
+
+// The records of the file `data`, by its first bytes.
+absl::StatusOr<std::unique_ptr<io_internal::PointRecords>> RecordsOf(
+    absl::string_view data, const std::optional<LasClasses>& classes) {
+  if (io_internal::IsLaz(data)) {
+    return absl::InvalidArgumentError(
+        "LAZ: its records are compressed in chunks and cannot be read one at a time; read the "
+        "file whole, or sample its decompressed LAS file");
+  }
+  if (absl::StartsWith(data, "LASF")) {
+    absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> las =
+        io_internal::LasRecords::Create(data, classes);
+    if (!las.ok()) return las.status();
+    return std::unique_ptr<io_internal::PointRecords>(*std::move(las));
+  }
+  if (absl::StartsWith(data, "ply")) return io_internal::PlyVertexRecords(data);
+  return absl::InvalidArgumentError(
+      "neither LAS nor PLY: only files whose point records all have one size, uncompressed LAS "
+      "and binary PLY, can be sampled where they lie");
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<OffCoreSampler>> OffCoreSampler::Open(
+    const std::string& path, const std::optional<LasClasses>& classes) {
+  NM_ASSIGN_OR_RETURN(MappedFile file, MappedFile::Open(path));
+  const auto invalid = [&path](absl::string_view message) {
+    return absl::InvalidArgumentError(absl::StrCat("'", path, "': ", message));
+  };
+  absl::StatusOr<std::unique_ptr<io_internal::PointRecords>> records =
+      RecordsOf(file.data(), classes);
+  if (!records.ok()) return invalid(records.status().message());
+  if ((*records)->size() == 0) return invalid("the file has no point records");
+  std::unique_ptr<OffCoreSampler> sampler(new OffCoreSampler(std::move(file), *std::move(records)));
+  const io_internal::PointRecords& points = *sampler->records_;
+
+  BoundingBox probed;
+  int kept = 0;
+  Random probe(kProbeSeed);
+  for (int i = 0; i < kProbeRecords; ++i) {
+    const uint64_t r = probe.NextIndex(points.size());
+    if (!points.Kept(r)) continue;
+    ++kept;
+    probed.Extend(ToVec3(points.Position(r)));
+  }
+  sampler->kept_share_ = static_cast<double>(kept) / kProbeRecords;
+  if (sampler->kept_share_ < kLeastKeptShare) {
+    return invalid(absl::StrFormat(
+        "%d of %d records drawn at random are points to read (the others %s): sampling the "
+        "file where it lies would read about %s records per sample; read it whole",
+        kept, kProbeRecords,
+        absl::StartsWith(sampler->file_.data(), "ply")
+            ? "have a coordinate that is not a finite number"
+        : classes.has_value() ? "withheld, noise or of other classes"
+                              : "withheld or noise",
+        kept == 0 ? std::string("countless") : absl::StrCat(kProbeRecords / kept)));
+  }
+  // The stated bounds, unless the probe finds them stale: records outside them, or a box more
+  // than twice the probe's (which covers nearly all of a scan's extent).
+  const std::optional<Point3d> resolution = points.Resolution();
+  const Vec3 step = resolution.has_value() ? ToVec3(*resolution) : Vec3(0, 0, 0);
+  BoundingBox bounds = probed;
+  if (const auto stated_bounds = points.StatedBounds(); stated_bounds.has_value()) {
+    const Vec3 low = ToVec3(stated_bounds->first), high = ToVec3(stated_bounds->second);
+    BoundingBox stated;
+    stated.Extend(low - step);
+    stated.Extend(high + step);
+    if (std::isfinite(stated.diagonal()) && stated.Contains(probed.min) &&
+        stated.Contains(probed.max) &&
+        stated.diagonal() <= 2 * probed.diagonal() + 4 * step.norm()) {
+      bounds.Extend(low);
+      bounds.Extend(high);
+    }
+  }
+  sampler->origin_ =
+      resolution.has_value()
+          ? io_internal::OriginKeepingResolution(ToPoint3d(bounds.min), ToPoint3d(bounds.max),
+                                                 *resolution)
+          : io_internal::OriginOfUnstatedResolution(ToPoint3d(bounds.min), ToPoint3d(bounds.max));
+  const Vec3 origin = ToVec3(sampler->origin_);
+  sampler->bounds_.Extend(bounds.min - origin);
+  sampler->bounds_.Extend(bounds.max - origin);
+  return sampler;
+}
+
+Vec3 OffCoreSampler::Sample(Random& rng) const {
+  Random tries(rng.NextU64());  // One draw of `rng` per sample, however many records it reads.
+  while (true) {
+    const uint64_t r = tries.NextIndex(records_->size());
+    if (records_->Kept(r)) return ToVec3(records_->Position(r)) - ToVec3(origin_);
+  }
+}
+
+void OffCoreSampler::PrefetchSample(const Random& rng) const {
+  Random peek = rng;
+  Random tries(peek.NextU64());
+  __builtin_prefetch(records_->Address(tries.NextIndex(records_->size())));
+}
+
+}  // namespace neuralmesh

@@ -7,7 +7,9 @@
 // with itself as a second tile, to the points kept twice; all with the default classes and
 // with some asked for; joined with a tile of another format (its points written by the writer),
 // to the points kept and the tile's, or refused. A LAZ input is read as the LAS file it
-// compresses, and cleaned as that (laz_format_fuzzer checks the codec itself).
+// compresses, and cleaned as that (laz_format_fuzzer checks the codec itself). Its records as
+// off-core sampling reads them (LasRecords) agree with the parser
+// (fuzz/point_records_properties.h).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -22,6 +24,7 @@
 #include "core/io/internal/laz.h"
 #include "fuzz/fuzz_check.h"
 #include "fuzz/geometry_parser_properties.h"
+#include "fuzz/point_records_properties.h"
 
 namespace {
 
@@ -136,6 +139,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     bytes = decompressed;
   }
   const absl::StatusOr<ParsedGeometry> parsed = neuralmesh::io_internal::ParseLas(bytes);
+  // The records as off-core sampling reads them (of the LAS file a LAZ input holds).
+  const auto records = neuralmesh::io_internal::LasRecords::Create(bytes, std::nullopt);
+  if (records.ok()) {
+    neuralmesh::fuzz::CheckRecordsAgreeWithParser(**records, parsed.ok() ? &*parsed : nullptr);
+  }
   if (parsed.ok()) {
     CheckWrittenAgain(*parsed);
     CheckCleaned(bytes, *parsed, std::nullopt);

@@ -1,6 +1,7 @@
 #include "core/sampling/off_core_sampler.h"
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "absl/strings/match.h"
@@ -22,6 +23,14 @@ constexpr uint64_t kProbeSeed = 0x6c61735f70726f62;
 
 Vec3 ToVec3(const Point3d& p) { return Vec3(p[0], p[1], p[2]); }
 Point3d ToPoint3d(const Vec3& v) { return {v[0], v[1], v[2]}; }
+
+// Whether the learner can take `p` (a record's position relative to the origin): coordinates
+// that a float holds, as the readers require, so that no mesh gets an infinite vertex.
+bool Learnable(const Vec3& p) {
+  constexpr double kLargestFloat = std::numeric_limits<float>::max();
+  return std::fabs(p[0]) <= kLargestFloat && std::fabs(p[1]) <= kLargestFloat &&
+         std::fabs(p[2]) <= kLargestFloat;
+}
 
 // The records of the file `data`, by its first bytes.
 absl::StatusOr<std::unique_ptr<io_internal::PointRecords>> RecordsOf(
@@ -63,7 +72,7 @@ absl::StatusOr<std::unique_ptr<OffCoreSampler>> OffCoreSampler::Open(
   Random probe(kProbeSeed);
   for (int i = 0; i < kProbeRecords; ++i) {
     const uint64_t r = probe.NextIndex(points.size());
-    if (!points.Kept(r)) continue;
+    if (!points.Kept(r) || !Learnable(ToVec3(points.Position(r)))) continue;
     ++kept;
     probed.Extend(ToVec3(points.Position(r)));
   }
@@ -73,10 +82,9 @@ absl::StatusOr<std::unique_ptr<OffCoreSampler>> OffCoreSampler::Open(
         "%d of %d records drawn at random are points to read (the others %s): sampling the "
         "file where it lies would read about %s records per sample; read it whole",
         kept, kProbeRecords,
-        absl::StartsWith(sampler->file_.data(), "ply")
-            ? "have a coordinate that is not a finite number"
-        : classes.has_value() ? "withheld, noise or of other classes"
-                              : "withheld or noise",
+        absl::StartsWith(sampler->file_.data(), "ply") ? "have a coordinate no float holds"
+        : classes.has_value() ? "withheld, noise or of other classes, or beyond a float's range"
+                              : "withheld or noise, or beyond a float's range",
         kept == 0 ? std::string("countless") : absl::StrCat(kProbeRecords / kept)));
   }
   // The stated bounds, unless the probe finds them stale: records outside them, or a box more
@@ -111,7 +119,9 @@ Vec3 OffCoreSampler::Sample(Random& rng) const {
   Random tries(rng.NextU64());  // One draw of `rng` per sample, however many records it reads.
   while (true) {
     const uint64_t r = tries.NextIndex(records_->size());
-    if (records_->Kept(r)) return ToVec3(records_->Position(r)) - ToVec3(origin_);
+    if (!records_->Kept(r)) continue;
+    const Vec3 sample = ToVec3(records_->Position(r)) - ToVec3(origin_);
+    if (Learnable(sample)) return sample;
   }
 }
 

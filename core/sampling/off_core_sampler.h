@@ -25,9 +25,10 @@ namespace neuralmesh {
 
 // Draws a file's point records uniformly, and draws again where a record is one that reading
 // the file leaves out (LAS: withheld, noise, or of a class not asked for, as
-// io_internal::ParseLas; PLY: a non-finite coordinate), so that every kept record is equally
-// likely, as when the file is read whole and sampled (UniformPointCloudSampler). Samples are
-// the records' coordinates relative to origin(), in doubles.
+// io_internal::ParseLas; PLY: a non-finite coordinate) or refuses the file for (a coordinate,
+// relative to origin(), beyond a float's range), so that every kept record is equally likely,
+// as when the file is read whole and sampled (UniformPointCloudSampler). Samples are the
+// records' coordinates relative to origin(), in doubles.
 class OffCoreSampler final : public Sampler {
  public:
   // Records drawn when the file is opened, to see what share of them is kept and where they

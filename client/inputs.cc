@@ -167,13 +167,14 @@ absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string
         "as one without it");
   }
   const std::string& input = inputs.front();
-  if (IsBuiltin(input) ||
-      !(absl::EndsWithIgnoreCase(input, ".las") || absl::EndsWithIgnoreCase(input, ".laz") ||
-        absl::EndsWithIgnoreCase(input, ".ply"))) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "--off_core samples uncompressed LAS (.las) and binary PLY (.ply) files where they lie; "
-        "INPUT '",
-        input, "' is read whole without it"));
+  const bool sampled_where_it_lies =
+      absl::EndsWithIgnoreCase(input, ".las") || absl::EndsWithIgnoreCase(input, ".laz") ||
+      absl::EndsWithIgnoreCase(input, ".ply") || absl::EndsWithIgnoreCase(input, ".pcd");
+  if (IsBuiltin(input) || !sampled_where_it_lies) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--off_core samples uncompressed LAS (.las), binary PLY (.ply) and binary "
+                     "PCD (.pcd) files where they lie; INPUT '",
+                     input, "' is read whole without it"));
   }
   if (mode != SamplingMode::kUniform) {
     return absl::InvalidArgumentError(

@@ -62,8 +62,8 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(
     const PointSelection& selection = {});
 
 // The target space of `inputs` sampled off-core (--off_core, OffCoreSampler): the records of
-// one uncompressed LAS or binary PLY file read where they lie, a LAS file's with `selection`'s
-// classes. Returns
+// one uncompressed LAS, binary PLY or binary PCD file read where they lie, a LAS file's with
+// `selection`'s classes. Returns
 // INVALID_ARGUMENT, saying why, for other inputs (several, builtin:NAME, another format), a
 // sampling mode other than uniform, or outlier removal (which needs every point in memory);
 // OffCoreSampler's errors. Colours are not painted off-core: the description says so when the

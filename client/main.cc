@@ -129,12 +129,13 @@ ABSL_FLAG(std::string, start_mesh, "",
           "area. --initial_mesh disc still keeps its longest border open. With --server the "
           "mesh is sent exactly (CreateSessionRequest.start_mesh); not with --resume.");
 
-ABSL_FLAG(bool, off_core, false,
-          "Sample the one INPUT, an uncompressed LAS or a binary PLY file, where it lies, mapped "
-          "into memory, instead of reading it: learning starts at once whatever the file's "
-          "size, and memory holds the mesh, not the points (the paper's off-core learning of "
-          "28 million points, Section 4.1). Uniform sampling; no --remove_outliers; colours "
-          "are not painted. Local only.");
+ABSL_FLAG(
+    bool, off_core, false,
+    "Sample the one INPUT, an uncompressed LAS, binary PLY or binary PCD file, where it "
+    "lies, mapped into memory, instead of reading it: learning starts at once whatever the file's "
+    "size, and memory holds the mesh, not the points (the paper's off-core learning of "
+    "28 million points, Section 4.1). Uniform sampling; no --remove_outliers; colours "
+    "are not painted. Local only.");
 
 ABSL_FLAG(std::string, pcd_data, "binary",
           "How convert stores the points of a .pcd OUTPUT (its DATA line): binary (point "

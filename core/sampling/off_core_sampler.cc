@@ -7,8 +7,10 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/io/internal/file_util.h"
 #include "core/io/internal/las.h"
 #include "core/io/internal/laz.h"
+#include "core/io/internal/pcd.h"
 #include "core/io/internal/ply_vertex_records.h"
 #include "core/io/internal/position_collector.h"
 #include "core/status_macros.h"
@@ -32,24 +34,30 @@ bool Learnable(const Vec3& p) {
          std::fabs(p[2]) <= kLargestFloat;
 }
 
-// The records of the file `data`, by its first bytes.
+// The records of the file `data` at `path`, by its extension.
 absl::StatusOr<std::unique_ptr<io_internal::PointRecords>> RecordsOf(
-    absl::string_view data, const std::optional<LasClasses>& classes) {
-  if (io_internal::IsLaz(data)) {
-    return absl::InvalidArgumentError(
-        "LAZ: its records are compressed in chunks and cannot be read one at a time; read the "
-        "file whole, or sample its decompressed LAS file");
+    const std::string& path, absl::string_view data, const std::optional<LasClasses>& classes) {
+  switch (io_internal::FormatFromPath(path)) {
+    case io_internal::FileFormat::kLas: {
+      if (io_internal::IsLaz(data)) {
+        return absl::InvalidArgumentError(
+            "LAZ: its records are compressed in chunks and cannot be read one at a time; read "
+            "the file whole, or sample its decompressed LAS file");
+      }
+      absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> las =
+          io_internal::LasRecords::Create(data, classes);
+      if (!las.ok()) return las.status();
+      return std::unique_ptr<io_internal::PointRecords>(*std::move(las));
+    }
+    case io_internal::FileFormat::kPly:
+      return io_internal::PlyVertexRecords(data);
+    case io_internal::FileFormat::kPcd:
+      return io_internal::PcdPointRecords(data);
+    default:
+      return absl::InvalidArgumentError(
+          "only files whose point records all have one size, uncompressed LAS (.las), binary "
+          "PLY (.ply) and binary PCD (.pcd), can be sampled where they lie");
   }
-  if (absl::StartsWith(data, "LASF")) {
-    absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> las =
-        io_internal::LasRecords::Create(data, classes);
-    if (!las.ok()) return las.status();
-    return std::unique_ptr<io_internal::PointRecords>(*std::move(las));
-  }
-  if (absl::StartsWith(data, "ply")) return io_internal::PlyVertexRecords(data);
-  return absl::InvalidArgumentError(
-      "neither LAS nor PLY: only files whose point records all have one size, uncompressed LAS "
-      "and binary PLY, can be sampled where they lie");
 }
 
 }  // namespace
@@ -61,7 +69,7 @@ absl::StatusOr<std::unique_ptr<OffCoreSampler>> OffCoreSampler::Open(
     return absl::InvalidArgumentError(absl::StrCat("'", path, "': ", message));
   };
   absl::StatusOr<std::unique_ptr<io_internal::PointRecords>> records =
-      RecordsOf(file.data(), classes);
+      RecordsOf(path, file.data(), classes);
   if (!records.ok()) return invalid(records.status().message());
   if ((*records)->size() == 0) return invalid("the file has no point records");
   std::unique_ptr<OffCoreSampler> sampler(new OffCoreSampler(std::move(file), *std::move(records)));
@@ -82,7 +90,8 @@ absl::StatusOr<std::unique_ptr<OffCoreSampler>> OffCoreSampler::Open(
         "%d of %d records drawn at random are points to read (the others %s): sampling the "
         "file where it lies would read about %s records per sample; read it whole",
         kept, kProbeRecords,
-        absl::StartsWith(sampler->file_.data(), "ply") ? "have a coordinate no float holds"
+        io_internal::FormatFromPath(path) != io_internal::FileFormat::kLas
+            ? "have a coordinate no float holds"
         : classes.has_value() ? "withheld, noise or of other classes, or beyond a float's range"
                               : "withheld or noise, or beyond a float's range",
         kept == 0 ? std::string("countless") : absl::StrCat(kProbeRecords / kept)));

@@ -3,7 +3,7 @@
 // each sample reads one record where it lies. Learning starts at once whatever the file's
 // size, and memory holds the mesh, not the points: a file larger than memory can be learned
 // (its records then come from the disk, one read per sample that misses the page cache).
-// Files whose records all have one size: uncompressed LAS and binary PLY.
+// Files whose records all have one size: uncompressed LAS, binary PLY and binary PCD.
 #ifndef NEURALMESH_CORE_SAMPLING_OFF_CORE_SAMPLER_H_
 #define NEURALMESH_CORE_SAMPLING_OFF_CORE_SAMPLER_H_
 
@@ -25,10 +25,11 @@ namespace neuralmesh {
 
 // Draws a file's point records uniformly, and draws again where a record is one that reading
 // the file leaves out (LAS: withheld, noise, or of a class not asked for, as
-// io_internal::ParseLas; PLY: a non-finite coordinate) or refuses the file for (a coordinate,
-// relative to origin(), beyond a float's range), so that every kept record is equally likely,
-// as when the file is read whole and sampled (UniformPointCloudSampler). Samples are the
-// records' coordinates relative to origin(), in doubles.
+// io_internal::ParseLas; PCD: no position) or refuses the file for (PLY: a non-finite
+// coordinate; any: a coordinate, relative to origin(), beyond a float's range), so that every
+// kept record is equally likely, as when the file is read whole and sampled
+// (UniformPointCloudSampler). Samples are the records' coordinates relative to origin(), in
+// doubles.
 class OffCoreSampler final : public Sampler {
  public:
   // Records drawn when the file is opened, to see what share of them is kept and where they
@@ -38,13 +39,13 @@ class OffCoreSampler final : public Sampler {
   // 100 records.
   static constexpr double kLeastKeptShare = 0.01;
 
-  // Maps the uncompressed LAS or binary PLY file at `path` (told apart by their first bytes);
+  // Maps the uncompressed LAS, binary PLY or binary PCD file at `path` (by its extension);
   // `classes` as ParseLas's, for LAS. Returns MappedFile's errors (NOT_FOUND for a missing
   // file); INVALID_ARGUMENT, naming the file and saying why, for a LAZ file (its records are
   // compressed in chunks: none can be read alone), another format, the errors of
-  // io_internal::LasRecords::Create and io_internal::PlyVertexRecords, a file without point
-  // records, and one where less than kLeastKeptShare of the probe is kept (read such a file
-  // whole).
+  // io_internal::LasRecords::Create, PlyVertexRecords and PcdPointRecords, a file without
+  // point records, and one where less than kLeastKeptShare of the probe is kept (read such a
+  // file whole).
   static absl::StatusOr<std::unique_ptr<OffCoreSampler>> Open(
       const std::string& path, const std::optional<LasClasses>& classes = std::nullopt);
 

@@ -953,7 +953,7 @@ std::vector<testing::LasPoint> UnitSphereLasPoints(int count, uint64_t seed,
 // --off_core: the scan sampled where it lies instead of read. The mesh lies on the sphere in
 // the scan's coordinates, a seed gives the same file again, and what cannot be sampled so is
 // refused, saying why.
-TEST_F(LocalCliTest, OffCoreLearnsALasOrPlyScanWhereItLies) {
+TEST_F(LocalCliTest, OffCoreLearnsALasPlyOrPcdScanWhereItLies) {
   const std::string las = *dir_ + "/scan.las";
   WriteGeoreferencedSphereLas(las);
   const std::string mesh = *dir_ + "/off_core.ply";
@@ -1007,6 +1007,15 @@ TEST_F(LocalCliTest, OffCoreLearnsALasOrPlyScanWhereItLies) {
     }
     ASSERT_NEAR(std::sqrt(squared), 10.0, 0.25) << "a vertex off the sphere";
   }
+
+  // And as binary PCD.
+  const std::string pcd = *dir_ + "/scan.pcd";
+  ASSERT_EQ(RunNeuralmesh({"convert", las, "-o", pcd}).exit_code, 0);
+  const RunResult pcd_run = RunNeuralmesh(
+      {"reconstruct", pcd, "-o", *dir_ + "/off_core_pcd.ply", "--vertices", "300", "--off_core"});
+  ASSERT_EQ(pcd_run.exit_code, 0) << pcd_run.Describe();
+  EXPECT_TRUE(absl::StrContains(pcd_run.out, "learning the 20000 records of " + pcd))
+      << pcd_run.out;
 
   const std::string laz = *dir_ + "/scan.laz";
   const std::string xyz = *dir_ + "/scan.xyz";

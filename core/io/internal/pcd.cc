@@ -375,7 +375,63 @@ void ReadBinary(const PcdHeader& header, const Roles& roles, const Locate& locat
   }
 }
 
+// Whether the binary points fit in `body`, the bytes after the header.
+absl::Status CheckBinaryPointsFit(const PcdHeader& header, absl::string_view body) {
+  if (header.points > body.size() / header.record_bytes) {
+    return Invalid(header.points, " points of ", header.record_bytes, " bytes do not fit in the ",
+                   body.size(), " bytes after the header");
+  }
+  return absl::OkStatus();
+}
+
+// Binary points read one at a time (PcdPointRecords).
+class BinaryPointRecords final : public PointRecords {
+ public:
+  BinaryPointRecords(absl::string_view body, PcdHeader header, const Roles& roles)
+      : body_(body), header_(std::move(header)), roles_(roles) {}
+
+  uint64_t size() const override { return header_.points; }
+  bool Kept(uint64_t i) const override {
+    const Point3d p = Position(i);
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(NarrowToFloat(p[c]))) return false;
+    }
+    return true;
+  }
+  Point3d Position(uint64_t i) const override {
+    Point3d p;
+    for (int c = 0; c < 3; ++c) {
+      const Field& field = header_.fields[roles_.position[c]];
+      p[c] = ValueAt(Address(i) + field.offset, field);
+    }
+    return p;
+  }
+  const char* Address(uint64_t i) const override { return body_.data() + i * header_.record_bytes; }
+  bool has_colors() const override { return roles_.color >= 0; }
+  std::optional<Point3d> Resolution() const override { return std::nullopt; }
+  std::optional<std::pair<Point3d, Point3d>> StatedBounds() const override { return std::nullopt; }
+
+ private:
+  absl::string_view body_;
+  PcdHeader header_;
+  Roles roles_;
+};
+
 }  // namespace
+
+absl::StatusOr<std::unique_ptr<PointRecords>> PcdPointRecords(absl::string_view data) {
+  NM_ASSIGN_OR_RETURN(PcdHeader header, ParseHeader(data));
+  if (header.kind != DataKind::kBinary) {
+    return Invalid(header.kind == DataKind::kAscii ? "ascii" : "binary_compressed",
+                   " data: no point can be found without reading those before (binary data "
+                   "can)");
+  }
+  const absl::string_view body = data.substr(header.data_offset);
+  NM_RETURN_IF_ERROR(CheckBinaryPointsFit(header, body));
+  const Roles roles = RolesOf(header);
+  return std::unique_ptr<PointRecords>(
+      std::make_unique<BinaryPointRecords>(body, std::move(header), roles));
+}
 
 absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data) {
   NM_ASSIGN_OR_RETURN(const PcdHeader header, ParseHeader(data));
@@ -388,10 +444,7 @@ absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data) {
         static_cast<int>(std::count(data.begin(), data.begin() + header.data_offset, '\n'));
     NM_RETURN_IF_ERROR(ReadAscii(body, header, roles, header_lines, &sink));
   } else if (header.kind == DataKind::kBinary) {
-    if (header.points > body.size() / header.record_bytes) {
-      return Invalid(header.points, " points of ", header.record_bytes, " bytes do not fit in the ",
-                     body.size(), " bytes after the header");
-    }
+    NM_RETURN_IF_ERROR(CheckBinaryPointsFit(header, body));
     ReadBinary(
         header, roles,
         [&](uint64_t i, int f) {

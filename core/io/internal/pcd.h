@@ -4,11 +4,13 @@
 #ifndef NEURALMESH_CORE_IO_INTERNAL_PCD_H_
 #define NEURALMESH_CORE_IO_INTERNAL_PCD_H_
 
+#include <memory>
 #include <string>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/point_records.h"
 #include "core/io/point_cloud_io.h"
 
 namespace neuralmesh::io_internal {
@@ -27,6 +29,14 @@ namespace neuralmesh::io_internal {
 // run past the end of the data, a malformed value, compressed data that do not decompress to
 // their stated size, or a file whose points all lack a position.
 absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data);
+
+// The points of a PCD file with binary data as point records read where they lie
+// (point_records.h), for off-core sampling: their x, y and z as ParsePcd reads them, the points
+// ParsePcd leaves out (no position: NaN or beyond a float's range) not kept. No resolution or
+// bounds are stated. `data` must outlive the result. Returns ParsePcd's errors for a malformed
+// header or points that run past the end of the data, and INVALID_ARGUMENT, saying why, for
+// ASCII and binary_compressed data (no point can be found without reading those before).
+absl::StatusOr<std::unique_ptr<PointRecords>> PcdPointRecords(absl::string_view data);
 
 // Formats points as a PCD 0.7 file that PCL and Open3D read: FIELDS x y z (float, or double
 // with geometry.origin added when the origin is not zero, as PLY does: PCD has no offset),

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "core/io/internal/las.h"
 #include "core/io/internal/las_layout.h"
 #include "core/io/internal/laz.h"
+#include "core/io/internal/pcd.h"
 #include "core/io/internal/ply.h"
 #include "core/random.h"
 #include "gtest/gtest.h"
@@ -179,7 +181,9 @@ TEST(OffCoreSamplerTest, RefusesWhatCannotBeSampledWhereItLies) {
                  "cannot open");
   expect_refused(Write("empty.las", ""), absl::StatusCode::kInvalidArgument, "is empty");
   expect_refused(Write("text.las", "x y z\n1 2 3\n"), absl::StatusCode::kInvalidArgument,
-                 "neither LAS nor PLY");
+                 "no LASF signature");
+  expect_refused(Write("points.xyz", "1 2 3\n"), absl::StatusCode::kInvalidArgument,
+                 "binary PCD (.pcd), can be sampled where they lie");
   const std::string las = testing::LasFile(Layout(), ScanLine(1000));
   absl::StatusOr<std::string> laz = io_internal::CompressLas(las);
   ASSERT_TRUE(laz.ok()) << laz.status();
@@ -302,6 +306,51 @@ TEST(OffCoreSamplerTest, PlyFilesWithoutRecordsOfOneSizeAreRefusedSayingWhy) {
                  "property float y\nend_header\n12345678",
                  "no scalar property 'z'");
   expect_refused("no_vertices.ply", PlyFile(0, true, false), "no point records");
+}
+
+TEST(OffCoreSamplerTest, BinaryPcdPointsAreSampledAsParsePcdReadsThem) {
+  // An organized cloud's empty pixels (NaN) among UTM points in doubles.
+  PointCloud cloud;
+  cloud.origin = {500000, 4100000, 0};
+  for (int i = 0; i < 2000; ++i) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    cloud.positions.push_back(i % 4 == 3 ? Vec3f(nan, nan, nan)
+                                         : Vec3f(i / 100.0f, static_cast<float>(i % 7), 80.f));
+  }
+  io_internal::GeometryView view;
+  view.positions = cloud.positions;
+  view.origin = cloud.origin;
+  absl::StatusOr<std::string> bytes = io_internal::FormatPcd(view);
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  absl::StatusOr<io_internal::ParsedGeometry> parsed = io_internal::ParsePcd(*bytes);
+  ASSERT_TRUE(parsed.ok()) << parsed.status();
+  ASSERT_EQ(parsed->left_out.invalid, 500u);
+  auto sampler = Open(Write("scan.pcd", *bytes));
+  ASSERT_NE(sampler, nullptr);
+  EXPECT_EQ(sampler->records(), 2000u);
+  EXPECT_NEAR(sampler->kept_share(), 0.75, 0.03);
+  EXPECT_EQ(sampler->origin(), parsed->origin);
+  Random rng(6);
+  std::map<int, int> counts;
+  for (int d = 0; d < 30000; ++d) {
+    const Vec3 s = sampler->Sample(rng) + Vec3(sampler->origin().data());
+    const int i = static_cast<int>(std::lround((s[0] - 500000) * 100));
+    ASSERT_NE(i % 4, 3) << "an empty pixel drawn";
+    EXPECT_EQ(s[1], 4100000 + i % 7);
+    ++counts[i];
+  }
+  EXPECT_EQ(counts.size(), 1500u) << "every point drawn";
+
+  for (PcdData data : {PcdData::kAscii, PcdData::kBinaryCompressed}) {
+    absl::StatusOr<std::string> other = io_internal::FormatPcd(view, data);
+    ASSERT_TRUE(other.ok()) << other.status();
+    absl::StatusOr<std::unique_ptr<OffCoreSampler>> refused =
+        OffCoreSampler::Open(Write("other.pcd", *other));
+    ASSERT_FALSE(refused.ok());
+    EXPECT_TRUE(absl::StrContains(refused.status().message(),
+                                  "no point can be found without reading those before"))
+        << refused.status();
+  }
 }
 
 }  // namespace

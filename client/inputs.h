@@ -63,11 +63,10 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(
 
 // The target space of `inputs` sampled off-core (--off_core, OffCoreSampler): the records of
 // one uncompressed LAS, binary PLY or binary PCD file read where they lie, a LAS file's with
-// `selection`'s classes. Returns
-// INVALID_ARGUMENT, saying why, for other inputs (several, builtin:NAME, another format), a
-// sampling mode other than uniform, or outlier removal (which needs every point in memory);
-// OffCoreSampler's errors. Colours are not painted off-core: the description says so when the
-// file carries them.
+// `selection`'s classes. Returns INVALID_ARGUMENT, saying why, for other inputs (several,
+// builtin:NAME, another format), a sampling mode other than uniform, or outlier removal (which
+// needs every point in memory); OffCoreSampler's errors. Colours are not painted off-core: the
+// description says so when the file carries them.
 absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string>& inputs,
                                                    SamplingMode mode, bool remove_outliers,
                                                    const PointSelection& selection = {});

@@ -35,7 +35,7 @@ struct LocalReconstructOptions {
   SamplingMode sampling = SamplingMode::kUniform;
   std::optional<OutlierOptions> outliers;  // Set: remove a point cloud's outliers first.
   PointSelection selection;                // Which points of a LAS file are read.
-  // Sample the one LAS file INPUT where it lies instead of reading it (LoadOffCoreTargetSpace).
+  // Sample the one file INPUT where it lies instead of reading it (LoadOffCoreTargetSpace).
   bool off_core = false;
   // Set: when the input carries colours, every mesh written gets them (color_source.h).
   std::optional<PointColorOptions> colors = PointColorOptions{};

@@ -129,13 +129,12 @@ ABSL_FLAG(std::string, start_mesh, "",
           "area. --initial_mesh disc still keeps its longest border open. With --server the "
           "mesh is sent exactly (CreateSessionRequest.start_mesh); not with --resume.");
 
-ABSL_FLAG(
-    bool, off_core, false,
-    "Sample the one INPUT, an uncompressed LAS, binary PLY or binary PCD file, where it "
-    "lies, mapped into memory, instead of reading it: learning starts at once whatever the file's "
-    "size, and memory holds the mesh, not the points (the paper's off-core learning of "
-    "28 million points, Section 4.1). Uniform sampling; no --remove_outliers; colours "
-    "are not painted. Local only.");
+ABSL_FLAG(bool, off_core, false,
+          "Sample the one INPUT, an uncompressed LAS, binary PLY or binary PCD file, where it "
+          "lies, mapped into memory, instead of reading it: learning starts at once whatever "
+          "the file's size, and memory holds the mesh, not the points (the paper's off-core "
+          "learning of 28 million points, Section 4.1). Uniform sampling; no "
+          "--remove_outliers; colours are not painted. Local only.");
 
 ABSL_FLAG(std::string, pcd_data, "binary",
           "How convert stores the points of a .pcd OUTPUT (its DATA line): binary (point "
@@ -698,10 +697,10 @@ std::vector<Subcommand> Commands() {
       "output", "vertices", "lod", "seed", "alpha_w", "alpha_l", "c_l", "c_vs", "c_ec",
       "early_phase_vertices", "early_c_vs", "early_c_ec", "alpha_sc", "alpha_r", "alpha_m",
       "remove_triangles", "merge_boundaries", "splits_per_step", "close_small_holes",
-      "max_closed_hole_vertices", "merge_only_settled_boundaries", "split_largest_cell_near_most_active",
-      "sewn_strip_grace_calls", "min_merged_loop_vertices", "cut_inactive_faces", "initial_mesh",
-      "start_mesh", "off_core", "las_classes", "remove_outliers", "outlier_neighbours", "outlier_std_ratio",
-      "outlier_passes", "outliers_on_server", "colors", "color_neighbours", "sampling",
+      "max_closed_hole_vertices", "merge_only_settled_boundaries",
+      "split_largest_cell_near_most_active", "sewn_strip_grace_calls", "min_merged_loop_vertices",
+      "cut_inactive_faces", "initial_mesh", "start_mesh", "off_core", "las_classes",
+      "remove_outliers", "outlier_neighbours", "outlier_std_ratio", "outlier_passes", "outliers_on_server", "colors", "color_neighbours", "sampling",
       "time_budget", "max_steps", "quantization_bits", "encode_speed", "gltf_draco", "progress",
       "server", "out-dir", "batch-size", "points", "ply", "glb", "resume", "reconnect_for"};
   // clang-format on

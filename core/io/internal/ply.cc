@@ -58,34 +58,8 @@ class BinaryBody {
                                                      element.name, " ", index, " (property '",
                                                      property.name, "'); the file is truncated"));
     }
-    const char* p = data_.data() + offset_;
+    *value = LoadPlyValue(data_.data() + offset_, type, big_endian_);
     offset_ += size;
-    switch (type) {
-      case PlyType::kInt8:
-        *value = LoadScalar<int8_t>(p, big_endian_);
-        break;
-      case PlyType::kUint8:
-        *value = LoadScalar<uint8_t>(p, big_endian_);
-        break;
-      case PlyType::kInt16:
-        *value = LoadScalar<int16_t>(p, big_endian_);
-        break;
-      case PlyType::kUint16:
-        *value = LoadScalar<uint16_t>(p, big_endian_);
-        break;
-      case PlyType::kInt32:
-        *value = LoadScalar<int32_t>(p, big_endian_);
-        break;
-      case PlyType::kUint32:
-        *value = LoadScalar<uint32_t>(p, big_endian_);
-        break;
-      case PlyType::kFloat32:
-        *value = LoadScalar<float>(p, big_endian_);
-        break;
-      case PlyType::kFloat64:
-        *value = LoadScalar<double>(p, big_endian_);
-        break;
-    }
     return absl::OkStatus();
   }
 

@@ -1,10 +1,12 @@
 #include "core/io/internal/ply_header.h"
 
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/io/internal/binary.h"
 #include "core/io/internal/text.h"
 #include "core/status_macros.h"
 
@@ -77,6 +79,28 @@ size_t PlyTypeSize(PlyType type) {
       return 4;
     case PlyType::kFloat64:
       return 8;
+  }
+  return 0;
+}
+
+double LoadPlyValue(const char* p, PlyType type, bool big_endian) {
+  switch (type) {
+    case PlyType::kInt8:
+      return LoadScalar<int8_t>(p, big_endian);
+    case PlyType::kUint8:
+      return LoadScalar<uint8_t>(p, big_endian);
+    case PlyType::kInt16:
+      return LoadScalar<int16_t>(p, big_endian);
+    case PlyType::kUint16:
+      return LoadScalar<uint16_t>(p, big_endian);
+    case PlyType::kInt32:
+      return LoadScalar<int32_t>(p, big_endian);
+    case PlyType::kUint32:
+      return LoadScalar<uint32_t>(p, big_endian);
+    case PlyType::kFloat32:
+      return LoadScalar<float>(p, big_endian);
+    case PlyType::kFloat64:
+      return LoadScalar<double>(p, big_endian);
   }
   return 0;
 }

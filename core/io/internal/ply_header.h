@@ -40,6 +40,9 @@ struct PlyHeader {
 // Size in bytes of one value of `type` in a binary body.
 size_t PlyTypeSize(PlyType type);
 
+// One value of `type` stored at `p` in a binary body, in that byte order, as a double.
+double LoadPlyValue(const char* p, PlyType type, bool big_endian);
+
 // True for the integer types.
 bool IsIntegralPlyType(PlyType type);
 

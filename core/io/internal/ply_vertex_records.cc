@@ -5,7 +5,6 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
-#include "core/io/internal/binary.h"
 #include "core/io/internal/ply.h"
 #include "core/io/internal/ply_header.h"
 #include "core/status_macros.h"
@@ -15,29 +14,6 @@ namespace {
 
 absl::Status Invalid(absl::string_view message) {
   return absl::InvalidArgumentError(absl::StrCat("PLY: ", message));
-}
-
-// One scalar of `type` at `p`, as a double.
-double LoadValue(const char* p, PlyType type, bool big_endian) {
-  switch (type) {
-    case PlyType::kInt8:
-      return LoadScalar<int8_t>(p, big_endian);
-    case PlyType::kUint8:
-      return LoadScalar<uint8_t>(p, big_endian);
-    case PlyType::kInt16:
-      return LoadScalar<int16_t>(p, big_endian);
-    case PlyType::kUint16:
-      return LoadScalar<uint16_t>(p, big_endian);
-    case PlyType::kInt32:
-      return LoadScalar<int32_t>(p, big_endian);
-    case PlyType::kUint32:
-      return LoadScalar<uint32_t>(p, big_endian);
-    case PlyType::kFloat32:
-      return LoadScalar<float>(p, big_endian);
-    case PlyType::kFloat64:
-      return LoadScalar<double>(p, big_endian);
-  }
-  return 0;
 }
 
 // The size of one record of `element`, or an error for a list property.
@@ -78,7 +54,7 @@ class VertexRecords final : public PointRecords {
   Point3d Position(uint64_t i) const override {
     const char* record = Address(i);
     Point3d p;
-    for (int c = 0; c < 3; ++c) p[c] = LoadValue(record + offsets_[c], types_[c], big_endian_);
+    for (int c = 0; c < 3; ++c) p[c] = LoadPlyValue(record + offsets_[c], types_[c], big_endian_);
     return p;
   }
   const char* Address(uint64_t i) const override { return data_.data() + first_ + i * length_; }

@@ -1,7 +1,7 @@
 // The point records of a file whose records all have one size, read one at a time where they
 // lie in the file's bytes instead of parsed all at once: what off-core sampling reads
-// (core/sampling/off_core_sampler.h). LAS files (las.h) and binary PLY files
-// (ply_vertex_records.h) have such records.
+// (core/sampling/off_core_sampler.h). Uncompressed LAS files (las.h), binary PLY files
+// (ply_vertex_records.h) and PCD files of binary data (pcd.h) have such records.
 #ifndef NEURALMESH_CORE_IO_INTERNAL_POINT_RECORDS_H_
 #define NEURALMESH_CORE_IO_INTERNAL_POINT_RECORDS_H_
 

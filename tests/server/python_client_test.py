@@ -2,7 +2,8 @@
 """A neuralmesh.v1 client in Python, against the .proto only (not our C++ client).
 
 Generates stubs with Debian's python3-grpc-tools into a temporary directory, then, against a
-running server: checks the health service and server reflection, creates a session, uploads a
+running server: checks the health service and server reflection, creates a session (with the
+paper's early phase, which the session echoes; an invalid one is refused), uploads a
 sphere in batches (client streaming), watches it (server streaming), finishes it, fetches the
 final mesh, checks that a NaN batch is rejected with INVALID_ARGUMENT, runs one Reconstruct
 call (bidirectional) and hands a session to another client. With --root_cert and --token it
@@ -139,10 +140,25 @@ def main():
     config = pb.SessionConfig(target_vertices=300)
     config.refresh_interval_ms.value = 50
     config.learner.alpha_w.value = 0.06
+    # The paper's early phase (its David setting, scaled down): C_vs = 300 up to 200 vertices.
+    config.learner.early_phase_vertices.value = 200
+    config.learner.early_c_vs.value = 300
     session = service.CreateSession(pb.CreateSessionRequest(config=config, name="python"),
                                  timeout=10)
     check(session.session_id.startswith("s-"), "unexpected session id " + session.session_id)
     check(session.config.learner.c_vs.value == 100, "defaults are not echoed")
+    check(session.config.learner.early_phase_vertices.value == 200 and
+          session.config.learner.early_c_vs.value == 300 and
+          session.config.learner.early_c_ec.value == 8,
+          "the early phase is not echoed: %s" % session.config.learner)
+    try:
+        bad = pb.SessionConfig(target_vertices=300)
+        bad.learner.early_c_ec.value = 0
+        service.CreateSession(pb.CreateSessionRequest(config=bad), timeout=10)
+        check(False, "early_c_ec = 0 was accepted")
+    except grpc.RpcError as e:
+        check(e.code() == grpc.StatusCode.INVALID_ARGUMENT and "early_c_ec" in e.details(),
+              "early_c_ec = 0 gave %s: %s" % (e.code(), e.details()))
     sid = session.session_id
 
     updates = []

@@ -6,11 +6,14 @@
 // file opened, or read and its sampler built), until the first coarse mesh (1,000 vertices)
 // and until the last, and the memory the process holds then: anonymous (its own allocations:
 // the points read whole) and file-backed (the pages of the mapped file that were touched).
-// The file is in the page cache when both start (it has just been written): off-core reading
-// from a disk costs a read per sample that misses the cache, which this does not measure.
+// The file is in the page cache when both start (it has just been written), or with --cold
+// dropped from it before each (posix_fadvise DONTNEED), as a file read from the disk.
 //
 //   build/bin/off-core-bench [--points=20000000] [--vertices=20000] [--format=las|ply]
-//                            [--file=PATH] [--keep]
+//                            [--cold] [--file=PATH] [--keep]
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -32,6 +35,7 @@ ABSL_FLAG(size_t, vertices, 20000, "Vertices to learn each way.");
 ABSL_FLAG(std::string, format, "las", "The file's format: las or ply.");
 ABSL_FLAG(std::string, file, "", "Where the file is written; /tmp/off-core-bench.FORMAT if empty.");
 ABSL_FLAG(bool, keep, false, "Keep the LAS file afterwards.");
+ABSL_FLAG(bool, cold, false, "Drop the file from the page cache before each way.");
 
 namespace neuralmesh {
 namespace {
@@ -40,6 +44,16 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Drops the file at `path` from the page cache, when --cold says so.
+void MaybeDropFromPageCache(const std::string& path) {
+  if (!absl::GetFlag(FLAGS_cold)) return;
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) return;
+  ::fdatasync(fd);
+  ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
+  ::close(fd);
 }
 
 // A field of /proc/self/status in MB ("RssAnon", "RssFile"), or -1.
@@ -114,6 +128,7 @@ int Run() {
 
   bool ok = true;
   {
+    MaybeDropFromPageCache(path);
     const Clock::time_point start = Clock::now();
     absl::StatusOr<std::unique_ptr<OffCoreSampler>> sampler = OffCoreSampler::Open(path);
     if (!sampler.ok()) {
@@ -123,6 +138,7 @@ int Run() {
     ok = LearnAndPrint("off-core", **sampler, SecondsSince(start), vertices, start);
   }
   if (ok) {
+    MaybeDropFromPageCache(path);
     const Clock::time_point start = Clock::now();
     absl::StatusOr<PointCloud> cloud = ReadPointCloud(path);
     if (!cloud.ok()) {
@@ -149,6 +165,6 @@ int main(int argc, char** argv) {
       argc, argv,
       "Off-core sampling of a LAS or PLY file against reading it whole.\n"
       "  build/bin/off-core-bench [--points=20000000] [--vertices=20000] [--format=las|ply]\n"
-      "                           [--file=PATH] [--keep]");
+      "                           [--cold] [--file=PATH] [--keep]");
   return neuralmesh::Run();
 }

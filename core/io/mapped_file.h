@@ -14,9 +14,11 @@ namespace neuralmesh {
 
 class MappedFile {
  public:
-  // Maps the whole file at `path`, advised for random access. Returns NOT_FOUND ("cannot open
-  // 'path': reason") when it cannot be opened, mapped or is not a regular file, and
-  // INVALID_ARGUMENT when it is empty (ReadFileContents's messages).
+  // Maps the whole file at `path` for reading at random. A file of at most half the memory
+  // available is read into the page cache in the background, in order (read_ahead()); a larger
+  // one page by page where it is touched. Returns NOT_FOUND ("cannot open 'path': reason") when
+  // it cannot be opened, mapped or is not a regular file, and INVALID_ARGUMENT when it is empty
+  // (ReadFileContents's messages).
   static absl::StatusOr<MappedFile> Open(const std::string& path);
 
   MappedFile(MappedFile&& other) noexcept;
@@ -27,12 +29,16 @@ class MappedFile {
 
   // The file's bytes, valid while this object lives.
   absl::string_view data() const { return absl::string_view(data_, size_); }
+  // Whether the whole file is being read ahead into the page cache.
+  bool read_ahead() const { return read_ahead_; }
 
  private:
-  MappedFile(const char* data, size_t size) : data_(data), size_(size) {}
+  MappedFile(const char* data, size_t size, bool read_ahead)
+      : data_(data), size_(size), read_ahead_(read_ahead) {}
 
   const char* data_ = nullptr;
   size_t size_ = 0;
+  bool read_ahead_ = false;
 };
 
 }  // namespace neuralmesh

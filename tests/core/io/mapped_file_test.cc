@@ -19,6 +19,7 @@ TEST(MappedFileTest, HoldsTheFilesBytesWhileItLivesMovedOrNot) {
   absl::StatusOr<MappedFile> file = MappedFile::Open(path);
   ASSERT_TRUE(file.ok()) << file.status();
   EXPECT_EQ(file->data(), bytes);
+  EXPECT_TRUE(file->read_ahead()) << "100 KB fit in memory";
   MappedFile moved = *std::move(file);
   EXPECT_EQ(moved.data(), bytes);
   EXPECT_TRUE(file->data().empty()) << "the moved-from object holds nothing";

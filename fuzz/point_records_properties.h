@@ -1,12 +1,13 @@
 // What off-core sampling reads (core/io/internal/point_records.h) must agree with what the
-// format's parser reads whole, checked by the LAS and PLY fuzzers: where the parser takes the
-// file, the kept records are its points, in order, each narrowing to the point the parser
+// format's parser reads whole, checked by the LAS, PLY and PCD fuzzers: where the parser takes
+// the file, the kept records are its points, in order, each narrowing to the point the parser
 // gives relative to its origin; and every record can be read (AddressSanitizer sees a read
 // past the file).
 #ifndef NEURALMESH_FUZZ_POINT_RECORDS_PROPERTIES_H_
 #define NEURALMESH_FUZZ_POINT_RECORDS_PROPERTIES_H_
 
 #include <cstdint>
+#include <optional>
 
 #include "core/io/internal/geometry_data.h"
 #include "core/io/internal/point_records.h"
@@ -19,13 +20,13 @@ inline void CheckRecordsAgreeWithParser(const io_internal::PointRecords& records
                                         const io_internal::ParsedGeometry* parsed) {
   uint64_t kept = 0;
   for (uint64_t i = 0; i < records.size(); ++i) {
-    const io_internal::Point3d p = records.Position(i);
-    if (!records.Kept(i)) continue;
+    const std::optional<io_internal::Point3d> p = records.KeptPoint(i);
+    if (!p.has_value()) continue;
     if (parsed != nullptr) {
       FUZZ_CHECK(kept < parsed->positions.size(), "more records kept than the %zu points read",
                  parsed->positions.size());
       for (int c = 0; c < 3; ++c) {
-        const float narrowed = io_internal::NarrowToFloat(p[c] - parsed->origin[c]);
+        const float narrowed = io_internal::NarrowToFloat((*p)[c] - parsed->origin[c]);
         FUZZ_CHECK(narrowed == parsed->positions[kept][c],
                    "record %llu (point %llu), axis %d: %.9g where the parser read %.9g",
                    static_cast<unsigned long long>(i), static_cast<unsigned long long>(kept), c,

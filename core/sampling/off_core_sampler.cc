@@ -79,9 +79,10 @@ absl::StatusOr<std::unique_ptr<OffCoreSampler>> OffCoreSampler::Open(
   Random probe(kProbeSeed);
   for (int i = 0; i < kProbeRecords; ++i) {
     const uint64_t r = probe.NextIndex(points.size());
-    if (!points.Kept(r) || !Learnable(ToVec3(points.Position(r)))) continue;
+    const std::optional<Point3d> p = points.KeptPoint(r);
+    if (!p.has_value() || !Learnable(ToVec3(*p))) continue;
     ++kept;
-    probed.Extend(ToVec3(points.Position(r)));
+    probed.Extend(ToVec3(*p));
   }
   sampler->kept_share_ = static_cast<double>(kept) / kProbeRecords;
   if (sampler->kept_share_ < kLeastKeptShare) {
@@ -127,8 +128,9 @@ Vec3 OffCoreSampler::Sample(Random& rng) const {
   Random tries(rng.NextU64());  // One draw of `rng` per sample, however many records it reads.
   while (true) {
     const uint64_t r = tries.NextIndex(records_->size());
-    if (!records_->Kept(r)) continue;
-    const Vec3 sample = ToVec3(records_->Position(r)) - ToVec3(origin_);
+    const std::optional<Point3d> p = records_->KeptPoint(r);
+    if (!p.has_value()) continue;
+    const Vec3 sample = ToVec3(*p) - ToVec3(origin_);
     if (Learnable(sample)) return sample;
   }
 }

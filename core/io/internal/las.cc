@@ -495,12 +495,9 @@ absl::StatusOr<std::unique_ptr<LasRecords>> LasRecords::Create(
   return records;
 }
 
-bool LasRecords::Kept(uint64_t i) const {
-  return Usability(data_, first_ + i * length_, format_, classes_) == kUsable;
-}
-
-Point3d LasRecords::Position(uint64_t i) const {
+std::optional<Point3d> LasRecords::KeptPoint(uint64_t i) const {
   const size_t at = first_ + i * length_;
+  if (Usability(data_, at, format_, classes_) != kUsable) return std::nullopt;
   Point3d p;
   for (int c = 0; c < 3; ++c) p[c] = Load<int32_t>(data_, at + 4 * c) * scale_[c] + offset_[c];
   return p;

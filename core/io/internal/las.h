@@ -48,11 +48,9 @@ class LasRecords final : public PointRecords {
       absl::string_view data, const std::optional<LasClasses>& classes);
 
   uint64_t size() const override { return count_; }
-  // Whether ParseLas reads record i: not withheld, and of a class in `classes`, or without
-  // them of no noise class.
-  bool Kept(uint64_t i) const override;
-  // Its integers times the scale, plus the offset.
-  Point3d Position(uint64_t i) const override;
+  // Its integers times the scale, plus the offset, when ParseLas reads it: not withheld, and of
+  // a class in `classes`, or without them of no noise class.
+  std::optional<Point3d> KeptPoint(uint64_t i) const override;
   const char* Address(uint64_t i) const override { return data_.data() + first_ + i * length_; }
   bool has_colors() const override;
   // Each axis's scale, made positive.

@@ -391,18 +391,13 @@ class BinaryPointRecords final : public PointRecords {
       : body_(body), header_(std::move(header)), roles_(roles) {}
 
   uint64_t size() const override { return header_.points; }
-  bool Kept(uint64_t i) const override {
-    const Point3d p = Position(i);
-    for (int c = 0; c < 3; ++c) {
-      if (!std::isfinite(NarrowToFloat(p[c]))) return false;
-    }
-    return true;
-  }
-  Point3d Position(uint64_t i) const override {
+  // Kept as ParsePcd keeps a point: with a position.
+  std::optional<Point3d> KeptPoint(uint64_t i) const override {
     Point3d p;
     for (int c = 0; c < 3; ++c) {
       const Field& field = header_.fields[roles_.position[c]];
       p[c] = ValueAt(Address(i) + field.offset, field);
+      if (!std::isfinite(NarrowToFloat(p[c]))) return std::nullopt;
     }
     return p;
   }

@@ -47,14 +47,14 @@ class VertexRecords final : public PointRecords {
   }
 
   uint64_t size() const override { return count_; }
-  bool Kept(uint64_t i) const override {
-    const Point3d p = Position(i);
-    return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
-  }
-  Point3d Position(uint64_t i) const override {
+  // Kept when its coordinates are finite.
+  std::optional<Point3d> KeptPoint(uint64_t i) const override {
     const char* record = Address(i);
     Point3d p;
-    for (int c = 0; c < 3; ++c) p[c] = LoadPlyValue(record + offsets_[c], types_[c], big_endian_);
+    for (int c = 0; c < 3; ++c) {
+      p[c] = LoadPlyValue(record + offsets_[c], types_[c], big_endian_);
+      if (!std::isfinite(p[c])) return std::nullopt;
+    }
     return p;
   }
   const char* Address(uint64_t i) const override { return data_.data() + first_ + i * length_; }

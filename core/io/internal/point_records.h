@@ -18,10 +18,9 @@ class PointRecords {
   virtual ~PointRecords() = default;
 
   virtual uint64_t size() const = 0;
-  // Whether reading the file whole would take record i (< size()) as a point.
-  virtual bool Kept(uint64_t i) const = 0;
-  // Record i's coordinates in the file's frame.
-  virtual Point3d Position(uint64_t i) const = 0;
+  // Record i's (< size()) coordinates in the file's frame when reading the file whole would
+  // take it as a point; nothing otherwise. Each record is read once, on the sampler's hot path.
+  virtual std::optional<Point3d> KeptPoint(uint64_t i) const = 0;
   // Where record i's bytes are (to start loading them).
   virtual const char* Address(uint64_t i) const = 0;
   // Whether the records carry colours.

@@ -158,27 +158,23 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::vector<std::string>& inpu
   return target;
 }
 
-absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string>& inputs,
-                                                   SamplingMode mode, bool remove_outliers,
-                                                   const PointSelection& selection) {
+absl::StatusOr<MappedPointFile> OpenOffCoreFile(const std::vector<std::string>& inputs,
+                                                bool remove_outliers,
+                                                const PointSelection& selection) {
   if (inputs.size() != 1) {
     return absl::InvalidArgumentError(
-        "--off_core samples one file where it lies; several INPUTs are read whole and learned "
-        "as one without it");
+        "--off_core reads one file where it lies; several INPUTs are read whole and learned as "
+        "one without it");
   }
   const std::string& input = inputs.front();
-  const bool sampled_where_it_lies =
+  const bool read_where_it_lies =
       absl::EndsWithIgnoreCase(input, ".las") || absl::EndsWithIgnoreCase(input, ".laz") ||
       absl::EndsWithIgnoreCase(input, ".ply") || absl::EndsWithIgnoreCase(input, ".pcd");
-  if (IsBuiltin(input) || !sampled_where_it_lies) {
+  if (IsBuiltin(input) || !read_where_it_lies) {
     return absl::InvalidArgumentError(
-        absl::StrCat("--off_core samples uncompressed LAS (.las), binary PLY (.ply) and binary "
+        absl::StrCat("--off_core reads uncompressed LAS (.las), binary PLY (.ply) and binary "
                      "PCD (.pcd) files where they lie; INPUT '",
                      input, "' is read whole without it"));
-  }
-  if (mode != SamplingMode::kUniform) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--off_core samples uniformly, not by --sampling ", ModeName(mode)));
   }
   if (remove_outliers) {
     return absl::InvalidArgumentError(
@@ -186,17 +182,26 @@ absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string
         "whole: not with --off_core");
   }
   NM_RETURN_IF_ERROR(CheckInputFile(input, "INPUT"));
-  absl::StatusOr<std::unique_ptr<OffCoreSampler>> sampler =
-      OffCoreSampler::Open(input, selection.las_classes);
-  if (!sampler.ok()) return InFile(sampler.status(), "INPUT", input);
+  absl::StatusOr<MappedPointFile> file = MappedPointFile::Open(input, selection.las_classes);
+  if (!file.ok()) return InFile(file.status(), "INPUT", input);
+  return file;
+}
+
+absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string>& inputs,
+                                                   SamplingMode mode, bool remove_outliers,
+                                                   const PointSelection& selection) {
+  if (mode != SamplingMode::kUniform) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--off_core samples uniformly, not by --sampling ", ModeName(mode)));
+  }
+  NM_ASSIGN_OR_RETURN(MappedPointFile file, OpenOffCoreFile(inputs, remove_outliers, selection));
   TargetSpace target;
-  target.origin = (*sampler)->origin();
+  target.origin = file.origin();
   target.description = absl::StrFormat(
       "the %d records of %s, sampled where they lie (off-core; %.1f%% of them points to read%s%s)",
-      (*sampler)->records(), input, 100 * (*sampler)->kept_share(),
-      (*sampler)->has_colors() ? "; colours are not painted off-core" : "",
-      OriginNote(target.origin));
-  target.sampler = *std::move(sampler);
+      file.records(), inputs.front(), 100 * file.kept_share(),
+      file.has_colors() ? "; colours are not painted off-core" : "", OriginNote(target.origin));
+  target.sampler = std::make_unique<OffCoreSampler>(std::move(file));
   return target;
 }
 

@@ -15,6 +15,7 @@
 #include "absl/strings/string_view.h"
 #include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
+#include "core/io/mapped_point_file.h"
 #include "core/io/point_selection.h"
 #include "core/point_cloud.h"
 #include "core/sampling/sampler.h"
@@ -61,12 +62,18 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(
     const std::optional<PointColorOptions>& colors = std::nullopt,
     const PointSelection& selection = {});
 
-// The target space of `inputs` sampled off-core (--off_core, OffCoreSampler): the records of
-// one uncompressed LAS, binary PLY or binary PCD file read where they lie, a LAS file's with
-// `selection`'s classes. Returns INVALID_ARGUMENT, saying why, for other inputs (several,
-// builtin:NAME, another format), a sampling mode other than uniform, or outlier removal (which
-// needs every point in memory); OffCoreSampler's errors. Colours are not painted off-core: the
-// description says so when the file carries them.
+// The one file of `inputs` read where it lies (--off_core): an uncompressed LAS, binary PLY or
+// binary PCD file mapped into memory, a LAS file's records with `selection`'s classes. Returns
+// INVALID_ARGUMENT, saying why, for other inputs (several, builtin:NAME, another format) or
+// outlier removal in the client (which needs every point in memory); MappedPointFile::Open's
+// errors, naming INPUT.
+absl::StatusOr<MappedPointFile> OpenOffCoreFile(const std::vector<std::string>& inputs,
+                                                bool remove_outliers,
+                                                const PointSelection& selection = {});
+
+// The target space of `inputs` sampled off-core (OffCoreSampler on OpenOffCoreFile's file).
+// Returns INVALID_ARGUMENT for a sampling mode other than uniform; OpenOffCoreFile's errors.
+// Colours are not painted off-core: the description says so when the file carries them.
 absl::StatusOr<TargetSpace> LoadOffCoreTargetSpace(const std::vector<std::string>& inputs,
                                                    SamplingMode mode, bool remove_outliers,
                                                    const PointSelection& selection = {});

@@ -130,11 +130,16 @@ ABSL_FLAG(std::string, start_mesh, "",
           "mesh is sent exactly (CreateSessionRequest.start_mesh); not with --resume.");
 
 ABSL_FLAG(bool, off_core, false,
-          "Sample the one INPUT, an uncompressed LAS, binary PLY or binary PCD file, where it "
-          "lies, mapped into memory, instead of reading it: learning starts at once whatever "
-          "the file's size, and memory holds the mesh, not the points (the paper's off-core "
-          "learning of 28 million points, Section 4.1). Uniform sampling; no "
-          "--remove_outliers; colours are not painted. Local only.");
+          "Read the one INPUT, an uncompressed LAS, binary PLY or binary PCD file, where it "
+          "lies, mapped into memory, instead of reading it whole: learning (or the upload) "
+          "starts at once whatever the file's size, and memory holds the mesh, not the points "
+          "(the paper's off-core learning of 28 million points, Section 4.1). Locally, records "
+          "are sampled where they lie (uniform sampling; colours are not painted). With "
+          "--server, the records are uploaded in an order spread over the whole file from the "
+          "first batch on (blocks of 256 records along a golden-ratio stride), so the first "
+          "meshes outline the whole scan; positions only, and --resume reads the records "
+          "before the session's points again. No --remove_outliers in the client "
+          "(--outliers_on_server is fine).");
 
 ABSL_FLAG(std::string, pcd_data, "binary",
           "How convert stores the points of a .pcd OUTPUT (its DATA line): binary (point "
@@ -487,9 +492,6 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     NM_RETURN_IF_ERROR(RejectFlags(
         args, {"output", "sampling", "time_budget", "max_steps", "gltf_draco"},
         "applies to a local reconstruct only (the server picks its own budget; use --out-dir)"));
-    NM_RETURN_IF_ERROR(RejectFlags(
-        args, {"off_core"},
-        "samples a local file where it lies; a server learns the points uploaded to it"));
     neuralmesh::client::RemoteReconstructOptions o;
     o.inputs = args.positional;
     o.server = absl::GetFlag(FLAGS_server);
@@ -500,6 +502,7 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     NM_ASSIGN_OR_RETURN(o.outliers, OutliersFromFlags());
     NM_ASSIGN_OR_RETURN(o.selection, SelectionFromFlags(o.inputs));
     o.outliers_on_server = absl::GetFlag(FLAGS_outliers_on_server);
+    o.off_core = absl::GetFlag(FLAGS_off_core);
     NM_ASSIGN_OR_RETURN(o.colors, ColorsFromFlags());
     if (o.outliers_on_server && !o.outliers.has_value()) {
       return absl::InvalidArgumentError("--outliers_on_server needs --remove_outliers");

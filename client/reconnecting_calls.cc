@@ -112,22 +112,33 @@ absl::StatusOr<v1::UploadPointsResponse> UploadPointsReconnecting(
     ReconstructionClient& client, const std::string& session_id, const PointCloud& cloud,
     size_t batch_size, const ReconstructionClient::UploadProgress& progress, size_t first_point,
     const ReconnectOptions& options) {
+  if (cloud.empty()) return absl::InvalidArgumentError("UploadPoints: no points to upload");
+  CloudUpload upload(cloud);
+  return UploadPointsReconnecting(client, session_id, upload, batch_size, progress, first_point,
+                                  options);
+}
+
+absl::StatusOr<v1::UploadPointsResponse> UploadPointsReconnecting(
+    ReconstructionClient& client, const std::string& session_id, PointUpload& upload,
+    size_t batch_size, const ReconstructionClient::UploadProgress& progress, uint64_t first_point,
+    const ReconnectOptions& options) {
   Reconnection reconnection(client, session_id, options);
-  size_t from = first_point;
+  uint64_t from = first_point;
   while (true) {
     absl::StatusOr<v1::UploadPointsResponse> response =
-        client.UploadPoints(session_id, cloud, batch_size, progress, from);
+        client.UploadPoints(session_id, upload, batch_size, progress, from);
     if (response.ok()) return response;
     NM_ASSIGN_OR_RETURN(const v1::Session session, reconnection.Recover(response.status()));
-    if (session.points_taken() > cloud.size()) {
+    if (!upload.SkipTo(session.points_taken()).ok()) {
       return absl::FailedPreconditionError(absl::StrCat(
           "session ", session_id, " has taken ", session.points_taken(), " points, more than the ",
-          cloud.size(), " of this upload: another client uploads into it"));
+          upload.size().value_or(0), " of this upload: another client uploads into it"));
     }
     if (session.points_taken() > from) reconnection.Progressed();
-    from = static_cast<size_t>(session.points_taken());
-    reconnection.Notify(absl::StrCat("reconnected: the upload into session ", session_id,
-                                     " goes on at point ", from, " of ", cloud.size()));
+    from = session.points_taken();
+    reconnection.Notify(absl::StrCat(
+        "reconnected: the upload into session ", session_id, " goes on at point ", from,
+        upload.size().has_value() ? absl::StrCat(" of ", *upload.size()) : std::string()));
   }
 }
 

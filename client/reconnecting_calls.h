@@ -51,6 +51,10 @@ absl::StatusOr<v1::UploadPointsResponse> UploadPointsReconnecting(
     ReconstructionClient& client, const std::string& session_id, const PointCloud& cloud,
     size_t batch_size, const ReconstructionClient::UploadProgress& progress, size_t first_point,
     const ReconnectOptions& options);
+absl::StatusOr<v1::UploadPointsResponse> UploadPointsReconnecting(
+    ReconstructionClient& client, const std::string& session_id, PointUpload& upload,
+    size_t batch_size, const ReconstructionClient::UploadProgress& progress, uint64_t first_point,
+    const ReconnectOptions& options);
 
 // Watch (the same arguments) that watches again after lost connections.
 absl::Status WatchReconnecting(ReconstructionClient& client, const std::string& session_id,

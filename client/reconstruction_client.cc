@@ -161,31 +161,47 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
     const std::string& session_id, const PointCloud& cloud, size_t batch_size,
     const UploadProgress& progress, size_t first_point) {
   if (cloud.empty()) return absl::InvalidArgumentError("UploadPoints: no points to upload");
+  CloudUpload upload(cloud);
+  return UploadPoints(session_id, upload, batch_size, progress, first_point);
+}
+
+absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
+    const std::string& session_id, PointUpload& upload, size_t batch_size,
+    const UploadProgress& progress, uint64_t first_point) {
   if (batch_size == 0) return absl::InvalidArgumentError("UploadPoints: batch size must be > 0");
-  if (first_point > cloud.size()) {
-    return absl::InvalidArgumentError(absl::StrCat("UploadPoints: the upload cannot start at point ",
-                                                   first_point, " of ", cloud.size()));
+  absl::StatusOr<v1::PointBatch> batch = upload.Batch(first_point, batch_size);
+  if (!batch.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("UploadPoints: ", batch.status().message()));
   }
   v1::UploadPointsResponse response;
   response.set_session_id(session_id);
   // A resumed upload whose every point the session has already: nothing to send.
-  if (first_point == cloud.size()) return response;
+  if (batch->packed().positions().empty()) return response;
   grpc::ClientContext context;
   const OpenCall open(*this, context);
   std::unique_ptr<grpc::ClientWriter<v1::UploadPointsRequest>> writer =
       stub_->UploadPoints(&context, &response);
   v1::UploadPointsRequest request;
   request.set_session_id(session_id);
-  for (size_t begin = first_point; begin < cloud.size(); begin += batch_size) {
-    const size_t end = std::min(cloud.size(), begin + batch_size);
-    *request.mutable_batch() = PackPointBatch(cloud, begin, end);
+  absl::Status batch_status;
+  while (true) {
+    const uint64_t points = batch->packed().positions().size() / (3 * sizeof(float));
+    *request.mutable_batch() = *std::move(batch);
     // A failed write means the call is over (the server rejected a batch or went away);
     // Finish() below returns why.
     if (!writer->Write(request)) break;
-    if (progress) progress(end, cloud.size());
+    if (progress) progress(upload.done(), upload.total());
+    batch = upload.Batch(request.batch().first_point().value() + points, batch_size);
+    if (!batch.ok()) {
+      batch_status = batch.status();
+      context.TryCancel();
+      break;
+    }
+    if (batch->packed().positions().empty()) break;
   }
   writer->WritesDone();
   const grpc::Status status = writer->Finish();
+  if (!batch_status.ok()) return batch_status;
   if (!status.ok()) return FromGrpcStatus(status, "UploadPoints");
   return response;
 }

@@ -33,6 +33,7 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "client/channel_credentials.h"
+#include "client/point_upload.h"
 #include "core/point_cloud.h"
 #include "core/triangle_mesh.h"
 #include "neuralmesh/v1/reconstruction.grpc.pb.h"
@@ -93,7 +94,8 @@ class ReconstructionClient {
                                             const std::string& name,
                                             const TriangleMesh* start_mesh = nullptr);
 
-  // Called after each batch is written, with the points written so far and the total.
+  // Called after each batch is written, with the points written so far and the total (for a
+  // file read where it lies, its records read so far and their number).
   using UploadProgress = std::function<void(uint64_t points_sent, uint64_t points_total)>;
 
   // Streams `cloud` into the session in batches of at most `batch_size` points (packed
@@ -108,6 +110,12 @@ class ReconstructionClient {
                                                         const PointCloud& cloud, size_t batch_size,
                                                         const UploadProgress& progress = {},
                                                         size_t first_point = 0);
+  // The same for the points of `upload` (a file's records read where they lie:
+  // FileRecordsUpload), with its progress (PointUpload::done and total); its errors.
+  absl::StatusOr<v1::UploadPointsResponse> UploadPoints(const std::string& session_id,
+                                                        PointUpload& upload, size_t batch_size,
+                                                        const UploadProgress& progress = {},
+                                                        uint64_t first_point = 0);
 
   // Called with each published mesh; returning false ends the watch early.
   using UpdateCallback = std::function<bool(const v1::MeshUpdate&)>;

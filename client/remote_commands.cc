@@ -15,6 +15,7 @@
 #include "client/interrupt.h"
 #include "client/lod_plan.h"
 #include "client/mesh_update_writer.h"
+#include "client/point_upload.h"
 #include "client/progress_bar.h"
 #include "client/proto_conversion.h"
 #include "client/reconnecting_calls.h"
@@ -59,6 +60,68 @@ absl::Status ExplainWatchEnd(const absl::Status& status, const std::string& sess
   return status;
 }
 
+// What an upload sends, and what the session is told of it before the first batch.
+struct UploadInput {
+  std::unique_ptr<PointCloud> cloud;      // The points, read whole (not off-core).
+  std::unique_ptr<MappedPointFile> file;  // Off-core: the file, read where it lies.
+  std::unique_ptr<PointUpload> points;    // Of `cloud` or of `file`.
+  Origin origin = kNoOrigin;
+  BoundingBox bounds;
+  // The points to send; off-core an estimate (the records times the share of the probe's that
+  // are points), as `estimated` says.
+  uint64_t size = 0;
+  bool estimated = false;
+};
+
+// The input of `options`: read whole (outliers removed when the client removes them, colours
+// dropped unless asked for), or off-core its one file mapped; what was done is said on `out`.
+absl::StatusOr<UploadInput> LoadUploadInput(const RemoteReconstructOptions& options,
+                                            bool outliers_on_server, std::ostream& out) {
+  UploadInput input;
+  if (options.off_core) {
+    NM_ASSIGN_OR_RETURN(
+        MappedPointFile file,
+        OpenOffCoreFile(options.inputs, options.outliers.has_value() && !outliers_on_server,
+                        options.selection));
+    input.file = std::make_unique<MappedPointFile>(std::move(file));
+    input.points = std::make_unique<FileRecordsUpload>(*input.file);
+    input.origin = input.file->origin();
+    input.bounds = input.file->bounds();
+    input.size = static_cast<uint64_t>(
+        std::llround(static_cast<double>(input.file->records()) * input.file->kept_share()));
+    input.estimated = true;
+    out << absl::StrFormat(
+        "INPUT '%s': %d records read where they lie (off-core; %.1f%% of them points%s)%s\n",
+        options.inputs.front(), input.file->records(), 100 * input.file->kept_share(),
+        input.file->has_colors() ? "; colours are not sent off-core" : "",
+        OriginNote(input.origin));
+    return input;
+  }
+  PointsLeftOut left_out;
+  std::string merge_note;
+  NM_ASSIGN_OR_RETURN(PointCloud points, LoadPointsForUpload(options.inputs, options.builtin_points,
+                                                             options.learner.seed, &left_out,
+                                                             &merge_note, options.selection));
+  input.cloud = std::make_unique<PointCloud>(std::move(points));
+  PointCloud& cloud = *input.cloud;
+  const size_t points_read = cloud.size();
+  if (!options.colors) cloud.colors.clear();
+  if (options.outliers.has_value() && !outliers_on_server) {
+    NM_ASSIGN_OR_RETURN(const size_t removed, RemoveStatisticalOutliers(cloud, *options.outliers));
+    out << "outliers removed: " << removed << " of " << points_read << " points\n";
+  }
+  if (const std::string notes =
+          absl::StrCat(merge_note, LeftOutNote(left_out), OriginNote(cloud.origin));
+      !notes.empty()) {
+    out << "INPUT " << QuotedInputs(options.inputs) << notes << "\n";
+  }
+  input.points = std::make_unique<CloudUpload>(cloud);
+  input.origin = cloud.origin;
+  input.bounds = BoundsOf(cloud);
+  input.size = cloud.size();
+  return input;
+}
+
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<ReconstructionClient>> ConnectTo(const std::string& server,
@@ -73,24 +136,8 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   NM_RETURN_IF_ERROR(options.draco.Validate());
   if (options.out_dir.empty()) return absl::InvalidArgumentError("--out-dir DIR is required");
   if (options.batch_size == 0) return absl::InvalidArgumentError("--batch-size must be > 0");
-  PointsLeftOut left_out;
-  std::string merge_note;
-  NM_ASSIGN_OR_RETURN(PointCloud cloud,
-                      LoadPointsForUpload(options.inputs, options.builtin_points,
-                                          options.learner.seed, &left_out, &merge_note,
-                                          options.selection));
-  const size_t points_read = cloud.size();
-  if (!options.colors) cloud.colors.clear();
   const bool outliers_on_server = options.outliers.has_value() && options.outliers_on_server;
-  if (options.outliers.has_value() && !outliers_on_server) {
-    NM_ASSIGN_OR_RETURN(const size_t removed, RemoveStatisticalOutliers(cloud, *options.outliers));
-    out << "outliers removed: " << removed << " of " << points_read << " points\n";
-  }
-  if (const std::string notes =
-          absl::StrCat(merge_note, LeftOutNote(left_out), OriginNote(cloud.origin));
-      !notes.empty()) {
-    out << "INPUT " << QuotedInputs(options.inputs) << notes << "\n";
-  }
+  NM_ASSIGN_OR_RETURN(UploadInput input, LoadUploadInput(options, outliers_on_server, out));
   std::optional<TriangleMesh> start_mesh;
   if (!options.start_mesh.empty()) {
     if (!options.resume_session.empty()) {
@@ -98,9 +145,9 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
           "--start_mesh applies to a new session; --resume goes on with the session's own");
     }
     NM_ASSIGN_OR_RETURN(start_mesh, ReadStartMesh(options.start_mesh));
-    NM_RETURN_IF_ERROR(MoveStartMesh(cloud.origin, options.start_mesh, &*start_mesh));
+    NM_RETURN_IF_ERROR(MoveStartMesh(input.origin, options.start_mesh, &*start_mesh));
   }
-  const size_t affordable = static_cast<size_t>(std::floor(cloud.size() / kDefaultPointsPerVertex));
+  const size_t affordable = static_cast<size_t>(std::floor(input.size / kDefaultPointsPerVertex));
   size_t target =
       options.vertices > 0 ? options.vertices : std::min(kDefaultMaxVertices, affordable);
   NM_ASSIGN_OR_RETURN(
@@ -114,10 +161,10 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     for (size_t m : milestones) config.add_lod_milestones(m);
   }
   *config.mutable_draco() = ToProto(options.draco);
-  if (cloud.origin != kNoOrigin) {
-    config.mutable_origin()->set_x(cloud.origin[0]);
-    config.mutable_origin()->set_y(cloud.origin[1]);
-    config.mutable_origin()->set_z(cloud.origin[2]);
+  if (input.origin != kNoOrigin) {
+    config.mutable_origin()->set_x(input.origin[0]);
+    config.mutable_origin()->set_y(input.origin[1]);
+    config.mutable_origin()->set_z(input.origin[2]);
   }
   if (options.colors.has_value()) {
     config.mutable_color_neighbours()->set_value(static_cast<uint32_t>(options.colors->neighbours));
@@ -128,8 +175,9 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     removal.mutable_neighbours()->set_value(options.outliers->neighbours);
     removal.mutable_std_ratio()->set_value(options.outliers->std_ratio);
   } else {
-    // All points are known before the upload: one quantization cube for the whole session.
-    *config.mutable_bounds() = ToProto(BoundsOf(cloud));
+    // Where the points lie is known before the upload: one quantization cube for the whole
+    // session (off-core, the cube of the file's probe, which grows if a point lies outside).
+    *config.mutable_bounds() = ToProto(input.bounds);
   }
 
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
@@ -161,19 +209,19 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
                                    " saves its meshes)")
                     : ""));
     }
-    if (session.points_taken() > cloud.size()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "session ", session.session_id(), " has taken ", session.points_taken(),
-          " points, more than the ", cloud.size(),
-          " of this input: resume with the input (and its flags) of the first run"));
-    }
     const v1::Origin& origin = session.config().origin();
-    if (Origin{origin.x(), origin.y(), origin.z()} != cloud.origin) {
+    if (Origin{origin.x(), origin.y(), origin.z()} != input.origin) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "session %s holds points relative to (%.15g, %.15g, %.15g), this input is read "
           "relative to (%.15g, %.15g, %.15g): resume with the input of the first run",
-          session.session_id(), origin.x(), origin.y(), origin.z(), cloud.origin[0],
-          cloud.origin[1], cloud.origin[2]));
+          session.session_id(), origin.x(), origin.y(), origin.z(), input.origin[0],
+          input.origin[1], input.origin[2]));
+    }
+    if (!input.points->SkipTo(session.points_taken()).ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("session ", session.session_id(), " has taken ", session.points_taken(),
+                       " points, more than the ", input.points->size().value_or(0),
+                       " of this input: resume with the input (and its flags) of the first run"));
     }
     first_point = static_cast<size_t>(session.points_taken());
     target = session.config().target_vertices();
@@ -183,20 +231,21 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
                                        ? session.config().points_per_vertex().value()
                                        : kDefaultPointsPerVertex;
   const size_t reachable =
-      std::min<size_t>(target, static_cast<size_t>(std::floor(cloud.size() / points_per_vertex)));
-  out << "session " << id << " on " << client->address() << ": " << cloud.size()
-      << " points, target " << target << " vertices";
+      std::min<size_t>(target, static_cast<size_t>(std::floor(input.size / points_per_vertex)));
+  out << "session " << id << " on " << client->address() << ": "
+      << (input.estimated ? "about " : "") << input.size << " points, target " << target
+      << " vertices";
   if (!options.resume_session.empty()) out << "; resuming at point " << first_point;
   out << "\n";
   if (reachable < target) {
-    err << "note: " << cloud.size() << " points allow at most " << reachable
-        << " vertices at the server's " << points_per_vertex << " points per vertex\n";
+    err << "note: " << (input.estimated ? "about " : "") << input.size << " points allow at most "
+        << reachable << " vertices at the server's " << points_per_vertex << " points per vertex\n";
   }
 
   // The watcher thread prints rows on `out` while this thread draws the upload bar on `err`;
   // both go through `mu` so a row never lands in the middle of a bar.
   absl::Mutex mu;
-  ProgressBar upload_bar(err, options.progress, "upload  ", "points");
+  ProgressBar upload_bar(err, options.progress, "upload  ", input.file ? "records" : "points");
   ProgressBar learn_bar(err, options.progress, "learning", "vertices");
   MeshUpdateWriter writer({options.out_dir, stem, options.also}, out);
   absl::Status write_status;
@@ -245,7 +294,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   };
 
   absl::StatusOr<v1::UploadPointsResponse> uploaded = UploadPointsReconnecting(
-      *client, id, cloud, options.batch_size,
+      *client, id, *input.points, options.batch_size,
       [&](uint64_t sent, uint64_t total) {
         absl::MutexLock lock(&mu);
         upload_bar.Update(sent, total);
@@ -263,7 +312,8 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
       const v1::LearningState& learning = finished->learning();
       absl::MutexLock lock(&mu);
       out << "outliers removed by the server: " << learning.points_removed_as_outliers() << " of "
-          << points_read << " points (" << learning.outliers_accepted_later()
+          << input.points->size().value_or(input.size) << " points ("
+          << learning.outliers_accepted_later()
           << " more held back on arrival and accepted later)\n";
     }
   }

@@ -39,6 +39,10 @@ struct RemoteReconstructOptions {
   std::optional<OutlierOptions> outliers;  // Set: remove the points' outliers before upload,
   bool outliers_on_server = false;         // or, when this is set, the session as they arrive.
   PointSelection selection;                // Which points of a LAS file are uploaded.
+  // Upload the one file INPUT's records read where they lie, spread over the file from the
+  // first batch on (FileRecordsUpload), instead of reading it whole: the upload starts at once
+  // and the client's memory holds no points. No client-side outlier removal; no colours.
+  bool off_core = false;
   // Set: upload the points' colours, which the session paints its meshes with, blending
   // `neighbours` points (SessionConfig.color_neighbours).
   std::optional<PointColorOptions> colors = PointColorOptions{};

@@ -1,144 +1,29 @@
 #include "core/sampling/off_core_sampler.h"
 
-#include <cmath>
-#include <limits>
 #include <utility>
 
-#include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
-#include "core/io/internal/file_util.h"
-#include "core/io/internal/las.h"
-#include "core/io/internal/laz.h"
-#include "core/io/internal/pcd.h"
-#include "core/io/internal/ply_vertex_records.h"
-#include "core/io/internal/position_collector.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh {
-namespace {
-
-using io_internal::Point3d;
-
-// Seeds the probe's draws: the same file gives the same probe.
-constexpr uint64_t kProbeSeed = 0x6c61735f70726f62;
-
-Vec3 ToVec3(const Point3d& p) { return Vec3(p[0], p[1], p[2]); }
-Point3d ToPoint3d(const Vec3& v) { return {v[0], v[1], v[2]}; }
-
-// Whether the learner can take `p` (a record's position relative to the origin): coordinates
-// that a float holds, as the readers require, so that no mesh gets an infinite vertex.
-bool Learnable(const Vec3& p) {
-  constexpr double kLargestFloat = std::numeric_limits<float>::max();
-  return std::fabs(p[0]) <= kLargestFloat && std::fabs(p[1]) <= kLargestFloat &&
-         std::fabs(p[2]) <= kLargestFloat;
-}
-
-// The records of the file `data` at `path`, by its extension.
-absl::StatusOr<std::unique_ptr<io_internal::PointRecords>> RecordsOf(
-    const std::string& path, absl::string_view data, const std::optional<LasClasses>& classes) {
-  switch (io_internal::FormatFromPath(path)) {
-    case io_internal::FileFormat::kLas: {
-      if (io_internal::IsLaz(data)) {
-        return absl::InvalidArgumentError(
-            "LAZ: its records are compressed in chunks and cannot be read one at a time; read "
-            "the file whole, or sample its decompressed LAS file");
-      }
-      absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> las =
-          io_internal::LasRecords::Create(data, classes);
-      if (!las.ok()) return las.status();
-      return std::unique_ptr<io_internal::PointRecords>(*std::move(las));
-    }
-    case io_internal::FileFormat::kPly:
-      return io_internal::PlyVertexRecords(data);
-    case io_internal::FileFormat::kPcd:
-      return io_internal::PcdPointRecords(data);
-    default:
-      return absl::InvalidArgumentError(
-          "only files whose point records all have one size, uncompressed LAS (.las), binary "
-          "PLY (.ply) and binary PCD (.pcd), can be sampled where they lie");
-  }
-}
-
-}  // namespace
 
 absl::StatusOr<std::unique_ptr<OffCoreSampler>> OffCoreSampler::Open(
     const std::string& path, const std::optional<LasClasses>& classes) {
-  NM_ASSIGN_OR_RETURN(MappedFile file, MappedFile::Open(path));
-  const auto invalid = [&path](absl::string_view message) {
-    return absl::InvalidArgumentError(absl::StrCat("'", path, "': ", message));
-  };
-  absl::StatusOr<std::unique_ptr<io_internal::PointRecords>> records =
-      RecordsOf(path, file.data(), classes);
-  if (!records.ok()) return invalid(records.status().message());
-  if ((*records)->size() == 0) return invalid("the file has no point records");
-  std::unique_ptr<OffCoreSampler> sampler(new OffCoreSampler(std::move(file), *std::move(records)));
-  const io_internal::PointRecords& points = *sampler->records_;
-
-  BoundingBox probed;
-  int kept = 0;
-  Random probe(kProbeSeed);
-  for (int i = 0; i < kProbeRecords; ++i) {
-    const uint64_t r = probe.NextIndex(points.size());
-    const std::optional<Point3d> p = points.KeptPoint(r);
-    if (!p.has_value() || !Learnable(ToVec3(*p))) continue;
-    ++kept;
-    probed.Extend(ToVec3(*p));
-  }
-  sampler->kept_share_ = static_cast<double>(kept) / kProbeRecords;
-  if (sampler->kept_share_ < kLeastKeptShare) {
-    return invalid(absl::StrFormat(
-        "%d of %d records drawn at random are points to read (the others %s): sampling the "
-        "file where it lies would read about %s records per sample; read it whole",
-        kept, kProbeRecords,
-        io_internal::FormatFromPath(path) != io_internal::FileFormat::kLas
-            ? "have a coordinate no float holds"
-        : classes.has_value() ? "withheld, noise or of other classes, or beyond a float's range"
-                              : "withheld or noise, or beyond a float's range",
-        kept == 0 ? std::string("countless") : absl::StrCat(kProbeRecords / kept)));
-  }
-  // The stated bounds, unless the probe finds them stale: records outside them, or a box more
-  // than twice the probe's (which covers nearly all of a scan's extent).
-  const std::optional<Point3d> resolution = points.Resolution();
-  const Vec3 step = resolution.has_value() ? ToVec3(*resolution) : Vec3(0, 0, 0);
-  BoundingBox bounds = probed;
-  if (const auto stated_bounds = points.StatedBounds(); stated_bounds.has_value()) {
-    const Vec3 low = ToVec3(stated_bounds->first), high = ToVec3(stated_bounds->second);
-    BoundingBox stated;
-    stated.Extend(low - step);
-    stated.Extend(high + step);
-    if (std::isfinite(stated.diagonal()) && stated.Contains(probed.min) &&
-        stated.Contains(probed.max) &&
-        stated.diagonal() <= 2 * probed.diagonal() + 4 * step.norm()) {
-      bounds.Extend(low);
-      bounds.Extend(high);
-    }
-  }
-  sampler->origin_ =
-      resolution.has_value()
-          ? io_internal::OriginKeepingResolution(ToPoint3d(bounds.min), ToPoint3d(bounds.max),
-                                                 *resolution)
-          : io_internal::OriginOfUnstatedResolution(ToPoint3d(bounds.min), ToPoint3d(bounds.max));
-  const Vec3 origin = ToVec3(sampler->origin_);
-  sampler->bounds_.Extend(bounds.min - origin);
-  sampler->bounds_.Extend(bounds.max - origin);
-  return sampler;
+  NM_ASSIGN_OR_RETURN(MappedPointFile file, MappedPointFile::Open(path, classes));
+  return std::make_unique<OffCoreSampler>(std::move(file));
 }
 
 Vec3 OffCoreSampler::Sample(Random& rng) const {
   Random tries(rng.NextU64());  // One draw of `rng` per sample, however many records it reads.
   while (true) {
-    const uint64_t r = tries.NextIndex(records_->size());
-    const std::optional<Point3d> p = records_->KeptPoint(r);
-    if (!p.has_value()) continue;
-    const Vec3 sample = ToVec3(*p) - ToVec3(origin_);
-    if (Learnable(sample)) return sample;
+    const std::optional<Vec3> point = file_.Point(tries.NextIndex(file_.records()));
+    if (point.has_value()) return *point;
   }
 }
 
 void OffCoreSampler::PrefetchSample(const Random& rng) const {
   Random peek = rng;
   Random tries(peek.NextU64());
-  __builtin_prefetch(records_->Address(tries.NextIndex(records_->size())));
+  file_.Prefetch(tries.NextIndex(file_.records()));
 }
 
 }  // namespace neuralmesh

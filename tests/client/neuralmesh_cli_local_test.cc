@@ -1038,11 +1038,6 @@ TEST_F(LocalCliTest, OffCoreLearnsALasPlyOrPcdScanWhereItLies) {
     EXPECT_TRUE(absl::StrContains(result.err, why)) << result.Describe();
   }
   EXPECT_FALSE(std::filesystem::exists(out)) << "nothing may be written";
-  const RunResult remote = RunNeuralmesh(
-      {"reconstruct", las, "--server", "127.0.0.1:1", "--out-dir", *dir_, "--off_core"});
-  EXPECT_NE(remote.exit_code, 0) << remote.Describe();
-  EXPECT_TRUE(absl::StrContains(remote.err, "--off_core samples a local file where it lies"))
-      << remote.Describe();
 }
 
 TEST_F(LocalCliTest, ClassifiedNoiseInLasScansIsLeftOutAndCounted) {

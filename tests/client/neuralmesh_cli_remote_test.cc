@@ -2,8 +2,10 @@
 // neuralmesh-server on 127.0.0.1, both run as subprocesses.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -18,10 +20,12 @@
 #include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
 #include "client/inputs.h"
+#include "client/point_upload.h"
 #include "client/reconstruction_client.h"
-#include "core/learning/learner_options.h"
+#include "core/io/mapped_point_file.h"
 #include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
+#include "core/learning/learner_options.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
@@ -457,6 +461,113 @@ TEST_F(RemoteCliTest, GeoreferencedScansComeBackInTheirCoordinates) {
                                 std::regex("\"origin\": \\[\\s*5e\\+05,\\s*4100000,\\s*0\\s*\\]")))
       << sessions.out;
   EXPECT_TRUE(absl::StrContains(sessions.out, "\"points_taken\": 6000")) << sessions.out;
+}
+
+// --off_core with --server: a georeferenced LAS scan, its building (class 6, a unit sphere)
+// stored bottom to top among ground points (class 2), uploaded from where it lies. The session
+// takes the building's every point once and learns it in the scan's coordinates; --resume goes
+// on from the points the session has taken.
+TEST_F(RemoteCliTest, OffCoreUploadsAScanFromWhereItLies) {
+  const double centre[3] = {500123.5, 4100456.25, 80};
+  testing::LasLayout layout;
+  layout.format = 1;
+  for (double& s : layout.scale) s = 0.0001;
+  layout.offset[0] = 500000;
+  layout.offset[1] = 4100000;
+  std::vector<Vec3f> sphere = ColoredUnitSpherePoints(4000, 21).positions;
+  std::sort(sphere.begin(), sphere.end(),
+            [](const Vec3f& a, const Vec3f& b) { return a[2] < b[2]; });
+  std::vector<testing::LasPoint> points;
+  for (const Vec3f& p : sphere) {
+    testing::LasPoint building{};
+    int32_t* fields[3] = {&building.x, &building.y, &building.z};
+    for (int i = 0; i < 3; ++i) {
+      *fields[i] =
+          static_cast<int32_t>(std::lround((centre[i] + p[i] - layout.offset[i]) / 0.0001));
+    }
+    building.classification = 6;
+    points.push_back(building);
+    testing::LasPoint ground{building.x + 40000, building.y, 700000};
+    ground.classification = 2;
+    points.push_back(ground);
+  }
+  const std::string las = *dir_ + "/strips.las";
+  std::ofstream(las, std::ios::binary) << testing::LasFile(layout, points);
+
+  const std::string out_dir = *dir_ + "/off_core";
+  const std::vector<std::string> upload = {"reconstruct",
+                                           las,
+                                           "--server",
+                                           server_->address(),
+                                           "--out-dir",
+                                           out_dir,
+                                           "--vertices",
+                                           "400",
+                                           "--las_classes",
+                                           "6",
+                                           "--off_core",
+                                           "--batch-size",
+                                           "500"};
+  const RunResult run = RunNeuralmesh(upload);
+  ASSERT_EQ(run.exit_code, 0) << run.Describe();
+  EXPECT_THAT(run.out, ::testing::HasSubstr(absl::StrCat(
+                           "INPUT '", las, "': 8000 records read where they lie (off-core; ")));
+  EXPECT_THAT(run.out, ::testing::HasSubstr("coordinates taken relative to (500000, 4100000, 0)"));
+  std::smatch id;
+  ASSERT_TRUE(std::regex_search(run.out, id, std::regex("session (s-[0-9a-f]+) on .*: about ")))
+      << run.out;
+  const absl::StatusOr<TriangleMesh> mesh = ReadMesh(out_dir + "/strips.drc");
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->origin, (std::array<double, 3>{500000, 4100000, 0}));
+  EXPECT_EQ(mesh->positions.size(), 400u);
+  for (const Vec3f& v : mesh->positions) {
+    double squared = 0;
+    for (int i = 0; i < 3; ++i) squared += std::pow(mesh->origin[i] + v[i] - centre[i], 2);
+    ASSERT_NEAR(std::sqrt(squared), 1.0, 0.05) << "a vertex off the building";
+  }
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
+      client::ReconstructionClient::Connect(server_->address());
+  ASSERT_TRUE(service.ok()) << service.status();
+  absl::StatusOr<v1::Session> session = (*service)->GetSession(id[1]);
+  ASSERT_TRUE(session.ok()) << session.status();
+  EXPECT_EQ(session->points_taken(), 4000u);
+  EXPECT_EQ(session->learning().points_received(), 4000u) << "every point once";
+
+  // The first 1,500 points of the same order in a session, then the command resumes it.
+  absl::StatusOr<MappedPointFile> file = MappedPointFile::Open(las, LasClasses().set(6));
+  ASSERT_TRUE(file.ok()) << file.status();
+  client::FileRecordsUpload order(*file);
+  absl::StatusOr<v1::PointBatch> first = order.Batch(0, 1500);
+  ASSERT_TRUE(first.ok()) << first.status();
+  PointCloud first_points;
+  first_points.positions.resize(1500);
+  ASSERT_EQ(first->packed().positions().size(), sizeof(Vec3f) * 1500);
+  std::memcpy(first_points.positions.data(), first->packed().positions().data(),
+              sizeof(Vec3f) * 1500);
+  v1::SessionConfig config;
+  config.set_target_vertices(400);
+  config.mutable_origin()->set_x(500000);
+  config.mutable_origin()->set_y(4100000);
+  absl::StatusOr<v1::Session> created = (*service)->CreateSession(config, "strips");
+  ASSERT_TRUE(created.ok()) << created.status();
+  ASSERT_TRUE((*service)->UploadPoints(created->session_id(), first_points, 500).ok());
+  std::vector<std::string> resume = upload;
+  resume[5] = *dir_ + "/off_core_resumed";
+  resume.insert(resume.end(), {"--resume", created->session_id()});
+  const RunResult resumed = RunNeuralmesh(resume);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.Describe();
+  EXPECT_THAT(resumed.out, ::testing::HasSubstr("resuming at point 1500"));
+  session = (*service)->GetSession(created->session_id());
+  ASSERT_TRUE(session.ok()) << session.status();
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_FINISHED);
+  EXPECT_EQ(session->points_taken(), 4000u);
+  EXPECT_EQ(session->learning().points_received(), 4000u) << "every point once";
+
+  std::vector<std::string> filtered = upload;
+  filtered.push_back("--remove_outliers");
+  const RunResult refused = RunNeuralmesh(filtered);
+  EXPECT_NE(refused.exit_code, 0) << refused.Describe();
+  EXPECT_THAT(refused.err, ::testing::HasSubstr("reads the file whole: not with --off_core"));
 }
 
 TEST_F(RemoteCliTest, SessionsListsTheFinishedSession) {

@@ -183,7 +183,7 @@ TEST(OffCoreSamplerTest, RefusesWhatCannotBeSampledWhereItLies) {
   expect_refused(Write("text.las", "x y z\n1 2 3\n"), absl::StatusCode::kInvalidArgument,
                  "no LASF signature");
   expect_refused(Write("points.xyz", "1 2 3\n"), absl::StatusCode::kInvalidArgument,
-                 "binary PCD (.pcd), can be sampled where they lie");
+                 "binary PCD (.pcd), can be read where they lie");
   const std::string las = testing::LasFile(Layout(), ScanLine(1000));
   absl::StatusOr<std::string> laz = io_internal::CompressLas(las);
   ASSERT_TRUE(laz.ok()) << laz.status();
@@ -228,7 +228,8 @@ std::string PlyFile(int n, bool doubles, bool big_endian, const std::string& ver
   };
   for (int i = 0; i < n; ++i) {
     out += static_cast<char>(i);
-    const double p[3] = {(doubles ? 500000 : 0) + i / 100.0, (doubles ? 4100000 : 0) + i % 7, 80};
+    const double p[3] = {(doubles ? 500000 : 0) + i / 100.0, (doubles ? 4100000.0 : 0.0) + i % 7,
+                         80};
     for (double c : p) doubles ? append(c) : append(static_cast<float>(c));
     out += "\x01\x02";
   }

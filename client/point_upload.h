@@ -1,0 +1,84 @@
+// The points an upload sends, in the order it sends them, batch by batch: a point cloud in
+// memory (CloudUpload), or the records of a file read where they lie, never whole
+// (FileRecordsUpload: `neuralmesh reconstruct --server --off_core`).
+#ifndef NEURALMESH_CLIENT_POINT_UPLOAD_H_
+#define NEURALMESH_CLIENT_POINT_UPLOAD_H_
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+
+#include "absl/status/statusor.h"
+#include "core/io/mapped_point_file.h"
+#include "core/io/spread_order.h"
+#include "core/point_cloud.h"
+#include "neuralmesh/v1/reconstruction.pb.h"
+
+namespace neuralmesh::client {
+
+class PointUpload {
+ public:
+  virtual ~PointUpload() = default;
+
+  // Makes point `first` the next one Batch packs. OUT_OF_RANGE when the upload has fewer
+  // than `first` points (its size() is then known).
+  virtual absl::Status SkipTo(uint64_t first) = 0;
+  // Points first, first + 1, ... of the upload, at most `count` (> 0) of them, as a batch
+  // that says where it starts (PointBatch.first_point = first); a batch without points when
+  // the upload has no point past `first`. SkipTo's errors.
+  virtual absl::StatusOr<v1::PointBatch> Batch(uint64_t first, size_t count) = 0;
+  // How far the batches so far went, and out of how much (points, or a file's records).
+  virtual uint64_t done() const = 0;
+  virtual uint64_t total() const = 0;
+  // The upload's number of points, where it is known.
+  virtual std::optional<uint64_t> size() const = 0;
+};
+
+// A cloud's points in their order, with the weights, normals and colours it carries.
+class CloudUpload final : public PointUpload {
+ public:
+  explicit CloudUpload(const PointCloud& cloud) : cloud_(cloud) {}
+
+  absl::Status SkipTo(uint64_t first) override;
+  absl::StatusOr<v1::PointBatch> Batch(uint64_t first, size_t count) override;
+  uint64_t done() const override { return done_; }
+  uint64_t total() const override { return cloud_.size(); }
+  std::optional<uint64_t> size() const override { return cloud_.size(); }
+
+ private:
+  const PointCloud& cloud_;
+  uint64_t done_ = 0;
+};
+
+// The points of a file's records (MappedPointFile::Point, relative to its origin), read where
+// they lie in SpreadOrder, so that every prefix of the upload is spread over the whole file.
+// Positions only: the records' colours are not sent. Each batch reads its records once; to
+// skip back, the order is walked again from its start (resuming an upload reads the records
+// before its first point again).
+class FileRecordsUpload final : public PointUpload {
+ public:
+  explicit FileRecordsUpload(const MappedPointFile& file) : file_(file), order_(file.records()) {}
+
+  absl::Status SkipTo(uint64_t first) override;
+  absl::StatusOr<v1::PointBatch> Batch(uint64_t first, size_t count) override;
+  // Records read (and skipped, at a resume) so far.
+  uint64_t done() const override { return std::min(slot_, file_.records()); }
+  uint64_t total() const override { return file_.records(); }
+  // Known once the order has been walked to its end.
+  std::optional<uint64_t> size() const override;
+
+ private:
+  // Reads the record at slot_ and moves on; gives `on_point` the record's point, if it is one.
+  template <typename OnPoint>
+  void ReadNext(const OnPoint& on_point);
+
+  const MappedPointFile& file_;
+  const SpreadOrder order_;
+  uint64_t slot_ = 0;    // The next position of order_ to read.
+  uint64_t points_ = 0;  // The points among the positions before slot_.
+};
+
+}  // namespace neuralmesh::client
+
+#endif  // NEURALMESH_CLIENT_POINT_UPLOAD_H_

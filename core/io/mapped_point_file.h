@@ -1,0 +1,93 @@
+// A point file whose records all have one size (uncompressed LAS, binary PLY, binary PCD),
+// mapped into memory and read one record at a time where it lies, never whole: what off-core
+// sampling (core/sampling/off_core_sampler.h) and the upload of a file read where it lies
+// (client/point_upload.h) read. Opening it draws a probe of records to learn where the points
+// lie and what share of the records are points.
+#ifndef NEURALMESH_CORE_IO_MAPPED_POINT_FILE_H_
+#define NEURALMESH_CORE_IO_MAPPED_POINT_FILE_H_
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/bounding_box.h"
+#include "core/io/internal/point_records.h"
+#include "core/io/mapped_file.h"
+#include "core/io/point_selection.h"
+#include "core/origin.h"
+
+namespace neuralmesh {
+
+class MappedPointFile {
+ public:
+  // Records drawn when the file is opened, to see what share of them is kept and where they
+  // lie.
+  static constexpr int kProbeRecords = 4096;
+  // The least share of the probe that must be kept: below it a point would take more than 100
+  // record reads.
+  static constexpr double kLeastKeptShare = 0.01;
+
+  // Maps the uncompressed LAS, binary PLY or binary PCD file at `path` (by its extension);
+  // `classes` as ParseLas's, for LAS. Returns MappedFile's errors (NOT_FOUND for a missing
+  // file); INVALID_ARGUMENT, naming the file and saying why, for a LAZ file (its records are
+  // compressed in chunks: none can be read alone), another format, the errors of
+  // io_internal::LasRecords::Create, PlyVertexRecords and PcdPointRecords, a file without
+  // point records, and one where less than kLeastKeptShare of the probe is kept (read such a
+  // file whole).
+  static absl::StatusOr<MappedPointFile> Open(
+      const std::string& path, const std::optional<LasClasses>& classes = std::nullopt);
+
+  uint64_t records() const { return records_->size(); }
+  // Record i's (< records()) position relative to origin() when reading the file whole takes it
+  // as a point; nothing for a record reading the file leaves out (LAS: withheld, noise, or of a
+  // class not asked for, as io_internal::ParseLas; PCD: no position) or refuses the file for
+  // (PLY: a non-finite coordinate; any: a coordinate, relative to origin(), beyond a float's
+  // range). Reads the record once.
+  std::optional<Vec3> Point(uint64_t i) const {
+    const std::optional<io_internal::Point3d> p = records_->KeptPoint(i);
+    if (!p.has_value()) return std::nullopt;
+    const Vec3 point((*p)[0] - origin_[0], (*p)[1] - origin_[1], (*p)[2] - origin_[2]);
+    if (!Learnable(point)) return std::nullopt;
+    return point;
+  }
+  // Starts loading record i.
+  void Prefetch(uint64_t i) const { __builtin_prefetch(records_->Address(i)); }
+
+  // The bounds the file states (a LAS header's) where the probe finds them fresh (no record
+  // outside them, and no more than twice the probe's box), else the probe's; relative to
+  // origin(). Records outside them are points all the same.
+  const BoundingBox& bounds() const { return bounds_; }
+  // Where the points' (0, 0, 0) lies in the file's coordinates (georeferenced scans), chosen
+  // from bounds() as reading the file whole chooses it from its points: with the file's
+  // resolution (a LAS file's scale) or, where it states none, PositionCollector's rule.
+  const Origin& origin() const { return origin_; }
+  bool has_colors() const { return records_->has_colors(); }
+  // The share of the probe's records that are points.
+  double kept_share() const { return kept_share_; }
+
+ private:
+  // Whether the learner can take `p`: coordinates that a float holds, as the readers require,
+  // so that no mesh gets an infinite vertex.
+  static bool Learnable(const Vec3& p) {
+    constexpr double kLargestFloat = std::numeric_limits<float>::max();
+    return std::fabs(p[0]) <= kLargestFloat && std::fabs(p[1]) <= kLargestFloat &&
+           std::fabs(p[2]) <= kLargestFloat;
+  }
+
+  MappedPointFile(MappedFile file, std::unique_ptr<io_internal::PointRecords> records)
+      : file_(std::move(file)), records_(std::move(records)) {}
+
+  MappedFile file_;  // Its mapping stays where it is when this object moves.
+  std::unique_ptr<io_internal::PointRecords> records_;  // A view of file_'s bytes.
+  Origin origin_ = kNoOrigin;
+  BoundingBox bounds_;
+  double kept_share_ = 0;
+};
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_IO_MAPPED_POINT_FILE_H_

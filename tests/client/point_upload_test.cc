@@ -1,0 +1,174 @@
+#include "client/point_upload.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "core/io/point_cloud_io.h"
+#include "gtest/gtest.h"
+#include "tests/testing/las_file.h"
+#include "tests/testing/shapes.h"
+#include "tests/testing/temp_dir.h"
+
+namespace neuralmesh::client {
+namespace {
+
+using Point = std::tuple<float, float, float>;
+
+std::vector<Point> PointsOf(const v1::PointBatch& batch) {
+  const std::string& bytes = batch.packed().positions();
+  std::vector<Point> points(bytes.size() / 12);
+  for (size_t i = 0; i < points.size(); ++i) {
+    float xyz[3];
+    std::memcpy(xyz, bytes.data() + 12 * i, 12);
+    points[i] = {xyz[0], xyz[1], xyz[2]};
+  }
+  return points;
+}
+
+// A georeferenced scan as a scanner leaves it, in strips: a building (class 6, a sphere of
+// radius 10, its points sorted by height), each of its points followed by one of the ground
+// (class 2), and every tenth building point withheld.
+std::string WriteStripScan(const std::string& name, size_t building_points = 6000) {
+  testing::LasLayout layout;
+  layout.format = 1;
+  for (double& s : layout.scale) s = 0.001;
+  layout.offset[0] = 500000;
+  layout.offset[1] = 4100000;
+  std::vector<Vec3f> sphere = testing::ColoredUnitSpherePoints(building_points, 3).positions;
+  std::sort(sphere.begin(), sphere.end(),
+            [](const Vec3f& a, const Vec3f& b) { return a[2] < b[2]; });
+  std::vector<testing::LasPoint> points;
+  for (size_t i = 0; i < sphere.size(); ++i) {
+    testing::LasPoint building{static_cast<int32_t>(std::lround(10000 * sphere[i][0])) + 12000,
+                               static_cast<int32_t>(std::lround(10000 * sphere[i][1])) + 45000,
+                               static_cast<int32_t>(std::lround(10000 * sphere[i][2])) + 80000};
+    building.classification = 6;
+    building.withheld = i % 10 == 9;
+    points.push_back(building);
+    testing::LasPoint ground{building.x * 2, building.y, 60000};
+    ground.classification = 2;
+    points.push_back(ground);
+  }
+  const std::string path = testing::MakeTempDir("point_upload") + "/" + name;
+  std::ofstream(path, std::ios::binary) << testing::LasFile(layout, points);
+  return path;
+}
+
+PointSelection Building() {
+  PointSelection selection;
+  selection.las_classes.emplace();
+  selection.las_classes->set(6);
+  return selection;
+}
+
+TEST(FileRecordsUploadTest, SendsEveryPointReadingTheFileWouldTakeOnce) {
+  const std::string path = WriteStripScan("scan.las");
+  absl::StatusOr<PointCloud> read = ReadPointCloud(path, nullptr, Building());
+  ASSERT_TRUE(read.ok()) << read.status();
+  ASSERT_EQ(read->size(), 5400u);
+  absl::StatusOr<MappedPointFile> file = MappedPointFile::Open(path, Building().las_classes);
+  ASSERT_TRUE(file.ok()) << file.status();
+  EXPECT_EQ(file->origin(), read->origin);
+  for (size_t batch_size : {size_t{1}, size_t{500}, size_t{7000}}) {
+    SCOPED_TRACE(batch_size);
+    FileRecordsUpload upload(*file);
+    EXPECT_EQ(upload.total(), 12000u);
+    std::vector<Point> sent;
+    while (true) {
+      EXPECT_FALSE(upload.size().has_value() && sent.size() < 5400);
+      absl::StatusOr<v1::PointBatch> batch = upload.Batch(sent.size(), batch_size);
+      ASSERT_TRUE(batch.ok()) << batch.status();
+      EXPECT_EQ(batch->first_point().value(), sent.size());
+      const std::vector<Point> points = PointsOf(*batch);
+      if (points.empty()) break;
+      EXPECT_LE(points.size(), batch_size);
+      sent.insert(sent.end(), points.begin(), points.end());
+    }
+    EXPECT_EQ(upload.size(), 5400u);
+    EXPECT_EQ(upload.done(), 12000u);
+    std::vector<Point> expected;
+    for (const Vec3f& p : read->positions) expected.emplace_back(p[0], p[1], p[2]);
+    std::sort(sent.begin(), sent.end());
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(sent, expected) << "the points read whole, each once";
+  }
+}
+
+// The file holds the building from its bottom to its top (60,000 points: 469 blocks of
+// records); the upload's first batch of 10,000 points (87 blocks) already holds all of it.
+// Each tenth of the building's height is a tenth of its points (a sphere's slabs of equal
+// height have equal areas), and of the file: 47 blocks, in which the first 87 blocks of the
+// order leave no gap longer than 3 / 87 of the file, 16 blocks. So at least two blocks of 128
+// building points fall in each tenth; in the file's order, all would lie in the lowest one.
+TEST(FileRecordsUploadTest, TheFirstBatchIsSpreadOverTheWholeFile) {
+  absl::StatusOr<MappedPointFile> file =
+      MappedPointFile::Open(WriteStripScan("strips.las", 60000), Building().las_classes);
+  ASSERT_TRUE(file.ok()) << file.status();
+  FileRecordsUpload upload(*file);
+  absl::StatusOr<v1::PointBatch> first = upload.Batch(0, 10000);
+  ASSERT_TRUE(first.ok()) << first.status();
+  const std::vector<Point> points = PointsOf(*first);
+  ASSERT_EQ(points.size(), 10000u);
+  int per_tenth[10] = {};
+  for (const Point& p : points) {
+    const double height = std::get<2>(p) - 80;  // The origin's height is 0.
+    ++per_tenth[std::clamp(static_cast<int>((height + 10) / 2), 0, 9)];
+  }
+  for (int tenth = 0; tenth < 10; ++tenth) {
+    EXPECT_GE(per_tenth[tenth], 250) << "height tenth " << tenth << " of the building";
+  }
+  EXPECT_LT(upload.done(), 23000u) << "the records read for the first 10,000 points";
+}
+
+TEST(FileRecordsUploadTest, SkippingBackOrPastTheEndReadsTheOrderAgain) {
+  absl::StatusOr<MappedPointFile> file =
+      MappedPointFile::Open(WriteStripScan("again.las"), Building().las_classes);
+  ASSERT_TRUE(file.ok()) << file.status();
+  FileRecordsUpload upload(*file);
+  absl::StatusOr<v1::PointBatch> first = upload.Batch(0, 3000);
+  ASSERT_TRUE(first.ok());
+  absl::StatusOr<v1::PointBatch> again = upload.Batch(1000, 1000);  // Back: read again.
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->first_point().value(), 1000u);
+  const std::vector<Point> all = PointsOf(*first);
+  EXPECT_EQ(PointsOf(*again), std::vector<Point>(all.begin() + 1000, all.begin() + 2000));
+
+  FileRecordsUpload resumed(*file);
+  ASSERT_TRUE(resumed.SkipTo(2000).ok());
+  absl::StatusOr<v1::PointBatch> rest = resumed.Batch(2000, 1000);
+  ASSERT_TRUE(rest.ok());
+  EXPECT_EQ(PointsOf(*rest), std::vector<Point>(all.begin() + 2000, all.begin() + 3000));
+
+  EXPECT_TRUE(resumed.SkipTo(5400).ok());
+  absl::StatusOr<v1::PointBatch> none = resumed.Batch(5400, 10);
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none->packed().positions().empty());
+  const absl::Status past = resumed.SkipTo(5401);
+  EXPECT_EQ(past.code(), absl::StatusCode::kOutOfRange) << past;
+  EXPECT_EQ(past.message(), "the upload cannot start at point 5401 of 5400");
+  EXPECT_EQ(resumed.size(), 5400u);
+}
+
+TEST(CloudUploadTest, SendsTheCloudInItsOrderWithWhatItCarries) {
+  PointCloud cloud = testing::ColoredUnitSpherePoints(25, 1);
+  CloudUpload upload(cloud);
+  EXPECT_EQ(upload.size(), 25u);
+  absl::StatusOr<v1::PointBatch> batch = upload.Batch(20, 10);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  EXPECT_EQ(batch->first_point().value(), 20u);
+  const std::vector<Point> points = PointsOf(*batch);
+  ASSERT_EQ(points.size(), 5u);
+  EXPECT_EQ(points[0],
+            Point(cloud.positions[20][0], cloud.positions[20][1], cloud.positions[20][2]));
+  EXPECT_EQ(batch->packed().colors().size(), 15u);
+  EXPECT_EQ(upload.done(), 25u);
+  EXPECT_EQ(upload.SkipTo(26).code(), absl::StatusCode::kOutOfRange);
+}
+
+}  // namespace
+}  // namespace neuralmesh::client

@@ -10,7 +10,7 @@
 // dropped from it before each (posix_fadvise DONTNEED), as a file read from the disk.
 //
 //   build/bin/off-core-bench [--points=20000000] [--vertices=20000] [--format=las|ply]
-//                            [--cold] [--file=PATH] [--keep]
+//                            [--cold] [--file=PATH] [--keep] [--write_only]
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -36,6 +36,8 @@ ABSL_FLAG(std::string, format, "las", "The file's format: las or ply.");
 ABSL_FLAG(std::string, file, "", "Where the file is written; /tmp/off-core-bench.FORMAT if empty.");
 ABSL_FLAG(bool, keep, false, "Keep the LAS file afterwards.");
 ABSL_FLAG(bool, cold, false, "Drop the file from the page cache before each way.");
+ABSL_FLAG(bool, write_only, false,
+          "Write the file and stop (scripts/upload-bench.sh uploads it to a server).");
 
 namespace neuralmesh {
 namespace {
@@ -118,6 +120,11 @@ int Run() {
       return 1;
     }
   }
+  if (absl::GetFlag(FLAGS_write_only)) {
+    std::printf("%zu points of a torus in %s (%.0f MB)\n", n, path.c_str(),
+                static_cast<double>(std::filesystem::file_size(path)) / 1e6);
+    return 0;
+  }
   std::printf(
       "%zu points of a torus in %s (%.0f MB), learned to %zu vertices; memory held "
       "at the end, RssAnon %.0f MB before either\n\n",
@@ -165,6 +172,6 @@ int main(int argc, char** argv) {
       argc, argv,
       "Off-core sampling of a LAS or PLY file against reading it whole.\n"
       "  build/bin/off-core-bench [--points=20000000] [--vertices=20000] [--format=las|ply]\n"
-      "                           [--cold] [--file=PATH] [--keep]");
+      "                           [--cold] [--file=PATH] [--keep] [--write_only]");
   return neuralmesh::Run();
 }

@@ -158,9 +158,7 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(const std::vector<std::string>& inpu
   return target;
 }
 
-absl::StatusOr<MappedPointFile> OpenOffCoreFile(const std::vector<std::string>& inputs,
-                                                bool remove_outliers,
-                                                const PointSelection& selection) {
+absl::Status CheckOffCoreInput(const std::vector<std::string>& inputs, bool remove_outliers) {
   if (inputs.size() != 1) {
     return absl::InvalidArgumentError(
         "--off_core reads one file where it lies; several INPUTs are read whole and learned as "
@@ -172,8 +170,8 @@ absl::StatusOr<MappedPointFile> OpenOffCoreFile(const std::vector<std::string>& 
       absl::EndsWithIgnoreCase(input, ".ply") || absl::EndsWithIgnoreCase(input, ".pcd");
   if (IsBuiltin(input) || !read_where_it_lies) {
     return absl::InvalidArgumentError(
-        absl::StrCat("--off_core reads uncompressed LAS (.las), binary PLY (.ply) and binary "
-                     "PCD (.pcd) files where they lie; INPUT '",
+        absl::StrCat("--off_core reads LAS (.las, .laz), binary PLY (.ply) and binary PCD "
+                     "(.pcd) files where they lie; INPUT '",
                      input, "' is read whole without it"));
   }
   if (remove_outliers) {
@@ -181,8 +179,22 @@ absl::StatusOr<MappedPointFile> OpenOffCoreFile(const std::vector<std::string>& 
         "--remove_outliers judges every point against its neighbours, so it reads the file "
         "whole: not with --off_core");
   }
-  NM_RETURN_IF_ERROR(CheckInputFile(input, "INPUT"));
-  absl::StatusOr<MappedPointFile> file = MappedPointFile::Open(input, selection.las_classes);
+  return CheckInputFile(input, "INPUT");
+}
+
+absl::StatusOr<MappedPointFile> OpenOffCoreFile(const std::vector<std::string>& inputs,
+                                                bool remove_outliers,
+                                                const PointSelection& selection) {
+  NM_RETURN_IF_ERROR(CheckOffCoreInput(inputs, remove_outliers));
+  absl::StatusOr<MappedPointFile> file =
+      MappedPointFile::Open(inputs.front(), selection.las_classes);
+  if (!file.ok()) return InFile(file.status(), "INPUT", inputs.front());
+  return file;
+}
+
+absl::StatusOr<MappedLazFile> OpenOffCoreLazFile(const std::string& input,
+                                                 const PointSelection& selection) {
+  absl::StatusOr<MappedLazFile> file = MappedLazFile::Open(input, selection.las_classes);
   if (!file.ok()) return InFile(file.status(), "INPUT", input);
   return file;
 }

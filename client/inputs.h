@@ -15,6 +15,7 @@
 #include "absl/strings/string_view.h"
 #include "core/analysis/color_source.h"
 #include "core/analysis/statistical_outliers.h"
+#include "core/io/mapped_laz_file.h"
 #include "core/io/mapped_point_file.h"
 #include "core/io/point_selection.h"
 #include "core/point_cloud.h"
@@ -62,14 +63,22 @@ absl::StatusOr<TargetSpace> LoadTargetSpace(
     const std::optional<PointColorOptions>& colors = std::nullopt,
     const PointSelection& selection = {});
 
+// OK when `inputs` is one file that --off_core reads where it lies (by its extension: .las,
+// .laz, .ply, .pcd) and no outliers are removed in the client (`remove_outliers`, which needs
+// every point in memory); else INVALID_ARGUMENT saying why. CheckInputFile's errors.
+absl::Status CheckOffCoreInput(const std::vector<std::string>& inputs, bool remove_outliers);
+
 // The one file of `inputs` read where it lies (--off_core): an uncompressed LAS, binary PLY or
-// binary PCD file mapped into memory, a LAS file's records with `selection`'s classes. Returns
-// INVALID_ARGUMENT, saying why, for other inputs (several, builtin:NAME, another format) or
-// outlier removal in the client (which needs every point in memory); MappedPointFile::Open's
-// errors, naming INPUT.
+// binary PCD file mapped into memory, a LAS file's records with `selection`'s classes.
+// CheckOffCoreInput's errors; MappedPointFile::Open's, naming INPUT.
 absl::StatusOr<MappedPointFile> OpenOffCoreFile(const std::vector<std::string>& inputs,
                                                 bool remove_outliers,
                                                 const PointSelection& selection = {});
+
+// The LAZ file `input` read a chunk at a time (--off_core with --server), its records with
+// `selection`'s classes; MappedLazFile::Open's errors, naming INPUT.
+absl::StatusOr<MappedLazFile> OpenOffCoreLazFile(const std::string& input,
+                                                 const PointSelection& selection = {});
 
 // The target space of `inputs` sampled off-core (OffCoreSampler on OpenOffCoreFile's file).
 // Returns INVALID_ARGUMENT for a sampling mode other than uniform; OpenOffCoreFile's errors.

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "core/parallel_ranges.h"
 #include "core/status_macros.h"
 #include "proto/packing.h"
 
@@ -62,6 +63,81 @@ absl::StatusOr<v1::PointBatch> FileRecordsUpload::Batch(uint64_t first, size_t c
       const Vec3f f(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
       positions.append(reinterpret_cast<const char*>(f.data()), sizeof(Vec3f));
     });
+  }
+  v1::PointBatch batch;
+  batch.mutable_first_point()->set_value(first);
+  batch.mutable_packed()->set_positions(std::move(positions));
+  return batch;
+}
+
+std::optional<uint64_t> LazFileUpload::size() const {
+  if (next_chunk_ < order_.slots()) return std::nullopt;
+  return wave_first_ + wave_.size();
+}
+
+absl::StatusOr<bool> LazFileUpload::NextWave() {
+  std::vector<size_t> chunks;
+  for (; next_chunk_ < order_.slots() && chunks.size() < kWaveChunks; ++next_chunk_) {
+    if (order_[next_chunk_] < file_.chunks()) chunks.push_back(order_[next_chunk_]);
+  }
+  if (chunks.empty()) return false;
+  std::vector<absl::StatusOr<std::vector<Vec3>>> decoded(chunks.size());
+  ForEachRange(chunks.size(), /*threads=*/0, 1, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) decoded[i] = file_.Points(chunks[i]);
+  });
+  wave_first_ += wave_.size();
+  wave_.clear();
+  size_t longest = 0;
+  for (size_t i = 0; i < chunks.size(); ++i) {
+    NM_RETURN_IF_ERROR(decoded[i].status());
+    records_done_ += file_.records_in(chunks[i]);
+    longest = std::max(longest, decoded[i]->size());
+  }
+  for (size_t block = 0; block < longest; block += SpreadOrder::kBlockRecords) {
+    for (const absl::StatusOr<std::vector<Vec3>>& points : decoded) {
+      for (size_t j = block; j < std::min(points->size(), block + SpreadOrder::kBlockRecords);
+           ++j) {
+        const Vec3& p = (*points)[j];
+        wave_.emplace_back(static_cast<float>(p[0]), static_cast<float>(p[1]),
+                           static_cast<float>(p[2]));
+      }
+    }
+  }
+  return true;
+}
+
+absl::Status LazFileUpload::SkipTo(uint64_t first) {
+  if (first < wave_first_) {
+    next_chunk_ = 0;
+    wave_.clear();
+    wave_first_ = 0;
+    records_done_ = 0;
+  }
+  while (first > wave_first_ + wave_.size()) {
+    NM_ASSIGN_OR_RETURN(const bool more, NextWave());
+    if (!more) {
+      return absl::OutOfRangeError(absl::StrCat("the upload cannot start at point ", first, " of ",
+                                                wave_first_ + wave_.size()));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<v1::PointBatch> LazFileUpload::Batch(uint64_t first, size_t count) {
+  NM_RETURN_IF_ERROR(SkipTo(first));
+  std::string positions;
+  positions.reserve(count * sizeof(Vec3f));
+  uint64_t next = first;
+  while (next < first + count) {
+    if (next == wave_first_ + wave_.size()) {
+      NM_ASSIGN_OR_RETURN(const bool more, NextWave());
+      if (!more) break;
+      continue;
+    }
+    const size_t from = next - wave_first_;
+    const size_t take = std::min<uint64_t>(wave_.size() - from, first + count - next);
+    positions.append(reinterpret_cast<const char*>(wave_.data() + from), take * sizeof(Vec3f));
+    next += take;
   }
   v1::PointBatch batch;
   batch.mutable_first_point()->set_value(first);

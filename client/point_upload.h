@@ -1,6 +1,7 @@
 // The points an upload sends, in the order it sends them, batch by batch: a point cloud in
 // memory (CloudUpload), or the records of a file read where they lie, never whole
-// (FileRecordsUpload: `neuralmesh reconstruct --server --off_core`).
+// (`neuralmesh reconstruct --server --off_core`: FileRecordsUpload for uncompressed LAS, binary
+// PLY and binary PCD, LazFileUpload for LAZ).
 #ifndef NEURALMESH_CLIENT_POINT_UPLOAD_H_
 #define NEURALMESH_CLIENT_POINT_UPLOAD_H_
 
@@ -8,8 +9,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/io/mapped_laz_file.h"
 #include "core/io/mapped_point_file.h"
 #include "core/io/spread_order.h"
 #include "core/point_cloud.h"
@@ -77,6 +80,40 @@ class FileRecordsUpload final : public PointUpload {
   const SpreadOrder order_;
   uint64_t slot_ = 0;    // The next position of order_ to read.
   uint64_t points_ = 0;  // The points among the positions before slot_.
+};
+
+// The points of a LAZ file's chunks (MappedLazFile::Points), decoded a wave of kWaveChunks at
+// a time: the waves take the chunks in SpreadOrder, and a wave's points go out in blocks of
+// SpreadOrder::kBlockRecords taken from its chunks in turn, so that every prefix of the upload
+// is spread over the file, the first batch over a wave's chunks. The order depends on the file
+// alone (not on the threads that decode a wave). Positions only. To skip back, the waves are
+// decoded again from the first (resuming an upload decodes the chunks before its first point
+// again).
+class LazFileUpload final : public PointUpload {
+ public:
+  static constexpr size_t kWaveChunks = 8;
+
+  explicit LazFileUpload(const MappedLazFile& file)
+      : file_(file), order_(file.chunks(), /*block_records=*/1) {}
+
+  absl::Status SkipTo(uint64_t first) override;
+  absl::StatusOr<v1::PointBatch> Batch(uint64_t first, size_t count) override;
+  // The records of the chunks decoded so far.
+  uint64_t done() const override { return records_done_; }
+  uint64_t total() const override { return file_.records(); }
+  // Known once the last wave is decoded.
+  std::optional<uint64_t> size() const override;
+
+ private:
+  // Decodes the next wave into wave_ (the chunks on several threads); false after the last.
+  absl::StatusOr<bool> NextWave();
+
+  const MappedLazFile& file_;
+  const SpreadOrder order_;  // Of the chunks.
+  size_t next_chunk_ = 0;    // The next position of order_ to decode.
+  std::vector<Vec3f> wave_;  // The points of the last wave decoded, in upload order.
+  uint64_t wave_first_ = 0;  // The upload's number of wave_'s first point.
+  uint64_t records_done_ = 0;
 };
 
 }  // namespace neuralmesh::client

@@ -63,8 +63,9 @@ absl::Status ExplainWatchEnd(const absl::Status& status, const std::string& sess
 // What an upload sends, and what the session is told of it before the first batch.
 struct UploadInput {
   std::unique_ptr<PointCloud> cloud;      // The points, read whole (not off-core).
-  std::unique_ptr<MappedPointFile> file;  // Off-core: the file, read where it lies.
-  std::unique_ptr<PointUpload> points;    // Of `cloud` or of `file`.
+  std::unique_ptr<MappedPointFile> file;  // Off-core: the file, read where it lies,
+  std::unique_ptr<MappedLazFile> laz;     // or a LAZ file's, a chunk at a time.
+  std::unique_ptr<PointUpload> points;    // Of `cloud`, `file` or `laz`.
   Origin origin = kNoOrigin;
   BoundingBox bounds;
   // The points to send; off-core an estimate (the records times the share of the probe's that
@@ -79,22 +80,34 @@ absl::StatusOr<UploadInput> LoadUploadInput(const RemoteReconstructOptions& opti
                                             bool outliers_on_server, std::ostream& out) {
   UploadInput input;
   if (options.off_core) {
-    NM_ASSIGN_OR_RETURN(
-        MappedPointFile file,
-        OpenOffCoreFile(options.inputs, options.outliers.has_value() && !outliers_on_server,
-                        options.selection));
-    input.file = std::make_unique<MappedPointFile>(std::move(file));
-    input.points = std::make_unique<FileRecordsUpload>(*input.file);
-    input.origin = input.file->origin();
-    input.bounds = input.file->bounds();
-    input.size = static_cast<uint64_t>(
-        std::llround(static_cast<double>(input.file->records()) * input.file->kept_share()));
-    input.estimated = true;
-    out << absl::StrFormat(
-        "INPUT '%s': %d records read where they lie (off-core; %.1f%% of them points%s)%s\n",
-        options.inputs.front(), input.file->records(), 100 * input.file->kept_share(),
-        input.file->has_colors() ? "; colours are not sent off-core" : "",
-        OriginNote(input.origin));
+    NM_RETURN_IF_ERROR(
+        CheckOffCoreInput(options.inputs, options.outliers.has_value() && !outliers_on_server));
+    const std::string& path = options.inputs.front();
+    const auto describe = [&](const auto& file, absl::string_view how) {
+      input.origin = file.origin();
+      input.bounds = file.bounds();
+      input.size = static_cast<uint64_t>(
+          std::llround(static_cast<double>(file.records()) * file.kept_share()));
+      input.estimated = true;
+      out << absl::StrFormat("INPUT '%s': %d records %s (off-core; %.1f%% of them points%s)%s\n",
+                             path, file.records(), how, 100 * file.kept_share(),
+                             file.has_colors() ? "; colours are not sent off-core" : "",
+                             OriginNote(input.origin));
+    };
+    if (IsLazFile(path)) {
+      NM_ASSIGN_OR_RETURN(MappedLazFile file, OpenOffCoreLazFile(path, options.selection));
+      input.laz = std::make_unique<MappedLazFile>(std::move(file));
+      input.points = std::make_unique<LazFileUpload>(*input.laz);
+      describe(*input.laz,
+               absl::StrCat("decoded where they lie, a LAZ chunk at a time (", input.laz->chunks(),
+                            input.laz->chunks() == 1 ? " chunk)" : " chunks)"));
+    } else {
+      NM_ASSIGN_OR_RETURN(MappedPointFile file,
+                          OpenOffCoreFile(options.inputs, false, options.selection));
+      input.file = std::make_unique<MappedPointFile>(std::move(file));
+      input.points = std::make_unique<FileRecordsUpload>(*input.file);
+      describe(*input.file, "read where they lie");
+    }
     return input;
   }
   PointsLeftOut left_out;
@@ -245,7 +258,8 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   // The watcher thread prints rows on `out` while this thread draws the upload bar on `err`;
   // both go through `mu` so a row never lands in the middle of a bar.
   absl::Mutex mu;
-  ProgressBar upload_bar(err, options.progress, "upload  ", input.file ? "records" : "points");
+  ProgressBar upload_bar(err, options.progress, "upload  ",
+                         options.off_core ? "records" : "points");
   ProgressBar learn_bar(err, options.progress, "learning", "vertices");
   MeshUpdateWriter writer({options.out_dir, stem, options.also}, out);
   absl::Status write_status;

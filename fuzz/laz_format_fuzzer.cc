@@ -8,10 +8,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <memory>
+#include <optional>
 #include <string>
 
+#include "core/io/internal/las.h"
 #include "core/io/internal/laz.h"
 #include "fuzz/fuzz_check.h"
+#include "fuzz/point_records_properties.h"
 
 namespace {
 
@@ -42,6 +46,32 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const absl::StatusOr<std::string> las = neuralmesh::io_internal::DecompressLaz(bytes);
   if (!las.ok()) return 0;
   FUZZ_CHECK(!neuralmesh::io_internal::IsLaz(*las), "the decompressed file says it is LAZ");
+  // Read a chunk at a time (the off-core upload: core/io/mapped_laz_file.h), the records are
+  // the points that parsing the decompressed file reads.
+  const absl::StatusOr<neuralmesh::io_internal::LazChunks> chunks =
+      neuralmesh::io_internal::LazChunks::Open(bytes);
+  FUZZ_CHECK(chunks.ok(), "a file that decompresses has no chunks: %s",
+             chunks.status().ToString().c_str());
+  const size_t records_at = chunks->las_header().size();
+  const size_t records_size = chunks->records() * chunks->record_length();
+  FUZZ_CHECK(las->size() >= records_at + records_size, "the records run past the LAS file");
+  for (size_t i = 0; i < chunks->size(); ++i) {
+    std::string decoded(chunks->records_in(i) * chunks->record_length(), '\0');
+    FUZZ_CHECK(chunks->Decode(i, decoded.data()).ok(), "chunk %zu does not decode alone", i);
+    FUZZ_CHECK(
+        decoded == las->substr(records_at + chunks->first_record(i) * chunks->record_length(),
+                               decoded.size()),
+        "chunk %zu decodes alone to other records", i);
+  }
+  const absl::StatusOr<std::unique_ptr<neuralmesh::io_internal::LasRecords>> records =
+      neuralmesh::io_internal::LasRecords::Create(
+          chunks->las_header(), absl::string_view(*las).substr(records_at, records_size),
+          std::nullopt);
+  const absl::StatusOr<neuralmesh::io_internal::ParsedGeometry> parsed =
+      neuralmesh::io_internal::ParseLas(*las, std::nullopt);
+  if (records.ok()) {
+    neuralmesh::fuzz::CheckRecordsAgreeWithParser(**records, parsed.ok() ? &*parsed : nullptr);
+  }
   if (!ExtendedRecordsPlaced(*las)) return 0;
   for (const uint32_t chunk_size : {50000u, 3u}) {
     const uint16_t version = chunk_size == 3 ? 4 : 3;

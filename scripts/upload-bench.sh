@@ -6,11 +6,14 @@
 # the session is created (the input is loaded or mapped), when the first mesh arrives, when the
 # final mesh arrives (every point uploaded, then the finish), and the client's peak memory:
 # anonymous (its own allocations, sampled every 20 ms) and resident (with the file's pages).
-# With COLD=1 the file is dropped from the page cache before each way, as a file on the disk.
+# With COLD=1 the file is dropped from the page cache before each way, as a file on the disk;
+# with LAZ=1 the file is compressed to LAZ first (`neuralmesh convert`), which off-core is
+# decoded a chunk at a time.
 #
 # Usage: scripts/upload-bench.sh   (after the build; from anywhere)
 # Environment: BUILD_DIR (default build), POINTS (default 20000000), VERTICES (default 2000),
-#              COLD (default 0), FILE (default /tmp/upload-bench.las, removed afterwards).
+#              COLD (default 0), LAZ (default 0), FILE (default /tmp/upload-bench.las, removed
+#              afterwards with its .laz).
 set -euo pipefail
 
 cd "$(dirname "$0")/.."
@@ -18,6 +21,7 @@ BUILD_DIR=${BUILD_DIR:-build}
 POINTS=${POINTS:-20000000}
 VERTICES=${VERTICES:-2000}
 COLD=${COLD:-0}
+LAZ=${LAZ:-0}
 FILE=${FILE:-/tmp/upload-bench.las}
 CLI="${BUILD_DIR}/bin/neuralmesh"
 SERVER="${BUILD_DIR}/bin/neuralmesh-server"
@@ -28,10 +32,17 @@ cleanup() {
   if [[ -n "${SERVER_PID}" ]]; then kill -TERM "${SERVER_PID}" 2>/dev/null || true; fi
   wait 2>/dev/null || true
   rm -rf "${WORK}" "${FILE}"
+  if [[ "${LAZ}" == 1 ]]; then rm -f "${FILE%.*}.laz"; fi
 }
 trap cleanup EXIT
 
 "${BUILD_DIR}/bin/off-core-bench" --points="${POINTS}" --file="${FILE}" --write_only
+INPUT="${FILE}"
+if [[ "${LAZ}" == 1 ]]; then
+  INPUT="${FILE%.*}.laz"
+  "${CLI}" convert "${FILE}" -o "${INPUT}" >/dev/null
+  echo "compressed to ${INPUT} ($(( $(stat -c %s "${INPUT}") / 1000000 )) MB)"
+fi
 
 "${SERVER}" --host=127.0.0.1 --port=0 --log_sessions=false >"${WORK}/server.out" \
   2>"${WORK}/server.err" &
@@ -63,10 +74,10 @@ printf '%-12s %10s %12s %12s %14s %13s\n' "way" "session s" "first mesh s" "fina
 for way in "read whole" "off-core"; do
   flags=()
   [[ "${way}" == "off-core" ]] && flags=(--off_core)
-  if [[ "${COLD}" == 1 ]]; then dd if="${FILE}" iflag=nocache count=0 status=none; fi
+  if [[ "${COLD}" == 1 ]]; then dd if="${INPUT}" iflag=nocache count=0 status=none; fi
   rm -rf "${WORK}/out"
   start=$(date +%s.%N)
-  "${CLI}" reconstruct "${FILE}" --server "${ADDRESS}" --out-dir "${WORK}/out" \
+  "${CLI}" reconstruct "${INPUT}" --server "${ADDRESS}" --out-dir "${WORK}/out" \
     --vertices "${VERTICES}" "${flags[@]}" > >(stamp "${start}" >"${WORK}/run.out") &
   pid=$!
   peak_anon=0

@@ -54,6 +54,36 @@ absl::StatusOr<std::unique_ptr<io_internal::PointRecords>> RecordsOf(
 
 }  // namespace
 
+ProbedPlacement PlaceProbe(const BoundingBox& probed, const io_internal::PointRecords& records) {
+  // The stated bounds, unless the probe finds them stale: records outside them, or a box more
+  // than twice the probe's (which covers nearly all of a scan's extent).
+  const std::optional<Point3d> resolution = records.Resolution();
+  const Vec3 step = resolution.has_value() ? ToVec3(*resolution) : Vec3(0, 0, 0);
+  BoundingBox bounds = probed;
+  if (const auto stated_bounds = records.StatedBounds(); stated_bounds.has_value()) {
+    const Vec3 low = ToVec3(stated_bounds->first), high = ToVec3(stated_bounds->second);
+    BoundingBox stated;
+    stated.Extend(low - step);
+    stated.Extend(high + step);
+    if (std::isfinite(stated.diagonal()) && stated.Contains(probed.min) &&
+        stated.Contains(probed.max) &&
+        stated.diagonal() <= 2 * probed.diagonal() + 4 * step.norm()) {
+      bounds.Extend(low);
+      bounds.Extend(high);
+    }
+  }
+  ProbedPlacement out;
+  out.origin =
+      resolution.has_value()
+          ? io_internal::OriginKeepingResolution(ToPoint3d(bounds.min), ToPoint3d(bounds.max),
+                                                 *resolution)
+          : io_internal::OriginOfUnstatedResolution(ToPoint3d(bounds.min), ToPoint3d(bounds.max));
+  const Vec3 origin = ToVec3(out.origin);
+  out.bounds.Extend(bounds.min - origin);
+  out.bounds.Extend(bounds.max - origin);
+  return out;
+}
+
 absl::StatusOr<MappedPointFile> MappedPointFile::Open(const std::string& path,
                                                       const std::optional<LasClasses>& classes) {
   NM_ASSIGN_OR_RETURN(MappedFile file, MappedFile::Open(path));
@@ -89,31 +119,9 @@ absl::StatusOr<MappedPointFile> MappedPointFile::Open(const std::string& path,
                               : "withheld or noise, or beyond a float's range",
         kept == 0 ? std::string("countless") : absl::StrCat(kProbeRecords / kept)));
   }
-  // The stated bounds, unless the probe finds them stale: records outside them, or a box more
-  // than twice the probe's (which covers nearly all of a scan's extent).
-  const std::optional<Point3d> resolution = points.Resolution();
-  const Vec3 step = resolution.has_value() ? ToVec3(*resolution) : Vec3(0, 0, 0);
-  BoundingBox bounds = probed;
-  if (const auto stated_bounds = points.StatedBounds(); stated_bounds.has_value()) {
-    const Vec3 low = ToVec3(stated_bounds->first), high = ToVec3(stated_bounds->second);
-    BoundingBox stated;
-    stated.Extend(low - step);
-    stated.Extend(high + step);
-    if (std::isfinite(stated.diagonal()) && stated.Contains(probed.min) &&
-        stated.Contains(probed.max) &&
-        stated.diagonal() <= 2 * probed.diagonal() + 4 * step.norm()) {
-      bounds.Extend(low);
-      bounds.Extend(high);
-    }
-  }
-  opened.origin_ =
-      resolution.has_value()
-          ? io_internal::OriginKeepingResolution(ToPoint3d(bounds.min), ToPoint3d(bounds.max),
-                                                 *resolution)
-          : io_internal::OriginOfUnstatedResolution(ToPoint3d(bounds.min), ToPoint3d(bounds.max));
-  const Vec3 origin = ToVec3(opened.origin_);
-  opened.bounds_.Extend(bounds.min - origin);
-  opened.bounds_.Extend(bounds.max - origin);
+  const ProbedPlacement placement = PlaceProbe(probed, points);
+  opened.origin_ = placement.origin;
+  opened.bounds_ = placement.bounds;
   return opened;
 }
 

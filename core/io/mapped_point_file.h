@@ -22,6 +22,22 @@
 
 namespace neuralmesh {
 
+// Where a file's points lie, judged from a probe of them.
+struct ProbedPlacement {
+  // The bounds the file states (a LAS header's) where the probe finds them fresh (no probed
+  // point outside them, and no more than twice the probe's box), else the probe's; relative to
+  // `origin`.
+  BoundingBox bounds;
+  // Where the points' (0, 0, 0) lies in the file's coordinates, chosen from the bounds as
+  // reading the file whole chooses it from its points: with the file's resolution (a LAS
+  // file's scale) or, where it states none, PositionCollector's rule.
+  Origin origin = kNoOrigin;
+};
+
+// The placement of the points of `records` whose probe, in the file's coordinates, has the box
+// `probed` (not empty).
+ProbedPlacement PlaceProbe(const BoundingBox& probed, const io_internal::PointRecords& records);
+
 class MappedPointFile {
  public:
   // Records drawn when the file is opened, to see what share of them is kept and where they
@@ -54,22 +70,6 @@ class MappedPointFile {
     if (!Learnable(point)) return std::nullopt;
     return point;
   }
-  // Starts loading record i.
-  void Prefetch(uint64_t i) const { __builtin_prefetch(records_->Address(i)); }
-
-  // The bounds the file states (a LAS header's) where the probe finds them fresh (no record
-  // outside them, and no more than twice the probe's box), else the probe's; relative to
-  // origin(). Records outside them are points all the same.
-  const BoundingBox& bounds() const { return bounds_; }
-  // Where the points' (0, 0, 0) lies in the file's coordinates (georeferenced scans), chosen
-  // from bounds() as reading the file whole chooses it from its points: with the file's
-  // resolution (a LAS file's scale) or, where it states none, PositionCollector's rule.
-  const Origin& origin() const { return origin_; }
-  bool has_colors() const { return records_->has_colors(); }
-  // The share of the probe's records that are points.
-  double kept_share() const { return kept_share_; }
-
- private:
   // Whether the learner can take `p`: coordinates that a float holds, as the readers require,
   // so that no mesh gets an infinite vertex.
   static bool Learnable(const Vec3& p) {
@@ -77,7 +77,17 @@ class MappedPointFile {
     return std::fabs(p[0]) <= kLargestFloat && std::fabs(p[1]) <= kLargestFloat &&
            std::fabs(p[2]) <= kLargestFloat;
   }
+  // Starts loading record i.
+  void Prefetch(uint64_t i) const { __builtin_prefetch(records_->Address(i)); }
 
+  // The probe's placement (PlaceProbe): records outside bounds() are points all the same.
+  const BoundingBox& bounds() const { return bounds_; }
+  const Origin& origin() const { return origin_; }
+  bool has_colors() const { return records_->has_colors(); }
+  // The share of the probe's records that are points.
+  double kept_share() const { return kept_share_; }
+
+ private:
   MappedPointFile(MappedFile file, std::unique_ptr<io_internal::PointRecords> records)
       : file_(std::move(file)), records_(std::move(records)) {}
 

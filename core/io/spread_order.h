@@ -1,10 +1,11 @@
 // An order of a file's records in which every prefix is spread over the whole file, so that
 // the first points of an upload read in this order already outline the whole scan (a server
 // learning while they arrive has a coarse mesh of all of it, not of its first strip). Records
-// go in blocks of kBlockRecords consecutive ones (a page or two of the file, read in order), and
-// the blocks are visited along a stride of the golden ratio times their count: a Kronecker
-// sequence, whose first k blocks leave gaps of at most three lengths between them, the longest
-// under 3 / k of the file (the three-distance theorem).
+// go in blocks of consecutive ones (by default kBlockRecords, a page or two of the file, read in
+// order; a LAZ file's chunks: blocks of one), and the blocks are visited along a stride of the
+// golden ratio times their count: a Kronecker sequence, whose first k blocks leave gaps of at
+// most three lengths between them, the longest under 3 / k of the file (the three-distance
+// theorem).
 #ifndef NEURALMESH_CORE_IO_SPREAD_ORDER_H_
 #define NEURALMESH_CORE_IO_SPREAD_ORDER_H_
 
@@ -16,22 +17,23 @@ class SpreadOrder {
  public:
   static constexpr uint64_t kBlockRecords = 256;
 
-  // The order of records 0 .. records - 1.
-  explicit SpreadOrder(uint64_t records);
+  // The order of records 0 .. records - 1 in blocks of `block_records` (> 0).
+  explicit SpreadOrder(uint64_t records, uint64_t block_records = kBlockRecords);
 
   // The positions of the order, 0 .. slots() - 1: every record once, and past the last record
   // the rest of its block (records() or more).
-  uint64_t slots() const { return blocks_ * kBlockRecords; }
+  uint64_t slots() const { return blocks_ * block_records_; }
   uint64_t records() const { return records_; }
   // The record at position `slot` (< slots()); records() or more for a slot past the last.
   uint64_t operator[](uint64_t slot) const {
     const uint64_t block = static_cast<uint64_t>(
-        static_cast<unsigned __int128>(slot / kBlockRecords) * stride_ % blocks_);
-    return block * kBlockRecords + slot % kBlockRecords;
+        static_cast<unsigned __int128>(slot / block_records_) * stride_ % blocks_);
+    return block * block_records_ + slot % block_records_;
   }
 
  private:
   uint64_t records_;
+  uint64_t block_records_;
   uint64_t blocks_;
   uint64_t stride_;  // Coprime with blocks_: the order visits each block once.
 };

@@ -464,9 +464,9 @@ TEST_F(RemoteCliTest, GeoreferencedScansComeBackInTheirCoordinates) {
 }
 
 // --off_core with --server: a georeferenced LAS scan, its building (class 6, a unit sphere)
-// stored bottom to top among ground points (class 2), uploaded from where it lies. The session
-// takes the building's every point once and learns it in the scan's coordinates; --resume goes
-// on from the points the session has taken.
+// stored bottom to top among ground points (class 2), uploaded from where it lies, and again
+// as LAZ. The session takes the building's every point once and learns it in the scan's
+// coordinates; --resume goes on from the points the session has taken.
 TEST_F(RemoteCliTest, OffCoreUploadsAScanFromWhereItLies) {
   const double centre[3] = {500123.5, 4100456.25, 80};
   testing::LasLayout layout;
@@ -562,6 +562,34 @@ TEST_F(RemoteCliTest, OffCoreUploadsAScanFromWhereItLies) {
   EXPECT_EQ(session->state(), v1::SESSION_STATE_FINISHED);
   EXPECT_EQ(session->points_taken(), 4000u);
   EXPECT_EQ(session->learning().points_received(), 4000u) << "every point once";
+
+  // The same scan as LAZ, decoded a chunk at a time.
+  const std::string laz = *dir_ + "/strips.laz";
+  ASSERT_EQ(RunNeuralmesh({"convert", las, "-o", laz}).exit_code, 0);
+  std::vector<std::string> from_laz = upload;
+  from_laz[1] = laz;
+  from_laz[5] = *dir_ + "/off_core_laz";
+  const RunResult laz_run = RunNeuralmesh(from_laz);
+  ASSERT_EQ(laz_run.exit_code, 0) << laz_run.Describe();
+  EXPECT_THAT(laz_run.out, ::testing::HasSubstr(absl::StrCat(
+                               "INPUT '", laz,
+                               "': 8000 records decoded where they lie, a LAZ chunk at a time (1 "
+                               "chunk) (off-core; 50.0% of them points)")));
+  ASSERT_TRUE(std::regex_search(laz_run.out, id, std::regex("session (s-[0-9a-f]+) on ")))
+      << laz_run.out;
+  session = (*service)->GetSession(id[1]);
+  ASSERT_TRUE(session.ok()) << session.status();
+  EXPECT_EQ(session->points_taken(), 4000u);
+  const absl::StatusOr<TriangleMesh> from_laz_mesh = ReadMesh(from_laz[5] + "/strips.drc");
+  ASSERT_TRUE(from_laz_mesh.ok()) << from_laz_mesh.status();
+  EXPECT_EQ(from_laz_mesh->origin, mesh->origin);
+  for (const Vec3f& v : from_laz_mesh->positions) {
+    double squared = 0;
+    for (int i = 0; i < 3; ++i) {
+      squared += std::pow(from_laz_mesh->origin[i] + v[i] - centre[i], 2);
+    }
+    ASSERT_NEAR(std::sqrt(squared), 1.0, 0.05) << "a vertex off the building";
+  }
 
   std::vector<std::string> filtered = upload;
   filtered.push_back("--remove_outliers");

@@ -8,8 +8,12 @@
 #include <tuple>
 #include <vector>
 
+#include "core/io/internal/laz.h"
 #include "core/io/point_cloud_io.h"
+#include "core/io/spread_order.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/client/subprocess.h"
 #include "tests/testing/las_file.h"
 #include "tests/testing/shapes.h"
 #include "tests/testing/temp_dir.h"
@@ -28,6 +32,12 @@ std::vector<Point> PointsOf(const v1::PointBatch& batch) {
     points[i] = {xyz[0], xyz[1], xyz[2]};
   }
   return points;
+}
+
+// This test's directory, made once.
+const std::string& Dir() {
+  static const std::string* dir = new std::string(testing::MakeTempDir("point_upload"));
+  return *dir;
 }
 
 // A georeferenced scan as a scanner leaves it, in strips: a building (class 6, a sphere of
@@ -54,7 +64,7 @@ std::string WriteStripScan(const std::string& name, size_t building_points = 600
     ground.classification = 2;
     points.push_back(ground);
   }
-  const std::string path = testing::MakeTempDir("point_upload") + "/" + name;
+  const std::string path = Dir() + "/" + name;
   std::ofstream(path, std::ios::binary) << testing::LasFile(layout, points);
   return path;
 }
@@ -152,6 +162,114 @@ TEST(FileRecordsUploadTest, SkippingBackOrPastTheEndReadsTheOrderAgain) {
   EXPECT_EQ(past.code(), absl::StatusCode::kOutOfRange) << past;
   EXPECT_EQ(past.message(), "the upload cannot start at point 5401 of 5400");
   EXPECT_EQ(resumed.size(), 5400u);
+}
+
+// The scan of WriteStripScan as LAZ in chunks of 1,000 records.
+std::string WriteStripScanLaz(const std::string& name, size_t building_points = 6000) {
+  const std::string las = WriteStripScan(name + ".las", building_points);
+  absl::StatusOr<std::string> laz =
+      io_internal::CompressLas(testing::ReadWholeFile(las), io_internal::LazWriteOptions{1000});
+  EXPECT_TRUE(laz.ok()) << laz.status();
+  const std::string path = Dir() + "/" + name;
+  std::ofstream(path, std::ios::binary) << *laz;
+  return path;
+}
+
+TEST(LazFileUploadTest, SendsEveryPointReadingTheFileWouldTakeOnce) {
+  const std::string path = WriteStripScanLaz("scan.laz");
+  EXPECT_TRUE(IsLazFile(path));
+  EXPECT_FALSE(IsLazFile(WriteStripScan("plain.las")));
+  absl::StatusOr<PointCloud> read = ReadPointCloud(path, nullptr, Building());
+  ASSERT_TRUE(read.ok()) << read.status();
+  ASSERT_EQ(read->size(), 5400u);
+  absl::StatusOr<MappedLazFile> file = MappedLazFile::Open(path, Building().las_classes);
+  ASSERT_TRUE(file.ok()) << file.status();
+  EXPECT_EQ(file->chunks(), 12u);
+  EXPECT_EQ(file->origin(), read->origin);
+  EXPECT_NEAR(file->kept_share(), 0.45, 0.01);
+  for (size_t batch_size : {size_t{1}, size_t{500}, size_t{7000}}) {
+    SCOPED_TRACE(batch_size);
+    LazFileUpload upload(*file);
+    EXPECT_EQ(upload.total(), 12000u);
+    std::vector<Point> sent;
+    while (true) {
+      absl::StatusOr<v1::PointBatch> batch = upload.Batch(sent.size(), batch_size);
+      ASSERT_TRUE(batch.ok()) << batch.status();
+      EXPECT_EQ(batch->first_point().value(), sent.size());
+      const std::vector<Point> points = PointsOf(*batch);
+      if (points.empty()) break;
+      EXPECT_LE(points.size(), batch_size);
+      sent.insert(sent.end(), points.begin(), points.end());
+    }
+    EXPECT_EQ(upload.size(), 5400u);
+    EXPECT_EQ(upload.done(), 12000u);
+    std::vector<Point> expected;
+    for (const Vec3f& p : read->positions) expected.emplace_back(p[0], p[1], p[2]);
+    std::sort(sent.begin(), sent.end());
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(sent, expected) << "the points read whole, each once";
+  }
+}
+
+// 60,000 building points in 120 chunks, bottom to top: the first batch holds the points of the
+// first wave's eight chunks, spread over the building's height.
+TEST(LazFileUploadTest, TheFirstBatchIsSpreadOverTheWaveOfChunks) {
+  absl::StatusOr<MappedLazFile> file =
+      MappedLazFile::Open(WriteStripScanLaz("strips.laz", 60000), Building().las_classes);
+  ASSERT_TRUE(file.ok()) << file.status();
+  LazFileUpload upload(*file);
+  absl::StatusOr<v1::PointBatch> first = upload.Batch(0, 3000);
+  ASSERT_TRUE(first.ok()) << first.status();
+  const std::vector<Point> points = PointsOf(*first);
+  ASSERT_EQ(points.size(), 3000u);
+  EXPECT_EQ(upload.done(), 8000u) << "one wave of eight chunks decoded";
+  int per_tenth[10] = {};
+  for (const Point& p : points) {
+    ++per_tenth[std::clamp(static_cast<int>((std::get<2>(p) - 70) / 2), 0, 9)];
+  }
+  EXPECT_GE(std::count_if(per_tenth, per_tenth + 10, [](int n) { return n > 0; }), 6)
+      << "the first batch in at most five tenths of the building's height";
+}
+
+TEST(LazFileUploadTest, SkippingBackDecodesAgainAndACorruptChunkIsAnError) {
+  const std::string path = WriteStripScanLaz("again.laz");
+  absl::StatusOr<MappedLazFile> file = MappedLazFile::Open(path, Building().las_classes);
+  ASSERT_TRUE(file.ok()) << file.status();
+  LazFileUpload upload(*file);
+  absl::StatusOr<v1::PointBatch> all = upload.Batch(0, 5400);
+  ASSERT_TRUE(all.ok()) << all.status();
+  const std::vector<Point> points = PointsOf(*all);
+  ASSERT_EQ(points.size(), 5400u);
+  absl::StatusOr<v1::PointBatch> again = upload.Batch(1000, 3000);
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_EQ(PointsOf(*again), std::vector<Point>(points.begin() + 1000, points.begin() + 4000));
+  LazFileUpload resumed(*file);
+  ASSERT_TRUE(resumed.SkipTo(4500).ok());
+  absl::StatusOr<v1::PointBatch> rest = resumed.Batch(4500, 2000);
+  ASSERT_TRUE(rest.ok()) << rest.status();
+  EXPECT_EQ(PointsOf(*rest), std::vector<Point>(points.begin() + 4500, points.end()));
+  EXPECT_EQ(resumed.SkipTo(5401).code(), absl::StatusCode::kOutOfRange);
+
+  // The last chunk of the order, past the probe's, overwritten.
+  std::string bytes = testing::ReadWholeFile(path);
+  absl::StatusOr<io_internal::LazChunks> chunks = io_internal::LazChunks::Open(bytes);
+  ASSERT_TRUE(chunks.ok()) << chunks.status();
+  const io_internal::LazChunks::ChunkSpan& last = chunks->chunk(SpreadOrder(12, 1)[11]);
+  for (size_t i = last.at + 30; i < last.at + last.size; ++i) bytes[i] = static_cast<char>(i * 7);
+  const std::string corrupt = Dir() + "/corrupt.laz";
+  std::ofstream(corrupt, std::ios::binary) << bytes;
+  absl::StatusOr<MappedLazFile> opened = MappedLazFile::Open(corrupt, Building().las_classes);
+  ASSERT_TRUE(opened.ok()) << opened.status();
+  LazFileUpload broken(*opened);
+  absl::Status status = absl::OkStatus();
+  for (uint64_t first = 0; status.ok();) {
+    absl::StatusOr<v1::PointBatch> batch = broken.Batch(first, 500);
+    status = batch.status();
+    if (!batch.ok() || batch->packed().positions().empty()) break;
+    first += PointsOf(*batch).size();
+  }
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+  EXPECT_THAT(std::string(status.message()), ::testing::HasSubstr(corrupt)) << status;
 }
 
 TEST(CloudUploadTest, SendsTheCloudInItsOrderWithWhatItCarries) {

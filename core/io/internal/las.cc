@@ -495,6 +495,24 @@ absl::StatusOr<std::unique_ptr<LasRecords>> LasRecords::Create(
   return records;
 }
 
+absl::StatusOr<std::unique_ptr<LasRecords>> LasRecords::Create(
+    absl::string_view header, absl::string_view records, const std::optional<LasClasses>& classes) {
+  // The header alone, counting no records, so that its checks see records that fit.
+  std::string alone(header);
+  if (alone.size() >= kLegacyHeaderSize) {
+    StoreLittleEndian(uint32_t{0}, kLegacyPointCount, &alone);
+    if (static_cast<uint8_t>(alone[kVersionMinor]) >= 4 &&
+        Load<uint16_t>(alone, kHeaderSize) >= kHeaderSize14 && alone.size() >= kHeaderSize14) {
+      StoreLittleEndian(uint64_t{0}, kPointCount, &alone);
+    }
+  }
+  NM_ASSIGN_OR_RETURN(std::unique_ptr<LasRecords> out, Create(alone, classes));
+  out->data_ = records;
+  out->first_ = 0;
+  out->count_ = records.size() / out->length_;
+  return out;
+}
+
 std::optional<Point3d> LasRecords::KeptPoint(uint64_t i) const {
   const size_t at = first_ + i * length_;
   if (Usability(data_, at, format_, classes_) != kUsable) return std::nullopt;

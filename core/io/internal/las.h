@@ -46,6 +46,12 @@ class LasRecords final : public PointRecords {
   // are compressed: INVALID_ARGUMENT). `classes` as ParseLas's.
   static absl::StatusOr<std::unique_ptr<LasRecords>> Create(
       absl::string_view data, const std::optional<LasClasses>& classes);
+  // The records at `records` (a decoded LAZ chunk: LazChunks) of the LAS file whose header and
+  // variable-length records are `header` (LazChunks::las_header); Create's errors for the
+  // header. Both must outlive the object.
+  static absl::StatusOr<std::unique_ptr<LasRecords>> Create(
+      absl::string_view header, absl::string_view records,
+      const std::optional<LasClasses>& classes);
 
   uint64_t size() const override { return count_; }
   // Its integers times the scale, plus the offset, when ParseLas reads it: not withheld, and of

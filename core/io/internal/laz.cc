@@ -580,38 +580,66 @@ absl::StatusOr<LazHeader> ReadLazHeader(absl::string_view laz) {
 
 }  // namespace
 
-absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOptions& options) {
+absl::StatusOr<LazChunks> LazChunks::Open(absl::string_view laz) {
   NM_ASSIGN_OR_RETURN(const LazHeader laz_header, ReadLazHeader(laz));
   const Header& header = laz_header.header;
   const Vlr* laszip = &laz_header.laszip;
   const Compression& compression = laz_header.compression;
-  const size_t points_end =
-      header.evlr_start > header.offset_to_points && header.evlr_start <= laz.size()
-          ? static_cast<size_t>(header.evlr_start)
-          : laz.size();
-  const uint64_t compressed = points_end - header.offset_to_points;
+  LazChunks out;
+  out.laz_ = laz;
+  out.points_end_ = header.evlr_start > header.offset_to_points && header.evlr_start <= laz.size()
+                        ? static_cast<size_t>(header.evlr_start)
+                        : laz.size();
+  out.evlr_start_ = header.evlr_start;
+  const uint64_t compressed = out.points_end_ - header.offset_to_points;
   if (header.count > (kMaxExpansion * compressed + (1u << 20)) / header.record_length) {
     return Invalid(absl::StrCat(header.count, " records of ", header.record_length,
                                 " bytes cannot come from ", compressed,
                                 " bytes of compressed data: the point count is corrupt"));
   }
-  std::vector<Chunk> chunks;
   if (header.count > 0) {
-    NM_ASSIGN_OR_RETURN(chunks, ReadChunkTable(laz, header, compression.chunk_size));
+    NM_ASSIGN_OR_RETURN(const std::vector<Chunk> chunks,
+                        ReadChunkTable(laz, header, compression.chunk_size));
+    uint64_t first = 0;
+    for (const Chunk& chunk : chunks) {
+      out.chunks_.push_back({chunk.at, chunk.size, chunk.count, first});
+      first += chunk.count;
+    }
   }
+  out.format_ = header.format();
+  out.record_length_ = header.record_length;
+  out.item_version_ = compression.item_version;
+  out.records_ = header.count;
+  out.compressed_ = compressed;
 
   const size_t laszip_size = laszip->end() - laszip->at;
-  std::string las;
-  las.reserve(header.offset_to_points +
-              std::min(header.count * header.record_length,
-                       kReservedExpansion * compressed + (uint64_t{1} << 20)));
+  std::string& las = out.las_header_;
   absl::StrAppend(&las, laz.substr(0, laszip->at));
   absl::StrAppend(&las, laz.substr(laszip->end(), header.offset_to_points - laszip->end()));
   las[kPointFormat] = static_cast<char>(header.format());
   SetUint32(header.vlr_count - 1, kVlrCount, &las);
   SetUint32(static_cast<uint32_t>(header.offset_to_points - laszip_size), kOffsetToPoints, &las);
-  // The chunks in waves of a few per thread, each thread decoding a run of them with coders
-  // of its own; the output grows wave by wave.
+  return out;
+}
+
+absl::Status LazChunks::Decode(size_t i, char* out) const {
+  const std::unique_ptr<ChunkCoder> coder = MakeChunkCoder(format_, record_length_, item_version_);
+  const ChunkSpan& chunk = chunks_[i];
+  return coder->Decode(laz_.substr(chunk.at, chunk.size), chunk.records,
+                       reinterpret_cast<uint8_t*>(out),
+                       absl::StrCat("chunk ", i + 1, " of ", chunks_.size()));
+}
+
+absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOptions& options) {
+  NM_ASSIGN_OR_RETURN(const LazChunks chunks, LazChunks::Open(laz));
+  const size_t record_length = chunks.record_length();
+  std::string las;
+  las.reserve(chunks.las_header().size() +
+              std::min(chunks.records() * record_length,
+                       kReservedExpansion * chunks.compressed_bytes() + (uint64_t{1} << 20)));
+  las = chunks.las_header();
+  // The chunks in waves of a few per thread, each thread decoding a run of them; the output
+  // grows wave by wave.
   const size_t wave = kChunksPerThread * ThreadCount(options.threads);
   std::vector<absl::Status> statuses(chunks.size());
   for (size_t begin = 0; begin < chunks.size(); begin += wave) {
@@ -619,22 +647,18 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOp
     std::vector<size_t> chunk_at(end - begin);
     for (size_t i = begin; i < end; ++i) {
       chunk_at[i - begin] = las.size();
-      las.resize(las.size() + chunks[i].count * header.record_length);
+      las.resize(las.size() + chunks.records_in(i) * record_length);
     }
     ForEachRange(end - begin, options.threads, 1, [&](size_t first, size_t last) {
-      const std::unique_ptr<ChunkCoder> coder =
-          MakeChunkCoder(header.format(), header.record_length, compression.item_version);
       for (size_t i = begin + first; i < begin + last; ++i) {
-        statuses[i] = coder->Decode(laz.substr(chunks[i].at, chunks[i].size), chunks[i].count,
-                                    reinterpret_cast<uint8_t*>(&las[chunk_at[i - begin]]),
-                                    absl::StrCat("chunk ", i + 1, " of ", chunks.size()));
+        statuses[i] = chunks.Decode(i, &las[chunk_at[i - begin]]);
       }
     });
     for (size_t i = begin; i < end; ++i) NM_RETURN_IF_ERROR(statuses[i]);
   }
-  if (header.evlr_start != 0 && points_end < laz.size()) {
+  if (chunks.evlr_start() != 0 && chunks.points_end() < laz.size()) {
     SetUint64(las.size(), kEvlrStart, &las);
-    absl::StrAppend(&las, laz.substr(points_end));
+    absl::StrAppend(&las, laz.substr(chunks.points_end()));
   }
   return las;
 }

@@ -8,8 +8,10 @@
 #ifndef NEURALMESH_CORE_IO_INTERNAL_LAZ_H_
 #define NEURALMESH_CORE_IO_INTERNAL_LAZ_H_
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
@@ -39,6 +41,55 @@ struct LazReadOptions {
 // version 1).
 absl::StatusOr<std::string> DecompressLaz(absl::string_view laz,
                                           const LazReadOptions& options = {});
+
+// The chunks of a LAZ file, each decoded on its own (LASzip starts every chunk afresh): the
+// records of a file read where it lies, a chunk at a time, instead of decompressed whole.
+class LazChunks {
+ public:
+  // Where a chunk's bytes are, how many records it holds and the first one's number.
+  struct ChunkSpan {
+    size_t at = 0;
+    size_t size = 0;
+    uint64_t records = 0;
+    uint64_t first = 0;
+  };
+
+  // DecompressLaz's checks of the header, the LASzip record, the records' count and the chunk
+  // table, with its errors. `laz` must outlive the object.
+  static absl::StatusOr<LazChunks> Open(absl::string_view laz);
+
+  size_t size() const { return chunks_.size(); }
+  const ChunkSpan& chunk(size_t i) const { return chunks_[i]; }
+  uint64_t records_in(size_t i) const { return chunks_[i].records; }
+  uint64_t first_record(size_t i) const { return chunks_[i].first; }
+  uint64_t records() const { return records_; }
+  size_t record_length() const { return record_length_; }
+  // The LAS file's header and variable-length records, as DecompressLaz's output begins.
+  const std::string& las_header() const { return las_header_; }
+  // Decodes chunk i (< size()) into the records_in(i) * record_length() bytes at `out`.
+  // DecompressLaz's errors for a chunk that cannot be decoded. Safe to call from several
+  // threads at once.
+  absl::Status Decode(size_t i, char* out) const;
+
+  // The compressed records' bytes; where they end, and LAS 1.4's extended records' start.
+  uint64_t compressed_bytes() const { return compressed_; }
+  size_t points_end() const { return points_end_; }
+  uint64_t evlr_start() const { return evlr_start_; }
+
+ private:
+  LazChunks() = default;
+
+  absl::string_view laz_;
+  std::vector<ChunkSpan> chunks_;
+  std::string las_header_;
+  int format_ = 0;
+  size_t record_length_ = 0;
+  uint16_t item_version_ = 0;
+  uint64_t records_ = 0;
+  uint64_t compressed_ = 0;
+  size_t points_end_ = 0;
+  uint64_t evlr_start_ = 0;
+};
 
 // How `laz` is compressed, for reports (`neuralmesh stats`): the LASzip version that wrote it,
 // the compressor, the item version and the chunks, as "LASzip 3.4 (revision 3), layered chunks,

@@ -76,6 +76,31 @@ PointSelection Building() {
   return selection;
 }
 
+// Uploads the whole of `upload` in batches of `batch_size`, checking each batch, and expects
+// the points sent to be those of `read`, each once, and the upload's counts to be the file's:
+// its 12,000 records and 5,400 points.
+void ExpectEveryPointOnce(PointUpload& upload, size_t batch_size, const PointCloud& read) {
+  EXPECT_EQ(upload.total(), 12000u);
+  std::vector<Point> sent;
+  while (true) {
+    if (upload.size().has_value()) EXPECT_EQ(*upload.size(), 5400u) << "a count before the end";
+    absl::StatusOr<v1::PointBatch> batch = upload.Batch(sent.size(), batch_size);
+    ASSERT_TRUE(batch.ok()) << batch.status();
+    EXPECT_EQ(batch->first_point().value(), sent.size());
+    const std::vector<Point> points = PointsOf(*batch);
+    if (points.empty()) break;
+    EXPECT_LE(points.size(), batch_size);
+    sent.insert(sent.end(), points.begin(), points.end());
+  }
+  EXPECT_EQ(upload.size(), 5400u);
+  EXPECT_EQ(upload.done(), 12000u);
+  std::vector<Point> expected;
+  for (const Vec3f& p : read.positions) expected.emplace_back(p[0], p[1], p[2]);
+  std::sort(sent.begin(), sent.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(sent, expected) << "the points read whole, each once";
+}
+
 TEST(FileRecordsUploadTest, SendsEveryPointReadingTheFileWouldTakeOnce) {
   const std::string path = WriteStripScan("scan.las");
   absl::StatusOr<PointCloud> read = ReadPointCloud(path, nullptr, Building());
@@ -87,25 +112,7 @@ TEST(FileRecordsUploadTest, SendsEveryPointReadingTheFileWouldTakeOnce) {
   for (size_t batch_size : {size_t{1}, size_t{500}, size_t{7000}}) {
     SCOPED_TRACE(batch_size);
     FileRecordsUpload upload(*file);
-    EXPECT_EQ(upload.total(), 12000u);
-    std::vector<Point> sent;
-    while (true) {
-      EXPECT_FALSE(upload.size().has_value() && sent.size() < 5400);
-      absl::StatusOr<v1::PointBatch> batch = upload.Batch(sent.size(), batch_size);
-      ASSERT_TRUE(batch.ok()) << batch.status();
-      EXPECT_EQ(batch->first_point().value(), sent.size());
-      const std::vector<Point> points = PointsOf(*batch);
-      if (points.empty()) break;
-      EXPECT_LE(points.size(), batch_size);
-      sent.insert(sent.end(), points.begin(), points.end());
-    }
-    EXPECT_EQ(upload.size(), 5400u);
-    EXPECT_EQ(upload.done(), 12000u);
-    std::vector<Point> expected;
-    for (const Vec3f& p : read->positions) expected.emplace_back(p[0], p[1], p[2]);
-    std::sort(sent.begin(), sent.end());
-    std::sort(expected.begin(), expected.end());
-    EXPECT_EQ(sent, expected) << "the points read whole, each once";
+    ExpectEveryPointOnce(upload, batch_size, *read);
   }
 }
 
@@ -190,24 +197,7 @@ TEST(LazFileUploadTest, SendsEveryPointReadingTheFileWouldTakeOnce) {
   for (size_t batch_size : {size_t{1}, size_t{500}, size_t{7000}}) {
     SCOPED_TRACE(batch_size);
     LazFileUpload upload(*file);
-    EXPECT_EQ(upload.total(), 12000u);
-    std::vector<Point> sent;
-    while (true) {
-      absl::StatusOr<v1::PointBatch> batch = upload.Batch(sent.size(), batch_size);
-      ASSERT_TRUE(batch.ok()) << batch.status();
-      EXPECT_EQ(batch->first_point().value(), sent.size());
-      const std::vector<Point> points = PointsOf(*batch);
-      if (points.empty()) break;
-      EXPECT_LE(points.size(), batch_size);
-      sent.insert(sent.end(), points.begin(), points.end());
-    }
-    EXPECT_EQ(upload.size(), 5400u);
-    EXPECT_EQ(upload.done(), 12000u);
-    std::vector<Point> expected;
-    for (const Vec3f& p : read->positions) expected.emplace_back(p[0], p[1], p[2]);
-    std::sort(sent.begin(), sent.end());
-    std::sort(expected.begin(), expected.end());
-    EXPECT_EQ(sent, expected) << "the points read whole, each once";
+    ExpectEveryPointOnce(upload, batch_size, *read);
   }
 }
 

@@ -22,9 +22,11 @@
 #include "client/inputs.h"
 #include "client/point_upload.h"
 #include "client/reconstruction_client.h"
+#include "core/io/internal/laz.h"
 #include "core/io/mapped_point_file.h"
 #include "core/io/mesh_io.h"
 #include "core/io/point_cloud_io.h"
+#include "core/io/spread_order.h"
 #include "core/learning/learner_options.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -590,6 +592,35 @@ TEST_F(RemoteCliTest, OffCoreUploadsAScanFromWhereItLies) {
     }
     ASSERT_NEAR(std::sqrt(squared), 1.0, 0.05) << "a vertex off the building";
   }
+
+  // A LAZ file of 500-record chunks whose last chunk in the upload's order (past the probe's
+  // wave) is corrupt: the upload stops there with the decoder's message, and the session is
+  // cancelled.
+  absl::StatusOr<std::string> chunked =
+      io_internal::CompressLas(ReadWholeFile(las), io_internal::LazWriteOptions{500});
+  ASSERT_TRUE(chunked.ok()) << chunked.status();
+  absl::StatusOr<io_internal::LazChunks> chunks = io_internal::LazChunks::Open(*chunked);
+  ASSERT_TRUE(chunks.ok()) << chunks.status();
+  ASSERT_EQ(chunks->size(), 16u);
+  const io_internal::LazChunks::ChunkSpan& last = chunks->chunk(SpreadOrder(16, 1)[15]);
+  std::string corrupt_bytes = *chunked;
+  for (size_t i = last.at + 30; i < last.at + last.size; ++i) {
+    corrupt_bytes[i] = static_cast<char>(i * 7);
+  }
+  const std::string corrupt = *dir_ + "/corrupt.laz";
+  std::ofstream(corrupt, std::ios::binary) << corrupt_bytes;
+  std::vector<std::string> from_corrupt = upload;
+  from_corrupt[1] = corrupt;
+  from_corrupt[5] = *dir_ + "/off_core_corrupt";
+  const RunResult broken = RunNeuralmesh(from_corrupt);
+  EXPECT_EQ(broken.exit_code, 1) << broken.Describe();
+  EXPECT_THAT(broken.err, ::testing::HasSubstr("'" + corrupt + "': LAZ: chunk "))
+      << broken.Describe();
+  ASSERT_TRUE(std::regex_search(broken.out, id, std::regex("session (s-[0-9a-f]+) on ")))
+      << broken.out;
+  session = (*service)->GetSession(id[1]);
+  ASSERT_TRUE(session.ok()) << session.status();
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_CANCELLED);
 
   std::vector<std::string> filtered = upload;
   filtered.push_back("--remove_outliers");

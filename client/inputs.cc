@@ -344,6 +344,7 @@ absl::Status MoveStartMesh(const Origin& origin, const std::string& path,
 
 std::string InputStem(const std::string& input) {
   if (IsBuiltin(input)) return input.substr(kBuiltinPrefix.size());
+  if (input == "-") return "stdin";
   return std::filesystem::path(input).stem().string();
 }
 

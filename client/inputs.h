@@ -149,8 +149,8 @@ absl::StatusOr<TriangleMesh> ReadStartMesh(const std::string& path);
 absl::Status MoveStartMesh(const Origin& origin, const std::string& path,
                            TriangleMesh* mesh);
 
-// A short name for output files: the file name without directory and extension, or NAME for
-// builtin:NAME.
+// A short name for output files: the file name without directory and extension, NAME for
+// builtin:NAME, "stdin" for '-' (points streamed from standard input).
 std::string InputStem(const std::string& input);
 
 }  // namespace neuralmesh::client

@@ -529,6 +529,10 @@ absl::Status Reconstruct(const ParsedArgs& args) {
       WithConnectionFlags({"out-dir", "batch-size", "points", "ply", "glb", "outliers_on_server",
                            "resume", "reconnect_for"}),
       "needs --server (a local reconstruct writes -o OUTPUT)"));
+  if (std::find(args.positional.begin(), args.positional.end(), "-") != args.positional.end()) {
+    return absl::InvalidArgumentError(
+        "INPUT '-' streams points from standard input to a server: it needs --server");
+  }
   if (!args.Has("vertices")) return absl::InvalidArgumentError("--vertices N is required");
   neuralmesh::client::LocalReconstructOptions o;
   o.inputs = args.positional;
@@ -721,7 +725,10 @@ std::vector<Subcommand> Commands() {
        "per station or tile) are learned as one, each where its coordinates put it.\n"
        "Locally it writes OUTPUT and one OUTPUT_lod<N> file per --lod; with --server it\n"
        "uploads the points and saves each mesh the server publishes into --out-dir. Prints\n"
-       "the figures of every level.",
+       "the figures of every level. With --server, INPUT '-' streams points from standard\n"
+       "input as they arrive (\"x y z\" per line, spaces, tabs or commas; further columns and\n"
+       "'#' comments ignored), a batch whenever --batch-size points came or 100 ms passed;\n"
+       "the session finishes at the end of the stream (files named stdin*).",
        WithConnectionFlags(reconstruct), Reconstruct},
       {"stats",
        "stats MESH|POINTS [--json]",
@@ -753,9 +760,9 @@ std::vector<Subcommand> Commands() {
        "when they share the coordinate system and extra bytes and hold no waveforms, those\n"
        "of other point formats in the format that holds every field of theirs.\n"
        "--outliers_as_noise classifies the outliers as noise instead of removing them.",
-       {"output", "gltf_draco", "pcd_data", "las_classes", "remove_outliers",
-        "outlier_neighbours", "outlier_std_ratio",
-        "outlier_passes", "outliers_as_noise", "quantization_bits", "encode_speed"},
+       {"output", "gltf_draco", "pcd_data", "las_classes", "remove_outliers", "outlier_neighbours",
+        "outlier_std_ratio", "outlier_passes", "outliers_as_noise", "quantization_bits",
+        "encode_speed"},
        Convert},
       {"eval",
        "eval MESH --reference REF [--json] [--samples N]",
@@ -768,19 +775,14 @@ std::vector<Subcommand> Commands() {
        Eval},
       {"watch",
        "watch SESSION --server HOST:PORT --out-dir DIR [--ply] [--glb] [--reconnect_for D]",
-       "Watches a server session until it ends, saving every milestone and the final mesh.",
-       "",
-       WithConnectionFlags({"server", "out-dir", "ply", "glb", "reconnect_for"}),
-       Watch},
-      {"sessions",
-       "sessions --server HOST:PORT [--json] [--reconnect_for D]",
+       "Watches a server session until it ends, saving every milestone and the final mesh.", "",
+       WithConnectionFlags({"server", "out-dir", "ply", "glb", "reconnect_for"}), Watch},
+      {"sessions", "sessions --server HOST:PORT [--json] [--reconnect_for D]",
        "Lists the sessions of a server.",
        "Lists the sessions of a server; a server restoring its sessions after a restart is\n"
        "asked again until it is done (at most --reconnect_for).",
-       WithConnectionFlags({"server", "json", "reconnect_for"}),
-       Sessions},
-      {"get",
-       "get SESSION --server HOST:PORT -o OUTPUT [--final] [--wait D]",
+       WithConnectionFlags({"server", "json", "reconnect_for"}), Sessions},
+      {"get", "get SESSION --server HOST:PORT -o OUTPUT [--final] [--wait D]",
        "Saves a session's latest or final mesh.",
        "Saves the latest mesh of a server session (with --final its final mesh) to OUTPUT:\n"
        ".drc keeps the server's Draco bytes as they are; .ply .obj .off .stl .glb .gltf are\n"

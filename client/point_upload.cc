@@ -4,6 +4,8 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "client/interrupt.h"
 #include "core/parallel_ranges.h"
 #include "core/status_macros.h"
 #include "proto/packing.h"
@@ -142,6 +144,79 @@ absl::StatusOr<v1::PointBatch> LazFileUpload::Batch(uint64_t first, size_t count
   v1::PointBatch batch;
   batch.mutable_first_point()->set_value(first);
   batch.mutable_packed()->set_positions(std::move(positions));
+  return batch;
+}
+
+std::optional<uint64_t> StreamUpload::size() const {
+  if (!ended_) return std::nullopt;
+  return points_.size();
+}
+
+absl::Status StreamUpload::ReadUntil(uint64_t want, uint64_t least, absl::Time deadline) {
+  constexpr absl::Duration kLongestWait = absl::Milliseconds(50);  // Between interrupt checks.
+  while (!ended_ && points_.size() + arrived_.size() < want) {
+    const absl::Time now = absl::Now();
+    if (now >= deadline && points_.size() + arrived_.size() > least) break;
+    if (InterruptScope::interrupted()) {
+      return absl::CancelledError(absl::StrCat("interrupted while reading ", stream_.name()));
+    }
+    // Past the deadline with nothing to send: wait for the next point as long as it takes.
+    const absl::Duration wait =
+        now >= deadline ? kLongestWait : std::min(deadline - now, kLongestWait);
+    NM_ASSIGN_OR_RETURN(const bool more, stream_.Read(wait, &arrived_));
+    ended_ = !more;
+    NM_RETURN_IF_ERROR(TakeArrived());
+  }
+  return absl::OkStatus();
+}
+
+absl::Status StreamUpload::TakeArrived() {
+  if (!started_) return absl::OkStatus();
+  for (const Vec3& p : arrived_) {
+    const Vec3 relative(p[0] - origin_[0], p[1] - origin_[1], p[2] - origin_[2]);
+    if (!MappedPointFile::Learnable(relative)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          stream_.name(), ", point ", points_.size() + 1, ": (", p[0], ", ", p[1], ", ", p[2],
+          ") lies beyond a float's range from the origin the first points chose (", origin_[0],
+          ", ", origin_[1], ", ", origin_[2], ")"));
+    }
+    points_.emplace_back(static_cast<float>(relative[0]), static_cast<float>(relative[1]),
+                         static_cast<float>(relative[2]));
+  }
+  arrived_.clear();
+  return absl::OkStatus();
+}
+
+absl::Status StreamUpload::Start(size_t count) {
+  NM_RETURN_IF_ERROR(ReadUntil(count, 0, absl::Now() + flush_after_));
+  if (arrived_.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        stream_.name(), " ended before its first point (", stream_.lines(), " lines read)"));
+  }
+  BoundingBox box;
+  for (const Vec3& p : arrived_) box.Extend(p);
+  origin_ = OriginOfStreamedPoints(box);
+  started_ = true;
+  return TakeArrived();
+}
+
+absl::Status StreamUpload::SkipTo(uint64_t first) {
+  NM_RETURN_IF_ERROR(ReadUntil(first, first, absl::InfiniteFuture()));
+  if (points_.size() < first) {
+    return absl::OutOfRangeError(
+        absl::StrCat("the upload cannot start at point ", first, " of ", points_.size()));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<v1::PointBatch> StreamUpload::Batch(uint64_t first, size_t count) {
+  NM_RETURN_IF_ERROR(SkipTo(first));
+  NM_RETURN_IF_ERROR(ReadUntil(first + count, first, absl::Now() + flush_after_));
+  const uint64_t end = std::min<uint64_t>(points_.size(), first + count);
+  v1::PointBatch batch;
+  batch.mutable_first_point()->set_value(first);
+  batch.mutable_packed()->set_positions(std::string(
+      reinterpret_cast<const char*>(points_.data() + first), (end - first) * sizeof(Vec3f)));
   return batch;
 }
 

@@ -12,8 +12,10 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/time/time.h"
 #include "core/io/mapped_laz_file.h"
 #include "core/io/mapped_point_file.h"
+#include "core/io/point_text_stream.h"
 #include "core/io/spread_order.h"
 #include "core/point_cloud.h"
 #include "neuralmesh/v1/reconstruction.pb.h"
@@ -114,6 +116,50 @@ class LazFileUpload final : public PointUpload {
   std::vector<Vec3f> wave_;  // The points of the last wave decoded, in upload order.
   uint64_t wave_first_ = 0;  // The upload's number of wave_'s first point.
   uint64_t records_done_ = 0;
+};
+
+// Points as they arrive on a text stream (PointTextStream: `neuralmesh reconstruct -
+// --server`), kept in memory as they come so that a batch can be sent again after a lost
+// connection. A batch goes out as soon as it is full, or once `flush_after` has passed with
+// points to send, so a slow stream's points reach the server within that time. Positions only,
+// relative to an origin chosen from the first batch (Start).
+class StreamUpload final : public PointUpload {
+ public:
+  static constexpr absl::Duration kFlushAfter = absl::Milliseconds(100);
+
+  explicit StreamUpload(PointTextStream stream, absl::Duration flush_after = kFlushAfter)
+      : stream_(std::move(stream)), flush_after_(flush_after) {}
+
+  // Waits for the first batch (`count` points, or fewer once flush_after has passed or the
+  // stream ended) and chooses the origin from it (OriginOfStreamedPoints). INVALID_ARGUMENT
+  // when the stream ends without a point; the stream's errors; CANCELLED on an interrupt
+  // (InterruptScope).
+  absl::Status Start(size_t count);
+  const Origin& origin() const { return origin_; }
+
+  // Start's errors, and INVALID_ARGUMENT for a point beyond a float's range from the origin.
+  absl::Status SkipTo(uint64_t first) override;
+  absl::StatusOr<v1::PointBatch> Batch(uint64_t first, size_t count) override;
+  // The points read so far, of an unknown total (0).
+  uint64_t done() const override { return points_.size(); }
+  uint64_t total() const override { return 0; }
+  // Known once the stream ended.
+  std::optional<uint64_t> size() const override;
+
+ private:
+  // Reads until there are `want` points, the stream ends, or `deadline` passes with more than
+  // `least` points.
+  absl::Status ReadUntil(uint64_t want, uint64_t least, absl::Time deadline);
+  // Once the origin is chosen, moves the points arrived_ holds into points_, relative to it.
+  absl::Status TakeArrived();
+
+  PointTextStream stream_;
+  absl::Duration flush_after_;
+  bool ended_ = false;
+  std::vector<Vec3> arrived_;  // Read, in the stream's coordinates, before the origin is set.
+  std::vector<Vec3f> points_;  // Relative to origin_.
+  Origin origin_ = kNoOrigin;
+  bool started_ = false;
 };
 
 }  // namespace neuralmesh::client

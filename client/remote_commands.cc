@@ -1,5 +1,7 @@
 #include "client/remote_commands.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -32,6 +34,7 @@ constexpr size_t kDefaultMaxVertices = 10000;
 // a server that stopped answering must not hold the command for the usual call timeout.
 constexpr absl::Duration kTidyCancelTimeout = absl::Seconds(5);
 constexpr double kDefaultPointsPerVertex = 2;  // SessionConfig.points_per_vertex's default.
+constexpr char kStandardInput[] = "-";         // The INPUT that streams points from standard input.
 
 BoundingBox BoundsOf(const PointCloud& cloud) {
   BoundingBox box;
@@ -65,19 +68,59 @@ struct UploadInput {
   std::unique_ptr<PointCloud> cloud;      // The points, read whole (not off-core).
   std::unique_ptr<MappedPointFile> file;  // Off-core: the file, read where it lies,
   std::unique_ptr<MappedLazFile> laz;     // or a LAZ file's, a chunk at a time.
-  std::unique_ptr<PointUpload> points;    // Of `cloud`, `file` or `laz`.
+  std::unique_ptr<PointUpload> points;    // Of `cloud`, `file` or `laz`, or streamed.
   Origin origin = kNoOrigin;
-  BoundingBox bounds;
+  // Where the points lie, when that is known before the upload.
+  std::optional<BoundingBox> bounds;
   // The points to send; off-core an estimate (the records times the share of the probe's that
-  // are points), as `estimated` says.
+  // are points), as `estimated` says; unknown (0) for points streamed from standard input.
   uint64_t size = 0;
   bool estimated = false;
+  bool streamed = false;
 };
 
+// Points streamed from standard input (INPUT '-'), sent as they arrive.
+absl::StatusOr<UploadInput> StreamUploadInput(const RemoteReconstructOptions& options,
+                                              bool outliers_on_server, std::ostream& out) {
+  if (options.off_core) {
+    return absl::InvalidArgumentError(
+        "--off_core reads a file where it lies; standard input ('-') is streamed as it comes");
+  }
+  if (options.outliers.has_value() && !outliers_on_server) {
+    return absl::InvalidArgumentError(
+        "--remove_outliers judges every point against its neighbours, so it needs them all "
+        "before the upload: with standard input ('-') add --outliers_on_server");
+  }
+  if (!options.resume_session.empty()) {
+    return absl::InvalidArgumentError(
+        "--resume uploads the input again from the points the session has taken; standard "
+        "input ('-') cannot be read again");
+  }
+  auto upload = std::make_unique<StreamUpload>(PointTextStream(STDIN_FILENO, "standard input"));
+  NM_RETURN_IF_ERROR(upload->Start(options.batch_size));
+  UploadInput input;
+  input.origin = upload->origin();
+  input.streamed = true;
+  out << "INPUT '-': points streamed from standard input, sent every "
+      << absl::FormatDuration(StreamUpload::kFlushAfter) << " or " << options.batch_size
+      << " points" << OriginNote(input.origin) << "\n";
+  input.points = std::move(upload);
+  return input;
+}
+
 // The input of `options`: read whole (outliers removed when the client removes them, colours
-// dropped unless asked for), or off-core its one file mapped; what was done is said on `out`.
+// dropped unless asked for), off-core its one file mapped, or standard input streamed; what was
+// done is said on `out`.
 absl::StatusOr<UploadInput> LoadUploadInput(const RemoteReconstructOptions& options,
                                             bool outliers_on_server, std::ostream& out) {
+  if (std::find(options.inputs.begin(), options.inputs.end(), kStandardInput) !=
+      options.inputs.end()) {
+    if (options.inputs.size() > 1) {
+      return absl::InvalidArgumentError(
+          "standard input ('-') is streamed alone; several INPUTs are files uploaded as one");
+    }
+    return StreamUploadInput(options, outliers_on_server, out);
+  }
   UploadInput input;
   if (options.off_core) {
     NM_RETURN_IF_ERROR(
@@ -160,7 +203,9 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     NM_ASSIGN_OR_RETURN(start_mesh, ReadStartMesh(options.start_mesh));
     NM_RETURN_IF_ERROR(MoveStartMesh(input.origin, options.start_mesh, &*start_mesh));
   }
-  const size_t affordable = static_cast<size_t>(std::floor(input.size / kDefaultPointsPerVertex));
+  const size_t affordable =
+      input.streamed ? kDefaultMaxVertices
+                     : static_cast<size_t>(std::floor(input.size / kDefaultPointsPerVertex));
   size_t target =
       options.vertices > 0 ? options.vertices : std::min(kDefaultMaxVertices, affordable);
   NM_ASSIGN_OR_RETURN(
@@ -187,10 +232,10 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     v1::OutlierRemoval& removal = *config.mutable_outlier_removal();
     removal.mutable_neighbours()->set_value(options.outliers->neighbours);
     removal.mutable_std_ratio()->set_value(options.outliers->std_ratio);
-  } else {
+  } else if (input.bounds.has_value()) {
     // Where the points lie is known before the upload: one quantization cube for the whole
     // session (off-core, the cube of the file's probe, which grows if a point lies outside).
-    *config.mutable_bounds() = ToProto(input.bounds);
+    *config.mutable_bounds() = ToProto(*input.bounds);
   }
 
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
@@ -244,10 +289,14 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
                                        ? session.config().points_per_vertex().value()
                                        : kDefaultPointsPerVertex;
   const size_t reachable =
-      std::min<size_t>(target, static_cast<size_t>(std::floor(input.size / points_per_vertex)));
+      input.streamed ? target
+                     : std::min<size_t>(
+                           target, static_cast<size_t>(std::floor(input.size / points_per_vertex)));
   out << "session " << id << " on " << client->address() << ": "
-      << (input.estimated ? "about " : "") << input.size << " points, target " << target
-      << " vertices";
+      << (input.streamed    ? std::string("points from standard input")
+          : input.estimated ? absl::StrCat("about ", input.size, " points")
+                            : absl::StrCat(input.size, " points"))
+      << ", target " << target << " vertices";
   if (!options.resume_session.empty()) out << "; resuming at point " << first_point;
   out << "\n";
   if (reachable < target) {

@@ -629,6 +629,102 @@ TEST_F(RemoteCliTest, OffCoreUploadsAScanFromWhereItLies) {
   EXPECT_THAT(refused.err, ::testing::HasSubstr("reads the file whole: not with --off_core"));
 }
 
+// INPUT '-': points streamed from standard input as a scanner's pipeline sends them. The
+// lower half of a georeferenced sphere arrives first, and a mesh of it is published before the
+// upper half comes; at the end of the stream the session is finished, and its final mesh is
+// the whole sphere in the scan's coordinates, from every point once.
+TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
+  const double centre[3] = {500123.5, 4100456.25, 80};
+  std::vector<Vec3f> sphere = ColoredUnitSpherePoints(4000, 31).positions;
+  std::sort(sphere.begin(), sphere.end(),
+            [](const Vec3f& a, const Vec3f& b) { return a[2] < b[2]; });
+  std::string lower, upper;
+  for (size_t i = 0; i < sphere.size(); ++i) {
+    (i < 2000 ? lower : upper) +=
+        absl::StrFormat("%.4f,%.4f,%.4f\n", centre[0] + sphere[i][0], centre[1] + sphere[i][1],
+                        centre[2] + sphere[i][2]);
+  }
+  const std::string out_dir = *dir_ + "/streamed";
+  BackgroundProcess run("neuralmesh",
+                        {"reconstruct", "-", "--server", server_->address(), "--out-dir", out_dir,
+                         "--vertices", "400", "--lod", "100", "--batch-size", "500"},
+                        /*stdin_pipe=*/true);
+  ASSERT_TRUE(run.WriteStdin("# x,y,z of a scan\n" + lower));
+  ASSERT_TRUE(run.AwaitStdout("lod ")) << "no mesh before the stream went on\n"
+                                       << run.Stdout() << run.Stderr();
+  // The half that arrived is an open cap: the mesh published so far lies on the lower half.
+  ASSERT_TRUE(run.WriteStdin(upper.substr(0, 10)));  // A line split across two writes.
+  absl::SleepFor(absl::Milliseconds(150));
+  ASSERT_TRUE(run.WriteStdin(upper.substr(10)));
+  run.CloseStdin();
+  for (int i = 0; i < 600 && run.Running(); ++i) absl::SleepFor(absl::Milliseconds(50));
+  ASSERT_FALSE(run.Running());
+  ASSERT_EQ(run.exit_code(), 0) << run.Stdout() << run.Stderr();
+  const std::string out = run.Stdout();
+  EXPECT_THAT(out, ::testing::HasSubstr("INPUT '-': points streamed from standard input"));
+  EXPECT_THAT(out, ::testing::HasSubstr("coordinates taken relative to (500000, 4100000, 0)"));
+  const absl::StatusOr<TriangleMesh> lod = ReadMesh(out_dir + "/stdin_lod100.drc");
+  ASSERT_TRUE(lod.ok()) << lod.status();
+  double highest = -INFINITY;
+  for (const Vec3f& v : lod->positions) highest = std::max(highest, lod->origin[2] + v[2]);
+  EXPECT_LT(highest, centre[2] + 0.5) << "the first mesh reaches the half not yet sent";
+  const absl::StatusOr<TriangleMesh> mesh = ReadMesh(out_dir + "/stdin.drc");
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->origin, (std::array<double, 3>{500000, 4100000, 0}));
+  EXPECT_EQ(mesh->positions.size(), 400u);
+  for (const Vec3f& v : mesh->positions) {
+    double squared = 0;
+    for (int i = 0; i < 3; ++i) squared += std::pow(mesh->origin[i] + v[i] - centre[i], 2);
+    ASSERT_NEAR(std::sqrt(squared), 1.0, 0.05) << "a vertex off the sphere";
+  }
+  std::smatch id;
+  ASSERT_TRUE(std::regex_search(out, id, std::regex("session (s-[0-9a-f]+) on "))) << out;
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
+      client::ReconstructionClient::Connect(server_->address());
+  ASSERT_TRUE(service.ok()) << service.status();
+  absl::StatusOr<v1::Session> session = (*service)->GetSession(id[1]);
+  ASSERT_TRUE(session.ok()) << session.status();
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_FINISHED);
+  EXPECT_EQ(session->points_taken(), 4000u);
+
+  // A line that is not a point ends the upload, naming it; the session is cancelled.
+  BackgroundProcess bad("neuralmesh",
+                        {"reconstruct", "-", "--server", server_->address(), "--out-dir",
+                         *dir_ + "/streamed_bad", "--batch-size", "2"},
+                        /*stdin_pipe=*/true);
+  ASSERT_TRUE(bad.WriteStdin("1 2 3\n4 5 6\n7 8 9\n10 11 12\n13 14 15\n1.5 2.5 oops\n"));
+  bad.CloseStdin();
+  for (int i = 0; i < 200 && bad.Running(); ++i) absl::SleepFor(absl::Milliseconds(50));
+  ASSERT_FALSE(bad.Running());
+  EXPECT_EQ(bad.exit_code(), 1);
+  EXPECT_THAT(bad.Stderr(),
+              ::testing::HasSubstr("standard input, line 6: '1.5 2.5 oops' does not start with "
+                                   "a point's x, y and z"));
+  BackgroundProcess empty(
+      "neuralmesh",
+      {"reconstruct", "-", "--server", server_->address(), "--out-dir", *dir_ + "/streamed_empty"},
+      /*stdin_pipe=*/true);
+  ASSERT_TRUE(empty.WriteStdin("# nothing\n\n"));
+  empty.CloseStdin();
+  for (int i = 0; i < 200 && empty.Running(); ++i) absl::SleepFor(absl::Milliseconds(50));
+  EXPECT_EQ(empty.exit_code(), 1);
+  EXPECT_THAT(empty.Stderr(),
+              ::testing::HasSubstr("standard input ended before its first point (2 lines read)"));
+  const std::vector<std::pair<std::vector<std::string>, std::string>> refused = {
+      {{"reconstruct", "-", "-o", *dir_ + "/local.ply", "--vertices", "100"}, "it needs --server"},
+      {{"reconstruct", "-", "--server", server_->address(), "--out-dir", out_dir, "--resume",
+        "s-0"},
+       "standard input ('-') cannot be read again"},
+      {{"reconstruct", "-", "a.xyz", "--server", server_->address(), "--out-dir", out_dir},
+       "streamed alone"},
+  };
+  for (const auto& [args, why] : refused) {
+    const RunResult result = RunNeuralmesh(args);
+    EXPECT_NE(result.exit_code, 0) << result.Describe();
+    EXPECT_THAT(result.err, ::testing::HasSubstr(why)) << result.Describe();
+  }
+}
+
 TEST_F(RemoteCliTest, SessionsListsTheFinishedSession) {
   ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
   const RunResult sessions = RunNeuralmesh({"sessions", "--server", server_->address()});

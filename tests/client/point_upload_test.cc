@@ -1,5 +1,7 @@
 #include "client/point_upload.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -83,7 +85,9 @@ void ExpectEveryPointOnce(PointUpload& upload, size_t batch_size, const PointClo
   EXPECT_EQ(upload.total(), 12000u);
   std::vector<Point> sent;
   while (true) {
-    if (upload.size().has_value()) EXPECT_EQ(*upload.size(), 5400u) << "a count before the end";
+    if (upload.size().has_value()) {
+      EXPECT_EQ(*upload.size(), 5400u) << "a count before the end";
+    }
     absl::StatusOr<v1::PointBatch> batch = upload.Batch(sent.size(), batch_size);
     ASSERT_TRUE(batch.ok()) << batch.status();
     EXPECT_EQ(batch->first_point().value(), sent.size());
@@ -260,6 +264,63 @@ TEST(LazFileUploadTest, SkippingBackDecodesAgainAndACorruptChunkIsAnError) {
   }
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
   EXPECT_THAT(std::string(status.message()), ::testing::HasSubstr(corrupt)) << status;
+}
+
+// Georeferenced points written to a pipe in two parts: the first batch chooses the origin, a
+// batch that is not full goes out once the flush time passes, and the upload's size is known
+// at the end of the stream.
+TEST(StreamUploadTest, SendsPointsAsTheyArriveRelativeToTheFirstPointsOrigin) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const std::string first = "500123.5 4100456.25 80\n500124.5 4100457.25 81\n";
+  ASSERT_EQ(write(fds[1], first.data(), first.size()), static_cast<ssize_t>(first.size()));
+  StreamUpload upload(PointTextStream(fds[0], "standard input"), absl::Milliseconds(50));
+  ASSERT_TRUE(upload.Start(1000).ok());
+  EXPECT_EQ(upload.origin(), (Origin{500000, 4100000, 0}));
+  EXPECT_EQ(upload.done(), 2u);
+  EXPECT_FALSE(upload.size().has_value());
+  const absl::Time before = absl::Now();
+  absl::StatusOr<v1::PointBatch> batch = upload.Batch(0, 1000);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  EXPECT_LT(absl::Now() - before, absl::Seconds(1)) << "a batch that is not full waited";
+  EXPECT_EQ(PointsOf(*batch), (std::vector<Point>{{123.5f, 456.25f, 80}, {124.5f, 457.25f, 81}}));
+
+  const std::string second = "500125.5 4100458.25 82\n";
+  ASSERT_EQ(write(fds[1], second.data(), second.size()), static_cast<ssize_t>(second.size()));
+  close(fds[1]);
+  batch = upload.Batch(2, 1000);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  EXPECT_EQ(batch->first_point().value(), 2u);
+  EXPECT_EQ(PointsOf(*batch), (std::vector<Point>{{125.5f, 458.25f, 82}}));
+  batch = upload.Batch(3, 1000);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  EXPECT_TRUE(batch->packed().positions().empty()) << "the end of the stream";
+  EXPECT_EQ(upload.size(), 3u);
+  batch = upload.Batch(1, 1);  // Again, as after a lost connection.
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  EXPECT_EQ(PointsOf(*batch), (std::vector<Point>{{124.5f, 457.25f, 81}}));
+  EXPECT_EQ(upload.SkipTo(4).code(), absl::StatusCode::kOutOfRange);
+  close(fds[0]);
+}
+
+TEST(StreamUploadTest, APointFarFromTheOriginIsAnError) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const std::string text = "1 2 3\n4 5 6\n";
+  ASSERT_EQ(write(fds[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  StreamUpload upload(PointTextStream(fds[0], "standard input"));
+  const absl::Status started = upload.Start(2);
+  ASSERT_TRUE(started.ok()) << started;
+  const std::string far = "1e300 0 0\n";
+  ASSERT_EQ(write(fds[1], far.data(), far.size()), static_cast<ssize_t>(far.size()));
+  close(fds[1]);
+  absl::StatusOr<v1::PointBatch> batch = upload.Batch(0, 10);
+  ASSERT_FALSE(batch.ok());
+  EXPECT_EQ(batch.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(batch.status().message()),
+              ::testing::HasSubstr("standard input, point 3: (1e+300, 0, 0) lies beyond a "
+                                   "float's range from the origin the first points chose"));
+  close(fds[0]);
 }
 
 TEST(CloudUploadTest, SendsTheCloudInItsOrderWithWhatItCarries) {

@@ -48,7 +48,7 @@ struct RunResult {
 
 namespace internal {
 inline pid_t Spawn(const std::string& binary, const std::vector<std::string>& args,
-                   const std::string& out_path, const std::string& err_path) {
+                   const std::string& out_path, const std::string& err_path, int stdin_fd = -1) {
   std::vector<std::string> argv_storage = {binary};
   argv_storage.insert(argv_storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
@@ -60,6 +60,7 @@ inline pid_t Spawn(const std::string& binary, const std::vector<std::string>& ar
     const int err = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(out, STDOUT_FILENO);
     dup2(err, STDERR_FILENO);
+    if (stdin_fd >= 0) dup2(stdin_fd, STDIN_FILENO);
     execv(binary.c_str(), argv.data());
     _exit(127);
   }
@@ -111,17 +112,45 @@ inline int PickFreePort() {
 }
 
 // A background process (a server) that is stopped (SIGTERM, then SIGKILL) on destruction.
+// With `stdin_pipe`, its standard input is a pipe that WriteStdin feeds and CloseStdin ends.
 class BackgroundProcess {
  public:
-  BackgroundProcess(const std::string& name, const std::vector<std::string>& args) {
+  BackgroundProcess(const std::string& name, const std::vector<std::string>& args,
+                    bool stdin_pipe = false) {
     // A directory of its own: two processes of one name must not share their output files.
     static int counter = 0;
     const std::string base = MakeTempDir(name + "_" + std::to_string(counter++));
     out_path_ = base + "/stdout";
     err_path_ = base + "/stderr";
-    pid_ = internal::Spawn(BinDir() + "/" + name, args, out_path_, err_path_);
+    int pipe_fds[2] = {-1, -1};
+    if (stdin_pipe) {
+      signal(SIGPIPE, SIG_IGN);  // A write after the process ended fails instead.
+      if (pipe(pipe_fds) != 0) pipe_fds[0] = pipe_fds[1] = -1;
+    }
+    if (pipe_fds[1] >= 0) fcntl(pipe_fds[1], F_SETFD, FD_CLOEXEC);
+    pid_ = internal::Spawn(BinDir() + "/" + name, args, out_path_, err_path_, pipe_fds[0]);
+    if (pipe_fds[0] >= 0) close(pipe_fds[0]);
+    stdin_ = pipe_fds[1];
   }
-  ~BackgroundProcess() { Stop(); }
+  ~BackgroundProcess() {
+    CloseStdin();
+    Stop();
+  }
+
+  // Writes `text` to its standard input (a pipe); whether all of it was written.
+  bool WriteStdin(const std::string& text) {
+    size_t written = 0;
+    while (stdin_ >= 0 && written < text.size()) {
+      const ssize_t n = write(stdin_, text.data() + written, text.size() - written);
+      if (n <= 0) return false;
+      written += static_cast<size_t>(n);
+    }
+    return written == text.size();
+  }
+  void CloseStdin() {
+    if (stdin_ >= 0) close(stdin_);
+    stdin_ = -1;
+  }
   BackgroundProcess(const BackgroundProcess&) = delete;
   BackgroundProcess& operator=(const BackgroundProcess&) = delete;
 
@@ -189,6 +218,7 @@ class BackgroundProcess {
 
   pid_t pid_ = -1;
   int exit_code_ = -1;
+  int stdin_ = -1;  // The pipe's end to write, or -1.
   std::string out_path_;
   std::string err_path_;
 };

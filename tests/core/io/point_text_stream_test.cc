@@ -1,0 +1,104 @@
+#include "core/io/point_text_stream.h"
+
+#include <unistd.h>
+
+#include <string>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "absl/time/time.h"
+#include "gtest/gtest.h"
+
+namespace neuralmesh {
+namespace {
+
+// A pipe whose read end a PointTextStream reads.
+class Pipe {
+ public:
+  Pipe() { EXPECT_EQ(pipe(fds_), 0); }
+  ~Pipe() {
+    CloseWriteEnd();
+    close(fds_[0]);
+  }
+  int read_end() const { return fds_[0]; }
+  void Write(const std::string& text) {
+    ASSERT_EQ(write(fds_[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  }
+  void CloseWriteEnd() {
+    if (fds_[1] >= 0) close(fds_[1]);
+    fds_[1] = -1;
+  }
+
+ private:
+  int fds_[2] = {-1, -1};
+};
+
+TEST(PointTextStreamTest, ReadsPointsAsTheirLinesComplete) {
+  Pipe pipe;
+  PointTextStream stream(pipe.read_end(), "standard input");
+  std::vector<Vec3> points;
+  absl::StatusOr<bool> more = stream.Read(absl::Milliseconds(10), &points);
+  ASSERT_TRUE(more.ok()) << more.status();
+  EXPECT_TRUE(*more) << "nothing arrived yet: the stream goes on";
+  EXPECT_TRUE(points.empty());
+
+  pipe.Write("# x y z\n1 2 3\n4.5,5.5,6.5,200,10,10\r\n\n7 8");
+  more = stream.Read(absl::Milliseconds(100), &points);
+  ASSERT_TRUE(more.ok()) << more.status();
+  EXPECT_TRUE(*more);
+  ASSERT_EQ(points.size(), 2u) << "the third line has not ended";
+  EXPECT_EQ(points[1], Vec3(4.5, 5.5, 6.5));
+  pipe.Write(" 9\n500000.25\t4100000.5\t80 # a comment\n10 11 12");
+  pipe.CloseWriteEnd();
+  while (*more) {
+    more = stream.Read(absl::Milliseconds(100), &points);
+    ASSERT_TRUE(more.ok()) << more.status();
+  }
+  ASSERT_EQ(points.size(), 5u) << "the last line is taken at the end without its newline";
+  EXPECT_EQ(points[2], Vec3(7, 8, 9));
+  EXPECT_EQ(points[3], Vec3(500000.25, 4100000.5, 80));
+  EXPECT_EQ(points[4], Vec3(10, 11, 12));
+  EXPECT_EQ(stream.lines(), 7u);
+  more = stream.Read(absl::Milliseconds(10), &points);
+  ASSERT_TRUE(more.ok());
+  EXPECT_FALSE(*more);
+}
+
+TEST(PointTextStreamTest, ALineThatIsNoPointIsAnErrorNamingIt) {
+  for (const std::string& bad : {"1 2\n", "1 2 x\n", "1 2 inf\n", "nan 1 2\n"}) {
+    Pipe pipe;
+    PointTextStream stream(pipe.read_end(), "standard input");
+    pipe.Write("1 2 3\n" + bad);
+    std::vector<Vec3> points;
+    absl::StatusOr<bool> more = stream.Read(absl::Milliseconds(100), &points);
+    ASSERT_FALSE(more.ok()) << bad;
+    EXPECT_EQ(more.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_TRUE(absl::StrContains(more.status().message(), "standard input, line 2: '"))
+        << more.status();
+  }
+  Pipe pipe;
+  PointTextStream stream(pipe.read_end(), "the scanner");
+  std::vector<Vec3> points;
+  absl::StatusOr<bool> more = true;
+  for (int i = 0; i < 40 && more.ok(); ++i) {
+    pipe.Write(std::string(1 << 15, '1'));
+    more = stream.Read(absl::Milliseconds(100), &points);
+  }
+  ASSERT_FALSE(more.ok()) << "a line without an end is no text of points";
+  EXPECT_TRUE(absl::StrContains(more.status().message(), "the scanner, line 1: over"))
+      << more.status();
+}
+
+TEST(PointTextStreamTest, TheOriginKeepsGeoreferencedPointsPrecise) {
+  BoundingBox box;
+  box.Extend(Vec3(500123.5, 4100456.25, 80));
+  box.Extend(Vec3(500133.5, 4100466.25, 95));
+  EXPECT_EQ(OriginOfStreamedPoints(box), (Origin{500000, 4100000, 0}));
+  BoundingBox small;
+  small.Extend(Vec3(-1, -1, -1));
+  small.Extend(Vec3(1, 1, 1));
+  EXPECT_EQ(OriginOfStreamedPoints(small), kNoOrigin);
+}
+
+}  // namespace
+}  // namespace neuralmesh

@@ -38,7 +38,7 @@ void FileRecordsUpload::ReadNext(const OnPoint& on_point) {
   if (record >= file_.records()) return;
   if (const std::optional<Vec3> point = file_.Point(record); point.has_value()) {
     ++points_;
-    on_point(*point);
+    on_point(*point, record);
   }
 }
 
@@ -47,7 +47,7 @@ absl::Status FileRecordsUpload::SkipTo(uint64_t first) {
     slot_ = 0;
     points_ = 0;
   }
-  while (points_ < first && slot_ < order_.slots()) ReadNext([](const Vec3&) {});
+  while (points_ < first && slot_ < order_.slots()) ReadNext([](const Vec3&, uint64_t) {});
   if (points_ < first) {
     return absl::OutOfRangeError(
         absl::StrCat("the upload cannot start at point ", first, " of ", points_));
@@ -57,18 +57,24 @@ absl::Status FileRecordsUpload::SkipTo(uint64_t first) {
 
 absl::StatusOr<v1::PointBatch> FileRecordsUpload::Batch(uint64_t first, size_t count) {
   NM_RETURN_IF_ERROR(SkipTo(first));
-  std::string positions;
+  std::string positions, colors;
   positions.reserve(count * sizeof(Vec3f));
+  if (colors_) colors.reserve(count * sizeof(Rgb));
   const uint64_t end = first + count;
   while (points_ < end && slot_ < order_.slots()) {
-    ReadNext([&positions](const Vec3& p) {
+    ReadNext([&](const Vec3& p, uint64_t record) {
       const Vec3f f(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
       positions.append(reinterpret_cast<const char*>(f.data()), sizeof(Vec3f));
+      if (colors_) {
+        const Rgb color = file_.Color(record).value_or(Rgb{0, 0, 0});
+        colors.append(reinterpret_cast<const char*>(color.data()), sizeof(Rgb));
+      }
     });
   }
   v1::PointBatch batch;
   batch.mutable_first_point()->set_value(first);
   batch.mutable_packed()->set_positions(std::move(positions));
+  batch.mutable_packed()->set_colors(std::move(colors));
   return batch;
 }
 
@@ -83,25 +89,27 @@ absl::StatusOr<bool> LazFileUpload::NextWave() {
     if (order_[next_chunk_] < file_.chunks()) chunks.push_back(order_[next_chunk_]);
   }
   if (chunks.empty()) return false;
-  std::vector<absl::StatusOr<std::vector<Vec3>>> decoded(chunks.size());
+  std::vector<absl::StatusOr<MappedLazFile::ChunkPoints>> decoded(chunks.size());
   ForEachRange(chunks.size(), /*threads=*/0, 1, [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) decoded[i] = file_.Points(chunks[i]);
   });
   wave_first_ += wave_.size();
   wave_.clear();
+  wave_colors_.clear();
   size_t longest = 0;
   for (size_t i = 0; i < chunks.size(); ++i) {
     NM_RETURN_IF_ERROR(decoded[i].status());
     records_done_ += file_.records_in(chunks[i]);
-    longest = std::max(longest, decoded[i]->size());
+    longest = std::max(longest, decoded[i]->positions.size());
   }
   for (size_t block = 0; block < longest; block += SpreadOrder::kBlockRecords) {
-    for (const absl::StatusOr<std::vector<Vec3>>& points : decoded) {
-      for (size_t j = block; j < std::min(points->size(), block + SpreadOrder::kBlockRecords);
-           ++j) {
-        const Vec3& p = (*points)[j];
+    for (const absl::StatusOr<MappedLazFile::ChunkPoints>& points : decoded) {
+      const size_t end = std::min(points->positions.size(), block + SpreadOrder::kBlockRecords);
+      for (size_t j = block; j < end; ++j) {
+        const Vec3& p = points->positions[j];
         wave_.emplace_back(static_cast<float>(p[0]), static_cast<float>(p[1]),
                            static_cast<float>(p[2]));
+        if (colors_) wave_colors_.push_back(points->colors[j]);
       }
     }
   }
@@ -112,6 +120,7 @@ absl::Status LazFileUpload::SkipTo(uint64_t first) {
   if (first < wave_first_) {
     next_chunk_ = 0;
     wave_.clear();
+    wave_colors_.clear();
     wave_first_ = 0;
     records_done_ = 0;
   }
@@ -127,7 +136,7 @@ absl::Status LazFileUpload::SkipTo(uint64_t first) {
 
 absl::StatusOr<v1::PointBatch> LazFileUpload::Batch(uint64_t first, size_t count) {
   NM_RETURN_IF_ERROR(SkipTo(first));
-  std::string positions;
+  std::string positions, colors;
   positions.reserve(count * sizeof(Vec3f));
   uint64_t next = first;
   while (next < first + count) {
@@ -139,11 +148,15 @@ absl::StatusOr<v1::PointBatch> LazFileUpload::Batch(uint64_t first, size_t count
     const size_t from = next - wave_first_;
     const size_t take = std::min<uint64_t>(wave_.size() - from, first + count - next);
     positions.append(reinterpret_cast<const char*>(wave_.data() + from), take * sizeof(Vec3f));
+    if (colors_) {
+      colors.append(reinterpret_cast<const char*>(wave_colors_.data() + from), take * sizeof(Rgb));
+    }
     next += take;
   }
   v1::PointBatch batch;
   batch.mutable_first_point()->set_value(first);
   batch.mutable_packed()->set_positions(std::move(positions));
+  batch.mutable_packed()->set_colors(std::move(colors));
   return batch;
 }
 

@@ -58,12 +58,14 @@ class CloudUpload final : public PointUpload {
 
 // The points of a file's records (MappedPointFile::Point, relative to its origin), read where
 // they lie in SpreadOrder, so that every prefix of the upload is spread over the whole file.
-// Positions only: the records' colours are not sent. Each batch reads its records once; to
-// skip back, the order is walked again from its start (resuming an upload reads the records
-// before its first point again).
+// With `colors`, their colours too where the file's can be read a record at a time
+// (MappedPointFile::Color: LAS). Each batch reads its records once; to skip back, the order is
+// walked again from its start (resuming an upload reads the records before its first point
+// again).
 class FileRecordsUpload final : public PointUpload {
  public:
-  explicit FileRecordsUpload(const MappedPointFile& file) : file_(file), order_(file.records()) {}
+  explicit FileRecordsUpload(const MappedPointFile& file, bool colors = false)
+      : file_(file), order_(file.records()), colors_(colors && file.colors_readable()) {}
 
   absl::Status SkipTo(uint64_t first) override;
   absl::StatusOr<v1::PointBatch> Batch(uint64_t first, size_t count) override;
@@ -74,12 +76,14 @@ class FileRecordsUpload final : public PointUpload {
   std::optional<uint64_t> size() const override;
 
  private:
-  // Reads the record at slot_ and moves on; gives `on_point` the record's point, if it is one.
+  // Reads the record at slot_ and moves on; gives `on_point` the record's point and number, if
+  // it is one.
   template <typename OnPoint>
   void ReadNext(const OnPoint& on_point);
 
   const MappedPointFile& file_;
   const SpreadOrder order_;
+  const bool colors_;
   uint64_t slot_ = 0;    // The next position of order_ to read.
   uint64_t points_ = 0;  // The points among the positions before slot_.
 };
@@ -88,15 +92,17 @@ class FileRecordsUpload final : public PointUpload {
 // a time: the waves take the chunks in SpreadOrder, and a wave's points go out in blocks of
 // SpreadOrder::kBlockRecords taken from its chunks in turn, so that every prefix of the upload
 // is spread over the file, the first batch over a wave's chunks. The order depends on the file
-// alone (not on the threads that decode a wave). Positions only. To skip back, the waves are
-// decoded again from the first (resuming an upload decodes the chunks before its first point
-// again).
+// alone (not on the threads that decode a wave). With `colors`, the points' colours too where
+// the file has them. To skip back, the waves are decoded again from the first (resuming an
+// upload decodes the chunks before its first point again).
 class LazFileUpload final : public PointUpload {
  public:
   static constexpr size_t kWaveChunks = 8;
 
-  explicit LazFileUpload(const MappedLazFile& file)
-      : file_(file), order_(file.chunks(), /*block_records=*/1) {}
+  explicit LazFileUpload(const MappedLazFile& file, bool colors = false)
+      : file_(file),
+        order_(file.chunks(), /*block_records=*/1),
+        colors_(colors && file.has_colors()) {}
 
   absl::Status SkipTo(uint64_t first) override;
   absl::StatusOr<v1::PointBatch> Batch(uint64_t first, size_t count) override;
@@ -112,8 +118,10 @@ class LazFileUpload final : public PointUpload {
 
   const MappedLazFile& file_;
   const SpreadOrder order_;  // Of the chunks.
+  const bool colors_;
   size_t next_chunk_ = 0;    // The next position of order_ to decode.
-  std::vector<Vec3f> wave_;  // The points of the last wave decoded, in upload order.
+  std::vector<Vec3f> wave_;  // The points of the last wave decoded, in upload order,
+  std::vector<Rgb> wave_colors_;  // and their colours (with colors_).
   uint64_t wave_first_ = 0;  // The upload's number of wave_'s first point.
   uint64_t records_done_ = 0;
 };

@@ -126,30 +126,35 @@ absl::StatusOr<UploadInput> LoadUploadInput(const RemoteReconstructOptions& opti
     NM_RETURN_IF_ERROR(
         CheckOffCoreInput(options.inputs, options.outliers.has_value() && !outliers_on_server));
     const std::string& path = options.inputs.front();
-    const auto describe = [&](const auto& file, absl::string_view how) {
+    const bool colors = options.colors.has_value();
+    // `readable`: whether the file's colours can be sent (LAS and LAZ: yes; PLY, PCD: no).
+    const auto describe = [&](const auto& file, absl::string_view how, bool readable) {
       input.origin = file.origin();
       input.bounds = file.bounds();
       input.size = static_cast<uint64_t>(
           std::llround(static_cast<double>(file.records()) * file.kept_share()));
       input.estimated = true;
+      const char* color_note = !file.has_colors() || !colors ? ""
+                               : readable                    ? "; with colours"
+                                          : "; colours of PLY and PCD are not sent off-core";
       out << absl::StrFormat("INPUT '%s': %d records %s (off-core; %.1f%% of them points%s)%s\n",
-                             path, file.records(), how, 100 * file.kept_share(),
-                             file.has_colors() ? "; colours are not sent off-core" : "",
+                             path, file.records(), how, 100 * file.kept_share(), color_note,
                              OriginNote(input.origin));
     };
     if (IsLazFile(path)) {
       NM_ASSIGN_OR_RETURN(MappedLazFile file, OpenOffCoreLazFile(path, options.selection));
       input.laz = std::make_unique<MappedLazFile>(std::move(file));
-      input.points = std::make_unique<LazFileUpload>(*input.laz);
+      input.points = std::make_unique<LazFileUpload>(*input.laz, colors);
       describe(*input.laz,
                absl::StrCat("decoded where they lie, a LAZ chunk at a time (", input.laz->chunks(),
-                            input.laz->chunks() == 1 ? " chunk)" : " chunks)"));
+                            input.laz->chunks() == 1 ? " chunk)" : " chunks)"),
+               /*readable=*/true);
     } else {
       NM_ASSIGN_OR_RETURN(MappedPointFile file,
                           OpenOffCoreFile(options.inputs, false, options.selection));
       input.file = std::make_unique<MappedPointFile>(std::move(file));
-      input.points = std::make_unique<FileRecordsUpload>(*input.file);
-      describe(*input.file, "read where they lie");
+      input.points = std::make_unique<FileRecordsUpload>(*input.file, colors);
+      describe(*input.file, "read where they lie", input.file->colors_readable());
     }
     return input;
   }

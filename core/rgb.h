@@ -25,6 +25,11 @@ inline uint8_t ChannelFromLevel(double level, double max) {
   return ChannelFromFraction(level / max);
 }
 
+// The full scale of integer colour levels that do not say how many bits they use (LAS: 8-bit
+// levels in 16-bit fields, or 16-bit ones), from the largest: 255 when none exceeds it, else
+// 65535. For ChannelFromLevel.
+inline double LevelScale(uint16_t largest_level) { return largest_level <= 255 ? 255.0 : 65535.0; }
+
 // The full scale of the colour channels of a text file that does not say which it uses, from
 // its largest channel: 1 when none exceeds 1 (fractions, as MeshLab and CloudCompare write
 // them), else 255 (0-255 levels). For ChannelFromLevel.

@@ -6,12 +6,15 @@
 #ifndef NEURALMESH_FUZZ_POINT_RECORDS_PROPERTIES_H_
 #define NEURALMESH_FUZZ_POINT_RECORDS_PROPERTIES_H_
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <optional>
 
 #include "core/io/internal/geometry_data.h"
 #include "core/io/internal/point_records.h"
 #include "core/io/internal/text.h"
+#include "core/rgb.h"
 #include "fuzz/fuzz_check.h"
 
 namespace neuralmesh::fuzz {
@@ -38,6 +41,28 @@ inline void CheckRecordsAgreeWithParser(const io_internal::PointRecords& records
   if (parsed != nullptr) {
     FUZZ_CHECK(kept == parsed->positions.size(), "%llu records kept, %zu points read",
                static_cast<unsigned long long>(kept), parsed->positions.size());
+  }
+  // Colours read a record at a time (LAS), scaled by the largest level of all kept records as
+  // the parser scales them, are the parser's.
+  if (parsed == nullptr || parsed->colors.empty()) return;
+  uint16_t largest = 0;
+  for (uint64_t i = 0; i < records.size(); ++i) {
+    if (!records.KeptPoint(i).has_value()) continue;
+    const std::optional<std::array<uint16_t, 3>> levels = records.ColorLevels(i);
+    if (!levels.has_value()) return;  // A format whose colours are not read so.
+    largest = std::max({largest, (*levels)[0], (*levels)[1], (*levels)[2]});
+  }
+  uint64_t point = 0;
+  for (uint64_t i = 0; i < records.size(); ++i) {
+    if (!records.KeptPoint(i).has_value()) continue;
+    const std::array<uint16_t, 3> levels = *records.ColorLevels(i);
+    for (int c = 0; c < 3; ++c) {
+      FUZZ_CHECK(ChannelFromLevel(levels[c], LevelScale(largest)) == parsed->colors[point][c],
+                 "record %llu, channel %d: level %u where the parser read %u",
+                 static_cast<unsigned long long>(i), c, unsigned{levels[c]},
+                 unsigned{parsed->colors[point][c]});
+    }
+    ++point;
   }
 }
 

@@ -42,14 +42,25 @@ absl::StatusOr<MappedLazFile> MappedLazFile::Open(const std::string& path,
 
   // The probe, with origin_ still (0, 0, 0): points in the file's coordinates.
   const SpreadOrder order(opened.chunks(), 1);
+  std::string decoded;
   BoundingBox probed;
   uint64_t records = 0, kept = 0;
+  uint16_t largest_level = 0;
   for (size_t k = 0; k < std::min(kProbeChunks, opened.chunks()); ++k) {
-    NM_ASSIGN_OR_RETURN(const std::vector<Vec3> points, opened.Points(order[k]));
-    records += opened.records_in(order[k]);
-    kept += points.size();
-    for (const Vec3& p : points) probed.Extend(p);
+    NM_ASSIGN_OR_RETURN(const std::unique_ptr<io_internal::LasRecords> chunk,
+                        opened.Records(order[k], &decoded));
+    records += chunk->size();
+    for (uint64_t i = 0; i < chunk->size(); ++i) {
+      const std::optional<Vec3> p = opened.Point(*chunk, i);
+      if (!p.has_value()) continue;
+      ++kept;
+      probed.Extend(*p);
+      if (const auto levels = chunk->ColorLevels(i); levels.has_value()) {
+        largest_level = std::max({largest_level, (*levels)[0], (*levels)[1], (*levels)[2]});
+      }
+    }
   }
+  opened.color_scale_ = LevelScale(largest_level);
   if (kept == 0) {
     return invalid(absl::StrCat(
         "none of the ", records, " records of ", std::min(kProbeChunks, opened.chunks()),
@@ -64,20 +75,38 @@ absl::StatusOr<MappedLazFile> MappedLazFile::Open(const std::string& path,
   return opened;
 }
 
-absl::StatusOr<std::vector<Vec3>> MappedLazFile::Points(size_t chunk) const {
-  std::string decoded(chunks_.records_in(chunk) * chunks_.record_length(), '\0');
-  if (const absl::Status status = chunks_.Decode(chunk, decoded.data()); !status.ok()) {
+absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> MappedLazFile::Records(
+    size_t chunk, std::string* decoded) const {
+  decoded->assign(chunks_.records_in(chunk) * chunks_.record_length(), '\0');
+  if (const absl::Status status = chunks_.Decode(chunk, decoded->data()); !status.ok()) {
     return io_internal::WithPath(status, path_);
   }
+  return io_internal::LasRecords::Create(chunks_.las_header(), *decoded, classes_);
+}
+
+std::optional<Vec3> MappedLazFile::Point(const io_internal::LasRecords& records, uint64_t i) const {
+  const std::optional<io_internal::Point3d> p = records.KeptPoint(i);
+  if (!p.has_value()) return std::nullopt;
+  const Vec3 point((*p)[0] - origin_[0], (*p)[1] - origin_[1], (*p)[2] - origin_[2]);
+  if (!MappedPointFile::Learnable(point)) return std::nullopt;
+  return point;
+}
+
+absl::StatusOr<MappedLazFile::ChunkPoints> MappedLazFile::Points(size_t chunk) const {
+  std::string decoded;
   NM_ASSIGN_OR_RETURN(const std::unique_ptr<io_internal::LasRecords> records,
-                      io_internal::LasRecords::Create(chunks_.las_header(), decoded, classes_));
-  std::vector<Vec3> points;
-  points.reserve(records->size());
+                      Records(chunk, &decoded));
+  ChunkPoints points;
+  points.positions.reserve(records->size());
   for (uint64_t i = 0; i < records->size(); ++i) {
-    const std::optional<io_internal::Point3d> p = records->KeptPoint(i);
+    const std::optional<Vec3> p = Point(*records, i);
     if (!p.has_value()) continue;
-    const Vec3 point((*p)[0] - origin_[0], (*p)[1] - origin_[1], (*p)[2] - origin_[2]);
-    if (MappedPointFile::Learnable(point)) points.push_back(point);
+    points.positions.push_back(*p);
+    if (const auto levels = records->ColorLevels(i); levels.has_value()) {
+      points.colors.push_back({ChannelFromLevel((*levels)[0], color_scale_),
+                               ChannelFromLevel((*levels)[1], color_scale_),
+                               ChannelFromLevel((*levels)[2], color_scale_)});
+    }
   }
   return points;
 }

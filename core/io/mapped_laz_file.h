@@ -6,16 +6,19 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/bounding_box.h"
+#include "core/io/internal/las.h"
 #include "core/io/internal/laz.h"
 #include "core/io/mapped_file.h"
 #include "core/io/point_selection.h"
 #include "core/origin.h"
+#include "core/rgb.h"
 
 namespace neuralmesh {
 
@@ -39,10 +42,17 @@ class MappedLazFile {
   size_t chunks() const { return chunks_.size(); }
   uint64_t records() const { return chunks_.records(); }
   uint64_t records_in(size_t chunk) const { return chunks_.records_in(chunk); }
-  // The points of chunk `chunk` (< chunks()) in their records' order, relative to origin():
-  // the records reading the file whole takes (MappedPointFile::Point's rules). INVALID_ARGUMENT,
-  // naming the file, for a chunk that cannot be decoded. Safe to call from several threads.
-  absl::StatusOr<std::vector<Vec3>> Points(size_t chunk) const;
+  // The points of a chunk: positions relative to origin(), and colours when the file has them
+  // (one each, scaled as reading the file whole scales them but with the largest level of the
+  // probe's records instead of all of them), else none.
+  struct ChunkPoints {
+    std::vector<Vec3> positions;
+    std::vector<Rgb> colors;
+  };
+  // The points of chunk `chunk` (< chunks()) in their records' order: the records reading the
+  // file whole takes (MappedPointFile::Point's rules). INVALID_ARGUMENT, naming the file, for a
+  // chunk that cannot be decoded. Safe to call from several threads.
+  absl::StatusOr<ChunkPoints> Points(size_t chunk) const;
 
   // The probe's placement (PlaceProbe: the header's bounds where the probe finds them fresh).
   const BoundingBox& bounds() const { return bounds_; }
@@ -52,6 +62,12 @@ class MappedLazFile {
   double kept_share() const { return kept_share_; }
 
  private:
+  // Chunk `chunk` decoded into `decoded`, as records.
+  absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> Records(size_t chunk,
+                                                                   std::string* decoded) const;
+  // Record i of `records` relative to origin_, when it is a point.
+  std::optional<Vec3> Point(const io_internal::LasRecords& records, uint64_t i) const;
+
   MappedLazFile(std::string path, MappedFile file, io_internal::LazChunks chunks)
       : path_(std::move(path)), file_(std::move(file)), chunks_(std::move(chunks)) {}
 
@@ -63,6 +79,7 @@ class MappedLazFile {
   BoundingBox bounds_;
   bool has_colors_ = false;
   double kept_share_ = 0;
+  double color_scale_ = 255;
 };
 
 }  // namespace neuralmesh

@@ -1,5 +1,6 @@
 #include "core/io/mapped_point_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -99,6 +100,7 @@ absl::StatusOr<MappedPointFile> MappedPointFile::Open(const std::string& path,
 
   BoundingBox probed;
   int kept = 0;
+  uint16_t largest_level = 0;
   Random probe(kProbeSeed);
   for (int i = 0; i < kProbeRecords; ++i) {
     const uint64_t r = probe.NextIndex(points.size());
@@ -106,7 +108,12 @@ absl::StatusOr<MappedPointFile> MappedPointFile::Open(const std::string& path,
     if (!p.has_value() || !Learnable(ToVec3(*p))) continue;
     ++kept;
     probed.Extend(ToVec3(*p));
+    if (const auto levels = points.ColorLevels(r); levels.has_value()) {
+      opened.colors_readable_ = true;
+      largest_level = std::max({largest_level, (*levels)[0], (*levels)[1], (*levels)[2]});
+    }
   }
+  opened.color_scale_ = LevelScale(largest_level);
   opened.kept_share_ = static_cast<double>(kept) / kProbeRecords;
   if (opened.kept_share_ < kLeastKeptShare) {
     return invalid(absl::StrFormat(

@@ -19,6 +19,7 @@
 #include "core/io/mapped_file.h"
 #include "core/io/point_selection.h"
 #include "core/origin.h"
+#include "core/rgb.h"
 
 namespace neuralmesh {
 
@@ -77,6 +78,18 @@ class MappedPointFile {
     return std::fabs(p[0]) <= kLargestFloat && std::fabs(p[1]) <= kLargestFloat &&
            std::fabs(p[2]) <= kLargestFloat;
   }
+  // Record i's colour when the file's colours can be read a record at a time (LAS), scaled as
+  // reading the file whole scales them but with the largest level of the probe's records
+  // instead of all of them (LevelScale); nothing otherwise.
+  std::optional<Rgb> Color(uint64_t i) const {
+    const std::optional<std::array<uint16_t, 3>> levels = records_->ColorLevels(i);
+    if (!levels.has_value()) return std::nullopt;
+    return Rgb{ChannelFromLevel((*levels)[0], color_scale_),
+               ChannelFromLevel((*levels)[1], color_scale_),
+               ChannelFromLevel((*levels)[2], color_scale_)};
+  }
+  // Whether Color gives the records' colours.
+  bool colors_readable() const { return colors_readable_; }
   // Starts loading record i.
   void Prefetch(uint64_t i) const { __builtin_prefetch(records_->Address(i)); }
 
@@ -96,6 +109,8 @@ class MappedPointFile {
   Origin origin_ = kNoOrigin;
   BoundingBox bounds_;
   double kept_share_ = 0;
+  bool colors_readable_ = false;
+  double color_scale_ = 255;
 };
 
 }  // namespace neuralmesh

@@ -391,6 +391,40 @@ TEST_F(RemoteCliTest, ColouredPointsComeBackAsColouredMeshes) {
       EXPECT_LE(worst, 8) << name;
     }
   }
+  // The same points as LAS, and LAZ, uploaded from where they lie: their colours go too.
+  testing::LasLayout layout;
+  layout.format = 3;
+  for (double& s : layout.scale) s = 0.0001;
+  std::vector<testing::LasPoint> records;
+  const PointCloud colored = ColoredUnitSpherePoints(8000, 12);
+  for (size_t i = 0; i < colored.size(); ++i) {
+    testing::LasPoint p{static_cast<int32_t>(std::lround(colored.positions[i][0] / 0.0001)),
+                        static_cast<int32_t>(std::lround(colored.positions[i][1] / 0.0001)),
+                        static_cast<int32_t>(std::lround(colored.positions[i][2] / 0.0001))};
+    p.red = colored.colors[i][0] * 257;
+    p.green = colored.colors[i][1] * 257;
+    p.blue = colored.colors[i][2] * 257;
+    records.push_back(p);
+  }
+  const std::string las = *dir_ + "/colored_scan.las";
+  std::ofstream(las, std::ios::binary) << testing::LasFile(layout, records);
+  const std::string laz = *dir_ + "/colored_scan_laz.laz";
+  ASSERT_EQ(RunNeuralmesh({"convert", las, "-o", laz}).exit_code, 0);
+  for (const std::string& input : {las, laz}) {
+    SCOPED_TRACE(input);
+    const std::string out_dir = *dir_ + "/colored_off_core";
+    const RunResult run =
+        RunNeuralmesh({"reconstruct", input, "--server", server_->address(), "--out-dir", out_dir,
+                       "--vertices", "600", "--off_core", "--color_neighbours", "4"});
+    ASSERT_EQ(run.exit_code, 0) << run.Describe();
+    EXPECT_THAT(run.out, ::testing::HasSubstr("of them points; with colours)"));
+    const absl::StatusOr<TriangleMesh> mesh =
+        ReadMesh(out_dir + "/" + client::InputStem(input) + ".drc");
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    const int worst = WorstColorErrorOnTheUnitSphere(*mesh);
+    EXPECT_GE(worst, 0) << "no colours";
+    EXPECT_LE(worst, 8);
+  }
   // --color_neighbours went to the coloured session's configuration.
   absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
       client::ReconstructionClient::Connect(server_->address());

@@ -323,6 +323,70 @@ TEST(StreamUploadTest, APointFarFromTheOriginIsAnError) {
   close(fds[0]);
 }
 
+// A LAS scan with 16-bit colours, and its LAZ: with colours asked for, each point goes with the
+// colour reading the file whole gives it; without, none go.
+TEST(FileUploadTest, ColoursGoWithTheirPointsWhenAsked) {
+  testing::LasLayout layout;
+  layout.format = 3;
+  std::vector<testing::LasPoint> records;
+  const PointCloud colored = testing::ColoredUnitSpherePoints(3000, 4);
+  for (size_t i = 0; i < colored.size(); ++i) {
+    testing::LasPoint p{static_cast<int32_t>(std::lround(colored.positions[i][0] * 100)),
+                        static_cast<int32_t>(std::lround(colored.positions[i][1] * 100)),
+                        static_cast<int32_t>(std::lround(colored.positions[i][2] * 100))};
+    p.red = colored.colors[i][0] * 257;
+    p.green = colored.colors[i][1] * 257;
+    p.blue = colored.colors[i][2] * 257;
+    p.classification = i % 3 == 0 ? 7 : 2;  // A third noise, left out.
+    records.push_back(p);
+  }
+  const std::string las = Dir() + "/colored.las";
+  std::ofstream(las, std::ios::binary) << testing::LasFile(layout, records);
+  absl::StatusOr<std::string> laz =
+      io_internal::CompressLas(testing::ReadWholeFile(las), io_internal::LazWriteOptions{400});
+  ASSERT_TRUE(laz.ok()) << laz.status();
+  const std::string laz_path = Dir() + "/colored.laz";
+  std::ofstream(laz_path, std::ios::binary) << *laz;
+  absl::StatusOr<PointCloud> read = ReadPointCloud(las);
+  ASSERT_TRUE(read.ok()) << read.status();
+  ASSERT_EQ(read->size(), 2000u);
+  std::vector<std::pair<Point, Rgb>> expected;
+  for (size_t i = 0; i < read->size(); ++i) {
+    const Vec3f& p = read->positions[i];
+    expected.push_back({{p[0], p[1], p[2]}, read->colors[i]});
+  }
+  std::sort(expected.begin(), expected.end());
+  // Every point of `upload` with its colour, or without one.
+  const auto sent = [](PointUpload& upload, bool colors) {
+    absl::StatusOr<v1::PointBatch> batch = upload.Batch(0, 5000);
+    EXPECT_TRUE(batch.ok()) << batch.status();
+    const std::vector<Point> points = PointsOf(*batch);
+    const std::string& bytes = batch->packed().colors();
+    EXPECT_EQ(bytes.size(), colors ? 3 * points.size() : 0);
+    std::vector<std::pair<Point, Rgb>> out;
+    for (size_t i = 0; i < points.size(); ++i) {
+      Rgb color = {0, 0, 0};
+      if (colors) std::memcpy(color.data(), bytes.data() + 3 * i, 3);
+      out.push_back({points[i], color});
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  absl::StatusOr<MappedPointFile> file = MappedPointFile::Open(las);
+  ASSERT_TRUE(file.ok()) << file.status();
+  EXPECT_TRUE(file->colors_readable());
+  FileRecordsUpload with(*file, /*colors=*/true);
+  EXPECT_EQ(sent(with, true), expected);
+  FileRecordsUpload without(*file);
+  EXPECT_EQ(sent(without, false).size(), 2000u);
+  absl::StatusOr<MappedLazFile> laz_file = MappedLazFile::Open(laz_path);
+  ASSERT_TRUE(laz_file.ok()) << laz_file.status();
+  LazFileUpload laz_with(*laz_file, /*colors=*/true);
+  EXPECT_EQ(sent(laz_with, true), expected);
+  LazFileUpload laz_without(*laz_file);
+  EXPECT_EQ(sent(laz_without, false).size(), 2000u);
+}
+
 TEST(CloudUploadTest, SendsTheCloudInItsOrderWithWhatItCarries) {
   PointCloud cloud = testing::ColoredUnitSpherePoints(25, 1);
   CloudUpload upload(cloud);

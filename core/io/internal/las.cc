@@ -422,7 +422,7 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
     return Invalid(absl::StrCat("point ", beyond, " lies beyond a float's range"));
   }
   if (format.rgb != 0) {
-    const double max = largest <= 255 ? 255.0 : 65535.0;
+    const double max = LevelScale(largest);
     out.colors.reserve(kept);
     for_each_usable([&](uint64_t, size_t at) {
       out.colors.push_back({ChannelFromLevel(channel(at, 0), max),
@@ -522,6 +522,14 @@ std::optional<Point3d> LasRecords::KeptPoint(uint64_t i) const {
 }
 
 bool LasRecords::has_colors() const { return kFormats[format_].rgb != 0; }
+
+std::optional<std::array<uint16_t, 3>> LasRecords::ColorLevels(uint64_t i) const {
+  const size_t rgb = kFormats[format_].rgb;
+  if (rgb == 0) return std::nullopt;
+  const size_t at = first_ + i * length_ + rgb;
+  return std::array<uint16_t, 3>{Load<uint16_t>(data_, at), Load<uint16_t>(data_, at + 2),
+                                 Load<uint16_t>(data_, at + 4)};
+}
 
 std::optional<Point3d> LasRecords::Resolution() const {
   return Point3d{std::fabs(scale_[0]), std::fabs(scale_[1]), std::fabs(scale_[2])};

@@ -59,6 +59,8 @@ class LasRecords final : public PointRecords {
   std::optional<Point3d> KeptPoint(uint64_t i) const override;
   const char* Address(uint64_t i) const override { return data_.data() + first_ + i * length_; }
   bool has_colors() const override;
+  // The red, green and blue levels of a format with colours.
+  std::optional<std::array<uint16_t, 3>> ColorLevels(uint64_t i) const override;
   // Each axis's scale, made positive.
   std::optional<Point3d> Resolution() const override;
   // The header's.

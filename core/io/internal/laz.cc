@@ -637,7 +637,7 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOp
   las.reserve(chunks.las_header().size() +
               std::min(chunks.records() * record_length,
                        kReservedExpansion * chunks.compressed_bytes() + (uint64_t{1} << 20)));
-  las = chunks.las_header();
+  las.append(chunks.las_header());
   // The chunks in waves of a few per thread, each thread decoding a run of them; the output
   // grows wave by wave.
   const size_t wave = kChunksPerThread * ThreadCount(options.threads);

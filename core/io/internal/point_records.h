@@ -5,6 +5,7 @@
 #ifndef NEURALMESH_CORE_IO_INTERNAL_POINT_RECORDS_H_
 #define NEURALMESH_CORE_IO_INTERNAL_POINT_RECORDS_H_
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <utility>
@@ -25,6 +26,12 @@ class PointRecords {
   virtual const char* Address(uint64_t i) const = 0;
   // Whether the records carry colours.
   virtual bool has_colors() const = 0;
+  // Record i's colour channels as the file stores them (LAS: levels of 16 bits), where a
+  // record's colour can be read alone; nothing otherwise (and for formats whose colours are not
+  // read so: PLY, PCD).
+  virtual std::optional<std::array<uint16_t, 3>> ColorLevels(uint64_t /*i*/) const {
+    return std::nullopt;
+  }
   // The coordinates' resolution per axis (a LAS file's scale), or nothing where the file
   // states none.
   virtual std::optional<Point3d> Resolution() const = 0;

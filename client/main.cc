@@ -139,7 +139,8 @@ ABSL_FLAG(bool, off_core, false,
           "--server, the records are uploaded in an order spread over the whole file from the "
           "first batch on (blocks of 256 records along a golden-ratio stride), so the first "
           "meshes outline the whole scan; a LAZ file is decoded a chunk at a time, eight "
-          "chunks spread over the file at once, never whole. Positions only, and --resume "
+          "chunks spread over the file at once, never whole. Colours go from LAS and LAZ, not "
+          "from PLY or PCD. --resume "
           "reads the records before the session's points again. No --remove_outliers in the "
           "client (--outliers_on_server is fine).");
 

@@ -11,6 +11,19 @@
 #include "proto/packing.h"
 
 namespace neuralmesh::client {
+namespace {
+
+// A batch of packed positions and colours (empty, or 3 bytes a point) from the upload's point
+// `first` on.
+v1::PointBatch MakeBatch(uint64_t first, std::string positions, std::string colors) {
+  v1::PointBatch batch;
+  batch.mutable_first_point()->set_value(first);
+  batch.mutable_packed()->set_positions(std::move(positions));
+  batch.mutable_packed()->set_colors(std::move(colors));
+  return batch;
+}
+
+}  // namespace
 
 absl::Status CloudUpload::SkipTo(uint64_t first) {
   if (first > cloud_.size()) {
@@ -71,11 +84,7 @@ absl::StatusOr<v1::PointBatch> FileRecordsUpload::Batch(uint64_t first, size_t c
       }
     });
   }
-  v1::PointBatch batch;
-  batch.mutable_first_point()->set_value(first);
-  batch.mutable_packed()->set_positions(std::move(positions));
-  batch.mutable_packed()->set_colors(std::move(colors));
-  return batch;
+  return MakeBatch(first, std::move(positions), std::move(colors));
 }
 
 std::optional<uint64_t> LazFileUpload::size() const {
@@ -153,11 +162,7 @@ absl::StatusOr<v1::PointBatch> LazFileUpload::Batch(uint64_t first, size_t count
     }
     next += take;
   }
-  v1::PointBatch batch;
-  batch.mutable_first_point()->set_value(first);
-  batch.mutable_packed()->set_positions(std::move(positions));
-  batch.mutable_packed()->set_colors(std::move(colors));
-  return batch;
+  return MakeBatch(first, std::move(positions), std::move(colors));
 }
 
 std::optional<uint64_t> StreamUpload::size() const {
@@ -226,11 +231,10 @@ absl::StatusOr<v1::PointBatch> StreamUpload::Batch(uint64_t first, size_t count)
   NM_RETURN_IF_ERROR(SkipTo(first));
   NM_RETURN_IF_ERROR(ReadUntil(first + count, first, absl::Now() + flush_after_));
   const uint64_t end = std::min<uint64_t>(points_.size(), first + count);
-  v1::PointBatch batch;
-  batch.mutable_first_point()->set_value(first);
-  batch.mutable_packed()->set_positions(std::string(
-      reinterpret_cast<const char*>(points_.data() + first), (end - first) * sizeof(Vec3f)));
-  return batch;
+  return MakeBatch(first,
+                   std::string(reinterpret_cast<const char*>(points_.data() + first),
+                               (end - first) * sizeof(Vec3f)),
+                   "");
 }
 
 }  // namespace neuralmesh::client

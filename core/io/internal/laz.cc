@@ -622,12 +622,17 @@ absl::StatusOr<LazChunks> LazChunks::Open(absl::string_view laz) {
   return out;
 }
 
-absl::Status LazChunks::Decode(size_t i, char* out) const {
+absl::Status LazChunks::Decode(size_t first, size_t last, char* out) const {
+  // One coder for the run: making one costs more than decoding a chunk of a few records.
   const std::unique_ptr<ChunkCoder> coder = MakeChunkCoder(format_, record_length_, item_version_);
-  const ChunkSpan& chunk = chunks_[i];
-  return coder->Decode(laz_.substr(chunk.at, chunk.size), chunk.records,
-                       reinterpret_cast<uint8_t*>(out),
-                       absl::StrCat("chunk ", i + 1, " of ", chunks_.size()));
+  for (size_t i = first; i < last; ++i) {
+    const ChunkSpan& chunk = chunks_[i];
+    NM_RETURN_IF_ERROR(coder->Decode(laz_.substr(chunk.at, chunk.size), chunk.records,
+                                     reinterpret_cast<uint8_t*>(out),
+                                     absl::StrCat("chunk ", i + 1, " of ", chunks_.size())));
+    out += chunk.records * record_length_;
+  }
+  return absl::OkStatus();
 }
 
 absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOptions& options) {
@@ -649,10 +654,9 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOp
       chunk_at[i - begin] = las.size();
       las.resize(las.size() + chunks.records_in(i) * record_length);
     }
+    // Each thread decodes a run of consecutive chunks, whose records follow one another.
     ForEachRange(end - begin, options.threads, 1, [&](size_t first, size_t last) {
-      for (size_t i = begin + first; i < begin + last; ++i) {
-        statuses[i] = chunks.Decode(i, &las[chunk_at[i - begin]]);
-      }
+      statuses[begin + first] = chunks.Decode(begin + first, begin + last, &las[chunk_at[first]]);
     });
     for (size_t i = begin; i < end; ++i) NM_RETURN_IF_ERROR(statuses[i]);
   }

@@ -66,10 +66,12 @@ class LazChunks {
   size_t record_length() const { return record_length_; }
   // The LAS file's header and variable-length records, as DecompressLaz's output begins.
   const std::string& las_header() const { return las_header_; }
-  // Decodes chunk i (< size()) into the records_in(i) * record_length() bytes at `out`.
-  // DecompressLaz's errors for a chunk that cannot be decoded. Safe to call from several
-  // threads at once.
-  absl::Status Decode(size_t i, char* out) const;
+  // Decodes chunks first to last - 1 (<= size()) into their records' bytes, one chunk's after
+  // another's, from `out` on. DecompressLaz's errors for a chunk that cannot be decoded. Safe
+  // to call from several threads at once.
+  absl::Status Decode(size_t first, size_t last, char* out) const;
+  // Chunk i alone.
+  absl::Status Decode(size_t i, char* out) const { return Decode(i, i + 1, out); }
 
   // The compressed records' bytes; where they end, and LAS 1.4's extended records' start.
   uint64_t compressed_bytes() const { return compressed_; }

@@ -131,18 +131,16 @@ ABSL_FLAG(std::string, start_mesh, "",
 
 ABSL_FLAG(bool, off_core, false,
           "Read the one INPUT, an uncompressed LAS, binary PLY or binary PCD file (or with "
-          "--server a LAZ file), where it lies, mapped into memory, instead of reading it whole: "
-          "learning (or the upload) "
-          "starts at once whatever the file's size, and memory holds the mesh, not the points "
-          "(the paper's off-core learning of 28 million points, Section 4.1). Locally, records "
-          "are sampled where they lie (uniform sampling; colours are not painted). With "
-          "--server, the records are uploaded in an order spread over the whole file from the "
-          "first batch on (blocks of 256 records along a golden-ratio stride), so the first "
-          "meshes outline the whole scan; a LAZ file is decoded a chunk at a time, eight "
-          "chunks spread over the file at once, never whole. Colours go from LAS and LAZ, not "
-          "from PLY or PCD. --resume "
-          "reads the records before the session's points again. No --remove_outliers in the "
-          "client (--outliers_on_server is fine).");
+          "--server a LAZ file), where it lies, mapped into memory, instead of reading it "
+          "whole: learning (or the upload) starts at once whatever the file's size, and memory "
+          "holds the mesh, not the points (the paper's off-core learning of 28 million points, "
+          "Section 4.1). Locally, records are sampled where they lie (uniform sampling; colours "
+          "are not painted). With --server, the records are uploaded in an order spread over "
+          "the whole file from the first batch on (blocks of 256 records along a golden-ratio "
+          "stride), so the first meshes outline the whole scan; a LAZ file is decoded a chunk "
+          "at a time, eight chunks spread over the file at once, never whole. Colours go from "
+          "LAS and LAZ, not from PLY or PCD. --resume reads the records before the session's "
+          "points again. No --remove_outliers in the client (--outliers_on_server is fine).");
 
 ABSL_FLAG(std::string, pcd_data, "binary",
           "How convert stores the points of a .pcd OUTPUT (its DATA line): binary (point "

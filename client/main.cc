@@ -725,7 +725,7 @@ std::vector<Subcommand> Commands() {
        "Locally it writes OUTPUT and one OUTPUT_lod<N> file per --lod; with --server it\n"
        "uploads the points and saves each mesh the server publishes into --out-dir. Prints\n"
        "the figures of every level. With --server, INPUT '-' streams points from standard\n"
-       "input as they arrive (\"x y z\" per line, spaces, tabs or commas; further columns and\n"
+       "input as they arrive (\"x y z\" per line, split as in XYZ files; further columns and\n"
        "'#' comments ignored), a batch whenever --batch-size points came or 100 ms passed;\n"
        "the session finishes at the end of the stream (files named stdin*).",
        WithConnectionFlags(reconstruct), Reconstruct},

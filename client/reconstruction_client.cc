@@ -171,7 +171,11 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
   if (batch_size == 0) return absl::InvalidArgumentError("UploadPoints: batch size must be > 0");
   absl::StatusOr<v1::PointBatch> batch = upload.Batch(first_point, batch_size);
   if (!batch.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("UploadPoints: ", batch.status().message()));
+    // A first point beyond the upload is the caller's argument; other errors are the input's.
+    const absl::StatusCode code = absl::IsOutOfRange(batch.status())
+                                      ? absl::StatusCode::kInvalidArgument
+                                      : batch.status().code();
+    return absl::Status(code, absl::StrCat("UploadPoints: ", batch.status().message()));
   }
   v1::UploadPointsResponse response;
   response.set_session_id(session_id);

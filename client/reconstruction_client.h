@@ -112,9 +112,10 @@ class ReconstructionClient {
                                                         size_t first_point = 0);
   // The same for the points of `upload` (a file's records read where they lie:
   // FileRecordsUpload, LazFileUpload), with its progress (PointUpload::done and total).
-  // INVALID_ARGUMENT for a zero batch size or when the first batch cannot be had (a first
-  // point beyond the upload, a LAZ chunk that does not decode); a later batch's error ends the
-  // call (the batches before it stay accepted) and is returned as it is.
+  // INVALID_ARGUMENT for a zero batch size or a first point beyond the upload; the upload's
+  // errors (a LAZ chunk that does not decode: INVALID_ARGUMENT) for the first batch, prefixed,
+  // and for a later one as they are, after ending the call (the batches before it stay
+  // accepted).
   absl::StatusOr<v1::UploadPointsResponse> UploadPoints(const std::string& session_id,
                                                         PointUpload& upload, size_t batch_size,
                                                         const UploadProgress& progress = {},

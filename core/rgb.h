@@ -25,6 +25,12 @@ inline uint8_t ChannelFromLevel(double level, double max) {
   return ChannelFromFraction(level / max);
 }
 
+// Three levels of `max` above zero each (ChannelFromLevel), as 8-bit channels.
+inline Rgb RgbFromLevels(const std::array<uint16_t, 3>& levels, double max) {
+  return {ChannelFromLevel(levels[0], max), ChannelFromLevel(levels[1], max),
+          ChannelFromLevel(levels[2], max)};
+}
+
 // The full scale of integer colour levels that do not say how many bits they use (LAS: 8-bit
 // levels in 16-bit fields, or 16-bit ones), from the largest: 255 when none exceeds it, else
 // 65535. For ChannelFromLevel.

@@ -51,7 +51,7 @@ absl::StatusOr<MappedLazFile> MappedLazFile::Open(const std::string& path,
                         opened.Records(order[k], &decoded));
     records += chunk->size();
     for (uint64_t i = 0; i < chunk->size(); ++i) {
-      const std::optional<Vec3> p = opened.Point(*chunk, i);
+      const std::optional<Vec3> p = MappedPointFile::PointOfRecord(*chunk, i, kNoOrigin);
       if (!p.has_value()) continue;
       ++kept;
       probed.Extend(*p);
@@ -84,14 +84,6 @@ absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> MappedLazFile::Records(
   return io_internal::LasRecords::Create(chunks_.las_header(), *decoded, classes_);
 }
 
-std::optional<Vec3> MappedLazFile::Point(const io_internal::LasRecords& records, uint64_t i) const {
-  const std::optional<io_internal::Point3d> p = records.KeptPoint(i);
-  if (!p.has_value()) return std::nullopt;
-  const Vec3 point((*p)[0] - origin_[0], (*p)[1] - origin_[1], (*p)[2] - origin_[2]);
-  if (!MappedPointFile::Learnable(point)) return std::nullopt;
-  return point;
-}
-
 absl::StatusOr<MappedLazFile::ChunkPoints> MappedLazFile::Points(size_t chunk) const {
   std::string decoded;
   NM_ASSIGN_OR_RETURN(const std::unique_ptr<io_internal::LasRecords> records,
@@ -99,13 +91,11 @@ absl::StatusOr<MappedLazFile::ChunkPoints> MappedLazFile::Points(size_t chunk) c
   ChunkPoints points;
   points.positions.reserve(records->size());
   for (uint64_t i = 0; i < records->size(); ++i) {
-    const std::optional<Vec3> p = Point(*records, i);
+    const std::optional<Vec3> p = MappedPointFile::PointOfRecord(*records, i, origin_);
     if (!p.has_value()) continue;
     points.positions.push_back(*p);
     if (const auto levels = records->ColorLevels(i); levels.has_value()) {
-      points.colors.push_back({ChannelFromLevel((*levels)[0], color_scale_),
-                               ChannelFromLevel((*levels)[1], color_scale_),
-                               ChannelFromLevel((*levels)[2], color_scale_)});
+      points.colors.push_back(RgbFromLevels(*levels, color_scale_));
     }
   }
   return points;

@@ -65,8 +65,6 @@ class MappedLazFile {
   // Chunk `chunk` decoded into `decoded`, as records.
   absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> Records(size_t chunk,
                                                                    std::string* decoded) const;
-  // Record i of `records` relative to origin_, when it is a point.
-  std::optional<Vec3> Point(const io_internal::LasRecords& records, uint64_t i) const;
 
   MappedLazFile(std::string path, MappedFile file, io_internal::LazChunks chunks)
       : path_(std::move(path)), file_(std::move(file)), chunks_(std::move(chunks)) {}

@@ -104,10 +104,10 @@ absl::StatusOr<MappedPointFile> MappedPointFile::Open(const std::string& path,
   Random probe(kProbeSeed);
   for (int i = 0; i < kProbeRecords; ++i) {
     const uint64_t r = probe.NextIndex(points.size());
-    const std::optional<Point3d> p = points.KeptPoint(r);
-    if (!p.has_value() || !Learnable(ToVec3(*p))) continue;
+    const std::optional<Vec3> p = PointOfRecord(points, r, kNoOrigin);
+    if (!p.has_value()) continue;
     ++kept;
-    probed.Extend(ToVec3(*p));
+    probed.Extend(*p);
     if (const auto levels = points.ColorLevels(r); levels.has_value()) {
       opened.colors_readable_ = true;
       largest_level = std::max({largest_level, (*levels)[0], (*levels)[1], (*levels)[2]});

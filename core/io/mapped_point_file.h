@@ -64,13 +64,7 @@ class MappedPointFile {
   // class not asked for, as io_internal::ParseLas; PCD: no position) or refuses the file for
   // (PLY: a non-finite coordinate; any: a coordinate, relative to origin(), beyond a float's
   // range). Reads the record once.
-  std::optional<Vec3> Point(uint64_t i) const {
-    const std::optional<io_internal::Point3d> p = records_->KeptPoint(i);
-    if (!p.has_value()) return std::nullopt;
-    const Vec3 point((*p)[0] - origin_[0], (*p)[1] - origin_[1], (*p)[2] - origin_[2]);
-    if (!Learnable(point)) return std::nullopt;
-    return point;
-  }
+  std::optional<Vec3> Point(uint64_t i) const { return PointOfRecord(*records_, i, origin_); }
   // Whether the learner can take `p`: coordinates that a float holds, as the readers require,
   // so that no mesh gets an infinite vertex.
   static bool Learnable(const Vec3& p) {
@@ -78,15 +72,23 @@ class MappedPointFile {
     return std::fabs(p[0]) <= kLargestFloat && std::fabs(p[1]) <= kLargestFloat &&
            std::fabs(p[2]) <= kLargestFloat;
   }
+  // Record i of `records` relative to `origin` when reading the file whole takes it as a point
+  // (Point's rules, for any records: a LAZ file's decoded chunk too).
+  static std::optional<Vec3> PointOfRecord(const io_internal::PointRecords& records, uint64_t i,
+                                           const Origin& origin) {
+    const std::optional<io_internal::Point3d> p = records.KeptPoint(i);
+    if (!p.has_value()) return std::nullopt;
+    const Vec3 point((*p)[0] - origin[0], (*p)[1] - origin[1], (*p)[2] - origin[2]);
+    if (!Learnable(point)) return std::nullopt;
+    return point;
+  }
   // Record i's colour when the file's colours can be read a record at a time (LAS), scaled as
   // reading the file whole scales them but with the largest level of the probe's records
   // instead of all of them (LevelScale); nothing otherwise.
   std::optional<Rgb> Color(uint64_t i) const {
     const std::optional<std::array<uint16_t, 3>> levels = records_->ColorLevels(i);
     if (!levels.has_value()) return std::nullopt;
-    return Rgb{ChannelFromLevel((*levels)[0], color_scale_),
-               ChannelFromLevel((*levels)[1], color_scale_),
-               ChannelFromLevel((*levels)[2], color_scale_)};
+    return RgbFromLevels(*levels, color_scale_);
   }
   // Whether Color gives the records' colours.
   bool colors_readable() const { return colors_readable_; }

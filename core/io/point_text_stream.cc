@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
@@ -21,13 +22,9 @@ constexpr size_t kLongestLine = 1 << 20;
 
 absl::Status PointTextStream::ParseLine(absl::string_view line, std::vector<Vec3>* points) {
   ++lines_;
-  line = io_internal::StripHashComment(line);
-  std::string spaced(line);
-  for (char& c : spaced) {
-    if (c == ',' || c == '\r') c = ' ';
-  }
+  line = absl::StripTrailingAsciiWhitespace(io_internal::StripHashComment(line));  // CRLF.
   std::vector<absl::string_view> tokens;
-  io_internal::SplitWhitespace(spaced, &tokens);
+  io_internal::SplitFields(line, &tokens);
   if (tokens.empty()) return absl::OkStatus();
   Vec3 p;
   for (int c = 0; c < 3; ++c) {

@@ -1,7 +1,8 @@
 // Points arriving as text on a file descriptor, a line at a time as they come: standard input
 // fed by a scanner's pipeline (`scanner | neuralmesh reconstruct - --server ...`), a pipe or a
-// socket. Each line holds a point's x, y and z, separated by spaces, tabs or commas; further
-// columns are ignored, as are blank lines and '#' comments. The stream never blocks longer than
+// socket. Each line holds a point's x, y and z, its fields split as the XYZ reader splits them
+// (spaces, tabs, commas or semicolons); further columns are ignored, as are blank lines and
+// '#' comments. The stream never blocks longer than
 // asked, so that a caller can send what has come at its own pace.
 #ifndef NEURALMESH_CORE_IO_POINT_TEXT_STREAM_H_
 #define NEURALMESH_CORE_IO_POINT_TEXT_STREAM_H_

@@ -425,9 +425,7 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
     const double max = LevelScale(largest);
     out.colors.reserve(kept);
     for_each_usable([&](uint64_t, size_t at) {
-      out.colors.push_back({ChannelFromLevel(channel(at, 0), max),
-                            ChannelFromLevel(channel(at, 1), max),
-                            ChannelFromLevel(channel(at, 2), max)});
+      out.colors.push_back(RgbFromLevels({channel(at, 0), channel(at, 1), channel(at, 2)}, max));
       return true;
     });
   }

@@ -7,6 +7,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 
 namespace neuralmesh::io_internal {
 namespace {
@@ -37,6 +38,14 @@ void SplitWhitespace(absl::string_view line, std::vector<absl::string_view>* tok
     const size_t start = i;
     while (i < line.size() && !IsSpace(line[i])) ++i;
     if (i > start) tokens->push_back(line.substr(start, i - start));
+  }
+}
+
+void SplitFields(absl::string_view line, std::vector<absl::string_view>* tokens) {
+  tokens->clear();
+  for (absl::string_view field :
+       absl::StrSplit(line, absl::ByAnyChar(" \t\v\f,;"), absl::SkipEmpty())) {
+    tokens->push_back(field);
   }
 }
 

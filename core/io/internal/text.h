@@ -36,6 +36,9 @@ class LineCursor {
 
 // Replaces `tokens` with the whitespace-separated tokens of `line`.
 void SplitWhitespace(absl::string_view line, std::vector<absl::string_view>* tokens);
+// Replaces `tokens` with the fields of `line`, separated by whitespace, commas or semicolons
+// (CloudCompare writes either): the columns of XYZ text.
+void SplitFields(absl::string_view line, std::vector<absl::string_view>* tokens);
 
 // `line` up to (not including) its first '#'.
 absl::string_view StripHashComment(absl::string_view line);

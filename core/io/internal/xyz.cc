@@ -175,16 +175,6 @@ void TakeColumns(const XyzLayout& layout, const ExtraColumns& extra, ParsedGeome
   }
 }
 
-// Replaces `tokens` with the fields of `line`, separated by whitespace, commas or semicolons
-// (CloudCompare writes either).
-void SplitFields(absl::string_view line, std::vector<absl::string_view>* tokens) {
-  tokens->clear();
-  for (absl::string_view field :
-       absl::StrSplit(line, absl::ByAnyChar(" \t\v\f,;"), absl::SkipEmpty())) {
-    tokens->push_back(field);
-  }
-}
-
 // The text of a comment line ("# ..." or "// ..."), or nullopt for a line that is not one.
 std::optional<absl::string_view> CommentText(absl::string_view line) {
   line = absl::StripLeadingAsciiWhitespace(line);

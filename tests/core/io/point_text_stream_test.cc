@@ -65,10 +65,10 @@ TEST(PointTextStreamTest, ReadsPointsAsTheirLinesComplete) {
 }
 
 TEST(PointTextStreamTest, ALineThatIsNoPointIsAnErrorNamingIt) {
-  for (const std::string& bad : {"1 2\n", "1 2 x\n", "1 2 inf\n", "nan 1 2\n"}) {
+  for (const char* bad : {"1 2\n", "1 2 x\n", "1 2 inf\n", "nan 1 2\n"}) {
     Pipe pipe;
     PointTextStream stream(pipe.read_end(), "standard input");
-    pipe.Write("1 2 3\n" + bad);
+    pipe.Write(std::string("1 2 3\n") + bad);
     std::vector<Vec3> points;
     absl::StatusOr<bool> more = stream.Read(absl::Milliseconds(100), &points);
     ASSERT_FALSE(more.ok()) << bad;

@@ -114,6 +114,7 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
   // A run whose mesh stops growing (too few points, all in one place) ends instead of spinning.
   GrowthWatch growth(LongestSplitInterval(options.learner), learner->num_vertices(), 0);
   absl::Status stalled;
+  absl::Status source;  // Sampler::CheckSource's last answer.
   for (size_t i = 0; i < targets.size(); ++i) {
     StopCriteria stop;
     stop.target_vertices = targets[i];
@@ -130,10 +131,18 @@ absl::Status RunLocalReconstruct(const LocalReconstructOptions& options, std::os
       stop.observer = [&](const LearnerProgress& p) {
         bar.Update(p.vertices, final_vertices, absl::StrFormat("%d basic steps", p.basic_steps));
         if (InterruptScope::interrupted()) return false;
+        source = target.sampler->CheckSource();
+        if (!source.ok()) return false;
         stalled = growth.Check(p.vertices, p.basic_steps);
         return stalled.ok();
       };
       NM_ASSIGN_OR_RETURN(reason, learner->Run(stop));
+    }
+    if (!source.ok()) {  // The mesh has learned points that are not the input's.
+      bar.Clear();
+      return absl::Status(source.code(), absl::StrCat(source.message(), "; learning stopped at ",
+                                                      learner->num_vertices(), " vertices and ",
+                                                      options.output, " was not written"));
     }
     const bool last = i + 1 == targets.size() || reason != StopReason::kTargetReached;
 

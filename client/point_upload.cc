@@ -36,8 +36,20 @@ absl::Status CloudUpload::SkipTo(uint64_t first) {
 absl::StatusOr<v1::PointBatch> CloudUpload::Batch(uint64_t first, size_t count) {
   NM_RETURN_IF_ERROR(SkipTo(first));
   const uint64_t end = std::min<uint64_t>(cloud_.size(), first + count);
+  v1::PointBatch batch;
+  batch.mutable_first_point()->set_value(first);
+  // The points go in runs: the rest of a block, or of the batch.
+  for (uint64_t k = first; k < end;) {
+    const uint64_t slot = order_.SlotOfNth(k);
+    const uint64_t begin = order_[slot];
+    const uint64_t run =
+        std::min({end - k, SpreadOrder::kBlockRecords - slot % SpreadOrder::kBlockRecords,
+                  cloud_.size() - begin});
+    AppendPackedPoints(cloud_, begin, begin + run, batch.mutable_packed());
+    k += run;
+  }
   done_ = end;
-  return PackPointBatch(cloud_, first, end);
+  return batch;
 }
 
 std::optional<uint64_t> FileRecordsUpload::size() const {
@@ -61,6 +73,7 @@ absl::Status FileRecordsUpload::SkipTo(uint64_t first) {
     points_ = 0;
   }
   while (points_ < first && slot_ < order_.slots()) ReadNext([](const Vec3&, uint64_t) {});
+  NM_RETURN_IF_ERROR(file_.CheckSize());
   if (points_ < first) {
     return absl::OutOfRangeError(
         absl::StrCat("the upload cannot start at point ", first, " of ", points_));
@@ -84,6 +97,7 @@ absl::StatusOr<v1::PointBatch> FileRecordsUpload::Batch(uint64_t first, size_t c
       }
     });
   }
+  NM_RETURN_IF_ERROR(file_.CheckSize());  // Else the batch may hold zeros read past its end.
   return MakeBatch(first, std::move(positions), std::move(colors));
 }
 
@@ -102,6 +116,8 @@ absl::StatusOr<bool> LazFileUpload::NextWave() {
   ForEachRange(chunks.size(), /*threads=*/0, 1, [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) decoded[i] = file_.Points(chunks[i]);
   });
+  // A file that shrank while its chunks were decoded explains what they decoded to.
+  NM_RETURN_IF_ERROR(file_.CheckSize());
   wave_first_ += wave_.size();
   wave_.clear();
   wave_colors_.clear();

@@ -40,10 +40,13 @@ class PointUpload {
   virtual std::optional<uint64_t> size() const = 0;
 };
 
-// A cloud's points in their order, with the weights, normals and colours it carries.
+// A cloud's points with the weights, normals and colours it carries, in SpreadOrder (blocks of
+// consecutive points visited along the golden ratio), so that every prefix of the upload is
+// spread over the whole cloud: a scan read whole, stored strip by strip, reaches the server as
+// a file read where it lies does (FileRecordsUpload).
 class CloudUpload final : public PointUpload {
  public:
-  explicit CloudUpload(const PointCloud& cloud) : cloud_(cloud) {}
+  explicit CloudUpload(const PointCloud& cloud) : cloud_(cloud), order_(cloud.size()) {}
 
   absl::Status SkipTo(uint64_t first) override;
   absl::StatusOr<v1::PointBatch> Batch(uint64_t first, size_t count) override;
@@ -53,19 +56,19 @@ class CloudUpload final : public PointUpload {
 
  private:
   const PointCloud& cloud_;
+  const SpreadOrder order_;
   uint64_t done_ = 0;
 };
 
 // The points of a file's records (MappedPointFile::Point, relative to its origin), read where
 // they lie in SpreadOrder, so that every prefix of the upload is spread over the whole file.
-// With `colors`, their colours too where the file's can be read a record at a time
-// (MappedPointFile::Color: LAS). Each batch reads its records once; to skip back, the order is
-// walked again from its start (resuming an upload reads the records before its first point
-// again).
+// With `colors`, their colours too where the file has them (MappedPointFile::Color). Each batch
+// reads its records once; to skip back, the order is walked again from its start (resuming an
+// upload reads the records before its first point again).
 class FileRecordsUpload final : public PointUpload {
  public:
   explicit FileRecordsUpload(const MappedPointFile& file, bool colors = false)
-      : file_(file), order_(file.records()), colors_(colors && file.colors_readable()) {}
+      : file_(file), order_(file.records()), colors_(colors && file.has_colors()) {}
 
   absl::Status SkipTo(uint64_t first) override;
   absl::StatusOr<v1::PointBatch> Batch(uint64_t first, size_t count) override;

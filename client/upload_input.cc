@@ -71,16 +71,13 @@ absl::StatusOr<UploadInput> LoadUploadInput(const RemoteReconstructOptions& opti
         CheckOffCoreInput(options.inputs, options.outliers.has_value() && !outliers_on_server));
     const std::string& path = options.inputs.front();
     const bool colors = options.colors.has_value();
-    // `readable`: whether the file's colours can be sent (LAS and LAZ: yes; PLY, PCD: no).
-    const auto describe = [&](const auto& file, absl::string_view how, bool readable) {
+    const auto describe = [&](const auto& file, absl::string_view how) {
       input.origin = file.origin();
       input.bounds = file.bounds();
       input.size = static_cast<uint64_t>(
           std::llround(static_cast<double>(file.records()) * file.kept_share()));
       input.estimated = true;
-      const char* color_note = !file.has_colors() || !colors ? ""
-                               : readable                    ? "; with colours"
-                                          : "; colours of PLY and PCD are not sent off-core";
+      const char* color_note = file.has_colors() && colors ? "; with colours" : "";
       out << absl::StrFormat("INPUT '%s': %d records %s (off-core; %.1f%% of them points%s)%s\n",
                              path, file.records(), how, 100 * file.kept_share(), color_note,
                              OriginNote(input.origin));
@@ -91,14 +88,13 @@ absl::StatusOr<UploadInput> LoadUploadInput(const RemoteReconstructOptions& opti
       input.points = std::make_unique<LazFileUpload>(*input.laz, colors);
       describe(*input.laz,
                absl::StrCat("decoded where they lie, a LAZ chunk at a time (", input.laz->chunks(),
-                            input.laz->chunks() == 1 ? " chunk)" : " chunks)"),
-               /*readable=*/true);
+                            input.laz->chunks() == 1 ? " chunk)" : " chunks)"));
     } else {
       NM_ASSIGN_OR_RETURN(MappedPointFile file,
                           OpenOffCoreFile(options.inputs, false, options.selection));
       input.file = std::make_unique<MappedPointFile>(std::move(file));
       input.points = std::make_unique<FileRecordsUpload>(*input.file, colors);
-      describe(*input.file, "read where they lie", input.file->colors_readable());
+      describe(*input.file, "read where they lie");
     }
     return input;
   }

@@ -42,24 +42,33 @@ inline void CheckRecordsAgreeWithParser(const io_internal::PointRecords& records
     FUZZ_CHECK(kept == parsed->positions.size(), "%llu records kept, %zu points read",
                static_cast<unsigned long long>(kept), parsed->positions.size());
   }
-  // Colours read a record at a time (LAS), scaled by the largest level of all kept records as
-  // the parser scales them, are the parser's.
-  if (parsed == nullptr || parsed->colors.empty()) return;
+  // Colours read a record at a time are the parser's: stated ones (PLY, PCD) as they are, LAS
+  // levels scaled by the largest level of all kept records as the parser scales them.
+  if (parsed == nullptr || parsed->positions.empty()) return;
+  FUZZ_CHECK(records.has_colors() == !parsed->colors.empty(),
+             "the records %s colours, the parser read %zu", records.has_colors() ? "have" : "lack",
+             parsed->colors.size());
+  if (parsed->colors.empty()) return;
   uint16_t largest = 0;
   for (uint64_t i = 0; i < records.size(); ++i) {
     if (!records.KeptPoint(i).has_value()) continue;
     const std::optional<std::array<uint16_t, 3>> levels = records.ColorLevels(i);
-    if (!levels.has_value()) return;  // A format whose colours are not read so.
-    largest = std::max({largest, (*levels)[0], (*levels)[1], (*levels)[2]});
+    if (levels.has_value()) largest = std::max({largest, (*levels)[0], (*levels)[1], (*levels)[2]});
   }
   uint64_t point = 0;
   for (uint64_t i = 0; i < records.size(); ++i) {
     if (!records.KeptPoint(i).has_value()) continue;
-    const std::array<uint16_t, 3> levels = *records.ColorLevels(i);
+    std::optional<Rgb> color = records.StatedColor(i);
+    if (const auto levels = records.ColorLevels(i); levels.has_value()) {
+      FUZZ_CHECK(!color.has_value(), "record %llu has stated colours and levels",
+                 static_cast<unsigned long long>(i));
+      color = RgbFromLevels(*levels, LevelScale(largest));
+    }
+    FUZZ_CHECK(color.has_value(), "record %llu has no colour", static_cast<unsigned long long>(i));
     for (int c = 0; c < 3; ++c) {
-      FUZZ_CHECK(ChannelFromLevel(levels[c], LevelScale(largest)) == parsed->colors[point][c],
-                 "record %llu, channel %d: level %u where the parser read %u",
-                 static_cast<unsigned long long>(i), c, unsigned{levels[c]},
+      FUZZ_CHECK((*color)[c] == parsed->colors[point][c],
+                 "record %llu, channel %d: %u where the parser read %u",
+                 static_cast<unsigned long long>(i), c, unsigned{(*color)[c]},
                  unsigned{parsed->colors[point][c]});
     }
     ++point;

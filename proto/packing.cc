@@ -15,15 +15,26 @@ std::string PackRange(const std::vector<T>& values, size_t begin, size_t end) {
   return bytes;
 }
 
+// Appends elements [begin, end) of `values` to `bytes`, as PackRange packs them.
+template <typename T>
+void AppendRange(const std::vector<T>& values, size_t begin, size_t end, std::string* bytes) {
+  bytes->append(reinterpret_cast<const char*>(values.data() + begin), (end - begin) * sizeof(T));
+}
+
 }  // namespace
 
 v1::PackedPoints PackPoints(const PointCloud& cloud, size_t begin, size_t end) {
   v1::PackedPoints packed;
-  packed.set_positions(PackRange(cloud.positions, begin, end));
-  if (!cloud.weights.empty()) packed.set_weights(PackRange(cloud.weights, begin, end));
-  if (!cloud.normals.empty()) packed.set_normals(PackRange(cloud.normals, begin, end));
-  if (!cloud.colors.empty()) packed.set_colors(PackRange(cloud.colors, begin, end));
+  AppendPackedPoints(cloud, begin, end, &packed);
   return packed;
+}
+
+void AppendPackedPoints(const PointCloud& cloud, size_t begin, size_t end,
+                        v1::PackedPoints* packed) {
+  AppendRange(cloud.positions, begin, end, packed->mutable_positions());
+  if (!cloud.weights.empty()) AppendRange(cloud.weights, begin, end, packed->mutable_weights());
+  if (!cloud.normals.empty()) AppendRange(cloud.normals, begin, end, packed->mutable_normals());
+  if (!cloud.colors.empty()) AppendRange(cloud.colors, begin, end, packed->mutable_colors());
 }
 
 v1::PointBatch PackPointBatch(const PointCloud& cloud, size_t begin, size_t end) {

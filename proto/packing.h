@@ -13,8 +13,12 @@
 
 namespace neuralmesh {
 
-// Points [begin, end) of `cloud`: positions, and weights and normals when the cloud has them.
+// Points [begin, end) of `cloud`: positions, and weights, normals and colours when the cloud
+// has them.
 v1::PackedPoints PackPoints(const PointCloud& cloud, size_t begin, size_t end);
+// Appends points [begin, end) of `cloud` to `packed`, as PackPoints packs them.
+void AppendPackedPoints(const PointCloud& cloud, size_t begin, size_t end,
+                        v1::PackedPoints* packed);
 
 // Points [begin, end) of `cloud` as a batch that says where it starts in the upload
 // (first_point = begin), so that a batch sent again after a lost connection is not taken twice.

@@ -1,6 +1,8 @@
 // A file mapped into memory read-only: its bytes are read from the page cache (or the disk)
 // when touched, not copied, so a file larger than memory can be read where it lies (off-core
-// sampling: core/sampling/off_core_sampler.h).
+// sampling: core/sampling/off_core_sampler.h). A file that shrinks while it is mapped does not
+// crash its reader: what lies past its new end reads as zeros (internal/shrink_guard.h), and
+// CheckSize says so.
 #ifndef NEURALMESH_CORE_IO_MAPPED_FILE_H_
 #define NEURALMESH_CORE_IO_MAPPED_FILE_H_
 
@@ -31,14 +33,22 @@ class MappedFile {
   absl::string_view data() const { return absl::string_view(data_, size_); }
   // Whether the whole file is being read ahead into the page cache.
   bool read_ahead() const { return read_ahead_; }
+  // OK while the file is as large as when it was mapped. DATA_LOSS ("'path' shrank from 1000 to
+  // 10 bytes while it was read; ...") once it is smaller, or once a read past its new end read
+  // zeros instead of its bytes: what was read since it shrank is not the file's. Reads done
+  // before a call that returns OK read the file's bytes. One fstat.
+  absl::Status CheckSize() const;
 
  private:
-  MappedFile(const char* data, size_t size, bool read_ahead)
-      : data_(data), size_(size), read_ahead_(read_ahead) {}
+  MappedFile(std::string path, int fd, const char* data, size_t size, bool read_ahead);
+  void Close();
 
+  std::string path_;
+  int fd_ = -1;  // Kept open to see the file's size.
   const char* data_ = nullptr;
   size_t size_ = 0;
   bool read_ahead_ = false;
+  int guard_slot_ = -1;  // io_internal::GuardRange's.
 };
 
 }  // namespace neuralmesh

@@ -60,6 +60,7 @@ absl::StatusOr<MappedLazFile> MappedLazFile::Open(const std::string& path,
       }
     }
   }
+  NM_RETURN_IF_ERROR(opened.CheckSize());
   opened.color_scale_ = LevelScale(largest_level);
   if (kept == 0) {
     return invalid(absl::StrCat(

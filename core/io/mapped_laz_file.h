@@ -60,6 +60,8 @@ class MappedLazFile {
   bool has_colors() const { return has_colors_; }
   // The share of the probe's records that are points.
   double kept_share() const { return kept_share_; }
+  // MappedFile::CheckSize: whether the chunks decoded so far are the file's.
+  absl::Status CheckSize() const { return file_.CheckSize(); }
 
  private:
   // Chunk `chunk` decoded into `decoded`, as records.

@@ -109,10 +109,10 @@ absl::StatusOr<MappedPointFile> MappedPointFile::Open(const std::string& path,
     ++kept;
     probed.Extend(*p);
     if (const auto levels = points.ColorLevels(r); levels.has_value()) {
-      opened.colors_readable_ = true;
       largest_level = std::max({largest_level, (*levels)[0], (*levels)[1], (*levels)[2]});
     }
   }
+  NM_RETURN_IF_ERROR(opened.CheckSize());
   opened.color_scale_ = LevelScale(largest_level);
   opened.kept_share_ = static_cast<double>(kept) / kProbeRecords;
   if (opened.kept_share_ < kLeastKeptShare) {

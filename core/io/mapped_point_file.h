@@ -82,16 +82,18 @@ class MappedPointFile {
     if (!Learnable(point)) return std::nullopt;
     return point;
   }
-  // Record i's colour when the file's colours can be read a record at a time (LAS), scaled as
-  // reading the file whole scales them but with the largest level of the probe's records
-  // instead of all of them (LevelScale); nothing otherwise.
+  // Record i's colour when the file has colours, as reading the file whole gives it (PLY, PCD:
+  // PointRecords::StatedColor), except that LAS levels are judged to be of 8 or 16 bits from
+  // the largest level of the probe's records instead of all of them (LevelScale); nothing
+  // otherwise.
   std::optional<Rgb> Color(uint64_t i) const {
+    if (const std::optional<Rgb> stated = records_->StatedColor(i); stated.has_value()) {
+      return stated;
+    }
     const std::optional<std::array<uint16_t, 3>> levels = records_->ColorLevels(i);
     if (!levels.has_value()) return std::nullopt;
     return RgbFromLevels(*levels, color_scale_);
   }
-  // Whether Color gives the records' colours.
-  bool colors_readable() const { return colors_readable_; }
   // Starts loading record i.
   void Prefetch(uint64_t i) const { __builtin_prefetch(records_->Address(i)); }
 
@@ -101,6 +103,8 @@ class MappedPointFile {
   bool has_colors() const { return records_->has_colors(); }
   // The share of the probe's records that are points.
   double kept_share() const { return kept_share_; }
+  // MappedFile::CheckSize: whether the records read so far are the file's.
+  absl::Status CheckSize() const { return file_.CheckSize(); }
 
  private:
   MappedPointFile(MappedFile file, std::unique_ptr<io_internal::PointRecords> records)
@@ -111,7 +115,6 @@ class MappedPointFile {
   Origin origin_ = kNoOrigin;
   BoundingBox bounds_;
   double kept_share_ = 0;
-  bool colors_readable_ = false;
   double color_scale_ = 255;
 };
 

@@ -30,12 +30,20 @@ class SpreadOrder {
         static_cast<unsigned __int128>(slot / block_records_) * stride_ % blocks_);
     return block * block_records_ + slot % block_records_;
   }
+  // The position of the order's k-th record (k < records()): its k-th slot, not counting the
+  // slots past the last record.
+  uint64_t SlotOfNth(uint64_t k) const {
+    return k < short_block_end_ ? k : k + (block_records_ - short_block_records_);
+  }
 
  private:
   uint64_t records_;
   uint64_t block_records_;
   uint64_t blocks_;
   uint64_t stride_;  // Coprime with blocks_: the order visits each block once.
+  // The last block's records, and the slot after them: the slots past the last record follow.
+  uint64_t short_block_records_;
+  uint64_t short_block_end_;
 };
 
 }  // namespace neuralmesh

@@ -43,6 +43,9 @@ class OffCoreSampler final : public Sampler {
   bool empty() const override { return false; }
   // MappedPointFile::bounds(): records outside them are sampled all the same.
   BoundingBox Bounds() const override { return file_.bounds(); }
+  // MappedPointFile::CheckSize: a file that shrinks while it is sampled gives zeros past its
+  // new end, not a crash, and this error.
+  absl::Status CheckSource() const override { return file_.CheckSize(); }
 
   const Origin& origin() const { return file_.origin(); }
   uint64_t records() const { return file_.records(); }

@@ -4,6 +4,7 @@
 #ifndef NEURALMESH_CORE_SAMPLING_SAMPLER_H_
 #define NEURALMESH_CORE_SAMPLING_SAMPLER_H_
 
+#include "absl/status/status.h"
 #include "core/bounding_box.h"
 #include "core/mesh.h"
 #include "core/random.h"
@@ -29,6 +30,11 @@ class Sampler {
 
   // The bounding box of the data seen so far (the initial tetrahedron is built around it).
   virtual BoundingBox Bounds() const = 0;
+
+  // OK while the points drawn so far are the target space's; an error saying why once they
+  // may not be (a file read where it lies that shrank: OffCoreSampler). Cheap enough to call
+  // every thousand Basic Steps. By default OK.
+  virtual absl::Status CheckSource() const { return absl::OkStatus(); }
 };
 
 }  // namespace neuralmesh

@@ -1040,6 +1040,42 @@ TEST_F(LocalCliTest, OffCoreLearnsALasPlyOrPcdScanWhereItLies) {
   EXPECT_FALSE(std::filesystem::exists(out)) << "nothing may be written";
 }
 
+// A scan cut short while it is learned where it lies (another program rewriting it): the run
+// stops with an error saying so instead of a crash (SIGBUS), and writes no mesh learned from
+// what was read past the file's new end; the levels of detail written before stand.
+TEST_F(LocalCliTest, OffCoreLearningStopsSayingSoWhenTheScanShrinks) {
+  const std::string las = *dir_ + "/shrinks.las";
+  testing::LasLayout layout;
+  layout.format = 1;
+  for (double& s : layout.scale) s = 0.0001;
+  std::ofstream(las, std::ios::binary)
+      << testing::LasFile(layout, UnitSphereLasPoints(300000, 3, layout));
+  const std::string mesh = *dir_ + "/shrinks.ply";
+  BackgroundProcess run("neuralmesh", {"reconstruct", las, "-o", mesh, "--vertices", "400000",
+                                       "--lod", "1000", "--off_core"});
+  const std::string lod = *dir_ + "/shrinks_lod1000.ply";
+  for (int i = 0; i < 500 && !std::filesystem::exists(lod) && run.Running(); ++i) {
+    usleep(20 * 1000);
+  }
+  ASSERT_TRUE(std::filesystem::exists(lod)) << run.Stderr();
+  std::filesystem::resize_file(las, 50000);
+  for (int i = 0; i < 500 && run.Running(); ++i) usleep(20 * 1000);
+  ASSERT_FALSE(run.Running()) << "learning went on from a file cut short";
+  EXPECT_EQ(run.exit_code(), 1) << run.Stderr();
+  EXPECT_TRUE(absl::StrContains(run.Stderr(),
+                                absl::StrCat("'", las,
+                                             "' shrank from 8400227 to 50000 bytes while it was "
+                                             "read; what lay past its new end is gone; learning "
+                                             "stopped at ")))
+      << run.Stderr();
+  EXPECT_TRUE(absl::StrContains(run.Stderr(), " vertices and " + mesh + " was not written"))
+      << run.Stderr();
+  EXPECT_FALSE(std::filesystem::exists(mesh));
+  const absl::StatusOr<TriangleMesh> first = ReadMesh(lod);
+  ASSERT_TRUE(first.ok()) << first.status();
+  for (const Vec3f& v : first->positions) ASSERT_NEAR(v.norm(), 1.0, 0.1) << "the LOD stands";
+}
+
 TEST_F(LocalCliTest, ClassifiedNoiseInLasScansIsLeftOutAndCounted) {
   testing::LasLayout layout;
   layout.format = 1;

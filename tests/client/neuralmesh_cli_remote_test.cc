@@ -403,7 +403,8 @@ TEST_F(RemoteCliTest, ColouredPointsComeBackAsColouredMeshes) {
       EXPECT_LE(worst, 8) << name;
     }
   }
-  // The same points as LAS, and LAZ, uploaded from where they lie: their colours go too.
+  // The same points as LAS, LAZ, PLY and PCD, uploaded from where they lie: their colours go
+  // too.
   testing::LasLayout layout;
   layout.format = 3;
   for (double& s : layout.scale) s = 0.0001;
@@ -421,8 +422,12 @@ TEST_F(RemoteCliTest, ColouredPointsComeBackAsColouredMeshes) {
   const std::string las = *dir_ + "/colored_scan.las";
   std::ofstream(las, std::ios::binary) << testing::LasFile(layout, records);
   const std::string laz = *dir_ + "/colored_scan_laz.laz";
-  ASSERT_EQ(RunNeuralmesh({"convert", las, "-o", laz}).exit_code, 0);
-  for (const std::string& input : {las, laz}) {
+  const std::string ply = *dir_ + "/colored_scan_ply.ply";
+  const std::string pcd = *dir_ + "/colored_scan_pcd.pcd";
+  for (const std::string& converted : {laz, ply, pcd}) {
+    ASSERT_EQ(RunNeuralmesh({"convert", las, "-o", converted}).exit_code, 0);
+  }
+  for (const std::string& input : {las, laz, ply, pcd}) {
     SCOPED_TRACE(input);
     const std::string out_dir = *dir_ + "/colored_off_core";
     const RunResult run =

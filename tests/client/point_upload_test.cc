@@ -10,6 +10,7 @@
 #include <tuple>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "core/io/internal/laz.h"
 #include "core/io/point_cloud_io.h"
 #include "core/io/spread_order.h"
@@ -175,6 +176,36 @@ TEST(FileRecordsUploadTest, SkippingBackOrPastTheEndReadsTheOrderAgain) {
   EXPECT_EQ(resumed.size(), 5400u);
 }
 
+// Uploads `upload` in batches of 500 until a batch fails; expects that to happen before its
+// end, with DATA_LOSS naming `path`, and no point sent to lie outside the scan's box (a
+// zeroed record's point would lie at the LAS offset, far from it).
+void ExpectShrinkToStopTheUpload(PointUpload& upload, const std::string& path) {
+  absl::Status status = absl::OkStatus();
+  uint64_t sent = 0;
+  while (status.ok()) {
+    absl::StatusOr<v1::PointBatch> batch = upload.Batch(sent, 500);
+    status = batch.status();
+    if (!batch.ok()) break;
+    const std::vector<Point> points = PointsOf(*batch);
+    ASSERT_FALSE(points.empty()) << "the upload ended without noticing the file shrank";
+    for (const Point& p : points) ASSERT_GT(std::get<2>(p), 50.0) << "a zeroed record sent";
+    sent += points.size();
+  }
+  EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << status;
+  EXPECT_THAT(std::string(status.message()), ::testing::HasSubstr("'" + path + "' shrank from "))
+      << status;
+}
+
+TEST(FileRecordsUploadTest, AFileThatShrinksDuringTheUploadStopsItWithDataLoss) {
+  const std::string path = WriteStripScan("shrinks.las", 60000);
+  absl::StatusOr<MappedPointFile> file = MappedPointFile::Open(path);
+  ASSERT_TRUE(file.ok()) << file.status();
+  FileRecordsUpload upload(*file);
+  ASSERT_TRUE(upload.Batch(0, 1000).ok());
+  ASSERT_EQ(::truncate(path.c_str(), 100000), 0);  // A LAS header and 3,000-odd records left.
+  ExpectShrinkToStopTheUpload(upload, path);
+}
+
 // The scan of WriteStripScan as LAZ in chunks of 1,000 records.
 std::string WriteStripScanLaz(const std::string& name, size_t building_points = 6000) {
   const std::string las = WriteStripScan(name + ".las", building_points);
@@ -266,6 +297,16 @@ TEST(LazFileUploadTest, SkippingBackDecodesAgainAndACorruptChunkIsAnError) {
   EXPECT_THAT(std::string(status.message()), ::testing::HasSubstr(corrupt)) << status;
 }
 
+TEST(LazFileUploadTest, AFileThatShrinksDuringTheUploadStopsItWithDataLoss) {
+  const std::string path = WriteStripScanLaz("shrinks.laz", 60000);
+  absl::StatusOr<MappedLazFile> file = MappedLazFile::Open(path);
+  ASSERT_TRUE(file.ok()) << file.status();
+  LazFileUpload upload(*file);
+  ASSERT_TRUE(upload.Batch(0, 1000).ok());
+  ASSERT_EQ(::truncate(path.c_str(), 20000), 0);
+  ExpectShrinkToStopTheUpload(upload, path);
+}
+
 // Georeferenced points written to a pipe in two parts: the first batch chooses the origin, a
 // batch that is not full goes out once the flush time passes, and the upload's size is known
 // at the end of the stream.
@@ -323,8 +364,32 @@ TEST(StreamUploadTest, APointFarFromTheOriginIsAnError) {
   close(fds[0]);
 }
 
-// A LAS scan with 16-bit colours, and its LAZ: with colours asked for, each point goes with the
-// colour reading the file whole gives it; without, none go.
+// A binary big-endian PLY file of `cloud`: double x, y, z, then its colours as a ushort red,
+// a float green and a uchar blue, and a property of no role between them.
+std::string PlyOfMixedChannels(const PointCloud& cloud) {
+  std::string out = absl::StrCat(
+      "ply\nformat binary_big_endian 1.0\nelement vertex ", cloud.size(),
+      "\nproperty double x\nproperty double y\nproperty double z\nproperty ushort red\n"
+      "property short return_number\nproperty float green\nproperty uchar blue\nend_header\n");
+  const auto append = [&out](auto value) {
+    char bytes[sizeof value];
+    std::memcpy(bytes, &value, sizeof value);
+    std::reverse(bytes, bytes + sizeof value);
+    out.append(bytes, sizeof value);
+  };
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    for (int c = 0; c < 3; ++c) append(static_cast<double>(cloud.positions[i][c]));
+    append(static_cast<uint16_t>(cloud.colors[i][0] * 257));
+    append(static_cast<int16_t>(-7));
+    append(static_cast<float>(cloud.colors[i][1] / 255.0));
+    append(cloud.colors[i][2]);
+  }
+  return out;
+}
+
+// A LAS scan with 16-bit colours, its LAZ, and its points as PLY (uchar channels, and channels
+// of three types) and PCD: with colours asked for, each point goes with the colour reading the
+// file whole gives it; without, none go.
 TEST(FileUploadTest, ColoursGoWithTheirPointsWhenAsked) {
   testing::LasLayout layout;
   layout.format = 3;
@@ -372,13 +437,22 @@ TEST(FileUploadTest, ColoursGoWithTheirPointsWhenAsked) {
     std::sort(out.begin(), out.end());
     return out;
   };
-  absl::StatusOr<MappedPointFile> file = MappedPointFile::Open(las);
-  ASSERT_TRUE(file.ok()) << file.status();
-  EXPECT_TRUE(file->colors_readable());
-  FileRecordsUpload with(*file, /*colors=*/true);
-  EXPECT_EQ(sent(with, true), expected);
-  FileRecordsUpload without(*file);
-  EXPECT_EQ(sent(without, false).size(), 2000u);
+  const std::string mixed = Dir() + "/colored_mixed.ply";
+  std::ofstream(mixed, std::ios::binary) << PlyOfMixedChannels(*read);
+  for (const std::string& path : {las, Dir() + "/colored.ply", Dir() + "/colored.pcd", mixed}) {
+    SCOPED_TRACE(path);
+    if (path != las && path != mixed) ASSERT_TRUE(WritePointCloud(*read, path).ok());
+    absl::StatusOr<PointCloud> whole = ReadPointCloud(path);
+    ASSERT_TRUE(whole.ok()) << whole.status();
+    ASSERT_EQ(whole->colors, read->colors) << "the file holds the scan's colours";
+    absl::StatusOr<MappedPointFile> file = MappedPointFile::Open(path);
+    ASSERT_TRUE(file.ok()) << file.status();
+    EXPECT_TRUE(file->has_colors());
+    FileRecordsUpload with(*file, /*colors=*/true);
+    EXPECT_EQ(sent(with, true), expected);
+    FileRecordsUpload without(*file);
+    EXPECT_EQ(sent(without, false).size(), 2000u);
+  }
   absl::StatusOr<MappedLazFile> laz_file = MappedLazFile::Open(laz_path);
   ASSERT_TRUE(laz_file.ok()) << laz_file.status();
   LazFileUpload laz_with(*laz_file, /*colors=*/true);
@@ -387,20 +461,60 @@ TEST(FileUploadTest, ColoursGoWithTheirPointsWhenAsked) {
   EXPECT_EQ(sent(laz_without, false).size(), 2000u);
 }
 
-TEST(CloudUploadTest, SendsTheCloudInItsOrderWithWhatItCarries) {
-  PointCloud cloud = testing::ColoredUnitSpherePoints(25, 1);
-  CloudUpload upload(cloud);
-  EXPECT_EQ(upload.size(), 25u);
-  absl::StatusOr<v1::PointBatch> batch = upload.Batch(20, 10);
-  ASSERT_TRUE(batch.ok()) << batch.status();
-  EXPECT_EQ(batch->first_point().value(), 20u);
-  const std::vector<Point> points = PointsOf(*batch);
-  ASSERT_EQ(points.size(), 5u);
-  EXPECT_EQ(points[0],
-            Point(cloud.positions[20][0], cloud.positions[20][1], cloud.positions[20][2]));
-  EXPECT_EQ(batch->packed().colors().size(), 15u);
-  EXPECT_EQ(upload.done(), 25u);
-  EXPECT_EQ(upload.SkipTo(26).code(), absl::StatusCode::kOutOfRange);
+// A cloud read whole goes as a file read where it lies does: each point once with what it
+// carries, in an order whose first batch is spread over the whole cloud though its points are
+// stored bottom to top.
+TEST(CloudUploadTest, SendsEachPointOnceWithWhatItCarriesSpreadOverTheCloud) {
+  PointCloud cloud = testing::ColoredUnitSpherePoints(60000, 1);
+  std::vector<size_t> by_height(cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) by_height[i] = i;
+  std::sort(by_height.begin(), by_height.end(),
+            [&](size_t a, size_t b) { return cloud.positions[a][2] < cloud.positions[b][2]; });
+  PointCloud sorted;
+  for (size_t i : by_height) {
+    sorted.positions.push_back(cloud.positions[i]);
+    sorted.colors.push_back(cloud.colors[i]);
+    sorted.weights.push_back(static_cast<float>(sorted.weights.size()));  // Which point it is.
+  }
+  CloudUpload upload(sorted);
+  EXPECT_EQ(upload.size(), 60000u);
+  EXPECT_EQ(upload.total(), 60000u);
+
+  std::vector<int> sent(sorted.size(), 0);
+  int per_tenth[10] = {};
+  for (uint64_t first = 0;;) {
+    absl::StatusOr<v1::PointBatch> batch = upload.Batch(first, 7000);
+    ASSERT_TRUE(batch.ok()) << batch.status();
+    EXPECT_EQ(batch->first_point().value(), first);
+    const std::vector<Point> points = PointsOf(*batch);
+    if (points.empty()) break;
+    const std::string& colors = batch->packed().colors();
+    const std::string& weights = batch->packed().weights();
+    ASSERT_EQ(colors.size(), 3 * points.size());
+    ASSERT_EQ(weights.size(), 4 * points.size());
+    for (size_t j = 0; j < points.size(); ++j) {
+      float weight;
+      std::memcpy(&weight, weights.data() + 4 * j, 4);
+      const size_t index = static_cast<size_t>(weight);
+      ASSERT_LT(index, sorted.size());
+      ++sent[index];
+      EXPECT_EQ(points[j], Point(sorted.positions[index][0], sorted.positions[index][1],
+                                 sorted.positions[index][2]));
+      EXPECT_EQ(0, std::memcmp(colors.data() + 3 * j, sorted.colors[index].data(), 3));
+      if (first == 0)
+        ++per_tenth[std::clamp(static_cast<int>((std::get<2>(points[j]) + 1) * 5), 0, 9)];
+    }
+    first += points.size();
+    EXPECT_EQ(upload.done(), first);
+  }
+  EXPECT_EQ(std::count(sent.begin(), sent.end(), 1), 60000) << "each point once";
+  for (int tenth = 0; tenth < 10; ++tenth) {
+    EXPECT_GE(per_tenth[tenth], 350) << "height tenth " << tenth << " in the first batch";
+  }
+  EXPECT_EQ(upload.SkipTo(60001).code(), absl::StatusCode::kOutOfRange);
+  absl::StatusOr<v1::PointBatch> again = upload.Batch(30000, 10);
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_EQ(PointsOf(*again).size(), 10u) << "a batch sent again after a lost connection";
 }
 
 }  // namespace

@@ -403,6 +403,10 @@ class BinaryPointRecords final : public PointRecords {
   }
   const char* Address(uint64_t i) const override { return body_.data() + i * header_.record_bytes; }
   bool has_colors() const override { return roles_.color >= 0; }
+  std::optional<Rgb> StatedColor(uint64_t i) const override {
+    if (roles_.color < 0) return std::nullopt;
+    return Unpacked(PackedColorAt(Address(i) + header_.fields[roles_.color].offset));
+  }
   std::optional<Point3d> Resolution() const override { return std::nullopt; }
   std::optional<std::pair<Point3d, Point3d>> StatedBounds() const override { return std::nullopt; }
 

@@ -244,15 +244,25 @@ absl::StatusOr<std::vector<Role>> VertexRoles(const PlyElement& element, bool* h
   return roles;
 }
 
+// The full scale of a colour channel of `type`: integers are levels of their type (uchar
+// 0-255, ushort 0-65535, ...), floating-point values fractions from 0 to 1.
+double ChannelScale(PlyType type) {
+  return IsIntegralPlyType(type) ? IntegralPlyRange(type).second : 1.0;
+}
+
 }  // namespace
 
 absl::StatusOr<PlyVertexLayout> FindPlyVertexLayout(const PlyElement& vertex) {
-  bool has_normals = false, has_weights = false;
+  bool has_normals = false, has_weights = false, has_colors = false;
   PlyVertexLayout layout;
   NM_ASSIGN_OR_RETURN(const std::vector<Role> roles,
-                      VertexRoles(vertex, &has_normals, &has_weights, &layout.has_colors));
+                      VertexRoles(vertex, &has_normals, &has_weights, &has_colors));
   for (size_t i = 0; i < roles.size(); ++i) {
     if (roles[i] >= kX && roles[i] <= kZ) layout.axes[roles[i] - kX] = static_cast<int>(i);
+    if (roles[i] >= kRed && roles[i] <= kBlue) {
+      layout.channels[roles[i] - kRed] = static_cast<int>(i);
+      layout.channel_scales[roles[i] - kRed] = ChannelScale(vertex.properties[i].type);
+    }
   }
   return layout;
 }
@@ -269,13 +279,10 @@ absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry*
   bool has_normals = false, has_weights = false, has_colors = false;
   NM_ASSIGN_OR_RETURN(std::vector<Role> roles,
                       VertexRoles(element, &has_normals, &has_weights, &has_colors));
-  // Integer channels are levels of their type (uchar 0-255, ushort 0-65535, ...), floating
-  // ones fractions from 0 to 1.
   double channel_max[3] = {1, 1, 1};
   for (size_t k = 0; k < roles.size(); ++k) {
-    const PlyType type = element.properties[k].type;
-    if (roles[k] >= kRed && roles[k] <= kBlue && IsIntegralPlyType(type)) {
-      channel_max[roles[k] - kRed] = IntegralPlyRange(type).second;
+    if (roles[k] >= kRed && roles[k] <= kBlue) {
+      channel_max[roles[k] - kRed] = ChannelScale(element.properties[k].type);
     }
   }
   // BeginElement has bounded the count by the remaining bytes.

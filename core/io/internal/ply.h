@@ -23,11 +23,14 @@ namespace neuralmesh::io_internal {
 // hold, missing or malformed values, non-finite coordinates or out-of-range face indices.
 absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces);
 
-// Which properties of the 'vertex' element ParsePly reads as x, y and z (their indices), and
-// whether it reads colours from it. INVALID_ARGUMENT "line N: ..." when x, y or z is missing.
+// Which properties of the 'vertex' element ParsePly reads as x, y and z, and as red, green and
+// blue (their indices; the channels -1 when it reads no colours), with each channel's full
+// scale (PlyChannelScale). INVALID_ARGUMENT "line N: ..." when x, y or z is missing.
 struct PlyVertexLayout {
   int axes[3] = {-1, -1, -1};
-  bool has_colors = false;
+  int channels[3] = {-1, -1, -1};
+  double channel_scales[3] = {1, 1, 1};
+  bool has_colors() const { return channels[0] >= 0; }
 };
 absl::StatusOr<PlyVertexLayout> FindPlyVertexLayout(const PlyElement& vertex);
 

@@ -30,20 +30,23 @@ absl::StatusOr<size_t> RecordSize(const PlyElement& element) {
   return size;
 }
 
+// Where a scalar property lies in a record, and its type.
+struct Field {
+  size_t offset = 0;
+  PlyType type = PlyType::kFloat32;
+};
+
 class VertexRecords final : public PointRecords {
  public:
   VertexRecords(absl::string_view data, size_t first, size_t length, uint64_t count,
-                bool big_endian, bool has_colors)
-      : data_(data),
-        first_(first),
-        length_(length),
-        count_(count),
-        big_endian_(big_endian),
-        has_colors_(has_colors) {}
+                bool big_endian)
+      : data_(data), first_(first), length_(length), count_(count), big_endian_(big_endian) {}
 
-  void SetAxis(int c, size_t offset, PlyType type) {
-    offsets_[c] = offset;
-    types_[c] = type;
+  void SetAxis(int c, Field field) { axes_[c] = field; }
+  void SetChannel(int c, Field field, double scale) {
+    channels_[c] = field;
+    channel_scales_[c] = scale;
+    has_colors_ = true;
   }
 
   uint64_t size() const override { return count_; }
@@ -52,13 +55,25 @@ class VertexRecords final : public PointRecords {
     const char* record = Address(i);
     Point3d p;
     for (int c = 0; c < 3; ++c) {
-      p[c] = LoadPlyValue(record + offsets_[c], types_[c], big_endian_);
+      p[c] = LoadPlyValue(record + axes_[c].offset, axes_[c].type, big_endian_);
       if (!std::isfinite(p[c])) return std::nullopt;
     }
     return p;
   }
   const char* Address(uint64_t i) const override { return data_.data() + first_ + i * length_; }
   bool has_colors() const override { return has_colors_; }
+  // As ParsePly scales the channels.
+  std::optional<Rgb> StatedColor(uint64_t i) const override {
+    if (!has_colors_) return std::nullopt;
+    const char* record = Address(i);
+    Rgb color;
+    for (int c = 0; c < 3; ++c) {
+      color[c] = ChannelFromLevel(
+          LoadPlyValue(record + channels_[c].offset, channels_[c].type, big_endian_),
+          channel_scales_[c]);
+    }
+    return color;
+  }
   std::optional<Point3d> Resolution() const override { return std::nullopt; }
   std::optional<std::pair<Point3d, Point3d>> StatedBounds() const override { return std::nullopt; }
 
@@ -66,10 +81,19 @@ class VertexRecords final : public PointRecords {
   absl::string_view data_;
   size_t first_, length_;
   uint64_t count_;
-  bool big_endian_, has_colors_;
-  size_t offsets_[3] = {0, 0, 0};
-  PlyType types_[3] = {PlyType::kFloat32, PlyType::kFloat32, PlyType::kFloat32};
+  bool big_endian_;
+  bool has_colors_ = false;
+  Field axes_[3];
+  Field channels_[3];
+  double channel_scales_[3] = {1, 1, 1};
 };
+
+// Where property `index` of `element` lies in its records (none of them lists).
+Field FieldOf(const PlyElement& element, int index) {
+  Field field{0, element.properties[index].type};
+  for (int i = 0; i < index; ++i) field.offset += PlyTypeSize(element.properties[i].type);
+  return field;
+}
 
 }  // namespace
 
@@ -95,14 +119,12 @@ absl::StatusOr<std::unique_ptr<PointRecords>> PlyVertexRecords(absl::string_view
     }
     NM_ASSIGN_OR_RETURN(const PlyVertexLayout layout, FindPlyVertexLayout(element));
     auto records = std::make_unique<VertexRecords>(data, at, length, element.count,
-                                                   header.format == PlyFormat::kBinaryBigEndian,
-                                                   layout.has_colors);
+                                                   header.format == PlyFormat::kBinaryBigEndian);
     for (int c = 0; c < 3; ++c) {
-      size_t offset = 0;
-      for (int i = 0; i < layout.axes[c]; ++i) {
-        offset += PlyTypeSize(element.properties[i].type);
+      records->SetAxis(c, FieldOf(element, layout.axes[c]));
+      if (layout.has_colors()) {
+        records->SetChannel(c, FieldOf(element, layout.channels[c]), layout.channel_scales[c]);
       }
-      records->SetAxis(c, offset, element.properties[layout.axes[c]].type);
     }
     return records;
   }

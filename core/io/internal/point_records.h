@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "core/io/internal/position_collector.h"
+#include "core/rgb.h"
 
 namespace neuralmesh::io_internal {
 
@@ -26,12 +27,16 @@ class PointRecords {
   virtual const char* Address(uint64_t i) const = 0;
   // Whether the records carry colours.
   virtual bool has_colors() const = 0;
-  // Record i's colour channels as the file stores them (LAS: levels of 16 bits), where a
-  // record's colour can be read alone; nothing otherwise (and for formats whose colours are not
-  // read so: PLY, PCD).
+  // Record i's colour channels as levels of 16 bits whose scale the file does not state (LAS:
+  // 8-bit levels or 16-bit ones; the reader judges which, LevelScale); nothing for formats that
+  // state it (StatedColor) or records without colours.
   virtual std::optional<std::array<uint16_t, 3>> ColorLevels(uint64_t /*i*/) const {
     return std::nullopt;
   }
+  // Record i's colour where the file states its channels' scale (PLY: each channel's type; PCD:
+  // the bytes of rgb or rgba), as reading the file whole gives it; nothing for formats that do
+  // not (ColorLevels) or records without colours.
+  virtual std::optional<Rgb> StatedColor(uint64_t /*i*/) const { return std::nullopt; }
   // The coordinates' resolution per axis (a LAS file's scale), or nothing where the file
   // states none.
   virtual std::optional<Point3d> Resolution() const = 0;

@@ -27,6 +27,25 @@ TEST(SpreadOrderTest, VisitsEveryRecordOnce) {
   }
 }
 
+// SlotOfNth counts the slots of records only, skipping those past the last record wherever
+// the order visits the last block.
+TEST(SpreadOrderTest, TheNthRecordsSlotSkipsTheSlotsPastTheLastRecord) {
+  for (uint64_t block_records : {uint64_t{1}, uint64_t{7}, SpreadOrder::kBlockRecords}) {
+    for (uint64_t records : {uint64_t{1}, uint64_t{6}, uint64_t{255}, uint64_t{256}, uint64_t{257},
+                             uint64_t{1000}, uint64_t{65537}, uint64_t{99991}}) {
+      SCOPED_TRACE(testing::Message() << records << " records in blocks of " << block_records);
+      const SpreadOrder order(records, block_records);
+      uint64_t k = 0;
+      for (uint64_t slot = 0; slot < order.slots(); ++slot) {
+        if (order[slot] >= records) continue;
+        ASSERT_EQ(order.SlotOfNth(k), slot) << "record number " << k;
+        ++k;
+      }
+      EXPECT_EQ(k, records);
+    }
+  }
+}
+
 TEST(SpreadOrderTest, ReadsEachBlockInOrder) {
   const SpreadOrder order(10000);
   for (uint64_t slot = 0; slot < order.slots(); ++slot) {

@@ -1,5 +1,7 @@
 #include "core/sampling/off_core_sampler.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -103,6 +105,27 @@ TEST(OffCoreSamplerTest, DrawsEveryKeptRecordAlikeAndNoOther) {
       }
     }
   }
+}
+
+// A file cut short while it is sampled (another program rewriting it): samples past its new
+// end read zeros instead of crashing the process, and CheckSource says the samples are no
+// longer the file's.
+TEST(OffCoreSamplerTest, AFileThatShrinksWhileSampledIsReportedNotACrash) {
+  const std::string path = Write("shrinks.las", testing::LasFile(Layout(), ScanLine(100000)));
+  auto sampler = Open(path);
+  ASSERT_NE(sampler, nullptr);
+  Random rng(5);
+  for (int i = 0; i < 1000; ++i) sampler->Sample(rng);
+  EXPECT_TRUE(sampler->CheckSource().ok()) << sampler->CheckSource();
+  ASSERT_EQ(::truncate(path.c_str(), 300000), 0);  // A tenth of the records left.
+  int past_the_end = 0;
+  for (int i = 0; i < 1000; ++i) {
+    past_the_end += RecordOf(sampler->Sample(rng), sampler->origin()) > 10000;
+  }
+  EXPECT_EQ(past_the_end, 0) << "zeroed records give points at the offset, not past the end";
+  const absl::Status source = sampler->CheckSource();
+  EXPECT_EQ(source.code(), absl::StatusCode::kDataLoss) << source;
+  EXPECT_TRUE(absl::StrContains(source.message(), "shrank from ")) << source;
 }
 
 TEST(OffCoreSamplerTest, SamplesAreTheRecordsAsReadingTheFileGivesThem) {

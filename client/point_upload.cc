@@ -25,6 +25,13 @@ v1::PointBatch MakeBatch(uint64_t first, std::string positions, std::string colo
 
 }  // namespace
 
+v1::UploadOrder MakeUploadOrder(absl::string_view name, uint64_t items) {
+  v1::UploadOrder order;
+  order.set_name(std::string(name));
+  order.set_items(items);
+  return order;
+}
+
 absl::Status CloudUpload::SkipTo(uint64_t first) {
   if (first > cloud_.size()) {
     return absl::OutOfRangeError(
@@ -42,9 +49,8 @@ absl::StatusOr<v1::PointBatch> CloudUpload::Batch(uint64_t first, size_t count) 
   for (uint64_t k = first; k < end;) {
     const uint64_t slot = order_.SlotOfNth(k);
     const uint64_t begin = order_[slot];
-    const uint64_t run =
-        std::min({end - k, SpreadOrder::kBlockRecords - slot % SpreadOrder::kBlockRecords,
-                  cloud_.size() - begin});
+    const uint64_t run = std::min(
+        {end - k, order_.block_records() - slot % order_.block_records(), cloud_.size() - begin});
     AppendPackedPoints(cloud_, begin, begin + run, batch.mutable_packed());
     k += run;
   }

@@ -38,25 +38,42 @@ class PointUpload {
   virtual uint64_t total() const = 0;
   // The upload's number of points, where it is known.
   virtual std::optional<uint64_t> size() const = 0;
+  // The order the batches go in (v1::UploadOrder), for the session to keep: a resumed upload
+  // must go in the same one over the same number of items.
+  virtual v1::UploadOrder upload_order() const = 0;
 };
 
-// A cloud's points with the weights, normals and colours it carries, in SpreadOrder (blocks of
-// consecutive points visited along the golden ratio), so that every prefix of the upload is
-// spread over the whole cloud: a scan read whole, stored strip by strip, reaches the server as
-// a file read where it lies does (FileRecordsUpload).
+// An UploadOrder of `items` named `name`.
+v1::UploadOrder MakeUploadOrder(absl::string_view name, uint64_t items);
+
+// A cloud's points with the weights, normals and colours it carries, in their stored order or
+// in SpreadOrder (blocks of consecutive points visited along the golden ratio), where every
+// prefix of the upload is spread over the whole cloud: a scan read whole, stored strip by
+// strip, then reaches the server as a file read where it lies does (FileRecordsUpload).
 class CloudUpload final : public PointUpload {
  public:
-  explicit CloudUpload(const PointCloud& cloud) : cloud_(cloud), order_(cloud.size()) {}
+  enum class Order { kStored, kSpread };
+
+  explicit CloudUpload(const PointCloud& cloud, Order order)
+      : cloud_(cloud),
+        spread_(order == Order::kSpread),
+        order_(cloud.size(), spread_ ? SpreadOrder::kBlockRecords
+                                     : std::max<uint64_t>(cloud.size(), 1)) {}  // One block.
 
   absl::Status SkipTo(uint64_t first) override;
   absl::StatusOr<v1::PointBatch> Batch(uint64_t first, size_t count) override;
   uint64_t done() const override { return done_; }
   uint64_t total() const override { return cloud_.size(); }
   std::optional<uint64_t> size() const override { return cloud_.size(); }
+  // "points-spread-256" or "points-stored", of the cloud's points.
+  v1::UploadOrder upload_order() const override {
+    return MakeUploadOrder(spread_ ? "points-spread-256" : "points-stored", cloud_.size());
+  }
 
  private:
   const PointCloud& cloud_;
-  const SpreadOrder order_;
+  const bool spread_;
+  const SpreadOrder order_;  // Of one block unless spread_.
   uint64_t done_ = 0;
 };
 
@@ -77,6 +94,10 @@ class FileRecordsUpload final : public PointUpload {
   uint64_t total() const override { return file_.records(); }
   // Known once the order has been walked to its end.
   std::optional<uint64_t> size() const override;
+  // "file-records-spread-256", of the file's records.
+  v1::UploadOrder upload_order() const override {
+    return MakeUploadOrder("file-records-spread-256", file_.records());
+  }
 
  private:
   // Reads the record at slot_ and moves on; gives `on_point` the record's point and number, if
@@ -114,6 +135,10 @@ class LazFileUpload final : public PointUpload {
   uint64_t total() const override { return file_.records(); }
   // Known once the last wave is decoded.
   std::optional<uint64_t> size() const override;
+  // "laz-chunks-spread-8", of the file's records.
+  v1::UploadOrder upload_order() const override {
+    return MakeUploadOrder("laz-chunks-spread-8", file_.records());
+  }
 
  private:
   // Decodes the next wave into wave_ (the chunks on several threads); false after the last.
@@ -156,6 +181,8 @@ class StreamUpload final : public PointUpload {
   uint64_t total() const override { return 0; }
   // Known once the stream ended.
   std::optional<uint64_t> size() const override;
+  // "stream", of an unknown number of points (0).
+  v1::UploadOrder upload_order() const override { return MakeUploadOrder("stream", 0); }
 
  private:
   // Reads until there are `want` points, the stream ends, or `deadline` passes with more than

@@ -113,7 +113,7 @@ absl::StatusOr<v1::UploadPointsResponse> UploadPointsReconnecting(
     size_t batch_size, const ReconstructionClient::UploadProgress& progress, size_t first_point,
     const ReconnectOptions& options) {
   if (cloud.empty()) return absl::InvalidArgumentError("UploadPoints: no points to upload");
-  CloudUpload upload(cloud);
+  CloudUpload upload(cloud, CloudUpload::Order::kStored);
   return UploadPointsReconnecting(client, session_id, upload, batch_size, progress, first_point,
                                   options);
 }

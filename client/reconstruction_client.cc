@@ -161,7 +161,7 @@ absl::StatusOr<v1::UploadPointsResponse> ReconstructionClient::UploadPoints(
     const std::string& session_id, const PointCloud& cloud, size_t batch_size,
     const UploadProgress& progress, size_t first_point) {
   if (cloud.empty()) return absl::InvalidArgumentError("UploadPoints: no points to upload");
-  CloudUpload upload(cloud);
+  CloudUpload upload(cloud, CloudUpload::Order::kStored);
   return UploadPoints(session_id, upload, batch_size, progress, first_point);
 }
 

@@ -113,6 +113,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     // session (off-core, the cube of the file's probe, which grows if a point lies outside).
     *config.mutable_bounds() = ToProto(*input.bounds);
   }
+  *config.mutable_upload_order() = input.points->upload_order();
 
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ConnectTo(options.server, options.connection));
@@ -150,6 +151,18 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
           "relative to (%.15g, %.15g, %.15g): resume with the input of the first run",
           session.session_id(), origin.x(), origin.y(), origin.z(), input.origin[0],
           input.origin[1], input.origin[2]));
+    }
+    // Another order would send some points twice and others never.
+    const v1::UploadOrder ours = input.points->upload_order();
+    if (const v1::UploadOrder& kept = session.config().upload_order();
+        session.config().has_upload_order() &&
+        (kept.name() != ours.name() || kept.items() != ours.items())) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("session ", session.session_id(), " was uploaded in the order '",
+                       kept.name(), "' of ", kept.items(), " items, this input goes in the order '",
+                       ours.name(), "' of ", ours.items(),
+                       ": resume with the input (and its flags, --off_core among them) of the "
+                       "first run"));
     }
     if (!input.points->SkipTo(session.points_taken()).ok()) {
       return absl::InvalidArgumentError(

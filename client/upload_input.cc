@@ -116,7 +116,7 @@ absl::StatusOr<UploadInput> LoadUploadInput(const RemoteReconstructOptions& opti
       !notes.empty()) {
     out << "INPUT " << QuotedInputs(options.inputs) << notes << "\n";
   }
-  input.points = std::make_unique<CloudUpload>(cloud);
+  input.points = std::make_unique<CloudUpload>(cloud, CloudUpload::Order::kSpread);
   input.origin = cloud.origin;
   input.bounds = BoundsOf(cloud);
   input.size = cloud.size();

@@ -140,6 +140,9 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
   if (proto.has_origin()) {
     config.origin = {proto.origin().x(), proto.origin().y(), proto.origin().z()};
   }
+  if (proto.has_upload_order() && !proto.upload_order().name().empty()) {
+    config.upload_order = UploadOrder{proto.upload_order().name(), proto.upload_order().items()};
+  }
   return config;
 }
 
@@ -213,6 +216,10 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
     origin.set_x(config.origin[0]);
     origin.set_y(config.origin[1]);
     origin.set_z(config.origin[2]);
+  }
+  if (config.upload_order.has_value()) {
+    proto.mutable_upload_order()->set_name(config.upload_order->name);
+    proto.mutable_upload_order()->set_items(config.upload_order->items);
   }
   return proto;
 }

@@ -624,6 +624,18 @@ SliceResult Session::RunSlice(absl::Time deadline) {
       }
     }
 
+    if (stalled_at_points_.has_value()) {
+      // Stalled while collecting: learning goes on once more points have come (or none will).
+      {
+        absl::MutexLock lock(&mu_);
+        if (!finishing && points_.size() <= *stalled_at_points_) return {SliceResult::kIdle};
+        stalled_at_points_.reset();
+        learning_.set_stalled(false);
+      }
+      growth_.emplace(LongestSplitInterval(config_.learner), learner_->num_vertices(),
+                      learner_->progress().basic_steps);
+    }
+
     const std::vector<size_t>& milestones = config_.lod_milestones;
     const size_t vertices = learner_->num_vertices();
 
@@ -706,8 +718,19 @@ SliceResult Session::RunSlice(absl::Time deadline) {
     if (absl::Status growth =
             growth_->Check(learner_->num_vertices(), learner_->progress().basic_steps);
         !growth.ok()) {
-      Fail(growth);
-      return {SliceResult::kDone};
+      if (finishing) {  // No point will come to let the mesh grow.
+        Fail(growth);
+        return {SliceResult::kDone};
+      }
+      size_t points = 0;
+      {
+        absl::MutexLock lock(&mu_);
+        points = points_.size();
+        stalled_at_points_ = points;
+        learning_.set_stalled(true);
+      }
+      Record(absl::StrCat("paused: ", growth.message(), "; waiting for points past ", points));
+      return {SliceResult::kIdle};
     }
   }
 }

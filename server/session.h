@@ -310,6 +310,9 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   absl::Time last_publish_time_ = absl::InfinitePast();
   uint64_t last_publish_steps_ = 0;
   std::optional<GrowthWatch> growth_;  // Stall detection for the current learner.
+  // While collecting, a stalled learner waits for points past this many instead of failing
+  // the session (more points may let the mesh grow); unset while learning goes on.
+  std::optional<size_t> stalled_at_points_;
 
   std::unique_ptr<SessionRecord> record_;  // Null without a state directory.
   ServerMetrics* metrics_ = nullptr;  // May be null.

@@ -101,6 +101,12 @@ absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& 
           "; it must be finite"));
     }
   }
+  if (config.upload_order.has_value() &&
+      config.upload_order->name.size() > UploadOrder::kMaxNameBytes) {
+    return absl::InvalidArgumentError(absl::StrCat("upload_order.name has ",
+                                                   config.upload_order->name.size(),
+                                                   " bytes; at most ", UploadOrder::kMaxNameBytes));
+  }
   NM_RETURN_IF_ERROR(config.learner.Validate());
   NM_RETURN_IF_ERROR(config.draco.Validate());
   if (config.outlier_removal.has_value()) {

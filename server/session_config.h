@@ -4,7 +4,9 @@
 #define NEURALMESH_SERVER_SESSION_CONFIG_H_
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -41,6 +43,13 @@ inline constexpr double kDefaultPointsPerVertex = 2.0;
 // per vertex (20 tori and 20 spheres each). So the series starts at 50.
 inline constexpr size_t kFirstDefaultMilestone = 50;
 
+// How the client orders its upload, in its own words: kept, never interpreted.
+struct UploadOrder {
+  static constexpr size_t kMaxNameBytes = 256;
+  std::string name;
+  uint64_t items = 0;
+};
+
 struct SessionConfig {
   LearnerOptions learner;       // The paper's parameters.
   size_t target_vertices = 0;   // The final vertex count, >= 4.
@@ -63,6 +72,8 @@ struct SessionConfig {
   // Where the points' (0, 0, 0) lies in the data's coordinates; carried by every published
   // mesh (TriangleMesh::origin).
   Origin origin = kNoOrigin;
+  // The client's upload order (v1::UploadOrder), kept for a client that resumes the upload.
+  std::optional<UploadOrder> upload_order;
 };
 
 // The 1-2-5 series from kFirstDefaultMilestone, 50, 100, 200, 500, 1000, ... below `target`,
@@ -74,7 +85,7 @@ std::vector<size_t> DefaultLodMilestones(size_t target);
 // above kMaxTargetVertices or unreachable within `max_points_per_session` points, milestones not
 // strictly increasing, below 4, above the target or more than 256 of them, a refresh interval
 // between 0 and 10 ms, points_per_vertex not finite and positive, bounds not finite or inverted,
-// an origin not finite,
+// an origin not finite, an upload order's name longer than UploadOrder::kMaxNameBytes,
 // and whatever LearnerOptions::Validate, DracoOptions::Validate, OutlierOptions::Validate and
 // PointColorOptions::Validate reject.
 absl::Status ResolveSessionConfig(size_t max_points_per_session, SessionConfig& config);

@@ -24,6 +24,7 @@ class SpreadOrder {
   // the rest of its block (records() or more).
   uint64_t slots() const { return blocks_ * block_records_; }
   uint64_t records() const { return records_; }
+  uint64_t block_records() const { return block_records_; }
   // The record at position `slot` (< slots()); records() or more for a slot past the last.
   uint64_t operator[](uint64_t slot) const {
     const uint64_t block = static_cast<uint64_t>(

@@ -139,24 +139,39 @@ TEST_F(RemoteCliTest, ReconstructWritesIncreasingLodsAndTheFinalMesh) {
   EXPECT_TRUE(std::filesystem::exists(*dir_ + "/out/sphere.ply"));
 }
 
+// The first `count` points `upload` sends, as a cloud: what a first run that lost its
+// connection had sent.
+PointCloud FirstPointsOf(client::PointUpload& upload, size_t count) {
+  absl::StatusOr<v1::PointBatch> batch = upload.Batch(0, count);
+  EXPECT_TRUE(batch.ok()) << batch.status();
+  const std::string& bytes = batch->packed().positions();
+  EXPECT_EQ(bytes.size(), sizeof(Vec3f) * count);
+  PointCloud points;
+  points.positions.resize(bytes.size() / sizeof(Vec3f));
+  std::memcpy(points.positions.data(), bytes.data(), bytes.size());
+  return points;
+}
+
 TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
-  // The first run: half of the input, then the connection was lost.
+  // The first run: part of the input in the command's order, then the connection was lost.
   absl::StatusOr<PointCloud> cloud =
       client::LoadPointsForUpload({"builtin:sphere"}, 4000, LearnerOptions().seed);
   ASSERT_TRUE(cloud.ok()) << cloud.status();
+  client::CloudUpload order(*cloud, client::CloudUpload::Order::kSpread);
   absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
       client::ReconstructionClient::Connect(server_->address());
   ASSERT_TRUE(service.ok()) << service.status();
-  auto upload_first = [&](size_t points) {
+  auto upload_first = [&](size_t points, const v1::UploadOrder& upload_order) {
     v1::SessionConfig config;
     config.set_target_vertices(400);
+    *config.mutable_upload_order() = upload_order;
     absl::StatusOr<v1::Session> created = (*service)->CreateSession(config, "sphere");
     EXPECT_TRUE(created.ok()) << created.status();
     EXPECT_TRUE(
-        (*service)->UploadPoints(created->session_id(), PointRange(*cloud, 0, points), 500).ok());
+        (*service)->UploadPoints(created->session_id(), FirstPointsOf(order, points), 500).ok());
     return created->session_id();
   };
-  const std::string id = upload_first(1500);
+  const std::string id = upload_first(1500, order.upload_order());
   const std::vector<std::string> resume = {"reconstruct", "builtin:sphere", "--server",
                                            server_->address(), "--out-dir", *dir_ + "/resumed",
                                            "--points", "4000", "--batch-size", "500",
@@ -176,18 +191,34 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
   EXPECT_THAT(finished.err, ::testing::HasSubstr("only a session that still takes points"));
   EXPECT_THAT(finished.err, ::testing::HasSubstr("neuralmesh watch " + id));
   // Every point was taken, but the finish never reached the server.
-  const std::string whole = upload_first(4000);
+  const std::string whole = upload_first(4000, order.upload_order());
   const RunResult finish_only =
       RunNeuralmesh({"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir",
                      *dir_ + "/whole", "--points", "4000", "--resume", whole});
   ASSERT_EQ(finish_only.exit_code, 0) << finish_only.Describe();
   EXPECT_THAT(finish_only.out, ::testing::HasSubstr("resuming at point 4000"));
   EXPECT_TRUE(std::filesystem::exists(*dir_ + "/whole/sphere.drc"));
-  const RunResult smaller = RunNeuralmesh({"reconstruct", "builtin:sphere", "--server",
-                                           server_->address(), "--out-dir", *dir_ + "/smaller",
-                                           "--points", "1000", "--resume", upload_first(1500)});
+  const RunResult smaller = RunNeuralmesh(
+      {"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir",
+       *dir_ + "/smaller", "--points", "1000", "--resume", upload_first(1500, v1::UploadOrder())});
   EXPECT_NE(smaller.exit_code, 0);
   EXPECT_THAT(smaller.err, ::testing::HasSubstr("more than the 1000 of this input"));
+  // A session uploaded in another order (a file read where it lies) is not resumed in this one.
+  const std::string other =
+      upload_first(1500, client::MakeUploadOrder("file-records-spread-256", 4000));
+  const RunResult reordered =
+      RunNeuralmesh({"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir",
+                     *dir_ + "/other", "--points", "4000", "--resume", other});
+  EXPECT_EQ(reordered.exit_code, 1) << reordered.Describe();
+  EXPECT_THAT(reordered.err,
+              ::testing::HasSubstr(absl::StrCat(
+                  "session ", other,
+                  " was uploaded in the order 'file-records-spread-256' of "
+                  "4000 items, this input goes in the order 'points-spread-256' of 4000: resume "
+                  "with the input (and its flags, --off_core among them) of the first run")));
+  absl::StatusOr<v1::Session> untouched = (*service)->GetSession(other);
+  ASSERT_TRUE(untouched.ok()) << untouched.status();
+  EXPECT_EQ(untouched->points_taken(), 1500u) << "nothing sent";
   const RunResult local = RunNeuralmesh(
       {"reconstruct", "builtin:sphere", "-o", *dir_ + "/local.ply", "--vertices", "100",
        "--resume", id});
@@ -582,20 +613,25 @@ TEST_F(RemoteCliTest, OffCoreUploadsAScanFromWhereItLies) {
   absl::StatusOr<MappedPointFile> file = MappedPointFile::Open(las, LasClasses().set(6));
   ASSERT_TRUE(file.ok()) << file.status();
   client::FileRecordsUpload order(*file);
-  absl::StatusOr<v1::PointBatch> first = order.Batch(0, 1500);
-  ASSERT_TRUE(first.ok()) << first.status();
-  PointCloud first_points;
-  first_points.positions.resize(1500);
-  ASSERT_EQ(first->packed().positions().size(), sizeof(Vec3f) * 1500);
-  std::memcpy(first_points.positions.data(), first->packed().positions().data(),
-              sizeof(Vec3f) * 1500);
   v1::SessionConfig config;
   config.set_target_vertices(400);
   config.mutable_origin()->set_x(500000);
   config.mutable_origin()->set_y(4100000);
+  *config.mutable_upload_order() = order.upload_order();
   absl::StatusOr<v1::Session> created = (*service)->CreateSession(config, "strips");
   ASSERT_TRUE(created.ok()) << created.status();
-  ASSERT_TRUE((*service)->UploadPoints(created->session_id(), first_points, 500).ok());
+  ASSERT_TRUE(
+      (*service)->UploadPoints(created->session_id(), FirstPointsOf(order, 1500), 500).ok());
+  // Without --off_core the file would be read whole and sent in another order: refused.
+  std::vector<std::string> read_whole = upload;
+  read_whole.erase(std::find(read_whole.begin(), read_whole.end(), "--off_core"));
+  read_whole.insert(read_whole.end(), {"--resume", created->session_id()});
+  const RunResult reordered = RunNeuralmesh(read_whole);
+  EXPECT_EQ(reordered.exit_code, 1) << reordered.Describe();
+  EXPECT_THAT(
+      reordered.err,
+      ::testing::HasSubstr("was uploaded in the order 'file-records-spread-256' of 8000 "
+                           "items, this input goes in the order 'points-spread-256' of 4000"));
   std::vector<std::string> resume = upload;
   resume[5] = *dir_ + "/off_core_resumed";
   resume.insert(resume.end(), {"--resume", created->session_id()});

@@ -476,7 +476,7 @@ TEST(CloudUploadTest, SendsEachPointOnceWithWhatItCarriesSpreadOverTheCloud) {
     sorted.colors.push_back(cloud.colors[i]);
     sorted.weights.push_back(static_cast<float>(sorted.weights.size()));  // Which point it is.
   }
-  CloudUpload upload(sorted);
+  CloudUpload upload(sorted, CloudUpload::Order::kSpread);
   EXPECT_EQ(upload.size(), 60000u);
   EXPECT_EQ(upload.total(), 60000u);
 
@@ -515,6 +515,23 @@ TEST(CloudUploadTest, SendsEachPointOnceWithWhatItCarriesSpreadOverTheCloud) {
   absl::StatusOr<v1::PointBatch> again = upload.Batch(30000, 10);
   ASSERT_TRUE(again.ok()) << again.status();
   EXPECT_EQ(PointsOf(*again).size(), 10u) << "a batch sent again after a lost connection";
+}
+
+TEST(CloudUploadTest, InItsStoredOrderTheCloudGoesAsItIs) {
+  const PointCloud cloud = testing::ColoredUnitSpherePoints(1000, 1);
+  CloudUpload upload(cloud, CloudUpload::Order::kStored);
+  absl::StatusOr<v1::PointBatch> batch = upload.Batch(600, 500);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  EXPECT_EQ(batch->first_point().value(), 600u);
+  const std::vector<Point> points = PointsOf(*batch);
+  ASSERT_EQ(points.size(), 400u);
+  for (size_t j = 0; j < points.size(); ++j) {
+    const Vec3f& p = cloud.positions[600 + j];
+    ASSERT_EQ(points[j], Point(p[0], p[1], p[2])) << j;
+  }
+  EXPECT_EQ(batch->packed().colors(),
+            std::string(reinterpret_cast<const char*>(cloud.colors.data() + 600), 3 * 400));
+  EXPECT_EQ(upload.done(), 1000u);
 }
 
 }  // namespace

@@ -145,6 +145,8 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   proto.mutable_color_neighbours()->set_value(3);
   proto.mutable_origin()->set_x(500000);
   proto.mutable_origin()->set_y(4100000.5);
+  proto.mutable_upload_order()->set_name("points-spread-256");
+  proto.mutable_upload_order()->set_items(20000);
   config = SessionConfigFromProto(proto);
   ASSERT_TRUE(config.ok());
   EXPECT_EQ(config->learner.alpha_l, 0.0);
@@ -164,6 +166,9 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(config->outlier_removal->std_ratio, 2.5);
   EXPECT_EQ(config->colors.neighbours, 3);
   EXPECT_EQ(config->origin, (std::array<double, 3>{500000, 4100000.5, 0}));
+  ASSERT_TRUE(config->upload_order.has_value());
+  EXPECT_EQ(config->upload_order->name, "points-spread-256");
+  EXPECT_EQ(config->upload_order->items, 20000u);
 
   // The echo has every field set and reads back to the same configuration.
   v1::SessionConfig echo = SessionConfigToProto(*config);
@@ -186,6 +191,13 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(again->outlier_removal->std_ratio, 2.5);
   EXPECT_EQ(again->colors.neighbours, 3);
   EXPECT_EQ(again->origin, config->origin);
+  EXPECT_EQ(echo.upload_order().name(), "points-spread-256");
+  EXPECT_EQ(echo.upload_order().items(), 20000u);
+  EXPECT_FALSE(SessionConfigToProto(SessionConfig()).has_upload_order()) << "unset stays unset";
+  proto.mutable_upload_order()->clear_name();
+  config = SessionConfigFromProto(proto);
+  ASSERT_TRUE(config.ok());
+  EXPECT_FALSE(config->upload_order.has_value()) << "an order without a name says nothing";
 }
 
 TEST(SessionConfigFromProtoTest, UnknownInitialMeshIsInvalidArgument) {

@@ -59,12 +59,14 @@ TEST(ResolveSessionConfigTest, RejectsInvalidOptionsNamingTheField) {
        "target_vertices"},
       {"alpha_w zero", [](SessionConfig& c) { c.learner.alpha_w = 0; }, "alpha_w"},
       {"alpha_w above 1", [](SessionConfig& c) { c.learner.alpha_w = 1.5; }, "alpha_w"},
-      {"milestones not increasing", [](SessionConfig& c) { c.lod_milestones = {100, 50}; },
+      {"milestones not increasing",
+       [](SessionConfig& c) {
+         c.lod_milestones = {100, 50};
+       },
        "lod_milestones[1]"},
       {"milestone above target", [](SessionConfig& c) { c.lod_milestones = {2000}; },
        "lod_milestones[0]"},
-      {"milestone below 4", [](SessionConfig& c) { c.lod_milestones = {2}; },
-       "lod_milestones[0]"},
+      {"milestone below 4", [](SessionConfig& c) { c.lod_milestones = {2}; }, "lod_milestones[0]"},
       {"points_per_vertex zero", [](SessionConfig& c) { c.points_per_vertex = 0; },
        "points_per_vertex"},
       {"refresh too short", [](SessionConfig& c) { c.refresh_interval = absl::Milliseconds(3); },
@@ -83,6 +85,11 @@ TEST(ResolveSessionConfigTest, RejectsInvalidOptionsNamingTheField) {
        "bounds: points from"},
       {"origin not finite", [](SessionConfig& c) { c.origin[1] = INFINITY; },
        "origin.y is inf; it must be finite"},
+      {"upload order's name too long",
+       [](SessionConfig& c) {
+         c.upload_order = UploadOrder{std::string(257, 'x'), 1};
+       },
+       "upload_order.name has 257 bytes; at most 256"},
       {"inverted bounds",
        [](SessionConfig& c) {
          BoundingBox b;

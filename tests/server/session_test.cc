@@ -433,6 +433,42 @@ TEST_F(SessionTest, AStalledLearnerFailsTheSessionInsteadOfSpinning) {
   EXPECT_THAT(events_.lines()[0], HasSubstr("session s-test failed: learning stalled"));
 }
 
+// A client that lost its connection after a few points may resume the upload: a session whose
+// learner stalls while it still collects points waits for more (without spinning), learns on
+// when they come, and fails only once it is finishing.
+TEST_F(SessionTest, AStallWhileCollectingWaitsForPointsInsteadOfFailing) {
+  SessionConfig config;
+  config.target_vertices = 100;
+  config.learner.c_ec = 0.01;  // Step 3 after every Basic Step: collapses win over splits.
+  config.learner.c_vs = 10;
+  auto session = NewSession(config);
+  ASSERT_TRUE(session->AddPoints(Torus(2000, 9)).ok());
+  const auto learning = [&] { return session->ToProto().learning(); };
+  for (int i = 0; i < 500 && !learning().stalled(); ++i) absl::SleepFor(absl::Milliseconds(20));
+  ASSERT_TRUE(learning().stalled()) << "the learner did not stall";
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_LEARNING);
+  const uint64_t steps = learning().basic_steps();
+  absl::SleepFor(absl::Milliseconds(300));
+  EXPECT_EQ(learning().basic_steps(), steps) << "a stalled session spins";
+  ASSERT_EQ(events_.lines().size(), 1u);
+  EXPECT_THAT(events_.lines()[0],
+              HasSubstr("session s-test paused: learning stalled: the mesh has not grown past "));
+  EXPECT_THAT(events_.lines()[0], HasSubstr("; waiting for points past 2000"));
+
+  ASSERT_TRUE(session->AddPoints(Torus(500, 10)).ok());
+  for (int i = 0; i < 500 && learning().basic_steps() == steps; ++i) {
+    absl::SleepFor(absl::Milliseconds(20));
+  }
+  EXPECT_GT(learning().basic_steps(), steps) << "new points did not wake the learner";
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_LEARNING);
+
+  ASSERT_TRUE(session->Finish().ok());
+  const absl::Status status = recorder_.AwaitClose();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInternal) << status;
+  EXPECT_EQ(session->state(), v1::SESSION_STATE_FAILED);
+  EXPECT_THAT(session->ToProto().error(), HasSubstr("stalled"));
+}
+
 TEST(IsSpatiallyBiasedTest, RandomOrderIsNotBiasedAScanIs) {
   const PointCloud random = Torus(20000, 7);
   EXPECT_FALSE(IsSpatiallyBiased(random.positions));

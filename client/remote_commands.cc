@@ -359,13 +359,21 @@ absl::Status RunSessions(const SessionsOptions& options, std::ostream& out, std:
   out << absl::StrFormat("%-20s %-16s %s%-10s %10s %9s %9s %9s %8s\n", "session", "name",
                          owner_cell("owner"), "state", "points", "vertices", "faces", "target",
                          "updates");
+  bool any_stalled = false;
   for (const v1::Session& s : sessions) {
+    const bool stalled = s.learning().stalled();
+    any_stalled = any_stalled || stalled;
     out << absl::StrFormat("%-20s %-16s %s%-10s %10d %9d %9d %9d %8d\n", s.session_id(), s.name(),
-                           owner_cell(s.owner()), SessionStateName(s.state()),
+                           owner_cell(s.owner()),
+                           stalled ? std::string("stalled") : SessionStateName(s.state()),
                            s.learning().points_received(), s.vertex_count(), s.face_count(),
                            s.config().target_vertices(), s.latest_sequence());
   }
   out << sessions.size() << (sessions.size() == 1 ? " session\n" : " sessions\n");
+  if (any_stalled) {
+    out << "stalled: learning, but the mesh stopped growing with the points so far; waiting for "
+           "more\n";
+  }
   return absl::OkStatus();
 }
 

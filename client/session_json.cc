@@ -42,6 +42,8 @@ void WriteSessionJson(const neuralmesh::v1::Session& s, JsonWriter& json) {
   json.Double(s.config().origin().x()).Double(s.config().origin().y());
   json.Double(s.config().origin().z()).EndArray();
   json.Key("basic_steps").Uint(s.learning().basic_steps());
+  // Learning waits for more points to grow the mesh (LearningState.stalled).
+  json.Key("stalled").Bool(s.learning().stalled());
   json.Key("latest_sequence").Uint(s.latest_sequence());
   json.Key("watchers").Uint(s.watchers());
   json.Key("error").String(s.error());

@@ -807,6 +807,40 @@ TEST_F(RemoteCliTest, SessionsListsTheFinishedSession) {
   EXPECT_TRUE(absl::StrContains(json.out, "\"points_taken\": 4000")) << json.out;
 }
 
+// A session whose learner stalls on its first points waits for more, and `sessions` says so.
+TEST_F(RemoteCliTest, SessionsSaysWhichSessionsWaitForPointsToGrow) {
+  absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
+      client::ReconstructionClient::Connect(server_->address());
+  ASSERT_TRUE(service.ok()) << service.status();
+  v1::SessionConfig config;
+  config.set_target_vertices(100);
+  config.mutable_learner()->mutable_c_ec()->set_value(0.01);  // Collapses win over splits.
+  config.mutable_learner()->mutable_c_vs()->set_value(10);
+  absl::StatusOr<v1::Session> created = (*service)->CreateSession(config, "stalling");
+  ASSERT_TRUE(created.ok()) << created.status();
+  absl::StatusOr<PointCloud> torus = client::LoadPointsForUpload({"builtin:torus"}, 2000, 9);
+  ASSERT_TRUE(torus.ok()) << torus.status();
+  ASSERT_TRUE((*service)->UploadPoints(created->session_id(), *torus, 1000).ok());
+  bool stalled = false;
+  for (int i = 0; i < 500 && !stalled; ++i) {
+    absl::SleepFor(absl::Milliseconds(20));
+    absl::StatusOr<v1::Session> session = (*service)->GetSession(created->session_id());
+    ASSERT_TRUE(session.ok()) << session.status();
+    stalled = session->learning().stalled();
+  }
+  ASSERT_TRUE(stalled) << "the learner did not stall";
+  const RunResult table = RunNeuralmesh({"sessions", "--server", server_->address()});
+  ASSERT_EQ(table.exit_code, 0) << table.Describe();
+  EXPECT_TRUE(std::regex_search(table.out,
+                                std::regex(created->session_id() + " +stalling +stalled +2000 ")))
+      << table.out;
+  EXPECT_THAT(table.out, ::testing::HasSubstr("stalled: learning, but the mesh stopped growing "
+                                              "with the points so far; waiting for more"));
+  const RunResult json = RunNeuralmesh({"sessions", "--server", server_->address(), "--json"});
+  EXPECT_THAT(json.out, ::testing::HasSubstr("\"stalled\": true")) << json.out;
+  EXPECT_TRUE((*service)->Delete(created->session_id()).ok());
+}
+
 TEST_F(RemoteCliTest, WatchingAFinishedSessionSavesItsFinalMesh) {
   ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
   const std::string out = reconstruct_->out;

@@ -284,7 +284,8 @@ async function refreshSessions() {
     const item = document.createElement('li');
     item.dataset.session = s.session_id;
     const title = document.createElement('div');
-    title.textContent = `${s.name || s.session_id} (${s.state})`;
+    const state = s.stalled ? `${s.state}, stalled: waiting for points` : s.state;
+    title.textContent = `${s.name || s.session_id} (${state})`;
     const figures = document.createElement('div');
     figures.className = 'figures';
     figures.textContent = `${s.points_received} points, ${s.vertices}/${s.target_vertices} ` +

@@ -185,6 +185,21 @@ TEST_F(ViewerServiceTest, ListsTheSessionsAsJson) {
   const HttpReply one = HttpGet(port_, "/api/sessions/" + id);
   EXPECT_EQ(one.status, 200);
   EXPECT_THAT(one.body, HasSubstr("\"state\":\"collecting\""));
+  EXPECT_THAT(one.body, HasSubstr("\"stalled\":false"));
+  // A session whose learner stalls on its first points says so while it waits for more.
+  v1::CreateSessionRequest stalling = st::CreateRequest(100);
+  stalling.mutable_config()->mutable_learner()->mutable_c_ec()->set_value(0.01);
+  stalling.mutable_config()->mutable_learner()->mutable_c_vs()->set_value(10);
+  const std::string stalled_id = st::MustCreate(*service_, stalling);
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(st::Upload(*service_, stalled_id, st::TorusPoints(2000, 9), 1, &response).ok());
+  std::string body;
+  for (int i = 0; i < 500 && !absl::StrContains(body, "\"stalled\":true"); ++i) {
+    absl::SleepFor(absl::Milliseconds(20));
+    body = HttpGet(port_, "/api/sessions/" + stalled_id).body;
+  }
+  EXPECT_THAT(body, HasSubstr("\"stalled\":true"));
+  EXPECT_THAT(body, HasSubstr("\"state\":\"learning\""));
   const HttpReply unknown = HttpGet(port_, "/api/sessions/s-unknown");
   EXPECT_EQ(unknown.status, 404);
   EXPECT_THAT(unknown.body, HasSubstr("s-unknown"));

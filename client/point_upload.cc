@@ -65,7 +65,10 @@ std::optional<uint64_t> FileRecordsUpload::size() const {
 
 template <typename OnPoint>
 void FileRecordsUpload::ReadNext(const OnPoint& on_point) {
-  const uint64_t record = order_[slot_++];
+  // The order's blocks are runs of consecutive records: one look-up per block.
+  if (slot_ % SpreadOrder::kBlockRecords == 0) block_first_record_ = order_[slot_];
+  const uint64_t record = block_first_record_ + slot_ % SpreadOrder::kBlockRecords;
+  ++slot_;
   if (record >= file_.records()) return;
   if (const std::optional<Vec3> point = file_.Point(record); point.has_value()) {
     ++points_;

@@ -109,6 +109,7 @@ class FileRecordsUpload final : public PointUpload {
   const SpreadOrder order_;
   const bool colors_;
   uint64_t slot_ = 0;    // The next position of order_ to read.
+  uint64_t block_first_record_ = 0;  // The first record of slot_'s block, once slot_ is in it.
   uint64_t points_ = 0;  // The points among the positions before slot_.
 };
 

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <fstream>
 #include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/internal/file_util.h"
@@ -11,6 +13,7 @@
 #include "core/io/internal/laz.h"
 #include "core/io/mapped_point_file.h"
 #include "core/io/spread_order.h"
+#include "core/parallel_ranges.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh {
@@ -40,15 +43,21 @@ absl::StatusOr<MappedLazFile> MappedLazFile::Open(const std::string& path,
   opened.classes_ = classes;
   opened.has_colors_ = (*no_records)->has_colors();
 
-  // The probe, with origin_ still (0, 0, 0): points in the file's coordinates.
+  // The probe, with origin_ still (0, 0, 0): points in the file's coordinates. Its chunks are
+  // decoded on every core: the first mesh of an upload waits for them.
   const SpreadOrder order(opened.chunks(), 1);
-  std::string decoded;
+  const size_t probe_chunks = std::min(kProbeChunks, opened.chunks());
+  std::vector<std::string> decoded(probe_chunks);
+  std::vector<absl::StatusOr<std::unique_ptr<io_internal::LasRecords>>> probe(probe_chunks);
+  ForEachRange(probe_chunks, /*threads=*/0, 1, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) probe[k] = opened.Records(order[k], &decoded[k]);
+  });
   BoundingBox probed;
   uint64_t records = 0, kept = 0;
   uint16_t largest_level = 0;
-  for (size_t k = 0; k < std::min(kProbeChunks, opened.chunks()); ++k) {
-    NM_ASSIGN_OR_RETURN(const std::unique_ptr<io_internal::LasRecords> chunk,
-                        opened.Records(order[k], &decoded));
+  for (size_t k = 0; k < probe_chunks; ++k) {
+    NM_RETURN_IF_ERROR(probe[k].status());
+    const io_internal::LasRecords* chunk = probe[k]->get();
     records += chunk->size();
     for (uint64_t i = 0; i < chunk->size(); ++i) {
       const std::optional<Vec3> p = MappedPointFile::PointOfRecord(*chunk, i, kNoOrigin);
@@ -59,12 +68,14 @@ absl::StatusOr<MappedLazFile> MappedLazFile::Open(const std::string& path,
         largest_level = std::max({largest_level, (*levels)[0], (*levels)[1], (*levels)[2]});
       }
     }
+    absl::MutexLock lock(&opened.probed_->mutex);
+    opened.probed_->decoded.emplace_back(order[k], std::move(decoded[k]));
   }
   NM_RETURN_IF_ERROR(opened.CheckSize());
   opened.color_scale_ = LevelScale(largest_level);
   if (kept == 0) {
     return invalid(absl::StrCat(
-        "none of the ", records, " records of ", std::min(kProbeChunks, opened.chunks()),
+        "none of the ", records, " records of ", probe_chunks,
         " chunks spread over the file is a point to read (",
         classes.has_value() ? "withheld, noise or of other classes" : "withheld or noise",
         ", or beyond a float's range); read the file whole"));
@@ -76,11 +87,25 @@ absl::StatusOr<MappedLazFile> MappedLazFile::Open(const std::string& path,
   return opened;
 }
 
+bool MappedLazFile::TakeProbed(size_t chunk, std::string* decoded) const {
+  absl::MutexLock lock(&probed_->mutex);
+  std::vector<std::pair<size_t, std::string>>& probed = probed_->decoded;
+  for (auto it = probed.begin(); it != probed.end(); ++it) {
+    if (it->first != chunk) continue;
+    *decoded = std::move(it->second);
+    probed.erase(it);
+    return true;
+  }
+  return false;
+}
+
 absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> MappedLazFile::Records(
     size_t chunk, std::string* decoded) const {
-  decoded->assign(chunks_.records_in(chunk) * chunks_.record_length(), '\0');
-  if (const absl::Status status = chunks_.Decode(chunk, decoded->data()); !status.ok()) {
-    return io_internal::WithPath(status, path_);
+  if (!TakeProbed(chunk, decoded)) {
+    decoded->assign(chunks_.records_in(chunk) * chunks_.record_length(), '\0');
+    if (const absl::Status status = chunks_.Decode(chunk, decoded->data()); !status.ok()) {
+      return io_internal::WithPath(status, path_);
+    }
   }
   return io_internal::LasRecords::Create(chunks_.las_header(), *decoded, classes_);
 }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 #include "core/bounding_box.h"
 #include "core/io/internal/las.h"
 #include "core/io/internal/laz.h"
@@ -69,7 +70,19 @@ class MappedLazFile {
                                                                    std::string* decoded) const;
 
   MappedLazFile(std::string path, MappedFile file, io_internal::LazChunks chunks)
-      : path_(std::move(path)), file_(std::move(file)), chunks_(std::move(chunks)) {}
+      : path_(std::move(path)),
+        file_(std::move(file)),
+        chunks_(std::move(chunks)),
+        probed_(std::make_unique<ProbedChunks>()) {}
+
+  // The records of the probe's chunks, decoded at open and kept until Records takes them: the
+  // first wave of an upload (LazFileUpload) is the same chunks, and each is decoded once.
+  struct ProbedChunks {
+    absl::Mutex mutex;
+    std::vector<std::pair<size_t, std::string>> decoded ABSL_GUARDED_BY(mutex);
+  };
+  // Moves chunk `chunk`'s records into `decoded` if the probe holds them.
+  bool TakeProbed(size_t chunk, std::string* decoded) const;
 
   std::string path_;
   MappedFile file_;                // Its mapping stays where it is when this object moves.
@@ -80,6 +93,7 @@ class MappedLazFile {
   bool has_colors_ = false;
   double kept_share_ = 0;
   double color_scale_ = 255;
+  std::unique_ptr<ProbedChunks> probed_;  // Its own address, for the mutex: this object moves.
 };
 
 }  // namespace neuralmesh

@@ -25,7 +25,8 @@ absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling fac
 
 // Which properties of the 'vertex' element ParsePly reads as x, y and z, and as red, green and
 // blue (their indices; the channels -1 when it reads no colours), with each channel's full
-// scale (PlyChannelScale). INVALID_ARGUMENT "line N: ..." when x, y or z is missing.
+// scale as ParsePly takes it (an integer type's largest value, 1 for floating point).
+// INVALID_ARGUMENT "line N: ..." when x, y or z is missing.
 struct PlyVertexLayout {
   int axes[3] = {-1, -1, -1};
   int channels[3] = {-1, -1, -1};

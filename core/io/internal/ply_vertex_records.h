@@ -12,9 +12,9 @@
 namespace neuralmesh::io_internal {
 
 // The 'vertex' element of the binary PLY file `data` (which must outlive the result), whose
-// records all have one size: its x, y and z as ParsePly reads them, records with a non-finite
-// coordinate not kept (ParsePly refuses the whole file for one). No resolution or bounds are
-// stated. Returns ParsePlyHeader's errors; INVALID_ARGUMENT, saying why, for an ASCII file (its
+// records all have one size: its x, y and z (and red, green and blue: StatedColor) as ParsePly
+// reads them, records with a non-finite coordinate not kept (ParsePly refuses the whole file for
+// one). No resolution or bounds are stated. Returns ParsePlyHeader's errors; INVALID_ARGUMENT, saying why, for an ASCII file (its
 // lines have no fixed length), no 'vertex' element or no x, y or z in it, a list property in
 // it or in an element before it (records whose size depends on their contents), and a body
 // too short for the elements before it and the vertices.

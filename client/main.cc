@@ -726,8 +726,9 @@ std::vector<Subcommand> Commands() {
        "uploads the points and saves each mesh the server publishes into --out-dir. Prints\n"
        "the figures of every level. With --server, INPUT '-' streams points from standard\n"
        "input as they arrive (\"x y z\" per line, split as in XYZ files; further columns and\n"
-       "'#' comments ignored), a batch whenever --batch-size points came or 100 ms passed;\n"
-       "the session finishes at the end of the stream (files named stdin*).",
+       "'#' comments ignored; or a LAS file's records), a batch whenever --batch-size points\n"
+       "came or 100 ms passed; the session finishes at the end of the stream (files named\n"
+       "stdin*).",
        WithConnectionFlags(reconstruct), Reconstruct},
       {"stats",
        "stats MESH|POINTS [--json]",

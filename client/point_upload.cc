@@ -201,12 +201,12 @@ absl::Status StreamUpload::ReadUntil(uint64_t want, uint64_t least, absl::Time d
     const absl::Time now = absl::Now();
     if (now >= deadline && points_.size() + arrived_.size() > least) break;
     if (InterruptScope::interrupted()) {
-      return absl::CancelledError(absl::StrCat("interrupted while reading ", stream_.name()));
+      return absl::CancelledError(absl::StrCat("interrupted while reading ", stream_->name()));
     }
     // Past the deadline with nothing to send: wait for the next point as long as it takes.
     const absl::Duration wait =
         now >= deadline ? kLongestWait : std::min(deadline - now, kLongestWait);
-    NM_ASSIGN_OR_RETURN(const bool more, stream_.Read(wait, &arrived_));
+    NM_ASSIGN_OR_RETURN(const bool more, stream_->Read(wait, &arrived_));
     ended_ = !more;
     NM_RETURN_IF_ERROR(TakeArrived());
   }
@@ -219,7 +219,7 @@ absl::Status StreamUpload::TakeArrived() {
     const Vec3 relative(p[0] - origin_[0], p[1] - origin_[1], p[2] - origin_[2]);
     if (!MappedPointFile::Learnable(relative)) {
       return absl::InvalidArgumentError(absl::StrCat(
-          stream_.name(), ", point ", points_.size() + 1, ": (", p[0], ", ", p[1], ", ", p[2],
+          stream_->name(), ", point ", points_.size() + 1, ": (", p[0], ", ", p[1], ", ", p[2],
           ") lies beyond a float's range from the origin the first points chose (", origin_[0],
           ", ", origin_[1], ", ", origin_[2], ")"));
     }
@@ -234,7 +234,7 @@ absl::Status StreamUpload::Start(size_t count) {
   NM_RETURN_IF_ERROR(ReadUntil(count, 0, absl::Now() + flush_after_));
   if (arrived_.empty()) {
     return absl::InvalidArgumentError(absl::StrCat(
-        stream_.name(), " ended before its first point (", stream_.lines(), " lines read)"));
+        stream_->name(), " ended before its first point (", stream_->ReadSoFar(), " read)"));
   }
   BoundingBox box;
   for (const Vec3& p : arrived_) box.Extend(p);

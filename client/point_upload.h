@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -15,7 +16,7 @@
 #include "absl/time/time.h"
 #include "core/io/mapped_laz_file.h"
 #include "core/io/mapped_point_file.h"
-#include "core/io/point_text_stream.h"
+#include "core/io/point_stream.h"
 #include "core/io/spread_order.h"
 #include "core/point_cloud.h"
 #include "neuralmesh/v1/reconstruction.pb.h"
@@ -155,16 +156,17 @@ class LazFileUpload final : public PointUpload {
   uint64_t records_done_ = 0;
 };
 
-// Points as they arrive on a text stream (PointTextStream: `neuralmesh reconstruct -
-// --server`), kept in memory as they come so that a batch can be sent again after a lost
-// connection. A batch goes out as soon as it is full, or once `flush_after` has passed with
-// points to send, so a slow stream's points reach the server within that time. Positions only,
-// relative to an origin chosen from the first batch (Start).
+// Points as they arrive on a stream (PointStream: text lines or a LAS file's records on
+// standard input, `neuralmesh reconstruct - --server`), kept in memory as they come so that a batch
+// can be sent again after a lost connection. A batch goes out as soon as it is full, or once
+// `flush_after` has passed with points to send, so a slow stream's points reach the server within
+// that time. Positions only, relative to an origin chosen from the first batch (Start).
 class StreamUpload final : public PointUpload {
  public:
   static constexpr absl::Duration kFlushAfter = absl::Milliseconds(100);
 
-  explicit StreamUpload(PointTextStream stream, absl::Duration flush_after = kFlushAfter)
+  explicit StreamUpload(std::unique_ptr<PointStream> stream,
+                        absl::Duration flush_after = kFlushAfter)
       : stream_(std::move(stream)), flush_after_(flush_after) {}
 
   // Waits for the first batch (`count` points, or fewer once flush_after has passed or the
@@ -192,7 +194,7 @@ class StreamUpload final : public PointUpload {
   // Once the origin is chosen, moves the points arrived_ holds into points_, relative to it.
   absl::Status TakeArrived();
 
-  PointTextStream stream_;
+  std::unique_ptr<PointStream> stream_;
   absl::Duration flush_after_;
   bool ended_ = false;
   std::vector<Vec3> arrived_;  // Read, in the stream's coordinates, before the origin is set.

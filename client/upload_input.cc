@@ -41,7 +41,7 @@ absl::StatusOr<UploadInput> StreamUploadInput(const RemoteReconstructOptions& op
         "--resume uploads the input again from the points the session has taken; standard "
         "input ('-') cannot be read again");
   }
-  auto upload = std::make_unique<StreamUpload>(PointTextStream(STDIN_FILENO, "standard input"));
+  auto upload = std::make_unique<StreamUpload>(OpenPointStream(STDIN_FILENO, "standard input"));
   NM_RETURN_IF_ERROR(upload->Start(options.batch_size));
   UploadInput input;
   input.origin = upload->origin();

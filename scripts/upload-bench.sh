@@ -8,7 +8,8 @@
 # anonymous (its own allocations, sampled every 20 ms) and resident (with the file's pages).
 # With COLD=1 the file is dropped from the page cache before each way, as a file on the disk;
 # with LAZ=1 the file is compressed to LAZ first (`neuralmesh convert`), which off-core is
-# decoded a chunk at a time.
+# decoded a chunk at a time. A LAS file is also piped into `neuralmesh reconstruct -` (stdin),
+# its records streamed as they arrive.
 #
 # Usage: scripts/upload-bench.sh   (after the build; from anywhere)
 # Environment: BUILD_DIR (default build), POINTS (default 20000000), VERTICES (default 2000),
@@ -71,14 +72,19 @@ when() { awk -v pattern="$2" '$0 ~ pattern { printf "%.2f", $1; found = 1; exit 
 
 printf '%-12s %10s %12s %12s %14s %13s\n' "way" "session s" "first mesh s" "final s" \
   "anonymous MB" "resident MB"
-for way in "read whole" "off-core"; do
+ways=("read whole" "off-core")
+[[ "${LAZ}" == 1 ]] || ways+=("stdin")  # LAS piped in; LAZ cannot be decoded as it arrives.
+for way in "${ways[@]}"; do
+  source_file="${INPUT}"
   flags=()
   [[ "${way}" == "off-core" ]] && flags=(--off_core)
+  if [[ "${way}" == "stdin" ]]; then source_file="-"; fi
   if [[ "${COLD}" == 1 ]]; then dd if="${INPUT}" iflag=nocache count=0 status=none; fi
   rm -rf "${WORK}/out"
   start=$(date +%s.%N)
-  "${CLI}" reconstruct "${INPUT}" --server "${ADDRESS}" --out-dir "${WORK}/out" \
-    --vertices "${VERTICES}" "${flags[@]}" > >(stamp "${start}" >"${WORK}/run.out") &
+  "${CLI}" reconstruct "${source_file}" --server "${ADDRESS}" --out-dir "${WORK}/out" \
+    --vertices "${VERTICES}" "${flags[@]}" <"${INPUT}" \
+    > >(stamp "${start}" >"${WORK}/run.out") &
   pid=$!
   peak_anon=0
   peak_rss=0

@@ -1,16 +1,11 @@
 #include "core/io/point_text_stream.h"
 
-#include <poll.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
-#include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
+#include "core/status_macros.h"
 
 namespace neuralmesh {
 namespace {
@@ -39,30 +34,35 @@ absl::Status PointTextStream::ParseLine(absl::string_view line, std::vector<Vec3
   return absl::OkStatus();
 }
 
+std::string PointTextStream::ReadSoFar() const {
+  return absl::StrCat(lines_, lines_ == 1 ? " line" : " lines");
+}
+
 absl::StatusOr<bool> PointTextStream::Read(absl::Duration wait, std::vector<Vec3>* points) {
   if (ended_) return false;
-  pollfd ready{fd_, POLLIN, 0};
-  const int waited = poll(&ready, 1, static_cast<int>(absl::ToInt64Milliseconds(wait)));
-  if (waited < 0 && errno != EINTR) {
-    return absl::UnavailableError(absl::StrCat("cannot read ", name_, ": ", strerror(errno)));
+  if (!pending_.empty()) {
+    const std::string bytes = std::move(pending_);
+    pending_.clear();
+    NM_RETURN_IF_ERROR(Take(bytes, points));
+    return true;
   }
-  if (waited <= 0) return true;
   char buffer[1 << 16];
-  const ssize_t got = read(fd_, buffer, sizeof(buffer));
-  if (got < 0) {
-    if (errno == EINTR || errno == EAGAIN) return true;
-    return absl::UnavailableError(absl::StrCat("cannot read ", name_, ": ", strerror(errno)));
-  }
-  if (got == 0) {
+  NM_ASSIGN_OR_RETURN(const StreamBytes got,
+                      ReadStreamBytes(fd_, wait, name_, buffer, sizeof(buffer)));
+  if (got.ended) {
     ended_ = true;
     if (!partial_.empty()) {
       const std::string last = std::move(partial_);
       partial_.clear();
-      if (absl::Status parsed = ParseLine(last, points); !parsed.ok()) return parsed;
+      NM_RETURN_IF_ERROR(ParseLine(last, points));
     }
     return false;
   }
-  absl::string_view text(buffer, static_cast<size_t>(got));
+  NM_RETURN_IF_ERROR(Take(got.bytes, points));
+  return true;
+}
+
+absl::Status PointTextStream::Take(absl::string_view text, std::vector<Vec3>* points) {
   for (size_t newline = text.find('\n'); newline != absl::string_view::npos;
        newline = text.find('\n')) {
     absl::Status parsed;
@@ -83,14 +83,7 @@ absl::StatusOr<bool> PointTextStream::Read(absl::Duration wait, std::vector<Vec3
                                                    " bytes without a line's end: not "
                                                    "text of points"));
   }
-  return true;
-}
-
-Origin OriginOfStreamedPoints(const BoundingBox& first_points) {
-  const Vec3& low = first_points.min;
-  const Vec3& high = first_points.max;
-  return io_internal::OriginOfUnstatedResolution({low[0], low[1], low[2]},
-                                                 {high[0], high[1], high[2]});
+  return absl::OkStatus();
 }
 
 }  // namespace neuralmesh

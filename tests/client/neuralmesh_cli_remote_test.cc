@@ -756,6 +756,41 @@ TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
   EXPECT_EQ(session->state(), v1::SESSION_STATE_FINISHED);
   EXPECT_EQ(session->points_taken(), 4000u);
 
+  // The same sphere as a LAS file piped in (a converter's `-stdout`): its records as they come.
+  testing::LasLayout layout;
+  layout.format = 1;
+  for (double& s : layout.scale) s = 0.0001;
+  layout.offset[0] = 500000;
+  layout.offset[1] = 4100000;
+  std::vector<testing::LasPoint> records;
+  for (const Vec3f& p : sphere) {
+    records.push_back({static_cast<int32_t>(std::lround((centre[0] + p[0] - 500000) / 0.0001)),
+                       static_cast<int32_t>(std::lround((centre[1] + p[1] - 4100000) / 0.0001)),
+                       static_cast<int32_t>(std::lround((centre[2] + p[2]) / 0.0001))});
+  }
+  records[7].classification = 7;  // Noise: left out, as reading the file leaves it out.
+  const std::string las = testing::LasFile(layout, records);
+  BackgroundProcess piped("neuralmesh",
+                          {"reconstruct", "-", "--server", server_->address(), "--out-dir",
+                           *dir_ + "/streamed_las", "--vertices", "400", "--batch-size", "500"},
+                          /*stdin_pipe=*/true);
+  ASSERT_TRUE(piped.WriteStdin(las.substr(0, 100)));  // The header split across writes.
+  absl::SleepFor(absl::Milliseconds(150));
+  ASSERT_TRUE(piped.WriteStdin(las.substr(100)));
+  piped.CloseStdin();
+  for (int i = 0; i < 600 && piped.Running(); ++i) absl::SleepFor(absl::Milliseconds(50));
+  ASSERT_FALSE(piped.Running());
+  ASSERT_EQ(piped.exit_code(), 0) << piped.Stdout() << piped.Stderr();
+  const absl::StatusOr<TriangleMesh> from_las = ReadMesh(*dir_ + "/streamed_las/stdin.drc");
+  ASSERT_TRUE(from_las.ok()) << from_las.status();
+  EXPECT_EQ(from_las->positions.size(), 400u);
+  EXPECT_LT(FarthestFromTheUnitSphere(*from_las, centre), 0.05) << "a vertex off the sphere";
+  const std::string piped_out = piped.Stdout();
+  ASSERT_TRUE(std::regex_search(piped_out, id, std::regex("session (s-[0-9a-f]+) on ")));
+  session = (*service)->GetSession(id[1]);
+  ASSERT_TRUE(session.ok()) << session.status();
+  EXPECT_EQ(session->points_taken(), 3999u) << "every record but the noise";
+
   // A line that is not a point ends the upload, naming it; the session is cancelled.
   BackgroundProcess bad("neuralmesh",
                         {"reconstruct", "-", "--server", server_->address(), "--out-dir",

@@ -315,7 +315,7 @@ TEST(StreamUploadTest, SendsPointsAsTheyArriveRelativeToTheFirstPointsOrigin) {
   ASSERT_EQ(pipe(fds), 0);
   const std::string first = "500123.5 4100456.25 80\n500124.5 4100457.25 81\n";
   ASSERT_EQ(write(fds[1], first.data(), first.size()), static_cast<ssize_t>(first.size()));
-  StreamUpload upload(PointTextStream(fds[0], "standard input"), absl::Milliseconds(50));
+  StreamUpload upload(OpenPointStream(fds[0], "standard input"), absl::Milliseconds(50));
   ASSERT_TRUE(upload.Start(1000).ok());
   EXPECT_EQ(upload.origin(), (Origin{500000, 4100000, 0}));
   EXPECT_EQ(upload.done(), 2u);
@@ -349,7 +349,7 @@ TEST(StreamUploadTest, APointFarFromTheOriginIsAnError) {
   ASSERT_EQ(pipe(fds), 0);
   const std::string text = "1 2 3\n4 5 6\n";
   ASSERT_EQ(write(fds[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
-  StreamUpload upload(PointTextStream(fds[0], "standard input"));
+  StreamUpload upload(OpenPointStream(fds[0], "standard input"));
   const absl::Status started = upload.Start(2);
   ASSERT_TRUE(started.ok()) << started;
   const std::string far = "1e300 0 0\n";

@@ -1,0 +1,229 @@
+#include "core/io/point_stream.h"
+
+#include <poll.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <utility>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "core/io/internal/binary.h"
+#include "core/io/internal/las.h"
+#include "core/io/internal/las_layout.h"
+#include "core/io/internal/position_collector.h"
+#include "core/io/point_text_stream.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh {
+namespace {
+
+using io_internal::LoadScalar;
+namespace las_layout = io_internal::las_layout;
+
+// The most bytes a LAS stream's header and variable-length records may take before its
+// records: real ones hold a few kilobytes of coordinate system.
+constexpr size_t kLongestLasHeader = size_t{64} << 20;
+
+// A LAS file's header and point records as they arrive (LasPointStream in point_stream.h):
+// each complete record is read as reading the file whole reads it (io_internal::LasRecords:
+// withheld records and those classified as noise left out), until the records the header
+// states before its extended variable-length records (LAS 1.4), or the stream's end.
+class LasPointStream final : public PointStream {
+ public:
+  LasPointStream(int fd, std::string name, std::string first_bytes)
+      : fd_(fd), name_(std::move(name)), pending_(std::move(first_bytes)) {}
+
+  absl::StatusOr<bool> Read(absl::Duration wait, std::vector<Vec3>* points) override {
+    if (ended_) return false;
+    if (!pending_.empty()) {
+      const std::string bytes = std::move(pending_);
+      pending_.clear();
+      NM_RETURN_IF_ERROR(Take(bytes, points));
+      return true;
+    }
+    char buffer[1 << 16];
+    NM_ASSIGN_OR_RETURN(const StreamBytes got,
+                        ReadStreamBytes(fd_, wait, name_, buffer, sizeof(buffer)));
+    if (got.ended) {
+      ended_ = true;
+      if (record_length_ == 0) {
+        return Invalid(
+            absl::StrCat("ended within the LAS header, after ", header_.size(), " bytes"));
+      }
+      if (!records_.empty() && records_left_ > 0) {
+        return Invalid(absl::StrCat("ended within LAS record ", records_read_ + 1, " (",
+                                    records_.size(), " of its ", record_length_, " bytes)"));
+      }
+      return false;
+    }
+    NM_RETURN_IF_ERROR(Take(got.bytes, points));
+    return true;
+  }
+
+  const std::string& name() const override { return name_; }
+  std::string ReadSoFar() const override {
+    return absl::StrCat(records_read_, records_read_ == 1 ? " LAS record" : " LAS records");
+  }
+
+ private:
+  absl::Status Invalid(absl::string_view why) const {
+    return absl::InvalidArgumentError(absl::StrCat(name_, ": ", why));
+  }
+
+  // Takes the stream's next bytes: the header's, then records'.
+  absl::Status Take(absl::string_view bytes, std::vector<Vec3>* points) {
+    if (record_length_ == 0) {
+      NM_RETURN_IF_ERROR(TakeHeader(&bytes));
+      if (record_length_ == 0) return absl::OkStatus();
+    }
+    if (records_left_ == 0) return absl::OkStatus();  // What follows the records is not read.
+    records_.append(bytes.data(), bytes.size());
+    return TakeRecords(points);
+  }
+
+  // Gathers the header and its variable-length records; once they are complete, checks them
+  // as reading the file checks them and sets record_length_. Moves `bytes` past what it took.
+  absl::Status TakeHeader(absl::string_view* bytes) {
+    const size_t wanted = offset_to_points_ > 0 ? offset_to_points_ : las_layout::kLegacyHeaderSize;
+    const size_t take = std::min(bytes->size(), wanted - header_.size());
+    header_.append(bytes->data(), take);
+    bytes->remove_prefix(take);
+    if (header_.size() < wanted) return absl::OkStatus();
+    if (offset_to_points_ == 0) {
+      offset_to_points_ = LoadScalar<uint32_t>(header_.data() + las_layout::kOffsetToPoints, false);
+      if (offset_to_points_ > kLongestLasHeader) {
+        return Invalid(absl::StrCat("the LAS header says its records start after ",
+                                    offset_to_points_, " bytes; at most ", kLongestLasHeader,
+                                    " are read"));
+      }
+      if (offset_to_points_ > header_.size()) return TakeHeader(bytes);
+    }
+    if ((static_cast<uint8_t>(header_[las_layout::kPointFormat]) & las_layout::kCompressedBits) !=
+        0) {
+      return Invalid(
+          "LAZ, whose records are not decoded as they arrive; pipe LAS instead "
+          "(laszip -olas -stdout)");
+    }
+    absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> checked =
+        io_internal::LasRecords::Create(header_, absl::string_view(), std::nullopt);
+    if (!checked.ok()) return Invalid(checked.status().message());
+    record_length_ = LoadScalar<uint16_t>(header_.data() + las_layout::kRecordLength, false);
+    if (record_length_ == 0) return Invalid("the LAS header gives records of 0 bytes");
+    // The records that come before anything else: all of them, unless LAS 1.4's extended
+    // variable-length records follow them.
+    if (static_cast<uint8_t>(header_[las_layout::kVersionMinor]) >= 4 &&
+        header_.size() >= las_layout::kHeaderSize14) {
+      const uint64_t evlr_start =
+          LoadScalar<uint64_t>(header_.data() + las_layout::kEvlrStart, false);
+      const uint32_t evlrs =
+          LoadScalar<uint32_t>(header_.data() + las_layout::kEvlrStart + 8, false);
+      if (evlrs > 0 && evlr_start >= offset_to_points_) {
+        records_left_ = (evlr_start - offset_to_points_) / record_length_;
+      }
+    }
+    return absl::OkStatus();
+  }
+
+  // Reads the complete records gathered in records_, keeping a partial one for later.
+  absl::Status TakeRecords(std::vector<Vec3>* points) {
+    const uint64_t complete = std::min<uint64_t>(records_.size() / record_length_, records_left_);
+    if (complete == 0) return absl::OkStatus();
+    absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> records =
+        io_internal::LasRecords::Create(
+            header_, absl::string_view(records_.data(), complete * record_length_), std::nullopt);
+    if (!records.ok()) return Invalid(records.status().message());
+    for (uint64_t i = 0; i < complete; ++i) {
+      const std::optional<io_internal::Point3d> p = (*records)->KeptPoint(i);
+      if (!p.has_value()) continue;
+      if (!std::isfinite((*p)[0]) || !std::isfinite((*p)[1]) || !std::isfinite((*p)[2])) continue;
+      points->emplace_back((*p)[0], (*p)[1], (*p)[2]);
+    }
+    records_read_ += complete;
+    records_left_ -= complete;
+    records_.erase(0, records_left_ == 0 ? records_.size() : complete * record_length_);
+    return absl::OkStatus();
+  }
+
+  int fd_;
+  std::string name_;
+  std::string pending_;          // Bytes read before the stream's format was known.
+  std::string header_;           // The header and variable-length records, as far as they came.
+  size_t offset_to_points_ = 0;  // Once the legacy header has come.
+  size_t record_length_ = 0;     // Once the whole header has come and passed its checks.
+  uint64_t records_left_ = std::numeric_limits<uint64_t>::max();
+  std::string records_;  // Records not read yet: a partial one at most between reads.
+  uint64_t records_read_ = 0;
+  bool ended_ = false;
+};
+
+// A stream whose format its first four bytes tell (OpenPointStream).
+class DetectedPointStream final : public PointStream {
+ public:
+  DetectedPointStream(int fd, std::string name) : fd_(fd), name_(std::move(name)) {}
+
+  absl::StatusOr<bool> Read(absl::Duration wait, std::vector<Vec3>* points) override {
+    if (stream_ == nullptr) {
+      char buffer[4];
+      NM_ASSIGN_OR_RETURN(const StreamBytes got,
+                          ReadStreamBytes(fd_, wait, name_, buffer, 4 - first_bytes_.size()));
+      first_bytes_.append(got.bytes.data(), got.bytes.size());
+      if (first_bytes_.size() < 4 && !got.ended) return true;
+      if (absl::StartsWith(first_bytes_, "LASF")) {
+        stream_ = std::make_unique<LasPointStream>(fd_, name_, std::move(first_bytes_));
+      } else {
+        stream_ = std::make_unique<PointTextStream>(fd_, name_, std::move(first_bytes_));
+      }
+      wait = absl::ZeroDuration();  // The bytes read are taken at once.
+    }
+    return stream_->Read(wait, points);
+  }
+
+  const std::string& name() const override { return name_; }
+  std::string ReadSoFar() const override {
+    return stream_ != nullptr ? stream_->ReadSoFar() : "0 lines";
+  }
+
+ private:
+  int fd_;
+  std::string name_;
+  std::string first_bytes_;
+  std::unique_ptr<PointStream> stream_;  // Once the format is known.
+};
+
+}  // namespace
+
+absl::StatusOr<StreamBytes> ReadStreamBytes(int fd, absl::Duration wait, const std::string& name,
+                                            char* buffer, size_t capacity) {
+  pollfd ready{fd, POLLIN, 0};
+  const int waited = poll(&ready, 1, static_cast<int>(absl::ToInt64Milliseconds(wait)));
+  if (waited < 0 && errno != EINTR) {
+    return absl::UnavailableError(absl::StrCat("cannot read ", name, ": ", strerror(errno)));
+  }
+  if (waited <= 0) return StreamBytes{};
+  const ssize_t got = read(fd, buffer, capacity);
+  if (got < 0) {
+    if (errno == EINTR || errno == EAGAIN) return StreamBytes{};
+    return absl::UnavailableError(absl::StrCat("cannot read ", name, ": ", strerror(errno)));
+  }
+  if (got == 0) return StreamBytes{absl::string_view(), true};
+  return StreamBytes{absl::string_view(buffer, static_cast<size_t>(got)), false};
+}
+
+std::unique_ptr<PointStream> OpenPointStream(int fd, std::string name) {
+  return std::make_unique<DetectedPointStream>(fd, std::move(name));
+}
+
+Origin OriginOfStreamedPoints(const BoundingBox& first_points) {
+  const Vec3& low = first_points.min;
+  const Vec3& high = first_points.max;
+  return io_internal::OriginOfUnstatedResolution({low[0], low[1], low[2]},
+                                                 {high[0], high[1], high[2]});
+}
+
+}  // namespace neuralmesh

@@ -1,0 +1,60 @@
+// Points arriving on a file descriptor as they come: standard input fed by a scanner's or a
+// converter's pipeline (`scanner | neuralmesh reconstruct - --server ...`), a pipe or a socket.
+// A stream is text of "x y z" lines (PointTextStream) or a LAS file's header and records
+// (LasPointStream), told apart by its first bytes (OpenPointStream). Reads never block longer
+// than asked, so that a caller can send what has come at its own pace.
+#ifndef NEURALMESH_CORE_IO_POINT_STREAM_H_
+#define NEURALMESH_CORE_IO_POINT_STREAM_H_
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "absl/time/time.h"
+#include "core/bounding_box.h"
+#include "core/origin.h"
+
+namespace neuralmesh {
+
+class PointStream {
+ public:
+  virtual ~PointStream() = default;
+
+  // Appends the points that have arrived to `points`, in the stream's coordinates, waiting up
+  // to `wait` for a first byte when none is there. Returns whether the stream goes on (false
+  // once it ended). INVALID_ARGUMENT, naming the stream and where in it, for content that is
+  // not points of its format; UNAVAILABLE for a read that fails.
+  virtual absl::StatusOr<bool> Read(absl::Duration wait, std::vector<Vec3>* points) = 0;
+
+  // The stream's name in messages ("standard input").
+  virtual const std::string& name() const = 0;
+  // What has been read so far, for messages: "12 lines", "3 LAS records".
+  virtual std::string ReadSoFar() const = 0;
+};
+
+// The bytes one wait on a descriptor gave: none when nothing came within the wait.
+struct StreamBytes {
+  absl::string_view bytes;
+  bool ended = false;  // The descriptor reached its end (no bytes then).
+};
+
+// Waits up to `wait` for bytes on `fd` and reads those there into `buffer` (of `capacity`
+// bytes). UNAVAILABLE, naming the stream `name`, for a failed poll or read.
+absl::StatusOr<StreamBytes> ReadStreamBytes(int fd, absl::Duration wait, const std::string& name,
+                                            char* buffer, size_t capacity);
+
+// The stream of `fd` (not closed here), named `name`: LAS when its first bytes are a LAS
+// file's signature ("LASF"), else text. The format is decided by the first Read calls, once
+// four bytes (or the end) have come.
+std::unique_ptr<PointStream> OpenPointStream(int fd, std::string name);
+
+// Where points of a stream should be taken relative to, from the box of its first points: the
+// origin reading an XYZ file of them chooses (PositionCollector's rule), so that
+// georeferenced coordinates keep their precision as floats.
+Origin OriginOfStreamedPoints(const BoundingBox& first_points);
+
+}  // namespace neuralmesh
+
+#endif  // NEURALMESH_CORE_IO_POINT_STREAM_H_

@@ -1,0 +1,183 @@
+#include "core/io/point_stream.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "absl/time/time.h"
+#include "core/io/internal/laz.h"
+#include "core/io/point_cloud_io.h"
+#include "core/random.h"
+#include "gtest/gtest.h"
+#include "tests/testing/las_file.h"
+#include "tests/testing/temp_dir.h"
+
+namespace neuralmesh {
+namespace {
+
+// A pipe whose read end a stream reads; what is written fits in its buffer.
+class Pipe {
+ public:
+  Pipe() { EXPECT_EQ(pipe(fds_), 0); }
+  ~Pipe() {
+    CloseWriteEnd();
+    close(fds_[0]);
+  }
+  int read_end() const { return fds_[0]; }
+  void Write(absl::string_view bytes) {
+    ASSERT_EQ(write(fds_[1], bytes.data(), bytes.size()), static_cast<ssize_t>(bytes.size()));
+  }
+  void CloseWriteEnd() {
+    if (fds_[1] >= 0) close(fds_[1]);
+    fds_[1] = -1;
+  }
+
+ private:
+  int fds_[2] = {-1, -1};
+};
+
+// A LAS 1.4 scan line in UTM millimetres, every 10th record withheld and every 7th noise, and
+// an extended variable-length record after the points, which is no record.
+std::string ScanLas(int records) {
+  testing::LasLayout layout;
+  layout.version_minor = 4;
+  layout.format = 6;
+  for (double& s : layout.scale) s = 0.001;
+  layout.offset[0] = 500000;
+  layout.offset[1] = 4100000;
+  std::string evlr(60, '\0');  // An EVLR's header: no payload.
+  evlr.replace(2, 8, "scanner!");
+  layout.after_points = evlr;
+  layout.evlr_count = 1;
+  std::vector<testing::LasPoint> points;
+  for (int i = 0; i < records; ++i) {
+    testing::LasPoint p{};
+    p.x = 37 * i;
+    p.y = 1000 * (i % 13);
+    p.z = 80000 + i;
+    p.withheld = i % 10 == 0;
+    p.classification = i % 7 == 0 ? 7 : 2;
+    points.push_back(p);
+  }
+  return testing::LasFile(layout, points);
+}
+
+// Reads `stream` to its end, writing `bytes` into `pipe` in pieces of the sizes `pieces` cycles
+// through, a read after each; returns the last status.
+absl::Status ReadInPieces(PointStream& stream, Pipe& pipe, absl::string_view bytes,
+                          const std::vector<size_t>& pieces, std::vector<Vec3>* points) {
+  for (size_t at = 0, k = 0; at < bytes.size(); ++k) {
+    const size_t size = std::min(pieces[k % pieces.size()], bytes.size() - at);
+    pipe.Write(bytes.substr(at, size));
+    at += size;
+    absl::StatusOr<bool> more = stream.Read(absl::Milliseconds(100), points);
+    if (!more.ok()) return more.status();
+  }
+  pipe.CloseWriteEnd();
+  for (int i = 0; i < 100; ++i) {
+    absl::StatusOr<bool> more = stream.Read(absl::Milliseconds(100), points);
+    if (!more.ok()) return more.status();
+    if (!*more) return absl::OkStatus();
+  }
+  return absl::DeadlineExceededError("the stream did not end");
+}
+
+TEST(LasPointStreamTest, ALasFileArrivingInPiecesGivesThePointsReadingItWholeDoes) {
+  const std::string bytes = ScanLas(1000);
+  const std::string path = testing::ProcessTempDir() + "/scan_line.las";
+  std::ofstream(path, std::ios::binary) << bytes;
+  absl::StatusOr<PointCloud> whole = ReadPointCloud(path);
+  ASSERT_TRUE(whole.ok()) << whole.status();
+  ASSERT_GT(whole->size(), 700u);
+  for (const std::vector<size_t>& pieces :
+       {std::vector<size_t>{1, 7, 100}, std::vector<size_t>{4096}, std::vector<size_t>{29, 31}}) {
+    SCOPED_TRACE(pieces.front());
+    Pipe pipe;
+    std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "standard input");
+    std::vector<Vec3> points;
+    const absl::Status read = ReadInPieces(*stream, pipe, bytes, pieces, &points);
+    ASSERT_TRUE(read.ok()) << read;
+    EXPECT_EQ(stream->ReadSoFar(), "1000 LAS records") << "the EVLR after them is no record";
+    ASSERT_EQ(points.size(), whole->size()) << "withheld and noise records left out";
+    for (size_t i = 0; i < points.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_EQ(static_cast<float>(points[i][c] - whole->origin[c]), whole->positions[i][c])
+            << "point " << i;
+      }
+    }
+  }
+}
+
+TEST(LasPointStreamTest, WhatIsNoLasStreamIsAnErrorSayingWhy) {
+  const std::string bytes = ScanLas(100);
+  const auto error_of = [](absl::string_view stream_bytes) {
+    Pipe pipe;
+    std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "the scanner");
+    std::vector<Vec3> points;
+    return ReadInPieces(*stream, pipe, stream_bytes, {1000}, &points);
+  };
+  absl::Status status = error_of(bytes.substr(0, 300));
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+  EXPECT_EQ(status.message(), "the scanner: ended within the LAS header, after 300 bytes");
+  status = error_of(bytes.substr(0, 375 + 30 * 4 + 12));
+  EXPECT_EQ(status.message(), "the scanner: ended within LAS record 5 (12 of its 30 bytes)");
+
+  absl::StatusOr<std::string> laz =
+      io_internal::CompressLas(bytes, io_internal::LazWriteOptions{50});
+  ASSERT_TRUE(laz.ok()) << laz.status();
+  status = error_of(*laz);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+  EXPECT_EQ(status.message(),
+            "the scanner: LAZ, whose records are not decoded as they arrive; pipe LAS instead "
+            "(laszip -olas -stdout)");
+}
+
+// Streams whose header bytes are mangled at random: each is read to its end or refused with
+// INVALID_ARGUMENT (AddressSanitizer's build checks that no byte is read out of bounds).
+TEST(LasPointStreamTest, MangledHeadersAreReadOrRefused) {
+  const std::string bytes = ScanLas(200);
+  Random random(11);
+  int refused = 0;
+  for (int round = 0; round < 1500; ++round) {
+    std::string mangled = bytes;
+    for (int k = 0, n = 1 + static_cast<int>(random.NextIndex(4)); k < n; ++k) {
+      mangled[random.NextIndex(400)] = static_cast<char>(random.NextIndex(256));
+    }
+    Pipe pipe;
+    std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "standard input");
+    std::vector<Vec3> points;
+    const absl::Status read = ReadInPieces(*stream, pipe, mangled, {4096}, &points);
+    if (!read.ok()) {
+      ASSERT_EQ(read.code(), absl::StatusCode::kInvalidArgument) << read;
+      ++refused;
+    }
+    ASSERT_LE(points.size(), 200u) << "more points than records";
+  }
+  EXPECT_GT(refused, 0);
+}
+
+TEST(LasPointStreamTest, AStreamNotStartingLikeLasIsText) {
+  for (const std::string text : {"1 2 3", "1 2 3\n4 5 6\n", "LAS 1 2\n"}) {
+    SCOPED_TRACE(text);
+    Pipe pipe;
+    std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "standard input");
+    std::vector<Vec3> points;
+    const absl::Status read = ReadInPieces(*stream, pipe, text, {2}, &points);
+    if (text == "LAS 1 2\n") {
+      EXPECT_EQ(read.code(), absl::StatusCode::kInvalidArgument) << read;
+      EXPECT_TRUE(absl::StrContains(read.message(), "line 1")) << read;
+      continue;
+    }
+    ASSERT_TRUE(read.ok()) << read;
+    ASSERT_FALSE(points.empty());
+    EXPECT_EQ(points[0], Vec3(1, 2, 3));
+    EXPECT_EQ(stream->ReadSoFar(), points.size() == 1 ? "1 line" : "2 lines");
+  }
+}
+
+}  // namespace
+}  // namespace neuralmesh

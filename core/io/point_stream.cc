@@ -41,15 +41,9 @@ class LasPointStream final : public PointStream {
 
   absl::StatusOr<bool> Read(absl::Duration wait, std::vector<Vec3>* points) override {
     if (ended_) return false;
-    if (!pending_.empty()) {
-      const std::string bytes = std::move(pending_);
-      pending_.clear();
-      NM_RETURN_IF_ERROR(Take(bytes, points));
-      return true;
-    }
     char buffer[1 << 16];
     NM_ASSIGN_OR_RETURN(const StreamBytes got,
-                        ReadStreamBytes(fd_, wait, name_, buffer, sizeof(buffer)));
+                        NextStreamBytes(fd_, wait, name_, &pending_, buffer, sizeof(buffer)));
     if (got.ended) {
       ended_ = true;
       if (record_length_ == 0) {
@@ -213,6 +207,15 @@ absl::StatusOr<StreamBytes> ReadStreamBytes(int fd, absl::Duration wait, const s
   }
   if (got == 0) return StreamBytes{absl::string_view(), true};
   return StreamBytes{absl::string_view(buffer, static_cast<size_t>(got)), false};
+}
+
+absl::StatusOr<StreamBytes> NextStreamBytes(int fd, absl::Duration wait, const std::string& name,
+                                            std::string* pending, char* buffer, size_t capacity) {
+  if (pending->empty()) return ReadStreamBytes(fd, wait, name, buffer, capacity);
+  const size_t size = std::min(pending->size(), capacity);
+  std::memcpy(buffer, pending->data(), size);
+  pending->erase(0, size);
+  return StreamBytes{absl::string_view(buffer, size), false};
 }
 
 std::unique_ptr<PointStream> OpenPointStream(int fd, std::string name) {

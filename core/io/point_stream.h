@@ -44,6 +44,10 @@ struct StreamBytes {
 // bytes). UNAVAILABLE, naming the stream `name`, for a failed poll or read.
 absl::StatusOr<StreamBytes> ReadStreamBytes(int fd, absl::Duration wait, const std::string& name,
                                             char* buffer, size_t capacity);
+// The bytes a stream takes next: those of `pending` (read before its format was known) first,
+// moved into `buffer` as far as they fit, else ReadStreamBytes's.
+absl::StatusOr<StreamBytes> NextStreamBytes(int fd, absl::Duration wait, const std::string& name,
+                                            std::string* pending, char* buffer, size_t capacity);
 
 // The stream of `fd` (not closed here), named `name`: LAS when its first bytes are a LAS
 // file's signature ("LASF"), else text. The format is decided by the first Read calls, once

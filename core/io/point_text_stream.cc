@@ -40,15 +40,9 @@ std::string PointTextStream::ReadSoFar() const {
 
 absl::StatusOr<bool> PointTextStream::Read(absl::Duration wait, std::vector<Vec3>* points) {
   if (ended_) return false;
-  if (!pending_.empty()) {
-    const std::string bytes = std::move(pending_);
-    pending_.clear();
-    NM_RETURN_IF_ERROR(Take(bytes, points));
-    return true;
-  }
   char buffer[1 << 16];
   NM_ASSIGN_OR_RETURN(const StreamBytes got,
-                      ReadStreamBytes(fd_, wait, name_, buffer, sizeof(buffer)));
+                      NextStreamBytes(fd_, wait, name_, &pending_, buffer, sizeof(buffer)));
   if (got.ended) {
     ended_ = true;
     if (!partial_.empty()) {

@@ -14,31 +14,13 @@
 #include "core/random.h"
 #include "gtest/gtest.h"
 #include "tests/testing/las_file.h"
+#include "tests/testing/pipe.h"
 #include "tests/testing/temp_dir.h"
 
 namespace neuralmesh {
 namespace {
 
-// A pipe whose read end a stream reads; what is written fits in its buffer.
-class Pipe {
- public:
-  Pipe() { EXPECT_EQ(pipe(fds_), 0); }
-  ~Pipe() {
-    CloseWriteEnd();
-    close(fds_[0]);
-  }
-  int read_end() const { return fds_[0]; }
-  void Write(absl::string_view bytes) {
-    ASSERT_EQ(write(fds_[1], bytes.data(), bytes.size()), static_cast<ssize_t>(bytes.size()));
-  }
-  void CloseWriteEnd() {
-    if (fds_[1] >= 0) close(fds_[1]);
-    fds_[1] = -1;
-  }
-
- private:
-  int fds_[2] = {-1, -1};
-};
+using testing::Pipe;
 
 // A LAS 1.4 scan line in UTM millimetres, every 10th record withheld and every 7th noise, and
 // an extended variable-length record after the points, which is no record.

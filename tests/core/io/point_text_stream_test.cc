@@ -8,30 +8,12 @@
 #include "absl/strings/match.h"
 #include "absl/time/time.h"
 #include "gtest/gtest.h"
+#include "tests/testing/pipe.h"
 
 namespace neuralmesh {
 namespace {
 
-// A pipe whose read end a PointTextStream reads.
-class Pipe {
- public:
-  Pipe() { EXPECT_EQ(pipe(fds_), 0); }
-  ~Pipe() {
-    CloseWriteEnd();
-    close(fds_[0]);
-  }
-  int read_end() const { return fds_[0]; }
-  void Write(const std::string& text) {
-    ASSERT_EQ(write(fds_[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
-  }
-  void CloseWriteEnd() {
-    if (fds_[1] >= 0) close(fds_[1]);
-    fds_[1] = -1;
-  }
-
- private:
-  int fds_[2] = {-1, -1};
-};
+using testing::Pipe;
 
 TEST(PointTextStreamTest, ReadsPointsAsTheirLinesComplete) {
   Pipe pipe;

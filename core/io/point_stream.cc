@@ -34,44 +34,34 @@ constexpr size_t kLongestLasHeader = size_t{64} << 20;
 // each complete record is read as reading the file whole reads it (io_internal::LasRecords:
 // withheld records and those classified as noise left out), until the records the header
 // states before its extended variable-length records (LAS 1.4), or the stream's end.
-class LasPointStream final : public PointStream {
+class LasPointStream final : public DescriptorPointStream {
  public:
   LasPointStream(int fd, std::string name, std::string first_bytes)
-      : fd_(fd), name_(std::move(name)), pending_(std::move(first_bytes)) {}
+      : DescriptorPointStream(fd, std::move(name), std::move(first_bytes)) {}
 
-  absl::StatusOr<bool> Read(absl::Duration wait, std::vector<Vec3>* points) override {
-    if (ended_) return false;
-    char buffer[1 << 16];
-    NM_ASSIGN_OR_RETURN(const StreamBytes got,
-                        NextStreamBytes(fd_, wait, name_, &pending_, buffer, sizeof(buffer)));
-    if (got.ended) {
-      ended_ = true;
-      if (record_length_ == 0) {
-        return Invalid(
-            absl::StrCat("ended within the LAS header, after ", header_.size(), " bytes"));
-      }
-      if (!records_.empty() && records_left_ > 0) {
-        return Invalid(absl::StrCat("ended within LAS record ", records_read_ + 1, " (",
-                                    records_.size(), " of its ", record_length_, " bytes)"));
-      }
-      return false;
-    }
-    NM_RETURN_IF_ERROR(Take(got.bytes, points));
-    return true;
-  }
-
-  const std::string& name() const override { return name_; }
   std::string ReadSoFar() const override {
     return absl::StrCat(records_read_, records_read_ == 1 ? " LAS record" : " LAS records");
   }
 
  private:
   absl::Status Invalid(absl::string_view why) const {
-    return absl::InvalidArgumentError(absl::StrCat(name_, ": ", why));
+    return absl::InvalidArgumentError(absl::StrCat(name(), ": ", why));
+  }
+
+  // A stream that ends within its header or a record is no LAS file.
+  absl::Status End(std::vector<Vec3>* /*points*/) override {
+    if (record_length_ == 0) {
+      return Invalid(absl::StrCat("ended within the LAS header, after ", header_.size(), " bytes"));
+    }
+    if (!records_.empty() && records_left_ > 0) {
+      return Invalid(absl::StrCat("ended within LAS record ", records_read_ + 1, " (",
+                                  records_.size(), " of its ", record_length_, " bytes)"));
+    }
+    return absl::OkStatus();
   }
 
   // Takes the stream's next bytes: the header's, then records'.
-  absl::Status Take(absl::string_view bytes, std::vector<Vec3>* points) {
+  absl::Status Take(absl::string_view bytes, std::vector<Vec3>* points) override {
     if (record_length_ == 0) {
       NM_RETURN_IF_ERROR(TakeHeader(&bytes));
       if (record_length_ == 0) return absl::OkStatus();
@@ -144,16 +134,12 @@ class LasPointStream final : public PointStream {
     return absl::OkStatus();
   }
 
-  int fd_;
-  std::string name_;
-  std::string pending_;          // Bytes read before the stream's format was known.
   std::string header_;           // The header and variable-length records, as far as they came.
   size_t offset_to_points_ = 0;  // Once the legacy header has come.
   size_t record_length_ = 0;     // Once the whole header has come and passed its checks.
   uint64_t records_left_ = std::numeric_limits<uint64_t>::max();
   std::string records_;  // Records not read yet: a partial one at most between reads.
   uint64_t records_read_ = 0;
-  bool ended_ = false;
 };
 
 // A stream whose format its first four bytes tell (OpenPointStream).
@@ -209,13 +195,24 @@ absl::StatusOr<StreamBytes> ReadStreamBytes(int fd, absl::Duration wait, const s
   return StreamBytes{absl::string_view(buffer, static_cast<size_t>(got)), false};
 }
 
-absl::StatusOr<StreamBytes> NextStreamBytes(int fd, absl::Duration wait, const std::string& name,
-                                            std::string* pending, char* buffer, size_t capacity) {
-  if (pending->empty()) return ReadStreamBytes(fd, wait, name, buffer, capacity);
-  const size_t size = std::min(pending->size(), capacity);
-  std::memcpy(buffer, pending->data(), size);
-  pending->erase(0, size);
-  return StreamBytes{absl::string_view(buffer, size), false};
+absl::StatusOr<bool> DescriptorPointStream::Read(absl::Duration wait, std::vector<Vec3>* points) {
+  if (ended_) return false;
+  if (!pending_.empty()) {
+    const std::string first_bytes = std::move(pending_);
+    pending_.clear();
+    NM_RETURN_IF_ERROR(Take(first_bytes, points));
+    return true;
+  }
+  char buffer[1 << 16];
+  NM_ASSIGN_OR_RETURN(const StreamBytes got,
+                      ReadStreamBytes(fd_, wait, name_, buffer, sizeof(buffer)));
+  if (got.ended) {
+    ended_ = true;
+    NM_RETURN_IF_ERROR(End(points));
+    return false;
+  }
+  NM_RETURN_IF_ERROR(Take(got.bytes, points));
+  return true;
 }
 
 std::unique_ptr<PointStream> OpenPointStream(int fd, std::string name) {

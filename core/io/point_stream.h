@@ -44,10 +44,31 @@ struct StreamBytes {
 // bytes). UNAVAILABLE, naming the stream `name`, for a failed poll or read.
 absl::StatusOr<StreamBytes> ReadStreamBytes(int fd, absl::Duration wait, const std::string& name,
                                             char* buffer, size_t capacity);
-// The bytes a stream takes next: those of `pending` (read before its format was known) first,
-// moved into `buffer` as far as they fit, else ReadStreamBytes's.
-absl::StatusOr<StreamBytes> NextStreamBytes(int fd, absl::Duration wait, const std::string& name,
-                                            std::string* pending, char* buffer, size_t capacity);
+
+// A stream of a file descriptor's bytes read in its format: Read waits for them and hands them
+// to Take as they arrive, and the end to End.
+class DescriptorPointStream : public PointStream {
+ public:
+  absl::StatusOr<bool> Read(absl::Duration wait, std::vector<Vec3>* points) final;
+  const std::string& name() const final { return name_; }
+
+ protected:
+  // The stream of `fd` (not closed here), named `name` in messages ("standard input");
+  // `first_bytes`: its bytes read already (OpenPointStream's, to tell its format), taken first.
+  DescriptorPointStream(int fd, std::string name, std::string first_bytes)
+      : fd_(fd), name_(std::move(name)), pending_(std::move(first_bytes)) {}
+
+  // Takes the bytes that arrived next: the points they complete.
+  virtual absl::Status Take(absl::string_view bytes, std::vector<Vec3>* points) = 0;
+  // The stream ended: takes what is left, or refuses it.
+  virtual absl::Status End(std::vector<Vec3>* points) = 0;
+
+ private:
+  int fd_;
+  std::string name_;
+  std::string pending_;  // Bytes read before the stream's format was known.
+  bool ended_ = false;
+};
 
 // The stream of `fd` (not closed here), named `name`: LAS when its first bytes are a LAS
 // file's signature ("LASF"), else text. The format is decided by the first Read calls, once

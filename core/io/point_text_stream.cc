@@ -26,7 +26,7 @@ absl::Status PointTextStream::ParseLine(absl::string_view line, std::vector<Vec3
     if (static_cast<size_t>(c) >= tokens.size() || !io_internal::ParseDouble(tokens[c], &p[c]) ||
         !std::isfinite(p[c])) {
       return absl::InvalidArgumentError(
-          absl::StrCat(name_, ", line ", lines_, ": ", io_internal::Quoted(line),
+          absl::StrCat(name(), ", line ", lines_, ": ", io_internal::Quoted(line),
                        " does not start with a point's x, y and z (three finite numbers)"));
     }
   }
@@ -38,22 +38,11 @@ std::string PointTextStream::ReadSoFar() const {
   return absl::StrCat(lines_, lines_ == 1 ? " line" : " lines");
 }
 
-absl::StatusOr<bool> PointTextStream::Read(absl::Duration wait, std::vector<Vec3>* points) {
-  if (ended_) return false;
-  char buffer[1 << 16];
-  NM_ASSIGN_OR_RETURN(const StreamBytes got,
-                      NextStreamBytes(fd_, wait, name_, &pending_, buffer, sizeof(buffer)));
-  if (got.ended) {
-    ended_ = true;
-    if (!partial_.empty()) {
-      const std::string last = std::move(partial_);
-      partial_.clear();
-      NM_RETURN_IF_ERROR(ParseLine(last, points));
-    }
-    return false;
-  }
-  NM_RETURN_IF_ERROR(Take(got.bytes, points));
-  return true;
+absl::Status PointTextStream::End(std::vector<Vec3>* points) {
+  if (partial_.empty()) return absl::OkStatus();
+  const std::string last = std::move(partial_);
+  partial_.clear();
+  return ParseLine(last, points);
 }
 
 absl::Status PointTextStream::Take(absl::string_view text, std::vector<Vec3>* points) {
@@ -72,7 +61,7 @@ absl::Status PointTextStream::Take(absl::string_view text, std::vector<Vec3>* po
   }
   partial_.append(text.data(), text.size());
   if (partial_.size() > kLongestLine) {
-    return absl::InvalidArgumentError(absl::StrCat(name_, ", line ", lines_ + 1, ": over ",
+    return absl::InvalidArgumentError(absl::StrCat(name(), ", line ", lines_ + 1, ": over ",
                                                    kLongestLine,
                                                    " bytes without a line's end: not "
                                                    "text of points"));

@@ -15,36 +15,32 @@
 
 namespace neuralmesh {
 
-class PointTextStream final : public PointStream {
+class PointTextStream final : public DescriptorPointStream {
  public:
   // The stream of `fd` (not closed here); `name` names it in messages ("standard input").
   // `first_bytes`: its bytes read already (OpenPointStream's, to tell its format).
   PointTextStream(int fd, std::string name, std::string first_bytes = "")
-      : fd_(fd), name_(std::move(name)), pending_(std::move(first_bytes)) {}
+      : DescriptorPointStream(fd, std::move(name), std::move(first_bytes)) {}
 
-  // PointStream::Read: the points of the lines that have arrived (a last line without a
-  // newline is taken at the end). INVALID_ARGUMENT, naming the stream and the line, for a line
-  // that does not start with three finite numbers.
-  absl::StatusOr<bool> Read(absl::Duration wait, std::vector<Vec3>* points) override;
+  // Read (PointStream::Read) gives the points of the lines that have arrived (a last line
+  // without a newline is taken at the end). INVALID_ARGUMENT, naming the stream and the line,
+  // for a line that does not start with three finite numbers.
 
-  const std::string& name() const override { return name_; }
   // "12 lines".
   std::string ReadSoFar() const override;
   // The lines read so far.
   uint64_t lines() const { return lines_; }
 
  private:
-  // Takes the stream's next bytes: the points of the lines they complete.
-  absl::Status Take(absl::string_view text, std::vector<Vec3>* points);
+  // The points of the lines `text` completes.
+  absl::Status Take(absl::string_view text, std::vector<Vec3>* points) override;
+  // The last line, if it has no newline.
+  absl::Status End(std::vector<Vec3>* points) override;
   // Parses the complete line `line` (without its newline) into `points`.
   absl::Status ParseLine(absl::string_view line, std::vector<Vec3>* points);
 
-  int fd_;
-  std::string name_;
-  std::string pending_;  // Bytes read before the stream's format was known.
   std::string partial_;  // The start of a line whose end has not arrived.
   uint64_t lines_ = 0;
-  bool ended_ = false;
 };
 
 }  // namespace neuralmesh

@@ -634,12 +634,7 @@ constexpr double kSphereScanCentre[3] = {500123.5, 4100456.25, 80};
 // centred at kSphereScanCentre, in UTM millimetres.
 void WriteGeoreferencedSphereLas(const std::string& path) {
   const PointCloud unit = ColoredUnitSpherePoints(20000, 5);
-  testing::LasLayout layout;
-  layout.version_minor = 4;
-  layout.format = 7;
-  for (double& s : layout.scale) s = 0.001;
-  layout.offset[0] = 500000;
-  layout.offset[1] = 4100000;
+  const testing::LasLayout layout = testing::UtmMillimetreLayout(7);
   std::vector<testing::LasPoint> points;
   for (size_t i = 0; i < unit.size(); ++i) {
     testing::LasPoint p{};

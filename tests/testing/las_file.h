@@ -67,6 +67,18 @@ inline std::string LasVariableLengthRecord(const std::string& user_id, uint16_t 
 // A LAS file as the specification lays it out: the public header block (227 bytes for 1.2,
 // 235 for 1.3, 375 for 1.4), the layout's variable-length records, the point records and the
 // layout's bytes after them.
+// LAS 1.4 of point format `format` in UTM millimetres, as a georeferenced scan: scale 0.001,
+// offset (500000, 4100000, 0).
+inline LasLayout UtmMillimetreLayout(int format) {
+  LasLayout layout;
+  layout.version_minor = 4;
+  layout.format = format;
+  for (double& s : layout.scale) s = 0.001;
+  layout.offset[0] = 500000;
+  layout.offset[1] = 4100000;
+  return layout;
+}
+
 inline std::string LasFile(const LasLayout& layout, const std::vector<LasPoint>& points) {
   const bool v14 = layout.version_minor >= 4;
   const size_t header_size = v14 ? 375 : layout.version_minor == 3 ? 235 : 227;

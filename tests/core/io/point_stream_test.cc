@@ -25,12 +25,7 @@ using testing::Pipe;
 // A LAS 1.4 scan line in UTM millimetres, every 10th record withheld and every 7th noise, and
 // an extended variable-length record after the points, which is no record.
 std::string ScanLas(int records) {
-  testing::LasLayout layout;
-  layout.version_minor = 4;
-  layout.format = 6;
-  for (double& s : layout.scale) s = 0.001;
-  layout.offset[0] = 500000;
-  layout.offset[1] = 4100000;
+  testing::LasLayout layout = testing::UtmMillimetreLayout(6);
   std::string evlr(60, '\0');  // An EVLR's header: no payload.
   evlr.replace(2, 8, "scanner!");
   layout.after_points = evlr;

@@ -29,15 +29,7 @@ namespace {
 // A scan line in UTM millimetres: record i at x = 500000 + i / 100 (so a sample names its
 // record), y = 4100000 + (i % 7), z = 80; every 10th record withheld, every 7th (not withheld)
 // classified as low noise (7), every 5th else as building (6), the rest ground (2).
-testing::LasLayout Layout() {
-  testing::LasLayout layout;
-  layout.version_minor = 4;
-  layout.format = 6;
-  for (double& s : layout.scale) s = 0.001;
-  layout.offset[0] = 500000;
-  layout.offset[1] = 4100000;
-  return layout;
-}
+testing::LasLayout Layout() { return testing::UtmMillimetreLayout(6); }
 
 std::vector<testing::LasPoint> ScanLine(int n) {
   std::vector<testing::LasPoint> points;

@@ -1,6 +1,8 @@
 // neuralmesh: Neural Meshes surface reconstruction (Ivrissimtzis, Jeong, Seidel) on the
 // command line, locally or through a neuralmesh-server. This file holds the flags and the
 // dispatch only; the commands live in the neuralmesh_client library.
+#include <grpcpp/grpcpp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -9,8 +11,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <grpcpp/grpcpp.h>
 
 #include "absl/flags/flag.h"
 #include "absl/status/status.h"
@@ -222,8 +222,7 @@ ABSL_FLAG(std::string, resume, "",
           "reconstruct --server: the id of a session whose upload lost its connection; the "
           "upload goes on from the points the session has taken (run with the same INPUT and "
           "input flags; the session keeps its configuration).");
-ABSL_FLAG(absl::Duration, reconnect_for,
-          neuralmesh::client::ReconnectOptions().give_up_after,
+ABSL_FLAG(absl::Duration, reconnect_for, neuralmesh::client::ReconnectOptions().give_up_after,
           "reconstruct --server and watch: how long to keep trying when the connection to the "
           "server is lost, counted from the last batch taken or mesh received (the upload goes "
           "on from the points the session has taken, the watch from its last mesh); 0: give up "
@@ -341,10 +340,13 @@ absl::StatusOr<neuralmesh::PointSelection> SelectionFromFlags(
   if (!parsed.ok()) {
     return absl::InvalidArgumentError(absl::StrCat("--las_classes: ", parsed.status().message()));
   }
-  if (std::none_of(inputs.begin(), inputs.end(), neuralmesh::IsLasPath)) {
+  // Standard input ('-') may be a LAS stream; it says so when it is text.
+  if (std::none_of(inputs.begin(), inputs.end(), [](const std::string& input) {
+        return input == "-" || neuralmesh::IsLasPath(input);
+      })) {
     return absl::InvalidArgumentError(
         "--las_classes selects the points of LAS files by class; no INPUT is a .las or .laz "
-        "file");
+        "file, nor standard input ('-')");
   }
   selection.las_classes = *parsed;
   return selection;
@@ -415,9 +417,10 @@ absl::StatusOr<neuralmesh::MeshWriteOptions> MeshWritingFromFlags() {
   return o;
 }
 
-constexpr const char* kConnectionFlags[] = {
-    "connect_timeout", "tls",          "tls_ca_file",       "tls_cert_file",
-    "tls_key_file",    "tls_server_name", "access_token_file", "max_message_bytes"};
+constexpr const char* kConnectionFlags[] = {"connect_timeout",   "tls",
+                                            "tls_ca_file",       "tls_cert_file",
+                                            "tls_key_file",      "tls_server_name",
+                                            "access_token_file", "max_message_bytes"};
 
 // How to reach the server: --connect_timeout, TLS and the access token.
 absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
@@ -425,8 +428,8 @@ absl::StatusOr<neuralmesh::client::ClientOptions> ConnectionFromFlags() {
   o.connect_timeout = absl::GetFlag(FLAGS_connect_timeout);
   o.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
   if (o.max_message_bytes < 1) {
-    return absl::InvalidArgumentError(absl::StrCat("--max_message_bytes must be at least 1, not ",
-                                                   o.max_message_bytes));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--max_message_bytes must be at least 1, not ", o.max_message_bytes));
   }
   neuralmesh::client::ClientSecurity& security = o.security;
   struct FileFlag {
@@ -523,11 +526,11 @@ absl::Status Reconstruct(const ParsedArgs& args) {
     NM_ASSIGN_OR_RETURN(o.connection, ConnectionFromFlags());
     return neuralmesh::client::RunRemoteReconstruct(o, std::cout, std::cerr);
   }
-  NM_RETURN_IF_ERROR(RejectFlags(
-      args,
-      WithConnectionFlags({"out-dir", "batch-size", "points", "ply", "glb", "outliers_on_server",
-                           "resume", "reconnect_for"}),
-      "needs --server (a local reconstruct writes -o OUTPUT)"));
+  NM_RETURN_IF_ERROR(
+      RejectFlags(args,
+                  WithConnectionFlags({"out-dir", "batch-size", "points", "ply", "glb",
+                                       "outliers_on_server", "resume", "reconnect_for"}),
+                  "needs --server (a local reconstruct writes -o OUTPUT)"));
   if (std::find(args.positional.begin(), args.positional.end(), "-") != args.positional.end()) {
     return absl::InvalidArgumentError(
         "INPUT '-' streams points from standard input to a server: it needs --server");
@@ -633,8 +636,7 @@ absl::Status OnSession(neuralmesh::client::SessionAction action, const ParsedArg
 // `neuralmesh NAME SESSION --server HOST:PORT`, which asks the server for `action`; `flags`
 // beyond --server and the connection's.
 Subcommand SessionActionCommand(const std::string& name, std::string summary,
-                                std::string description,
-                                neuralmesh::client::SessionAction action,
+                                std::string description, neuralmesh::client::SessionAction action,
                                 const std::string& usage_flags = "",
                                 std::vector<std::string> flags = {}) {
   flags.insert(flags.begin(), "server");
@@ -726,7 +728,8 @@ std::vector<Subcommand> Commands() {
        "uploads the points and saves each mesh the server publishes into --out-dir. Prints\n"
        "the figures of every level. With --server, INPUT '-' streams points from standard\n"
        "input as they arrive (\"x y z\" per line, split as in XYZ files; further columns and\n"
-       "'#' comments ignored; or a LAS file's records), a batch whenever --batch-size points\n"
+       "'#' comments ignored; or a LAS file's records, with their colours, of the\n"
+       "--las_classes chosen), a batch whenever --batch-size points\n"
        "came or 100 ms passed; the session finishes at the end of the stream (files named\n"
        "stdin*).",
        WithConnectionFlags(reconstruct), Reconstruct},
@@ -828,6 +831,5 @@ std::vector<Subcommand> Commands() {
 int main(int argc, char** argv) {
   const std::string version =
       neuralmesh::VersionLine("neuralmesh", absl::StrCat("gRPC ", grpc::Version()));
-  return neuralmesh::client::RunCommandLine(argc, argv, Commands(), version, std::cout,
-                                            std::cerr);
+  return neuralmesh::client::RunCommandLine(argc, argv, Commands(), version, std::cout, std::cerr);
 }

@@ -215,7 +215,14 @@ absl::Status StreamUpload::ReadUntil(uint64_t want, uint64_t least, absl::Time d
 
 absl::Status StreamUpload::TakeArrived() {
   if (!started_) return absl::OkStatus();
-  for (const Vec3& p : arrived_) {
+  // A LAS stream's format gives every record colours or none.
+  if (has_colors() && arrived_.color_levels.size() != arrived_.size()) {
+    return absl::InternalError(absl::StrCat(stream_->name(), " gave ", arrived_.size(),
+                                            " points with ", arrived_.color_levels.size(),
+                                            " colours"));
+  }
+  for (size_t i = 0; i < arrived_.size(); ++i) {
+    const Vec3& p = arrived_.positions[i];
     const Vec3 relative(p[0] - origin_[0], p[1] - origin_[1], p[2] - origin_[2]);
     if (!MappedPointFile::Learnable(relative)) {
       return absl::InvalidArgumentError(absl::StrCat(
@@ -225,6 +232,7 @@ absl::Status StreamUpload::TakeArrived() {
     }
     points_.emplace_back(static_cast<float>(relative[0]), static_cast<float>(relative[1]),
                          static_cast<float>(relative[2]));
+    if (has_colors()) colors_.push_back(RgbFromLevels(arrived_.color_levels[i], color_scale_));
   }
   arrived_.clear();
   return absl::OkStatus();
@@ -232,13 +240,20 @@ absl::Status StreamUpload::TakeArrived() {
 
 absl::Status StreamUpload::Start(size_t count) {
   NM_RETURN_IF_ERROR(ReadUntil(count, 0, absl::Now() + flush_after_));
-  if (arrived_.empty()) {
+  if (arrived_.size() == 0) {
     return absl::InvalidArgumentError(absl::StrCat(
         stream_->name(), " ended before its first point (", stream_->ReadSoFar(), " read)"));
   }
   BoundingBox box;
-  for (const Vec3& p : arrived_) box.Extend(p);
+  for (const Vec3& p : arrived_.positions) box.Extend(p);
   origin_ = OriginOfStreamedPoints(box);
+  if (colors_wanted_ && !arrived_.color_levels.empty()) {
+    uint16_t largest = 0;
+    for (const std::array<uint16_t, 3>& levels : arrived_.color_levels) {
+      largest = std::max({largest, levels[0], levels[1], levels[2]});
+    }
+    color_scale_ = LevelScale(largest);
+  }
   started_ = true;
   return TakeArrived();
 }
@@ -259,7 +274,9 @@ absl::StatusOr<v1::PointBatch> StreamUpload::Batch(uint64_t first, size_t count)
   return MakeBatch(first,
                    std::string(reinterpret_cast<const char*>(points_.data() + first),
                                (end - first) * sizeof(Vec3f)),
-                   "");
+                   has_colors() ? std::string(reinterpret_cast<const char*>(colors_.data() + first),
+                                              (end - first) * sizeof(Rgb))
+                                : "");
 }
 
 }  // namespace neuralmesh::client

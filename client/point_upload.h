@@ -109,9 +109,9 @@ class FileRecordsUpload final : public PointUpload {
   const MappedPointFile& file_;
   const SpreadOrder order_;
   const bool colors_;
-  uint64_t slot_ = 0;    // The next position of order_ to read.
+  uint64_t slot_ = 0;                // The next position of order_ to read.
   uint64_t block_first_record_ = 0;  // The first record of slot_'s block, once slot_ is in it.
-  uint64_t points_ = 0;  // The points among the positions before slot_.
+  uint64_t points_ = 0;              // The points among the positions before slot_.
 };
 
 // The points of a LAZ file's chunks (MappedLazFile::Points), decoded a wave of kWaveChunks at
@@ -149,10 +149,10 @@ class LazFileUpload final : public PointUpload {
   const MappedLazFile& file_;
   const SpreadOrder order_;  // Of the chunks.
   const bool colors_;
-  size_t next_chunk_ = 0;    // The next position of order_ to decode.
-  std::vector<Vec3f> wave_;  // The points of the last wave decoded, in upload order,
+  size_t next_chunk_ = 0;         // The next position of order_ to decode.
+  std::vector<Vec3f> wave_;       // The points of the last wave decoded, in upload order,
   std::vector<Rgb> wave_colors_;  // and their colours (with colors_).
-  uint64_t wave_first_ = 0;  // The upload's number of wave_'s first point.
+  uint64_t wave_first_ = 0;       // The upload's number of wave_'s first point.
   uint64_t records_done_ = 0;
 };
 
@@ -160,21 +160,25 @@ class LazFileUpload final : public PointUpload {
 // standard input, `neuralmesh reconstruct - --server`), kept in memory as they come so that a batch
 // can be sent again after a lost connection. A batch goes out as soon as it is full, or once
 // `flush_after` has passed with points to send, so a slow stream's points reach the server within
-// that time. Positions only, relative to an origin chosen from the first batch (Start).
+// that time. Positions relative to an origin chosen from the first batch (Start); with `colors`,
+// the colours of a stream whose points carry them, their levels' scale (8 or 16 bits: LevelScale)
+// judged from the first batch's largest level, as an upload off-core judges it from its probe.
 class StreamUpload final : public PointUpload {
  public:
   static constexpr absl::Duration kFlushAfter = absl::Milliseconds(100);
 
-  explicit StreamUpload(std::unique_ptr<PointStream> stream,
+  explicit StreamUpload(std::unique_ptr<PointStream> stream, bool colors = false,
                         absl::Duration flush_after = kFlushAfter)
-      : stream_(std::move(stream)), flush_after_(flush_after) {}
+      : stream_(std::move(stream)), flush_after_(flush_after), colors_wanted_(colors) {}
 
   // Waits for the first batch (`count` points, or fewer once flush_after has passed or the
-  // stream ended) and chooses the origin from it (OriginOfStreamedPoints). INVALID_ARGUMENT
-  // when the stream ends without a point; the stream's errors; CANCELLED on an interrupt
-  // (InterruptScope).
+  // stream ended), chooses the origin from it (OriginOfStreamedPoints) and, with colours
+  // wanted, their scale. INVALID_ARGUMENT when the stream ends without a point; the stream's
+  // errors; CANCELLED on an interrupt (InterruptScope).
   absl::Status Start(size_t count);
   const Origin& origin() const { return origin_; }
+  // Whether the batches carry colours: wanted, and the first batch's points had them.
+  bool has_colors() const { return color_scale_ > 0; }
 
   // Start's errors, and INVALID_ARGUMENT for a point beyond a float's range from the origin.
   absl::Status SkipTo(uint64_t first) override;
@@ -196,10 +200,13 @@ class StreamUpload final : public PointUpload {
 
   std::unique_ptr<PointStream> stream_;
   absl::Duration flush_after_;
+  const bool colors_wanted_;
   bool ended_ = false;
-  std::vector<Vec3> arrived_;  // Read, in the stream's coordinates, before the origin is set.
-  std::vector<Vec3f> points_;  // Relative to origin_.
+  StreamedPoints arrived_;     // Read, in the stream's coordinates, not yet in points_.
+  std::vector<Vec3f> points_;  // Relative to origin_,
+  std::vector<Rgb> colors_;    // and their colours, with has_colors().
   Origin origin_ = kNoOrigin;
+  double color_scale_ = 0;  // The full scale of the colour levels, once has_colors().
   bool started_ = false;
 };
 

@@ -41,12 +41,15 @@ absl::StatusOr<UploadInput> StreamUploadInput(const RemoteReconstructOptions& op
         "--resume uploads the input again from the points the session has taken; standard "
         "input ('-') cannot be read again");
   }
-  auto upload = std::make_unique<StreamUpload>(OpenPointStream(STDIN_FILENO, "standard input"));
+  auto upload = std::make_unique<StreamUpload>(
+      OpenPointStream(STDIN_FILENO, "standard input", options.selection.las_classes),
+      options.colors.has_value());
   NM_RETURN_IF_ERROR(upload->Start(options.batch_size));
   UploadInput input;
   input.origin = upload->origin();
   input.streamed = true;
-  out << "INPUT '-': points streamed from standard input, sent every "
+  out << "INPUT '-': points streamed from standard input"
+      << (upload->has_colors() ? " with their colours" : "") << ", sent every "
       << absl::FormatDuration(StreamUpload::kFlushAfter) << " or " << options.batch_size
       << " points" << OriginNote(input.origin) << "\n";
   input.points = std::move(upload);

@@ -32,12 +32,15 @@ constexpr size_t kLongestLasHeader = size_t{64} << 20;
 
 // A LAS file's header and point records as they arrive (LasPointStream in point_stream.h):
 // each complete record is read as reading the file whole reads it (io_internal::LasRecords:
-// withheld records and those classified as noise left out), until the records the header
-// states before its extended variable-length records (LAS 1.4), or the stream's end.
+// withheld records left out, and those of other classes than `classes`, or without them those
+// classified as noise), with its colour levels in formats with colours, until the records the
+// header states before its extended variable-length records (LAS 1.4), or the stream's end.
 class LasPointStream final : public DescriptorPointStream {
  public:
-  LasPointStream(int fd, std::string name, std::string first_bytes)
-      : DescriptorPointStream(fd, std::move(name), std::move(first_bytes)) {}
+  LasPointStream(int fd, std::string name, std::string first_bytes,
+                 std::optional<LasClasses> classes)
+      : DescriptorPointStream(fd, std::move(name), std::move(first_bytes)),
+        classes_(std::move(classes)) {}
 
   std::string ReadSoFar() const override {
     return absl::StrCat(records_read_, records_read_ == 1 ? " LAS record" : " LAS records");
@@ -49,7 +52,7 @@ class LasPointStream final : public DescriptorPointStream {
   }
 
   // A stream that ends within its header or a record is no LAS file.
-  absl::Status End(std::vector<Vec3>* /*points*/) override {
+  absl::Status End(StreamedPoints* /*points*/) override {
     if (record_length_ == 0) {
       return Invalid(absl::StrCat("ended within the LAS header, after ", header_.size(), " bytes"));
     }
@@ -61,7 +64,7 @@ class LasPointStream final : public DescriptorPointStream {
   }
 
   // Takes the stream's next bytes: the header's, then records'.
-  absl::Status Take(absl::string_view bytes, std::vector<Vec3>* points) override {
+  absl::Status Take(absl::string_view bytes, StreamedPoints* points) override {
     if (record_length_ == 0) {
       NM_RETURN_IF_ERROR(TakeHeader(&bytes));
       if (record_length_ == 0) return absl::OkStatus();
@@ -95,7 +98,7 @@ class LasPointStream final : public DescriptorPointStream {
           "(laszip -olas -stdout)");
     }
     absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> checked =
-        io_internal::LasRecords::Create(header_, absl::string_view(), std::nullopt);
+        io_internal::LasRecords::Create(header_, absl::string_view(), classes_);
     if (!checked.ok()) return Invalid(checked.status().message());
     record_length_ = LoadScalar<uint16_t>(header_.data() + las_layout::kRecordLength, false);
     if (record_length_ == 0) return Invalid("the LAS header gives records of 0 bytes");
@@ -115,18 +118,21 @@ class LasPointStream final : public DescriptorPointStream {
   }
 
   // Reads the complete records gathered in records_, keeping a partial one for later.
-  absl::Status TakeRecords(std::vector<Vec3>* points) {
+  absl::Status TakeRecords(StreamedPoints* points) {
     const uint64_t complete = std::min<uint64_t>(records_.size() / record_length_, records_left_);
     if (complete == 0) return absl::OkStatus();
     absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> records =
         io_internal::LasRecords::Create(
-            header_, absl::string_view(records_.data(), complete * record_length_), std::nullopt);
+            header_, absl::string_view(records_.data(), complete * record_length_), classes_);
     if (!records.ok()) return Invalid(records.status().message());
     for (uint64_t i = 0; i < complete; ++i) {
       const std::optional<io_internal::Point3d> p = (*records)->KeptPoint(i);
       if (!p.has_value()) continue;
       if (!std::isfinite((*p)[0]) || !std::isfinite((*p)[1]) || !std::isfinite((*p)[2])) continue;
-      points->emplace_back((*p)[0], (*p)[1], (*p)[2]);
+      points->positions.emplace_back((*p)[0], (*p)[1], (*p)[2]);
+      if (const auto levels = (*records)->ColorLevels(i); levels.has_value()) {
+        points->color_levels.push_back(*levels);
+      }
     }
     records_read_ += complete;
     records_left_ -= complete;
@@ -140,14 +146,16 @@ class LasPointStream final : public DescriptorPointStream {
   uint64_t records_left_ = std::numeric_limits<uint64_t>::max();
   std::string records_;  // Records not read yet: a partial one at most between reads.
   uint64_t records_read_ = 0;
+  const std::optional<LasClasses> classes_;
 };
 
 // A stream whose format its first four bytes tell (OpenPointStream).
 class DetectedPointStream final : public PointStream {
  public:
-  DetectedPointStream(int fd, std::string name) : fd_(fd), name_(std::move(name)) {}
+  DetectedPointStream(int fd, std::string name, std::optional<LasClasses> las_classes)
+      : fd_(fd), name_(std::move(name)), las_classes_(std::move(las_classes)) {}
 
-  absl::StatusOr<bool> Read(absl::Duration wait, std::vector<Vec3>* points) override {
+  absl::StatusOr<bool> Read(absl::Duration wait, StreamedPoints* points) override {
     if (stream_ == nullptr) {
       char buffer[4];
       NM_ASSIGN_OR_RETURN(const StreamBytes got,
@@ -155,7 +163,13 @@ class DetectedPointStream final : public PointStream {
       first_bytes_.append(got.bytes.data(), got.bytes.size());
       if (first_bytes_.size() < 4 && !got.ended) return true;
       if (absl::StartsWith(first_bytes_, "LASF")) {
-        stream_ = std::make_unique<LasPointStream>(fd_, name_, std::move(first_bytes_));
+        stream_ =
+            std::make_unique<LasPointStream>(fd_, name_, std::move(first_bytes_), las_classes_);
+      } else if (las_classes_.has_value()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(name_,
+                         ": text, whose points have no LAS classes to choose from; "
+                         "classes choose the records of a LAS stream"));
       } else {
         stream_ = std::make_unique<PointTextStream>(fd_, name_, std::move(first_bytes_));
       }
@@ -172,6 +186,7 @@ class DetectedPointStream final : public PointStream {
  private:
   int fd_;
   std::string name_;
+  const std::optional<LasClasses> las_classes_;
   std::string first_bytes_;
   std::unique_ptr<PointStream> stream_;  // Once the format is known.
 };
@@ -195,7 +210,7 @@ absl::StatusOr<StreamBytes> ReadStreamBytes(int fd, absl::Duration wait, const s
   return StreamBytes{absl::string_view(buffer, static_cast<size_t>(got)), false};
 }
 
-absl::StatusOr<bool> DescriptorPointStream::Read(absl::Duration wait, std::vector<Vec3>* points) {
+absl::StatusOr<bool> DescriptorPointStream::Read(absl::Duration wait, StreamedPoints* points) {
   if (ended_) return false;
   if (!pending_.empty()) {
     const std::string first_bytes = std::move(pending_);
@@ -215,8 +230,9 @@ absl::StatusOr<bool> DescriptorPointStream::Read(absl::Duration wait, std::vecto
   return true;
 }
 
-std::unique_ptr<PointStream> OpenPointStream(int fd, std::string name) {
-  return std::make_unique<DetectedPointStream>(fd, std::move(name));
+std::unique_ptr<PointStream> OpenPointStream(int fd, std::string name,
+                                             std::optional<LasClasses> las_classes) {
+  return std::make_unique<DetectedPointStream>(fd, std::move(name), std::move(las_classes));
 }
 
 Origin OriginOfStreamedPoints(const BoundingBox& first_points) {

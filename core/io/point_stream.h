@@ -1,12 +1,16 @@
 // Points arriving on a file descriptor as they come: standard input fed by a scanner's or a
 // converter's pipeline (`scanner | neuralmesh reconstruct - --server ...`), a pipe or a socket.
 // A stream is text of "x y z" lines (PointTextStream) or a LAS file's header and records
-// (LasPointStream), told apart by its first bytes (OpenPointStream). Reads never block longer
-// than asked, so that a caller can send what has come at its own pace.
+// (LasPointStream: their colours too, and a choice of their classes), told apart by its first
+// bytes (OpenPointStream). Reads never block longer than asked, so that a caller can send what
+// has come at its own pace.
 #ifndef NEURALMESH_CORE_IO_POINT_STREAM_H_
 #define NEURALMESH_CORE_IO_POINT_STREAM_H_
 
+#include <array>
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,19 +18,34 @@
 #include "absl/strings/string_view.h"
 #include "absl/time/time.h"
 #include "core/bounding_box.h"
+#include "core/io/point_selection.h"
 #include "core/origin.h"
 
 namespace neuralmesh {
+
+// The points a stream gave, in its coordinates, with their colour levels where its records
+// carry colours (LAS formats 2, 3, 5, 7, 8 and 10: 16-bit fields holding 8- or 16-bit levels,
+// which the levels' largest tells apart: LevelScale in core/rgb.h).
+struct StreamedPoints {
+  std::vector<Vec3> positions;
+  std::vector<std::array<uint16_t, 3>> color_levels;  // Empty, or one per position.
+
+  size_t size() const { return positions.size(); }
+  void clear() {
+    positions.clear();
+    color_levels.clear();
+  }
+};
 
 class PointStream {
  public:
   virtual ~PointStream() = default;
 
-  // Appends the points that have arrived to `points`, in the stream's coordinates, waiting up
-  // to `wait` for a first byte when none is there. Returns whether the stream goes on (false
-  // once it ended). INVALID_ARGUMENT, naming the stream and where in it, for content that is
-  // not points of its format; UNAVAILABLE for a read that fails.
-  virtual absl::StatusOr<bool> Read(absl::Duration wait, std::vector<Vec3>* points) = 0;
+  // Appends the points that have arrived to `points`, waiting up to `wait` for a first byte
+  // when none is there. Returns whether the stream goes on (false once it ended).
+  // INVALID_ARGUMENT, naming the stream and where in it, for content that is not points of its
+  // format; UNAVAILABLE for a read that fails.
+  virtual absl::StatusOr<bool> Read(absl::Duration wait, StreamedPoints* points) = 0;
 
   // The stream's name in messages ("standard input").
   virtual const std::string& name() const = 0;
@@ -49,7 +68,7 @@ absl::StatusOr<StreamBytes> ReadStreamBytes(int fd, absl::Duration wait, const s
 // to Take as they arrive, and the end to End.
 class DescriptorPointStream : public PointStream {
  public:
-  absl::StatusOr<bool> Read(absl::Duration wait, std::vector<Vec3>* points) final;
+  absl::StatusOr<bool> Read(absl::Duration wait, StreamedPoints* points) final;
   const std::string& name() const final { return name_; }
 
  protected:
@@ -59,9 +78,9 @@ class DescriptorPointStream : public PointStream {
       : fd_(fd), name_(std::move(name)), pending_(std::move(first_bytes)) {}
 
   // Takes the bytes that arrived next: the points they complete.
-  virtual absl::Status Take(absl::string_view bytes, std::vector<Vec3>* points) = 0;
+  virtual absl::Status Take(absl::string_view bytes, StreamedPoints* points) = 0;
   // The stream ended: takes what is left, or refuses it.
-  virtual absl::Status End(std::vector<Vec3>* points) = 0;
+  virtual absl::Status End(StreamedPoints* points) = 0;
 
  private:
   int fd_;
@@ -72,8 +91,11 @@ class DescriptorPointStream : public PointStream {
 
 // The stream of `fd` (not closed here), named `name`: LAS when its first bytes are a LAS
 // file's signature ("LASF"), else text. The format is decided by the first Read calls, once
-// four bytes (or the end) have come.
-std::unique_ptr<PointStream> OpenPointStream(int fd, std::string name);
+// four bytes (or the end) have come. With `las_classes`, a LAS stream gives the points of those
+// classes (as reading the file with them: point_selection.h), and a text stream is refused
+// (INVALID_ARGUMENT), having no classes to choose from.
+std::unique_ptr<PointStream> OpenPointStream(int fd, std::string name,
+                                             std::optional<LasClasses> las_classes = std::nullopt);
 
 // Where points of a stream should be taken relative to, from the box of its first points: the
 // origin reading an XYZ file of them chooses (PositionCollector's rule), so that

@@ -15,7 +15,7 @@ constexpr size_t kLongestLine = 1 << 20;
 
 }  // namespace
 
-absl::Status PointTextStream::ParseLine(absl::string_view line, std::vector<Vec3>* points) {
+absl::Status PointTextStream::ParseLine(absl::string_view line, StreamedPoints* points) {
   ++lines_;
   line = absl::StripTrailingAsciiWhitespace(io_internal::StripHashComment(line));  // CRLF.
   std::vector<absl::string_view> tokens;
@@ -30,7 +30,7 @@ absl::Status PointTextStream::ParseLine(absl::string_view line, std::vector<Vec3
                        " does not start with a point's x, y and z (three finite numbers)"));
     }
   }
-  points->push_back(p);
+  points->positions.push_back(p);
   return absl::OkStatus();
 }
 
@@ -38,14 +38,14 @@ std::string PointTextStream::ReadSoFar() const {
   return absl::StrCat(lines_, lines_ == 1 ? " line" : " lines");
 }
 
-absl::Status PointTextStream::End(std::vector<Vec3>* points) {
+absl::Status PointTextStream::End(StreamedPoints* points) {
   if (partial_.empty()) return absl::OkStatus();
   const std::string last = std::move(partial_);
   partial_.clear();
   return ParseLine(last, points);
 }
 
-absl::Status PointTextStream::Take(absl::string_view text, std::vector<Vec3>* points) {
+absl::Status PointTextStream::Take(absl::string_view text, StreamedPoints* points) {
   for (size_t newline = text.find('\n'); newline != absl::string_view::npos;
        newline = text.find('\n')) {
     absl::Status parsed;

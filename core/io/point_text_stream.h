@@ -33,11 +33,11 @@ class PointTextStream final : public DescriptorPointStream {
 
  private:
   // The points of the lines `text` completes.
-  absl::Status Take(absl::string_view text, std::vector<Vec3>* points) override;
+  absl::Status Take(absl::string_view text, StreamedPoints* points) override;
   // The last line, if it has no newline.
-  absl::Status End(std::vector<Vec3>* points) override;
+  absl::Status End(StreamedPoints* points) override;
   // Parses the complete line `line` (without its newline) into `points`.
-  absl::Status ParseLine(absl::string_view line, std::vector<Vec3>* points);
+  absl::Status ParseLine(absl::string_view line, StreamedPoints* points);
 
   std::string partial_;  // The start of a line whose end has not arrived.
   uint64_t lines_ = 0;

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <numeric>
 #include <regex>
 #include <string>
 #include <vector>
@@ -172,10 +173,12 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
     return created->session_id();
   };
   const std::string id = upload_first(1500, order.upload_order());
-  const std::vector<std::string> resume = {"reconstruct", "builtin:sphere", "--server",
-                                           server_->address(), "--out-dir", *dir_ + "/resumed",
-                                           "--points", "4000", "--batch-size", "500",
-                                           "--resume", id};
+  const std::vector<std::string> resume = {"reconstruct",  "builtin:sphere",
+                                           "--server",     server_->address(),
+                                           "--out-dir",    *dir_ + "/resumed",
+                                           "--points",     "4000",
+                                           "--batch-size", "500",
+                                           "--resume",     id};
   const RunResult resumed = RunNeuralmesh(resume);
   ASSERT_EQ(resumed.exit_code, 0) << resumed.Describe();
   EXPECT_THAT(resumed.out, ::testing::HasSubstr("resuming at point 1500"));
@@ -219,9 +222,9 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
   absl::StatusOr<v1::Session> untouched = (*service)->GetSession(other);
   ASSERT_TRUE(untouched.ok()) << untouched.status();
   EXPECT_EQ(untouched->points_taken(), 1500u) << "nothing sent";
-  const RunResult local = RunNeuralmesh(
-      {"reconstruct", "builtin:sphere", "-o", *dir_ + "/local.ply", "--vertices", "100",
-       "--resume", id});
+  const RunResult local =
+      RunNeuralmesh({"reconstruct", "builtin:sphere", "-o", *dir_ + "/local.ply", "--vertices",
+                     "100", "--resume", id});
   EXPECT_NE(local.exit_code, 0);
   EXPECT_THAT(local.err, ::testing::HasSubstr("--resume needs --server"));
 }
@@ -232,10 +235,10 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
 TEST_F(RemoteCliTest, AStartMeshIsRefinedOnTheServer) {
   ASSERT_EQ(reconstruct_->exit_code, 0) << reconstruct_->Describe();
   const std::string out = *dir_ + "/refined";
-  const RunResult run = RunNeuralmesh(
-      {"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir", out,
-       "--vertices", "1500", "--points", "6000", "--lod", "1000", "--start_mesh",
-       *dir_ + "/out/sphere.ply"});
+  const RunResult run =
+      RunNeuralmesh({"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir",
+                     out, "--vertices", "1500", "--points", "6000", "--lod", "1000", "--start_mesh",
+                     *dir_ + "/out/sphere.ply"});
   ASSERT_EQ(run.exit_code, 0) << run.Describe();
   EXPECT_EQ(RowVertices(run.out, "refresh").front(), 400u) << run.out;
   EXPECT_EQ(RowVertices(run.out, "lod"), std::vector<uint64_t>{1000}) << run.out;
@@ -246,9 +249,9 @@ TEST_F(RemoteCliTest, AStartMeshIsRefinedOnTheServer) {
   EXPECT_LT(basic_steps, 130000) << run.out;
   EXPECT_LT(HausdorffToTheUnitSphere(out + "/sphere.drc"), 0.02);
 
-  const RunResult resumed = RunNeuralmesh(
-      {"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir", out,
-       "--resume", "s-0", "--start_mesh", *dir_ + "/out/sphere.ply"});
+  const RunResult resumed =
+      RunNeuralmesh({"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir",
+                     out, "--resume", "s-0", "--start_mesh", *dir_ + "/out/sphere.ply"});
   EXPECT_EQ(resumed.exit_code, 1) << resumed.Describe();
   EXPECT_THAT(resumed.err, ::testing::HasSubstr("--start_mesh applies to a new session"));
 }
@@ -259,10 +262,10 @@ TEST_F(RemoteCliTest, ALostConnectionIsRiddenOutAndEveryPointArrivesOnce) {
   const std::string& address = server_->address();
   TcpProxy proxy(std::stoi(address.substr(address.rfind(':') + 1)),
                  /*cut_after_client_bytes=*/300 * 1000);
-  const RunResult run = RunNeuralmesh(
-      {"reconstruct", "builtin:sphere", "--server", absl::StrCat("127.0.0.1:", proxy.port()),
-       "--out-dir", *dir_ + "/ridden", "--points", "60000", "--batch-size", "1000", "--vertices",
-       "400"});
+  const RunResult run =
+      RunNeuralmesh({"reconstruct", "builtin:sphere", "--server",
+                     absl::StrCat("127.0.0.1:", proxy.port()), "--out-dir", *dir_ + "/ridden",
+                     "--points", "60000", "--batch-size", "1000", "--vertices", "400"});
   ASSERT_TRUE(proxy.cut()) << "the upload of 720 KB passed the 300 KB mark";
   ASSERT_EQ(run.exit_code, 0) << run.Describe();
   EXPECT_THAT(run.err, ::testing::HasSubstr("lost (UploadPoints")) << run.Describe();
@@ -288,10 +291,13 @@ TEST_F(RemoteCliTest, ALostConnectionKeepsTheSessionAndResumeFinishesIt) {
   const std::string& address = server_->address();
   TcpProxy proxy(std::stoi(address.substr(address.rfind(':') + 1)),
                  /*cut_after_client_bytes=*/300 * 1000);
-  std::vector<std::string> args = {
-      "reconstruct", "builtin:sphere", "--server", absl::StrCat("127.0.0.1:", proxy.port()),
-      "--out-dir", *dir_ + "/lost", "--points", "60000", "--batch-size", "1000",
-      "--vertices", "400", "--reconnect_for", "0"};
+  std::vector<std::string> args = {"reconstruct",     "builtin:sphere",
+                                   "--server",        absl::StrCat("127.0.0.1:", proxy.port()),
+                                   "--out-dir",       *dir_ + "/lost",
+                                   "--points",        "60000",
+                                   "--batch-size",    "1000",
+                                   "--vertices",      "400",
+                                   "--reconnect_for", "0"};
   const RunResult lost = RunNeuralmesh(args);
   ASSERT_TRUE(proxy.cut()) << "the upload of 720 KB passed the 300 KB mark";
   EXPECT_NE(lost.exit_code, 0) << lost.Describe();
@@ -316,8 +322,8 @@ TEST_F(RemoteCliTest, ALostConnectionKeepsTheSessionAndResumeFinishesIt) {
   args.insert(args.end(), {"--resume", id});
   const RunResult resumed = RunNeuralmesh(args);
   ASSERT_EQ(resumed.exit_code, 0) << resumed.Describe();
-  EXPECT_THAT(resumed.out, ::testing::HasSubstr(
-                               absl::StrCat("resuming at point ", kept->points_taken())));
+  EXPECT_THAT(resumed.out,
+              ::testing::HasSubstr(absl::StrCat("resuming at point ", kept->points_taken())));
   absl::StatusOr<v1::Session> done = (*service)->GetSession(id);
   ASSERT_TRUE(done.ok()) << done.status();
   EXPECT_EQ(done->state(), v1::SESSION_STATE_FINISHED);
@@ -378,9 +384,9 @@ TEST_F(RemoteCliTest, LasClassesChooseThePointsUploaded) {
   }
   const std::string las = *dir_ + "/site.las";
   std::ofstream(las, std::ios::binary) << testing::LasFile(layout, points);
-  const RunResult run = RunNeuralmesh({"reconstruct", las, "--server", server_->address(),
-                                       "--out-dir", *dir_ + "/building", "--vertices", "400",
-                                       "--las_classes", "6"});
+  const RunResult run =
+      RunNeuralmesh({"reconstruct", las, "--server", server_->address(), "--out-dir",
+                     *dir_ + "/building", "--vertices", "400", "--las_classes", "6"});
   ASSERT_EQ(run.exit_code, 0) << run.Describe();
   EXPECT_TRUE(absl::StrContains(run.out, "left out 4000 points of other classes")) << run.out;
   const double hausdorff = HausdorffToTheUnitSphere(*dir_ + "/building/site.drc");
@@ -415,14 +421,14 @@ TEST_F(RemoteCliTest, ColouredPointsComeBackAsColouredMeshes) {
   for (const bool colors : {true, false}) {
     SCOPED_TRACE(colors ? "colours" : "--nocolors");
     const std::string out_dir = *dir_ + (colors ? "/colored" : "/uncolored");
-    std::vector<std::string> args = {"reconstruct", cloud, "--server", server_->address(),
-                                     "--out-dir", out_dir, "--vertices", "600", "--ply",
-                                     "--glb", "--color_neighbours", "4"};
+    std::vector<std::string> args = {
+        "reconstruct", cloud,   "--server",           server_->address(),
+        "--out-dir",   out_dir, "--vertices",         "600",
+        "--ply",       "--glb", "--color_neighbours", "4"};
     if (!colors) args.push_back("--nocolors");
     const RunResult run = RunNeuralmesh(args);
     ASSERT_EQ(run.exit_code, 0) << run.Describe();
-    for (const char* name :
-         {"/colored_sphere.drc", "/colored_sphere.ply", "/colored_sphere.glb"}) {
+    for (const char* name : {"/colored_sphere.drc", "/colored_sphere.ply", "/colored_sphere.glb"}) {
       const absl::StatusOr<TriangleMesh> mesh = ReadMesh(out_dir + name);
       ASSERT_TRUE(mesh.ok()) << mesh.status();
       if (!colors) {
@@ -499,17 +505,16 @@ TEST_F(RemoteCliTest, GeoreferencedScansComeBackInTheirCoordinates) {
   std::string xyz[2];
   for (size_t i = 0; i < unit.size(); ++i) {
     const Vec3f& p = unit.positions[i];
-    xyz[i % 2] += absl::StrFormat("%.4f %.4f %.4f\n", centre[0] + p[0], centre[1] + p[1],
-                                  centre[2] + p[2]);
+    xyz[i % 2] +=
+        absl::StrFormat("%.4f %.4f %.4f\n", centre[0] + p[0], centre[1] + p[1], centre[2] + p[2]);
   }
   const std::string scan = *dir_ + "/utm_scan.xyz";
   const std::string second = *dir_ + "/utm_scan_2.xyz";
   std::ofstream(scan) << xyz[0];
   std::ofstream(second) << xyz[1];
   const std::string out_dir = *dir_ + "/utm";
-  const RunResult run =
-      RunNeuralmesh({"reconstruct", scan, second, "--server", server_->address(), "--out-dir",
-                     out_dir, "--vertices", "500", "--ply"});
+  const RunResult run = RunNeuralmesh({"reconstruct", scan, second, "--server", server_->address(),
+                                       "--out-dir", out_dir, "--vertices", "500", "--ply"});
   ASSERT_EQ(run.exit_code, 0) << run.Describe();
   EXPECT_TRUE(absl::StrContains(run.out, "coordinates taken relative to (500000, 4100000, 0)"))
       << run.out;
@@ -708,9 +713,14 @@ TEST_F(RemoteCliTest, OffCoreUploadsAScanFromWhereItLies) {
 // the whole sphere in the scan's coordinates, from every point once.
 TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
   const double centre[3] = {500123.5, 4100456.25, 80};
-  std::vector<Vec3f> sphere = ColoredUnitSpherePoints(4000, 31).positions;
-  std::sort(sphere.begin(), sphere.end(),
-            [](const Vec3f& a, const Vec3f& b) { return a[2] < b[2]; });
+  const PointCloud colored = ColoredUnitSpherePoints(4000, 31);
+  std::vector<size_t> bottom_up(colored.size());
+  std::iota(bottom_up.begin(), bottom_up.end(), 0);
+  std::sort(bottom_up.begin(), bottom_up.end(), [&colored](size_t a, size_t b) {
+    return colored.positions[a][2] < colored.positions[b][2];
+  });
+  std::vector<Vec3f> sphere;
+  for (size_t i : bottom_up) sphere.push_back(colored.positions[i]);
   std::string lower, upper;
   for (size_t i = 0; i < sphere.size(); ++i) {
     (i < 2000 ? lower : upper) +=
@@ -756,24 +766,35 @@ TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
   EXPECT_EQ(session->state(), v1::SESSION_STATE_FINISHED);
   EXPECT_EQ(session->points_taken(), 4000u);
 
-  // The same sphere as a LAS file piped in (a converter's `-stdout`): its records as they come.
+  // The same sphere as a LAS file piped in (a converter's `-stdout`): its records as they come,
+  // of the classes asked for, with their colours (16-bit levels).
   testing::LasLayout layout;
-  layout.format = 1;
+  layout.format = 3;
   for (double& s : layout.scale) s = 0.0001;
   layout.offset[0] = 500000;
   layout.offset[1] = 4100000;
   std::vector<testing::LasPoint> records;
-  for (const Vec3f& p : sphere) {
-    records.push_back({static_cast<int32_t>(std::lround((centre[0] + p[0] - 500000) / 0.0001)),
-                       static_cast<int32_t>(std::lround((centre[1] + p[1] - 4100000) / 0.0001)),
-                       static_cast<int32_t>(std::lround((centre[2] + p[2]) / 0.0001))});
+  for (size_t i : bottom_up) {
+    const Vec3f& p = colored.positions[i];
+    testing::LasPoint record{
+        static_cast<int32_t>(std::lround((centre[0] + p[0] - 500000) / 0.0001)),
+        static_cast<int32_t>(std::lround((centre[1] + p[1] - 4100000) / 0.0001)),
+        static_cast<int32_t>(std::lround((centre[2] + p[2]) / 0.0001))};
+    record.red = colored.colors[i][0] * 257;
+    record.green = colored.colors[i][1] * 257;
+    record.blue = colored.colors[i][2] * 257;
+    record.classification = 2;
+    records.push_back(record);
   }
-  records[7].classification = 7;  // Noise: left out, as reading the file leaves it out.
+  records[7].classification = 7;  // Noise, not asked for.
+  records[8].classification = 6;  // A building, not asked for.
+  records[9].classification = 1;
   const std::string las = testing::LasFile(layout, records);
-  BackgroundProcess piped("neuralmesh",
-                          {"reconstruct", "-", "--server", server_->address(), "--out-dir",
-                           *dir_ + "/streamed_las", "--vertices", "400", "--batch-size", "500"},
-                          /*stdin_pipe=*/true);
+  BackgroundProcess piped(
+      "neuralmesh",
+      {"reconstruct", "-", "--server", server_->address(), "--out-dir", *dir_ + "/streamed_las",
+       "--vertices", "400", "--batch-size", "500", "--las_classes", "1-2"},
+      /*stdin_pipe=*/true);
   ASSERT_TRUE(piped.WriteStdin(las.substr(0, 100)));  // The header split across writes.
   absl::SleepFor(absl::Milliseconds(150));
   ASSERT_TRUE(piped.WriteStdin(las.substr(100)));
@@ -785,11 +806,39 @@ TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
   ASSERT_TRUE(from_las.ok()) << from_las.status();
   EXPECT_EQ(from_las->positions.size(), 400u);
   EXPECT_LT(FarthestFromTheUnitSphere(*from_las, centre), 0.05) << "a vertex off the sphere";
+  ASSERT_EQ(from_las->colors.size(), from_las->positions.size()) << "the colours were not sent";
+  int worst = 0;
+  for (size_t v = 0; v < from_las->positions.size(); ++v) {
+    Vec3f on_sphere;
+    for (int c = 0; c < 3; ++c) {
+      on_sphere[c] =
+          static_cast<float>(from_las->origin[c] + from_las->positions[v][c] - centre[c]);
+    }
+    worst = std::max(worst, ColorError(from_las->colors[v], on_sphere.normalized()));
+  }
+  EXPECT_LE(worst, 8) << "a vertex's colour is not its place's";
   const std::string piped_out = piped.Stdout();
+  EXPECT_THAT(piped_out, ::testing::HasSubstr("from standard input with their colours"));
   ASSERT_TRUE(std::regex_search(piped_out, id, std::regex("session (s-[0-9a-f]+) on ")));
   session = (*service)->GetSession(id[1]);
   ASSERT_TRUE(session.ok()) << session.status();
-  EXPECT_EQ(session->points_taken(), 3999u) << "every record but the noise";
+  EXPECT_EQ(session->points_taken(), 3998u) << "every record of classes 1 and 2";
+
+  // Classes choose among LAS records: a stream of text has none.
+  BackgroundProcess classes_of_text("neuralmesh",
+                                    {"reconstruct", "-", "--server", server_->address(),
+                                     "--out-dir", *dir_ + "/streamed_text", "--las_classes", "2"},
+                                    /*stdin_pipe=*/true);
+  ASSERT_TRUE(classes_of_text.WriteStdin("1 2 3\n"));  // One write: it cannot fail before.
+  classes_of_text.CloseStdin();
+  for (int i = 0; i < 600 && classes_of_text.Running(); ++i) {
+    absl::SleepFor(absl::Milliseconds(50));
+  }
+  ASSERT_FALSE(classes_of_text.Running());
+  EXPECT_EQ(classes_of_text.exit_code(), 1);
+  EXPECT_THAT(classes_of_text.Stderr(),
+              ::testing::HasSubstr("standard input: text, whose points have no LAS classes to "
+                                   "choose from"));
 
   // A line that is not a point ends the upload, naming it; the session is cancelled.
   BackgroundProcess bad("neuralmesh",
@@ -911,15 +960,15 @@ TEST_F(RemoteCliTest, SessionCommandsGetFinishCancelTransferAndDelete) {
   absl::StatusOr<PointCloud> cloud = client::LoadPointsForUpload({"builtin:sphere"}, 4000, 5);
   ASSERT_TRUE(cloud.ok()) << cloud.status();
   ASSERT_TRUE((*service)->UploadPoints(id, *cloud, 1000).ok());
-  const RunResult latest = RunNeuralmesh(
-      {"get", id, "--server", address, "-o", out + "/latest.ply", "--wait", "30s"});
+  const RunResult latest =
+      RunNeuralmesh({"get", id, "--server", address, "-o", out + "/latest.ply", "--wait", "30s"});
   ASSERT_EQ(latest.exit_code, 0) << latest.Describe();
   absl::StatusOr<TriangleMesh> latest_mesh = ReadMesh(out + "/latest.ply");
   ASSERT_TRUE(latest_mesh.ok()) << latest_mesh.status();
   EXPECT_GE(latest_mesh->positions.size(), 4u);
   EXPECT_THAT(latest.out, ::testing::HasSubstr(out + "/latest.ply"));
-  const RunResult as_gltf = RunNeuralmesh(
-      {"get", id, "--server", address, "-o", out + "/latest.glb", "--gltf_draco"});
+  const RunResult as_gltf =
+      RunNeuralmesh({"get", id, "--server", address, "-o", out + "/latest.glb", "--gltf_draco"});
   ASSERT_EQ(as_gltf.exit_code, 0) << as_gltf.Describe();
   absl::StatusOr<TriangleMesh> gltf_mesh = ReadMesh(out + "/latest.glb");
   ASSERT_TRUE(gltf_mesh.ok()) << gltf_mesh.status();
@@ -966,7 +1015,8 @@ TEST_F(RemoteCliTest, SessionCommandsGetFinishCancelTransferAndDelete) {
   const RunResult bad_format =
       RunNeuralmesh({"get", id, "--server", address, "-o", out + "/mesh.txt"});
   EXPECT_EQ(bad_format.exit_code, 1) << bad_format.Describe();
-  EXPECT_THAT(bad_format.err, ::testing::HasSubstr("use one of .ply, .obj, .off, .stl, .drc, .glb, .gltf"));
+  EXPECT_THAT(bad_format.err,
+              ::testing::HasSubstr("use one of .ply, .obj, .off, .stl, .drc, .glb, .gltf"));
   const RunResult bad_wait =
       RunNeuralmesh({"get", id, "--server", address, "-o", out + "/m.ply", "--wait", "-1s"});
   EXPECT_EQ(bad_wait.exit_code, 1) << bad_wait.Describe();
@@ -1035,9 +1085,9 @@ TEST(RemoteCliWatchTest, AWatchWhoseServerStaysAwaySaysHowToGoOn) {
   absl::StatusOr<client::v1::Session> session = (*service)->CreateSession(config, "waiting");
   ASSERT_TRUE(session.ok()) << session.status();
   const std::string dir = MakeTempDir("cli_watch_away");
-  BackgroundProcess watch("neuralmesh", {"watch", session->session_id(), "--server",
-                                         server->address(), "--out-dir", dir, "--reconnect_for",
-                                         "1s"});
+  BackgroundProcess watch(
+      "neuralmesh", {"watch", session->session_id(), "--server", server->address(), "--out-dir",
+                     dir, "--reconnect_for", "1s"});
   usleep(500 * 1000);  // The watch is open on a session without points.
   server->Signal(SIGKILL);
   const absl::Time killed = absl::Now();

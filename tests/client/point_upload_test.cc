@@ -315,7 +315,8 @@ TEST(StreamUploadTest, SendsPointsAsTheyArriveRelativeToTheFirstPointsOrigin) {
   ASSERT_EQ(pipe(fds), 0);
   const std::string first = "500123.5 4100456.25 80\n500124.5 4100457.25 81\n";
   ASSERT_EQ(write(fds[1], first.data(), first.size()), static_cast<ssize_t>(first.size()));
-  StreamUpload upload(OpenPointStream(fds[0], "standard input"), absl::Milliseconds(50));
+  StreamUpload upload(OpenPointStream(fds[0], "standard input"), /*colors=*/false,
+                      absl::Milliseconds(50));
   ASSERT_TRUE(upload.Start(1000).ok());
   EXPECT_EQ(upload.origin(), (Origin{500000, 4100000, 0}));
   EXPECT_EQ(upload.done(), 2u);
@@ -342,6 +343,51 @@ TEST(StreamUploadTest, SendsPointsAsTheyArriveRelativeToTheFirstPointsOrigin) {
   EXPECT_EQ(PointsOf(*batch), (std::vector<Point>{{124.5f, 457.25f, 81}}));
   EXPECT_EQ(upload.SkipTo(4).code(), absl::StatusCode::kOutOfRange);
   close(fds[0]);
+}
+
+// A LAS stream of 8-bit colour levels (format 2): with colours asked for, each batch carries
+// its points' colours as they are; without, none.
+TEST(StreamUploadTest, SendsTheColoursOfALasStreamWhenAsked) {
+  std::vector<testing::LasPoint> records;
+  for (int i = 0; i < 300; ++i) {
+    testing::LasPoint p{};
+    p.x = 100 * i;
+    p.y = 7 * (i % 11);
+    p.z = i % 5;
+    p.red = static_cast<uint16_t>(i % 256);
+    p.green = static_cast<uint16_t>(255 - i % 256);
+    p.blue = 17;
+    records.push_back(p);
+  }
+  testing::LasLayout layout;
+  layout.format = 2;
+  const std::string las = testing::LasFile(layout, records);
+  for (const bool colors : {true, false}) {
+    SCOPED_TRACE(colors ? "colours" : "no colours");
+    int fds[2];
+    ASSERT_EQ(pipe(fds), 0);
+    ASSERT_EQ(write(fds[1], las.data(), las.size()), static_cast<ssize_t>(las.size()));
+    close(fds[1]);
+    StreamUpload upload(OpenPointStream(fds[0], "standard input"), colors);
+    ASSERT_TRUE(upload.Start(100).ok());
+    EXPECT_EQ(upload.has_colors(), colors);
+    absl::StatusOr<v1::PointBatch> batch = upload.Batch(200, 1000);
+    ASSERT_TRUE(batch.ok()) << batch.status();
+    ASSERT_EQ(PointsOf(*batch).size(), 100u);
+    const std::string& packed = batch->packed().colors();
+    if (!colors) {
+      EXPECT_TRUE(packed.empty());
+    } else {
+      ASSERT_EQ(packed.size(), 300u);
+      for (int k = 0; k < 100; ++k) {
+        const int i = 200 + k;
+        ASSERT_EQ(static_cast<uint8_t>(packed[3 * k]), i % 256) << "point " << i;
+        ASSERT_EQ(static_cast<uint8_t>(packed[3 * k + 1]), 255 - i % 256) << "point " << i;
+        ASSERT_EQ(static_cast<uint8_t>(packed[3 * k + 2]), 17) << "point " << i;
+      }
+    }
+    close(fds[0]);
+  }
 }
 
 TEST(StreamUploadTest, APointFarFromTheOriginIsAnError) {
@@ -441,7 +487,9 @@ TEST(FileUploadTest, ColoursGoWithTheirPointsWhenAsked) {
   std::ofstream(mixed, std::ios::binary) << PlyOfMixedChannels(*read);
   for (const std::string& path : {las, Dir() + "/colored.ply", Dir() + "/colored.pcd", mixed}) {
     SCOPED_TRACE(path);
-    if (path != las && path != mixed) ASSERT_TRUE(WritePointCloud(*read, path).ok());
+    if (path != las && path != mixed) {
+      ASSERT_TRUE(WritePointCloud(*read, path).ok());
+    }
     absl::StatusOr<PointCloud> whole = ReadPointCloud(path);
     ASSERT_TRUE(whole.ok()) << whole.status();
     ASSERT_EQ(whole->colors, read->colors) << "the file holds the scan's colours";

@@ -11,6 +11,7 @@
 #include "absl/time/time.h"
 #include "core/io/internal/laz.h"
 #include "core/io/point_cloud_io.h"
+#include "core/io/point_selection.h"
 #include "core/random.h"
 #include "gtest/gtest.h"
 #include "tests/testing/las_file.h"
@@ -46,7 +47,7 @@ std::string ScanLas(int records) {
 // Reads `stream` to its end, writing `bytes` into `pipe` in pieces of the sizes `pieces` cycles
 // through, a read after each; returns the last status.
 absl::Status ReadInPieces(PointStream& stream, Pipe& pipe, absl::string_view bytes,
-                          const std::vector<size_t>& pieces, std::vector<Vec3>* points) {
+                          const std::vector<size_t>& pieces, StreamedPoints* points) {
   for (size_t at = 0, k = 0; at < bytes.size(); ++k) {
     const size_t size = std::min(pieces[k % pieces.size()], bytes.size() - at);
     pipe.Write(bytes.substr(at, size));
@@ -75,8 +76,9 @@ TEST(LasPointStreamTest, ALasFileArrivingInPiecesGivesThePointsReadingItWholeDoe
     SCOPED_TRACE(pieces.front());
     Pipe pipe;
     std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "standard input");
-    std::vector<Vec3> points;
-    const absl::Status read = ReadInPieces(*stream, pipe, bytes, pieces, &points);
+    StreamedPoints streamed;
+    std::vector<Vec3>& points = streamed.positions;
+    const absl::Status read = ReadInPieces(*stream, pipe, bytes, pieces, &streamed);
     ASSERT_TRUE(read.ok()) << read;
     EXPECT_EQ(stream->ReadSoFar(), "1000 LAS records") << "the EVLR after them is no record";
     ASSERT_EQ(points.size(), whole->size()) << "withheld and noise records left out";
@@ -94,8 +96,8 @@ TEST(LasPointStreamTest, WhatIsNoLasStreamIsAnErrorSayingWhy) {
   const auto error_of = [](absl::string_view stream_bytes) {
     Pipe pipe;
     std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "the scanner");
-    std::vector<Vec3> points;
-    return ReadInPieces(*stream, pipe, stream_bytes, {1000}, &points);
+    StreamedPoints streamed;
+    return ReadInPieces(*stream, pipe, stream_bytes, {1000}, &streamed);
   };
   absl::Status status = error_of(bytes.substr(0, 300));
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
@@ -113,6 +115,63 @@ TEST(LasPointStreamTest, WhatIsNoLasStreamIsAnErrorSayingWhy) {
             "(laszip -olas -stdout)");
 }
 
+// A coloured scan of buildings and ground (LAS 1.4, format 7) read with classes: the records
+// and colour levels reading the file with them gives; text with classes is refused.
+TEST(LasPointStreamTest, ClassesChooseTheRecordsAndColoursComeWithThem) {
+  std::vector<testing::LasPoint> records;
+  for (int i = 0; i < 600; ++i) {
+    testing::LasPoint p{};
+    p.x = 41 * i;
+    p.y = 1000 * (i % 17);
+    p.z = 90000 + 3 * i;
+    p.classification = i % 3 == 0 ? 6 : i % 3 == 1 ? 2 : 5;  // Building, ground, vegetation.
+    p.withheld = i % 50 == 0;
+    p.red = static_cast<uint16_t>(100 * i);
+    p.green = static_cast<uint16_t>(65535 - 90 * i);
+    p.blue = static_cast<uint16_t>(i);
+    records.push_back(p);
+  }
+  const std::string bytes = testing::LasFile(testing::UtmMillimetreLayout(7), records);
+  const std::string path = testing::ProcessTempDir() + "/coloured_scan.las";
+  std::ofstream(path, std::ios::binary) << bytes;
+  absl::StatusOr<LasClasses> classes = ParseLasClasses("2,6");
+  ASSERT_TRUE(classes.ok());
+  absl::StatusOr<PointCloud> whole = ReadPointCloud(path, nullptr, PointSelection{*classes});
+  ASSERT_TRUE(whole.ok()) << whole.status();
+  ASSERT_EQ(whole->colors.size(), whole->size());
+
+  Pipe pipe;
+  std::unique_ptr<PointStream> stream =
+      OpenPointStream(pipe.read_end(), "standard input", *classes);
+  StreamedPoints streamed;
+  const absl::Status read = ReadInPieces(*stream, pipe, bytes, {333}, &streamed);
+  ASSERT_TRUE(read.ok()) << read;
+  ASSERT_EQ(streamed.size(), 392u) << "400 records of classes 2 and 6, 8 of them withheld";
+  ASSERT_EQ(streamed.size(), whole->size());
+  ASSERT_EQ(streamed.color_levels.size(), streamed.size());
+  for (size_t i = 0; i < streamed.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_EQ(static_cast<float>(streamed.positions[i][c] - whole->origin[c]),
+                whole->positions[i][c])
+          << "point " << i;
+    }
+    ASSERT_EQ(RgbFromLevels(streamed.color_levels[i], 65535), whole->colors[i]) << "point " << i;
+  }
+  EXPECT_EQ(streamed.color_levels[1], (std::array<uint16_t, 3>{300, 65535 - 270, 3}))
+      << "the second point is record 3 (record 0 is withheld, record 2 vegetation)";
+
+  Pipe text_pipe;
+  std::unique_ptr<PointStream> text =
+      OpenPointStream(text_pipe.read_end(), "the scanner", *classes);
+  StreamedPoints none;
+  const absl::Status refused = ReadInPieces(*text, text_pipe, "1 2 3\n", {6}, &none);
+  EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument) << refused;
+  EXPECT_EQ(refused.message(),
+            "the scanner: text, whose points have no LAS classes to choose from; classes choose "
+            "the records of a LAS stream");
+  EXPECT_EQ(none.size(), 0u);
+}
+
 // Streams whose header bytes are mangled at random: each is read to its end or refused with
 // INVALID_ARGUMENT (AddressSanitizer's build checks that no byte is read out of bounds).
 TEST(LasPointStreamTest, MangledHeadersAreReadOrRefused) {
@@ -126,8 +185,9 @@ TEST(LasPointStreamTest, MangledHeadersAreReadOrRefused) {
     }
     Pipe pipe;
     std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "standard input");
-    std::vector<Vec3> points;
-    const absl::Status read = ReadInPieces(*stream, pipe, mangled, {4096}, &points);
+    StreamedPoints streamed;
+    std::vector<Vec3>& points = streamed.positions;
+    const absl::Status read = ReadInPieces(*stream, pipe, mangled, {4096}, &streamed);
     if (!read.ok()) {
       ASSERT_EQ(read.code(), absl::StatusCode::kInvalidArgument) << read;
       ++refused;
@@ -142,8 +202,9 @@ TEST(LasPointStreamTest, AStreamNotStartingLikeLasIsText) {
     SCOPED_TRACE(text);
     Pipe pipe;
     std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "standard input");
-    std::vector<Vec3> points;
-    const absl::Status read = ReadInPieces(*stream, pipe, text, {2}, &points);
+    StreamedPoints streamed;
+    std::vector<Vec3>& points = streamed.positions;
+    const absl::Status read = ReadInPieces(*stream, pipe, text, {2}, &streamed);
     if (text == "LAS 1 2\n") {
       EXPECT_EQ(read.code(), absl::StatusCode::kInvalidArgument) << read;
       EXPECT_TRUE(absl::StrContains(read.message(), "line 1")) << read;

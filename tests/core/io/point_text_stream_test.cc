@@ -18,14 +18,15 @@ using testing::Pipe;
 TEST(PointTextStreamTest, ReadsPointsAsTheirLinesComplete) {
   Pipe pipe;
   PointTextStream stream(pipe.read_end(), "standard input");
-  std::vector<Vec3> points;
-  absl::StatusOr<bool> more = stream.Read(absl::Milliseconds(10), &points);
+  StreamedPoints read;
+  std::vector<Vec3>& points = read.positions;
+  absl::StatusOr<bool> more = stream.Read(absl::Milliseconds(10), &read);
   ASSERT_TRUE(more.ok()) << more.status();
   EXPECT_TRUE(*more) << "nothing arrived yet: the stream goes on";
   EXPECT_TRUE(points.empty());
 
   pipe.Write("# x y z\n1 2 3\n4.5,5.5,6.5,200,10,10\r\n\n7 8");
-  more = stream.Read(absl::Milliseconds(100), &points);
+  more = stream.Read(absl::Milliseconds(100), &read);
   ASSERT_TRUE(more.ok()) << more.status();
   EXPECT_TRUE(*more);
   ASSERT_EQ(points.size(), 2u) << "the third line has not ended";
@@ -33,7 +34,7 @@ TEST(PointTextStreamTest, ReadsPointsAsTheirLinesComplete) {
   pipe.Write(" 9\n500000.25\t4100000.5\t80 # a comment\n10 11 12");
   pipe.CloseWriteEnd();
   while (*more) {
-    more = stream.Read(absl::Milliseconds(100), &points);
+    more = stream.Read(absl::Milliseconds(100), &read);
     ASSERT_TRUE(more.ok()) << more.status();
   }
   ASSERT_EQ(points.size(), 5u) << "the last line is taken at the end without its newline";
@@ -41,7 +42,8 @@ TEST(PointTextStreamTest, ReadsPointsAsTheirLinesComplete) {
   EXPECT_EQ(points[3], Vec3(500000.25, 4100000.5, 80));
   EXPECT_EQ(points[4], Vec3(10, 11, 12));
   EXPECT_EQ(stream.lines(), 7u);
-  more = stream.Read(absl::Milliseconds(10), &points);
+  EXPECT_TRUE(read.color_levels.empty()) << "further columns are ignored";
+  more = stream.Read(absl::Milliseconds(10), &read);
   ASSERT_TRUE(more.ok());
   EXPECT_FALSE(*more);
 }
@@ -51,8 +53,8 @@ TEST(PointTextStreamTest, ALineThatIsNoPointIsAnErrorNamingIt) {
     Pipe pipe;
     PointTextStream stream(pipe.read_end(), "standard input");
     pipe.Write(std::string("1 2 3\n") + bad);
-    std::vector<Vec3> points;
-    absl::StatusOr<bool> more = stream.Read(absl::Milliseconds(100), &points);
+    StreamedPoints read;
+    absl::StatusOr<bool> more = stream.Read(absl::Milliseconds(100), &read);
     ASSERT_FALSE(more.ok()) << bad;
     EXPECT_EQ(more.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_TRUE(absl::StrContains(more.status().message(), "standard input, line 2: '"))
@@ -60,11 +62,11 @@ TEST(PointTextStreamTest, ALineThatIsNoPointIsAnErrorNamingIt) {
   }
   Pipe pipe;
   PointTextStream stream(pipe.read_end(), "the scanner");
-  std::vector<Vec3> points;
+  StreamedPoints read;
   absl::StatusOr<bool> more = true;
   for (int i = 0; i < 40 && more.ok(); ++i) {
     pipe.Write(std::string(1 << 15, '1'));
-    more = stream.Read(absl::Milliseconds(100), &points);
+    more = stream.Read(absl::Milliseconds(100), &read);
   }
   ASSERT_FALSE(more.ok()) << "a line without an end is no text of points";
   EXPECT_TRUE(absl::StrContains(more.status().message(), "the scanner, line 1: over"))

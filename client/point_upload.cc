@@ -32,6 +32,20 @@ v1::UploadOrder MakeUploadOrder(absl::string_view name, uint64_t items) {
   return order;
 }
 
+uint64_t OrderFingerprint(absl::string_view positions) {
+  uint64_t hash = 14695981039346656037ull;
+  for (const char byte : positions) hash = (hash ^ static_cast<uint8_t>(byte)) * 1099511628211ull;
+  return hash;
+}
+
+absl::StatusOr<v1::UploadOrder> PointUpload::FingerprintedOrder(absl::string_view name,
+                                                                uint64_t items) {
+  NM_ASSIGN_OR_RETURN(const v1::PointBatch first, Batch(0, kFingerprintPoints));
+  v1::UploadOrder order = MakeUploadOrder(name, items);
+  order.set_fingerprint(OrderFingerprint(first.packed().positions()));
+  return order;
+}
+
 absl::Status CloudUpload::SkipTo(uint64_t first) {
   if (first > cloud_.size()) {
     return absl::OutOfRangeError(

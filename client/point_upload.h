@@ -40,12 +40,25 @@ class PointUpload {
   // The upload's number of points, where it is known.
   virtual std::optional<uint64_t> size() const = 0;
   // The order the batches go in (v1::UploadOrder), for the session to keep: a resumed upload
-  // must go in the same one over the same number of items.
-  virtual v1::UploadOrder upload_order() const = 0;
+  // must go in the same one, over the same number of items, from the same first points (the
+  // order's fingerprint). Reads those points: Batch's errors.
+  virtual absl::StatusOr<v1::UploadOrder> DescribeOrder() = 0;
+
+  // The points an order's fingerprint is taken of: the upload's first ones.
+  static constexpr size_t kFingerprintPoints = 1024;
+
+ protected:
+  // An UploadOrder of `items` named `name`, with the fingerprint of this upload's first
+  // kFingerprintPoints points (OrderFingerprint). Batch's errors.
+  absl::StatusOr<v1::UploadOrder> FingerprintedOrder(absl::string_view name, uint64_t items);
 };
 
-// An UploadOrder of `items` named `name`.
+// An UploadOrder of `items` named `name`, without a fingerprint.
 v1::UploadOrder MakeUploadOrder(absl::string_view name, uint64_t items);
+
+// The fingerprint of an order whose first batch of PointUpload::kFingerprintPoints points
+// packs positions `positions` (PackedPoints.positions): their 64-bit FNV-1a hash.
+uint64_t OrderFingerprint(absl::string_view positions);
 
 // A cloud's points with the weights, normals and colours it carries, in their stored order or
 // in SpreadOrder (blocks of consecutive points visited along the golden ratio), where every
@@ -67,8 +80,8 @@ class CloudUpload final : public PointUpload {
   uint64_t total() const override { return cloud_.size(); }
   std::optional<uint64_t> size() const override { return cloud_.size(); }
   // "points-spread-256" or "points-stored", of the cloud's points.
-  v1::UploadOrder upload_order() const override {
-    return MakeUploadOrder(spread_ ? "points-spread-256" : "points-stored", cloud_.size());
+  absl::StatusOr<v1::UploadOrder> DescribeOrder() override {
+    return FingerprintedOrder(spread_ ? "points-spread-256" : "points-stored", cloud_.size());
   }
 
  private:
@@ -96,8 +109,8 @@ class FileRecordsUpload final : public PointUpload {
   // Known once the order has been walked to its end.
   std::optional<uint64_t> size() const override;
   // "file-records-spread-256", of the file's records.
-  v1::UploadOrder upload_order() const override {
-    return MakeUploadOrder("file-records-spread-256", file_.records());
+  absl::StatusOr<v1::UploadOrder> DescribeOrder() override {
+    return FingerprintedOrder("file-records-spread-256", file_.records());
   }
 
  private:
@@ -137,9 +150,9 @@ class LazFileUpload final : public PointUpload {
   uint64_t total() const override { return file_.records(); }
   // Known once the last wave is decoded.
   std::optional<uint64_t> size() const override;
-  // "laz-chunks-spread-8", of the file's records.
-  v1::UploadOrder upload_order() const override {
-    return MakeUploadOrder("laz-chunks-spread-8", file_.records());
+  // "laz-chunks-spread-8", of the file's records (its first wave holds the first points).
+  absl::StatusOr<v1::UploadOrder> DescribeOrder() override {
+    return FingerprintedOrder("laz-chunks-spread-8", file_.records());
   }
 
  private:
@@ -188,8 +201,9 @@ class StreamUpload final : public PointUpload {
   uint64_t total() const override { return 0; }
   // Known once the stream ended.
   std::optional<uint64_t> size() const override;
-  // "stream", of an unknown number of points (0).
-  v1::UploadOrder upload_order() const override { return MakeUploadOrder("stream", 0); }
+  // "stream", of an unknown number of points (0), without a fingerprint (a stream is not
+  // resumed, and its first points may be yet to come).
+  absl::StatusOr<v1::UploadOrder> DescribeOrder() override { return MakeUploadOrder("stream", 0); }
 
  private:
   // Reads until there are `want` points, the stream ends, or `deadline` passes with more than

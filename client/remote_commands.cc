@@ -113,7 +113,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
     // session (off-core, the cube of the file's probe, which grows if a point lies outside).
     *config.mutable_bounds() = ToProto(*input.bounds);
   }
-  *config.mutable_upload_order() = input.points->upload_order();
+  NM_ASSIGN_OR_RETURN(*config.mutable_upload_order(), input.points->DescribeOrder());
 
   NM_ASSIGN_OR_RETURN(std::unique_ptr<ReconstructionClient> client,
                       ConnectTo(options.server, options.connection));
@@ -124,8 +124,8 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   size_t first_point = 0;
   v1::Session session;
   if (options.resume_session.empty()) {
-    NM_ASSIGN_OR_RETURN(session, client->CreateSession(
-                                     config, stem, start_mesh ? &*start_mesh : nullptr));
+    NM_ASSIGN_OR_RETURN(session,
+                        client->CreateSession(config, stem, start_mesh ? &*start_mesh : nullptr));
   } else {
     // Right after a restart the server may still be restoring the session.
     ReconnectOptions reconnect;
@@ -140,9 +140,9 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
       return absl::FailedPreconditionError(absl::StrCat(
           "session ", session.session_id(), " is ", SessionStateName(session.state()),
           "; only a session that still takes points can be resumed",
-          finishing ? absl::StrCat(" (neuralmesh watch ", session.session_id(),
-                                   " saves its meshes)")
-                    : ""));
+          finishing
+              ? absl::StrCat(" (neuralmesh watch ", session.session_id(), " saves its meshes)")
+              : ""));
     }
     const v1::Origin& origin = session.config().origin();
     if (Origin{origin.x(), origin.y(), origin.z()} != input.origin) {
@@ -153,7 +153,7 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
           input.origin[1], input.origin[2]));
     }
     // Another order would send some points twice and others never.
-    const v1::UploadOrder ours = input.points->upload_order();
+    const v1::UploadOrder& ours = config.upload_order();
     if (const v1::UploadOrder& kept = session.config().upload_order();
         session.config().has_upload_order() &&
         (kept.name() != ours.name() || kept.items() != ours.items())) {
@@ -163,6 +163,15 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
                        ours.name(), "' of ", ours.items(),
                        ": resume with the input (and its flags, --off_core among them) of the "
                        "first run"));
+    }
+    // The same order over as many items, yet other points: another file, other LAS classes.
+    if (const uint64_t kept = session.config().upload_order().fingerprint();
+        kept != 0 && ours.fingerprint() != 0 && kept != ours.fingerprint()) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "session %s was uploaded from other points: the first %d it took differ from this "
+          "input's (fingerprints %016x and %016x); resume with the input (and its flags, "
+          "--las_classes among them) of the first run",
+          session.session_id(), PointUpload::kFingerprintPoints, kept, ours.fingerprint()));
     }
     if (!input.points->SkipTo(session.points_taken()).ok()) {
       return absl::InvalidArgumentError(
@@ -290,9 +299,10 @@ absl::Status RunRemoteReconstruct(const RemoteReconstructOptions& options, std::
   }
   if (connection_lost) {
     // The session keeps what it has taken; the same command with --resume goes on from there.
-    return absl::UnavailableError(absl::StrCat(
-        status.message(), "; session ", id, " keeps the points it has taken: run this command "
-        "again with --resume ", id, " to go on from there"));
+    return absl::UnavailableError(absl::StrCat(status.message(), "; session ", id,
+                                               " keeps the points it has taken: run this command "
+                                               "again with --resume ",
+                                               id, " to go on from there"));
   }
   NM_RETURN_IF_ERROR(status);
   if (!write_status.ok()) {

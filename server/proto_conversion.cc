@@ -141,7 +141,8 @@ absl::StatusOr<SessionConfig> SessionConfigFromProto(const v1::SessionConfig& pr
     config.origin = {proto.origin().x(), proto.origin().y(), proto.origin().z()};
   }
   if (proto.has_upload_order() && !proto.upload_order().name().empty()) {
-    config.upload_order = UploadOrder{proto.upload_order().name(), proto.upload_order().items()};
+    config.upload_order = UploadOrder{proto.upload_order().name(), proto.upload_order().items(),
+                                      proto.upload_order().fingerprint()};
   }
   return config;
 }
@@ -168,8 +169,7 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
   l.mutable_close_small_holes()->set_value(o.close_small_holes);
   l.mutable_max_closed_hole_vertices()->set_value(o.max_closed_hole_vertices);
   l.mutable_merge_only_settled_boundaries()->set_value(o.merge_only_settled_boundaries);
-  l.mutable_split_largest_cell_near_most_active()->set_value(
-      o.split_largest_cell_near_most_active);
+  l.mutable_split_largest_cell_near_most_active()->set_value(o.split_largest_cell_near_most_active);
   l.mutable_sewn_strip_grace_calls()->set_value(o.sewn_strip_grace_calls);
   l.mutable_min_merged_loop_vertices()->set_value(o.min_merged_loop_vertices);
   l.mutable_cut_inactive_faces()->set_value(o.cut_inactive_faces);
@@ -220,6 +220,7 @@ v1::SessionConfig SessionConfigToProto(const SessionConfig& config) {
   if (config.upload_order.has_value()) {
     proto.mutable_upload_order()->set_name(config.upload_order->name);
     proto.mutable_upload_order()->set_items(config.upload_order->items);
+    proto.mutable_upload_order()->set_fingerprint(config.upload_order->fingerprint);
   }
   return proto;
 }
@@ -254,15 +255,15 @@ absl::StatusOr<PointCloud> PointBatchFromProto(const v1::PointBatch& batch,
       const std::string& positions = packed.positions();
       if (positions.empty()) return absl::InvalidArgumentError("the batch has no points");
       if (positions.size() % sizeof(Vec3f) != 0) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "PackedPoints.positions has ", positions.size(),
-            " bytes, not a multiple of 12 (x, y, z as little-endian float32)"));
+        return absl::InvalidArgumentError(
+            absl::StrCat("PackedPoints.positions has ", positions.size(),
+                         " bytes, not a multiple of 12 (x, y, z as little-endian float32)"));
       }
       const size_t n = positions.size() / sizeof(Vec3f);
       if (n > max_batch_points) {
-        return absl::ResourceExhaustedError(absl::StrCat(
-            "the batch has ", n, " points; this server takes at most ", max_batch_points,
-            " per batch"));
+        return absl::ResourceExhaustedError(absl::StrCat("the batch has ", n,
+                                                         " points; this server takes at most ",
+                                                         max_batch_points, " per batch"));
       }
       absl::Status status = UnpackFloats(positions, "positions", n, cloud.positions);
       if (status.ok() && !packed.weights().empty()) {
@@ -272,8 +273,7 @@ absl::StatusOr<PointCloud> PointBatchFromProto(const v1::PointBatch& batch,
         status = UnpackFloats(packed.normals(), "normals", n, cloud.normals);
       }
       if (status.ok() && !packed.colors().empty()) {
-        status = UnpackArray(packed.colors(), "colors", n, "red, green, blue bytes",
-                             cloud.colors);
+        status = UnpackArray(packed.colors(), "colors", n, "red, green, blue bytes", cloud.colors);
       }
       if (!status.ok()) return status;
       return cloud;
@@ -295,9 +295,9 @@ absl::StatusOr<PointCloud> PointBatchFromProto(const v1::PointBatch& batch,
       }
       if (decoded->empty()) return absl::InvalidArgumentError("the batch has no points");
       if (decoded->size() > max_batch_points) {
-        return absl::ResourceExhaustedError(absl::StrCat(
-            "the Draco batch decodes to ", decoded->size(), " points; this server takes at most ",
-            max_batch_points, " per batch"));
+        return absl::ResourceExhaustedError(
+            absl::StrCat("the Draco batch decodes to ", decoded->size(),
+                         " points; this server takes at most ", max_batch_points, " per batch"));
       }
       return decoded;
     }

@@ -48,11 +48,12 @@ struct UploadOrder {
   static constexpr size_t kMaxNameBytes = 256;
   std::string name;
   uint64_t items = 0;
+  uint64_t fingerprint = 0;  // Of the first points sent; 0: not told.
 };
 
 struct SessionConfig {
-  LearnerOptions learner;       // The paper's parameters.
-  size_t target_vertices = 0;   // The final vertex count, >= 4.
+  LearnerOptions learner;      // The paper's parameters.
+  size_t target_vertices = 0;  // The final vertex count, >= 4.
   // Publication milestones, strictly increasing, ending with target_vertices once resolved.
   // Empty before ResolveSessionConfig: the 1-2-5 series from 50 (DefaultLodMilestones).
   std::vector<size_t> lod_milestones;

@@ -172,7 +172,9 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
         (*service)->UploadPoints(created->session_id(), FirstPointsOf(order, points), 500).ok());
     return created->session_id();
   };
-  const std::string id = upload_first(1500, order.upload_order());
+  absl::StatusOr<v1::UploadOrder> described = order.DescribeOrder();
+  ASSERT_TRUE(described.ok()) << described.status();
+  const std::string id = upload_first(1500, *described);
   const std::vector<std::string> resume = {"reconstruct",  "builtin:sphere",
                                            "--server",     server_->address(),
                                            "--out-dir",    *dir_ + "/resumed",
@@ -194,7 +196,7 @@ TEST_F(RemoteCliTest, ResumeGoesOnFromThePointsTheSessionHasTaken) {
   EXPECT_THAT(finished.err, ::testing::HasSubstr("only a session that still takes points"));
   EXPECT_THAT(finished.err, ::testing::HasSubstr("neuralmesh watch " + id));
   // Every point was taken, but the finish never reached the server.
-  const std::string whole = upload_first(4000, order.upload_order());
+  const std::string whole = upload_first(4000, *described);
   const RunResult finish_only =
       RunNeuralmesh({"reconstruct", "builtin:sphere", "--server", server_->address(), "--out-dir",
                      *dir_ + "/whole", "--points", "4000", "--resume", whole});
@@ -622,7 +624,9 @@ TEST_F(RemoteCliTest, OffCoreUploadsAScanFromWhereItLies) {
   config.set_target_vertices(400);
   config.mutable_origin()->set_x(500000);
   config.mutable_origin()->set_y(4100000);
-  *config.mutable_upload_order() = order.upload_order();
+  absl::StatusOr<v1::UploadOrder> described = order.DescribeOrder();
+  ASSERT_TRUE(described.ok()) << described.status();
+  *config.mutable_upload_order() = *described;
   absl::StatusOr<v1::Session> created = (*service)->CreateSession(config, "strips");
   ASSERT_TRUE(created.ok()) << created.status();
   ASSERT_TRUE(
@@ -637,6 +641,18 @@ TEST_F(RemoteCliTest, OffCoreUploadsAScanFromWhereItLies) {
       reordered.err,
       ::testing::HasSubstr("was uploaded in the order 'file-records-spread-256' of 8000 "
                            "items, this input goes in the order 'points-spread-256' of 4000"));
+  // Other classes of the same file go in the same order over as many records, but are other
+  // points: refused, by the fingerprint of the first points.
+  std::vector<std::string> ground = upload;
+  *std::find(ground.begin(), ground.end(), "6") = "2";
+  ground.insert(ground.end(), {"--resume", created->session_id()});
+  const RunResult other_classes = RunNeuralmesh(ground);
+  EXPECT_EQ(other_classes.exit_code, 1) << other_classes.Describe();
+  EXPECT_THAT(other_classes.err, ::testing::HasSubstr(absl::StrCat(
+                                     "session ", created->session_id(),
+                                     " was uploaded from other points: the first 1024 "
+                                     "it took differ from this input's (fingerprints ")));
+  EXPECT_THAT(other_classes.err, ::testing::HasSubstr("--las_classes among them"));
   std::vector<std::string> resume = upload;
   resume[5] = *dir_ + "/off_core_resumed";
   resume.insert(resume.end(), {"--resume", created->session_id()});

@@ -307,6 +307,65 @@ TEST(LazFileUploadTest, AFileThatShrinksDuringTheUploadStopsItWithDataLoss) {
   ExpectShrinkToStopTheUpload(upload, path);
 }
 
+// An upload's order is named for how it goes, over how many items, with a fingerprint of its
+// first points: the same file and classes give the same order, other classes of the same
+// records another fingerprint; describing the order leaves the upload as it was.
+TEST(UploadOrderTest, TheFingerprintTellsOtherPointsInTheSameOrderApart) {
+  const std::string las = WriteStripScan("order.las");
+  PointSelection ground;
+  ground.las_classes.emplace().set(2);
+  absl::StatusOr<MappedPointFile> building = MappedPointFile::Open(las, Building().las_classes);
+  absl::StatusOr<MappedPointFile> again = MappedPointFile::Open(las, Building().las_classes);
+  absl::StatusOr<MappedPointFile> of_ground = MappedPointFile::Open(las, ground.las_classes);
+  ASSERT_TRUE(building.ok() && again.ok() && of_ground.ok());
+  FileRecordsUpload upload(*building), same(*again), other(*of_ground);
+  absl::StatusOr<v1::UploadOrder> order = upload.DescribeOrder();
+  ASSERT_TRUE(order.ok()) << order.status();
+  EXPECT_EQ(order->name(), "file-records-spread-256");
+  EXPECT_EQ(order->items(), 12000u);
+  EXPECT_NE(order->fingerprint(), 0u);
+  absl::StatusOr<v1::UploadOrder> same_order = same.DescribeOrder();
+  ASSERT_TRUE(same_order.ok());
+  EXPECT_EQ(same_order->fingerprint(), order->fingerprint());
+  absl::StatusOr<v1::UploadOrder> other_order = other.DescribeOrder();
+  ASSERT_TRUE(other_order.ok());
+  EXPECT_EQ(other_order->name(), order->name());
+  EXPECT_EQ(other_order->items(), order->items());
+  EXPECT_NE(other_order->fingerprint(), order->fingerprint()) << "the ground's points";
+  absl::StatusOr<PointCloud> read = ReadPointCloud(las, nullptr, Building());
+  ASSERT_TRUE(read.ok()) << read.status();
+  ExpectEveryPointOnce(upload, 1000, *read);
+
+  // LAZ: the first points come from the first wave, which the upload keeps.
+  absl::StatusOr<MappedLazFile> laz =
+      MappedLazFile::Open(WriteStripScanLaz("order.laz"), Building().las_classes);
+  ASSERT_TRUE(laz.ok()) << laz.status();
+  LazFileUpload laz_upload(*laz);
+  order = laz_upload.DescribeOrder();
+  ASSERT_TRUE(order.ok()) << order.status();
+  EXPECT_EQ(order->name(), "laz-chunks-spread-8");
+  EXPECT_EQ(order->items(), 12000u);
+  absl::StatusOr<v1::PointBatch> first = laz_upload.Batch(0, PointUpload::kFingerprintPoints);
+  ASSERT_TRUE(first.ok()) << first.status();
+  EXPECT_EQ(order->fingerprint(), OrderFingerprint(first->packed().positions()));
+  ExpectEveryPointOnce(laz_upload, 700, *read);
+
+  CloudUpload cloud_upload(*read, CloudUpload::Order::kSpread);
+  order = cloud_upload.DescribeOrder();
+  ASSERT_TRUE(order.ok()) << order.status();
+  EXPECT_EQ(order->name(), "points-spread-256");
+  EXPECT_EQ(order->items(), 5400u);
+  first = cloud_upload.Batch(0, PointUpload::kFingerprintPoints);
+  ASSERT_TRUE(first.ok()) << first.status();
+  EXPECT_EQ(order->fingerprint(), OrderFingerprint(first->packed().positions()));
+  CloudUpload stored(*read, CloudUpload::Order::kStored);
+  absl::StatusOr<v1::UploadOrder> stored_order = stored.DescribeOrder();
+  ASSERT_TRUE(stored_order.ok());
+  EXPECT_EQ(stored_order->name(), "points-stored");
+  EXPECT_NE(stored_order->fingerprint(), order->fingerprint())
+      << "the same points, in another order";
+}
+
 // Georeferenced points written to a pipe in two parts: the first batch chooses the origin, a
 // batch that is not full goes out once the flush time passes, and the upload's size is known
 // at the end of the stream.
@@ -338,6 +397,10 @@ TEST(StreamUploadTest, SendsPointsAsTheyArriveRelativeToTheFirstPointsOrigin) {
   ASSERT_TRUE(batch.ok()) << batch.status();
   EXPECT_TRUE(batch->packed().positions().empty()) << "the end of the stream";
   EXPECT_EQ(upload.size(), 3u);
+  absl::StatusOr<v1::UploadOrder> order = upload.DescribeOrder();
+  ASSERT_TRUE(order.ok());
+  EXPECT_EQ(order->name(), "stream");
+  EXPECT_EQ(order->fingerprint(), 0u) << "a stream is not resumed";
   batch = upload.Batch(1, 1);  // Again, as after a lost connection.
   ASSERT_TRUE(batch.ok()) << batch.status();
   EXPECT_EQ(PointsOf(*batch), (std::vector<Point>{{124.5f, 457.25f, 81}}));

@@ -38,8 +38,8 @@ TEST(PointBatchFromProtoTest, RejectsMalformedBatchesSayingWhatIsWrong) {
     const char* message;
   };
   std::vector<Case> cases;
-  cases.push_back({"no encoding", v1::PointBatch(), absl::StatusCode::kInvalidArgument,
-                   "no points"});
+  cases.push_back(
+      {"no encoding", v1::PointBatch(), absl::StatusCode::kInvalidArgument, "no points"});
   {
     v1::PointBatch b;
     b.mutable_packed();
@@ -48,8 +48,8 @@ TEST(PointBatchFromProtoTest, RejectsMalformedBatchesSayingWhatIsWrong) {
   {
     v1::PointBatch b = testing::Batch(ThreePoints());
     b.mutable_packed()->mutable_positions()->push_back('x');
-    cases.push_back({"ragged positions", b, absl::StatusCode::kInvalidArgument,
-                     "not a multiple of 12"});
+    cases.push_back(
+        {"ragged positions", b, absl::StatusCode::kInvalidArgument, "not a multiple of 12"});
   }
   {
     v1::PointBatch b = testing::Batch(ThreePoints());
@@ -66,8 +66,7 @@ TEST(PointBatchFromProtoTest, RejectsMalformedBatchesSayingWhatIsWrong) {
   {
     v1::PointBatch b;
     b.set_draco_point_cloud("DRACO this is not");
-    cases.push_back({"corrupt Draco", b, absl::StatusCode::kInvalidArgument,
-                     "draco_point_cloud"});
+    cases.push_back({"corrupt Draco", b, absl::StatusCode::kInvalidArgument, "draco_point_cloud"});
   }
   for (const Case& c : cases) {
     absl::StatusOr<PointCloud> result = PointBatchFromProto(c.batch, 100);
@@ -147,6 +146,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   proto.mutable_origin()->set_y(4100000.5);
   proto.mutable_upload_order()->set_name("points-spread-256");
   proto.mutable_upload_order()->set_items(20000);
+  proto.mutable_upload_order()->set_fingerprint(0xfedcba9876543210);
   config = SessionConfigFromProto(proto);
   ASSERT_TRUE(config.ok());
   EXPECT_EQ(config->learner.alpha_l, 0.0);
@@ -169,6 +169,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   ASSERT_TRUE(config->upload_order.has_value());
   EXPECT_EQ(config->upload_order->name, "points-spread-256");
   EXPECT_EQ(config->upload_order->items, 20000u);
+  EXPECT_EQ(config->upload_order->fingerprint, 0xfedcba9876543210);
 
   // The echo has every field set and reads back to the same configuration.
   v1::SessionConfig echo = SessionConfigToProto(*config);
@@ -193,6 +194,7 @@ TEST(SessionConfigFromProtoTest, UnsetFieldsTakeDefaultsAndSetOnesAreKept) {
   EXPECT_EQ(again->origin, config->origin);
   EXPECT_EQ(echo.upload_order().name(), "points-spread-256");
   EXPECT_EQ(echo.upload_order().items(), 20000u);
+  EXPECT_EQ(echo.upload_order().fingerprint(), 0xfedcba9876543210);
   EXPECT_FALSE(SessionConfigToProto(SessionConfig()).has_upload_order()) << "unset stays unset";
   proto.mutable_upload_order()->clear_name();
   config = SessionConfigFromProto(proto);

@@ -727,8 +727,9 @@ std::vector<Subcommand> Commands() {
        "Locally it writes OUTPUT and one OUTPUT_lod<N> file per --lod; with --server it\n"
        "uploads the points and saves each mesh the server publishes into --out-dir. Prints\n"
        "the figures of every level. With --server, INPUT '-' streams points from standard\n"
-       "input as they arrive (\"x y z\" per line, split as in XYZ files; further columns and\n"
-       "'#' comments ignored; or a LAS file's records, with their colours, of the\n"
+       "input as they arrive (\"x y z\" per line, split as in XYZ files, '#' and '//'\n"
+       "comments skipped, further columns ignored unless a header comment names them,\n"
+       "\"# x y z r g b\"; or a LAS file's records, with their colours, of the\n"
        "--las_classes chosen), a batch whenever --batch-size points\n"
        "came or 100 ms passed; the session finishes at the end of the stream (files named\n"
        "stdin*).",

@@ -229,11 +229,10 @@ absl::Status StreamUpload::ReadUntil(uint64_t want, uint64_t least, absl::Time d
 
 absl::Status StreamUpload::TakeArrived() {
   if (!started_) return absl::OkStatus();
-  // A LAS stream's format gives every record colours or none.
-  if (has_colors() && arrived_.color_levels.size() != arrived_.size()) {
+  // A stream's format (a LAS format, a text header) gives every point a colour or none.
+  if (has_colors() && arrived_.colors.size() != arrived_.size()) {
     return absl::InternalError(absl::StrCat(stream_->name(), " gave ", arrived_.size(),
-                                            " points with ", arrived_.color_levels.size(),
-                                            " colours"));
+                                            " points with ", arrived_.colors.size(), " colours"));
   }
   for (size_t i = 0; i < arrived_.size(); ++i) {
     const Vec3& p = arrived_.positions[i];
@@ -246,7 +245,12 @@ absl::Status StreamUpload::TakeArrived() {
     }
     points_.emplace_back(static_cast<float>(relative[0]), static_cast<float>(relative[1]),
                          static_cast<float>(relative[2]));
-    if (has_colors()) colors_.push_back(RgbFromLevels(arrived_.color_levels[i], color_scale_));
+    if (has_colors()) {
+      const std::array<float, 3>& channels = arrived_.colors[i];
+      colors_.push_back({ChannelFromLevel(channels[0], color_scale_),
+                         ChannelFromLevel(channels[1], color_scale_),
+                         ChannelFromLevel(channels[2], color_scale_)});
+    }
   }
   arrived_.clear();
   return absl::OkStatus();
@@ -261,12 +265,12 @@ absl::Status StreamUpload::Start(size_t count) {
   BoundingBox box;
   for (const Vec3& p : arrived_.positions) box.Extend(p);
   origin_ = OriginOfStreamedPoints(box);
-  if (colors_wanted_ && !arrived_.color_levels.empty()) {
-    uint16_t largest = 0;
-    for (const std::array<uint16_t, 3>& levels : arrived_.color_levels) {
-      largest = std::max({largest, levels[0], levels[1], levels[2]});
+  if (colors_wanted_ && !arrived_.colors.empty()) {
+    float largest = 0;
+    for (const std::array<float, 3>& channels : arrived_.colors) {
+      largest = std::max({largest, channels[0], channels[1], channels[2]});
     }
-    color_scale_ = LevelScale(largest);
+    color_scale_ = stream_->ColorScale(largest);
   }
   started_ = true;
   return TakeArrived();

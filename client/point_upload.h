@@ -174,8 +174,9 @@ class LazFileUpload final : public PointUpload {
 // can be sent again after a lost connection. A batch goes out as soon as it is full, or once
 // `flush_after` has passed with points to send, so a slow stream's points reach the server within
 // that time. Positions relative to an origin chosen from the first batch (Start); with `colors`,
-// the colours of a stream whose points carry them, their levels' scale (8 or 16 bits: LevelScale)
-// judged from the first batch's largest level, as an upload off-core judges it from its probe.
+// the colours of a stream whose points carry them, their scale (LAS: 8- or 16-bit levels; text:
+// levels or fractions: PointStream::ColorScale) judged from the first batch's largest channel,
+// as an upload off-core judges it from its probe.
 class StreamUpload final : public PointUpload {
  public:
   static constexpr absl::Duration kFlushAfter = absl::Milliseconds(100);

@@ -18,6 +18,7 @@
 #include "core/io/internal/las_layout.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/point_text_stream.h"
+#include "core/rgb.h"
 #include "core/status_macros.h"
 
 namespace neuralmesh {
@@ -44,6 +45,9 @@ class LasPointStream final : public DescriptorPointStream {
 
   std::string ReadSoFar() const override {
     return absl::StrCat(records_read_, records_read_ == 1 ? " LAS record" : " LAS records");
+  }
+  double ColorScale(float largest) const override {
+    return LevelScale(static_cast<uint16_t>(std::clamp(largest, 0.0f, 65535.0f)));
   }
 
  private:
@@ -131,7 +135,9 @@ class LasPointStream final : public DescriptorPointStream {
       if (!std::isfinite((*p)[0]) || !std::isfinite((*p)[1]) || !std::isfinite((*p)[2])) continue;
       points->positions.emplace_back((*p)[0], (*p)[1], (*p)[2]);
       if (const auto levels = (*records)->ColorLevels(i); levels.has_value()) {
-        points->color_levels.push_back(*levels);
+        points->colors.push_back({static_cast<float>((*levels)[0]),
+                                  static_cast<float>((*levels)[1]),
+                                  static_cast<float>((*levels)[2])});
       }
     }
     records_read_ += complete;
@@ -181,6 +187,9 @@ class DetectedPointStream final : public PointStream {
   const std::string& name() const override { return name_; }
   std::string ReadSoFar() const override {
     return stream_ != nullptr ? stream_->ReadSoFar() : "0 lines";
+  }
+  double ColorScale(float largest) const override {
+    return stream_ != nullptr ? stream_->ColorScale(largest) : TextChannelScale(largest);
   }
 
  private:

@@ -1,9 +1,9 @@
 // Points arriving on a file descriptor as they come: standard input fed by a scanner's or a
 // converter's pipeline (`scanner | neuralmesh reconstruct - --server ...`), a pipe or a socket.
-// A stream is text of "x y z" lines (PointTextStream) or a LAS file's header and records
-// (LasPointStream: their colours too, and a choice of their classes), told apart by its first
-// bytes (OpenPointStream). Reads never block longer than asked, so that a caller can send what
-// has come at its own pace.
+// A stream is text of "x y z" lines (PointTextStream: with colours where a header comment names
+// their columns) or a LAS file's header and records (LasPointStream: with their colours, and a
+// choice of their classes), told apart by its first bytes (OpenPointStream). Reads never block
+// longer than asked, so that a caller can send what has come at its own pace.
 #ifndef NEURALMESH_CORE_IO_POINT_STREAM_H_
 #define NEURALMESH_CORE_IO_POINT_STREAM_H_
 
@@ -23,17 +23,18 @@
 
 namespace neuralmesh {
 
-// The points a stream gave, in its coordinates, with their colour levels where its records
-// carry colours (LAS formats 2, 3, 5, 7, 8 and 10: 16-bit fields holding 8- or 16-bit levels,
-// which the levels' largest tells apart: LevelScale in core/rgb.h).
+// The points a stream gave, in its coordinates, with their colours where they carry them: the
+// red, green and blue channels as the stream states them (LAS: 16-bit fields holding 8- or
+// 16-bit levels; text: 0-255 levels or fractions), whose full scale the stream's ColorScale
+// tells from the largest channel of its first points.
 struct StreamedPoints {
   std::vector<Vec3> positions;
-  std::vector<std::array<uint16_t, 3>> color_levels;  // Empty, or one per position.
+  std::vector<std::array<float, 3>> colors;  // Empty, or one per position.
 
   size_t size() const { return positions.size(); }
   void clear() {
     positions.clear();
-    color_levels.clear();
+    colors.clear();
   }
 };
 
@@ -47,6 +48,9 @@ class PointStream {
   // format; UNAVAILABLE for a read that fails.
   virtual absl::StatusOr<bool> Read(absl::Duration wait, StreamedPoints* points) = 0;
 
+  // The full scale of the colour channels of points whose largest channel is `largest`, for
+  // ChannelFromLevel (core/rgb.h): LAS's LevelScale, text's TextChannelScale.
+  virtual double ColorScale(float largest) const = 0;
   // The stream's name in messages ("standard input").
   virtual const std::string& name() const = 0;
   // What has been read so far, for messages: "12 lines", "3 LAS records".

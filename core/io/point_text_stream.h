@@ -1,17 +1,23 @@
 // Points arriving as text on a file descriptor, a line at a time as they come (a PointStream:
 // point_stream.h). Each line holds a point's x, y and z, its fields split as the XYZ reader
-// splits them (spaces, tabs, commas or semicolons); further columns are ignored, as are blank
-// lines and '#' comments.
+// splits them (spaces, tabs, commas or semicolons); blank lines and comments ('#', or a line
+// starting with "//") are skipped. Further columns are ignored, unless a header comment before
+// the first point names the columns as an XYZ file's does ("# x y z r g b", CloudCompare's
+// "//X,Y,Z,R,G,B": as many names as the first point's values): then each line's red, green and
+// blue come too, as 0-255 levels or fractions (ColorScale: TextChannelScale).
 #ifndef NEURALMESH_CORE_IO_POINT_TEXT_STREAM_H_
 #define NEURALMESH_CORE_IO_POINT_TEXT_STREAM_H_
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "core/io/point_stream.h"
+#include "core/rgb.h"
 
 namespace neuralmesh {
 
@@ -28,6 +34,7 @@ class PointTextStream final : public DescriptorPointStream {
 
   // "12 lines".
   std::string ReadSoFar() const override;
+  double ColorScale(float largest) const override { return TextChannelScale(largest); }
   // The lines read so far.
   uint64_t lines() const { return lines_; }
 
@@ -41,6 +48,9 @@ class PointTextStream final : public DescriptorPointStream {
 
   std::string partial_;  // The start of a line whose end has not arrived.
   uint64_t lines_ = 0;
+  bool first_point_read_ = false;
+  std::vector<std::string> comments_;  // Before the first point: the header's candidates.
+  std::optional<std::array<int, 3>> color_columns_;  // As the header names them.
 };
 
 }  // namespace neuralmesh

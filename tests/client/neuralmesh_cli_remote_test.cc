@@ -738,17 +738,32 @@ TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
   std::vector<Vec3f> sphere;
   for (size_t i : bottom_up) sphere.push_back(colored.positions[i]);
   std::string lower, upper;
-  for (size_t i = 0; i < sphere.size(); ++i) {
-    (i < 2000 ? lower : upper) +=
-        absl::StrFormat("%.4f,%.4f,%.4f\n", centre[0] + sphere[i][0], centre[1] + sphere[i][1],
-                        centre[2] + sphere[i][2]);
+  for (size_t k = 0; k < sphere.size(); ++k) {
+    const Rgb& color = colored.colors[bottom_up[k]];
+    (k < 2000 ? lower : upper) += absl::StrFormat(
+        "%.4f,%.4f,%.4f,%d,%d,%d\n", centre[0] + sphere[k][0], centre[1] + sphere[k][1],
+        centre[2] + sphere[k][2], color[0], color[1], color[2]);
   }
+  // The largest difference of a channel between a vertex's colour and that of the sphere's
+  // point nearest it; -1 without colours.
+  const auto worst_color_error = [&centre](const TriangleMesh& mesh) {
+    if (mesh.colors.size() != mesh.positions.size()) return -1;
+    int worst = 0;
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+      Vec3f on_sphere;
+      for (int c = 0; c < 3; ++c) {
+        on_sphere[c] = static_cast<float>(mesh.origin[c] + mesh.positions[v][c] - centre[c]);
+      }
+      worst = std::max(worst, ColorError(mesh.colors[v], on_sphere.normalized()));
+    }
+    return worst;
+  };
   const std::string out_dir = *dir_ + "/streamed";
   BackgroundProcess run("neuralmesh",
                         {"reconstruct", "-", "--server", server_->address(), "--out-dir", out_dir,
                          "--vertices", "400", "--lod", "100", "--batch-size", "500"},
                         /*stdin_pipe=*/true);
-  ASSERT_TRUE(run.WriteStdin("# x,y,z of a scan\n" + lower));
+  ASSERT_TRUE(run.WriteStdin("# a scan\n# x,y,z,r,g,b\n" + lower));
   ASSERT_TRUE(run.AwaitStdout("lod ")) << "no mesh before the stream went on\n"
                                        << run.Stdout() << run.Stderr();
   // The half that arrived is an open cap: the mesh published so far lies on the lower half.
@@ -772,6 +787,9 @@ TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
   EXPECT_EQ(mesh->origin, (std::array<double, 3>{500000, 4100000, 0}));
   EXPECT_EQ(mesh->positions.size(), 400u);
   EXPECT_LT(FarthestFromTheUnitSphere(*mesh, centre), 0.05) << "a vertex off the sphere";
+  const int text_color_error = worst_color_error(*mesh);
+  EXPECT_GE(text_color_error, 0) << "the colours the header names were not sent";
+  EXPECT_LE(text_color_error, 8) << "a vertex's colour is not its place's";
   std::smatch id;
   ASSERT_TRUE(std::regex_search(out, id, std::regex("session (s-[0-9a-f]+) on "))) << out;
   absl::StatusOr<std::unique_ptr<client::ReconstructionClient>> service =
@@ -822,17 +840,9 @@ TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
   ASSERT_TRUE(from_las.ok()) << from_las.status();
   EXPECT_EQ(from_las->positions.size(), 400u);
   EXPECT_LT(FarthestFromTheUnitSphere(*from_las, centre), 0.05) << "a vertex off the sphere";
-  ASSERT_EQ(from_las->colors.size(), from_las->positions.size()) << "the colours were not sent";
-  int worst = 0;
-  for (size_t v = 0; v < from_las->positions.size(); ++v) {
-    Vec3f on_sphere;
-    for (int c = 0; c < 3; ++c) {
-      on_sphere[c] =
-          static_cast<float>(from_las->origin[c] + from_las->positions[v][c] - centre[c]);
-    }
-    worst = std::max(worst, ColorError(from_las->colors[v], on_sphere.normalized()));
-  }
-  EXPECT_LE(worst, 8) << "a vertex's colour is not its place's";
+  const int las_color_error = worst_color_error(*from_las);
+  EXPECT_GE(las_color_error, 0) << "the colours were not sent";
+  EXPECT_LE(las_color_error, 8) << "a vertex's colour is not its place's";
   const std::string piped_out = piped.Stdout();
   EXPECT_THAT(piped_out, ::testing::HasSubstr("from standard input with their colours"));
   ASSERT_TRUE(std::regex_search(piped_out, id, std::regex("session (s-[0-9a-f]+) on ")));

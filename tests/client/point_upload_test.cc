@@ -453,6 +453,22 @@ TEST(StreamUploadTest, SendsTheColoursOfALasStreamWhenAsked) {
   }
 }
 
+// Text whose header names colour columns: their fractions go as 8-bit channels.
+TEST(StreamUploadTest, SendsTheColoursATextHeaderNames) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const std::string text = "# x y z r g b\n0 0 0 1 0.5 0\n1 0 0 0 0 1\n";
+  ASSERT_EQ(write(fds[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  close(fds[1]);
+  StreamUpload upload(OpenPointStream(fds[0], "standard input"), /*colors=*/true);
+  ASSERT_TRUE(upload.Start(100).ok());
+  EXPECT_TRUE(upload.has_colors());
+  absl::StatusOr<v1::PointBatch> batch = upload.Batch(0, 100);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  EXPECT_EQ(batch->packed().colors(), std::string("\xff\x80\x00\x00\x00\xff", 6));
+  close(fds[0]);
+}
+
 TEST(StreamUploadTest, APointFarFromTheOriginIsAnError) {
   int fds[2];
   ASSERT_EQ(pipe(fds), 0);

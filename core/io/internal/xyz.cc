@@ -22,13 +22,6 @@ namespace {
 // More columns than this are not a point list, header or not.
 constexpr size_t kMaxColumns = 64;
 
-// Which columns of a row hold each attribute (-1: none).
-struct XyzLayout {
-  std::array<int, 3> normal = {-1, -1, -1};
-  std::array<int, 3> color = {-1, -1, -1};
-  int weight = -1;
-};
-
 // Three consecutive columns from `first`.
 std::array<int, 3> Triple(int first) { return {first, first + 1, first + 2}; }
 
@@ -37,34 +30,6 @@ bool IsOneOf(absl::string_view name, std::initializer_list<absl::string_view> na
     if (absl::EqualsIgnoreCase(name, candidate)) return true;
   }
   return false;
-}
-
-// The layout that the comment `text` gives a file of `columns` columns, or nullopt when it is
-// not a header of that many columns beginning with x, y, z.
-std::optional<XyzLayout> LayoutFromHeader(absl::string_view text, size_t columns) {
-  const std::vector<absl::string_view> names =
-      absl::StrSplit(text, absl::ByAnyChar(" \t\v\f,;"), absl::SkipEmpty());
-  if (names.size() != columns || !IsOneOf(names[0], {"x"}) || !IsOneOf(names[1], {"y"}) ||
-      !IsOneOf(names[2], {"z"})) {
-    return std::nullopt;
-  }
-  XyzLayout layout;
-  const std::initializer_list<absl::string_view> normal_names[3] = {
-      {"nx", "normal_x"}, {"ny", "normal_y"}, {"nz", "normal_z"}};
-  const std::initializer_list<absl::string_view> color_names[3] = {
-      {"r", "red"}, {"g", "green"}, {"b", "blue"}};
-  for (int k = 3; k < static_cast<int>(columns); ++k) {
-    for (int c = 0; c < 3; ++c) {
-      if (IsOneOf(names[k], normal_names[c]) && layout.normal[c] < 0) layout.normal[c] = k;
-      if (IsOneOf(names[k], color_names[c]) && layout.color[c] < 0) layout.color[c] = k;
-    }
-    if (IsOneOf(names[k], {"w", "weight", "confidence"}) && layout.weight < 0) layout.weight = k;
-  }
-  // A normal or colour of fewer than three channels is skipped.
-  for (std::array<int, 3>* triple : {&layout.normal, &layout.color}) {
-    if ((*triple)[0] < 0 || (*triple)[1] < 0 || (*triple)[2] < 0) *triple = {-1, -1, -1};
-  }
-  return layout;
 }
 
 // The rows' values past x, y, z: row i's column k (k >= 3) at i * stride + k - 3.
@@ -175,14 +140,39 @@ void TakeColumns(const XyzLayout& layout, const ExtraColumns& extra, ParsedGeome
   }
 }
 
-// The text of a comment line ("# ..." or "// ..."), or nullopt for a line that is not one.
-std::optional<absl::string_view> CommentText(absl::string_view line) {
+}  // namespace
+
+std::optional<XyzLayout> XyzLayoutFromHeader(absl::string_view text, size_t columns) {
+  const std::vector<absl::string_view> names =
+      absl::StrSplit(text, absl::ByAnyChar(" \t\v\f,;"), absl::SkipEmpty());
+  if (names.size() != columns || !IsOneOf(names[0], {"x"}) || !IsOneOf(names[1], {"y"}) ||
+      !IsOneOf(names[2], {"z"})) {
+    return std::nullopt;
+  }
+  XyzLayout layout;
+  const std::initializer_list<absl::string_view> normal_names[3] = {
+      {"nx", "normal_x"}, {"ny", "normal_y"}, {"nz", "normal_z"}};
+  const std::initializer_list<absl::string_view> color_names[3] = {
+      {"r", "red"}, {"g", "green"}, {"b", "blue"}};
+  for (int k = 3; k < static_cast<int>(columns); ++k) {
+    for (int c = 0; c < 3; ++c) {
+      if (IsOneOf(names[k], normal_names[c]) && layout.normal[c] < 0) layout.normal[c] = k;
+      if (IsOneOf(names[k], color_names[c]) && layout.color[c] < 0) layout.color[c] = k;
+    }
+    if (IsOneOf(names[k], {"w", "weight", "confidence"}) && layout.weight < 0) layout.weight = k;
+  }
+  // A normal or colour of fewer than three channels is skipped.
+  for (std::array<int, 3>* triple : {&layout.normal, &layout.color}) {
+    if ((*triple)[0] < 0 || (*triple)[1] < 0 || (*triple)[2] < 0) *triple = {-1, -1, -1};
+  }
+  return layout;
+}
+
+std::optional<absl::string_view> XyzCommentText(absl::string_view line) {
   line = absl::StripLeadingAsciiWhitespace(line);
   if (absl::ConsumePrefix(&line, "#") || absl::ConsumePrefix(&line, "//")) return line;
   return std::nullopt;
 }
-
-}  // namespace
 
 absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data) {
   ParsedGeometry out;
@@ -198,7 +188,7 @@ absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data) {
   bool first_content_line = true;
   while (cursor.Next(&line)) {
     const int n = cursor.line_number();
-    const std::optional<absl::string_view> comment = CommentText(line);
+    const std::optional<absl::string_view> comment = XyzCommentText(line);
     if (comment.has_value()) {
       if (columns == 0) comments.push_back(*comment);
       continue;
@@ -220,7 +210,7 @@ absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data) {
       extra.stride = columns - 3;
       first_point_line = n;
       for (auto it = comments.rbegin(); it != comments.rend() && !header; ++it) {
-        header = LayoutFromHeader(*it, columns);
+        header = XyzLayoutFromHeader(*it, columns);
       }
     } else if (tokens.size() != columns) {
       return LineError(n, absl::StrCat("expected ", columns, " numbers like line ",
@@ -267,8 +257,7 @@ std::string FormatXyz(const GeometryView& geometry) {
                   [](const Rgb& rgb) { return rgb[0] > 1 || rgb[1] > 1 || rgb[2] > 1; });
   if (normals || colors) {  // Without the header, unnormalised normals might read as colours.
     absl::StrAppend(&out, "# x y z", normals ? " nx ny nz" : "", colors ? " r g b" : "",
-                    weights ? " w" : "",
-                    "\n");
+                    weights ? " w" : "", "\n");
   }
   for (size_t i = 0; i < geometry.positions.size(); ++i) {
     for (int c = 0; c < 3; ++c) {

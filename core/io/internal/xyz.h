@@ -2,6 +2,8 @@
 #ifndef NEURALMESH_CORE_IO_INTERNAL_XYZ_H_
 #define NEURALMESH_CORE_IO_INTERNAL_XYZ_H_
 
+#include <array>
+#include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
@@ -34,6 +36,21 @@ namespace neuralmesh::io_internal {
 // count differs from the first point's, a non-finite value, or a column count that neither a
 // header nor the list above explains.
 absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data);
+
+// Which columns of a line hold each attribute (-1: none).
+struct XyzLayout {
+  std::array<int, 3> normal = {-1, -1, -1};
+  std::array<int, 3> color = {-1, -1, -1};
+  int weight = -1;
+};
+
+// The layout that a header comment's text `text` (XyzCommentText) gives lines of `columns`
+// values, as ParseXyz reads it; nullopt when it is not a header of that many columns beginning
+// with x, y, z.
+std::optional<XyzLayout> XyzLayoutFromHeader(absl::string_view text, size_t columns);
+
+// The text of a comment line ("# ..." or "// ..."), or nullopt for a line that is not one.
+std::optional<absl::string_view> XyzCommentText(absl::string_view line);
 
 // Formats `geometry` as "x y z [nx ny nz] [r g b] [w]" lines (positions with geometry.origin
 // added: AppendCoordinate; colours as 0-255 levels, or as

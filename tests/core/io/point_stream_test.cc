@@ -148,16 +148,21 @@ TEST(LasPointStreamTest, ClassesChooseTheRecordsAndColoursComeWithThem) {
   ASSERT_TRUE(read.ok()) << read;
   ASSERT_EQ(streamed.size(), 392u) << "400 records of classes 2 and 6, 8 of them withheld";
   ASSERT_EQ(streamed.size(), whole->size());
-  ASSERT_EQ(streamed.color_levels.size(), streamed.size());
+  ASSERT_EQ(streamed.colors.size(), streamed.size());
   for (size_t i = 0; i < streamed.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
       ASSERT_EQ(static_cast<float>(streamed.positions[i][c] - whole->origin[c]),
                 whole->positions[i][c])
           << "point " << i;
     }
-    ASSERT_EQ(RgbFromLevels(streamed.color_levels[i], 65535), whole->colors[i]) << "point " << i;
+    const double scale = stream->ColorScale(65535);
+    ASSERT_EQ(scale, 65535);
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_EQ(ChannelFromLevel(streamed.colors[i][c], scale), whole->colors[i][c])
+          << "point " << i;
+    }
   }
-  EXPECT_EQ(streamed.color_levels[1], (std::array<uint16_t, 3>{300, 65535 - 270, 3}))
+  EXPECT_EQ(streamed.colors[1], (std::array<float, 3>{300, 65535 - 270, 3}))
       << "the second point is record 3 (record 0 is withheld, record 2 vegetation)";
 
   Pipe text_pipe;
@@ -170,6 +175,7 @@ TEST(LasPointStreamTest, ClassesChooseTheRecordsAndColoursComeWithThem) {
             "the scanner: text, whose points have no LAS classes to choose from; classes choose "
             "the records of a LAS stream");
   EXPECT_EQ(none.size(), 0u);
+  EXPECT_EQ(stream->ColorScale(255), 255) << "8-bit levels in 16-bit fields";
 }
 
 // Streams whose header bytes are mangled at random: each is read to its end or refused with

@@ -42,10 +42,62 @@ TEST(PointTextStreamTest, ReadsPointsAsTheirLinesComplete) {
   EXPECT_EQ(points[3], Vec3(500000.25, 4100000.5, 80));
   EXPECT_EQ(points[4], Vec3(10, 11, 12));
   EXPECT_EQ(stream.lines(), 7u);
-  EXPECT_TRUE(read.color_levels.empty()) << "further columns are ignored";
+  EXPECT_TRUE(read.colors.empty()) << "further columns are ignored";
   more = stream.Read(absl::Milliseconds(10), &read);
   ASSERT_TRUE(more.ok());
   EXPECT_FALSE(*more);
+}
+
+// Reads what `text` holds, written at once and ended.
+absl::StatusOr<StreamedPoints> ReadAll(absl::string_view text) {
+  Pipe pipe;
+  PointTextStream stream(pipe.read_end(), "standard input");
+  pipe.Write(text);
+  pipe.CloseWriteEnd();
+  StreamedPoints read;
+  for (absl::StatusOr<bool> more = true; *more;) {
+    more = stream.Read(absl::Milliseconds(100), &read);
+    if (!more.ok()) return more.status();
+  }
+  return read;
+}
+
+// A header comment before the first point naming the columns as an XYZ file's does brings the
+// colours it names; a header of another number of columns, or one after the first point, is a
+// comment like any other.
+TEST(PointTextStreamTest, AHeaderNamingColourColumnsBringsTheColours) {
+  absl::StatusOr<StreamedPoints> read =
+      ReadAll("# a scan\n# x y z intensity r g b\n1 2 3 0.5 255 128 0\n4 5 6 0.7 10 20 30\n");
+  ASSERT_TRUE(read.ok()) << read.status();
+  ASSERT_EQ(read->size(), 2u);
+  ASSERT_EQ(read->colors.size(), 2u);
+  EXPECT_EQ(read->colors[0], (std::array<float, 3>{255, 128, 0}));
+  EXPECT_EQ(read->colors[1], (std::array<float, 3>{10, 20, 30}));
+  EXPECT_EQ(read->positions[1], Vec3(4, 5, 6));
+
+  read = ReadAll("//X,Y,Z,R,G,B\n1,2,3,0.5,1,0\n");  // CloudCompare's, with fractions.
+  ASSERT_TRUE(read.ok()) << read.status();
+  ASSERT_EQ(read->colors.size(), 1u);
+  EXPECT_EQ(read->colors[0], (std::array<float, 3>{0.5f, 1, 0}));
+  Pipe pipe;
+  PointTextStream stream(pipe.read_end(), "standard input");
+  EXPECT_EQ(stream.ColorScale(1), 1) << "fractions";
+  EXPECT_EQ(stream.ColorScale(200), 255) << "levels";
+
+  for (const char* no_colours :
+       {"# x y z r g b\n1 2 3\n", "1 2 3 4 5 6\n# x y z r g b\n7 8 9 1 2 3\n",
+        "# x y z nx ny nz\n1 2 3 0 0 1\n"}) {
+    read = ReadAll(no_colours);
+    ASSERT_TRUE(read.ok()) << read.status();
+    EXPECT_TRUE(read->colors.empty()) << no_colours;
+    EXPECT_FALSE(read->positions.empty());
+  }
+
+  read = ReadAll("# x y z r g b\n1 2 3 4 5 6\n7 8 9 10 11\n");
+  ASSERT_FALSE(read.ok());
+  EXPECT_EQ(read.status().message(),
+            "standard input, line 3: '7 8 9 10 11' has no blue in column 6, where the header "
+            "names it (a finite number)");
 }
 
 TEST(PointTextStreamTest, ALineThatIsNoPointIsAnErrorNamingIt) {

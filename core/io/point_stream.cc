@@ -34,8 +34,11 @@ constexpr size_t kLongestLasHeader = size_t{64} << 20;
 // A LAS file's header and point records as they arrive (LasPointStream in point_stream.h):
 // each complete record is read as reading the file whole reads it (io_internal::LasRecords:
 // withheld records left out, and those of other classes than `classes`, or without them those
-// classified as noise), with its colour levels in formats with colours, until the records the
-// header states before its extended variable-length records (LAS 1.4), or the stream's end.
+// classified as noise), with its colour levels in formats with colours, up to the number of
+// records the header states (what follows them, LAS 1.3's waveform packets or LAS 1.4's
+// extended variable-length records, is not read). A stream that ends before them is an error;
+// a header that states none (a writer that did not know how many would come) is read to the
+// stream's end.
 class LasPointStream final : public DescriptorPointStream {
  public:
   LasPointStream(int fd, std::string name, std::string first_bytes,
@@ -55,7 +58,8 @@ class LasPointStream final : public DescriptorPointStream {
     return absl::InvalidArgumentError(absl::StrCat(name(), ": ", why));
   }
 
-  // A stream that ends within its header or a record is no LAS file.
+  // A stream that ends within its header or a record, or before the records its header
+  // states, is cut short.
   absl::Status End(StreamedPoints* /*points*/) override {
     if (record_length_ == 0) {
       return Invalid(absl::StrCat("ended within the LAS header, after ", header_.size(), " bytes"));
@@ -63,6 +67,10 @@ class LasPointStream final : public DescriptorPointStream {
     if (!records_.empty() && records_left_ > 0) {
       return Invalid(absl::StrCat("ended within LAS record ", records_read_ + 1, " (",
                                   records_.size(), " of its ", record_length_, " bytes)"));
+    }
+    if (stated_records_ > 0 && records_left_ > 0) {
+      return Invalid(absl::StrCat("ended after ", records_read_, " of the ", stated_records_,
+                                  " LAS records its header states"));
     }
     return absl::OkStatus();
   }
@@ -106,16 +114,26 @@ class LasPointStream final : public DescriptorPointStream {
     if (!checked.ok()) return Invalid(checked.status().message());
     record_length_ = LoadScalar<uint16_t>(header_.data() + las_layout::kRecordLength, false);
     if (record_length_ == 0) return Invalid("the LAS header gives records of 0 bytes");
-    // The records that come before anything else: all of them, unless LAS 1.4's extended
-    // variable-length records follow them.
-    if (static_cast<uint8_t>(header_[las_layout::kVersionMinor]) >= 4 &&
-        header_.size() >= las_layout::kHeaderSize14) {
+    // The records the header states (as reading the file counts them: LAS 1.4's count where it
+    // gives one, else the legacy one), and at most those before LAS 1.4's extended
+    // variable-length records.
+    stated_records_ = LoadScalar<uint32_t>(header_.data() + las_layout::kLegacyPointCount, false);
+    const bool las14 = static_cast<uint8_t>(header_[las_layout::kVersionMinor]) >= 4 &&
+                       header_.size() >= las_layout::kHeaderSize14;
+    if (las14) {
+      const uint64_t count14 =
+          LoadScalar<uint64_t>(header_.data() + las_layout::kPointCount, false);
+      if (count14 != 0) stated_records_ = count14;
+    }
+    if (stated_records_ > 0) records_left_ = stated_records_;
+    if (las14) {
       const uint64_t evlr_start =
           LoadScalar<uint64_t>(header_.data() + las_layout::kEvlrStart, false);
       const uint32_t evlrs =
           LoadScalar<uint32_t>(header_.data() + las_layout::kEvlrStart + 8, false);
       if (evlrs > 0 && evlr_start >= offset_to_points_) {
-        records_left_ = (evlr_start - offset_to_points_) / record_length_;
+        records_left_ =
+            std::min<uint64_t>(records_left_, (evlr_start - offset_to_points_) / record_length_);
       }
     }
     return absl::OkStatus();
@@ -149,6 +167,7 @@ class LasPointStream final : public DescriptorPointStream {
   std::string header_;           // The header and variable-length records, as far as they came.
   size_t offset_to_points_ = 0;  // Once the legacy header has come.
   size_t record_length_ = 0;     // Once the whole header has come and passed its checks.
+  uint64_t stated_records_ = 0;  // By the header; 0: not stated.
   uint64_t records_left_ = std::numeric_limits<uint64_t>::max();
   std::string records_;  // Records not read yet: a partial one at most between reads.
   uint64_t records_read_ = 0;

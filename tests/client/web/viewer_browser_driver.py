@@ -171,6 +171,9 @@ def main():
     parser.add_argument("--timeout", type=float, default=60)
     parser.add_argument("--screenshot")
     parser.add_argument("--stop_when_watching", action="store_true")
+    parser.add_argument("--print_sessions", action="store_true",
+                        help="with --stop_when_watching: print the session list's items too, "
+                             "as 'listed ID TITLE'")
     parser.add_argument("--trust_certificate",
                         help="a PEM certificate whose key the browser trusts (an https:// URL "
                              "served with a test certificate)")
@@ -195,6 +198,13 @@ def main():
                     ready = True
                     if args.stop_when_watching:
                         print("watching %s" % status["session"], flush=True)
+                        if args.print_sessions:
+                            items = page.call("Runtime.evaluate", returnByValue=True, expression=(
+                                "[...document.querySelectorAll('#sessions li')].map((li) =>"
+                                " li.dataset.session + ' ' + li.firstChild.textContent)"
+                            ))["result"]["value"]
+                            for item in items:
+                                print("listed %s" % item, flush=True)
                         return 0
                 sequence = int(status.get("sequence", "0"))
                 if sequence > 0 and sequence not in shown:

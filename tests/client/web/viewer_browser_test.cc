@@ -159,11 +159,24 @@ TEST(ViewerBrowserTest, ThePageOpensOnTheNewestSessionStillLearning) {
   ASSERT_TRUE(st::Upload(*service, finished, st::SpherePoints(2000, 1), 1, &response).ok());
   ASSERT_TRUE(st::Finish(*service, finished).ok());
   const std::string older = st::MustCreate(*service, st::CreateRequest(500));
+  // A session whose learner stalls on its first points, waiting for more: listed as such.
+  v1::CreateSessionRequest stalling = st::CreateRequest(100);
+  stalling.mutable_config()->mutable_learner()->mutable_c_ec()->set_value(0.01);
+  stalling.mutable_config()->mutable_learner()->mutable_c_vs()->set_value(10);
+  const std::string stalled = st::MustCreate(*service, stalling);
+  ASSERT_TRUE(st::Upload(*service, stalled, st::TorusPoints(2000, 9), 1, &response).ok());
   const std::string newest = st::MustCreate(*service, st::CreateRequest(500));
   v1::MeshUpdate final_mesh;
   ASSERT_TRUE(st::WaitFinal(*service, finished, &final_mesh).ok());
   const std::string newer_finished = st::MustCreate(*service, st::CreateRequest(500));
   ASSERT_TRUE(st::Cancel(*service, newer_finished).ok());
+
+  bool paused = false;
+  for (int i = 0; i < 600 && !paused; ++i) {
+    absl::SleepFor(absl::Milliseconds(50));
+    paused = st::GetSession(*service, stalled).learning().stalled();
+  }
+  ASSERT_TRUE(paused) << "the stalling session did not stall";
 
   BackgroundProcess viewer("neuralmesh",
                            {"view", "--server=" + server->target(), "--listen=127.0.0.1:0"});
@@ -172,11 +185,16 @@ TEST(ViewerBrowserTest, ThePageOpensOnTheNewestSessionStillLearning) {
   const std::string dir = testing::MakeTempDir("browser_newest");
   const std::string command = absl::StrCat(
       "/usr/bin/python3 tests/client/web/viewer_browser_driver.py --timeout=60 "
-      "--stop_when_watching --url=http://127.0.0.1:",
+      "--stop_when_watching --print_sessions --url=http://127.0.0.1:",
       port, "/ --ready_file=", dir, "/ready > ", dir, "/out 2> ", dir, "/err");
   ASSERT_EQ(std::system(command.c_str()), 0) << testing::ReadWholeFile(dir + "/err");
-  EXPECT_EQ(testing::ReadWholeFile(dir + "/out"), absl::StrCat("watching ", newest, "\n"))
-      << "not the older live one (" << older << "), nor the finished or cancelled ones";
+  const std::string out = testing::ReadWholeFile(dir + "/out");
+  EXPECT_THAT(out, ::testing::StartsWith(absl::StrCat("watching ", newest, "\n")))
+      << "not the older live ones (" << older << ", " << stalled
+      << "), nor the finished or cancelled ones";
+  EXPECT_THAT(out, ::testing::HasSubstr(absl::StrCat(
+                       "listed ", stalled, " test (learning, stalled: waiting for points)\n")));
+  EXPECT_THAT(out, ::testing::HasSubstr(absl::StrCat("listed ", older, " test (collecting)\n")));
 }
 
 // A keyed viewer (neuralmesh view --view_key_file) of a server with one live session, over

@@ -104,6 +104,9 @@ TEST(LasPointStreamTest, WhatIsNoLasStreamIsAnErrorSayingWhy) {
   EXPECT_EQ(status.message(), "the scanner: ended within the LAS header, after 300 bytes");
   status = error_of(bytes.substr(0, 375 + 30 * 4 + 12));
   EXPECT_EQ(status.message(), "the scanner: ended within LAS record 5 (12 of its 30 bytes)");
+  status = error_of(bytes.substr(0, 375 + 30 * 4));
+  EXPECT_EQ(status.message(),
+            "the scanner: ended after 4 of the 100 LAS records its header states");
 
   absl::StatusOr<std::string> laz =
       io_internal::CompressLas(bytes, io_internal::LazWriteOptions{50});
@@ -113,6 +116,35 @@ TEST(LasPointStreamTest, WhatIsNoLasStreamIsAnErrorSayingWhy) {
   EXPECT_EQ(status.message(),
             "the scanner: LAZ, whose records are not decoded as they arrive; pipe LAS instead "
             "(laszip -olas -stdout)");
+}
+
+// The records a LAS stream's header states are read, and what follows them is not (LAS 1.3's
+// waveform packets); a header that states none is read to the stream's end.
+TEST(LasPointStreamTest, TheHeadersCountSaysWhereTheRecordsEnd) {
+  std::vector<testing::LasPoint> records;
+  for (int i = 0; i < 50; ++i) records.push_back({100 * i, 200, 300 + i});
+  testing::LasLayout layout;
+  layout.version_minor = 3;
+  layout.after_points = std::string(20 * 17, '\x7f');  // 17 records' worth of waveform bytes.
+  const std::string with_waveforms = testing::LasFile(layout, records);
+  const auto read = [](const std::string& bytes, StreamedPoints* streamed) {
+    Pipe pipe;
+    std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "standard input");
+    return ReadInPieces(*stream, pipe, bytes, {100}, streamed);
+  };
+  StreamedPoints streamed;
+  absl::Status status = read(with_waveforms, &streamed);
+  ASSERT_TRUE(status.ok()) << status;
+  ASSERT_EQ(streamed.size(), 50u) << "the waveform packets are no records";
+  EXPECT_EQ(streamed.positions[49], Vec3(49, 2, 3.49));
+
+  testing::LasLayout unstated;
+  std::string bytes = testing::LasFile(unstated, records);
+  bytes.replace(107, 4, std::string(4, '\0'));  // The legacy point count.
+  streamed.clear();
+  status = read(bytes, &streamed);
+  ASSERT_TRUE(status.ok()) << status;
+  EXPECT_EQ(streamed.size(), 50u) << "read to the end";
 }
 
 // A coloured scan of buildings and ground (LAS 1.4, format 7) read with classes: the records

@@ -3,8 +3,9 @@
 // sets the pieces' size and whether classes are chosen, the rest is the stream. Properties:
 // a stream ends or is refused with INVALID_ARGUMENT, never another error or a crash; its
 // points are finite, with one colour each or none; and a LAS stream read without classes
-// gives the points reading its bytes as a file gives (ParseLas), or the first of them where
-// LAS 1.4's extended records start earlier.
+// whose header states its records gives the points reading its bytes as a file gives
+// (ParseLas), or the first of them where LAS 1.4's extended records start earlier (a header
+// that states none is read to the stream's end, a file of it has no points).
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -83,6 +84,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // Points beyond a float's range from the origin the file's range chooses are left out of
   // the file and not of the stream, which chooses its origin later (StreamUpload).
   if (!parsed.ok() || parsed->left_out.invalid > 0) return 0;
+  const absl::StatusOr<uint64_t> stated = neuralmesh::io_internal::LasRecordCount(bytes);
+  if (!stated.ok() || *stated == 0) return 0;
   FUZZ_CHECK(points.size() <= parsed->positions.size(), "the stream gave %zu points, the file %zu",
              points.size(), parsed->positions.size());
   for (size_t i = 0; i < points.size(); ++i) {

@@ -118,8 +118,10 @@ class LasPointStream final : public DescriptorPointStream {
     // gives one, else the legacy one), and at most those before LAS 1.4's extended
     // variable-length records.
     stated_records_ = LoadScalar<uint32_t>(header_.data() + las_layout::kLegacyPointCount, false);
-    const bool las14 = static_cast<uint8_t>(header_[las_layout::kVersionMinor]) >= 4 &&
-                       header_.size() >= las_layout::kHeaderSize14;
+    const bool las14 =
+        static_cast<uint8_t>(header_[las_layout::kVersionMinor]) >= 4 &&
+        LoadScalar<uint16_t>(header_.data() + las_layout::kHeaderSize, false) >=
+            las_layout::kHeaderSize14;
     if (las14) {
       const uint64_t count14 =
           LoadScalar<uint64_t>(header_.data() + las_layout::kPointCount, false);

@@ -373,8 +373,10 @@ void Session::StoreMesh(const v1::MeshUpdate& update, bool durable) {
   if (record_ == nullptr) return;
   const absl::Status stored = record_->WriteLatestMesh(update, durable);
   if (!stored.ok() && !mesh_store_failed_.exchange(true)) {
-    Record(absl::StrCat("could not store mesh ", update.sequence(), " (a restart would learn it "
-                        "again; later failures are not recorded): ", stored.message()));
+    Record(absl::StrCat("could not store mesh ", update.sequence(),
+                        " (a restart would learn it "
+                        "again; later failures are not recorded): ",
+                        stored.message()));
   }
 }
 
@@ -387,24 +389,25 @@ void Session::SkipMilestonesUpToLocked(size_t vertices) {
 
 void Session::StoreCheckpoint(const Snapshot& snapshot) {
   if (record_ == nullptr) return;
-  const absl::Status stored = record_->WriteCheckpoint(
-      snapshot.mesh, snapshot.learning,
-      snapshot.kind == v1::UPDATE_KIND_MILESTONE ? CheckpointKind::kMilestone
-                                                 : CheckpointKind::kRefresh);
+  const absl::Status stored = record_->WriteCheckpoint(snapshot.mesh, snapshot.learning,
+                                                       snapshot.kind == v1::UPDATE_KIND_MILESTONE
+                                                           ? CheckpointKind::kMilestone
+                                                           : CheckpointKind::kRefresh);
   if (!stored.ok() && !checkpoint_store_failed_.exchange(true)) {
     Record(absl::StrCat("could not store the learner's mesh of ", snapshot.mesh.positions.size(),
                         " vertices (a restart would learn on from an older one or from the "
-                        "initial mesh; later failures are not recorded): ", stored.message()));
+                        "initial mesh; later failures are not recorded): ",
+                        stored.message()));
   }
 }
 
 void Session::FinishRestore(v1::SessionState state, const std::string& error,
-                            std::shared_ptr<v1::MeshUpdate> latest,
+                            uint64_t paused_at_points, std::shared_ptr<v1::MeshUpdate> latest,
                             std::optional<LearnerCheckpoint> checkpoint,
                             std::unique_ptr<SessionRecord> record) {
   record_ = std::move(record);
-  const bool ended = state == v1::SESSION_STATE_FINISHED ||
-                     state == v1::SESSION_STATE_CANCELLED || state == v1::SESSION_STATE_FAILED;
+  const bool ended = state == v1::SESSION_STATE_FINISHED || state == v1::SESSION_STATE_CANCELLED ||
+                     state == v1::SESSION_STATE_FAILED;
   if (checkpoint.has_value() && !ended) {
     // Learning goes on from the checkpoint's mesh, and its counts from the checkpoint's.
     const v1::LearningState& before = checkpoint->learning;
@@ -454,19 +457,26 @@ void Session::FinishRestore(v1::SessionState state, const std::string& error,
         error_ = error;
         cancel_.store(true);
       }
-      updates_.Close(state == v1::SESSION_STATE_CANCELLED
-                         ? absl::CancelledError(absl::StrCat("session ", id_,
-                                                             " was cancelled: ", error))
-                         : absl::InternalError(absl::StrCat("learning failed in session ", id_,
-                                                            ": ", error)));
+      updates_.Close(
+          state == v1::SESSION_STATE_CANCELLED
+              ? absl::CancelledError(absl::StrCat("session ", id_, " was cancelled: ", error))
+              : absl::InternalError(absl::StrCat("learning failed in session ", id_, ": ", error)));
       return;
     }
     case v1::SESSION_STATE_FINISHING:
       if (absl::Status finished = Finish(); !finished.ok()) Fail(finished);
       return;
-    default:
+    default: {
+      {
+        absl::MutexLock lock(&mu_);
+        if (paused_at_points > 0 && points_.size() <= paused_at_points) {
+          stalled_at_points_ = paused_at_points;
+          learning_.set_stalled(true);
+        }
+      }
       Wake();
       return;
+    }
   }
 }
 
@@ -548,9 +558,8 @@ void Session::UpdateLearningState() {
   learning_.set_splits(earlier_learning_.splits + progress.splits);
   learning_.set_collapses(earlier_learning_.collapses + progress.collapses);
   learning_.set_learning_seconds(absl::ToDoubleSeconds(learning_time_));
-  learning_.set_steps_per_second(learning_time_ > absl::ZeroDuration()
-                                     ? steps / absl::ToDoubleSeconds(learning_time_)
-                                     : 0.0);
+  learning_.set_steps_per_second(
+      learning_time_ > absl::ZeroDuration() ? steps / absl::ToDoubleSeconds(learning_time_) : 0.0);
   learning_.set_relearning(relearning_);
   last_activity_ = absl::Now();
 }
@@ -654,8 +663,7 @@ SliceResult Session::RunSlice(absl::Time deadline) {
     if (vertices >= allowed) {
       if (finishing) {
         uint32_t lod_index = static_cast<uint32_t>(
-            std::lower_bound(milestones.begin(), milestones.end(), allowed) -
-            milestones.begin());
+            std::lower_bound(milestones.begin(), milestones.end(), allowed) - milestones.begin());
         TakeSnapshot(v1::UPDATE_KIND_FINAL, allowed, lod_index);
         {
           absl::MutexLock lock(&mu_);
@@ -688,9 +696,8 @@ SliceResult Session::RunSlice(absl::Time deadline) {
     if (refreshing && last_publish_time_ != absl::InfinitePast()) {
       const absl::Time due = last_publish_time_ + config_.refresh_interval;
       if (now >= due && learner_->progress().basic_steps != last_publish_steps_) {
-        const size_t heading = milestone_index < milestones.size()
-                                   ? milestones[milestone_index]
-                                   : config_.target_vertices;
+        const size_t heading = milestone_index < milestones.size() ? milestones[milestone_index]
+                                                                   : config_.target_vertices;
         TakeSnapshot(v1::UPDATE_KIND_REFRESH, heading, static_cast<uint32_t>(milestone_index));
         continue;
       }
@@ -730,6 +737,14 @@ SliceResult Session::RunSlice(absl::Time deadline) {
         learning_.set_stalled(true);
       }
       Record(absl::StrCat("paused: ", growth.message(), "; waiting for points past ", points));
+      if (record_ != nullptr) {
+        if (absl::Status stored = record_->SetPausedAt(points); !stored.ok()) {
+          Record(
+              absl::StrCat("could not store the pause (a restart would learn until it "
+                           "stalls again): ",
+                           stored.message()));
+        }
+      }
       return {SliceResult::kIdle};
     }
   }
@@ -742,12 +757,12 @@ absl::StatusOr<std::unique_ptr<Learner>> Session::CreateLearner() {
   absl::StatusOr<std::unique_ptr<Learner>> learner =
       Learner::CreateFrom(config_.learner, &points_, start);
   if (learner.ok()) {
-    Record(absl::StrCat("learning goes on from ", start_mesh_name_, " of ",
-                        start.positions.size(), " vertices"));
+    Record(absl::StrCat("learning goes on from ", start_mesh_name_, " of ", start.positions.size(),
+                        " vertices"));
     return learner;
   }
-  Record(absl::StrCat("cannot learn on from ", start_mesh_name_, " (",
-                      learner.status().message(), "); learning again from the initial mesh"));
+  Record(absl::StrCat("cannot learn on from ", start_mesh_name_, " (", learner.status().message(),
+                      "); learning again from the initial mesh"));
   return Learner::Create(config_.learner, &points_);
 }
 
@@ -823,8 +838,10 @@ void Session::EncodeNext() {
       final_mesh_ptr->set_sequence(updates_.next_sequence());
       StoreMesh(final_mesh, /*durable=*/true);
       if (absl::Status stored = StoreState(v1::SESSION_STATE_FINISHED, ""); !stored.ok()) {
-        Record(absl::StrCat("could not store the finish (a restart would learn the final mesh "
-                            "again): ", stored.message()));
+        Record(
+            absl::StrCat("could not store the finish (a restart would learn the final mesh "
+                         "again): ",
+                         stored.message()));
       }
       if (updates_.Publish(final_mesh_ptr) != 0 && metrics_ != nullptr) {
         metrics_->AddMeshPublished(final_mesh.draco_mesh().size());
@@ -874,8 +891,8 @@ absl::StatusOr<std::shared_ptr<v1::MeshUpdate>> Session::Encode(const Snapshot& 
     return true;
   };
   // A clamped or painted mesh is one copy of the snapshot, clamped first.
-  const bool clamp = !std::all_of(snapshot.mesh.positions.begin(),
-                                  snapshot.mesh.positions.end(), inside);
+  const bool clamp =
+      !std::all_of(snapshot.mesh.positions.begin(), snapshot.mesh.positions.end(), inside);
   const bool paint = point_colors_.size() > 0;
   const TriangleMesh* mesh = &snapshot.mesh;
   TriangleMesh copy;

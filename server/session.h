@@ -65,8 +65,8 @@
 #include "server/event_log.h"
 #include "server/executor.h"
 #include "server/held_outliers.h"
-#include "server/session_config.h"
 #include "server/server_metrics.h"
+#include "server/session_config.h"
 #include "server/session_store.h"
 #include "server/update_channel.h"
 #include "server/worker_pool.h"
@@ -118,9 +118,10 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // number), attaches `record`, and sets learning going again unless the session had ended:
   // from `checkpoint`'s mesh when there is one (unless the final pass relearns, see
   // SessionConfig::final_pass), and from the initial mesh when there is none or the learner
-  // cannot take it (the event log says why).
+  // cannot take it (the event log says why). A collecting session that had paused for lack of
+  // growth at `paused_at_points` points (0: never) and has no more waits paused again.
   absl::Status ReplayBatch(const PointCloud& batch) ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
-  void FinishRestore(v1::SessionState state, const std::string& error,
+  void FinishRestore(v1::SessionState state, const std::string& error, uint64_t paused_at_points,
                      std::shared_ptr<v1::MeshUpdate> latest,
                      std::optional<LearnerCheckpoint> checkpoint,
                      std::unique_ptr<SessionRecord> record) ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
@@ -156,8 +157,7 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   // RESOURCE_EXHAUSTED) the batch is refused and nothing changes.
   absl::StatusOr<size_t> AddPoints(const PointCloud& batch, size_t* held_back = nullptr,
                                    std::optional<uint64_t> first_point = std::nullopt,
-                                   size_t* skipped = nullptr)
-      ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
+                                   size_t* skipped = nullptr) ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
 
   // No more points: learn to the final vertex count and publish the final mesh. The points
   // outlier removal still holds back are dropped. FAILED_PRECONDITION when already finishing,
@@ -207,9 +207,8 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   };
 
   absl::StatusOr<size_t> AddPointsAndMaybeWake(const PointCloud& sent, size_t* held_back,
-                                               std::optional<uint64_t> first_point,
-                                               size_t* skipped, bool wake)
-      ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
+                                               std::optional<uint64_t> first_point, size_t* skipped,
+                                               bool wake) ABSL_LOCKS_EXCLUDED(ingest_mu_, mu_);
   // Stores a new state; OK without a record.
   absl::Status StoreState(v1::SessionState state, const std::string& error) const;
   // Stores a published mesh; a failure is recorded in the event log (once per session), as the
@@ -315,7 +314,7 @@ class Session : public Schedulable, public std::enable_shared_from_this<Session>
   std::optional<size_t> stalled_at_points_;
 
   std::unique_ptr<SessionRecord> record_;  // Null without a state directory.
-  ServerMetrics* metrics_ = nullptr;  // May be null.
+  ServerMetrics* metrics_ = nullptr;       // May be null.
   std::atomic<bool> mesh_store_failed_{false};
   std::atomic<bool> checkpoint_store_failed_{false};
 };

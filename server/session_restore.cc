@@ -35,9 +35,9 @@ absl::StatusOr<Replay> ReplayJournal(const std::string& path, Session& session,
     }
     if (!replay.status.ok()) return absl::OkStatus();
     if (absl::Status taken = session.ReplayBatch(batch); !taken.ok()) {
-      replay.status = absl::Status(taken.code(), absl::StrCat("batch ", replay.batches + 1,
-                                                              " of its journal: ",
-                                                              taken.message()));
+      replay.status = absl::Status(
+          taken.code(),
+          absl::StrCat("batch ", replay.batches + 1, " of its journal: ", taken.message()));
     } else {
       ++replay.batches;
     }
@@ -66,8 +66,8 @@ std::shared_ptr<Session> RestoreSession(const StoredSessionFiles& files, Session
   const storage::v1::StoredSession& stored = files.stored;
   const std::string& id = stored.session_id();
   auto unrestored = [&](const absl::Status& status) {
-    problems.push_back(absl::StrCat("session ", id, " stays on disk unrestored: ",
-                                    status.message()));
+    problems.push_back(
+        absl::StrCat("session ", id, " stays on disk unrestored: ", status.message()));
     return nullptr;
   };
   absl::StatusOr<SessionConfig> config = SessionConfigFromProto(stored.config());
@@ -75,10 +75,9 @@ std::shared_ptr<Session> RestoreSession(const StoredSessionFiles& files, Session
   if (absl::Status valid = ResolveSessionConfig(max_points_per_session, *config); !valid.ok()) {
     return unrestored(valid);
   }
-  auto session = std::make_shared<Session>(id, stored.name(), *std::move(config),
-                                           max_points_per_session, pool, encoder, log,
-                                           stored.owner(),
-                                           absl::FromUnixMicros(stored.create_time_us()));
+  auto session = std::make_shared<Session>(
+      id, stored.name(), *std::move(config), max_points_per_session, pool, encoder, log,
+      stored.owner(), absl::FromUnixMicros(stored.create_time_us()));
   absl::StatusOr<Replay> replay = ReplayJournal(files.journal_path, *session, problems, stop);
   if (!replay.ok()) return unrestored(replay.status());
 
@@ -96,35 +95,38 @@ std::shared_ptr<Session> RestoreSession(const StoredSessionFiles& files, Session
   if (!replay->status.ok()) {
     state = v1::SESSION_STATE_FAILED;
     error = absl::StrCat("restoring it after a restart failed at ", replay->status.message());
-    problems.push_back(absl::StrCat("session ", id,
-                                    " is restored as failed (its files stay as they are): ",
-                                    error));
+    problems.push_back(absl::StrCat(
+        "session ", id, " is restored as failed (its files stay as they are): ", error));
   }
   absl::StatusOr<std::unique_ptr<SessionRecord>> record =
       store.Reopen(files, replay->journal_bytes);
   if (!record.ok()) return unrestored(record.status());
-  std::string latest_note =
-      latest == nullptr ? std::string()
-                        : absl::StrCat(", mesh ", latest->sequence(), " of ",
-                                       latest->vertex_count(), " vertices");
+  std::string latest_note = latest == nullptr ? std::string()
+                                              : absl::StrCat(", mesh ", latest->sequence(), " of ",
+                                                             latest->vertex_count(), " vertices");
   if (!files.checkpoint_damage.empty()) {
     problems.push_back(absl::StrCat("session ", id, ": its learner checkpoint cannot be used (",
                                     files.checkpoint_damage,
                                     "); it learns again from the initial mesh"));
   }
   std::optional<LearnerCheckpoint> checkpoint = files.checkpoint;
-  if (checkpoint.has_value() && (state == v1::SESSION_STATE_COLLECTING ||
-                                 state == v1::SESSION_STATE_FINISHING)) {
-    absl::StrAppend(&latest_note, ", learner checkpoint of ",
-                    checkpoint->mesh.positions.size(), " vertices");
+  if (checkpoint.has_value() &&
+      (state == v1::SESSION_STATE_COLLECTING || state == v1::SESSION_STATE_FINISHING)) {
+    absl::StrAppend(&latest_note, ", learner checkpoint of ", checkpoint->mesh.positions.size(),
+                    " vertices");
+  }
+  if (state == v1::SESSION_STATE_COLLECTING && stored.paused_at_points() > 0 &&
+      session->points_received() <= stored.paused_at_points()) {
+    absl::StrAppend(&latest_note, ", paused for lack of growth until more than ",
+                    stored.paused_at_points(), " points come");
   }
   session->AttachMetrics(metrics);  // After the replay: its batches are not new work.
-  session->FinishRestore(state, error, std::move(latest), std::move(checkpoint),
-                         *std::move(record));
+  session->FinishRestore(state, error, stored.paused_at_points(), std::move(latest),
+                         std::move(checkpoint), *std::move(record));
   if (log != nullptr) {
-    log->Record(id, absl::StrCat("restored after a restart: ", session->points_received(),
-                                 " points in ", replay->batches, " batches, ",
-                                 StateName(session->state()), latest_note));
+    log->Record(
+        id, absl::StrCat("restored after a restart: ", session->points_received(), " points in ",
+                         replay->batches, " batches, ", StateName(session->state()), latest_note));
   }
   return session;
 }

@@ -14,9 +14,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/file_contents.h"
-#include "proto/packing.h"
 #include "core/status_macros.h"
 #include "neuralmesh/storage/v1/learner_checkpoint.pb.h"
+#include "proto/packing.h"
 #include "server/proto_conversion.h"
 
 namespace neuralmesh::server {
@@ -43,10 +43,9 @@ absl::Status SyncPath(const std::string& path) {
 
 // Whether `name` can be a session id the server made (server/session_manager.cc).
 bool IsSessionId(const std::string& name) {
-  return !name.empty() && name.size() <= 64 &&
-         std::all_of(name.begin(), name.end(), [](char c) {
-           return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-';
-         });
+  return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-';
+  });
 }
 
 bool Ended(v1::SessionState state) {
@@ -63,9 +62,9 @@ absl::StatusOr<LearnerCheckpoint> ParseCheckpoint(const std::string& contents,
     return absl::DataLossError("it is not a learner checkpoint");
   }
   if (stored.format_version() != kFormatVersion) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        "it has format version ", stored.format_version(), "; this server reads version ",
-        kFormatVersion));
+    return absl::FailedPreconditionError(
+        absl::StrCat("it has format version ", stored.format_version(),
+                     "; this server reads version ", kFormatVersion));
   }
   if (stored.session_id() != id) {
     return absl::DataLossError(absl::StrCat("it is of session \"", stored.session_id(), "\""));
@@ -85,8 +84,8 @@ absl::StatusOr<StoredSessionFiles> ReadSessionDirectory(const std::string& direc
   NM_ASSIGN_OR_RETURN(const std::string state,
                       ReadFileContents(absl::StrCat(directory, "/", kStoredSessionFile)));
   if (!files.stored.ParseFromString(state)) {
-    return absl::DataLossError(absl::StrCat("'", directory, "/", kStoredSessionFile,
-                                            "' is not a stored session"));
+    return absl::DataLossError(
+        absl::StrCat("'", directory, "/", kStoredSessionFile, "' is not a stored session"));
   }
   if (files.stored.format_version() != kFormatVersion) {
     return absl::FailedPreconditionError(
@@ -95,8 +94,8 @@ absl::StatusOr<StoredSessionFiles> ReadSessionDirectory(const std::string& direc
   }
   const std::string id = std::filesystem::path(directory).filename().string();
   if (files.stored.session_id() != id) {
-    return absl::DataLossError(absl::StrCat("'", directory, "' holds session \"",
-                                            files.stored.session_id(), "\""));
+    return absl::DataLossError(
+        absl::StrCat("'", directory, "' holds session \"", files.stored.session_id(), "\""));
   }
   if (absl::StatusOr<std::string> latest =
           ReadFileContents(absl::StrCat(directory, "/", kLatestMeshFile));
@@ -154,6 +153,16 @@ absl::Status SessionRecord::SetOwner(const std::string& owner) {
   storage::v1::StoredSession changed = stored_;
   changed.set_owner(owner);
   NM_RETURN_IF_ERROR(ReplaceFile(kStoredSessionFile, changed, /*durable=*/true));
+  stored_ = std::move(changed);
+  return absl::OkStatus();
+}
+
+absl::Status SessionRecord::SetPausedAt(uint64_t points) {
+  absl::MutexLock lock(&mu_);
+  if (removed_) return absl::OkStatus();
+  storage::v1::StoredSession changed = stored_;
+  changed.set_paused_at_points(points);
+  NM_RETURN_IF_ERROR(ReplaceFile(kStoredSessionFile, changed, /*durable=*/false));
   stored_ = std::move(changed);
   return absl::OkStatus();
 }
@@ -245,8 +254,8 @@ absl::StatusOr<std::unique_ptr<SessionStore>> SessionStore::Open(
   const std::string sessions = absl::StrCat(directory, "/", kSessionsDirectory);
   std::filesystem::create_directories(sessions, error);
   if (error) {
-    return ErrorCodeStatus(error, absl::StrCat("cannot create the state directory '", directory,
-                                               "'"));
+    return ErrorCodeStatus(error,
+                           absl::StrCat("cannot create the state directory '", directory, "'"));
   }
   // The points are the clients' data: readable by the server's user only.
   std::filesystem::permissions(sessions, std::filesystem::perms::owner_all,
@@ -266,8 +275,7 @@ absl::StatusOr<std::unique_ptr<SessionStore>> SessionStore::Open(
     }
     return absl::ErrnoToStatus(lock_error, absl::StrCat("cannot lock '", lock_path, "'"));
   }
-  return std::unique_ptr<SessionStore>(
-      new SessionStore(directory, fd, sync, checkpoint_interval));
+  return std::unique_ptr<SessionStore>(new SessionStore(directory, fd, sync, checkpoint_interval));
 }
 
 SessionStore::~SessionStore() { close(lock_fd_); }
@@ -290,8 +298,7 @@ std::vector<StoredSessionFiles> SessionStore::List(std::vector<std::string>* pro
     found.push_back(*std::move(files));
   }
   if (error) {
-    problems->push_back(
-        absl::StrCat("cannot list '", sessions, "': ", error.message()));
+    problems->push_back(absl::StrCat("cannot list '", sessions, "': ", error.message()));
   }
   std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) {
     if (a.stored.create_time_us() != b.stored.create_time_us()) {
@@ -328,12 +335,12 @@ absl::StatusOr<std::unique_ptr<SessionRecord>> SessionStore::Create(
                                          checkpoint_interval_);
 }
 
-absl::StatusOr<std::unique_ptr<SessionRecord>> SessionStore::Reopen(
-    const StoredSessionFiles& files, uint64_t journal_bytes) {
+absl::StatusOr<std::unique_ptr<SessionRecord>> SessionStore::Reopen(const StoredSessionFiles& files,
+                                                                    uint64_t journal_bytes) {
   NM_ASSIGN_OR_RETURN(std::unique_ptr<PointsJournal> journal,
                       PointsJournal::Open(files.journal_path, journal_bytes, sync_));
-  return std::make_unique<SessionRecord>(files.directory, files.stored, std::move(journal),
-                                         sync_, checkpoint_interval_);
+  return std::make_unique<SessionRecord>(files.directory, files.stored, std::move(journal), sync_,
+                                         checkpoint_interval_);
 }
 
 }  // namespace neuralmesh::server

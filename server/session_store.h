@@ -60,13 +60,14 @@ class SessionRecord {
   absl::Status AppendBatch(const PointCloud& batch) ABSL_LOCKS_EXCLUDED(mu_);
   // Records a new state and its reason (the error of a cancelled or failed session). An ended
   // state (finished, cancelled, failed) removes the learner checkpoint.
-  absl::Status SetState(v1::SessionState state, const std::string& error)
-      ABSL_LOCKS_EXCLUDED(mu_);
+  absl::Status SetState(v1::SessionState state, const std::string& error) ABSL_LOCKS_EXCLUDED(mu_);
   // Records a new owner (TransferSession), synced like a state.
   absl::Status SetOwner(const std::string& owner) ABSL_LOCKS_EXCLUDED(mu_);
+  // Records that learning paused for lack of growth with `points` points taken
+  // (StoredSession.paused_at_points). Not synced: a pause lost to a crash is found again.
+  absl::Status SetPausedAt(uint64_t points) ABSL_LOCKS_EXCLUDED(mu_);
   // Replaces the stored latest mesh; with `durable` (the final mesh) synced like a state.
-  absl::Status WriteLatestMesh(const v1::MeshUpdate& update, bool durable)
-      ABSL_LOCKS_EXCLUDED(mu_);
+  absl::Status WriteLatestMesh(const v1::MeshUpdate& update, bool durable) ABSL_LOCKS_EXCLUDED(mu_);
   // Replaces the stored learner checkpoint: `mesh` as the learner had it, and the session's
   // learning counters then. Not synced. OK and nothing written once the state is an ended
   // one, and for a refresh that comes before checkpoint_interval has passed since the last

@@ -151,12 +151,8 @@ TEST(MetricsHttpTest, CountsCancelledFailedAndIdleSessions) {
 
   const std::string cancelled = testing::MustCreate(*stub, testing::CreateRequest(300));
   ASSERT_TRUE(testing::Cancel(*stub, cancelled).ok());
-  // Step 3 after every Basic Step: collapses win over splits, learning stalls and the session
-  // fails (session.h).
-  v1::CreateSessionRequest stalling = testing::CreateRequest(100);
-  stalling.mutable_config()->mutable_learner()->mutable_c_ec()->set_value(0.01);
-  stalling.mutable_config()->mutable_learner()->mutable_c_vs()->set_value(10);
-  const std::string failed = testing::MustCreate(*stub, stalling);
+  // Learning stalls and the finishing session fails (session.h).
+  const std::string failed = testing::MustCreate(*stub, testing::StallingRequest());
   v1::UploadPointsResponse uploaded;
   ASSERT_TRUE(testing::Upload(*stub, failed, testing::TorusPoints(2000, 9), 1, &uploaded).ok());
   ASSERT_TRUE(testing::Finish(*stub, failed).ok());
@@ -300,30 +296,23 @@ TEST(MetricsHttpTest, OverTlsWithATokenOnlyTheTokensHolderReadsTheMetrics) {
   // A renewed certificate (here for 127.0.0.1) serves the metrics page too.
   HttpsTarget at_address = target;
   at_address.host = "127.0.0.1";
-  EXPECT_EQ(HttpsGet(at_address, "/healthz").status,
-            0);
+  EXPECT_EQ(HttpsGet(at_address, "/healthz").status, 0);
   ServerTls renewed;
   renewed.certificate_chain = certificates->server_chain;
   renewed.private_key = certificates->server_key;
   ASSERT_TRUE(server->ReplaceTls(renewed).ok());
-  EXPECT_EQ(HttpsGet(at_address, "/healthz", "",
-                     &error)
-                .status,
-            200)
-      << error;
+  EXPECT_EQ(HttpsGet(at_address, "/healthz", "", &error).status, 200) << error;
   // A key of another certificate is refused, and the page keeps the renewed one.
   renewed.private_key = certificates->client_key;
   EXPECT_EQ(server->ReplaceTls(renewed).code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_EQ(HttpsGet(at_address, "/healthz").status,
-            200);
+  EXPECT_EQ(HttpsGet(at_address, "/healthz").status, 200);
 
   // Without a token from the start, none can be added.
   std::unique_ptr<ReconstructionServer> open = StartWithMetrics();
   ASSERT_NE(open, nullptr);
   EXPECT_EQ(open->metrics_url(),
             absl::StrCat("http://127.0.0.1:", open->metrics_port(), "/metrics"));
-  EXPECT_EQ(open->ReplaceMetricsToken(kMetricsToken).code(),
-            absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(open->ReplaceMetricsToken(kMetricsToken).code(), absl::StatusCode::kFailedPrecondition);
 }
 
 // --metrics_client_certificate: /metrics for clients with a certificate of the server's client

@@ -117,6 +117,15 @@ inline v1::CreateSessionRequest CreateRequest(uint64_t target, uint32_t refresh_
   return request;
 }
 
+// A session whose learner stalls on TorusPoints(2000, 9): Step 3 after every Basic Step, so
+// collapses win over splits; collecting, it pauses for more points, finishing, it fails.
+inline v1::CreateSessionRequest StallingRequest() {
+  v1::CreateSessionRequest request = CreateRequest(100);
+  request.mutable_config()->mutable_learner()->mutable_c_ec()->set_value(0.01);
+  request.mutable_config()->mutable_learner()->mutable_c_vs()->set_value(10);
+  return request;
+}
+
 inline std::string MustCreate(v1::ReconstructionService::Stub& stub,
                               const v1::CreateSessionRequest& request) {
   grpc::ClientContext context;

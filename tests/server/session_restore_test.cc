@@ -148,9 +148,8 @@ TEST_F(SessionRestoreTest, AnUploadGoesOnWhereItWasAndEndsOnTheSphere) {
   // the points the session has (the overlap is skipped).
   std::vector<v1::MeshUpdate> watched;
   grpc::Status watch_status;
-  std::thread watcher([&] {
-    watch_status = WatchAfter(*service_, id, restored_mesh.sequence(), &watched);
-  });
+  std::thread watcher(
+      [&] { watch_status = WatchAfter(*service_, id, restored_mesh.sequence(), &watched); });
   ASSERT_TRUE(UploadFrom(*service_, id, cloud, 10000, 40000, 6, &response).ok());
   EXPECT_EQ(response.total_points(), 40000u);
   EXPECT_EQ(response.points_accepted(), 25000u);  // Its first batch was there already.
@@ -270,9 +269,10 @@ TEST_F(SessionRestoreTest, ARefreshIsTheCheckpointOfASessionWithoutMilestones) {
     }
     Restart(options);
     if (interval > absl::ZeroDuration()) {
-      EXPECT_FALSE(events_.Await(absl::StrCat("session ", id,
-                                              " learning goes on from the stored mesh of 3000"))
-                       .empty());
+      EXPECT_FALSE(
+          events_
+              .Await(absl::StrCat("session ", id, " learning goes on from the stored mesh of 3000"))
+              .empty());
     }
     ASSERT_TRUE(testing::Finish(*service_, id).ok());
     v1::MeshUpdate final_mesh;
@@ -315,7 +315,8 @@ TEST_F(SessionRestoreTest, ACheckpointThatCannotBeUsedMeansLearningFromTheInitia
   const std::vector<std::string> problems = server_->WaitForRestore().problems;
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_TRUE(absl::StrContains(problems[0],
-                                absl::StrCat("session ", ids[0], ": its learner checkpoint "
+                                absl::StrCat("session ", ids[0],
+                                             ": its learner checkpoint "
                                              "cannot be used (it is not a learner checkpoint)")))
       << problems[0];
   EXPECT_FALSE(events_.Await("cannot learn on from the stored mesh (face 2").empty());
@@ -445,8 +446,7 @@ TEST_F(SessionRestoreTest, OutlierVerdictsComeOutAsBefore) {
   v1::UploadPointsResponse response;
   ASSERT_TRUE(Upload(*service_, id, cloud, 6, &response).ok());
   const v1::Session before = GetSession(*service_, id);
-  EXPECT_GT(before.learning().points_removed_as_outliers() + before.learning().outliers_held(),
-            0u);
+  EXPECT_GT(before.learning().points_removed_as_outliers() + before.learning().outliers_held(), 0u);
 
   Restart();
   const v1::Session after = GetSession(*service_, id);
@@ -540,6 +540,32 @@ TEST_F(SessionRestoreTest, ABatchThatCannotBeStoredIsRefusedAndChangesNothing) {
   EXPECT_EQ(GetSession(*service_, id).points_taken(), 15000u);
 }
 
+// A session paused for lack of growth while collecting (SessionTest.AStallWhileCollecting...)
+// is restored paused: no Basic Step until more points come.
+TEST_F(SessionRestoreTest, APausedSessionStaysPausedUntilMorePointsCome) {
+  Restart();
+  const std::string id = MustCreate(*service_, testing::StallingRequest());
+  const PointCloud torus = TorusPoints(2500, 9);
+  v1::UploadPointsResponse response;
+  ASSERT_TRUE(UploadFrom(*service_, id, torus, 0, 2000, 1, &response).ok());
+  const auto learning = [&] { return GetSession(*service_, id).learning(); };
+  for (int i = 0; i < 500 && !learning().stalled(); ++i) absl::SleepFor(absl::Milliseconds(20));
+  ASSERT_TRUE(learning().stalled()) << "the learner did not stall";
+
+  Restart();
+  EXPECT_TRUE(learning().stalled()) << "restored learning, not paused";
+  const uint64_t steps = learning().basic_steps();
+  absl::SleepFor(absl::Milliseconds(500));
+  EXPECT_EQ(learning().basic_steps(), steps) << "a paused session learns after a restart";
+  EXPECT_NE(events_.Await("paused for lack of growth until more than 2000 points come"), "");
+
+  ASSERT_TRUE(UploadFrom(*service_, id, torus, 2000, 2500, 1, &response).ok());
+  for (int i = 0; i < 500 && learning().basic_steps() == steps; ++i) {
+    absl::SleepFor(absl::Milliseconds(20));
+  }
+  EXPECT_GT(learning().basic_steps(), steps) << "new points did not wake the learner";
+}
+
 TEST_F(SessionRestoreTest, ARestoredSessionsIdleTimeStartsAtTheRestart) {
   ServerOptions options;
   options.limits.idle_timeout = absl::Milliseconds(400);
@@ -567,8 +593,7 @@ TEST_F(SessionRestoreTest, OneServerAtATimeUsesAStateDirectory) {
   absl::StatusOr<std::unique_ptr<ReconstructionServer>> second =
       ReconstructionServer::Start(options);
   EXPECT_EQ(second.status().code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_TRUE(absl::StrContains(second.status().message(), "in use by another"))
-      << second.status();
+  EXPECT_TRUE(absl::StrContains(second.status().message(), "in use by another")) << second.status();
 }
 
 }  // namespace

@@ -160,10 +160,7 @@ TEST(ViewerBrowserTest, ThePageOpensOnTheNewestSessionStillLearning) {
   ASSERT_TRUE(st::Finish(*service, finished).ok());
   const std::string older = st::MustCreate(*service, st::CreateRequest(500));
   // A session whose learner stalls on its first points, waiting for more: listed as such.
-  v1::CreateSessionRequest stalling = st::CreateRequest(100);
-  stalling.mutable_config()->mutable_learner()->mutable_c_ec()->set_value(0.01);
-  stalling.mutable_config()->mutable_learner()->mutable_c_vs()->set_value(10);
-  const std::string stalled = st::MustCreate(*service, stalling);
+  const std::string stalled = st::MustCreate(*service, st::StallingRequest());
   ASSERT_TRUE(st::Upload(*service, stalled, st::TorusPoints(2000, 9), 1, &response).ok());
   const std::string newest = st::MustCreate(*service, st::CreateRequest(500));
   v1::MeshUpdate final_mesh;

@@ -187,10 +187,7 @@ TEST_F(ViewerServiceTest, ListsTheSessionsAsJson) {
   EXPECT_THAT(one.body, HasSubstr("\"state\":\"collecting\""));
   EXPECT_THAT(one.body, HasSubstr("\"stalled\":false"));
   // A session whose learner stalls on its first points says so while it waits for more.
-  v1::CreateSessionRequest stalling = st::CreateRequest(100);
-  stalling.mutable_config()->mutable_learner()->mutable_c_ec()->set_value(0.01);
-  stalling.mutable_config()->mutable_learner()->mutable_c_vs()->set_value(10);
-  const std::string stalled_id = st::MustCreate(*service_, stalling);
+  const std::string stalled_id = st::MustCreate(*service_, st::StallingRequest());
   v1::UploadPointsResponse response;
   ASSERT_TRUE(st::Upload(*service_, stalled_id, st::TorusPoints(2000, 9), 1, &response).ok());
   std::string body;

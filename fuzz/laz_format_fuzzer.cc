@@ -4,7 +4,9 @@
 // the point formats it writes, 0 to 3 and 6 to 8, and a LAS 1.4 header whose extended records
 // start after the points or nowhere). The coders' round trip is checked on the records the
 // input decodes to, which random inputs make as wild as records get, in item versions 3 and 4
-// for the layered formats 6 to 8.
+// for the layered formats 6 to 8. Parsed and described (ParseLas and DescribeLas read a LAZ
+// file a chunk at a time), the input gives what the LAS file it decompresses to gives: the same
+// points, colours, origin and records left out, the same classes, or the same error.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -71,6 +73,36 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       neuralmesh::io_internal::ParseLas(*las, std::nullopt);
   if (records.ok()) {
     neuralmesh::fuzz::CheckRecordsAgreeWithParser(**records, parsed.ok() ? &*parsed : nullptr);
+  }
+  const absl::StatusOr<neuralmesh::io_internal::ParsedGeometry> chunked =
+      neuralmesh::io_internal::ParseLas(bytes, std::nullopt);
+  FUZZ_CHECK(chunked.status() == parsed.status(), "read a chunk at a time: %s; decompressed: %s",
+             chunked.status().ToString().c_str(), parsed.status().ToString().c_str());
+  const absl::StatusOr<neuralmesh::LasDescription> described =
+      neuralmesh::io_internal::DescribeLas(*las);
+  const absl::StatusOr<neuralmesh::LasDescription> described_by_chunk =
+      neuralmesh::io_internal::DescribeLas(bytes);
+  FUZZ_CHECK(described_by_chunk.status() == described.status(),
+             "described a chunk at a time: %s; decompressed: %s",
+             described_by_chunk.status().ToString().c_str(), described.status().ToString().c_str());
+  if (described.ok()) {
+    FUZZ_CHECK(described_by_chunk->records_by_class == described->records_by_class &&
+                   described_by_chunk->withheld == described->withheld,
+               "other classes described a chunk at a time");
+  }
+  if (parsed.ok()) {
+    FUZZ_CHECK(chunked->positions.size() == parsed->positions.size(), "%zu points, not %zu",
+               chunked->positions.size(), parsed->positions.size());
+    FUZZ_CHECK(parsed->positions.empty() ||
+                   std::memcmp(chunked->positions.data(), parsed->positions.data(),
+                               parsed->positions.size() * sizeof(parsed->positions[0])) == 0,
+               "other positions read a chunk at a time");
+    FUZZ_CHECK(chunked->colors == parsed->colors, "other colours read a chunk at a time");
+    FUZZ_CHECK(chunked->origin == parsed->origin, "another origin read a chunk at a time");
+    FUZZ_CHECK(chunked->left_out.total() == parsed->left_out.total() &&
+                   chunked->left_out.withheld == parsed->left_out.withheld &&
+                   chunked->left_out.noise == parsed->left_out.noise,
+               "other records left out read a chunk at a time");
   }
   if (!ExtendedRecordsPlaced(*las)) return 0;
   for (const uint32_t chunk_size : {50000u, 3u}) {

@@ -1,12 +1,15 @@
 #include "core/io/internal/las.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <iterator>
 #include <limits>
 #include <optional>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -18,6 +21,7 @@
 #include "core/io/internal/laz.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
+#include "core/parallel_ranges.h"
 #include "core/rgb.h"
 #include "core/status_macros.h"
 #include "core/version.h"
@@ -105,7 +109,12 @@ struct LasHeader {
   }
 };
 
-absl::StatusOr<LasHeader> ReadHeader(absl::string_view data) {
+// The header of the LAS file `data` begins (its header and variable-length records at least,
+// header_size bytes), checked against the file's size: `file_size`, or data.size() when it is
+// the whole file.
+absl::StatusOr<LasHeader> ReadHeader(absl::string_view data,
+                                     size_t file_size = absl::string_view::npos) {
+  if (file_size == absl::string_view::npos) file_size = data.size();
   if (data.size() < kLegacyHeaderSize || data.substr(0, 4) != "LASF") {
     return Invalid(data.size() >= 4 && data.substr(0, 4) == "LASF"
                        ? absl::StrCat("the file ends within its header (", data.size(), " bytes)")
@@ -121,9 +130,9 @@ absl::StatusOr<LasHeader> ReadHeader(absl::string_view data) {
   header.offset_to_points = Load<uint32_t>(data, kOffsetToPoints);
   const uint8_t format_byte = static_cast<uint8_t>(data[kPointFormat]);
   header.record_length = Load<uint16_t>(data, kRecordLength);
-  if (header.header_size < kLegacyHeaderSize || header.header_size > data.size()) {
+  if (header.header_size < kLegacyHeaderSize || header.header_size > file_size) {
     return Invalid(absl::StrCat("header size ", header.header_size, " is not between ",
-                                kLegacyHeaderSize, " and the file's ", data.size(), " bytes"));
+                                kLegacyHeaderSize, " and the file's ", file_size, " bytes"));
   }
   if (format_byte & kCompressedBits) {
     return Invalid("the points are compressed (LAZ); DecompressLaz reads them");
@@ -142,11 +151,11 @@ absl::StatusOr<LasHeader> ReadHeader(absl::string_view data) {
     const uint64_t count14 = Load<uint64_t>(data, kPointCount);
     if (count14 != 0) header.count = count14;
   }
-  if (header.offset_to_points < header.header_size || header.offset_to_points > data.size() ||
-      header.count > (data.size() - header.offset_to_points) / header.record_length) {
+  if (header.offset_to_points < header.header_size || header.offset_to_points > file_size ||
+      header.count > (file_size - header.offset_to_points) / header.record_length) {
     return Invalid(absl::StrCat(header.count, " points of ", header.record_length,
                                 " bytes from byte ", header.offset_to_points,
-                                " do not fit in the file's ", data.size(), " bytes"));
+                                " do not fit in the file's ", file_size, " bytes"));
   }
   for (int c = 0; c < 3; ++c) {
     header.scale[c] = Load<double>(data, kScale + 8 * c);
@@ -351,12 +360,161 @@ void AppendRecordFields(const LasRecordFields& f, int format, std::string* out) 
 
 }  // namespace
 
-absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
+namespace {
+
+// The error of a file whose `count` records are all left out.
+absl::Status NothingKept(uint64_t count, const PointsLeftOut& left_out,
+                         const std::optional<LasClasses>& classes) {
+  return Invalid(absl::StrCat(
+      "all ", count, " points are withheld (", left_out.withheld, ") or ",
+      classes.has_value() ? absl::StrCat("of classes not asked for (", left_out.other_class, ")")
+                          : absl::StrCat("classified as noise (", left_out.noise, ")")));
+}
+
+// A LAZ file's chunks and the header of the LAS file they hold, checked as ReadHeader checks
+// that file decompressed (DecompressLaz): for reading its records a chunk at a time.
+struct LazRecords {
+  LazChunks chunks;
+  LasHeader header;
+};
+
+// DecompressLaz's checks of `laz` and its errors, then ReadHeader's of the LAS header it holds.
+// Nothing for a header that says it is longer than the bytes before its records, which only
+// the decompressed file can be checked against.
+absl::StatusOr<std::optional<LazRecords>> OpenLazRecords(absl::string_view laz) {
+  NM_ASSIGN_OR_RETURN(LazChunks chunks, LazChunks::Open(laz));
+  const std::string& las_header = chunks.las_header();
+  if (las_header.size() < kLegacyHeaderSize ||
+      Load<uint16_t>(las_header, kHeaderSize) > las_header.size()) {
+    return std::nullopt;
+  }
+  // The decompressed file's size: its header, records and extended records.
+  const size_t file_size = las_header.size() + chunks.records() * chunks.record_length() +
+                           (chunks.evlr_start() != 0 && chunks.points_end() < laz.size()
+                                ? laz.size() - chunks.points_end()
+                                : 0);
+  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(las_header, file_size));
+  return LazRecords{std::move(chunks), header};
+}
+
+// Decodes every chunk of `chunks`, a wave of a few per core at a time, and gives each chunk's
+// records to visit(chunk, records) in order. The first chunk's error that cannot be decoded.
+template <typename Visit>
+absl::Status ForEachDecodedChunk(const LazChunks& chunks, const Visit& visit) {
+  const size_t threads = std::max(1u, std::thread::hardware_concurrency());
+  const size_t wave = 4 * threads;
+  std::vector<std::string> decoded(wave);
+  std::vector<absl::Status> statuses(wave);
+  for (size_t begin = 0; begin < chunks.size(); begin += wave) {
+    const size_t end = std::min(chunks.size(), begin + wave);
+    ForEachRange(end - begin, static_cast<int>(threads), 1, [&](size_t first, size_t last) {
+      for (size_t i = first; i < last; ++i) {
+        decoded[i].resize(chunks.records_in(begin + i) * chunks.record_length());
+        statuses[i] = chunks.Decode(begin + i, decoded[i].data());
+      }
+    });
+    for (size_t i = begin; i < end; ++i) {
+      NM_RETURN_IF_ERROR(statuses[i - begin]);
+      visit(i, absl::string_view(decoded[i - begin]));
+    }
+  }
+  return absl::OkStatus();
+}
+
+// Reads a LAZ file as ParseLas reads the LAS file it compresses, without that file: its chunks
+// are decoded a wave at a time (ForEachDecodedChunk), and each chunk's records are read as they
+// come, their integer coordinates kept (in the floats' place) until the origin, which the
+// records' range decides, is known.
+absl::StatusOr<ParsedGeometry> ParseLaz(absl::string_view laz,
                                         const std::optional<LasClasses>& classes) {
-  if (IsLaz(data)) {
-    NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(data));
+  NM_ASSIGN_OR_RETURN(const std::optional<LazRecords> opened, OpenLazRecords(laz));
+  if (!opened.has_value()) {
+    NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(laz));
     return ParseLas(las, classes);
   }
+  const LazChunks& chunks = opened->chunks;
+  const LasHeader& header = opened->header;
+  const PointFormat format = kFormats[header.format];
+  const size_t length = header.record_length;
+
+  ParsedGeometry out;
+  std::vector<std::array<uint16_t, 3>> levels;  // Of the kept records, with format.rgb.
+  // Room for every record, unless the count is far beyond what the compressed bytes could
+  // plausibly hold (then the vectors grow as the records come).
+  const uint64_t plausible = (64 * chunks.compressed_bytes() + (uint64_t{1} << 20)) / length;
+  out.positions.reserve(std::min(header.count, plausible));
+  if (format.rgb != 0) levels.reserve(std::min(header.count, plausible));
+  std::vector<uint64_t> kept_before(chunks.size() + 1, 0);  // Kept records of earlier chunks.
+  Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
+  uint16_t largest = 0;
+  const auto read_chunk = [&](size_t chunk, absl::string_view records) {
+    for (size_t at = 0; at + length <= records.size(); at += length) {
+      const RecordUsability usability = Usability(records, at, header.format, classes);
+      out.left_out.withheld += usability == kWithheld;
+      out.left_out.noise += usability == kNoise;
+      out.left_out.other_class += usability == kOtherClass;
+      if (usability != kUsable) continue;
+      std::array<int32_t, 3> integers;
+      for (int c = 0; c < 3; ++c) {
+        integers[c] = Load<int32_t>(records, at + 4 * c);
+        const double coordinate = header.Coordinate(records, at, c);
+        low[c] = std::min(low[c], coordinate);
+        high[c] = std::max(high[c], coordinate);
+      }
+      Vec3f& slot = out.positions.emplace_back();
+      static_assert(sizeof(slot) == sizeof(integers));
+      std::memcpy(slot.data(), integers.data(), sizeof(integers));
+      if (format.rgb != 0) {
+        std::array<uint16_t, 3>& rgb = levels.emplace_back();
+        for (int c = 0; c < 3; ++c) {
+          rgb[c] = Load<uint16_t>(records, at + format.rgb + 2 * c);
+          largest = std::max(largest, rgb[c]);
+        }
+      }
+    }
+    kept_before[chunk + 1] = out.positions.size();
+  };
+  NM_RETURN_IF_ERROR(ForEachDecodedChunk(chunks, read_chunk));
+
+  const uint64_t count = header.count;
+  if (out.positions.empty() && count > 0) return NothingKept(count, out.left_out, classes);
+  if (!out.positions.empty()) {
+    const Point3d step = {std::fabs(header.scale[0]), std::fabs(header.scale[1]),
+                          std::fabs(header.scale[2])};
+    out.origin = OriginKeepingResolution(low, high, step);
+  }
+  for (size_t k = 0; k < out.positions.size(); ++k) {
+    std::array<int32_t, 3> integers;
+    std::memcpy(integers.data(), out.positions[k].data(), sizeof(integers));
+    Vec3f& p = out.positions[k];
+    for (int c = 0; c < 3; ++c) {
+      p[c] = NarrowToFloat(integers[c] * header.scale[c] + header.offset[c] - out.origin[c]);
+    }
+    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) continue;
+    // Named by its record, as ParseLas names it: found again in its chunk.
+    const size_t chunk = static_cast<size_t>(
+        std::upper_bound(kept_before.begin(), kept_before.end(), k) - kept_before.begin() - 1);
+    std::string records(chunks.records_in(chunk) * length, '\0');
+    NM_RETURN_IF_ERROR(chunks.Decode(chunk, records.data()));
+    uint64_t kept = kept_before[chunk], record = chunks.first_record(chunk);
+    for (size_t at = 0;; at += length, ++record) {
+      if (Usability(records, at, header.format, classes) == kUsable && kept++ == k) break;
+    }
+    return Invalid(absl::StrCat("point ", record, " lies beyond a float's range"));
+  }
+  if (format.rgb != 0) {
+    const double max = LevelScale(largest);
+    out.colors.reserve(levels.size());
+    for (const std::array<uint16_t, 3>& rgb : levels) out.colors.push_back(RgbFromLevels(rgb, max));
+  }
+  return out;
+}
+
+}  // namespace
+
+absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
+                                        const std::optional<LasClasses>& classes) {
+  if (IsLaz(data)) return ParseLaz(data, classes);
   NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
   const uint8_t format_byte = header.format;
   const PointFormat format = kFormats[format_byte];
@@ -395,13 +553,7 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
     }
   }
   const size_t kept = count - out.left_out.total();
-  if (kept == 0 && count > 0) {
-    return Invalid(
-        absl::StrCat("all ", count, " points are withheld (", out.left_out.withheld, ") or ",
-                     classes.has_value()
-                         ? absl::StrCat("of classes not asked for (", out.left_out.other_class, ")")
-                         : absl::StrCat("classified as noise (", out.left_out.noise, ")")));
-  }
+  if (kept == 0 && count > 0) return NothingKept(count, out.left_out, classes);
   if (kept > 0) {
     const Point3d step = {std::fabs(scale[0]), std::fabs(scale[1]), std::fabs(scale[2])};
     out.origin = OriginKeepingResolution(low, high, step);
@@ -432,12 +584,11 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
   return out;
 }
 
-absl::StatusOr<LasDescription> DescribeLas(absl::string_view data) {
-  if (IsLaz(data)) {
-    NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(data));
-    return DescribeLas(las);
-  }
-  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
+namespace {
+
+// What the header and variable-length records that `data` begins with say of a LAS file
+// (DescribeLas), its records not counted yet.
+LasDescription DescribeHeader(absl::string_view data, const LasHeader& header) {
   LasDescription out;
   out.version_minor = header.minor;
   out.point_format = header.format;
@@ -464,13 +615,39 @@ absl::StatusOr<LasDescription> DescribeLas(absl::string_view data) {
     at += kVlrHeaderSize + Load<uint16_t>(data, at + kVlrLength);
   }
   out.records_by_class.assign(256, 0);
+  return out;
+}
+
+// Counts the withheld records and those of each class among `records`, consecutive records of
+// the file `header` describes.
+void CountClasses(absl::string_view records, const LasHeader& header, LasDescription* out) {
   const bool extended = header.format >= 6;
-  for (uint64_t i = 0; i < header.count; ++i) {
-    const size_t record = header.record(i);
-    const uint8_t flags = static_cast<uint8_t>(data[record + 15]);
-    out.withheld += extended ? (flags & 0x04) != 0 : (flags & 0x80) != 0;
-    ++out.records_by_class[extended ? static_cast<uint8_t>(data[record + 16]) : flags & 0x1F];
+  for (size_t at = 0; at + header.record_length <= records.size(); at += header.record_length) {
+    const uint8_t flags = static_cast<uint8_t>(records[at + 15]);
+    out->withheld += extended ? (flags & 0x04) != 0 : (flags & 0x80) != 0;
+    ++out->records_by_class[extended ? static_cast<uint8_t>(records[at + 16]) : flags & 0x1F];
   }
+}
+
+}  // namespace
+
+absl::StatusOr<LasDescription> DescribeLas(absl::string_view data) {
+  if (IsLaz(data)) {
+    NM_ASSIGN_OR_RETURN(const std::optional<LazRecords> opened, OpenLazRecords(data));
+    if (!opened.has_value()) {
+      NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(data));
+      return DescribeLas(las);
+    }
+    LasDescription out = DescribeHeader(opened->chunks.las_header(), opened->header);
+    NM_RETURN_IF_ERROR(ForEachDecodedChunk(opened->chunks, [&](size_t, absl::string_view records) {
+      CountClasses(records, opened->header, &out);
+    }));
+    return out;
+  }
+  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
+  LasDescription out = DescribeHeader(data, header);
+  CountClasses(data.substr(header.offset_to_points, header.count * header.record_length), header,
+               &out);
   return out;
 }
 

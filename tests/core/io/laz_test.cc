@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/io/internal/las.h"
 #include "core/io/internal/laz_arithmetic_coder.h"
 #include "core/io/internal/laz_integer_coder.h"
 #include "core/io/las_cleaning.h"
@@ -182,8 +183,42 @@ std::string With(std::string bytes, size_t at, T value) {
   return bytes;
 }
 
+// The points of `laz`, read a chunk at a time (ParseLas), are those of `las`, read whole, with
+// the same colours, origin and records left out, with the default classes and with 1 and 2;
+// and its description (DescribeLas, also a chunk at a time) is that of `las`.
+void ExpectReadAlike(const std::string& las, const std::string& laz) {
+  const absl::StatusOr<LasDescription> described = io_internal::DescribeLas(las);
+  const absl::StatusOr<LasDescription> chunk_by_chunk = io_internal::DescribeLas(laz);
+  ASSERT_EQ(chunk_by_chunk.status(), described.status());
+  if (described.ok()) {
+    EXPECT_EQ(chunk_by_chunk->records_by_class, described->records_by_class);
+    EXPECT_EQ(chunk_by_chunk->withheld, described->withheld);
+    EXPECT_EQ(chunk_by_chunk->records, described->records);
+    EXPECT_EQ(chunk_by_chunk->variable_length_records, described->variable_length_records);
+    EXPECT_EQ(chunk_by_chunk->coordinate_system, described->coordinate_system);
+    EXPECT_EQ(chunk_by_chunk->generating_software, described->generating_software);
+    EXPECT_EQ(chunk_by_chunk->point_format, described->point_format);
+    EXPECT_EQ(chunk_by_chunk->extra_bytes, described->extra_bytes);
+  }
+  for (const std::optional<LasClasses>& classes :
+       {std::optional<LasClasses>(), std::optional<LasClasses>(LasClasses().set(1).set(2))}) {
+    SCOPED_TRACE(classes.has_value() ? "classes 1 and 2" : "default classes");
+    const absl::StatusOr<io_internal::ParsedGeometry> whole = io_internal::ParseLas(las, classes);
+    const absl::StatusOr<io_internal::ParsedGeometry> chunked = io_internal::ParseLas(laz, classes);
+    ASSERT_EQ(chunked.status(), whole.status());
+    if (!whole.ok()) continue;
+    EXPECT_EQ(chunked->positions, whole->positions);
+    EXPECT_EQ(chunked->colors, whole->colors);
+    EXPECT_EQ(chunked->origin, whole->origin);
+    EXPECT_EQ(chunked->left_out.withheld, whole->left_out.withheld);
+    EXPECT_EQ(chunked->left_out.noise, whole->left_out.noise);
+    EXPECT_EQ(chunked->left_out.other_class, whole->left_out.other_class);
+    EXPECT_EQ(chunked->left_out.invalid, whole->left_out.invalid);
+  }
+}
+
 // `las` through LAZ (chunks of `chunk_size`, formats 6-8 in item `version`) and back: the same
-// bytes. Returns the LAZ file.
+// bytes, and read alike (ExpectReadAlike). Returns the LAZ file.
 std::string ExpectSameThroughLaz(const std::string& las, uint32_t chunk_size = 50000,
                                  uint16_t version = 3) {
   const absl::StatusOr<std::string> laz = CompressLas(las, {chunk_size, version});
@@ -193,6 +228,7 @@ std::string ExpectSameThroughLaz(const std::string& las, uint32_t chunk_size = 5
   EXPECT_TRUE(back.ok()) << back.status();
   EXPECT_TRUE(back.ok() && *back == las)
       << "sizes " << las.size() << " and " << (back.ok() ? back->size() : 0);
+  ExpectReadAlike(las, *laz);
   return *laz;
 }
 

@@ -1,7 +1,7 @@
 #include "core/io/las_description.h"
 
 #include "absl/strings/str_cat.h"
-#include "core/io/file_contents.h"
+#include "core/io/file_bytes.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/las.h"
 #include "core/io/internal/laz.h"
@@ -14,8 +14,10 @@ absl::StatusOr<LasDescription> DescribeLasFile(const std::string& path) {
   if (!IsLasPath(path)) {
     return absl::InvalidArgumentError(absl::StrCat("'", path, "' is not a .las or .laz file"));
   }
-  NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
+  NM_ASSIGN_OR_RETURN(const FileBytes bytes, FileBytes::Read(path));
+  const absl::string_view data = bytes.data();
   absl::StatusOr<LasDescription> description = io_internal::DescribeLas(data);
+  NM_RETURN_IF_ERROR(bytes.CheckSize());
   if (!description.ok()) return io_internal::WithPath(description.status(), path);
   description->file_bytes = data.size();
   if (io_internal::IsLaz(data)) {

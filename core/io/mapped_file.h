@@ -16,12 +16,16 @@ namespace neuralmesh {
 
 class MappedFile {
  public:
-  // Maps the whole file at `path` for reading at random. A file of at most half the memory
-  // available is read into the page cache in the background, in order (read_ahead()); a larger
-  // one page by page where it is touched. Returns NOT_FOUND ("cannot open 'path': reason") when
+  // How the file's bytes will be read: at random, or once from the first to the last.
+  enum class Access { kRandom, kInOrder };
+
+  // Maps the whole file at `path` for reading. At random, a file of at most half the memory
+  // available is read into the page cache in the background, in order (read_ahead()), a larger
+  // one page by page where it is touched; in order, each page is read ahead of the reads
+  // (the kernel's sequential read-ahead). Returns NOT_FOUND ("cannot open 'path': reason") when
   // it cannot be opened, mapped or is not a regular file, and INVALID_ARGUMENT when it is empty
   // (ReadFileContents's messages).
-  static absl::StatusOr<MappedFile> Open(const std::string& path);
+  static absl::StatusOr<MappedFile> Open(const std::string& path, Access access = Access::kRandom);
 
   MappedFile(MappedFile&& other) noexcept;
   MappedFile& operator=(MappedFile&& other) noexcept;

@@ -1,21 +1,24 @@
 #include "core/io/point_cloud_io.h"
 
+#include <optional>
+#include <string>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "core/io/file_bytes.h"
 #include "core/io/file_contents.h"
-#include "core/io/internal/gltf.h"
 #include "core/io/internal/e57.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/gltf.h"
 #include "core/io/internal/las.h"
 #include "core/io/internal/laz.h"
 #include "core/io/internal/obj.h"
 #include "core/io/internal/off.h"
 #include "core/io/internal/pcd.h"
-#include "core/io/internal/ptx.h"
 #include "core/io/internal/ply.h"
+#include "core/io/internal/ptx.h"
 #include "core/io/internal/xyz.h"
 #include "core/status_macros.h"
 
@@ -29,9 +32,9 @@ bool IsReadable(FileFormat format) {
 }
 
 bool IsWritable(FileFormat format) {
-  return format == FileFormat::kPly || format == FileFormat::kXyz ||
-         format == FileFormat::kPtx || format == FileFormat::kLas || format == FileFormat::kPcd ||
-         format == FileFormat::kE57 || format == FileFormat::kDraco || format == FileFormat::kGltf;
+  return format == FileFormat::kPly || format == FileFormat::kXyz || format == FileFormat::kPtx ||
+         format == FileFormat::kLas || format == FileFormat::kPcd || format == FileFormat::kE57 ||
+         format == FileFormat::kDraco || format == FileFormat::kGltf;
 }
 
 absl::Status UnsupportedExtension(const std::string& path, const char* supported) {
@@ -125,10 +128,22 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, PointsLeftOut
   if (!IsReadable(format)) {
     return UnsupportedExtension(path, kReadablePointCloudExtensions);
   }
-  NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
+  // LAS and LAZ files, scans of up to billions of bytes, are read where they lie, not copied.
+  std::optional<FileBytes> mapped;
+  std::string contents;
+  absl::string_view data;
+  if (format == FileFormat::kLas) {
+    NM_ASSIGN_OR_RETURN(mapped, FileBytes::Read(path));
+    data = mapped->data();
+  } else {
+    NM_ASSIGN_OR_RETURN(contents, ReadFileContents(path));
+    data = contents;
+  }
   PointsLeftOut ignored;
   absl::StatusOr<PointCloud> cloud =
       ParsePointCloud(format, data, path, left_out != nullptr ? left_out : &ignored, selection);
+  // A file that shrank while it was read explains what was read past its new end.
+  if (mapped.has_value()) NM_RETURN_IF_ERROR(mapped->CheckSize());
   if (!cloud.ok()) return io_internal::WithPath(cloud.status(), path);
   if (cloud->empty()) {
     return absl::InvalidArgumentError(absl::StrCat("'", path, "' contains no points"));

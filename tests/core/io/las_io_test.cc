@@ -1,10 +1,15 @@
 // LAS point clouds (core/io/internal/las.h) through ReadPointCloud: every point format, with
 // and without colours, LAS 1.2 and 1.4 headers, georeferenced coordinates moved to an origin,
 // and malformed files refused with what is wrong (LAZ: laz_test.cc).
+#include <sys/stat.h>
+
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -124,7 +129,7 @@ TEST(LasIoTest, WithheldAndNoisePointsAreLeftOutAndCounted) {
     for (double& s : layout.scale) s = 0.001;
     layout.offset[0] = 500000;
     std::vector<LasPoint> points = {{1000, 2000, 3000}, {1500, 2500, 3500}, {1, 2, 3},
-                                    {-400000000, 0, 0}, {7, 8, 9}, {4, 5, 6}};
+                                    {-400000000, 0, 0}, {7, 8, 9},          {4, 5, 6}};
     points[0].classification = 2;  // Ground: kept.
     points[1].classification = 6;  // Building: kept.
     points[2].classification = 7;
@@ -186,6 +191,25 @@ TEST(LasIoTest, GeoreferencedCoordinatesKeepTheirResolutionRelativeToAnOrigin) {
   ASSERT_TRUE(near_zero.ok()) << near_zero.status();
   EXPECT_EQ(near_zero->origin, (std::array<double, 3>{0, 0, 0}));
   EXPECT_FLOAT_EQ(near_zero->positions[0][0], -50.0f);
+}
+
+// A LAS file is read where it lies (mapped); one that cannot be mapped, a named pipe fed by
+// another program, is read as it comes, to the same points.
+TEST(LasIoTest, ANamedPipeIsReadLikeAFile) {
+  const std::string bytes = LasFile(LasLayout{}, kPoints);
+  absl::StatusOr<PointCloud> from_file = ReadLas("mapped.las", bytes);
+  ASSERT_TRUE(from_file.ok()) << from_file.status();
+  const std::string fifo = TempPath("piped.las");
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] {
+    std::ofstream(fifo, std::ios::binary) << bytes;  // Opening waits for the reader.
+  });
+  absl::StatusOr<PointCloud> from_pipe = ReadPointCloud(fifo);
+  writer.join();
+  ASSERT_TRUE(from_pipe.ok()) << from_pipe.status();
+  EXPECT_EQ(from_pipe->positions, from_file->positions);
+  EXPECT_EQ(from_pipe->origin, from_file->origin);
 }
 
 TEST(LasIoTest, MalformedFilesAreRefusedWithWhatIsWrong) {

@@ -1,0 +1,27 @@
+#include "core/io/file_bytes.h"
+
+#include <sys/stat.h>
+
+#include <utility>
+
+#include "core/io/file_contents.h"
+#include "core/status_macros.h"
+
+namespace neuralmesh {
+
+absl::StatusOr<FileBytes> FileBytes::Read(const std::string& path) {
+  FileBytes bytes;
+  // A named pipe is opened once: mapping is tried only where it can work.
+  struct stat status;
+  if (::stat(path.c_str(), &status) == 0 && S_ISREG(status.st_mode)) {
+    if (absl::StatusOr<MappedFile> mapped = MappedFile::Open(path, MappedFile::Access::kInOrder);
+        mapped.ok()) {
+      bytes.mapped_ = *std::move(mapped);
+      return bytes;
+    }
+  }
+  NM_ASSIGN_OR_RETURN(bytes.contents_, ReadFileContents(path));
+  return bytes;
+}
+
+}  // namespace neuralmesh

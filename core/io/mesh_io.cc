@@ -5,6 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "core/io/file_bytes.h"
 #include "core/io/file_contents.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/geometry_data.h"
@@ -83,9 +84,8 @@ absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data
 absl::Status CheckWritable(const TriangleMesh& mesh, FileFormat format) {
   if (mesh.positions.empty()) return absl::InvalidArgumentError("the mesh is empty");
   if (!mesh.colors.empty() && mesh.colors.size() != mesh.positions.size()) {
-    return absl::InvalidArgumentError(absl::StrCat("there are ", mesh.colors.size(),
-                                                   " colours for ", mesh.positions.size(),
-                                                   " vertices"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "there are ", mesh.colors.size(), " colours for ", mesh.positions.size(), " vertices"));
   }
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     const Vec3f& p = mesh.positions[i];
@@ -119,8 +119,9 @@ bool IsSupportedMeshExtension(std::string_view path) {
 
 absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path) {
   NM_ASSIGN_OR_RETURN(const FileFormat format, MeshFormat(path));
-  NM_ASSIGN_OR_RETURN(const std::string data, ReadFileContents(path));
-  absl::StatusOr<TriangleMesh> mesh = ParseMesh(format, data, path);
+  NM_ASSIGN_OR_RETURN(const FileBytes bytes, FileBytes::Read(path));  // Mapped, not copied.
+  absl::StatusOr<TriangleMesh> mesh = ParseMesh(format, bytes.data(), path);
+  NM_RETURN_IF_ERROR(bytes.CheckSize());
   if (!mesh.ok()) return io_internal::WithPath(mesh.status(), path);
   if (mesh->positions.empty()) {
     return absl::InvalidArgumentError(absl::StrCat("'", path, "' contains no vertices"));

@@ -140,8 +140,7 @@ absl::Status SessionRecord::SetState(v1::SessionState state, const std::string& 
   storage::v1::StoredSession changed = stored_;
   changed.set_state(state);
   changed.set_error(error);
-  NM_RETURN_IF_ERROR(ReplaceFile(kStoredSessionFile, changed, /*durable=*/true));
-  stored_ = std::move(changed);
+  NM_RETURN_IF_ERROR(StoreLocked(std::move(changed), /*durable=*/true));
   // An ended session learns no more; a checkpoint left behind (the removal failing) is unused.
   if (Ended(state)) std::remove(absl::StrCat(directory_, "/", kCheckpointFile).c_str());
   return absl::OkStatus();
@@ -152,9 +151,7 @@ absl::Status SessionRecord::SetOwner(const std::string& owner) {
   if (removed_) return absl::OkStatus();
   storage::v1::StoredSession changed = stored_;
   changed.set_owner(owner);
-  NM_RETURN_IF_ERROR(ReplaceFile(kStoredSessionFile, changed, /*durable=*/true));
-  stored_ = std::move(changed);
-  return absl::OkStatus();
+  return StoreLocked(std::move(changed), /*durable=*/true);
 }
 
 absl::Status SessionRecord::SetPausedAt(uint64_t points) {
@@ -162,7 +159,11 @@ absl::Status SessionRecord::SetPausedAt(uint64_t points) {
   if (removed_) return absl::OkStatus();
   storage::v1::StoredSession changed = stored_;
   changed.set_paused_at_points(points);
-  NM_RETURN_IF_ERROR(ReplaceFile(kStoredSessionFile, changed, /*durable=*/false));
+  return StoreLocked(std::move(changed), /*durable=*/false);
+}
+
+absl::Status SessionRecord::StoreLocked(storage::v1::StoredSession changed, bool durable) {
+  NM_RETURN_IF_ERROR(ReplaceFile(kStoredSessionFile, changed, durable));
   stored_ = std::move(changed);
   return absl::OkStatus();
 }

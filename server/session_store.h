@@ -84,6 +84,9 @@ class SessionRecord {
 
  private:
   // Writes `message` to `name` in the directory through a temporary file and a rename.
+  // Writes `changed` as the session's file (ReplaceFile) and keeps it as stored_.
+  absl::Status StoreLocked(storage::v1::StoredSession changed, bool durable)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   absl::Status ReplaceFile(const std::string& name, const google::protobuf::Message& message,
                            bool durable) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // The two halves of ReplaceFile: the temporary file of `name` written (which needs no lock

@@ -18,6 +18,7 @@
 #include "gtest/gtest.h"
 #include "tests/client/subprocess.h"
 #include "tests/testing/las_file.h"
+#include "tests/testing/pipe.h"
 #include "tests/testing/shapes.h"
 #include "tests/testing/temp_dir.h"
 
@@ -427,11 +428,10 @@ TEST(StreamUploadTest, SendsTheColoursOfALasStreamWhenAsked) {
   const std::string las = testing::LasFile(layout, records);
   for (const bool colors : {true, false}) {
     SCOPED_TRACE(colors ? "colours" : "no colours");
-    int fds[2];
-    ASSERT_EQ(pipe(fds), 0);
-    ASSERT_EQ(write(fds[1], las.data(), las.size()), static_cast<ssize_t>(las.size()));
-    close(fds[1]);
-    StreamUpload upload(OpenPointStream(fds[0], "standard input"), colors);
+    testing::Pipe pipe;
+    pipe.Write(las);
+    pipe.CloseWriteEnd();
+    StreamUpload upload(OpenPointStream(pipe.read_end(), "standard input"), colors);
     ASSERT_TRUE(upload.Start(100).ok());
     EXPECT_EQ(upload.has_colors(), colors);
     absl::StatusOr<v1::PointBatch> batch = upload.Batch(200, 1000);
@@ -449,24 +449,20 @@ TEST(StreamUploadTest, SendsTheColoursOfALasStreamWhenAsked) {
         ASSERT_EQ(static_cast<uint8_t>(packed[3 * k + 2]), 17) << "point " << i;
       }
     }
-    close(fds[0]);
   }
 }
 
 // Text whose header names colour columns: their fractions go as 8-bit channels.
 TEST(StreamUploadTest, SendsTheColoursATextHeaderNames) {
-  int fds[2];
-  ASSERT_EQ(pipe(fds), 0);
-  const std::string text = "# x y z r g b\n0 0 0 1 0.5 0\n1 0 0 0 0 1\n";
-  ASSERT_EQ(write(fds[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
-  close(fds[1]);
-  StreamUpload upload(OpenPointStream(fds[0], "standard input"), /*colors=*/true);
+  testing::Pipe pipe;
+  pipe.Write("# x y z r g b\n0 0 0 1 0.5 0\n1 0 0 0 0 1\n");
+  pipe.CloseWriteEnd();
+  StreamUpload upload(OpenPointStream(pipe.read_end(), "standard input"), /*colors=*/true);
   ASSERT_TRUE(upload.Start(100).ok());
   EXPECT_TRUE(upload.has_colors());
   absl::StatusOr<v1::PointBatch> batch = upload.Batch(0, 100);
   ASSERT_TRUE(batch.ok()) << batch.status();
   EXPECT_EQ(batch->packed().colors(), std::string("\xff\x80\x00\x00\x00\xff", 6));
-  close(fds[0]);
 }
 
 TEST(StreamUploadTest, APointFarFromTheOriginIsAnError) {

@@ -723,6 +723,12 @@ TEST_F(RemoteCliTest, OffCoreUploadsAScanFromWhereItLies) {
   EXPECT_THAT(refused.err, ::testing::HasSubstr("reads the file whole: not with --off_core"));
 }
 
+// Whether `process` ended within 30 s.
+bool Ended(BackgroundProcess& process) {
+  for (int i = 0; i < 600 && process.Running(); ++i) absl::SleepFor(absl::Milliseconds(50));
+  return !process.Running();
+}
+
 // INPUT '-': points streamed from standard input as a scanner's pipeline sends them. The
 // lower half of a georeferenced sphere arrives first, and a mesh of it is published before the
 // upper half comes; at the end of the stream the session is finished, and its final mesh is
@@ -771,8 +777,7 @@ TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
   absl::SleepFor(absl::Milliseconds(150));
   ASSERT_TRUE(run.WriteStdin(upper.substr(10)));
   run.CloseStdin();
-  for (int i = 0; i < 600 && run.Running(); ++i) absl::SleepFor(absl::Milliseconds(50));
-  ASSERT_FALSE(run.Running());
+  ASSERT_TRUE(Ended(run));
   ASSERT_EQ(run.exit_code(), 0) << run.Stdout() << run.Stderr();
   const std::string out = run.Stdout();
   EXPECT_THAT(out, ::testing::HasSubstr("INPUT '-': points streamed from standard input"));
@@ -833,8 +838,7 @@ TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
   absl::SleepFor(absl::Milliseconds(150));
   ASSERT_TRUE(piped.WriteStdin(las.substr(100)));
   piped.CloseStdin();
-  for (int i = 0; i < 600 && piped.Running(); ++i) absl::SleepFor(absl::Milliseconds(50));
-  ASSERT_FALSE(piped.Running());
+  ASSERT_TRUE(Ended(piped));
   ASSERT_EQ(piped.exit_code(), 0) << piped.Stdout() << piped.Stderr();
   const absl::StatusOr<TriangleMesh> from_las = ReadMesh(*dir_ + "/streamed_las/stdin.drc");
   ASSERT_TRUE(from_las.ok()) << from_las.status();
@@ -857,10 +861,7 @@ TEST_F(RemoteCliTest, PointsStreamedFromStandardInputAreLearnedAsTheyArrive) {
                                     /*stdin_pipe=*/true);
   ASSERT_TRUE(classes_of_text.WriteStdin("1 2 3\n"));  // One write: it cannot fail before.
   classes_of_text.CloseStdin();
-  for (int i = 0; i < 600 && classes_of_text.Running(); ++i) {
-    absl::SleepFor(absl::Milliseconds(50));
-  }
-  ASSERT_FALSE(classes_of_text.Running());
+  ASSERT_TRUE(Ended(classes_of_text));
   EXPECT_EQ(classes_of_text.exit_code(), 1);
   EXPECT_THAT(classes_of_text.Stderr(),
               ::testing::HasSubstr("standard input: text, whose points have no LAS classes to "

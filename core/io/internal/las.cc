@@ -5,11 +5,11 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <iterator>
 #include <limits>
 #include <optional>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -21,7 +21,6 @@
 #include "core/io/internal/laz.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/internal/text.h"
-#include "core/parallel_ranges.h"
 #include "core/rgb.h"
 #include "core/status_macros.h"
 #include "core/version.h"
@@ -397,34 +396,112 @@ absl::StatusOr<std::optional<LazRecords>> OpenLazRecords(absl::string_view laz) 
   return LazRecords{std::move(chunks), header};
 }
 
-// Decodes every chunk of `chunks`, a wave of a few per core at a time, and gives each chunk's
-// records to visit(chunk, records) in order. The first chunk's error that cannot be decoded.
-template <typename Visit>
-absl::Status ForEachDecodedChunk(const LazChunks& chunks, const Visit& visit) {
-  const size_t threads = std::max(1u, std::thread::hardware_concurrency());
-  const size_t wave = 4 * threads;
-  std::vector<std::string> decoded(wave);
-  std::vector<absl::Status> statuses(wave);
-  for (size_t begin = 0; begin < chunks.size(); begin += wave) {
-    const size_t end = std::min(chunks.size(), begin + wave);
-    ForEachRange(end - begin, static_cast<int>(threads), 1, [&](size_t first, size_t last) {
-      for (size_t i = first; i < last; ++i) {
-        decoded[i].resize(chunks.records_in(begin + i) * chunks.record_length());
-        statuses[i] = chunks.Decode(begin + i, decoded[i].data());
+// The points of consecutive blocks of a LAS file's records (a file's whole block, or a LAZ
+// file's chunks in order), read as ParseLas reads them in one pass: each kept record's integer
+// coordinates are kept in its float's place until the origin, which the kept records' range
+// decides, is known.
+class LasPointCollector {
+ public:
+  // Room for `capacity` points.
+  LasPointCollector(const LasHeader& header, const std::optional<LasClasses>& classes,
+                    uint64_t capacity)
+      : header_(header), classes_(classes), format_(kFormats[header.format]) {
+    out_.positions.reserve(capacity);
+    if (format_.rgb != 0) levels_.reserve(capacity);
+  }
+
+  // Takes the next records.
+  void Take(absl::string_view records) {
+    const size_t length = header_.record_length;
+    for (size_t at = 0; at + length <= records.size(); at += length) {
+      const RecordUsability usability = Usability(records, at, header_.format, classes_);
+      out_.left_out.withheld += usability == kWithheld;
+      out_.left_out.noise += usability == kNoise;
+      out_.left_out.other_class += usability == kOtherClass;
+      if (usability != kUsable) continue;
+      std::array<int32_t, 3> integers;
+      for (int c = 0; c < 3; ++c) {
+        integers[c] = Load<int32_t>(records, at + 4 * c);
+        const double coordinate = header_.Coordinate(records, at, c);
+        low_[c] = std::min(low_[c], coordinate);
+        high_[c] = std::max(high_[c], coordinate);
       }
-    });
-    for (size_t i = begin; i < end; ++i) {
-      NM_RETURN_IF_ERROR(statuses[i - begin]);
-      visit(i, absl::string_view(decoded[i - begin]));
+      Vec3f& slot = out_.positions.emplace_back();
+      static_assert(sizeof(slot) == sizeof(integers));
+      std::memcpy(slot.data(), integers.data(), sizeof(integers));
+      if (format_.rgb != 0) {
+        std::array<uint16_t, 3>& rgb = levels_.emplace_back();
+        for (int c = 0; c < 3; ++c) {
+          rgb[c] = Load<uint16_t>(records, at + format_.rgb + 2 * c);
+          largest_level_ = std::max(largest_level_, rgb[c]);
+        }
+      }
     }
   }
-  return absl::OkStatus();
+
+  // The points kept so far.
+  uint64_t kept() const { return out_.positions.size(); }
+
+  // The points taken, relative to their origin, with their colours. ParseLas's errors for
+  // records all left out, and for a point a float cannot hold: `record_of_kept(k)` numbers the
+  // record of kept point k, to name it.
+  absl::StatusOr<ParsedGeometry> Finish(
+      const std::function<uint64_t(uint64_t)>& record_of_kept) && {
+    if (out_.positions.empty() && header_.count > 0) {
+      return NothingKept(header_.count, out_.left_out, classes_);
+    }
+    if (!out_.positions.empty()) {
+      const Point3d step = {std::fabs(header_.scale[0]), std::fabs(header_.scale[1]),
+                            std::fabs(header_.scale[2])};
+      out_.origin = OriginKeepingResolution(low_, high_, step);
+    }
+    for (size_t k = 0; k < out_.positions.size(); ++k) {
+      std::array<int32_t, 3> integers;
+      Vec3f& p = out_.positions[k];
+      std::memcpy(integers.data(), p.data(), sizeof(integers));
+      for (int c = 0; c < 3; ++c) {
+        p[c] = NarrowToFloat(integers[c] * header_.scale[c] + header_.offset[c] - out_.origin[c]);
+      }
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+        return Invalid(absl::StrCat("point ", record_of_kept(k), " lies beyond a float's range"));
+      }
+    }
+    if (format_.rgb != 0) {
+      const double max = LevelScale(largest_level_);
+      out_.colors.reserve(levels_.size());
+      for (const std::array<uint16_t, 3>& rgb : levels_) {
+        out_.colors.push_back(RgbFromLevels(rgb, max));
+      }
+    }
+    return std::move(out_);
+  }
+
+ private:
+  const LasHeader& header_;
+  const std::optional<LasClasses>& classes_;
+  const PointFormat format_;
+  ParsedGeometry out_;
+  std::vector<std::array<uint16_t, 3>> levels_;  // Of the kept records, with format_.rgb.
+  Point3d low_ = {INFINITY, INFINITY, INFINITY}, high_ = {-INFINITY, -INFINITY, -INFINITY};
+  uint16_t largest_level_ = 0;
+};
+
+// The number of the record among `records`, the first numbered `first_record`, that is kept
+// point `k`, the first of them kept being kept point `first_kept`.
+uint64_t RecordOfKept(absl::string_view records, const LasHeader& header,
+                      const std::optional<LasClasses>& classes, uint64_t first_record,
+                      uint64_t first_kept, uint64_t k) {
+  uint64_t record = first_record;
+  for (size_t at = 0; at + header.record_length <= records.size();
+       at += header.record_length, ++record) {
+    if (Usability(records, at, header.format, classes) == kUsable && first_kept++ == k) break;
+  }
+  return record;
 }
 
 // Reads a LAZ file as ParseLas reads the LAS file it compresses, without that file: its chunks
-// are decoded a wave at a time (ForEachDecodedChunk), and each chunk's records are read as they
-// come, their integer coordinates kept (in the floats' place) until the origin, which the
-// records' range decides, is known.
+// are decoded a wave at a time (LazChunks::DecodeInOrder), and each chunk's records are taken
+// as they come.
 absl::StatusOr<ParsedGeometry> ParseLaz(absl::string_view laz,
                                         const std::optional<LasClasses>& classes) {
   NM_ASSIGN_OR_RETURN(const std::optional<LazRecords> opened, OpenLazRecords(laz));
@@ -434,80 +511,25 @@ absl::StatusOr<ParsedGeometry> ParseLaz(absl::string_view laz,
   }
   const LazChunks& chunks = opened->chunks;
   const LasHeader& header = opened->header;
-  const PointFormat format = kFormats[header.format];
-  const size_t length = header.record_length;
-
-  ParsedGeometry out;
-  std::vector<std::array<uint16_t, 3>> levels;  // Of the kept records, with format.rgb.
   // Room for every record, unless the count is far beyond what the compressed bytes could
   // plausibly hold (then the vectors grow as the records come).
-  const uint64_t plausible = (64 * chunks.compressed_bytes() + (uint64_t{1} << 20)) / length;
-  out.positions.reserve(std::min(header.count, plausible));
-  if (format.rgb != 0) levels.reserve(std::min(header.count, plausible));
-  std::vector<uint64_t> kept_before(chunks.size() + 1, 0);  // Kept records of earlier chunks.
-  Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
-  uint16_t largest = 0;
-  const auto read_chunk = [&](size_t chunk, absl::string_view records) {
-    for (size_t at = 0; at + length <= records.size(); at += length) {
-      const RecordUsability usability = Usability(records, at, header.format, classes);
-      out.left_out.withheld += usability == kWithheld;
-      out.left_out.noise += usability == kNoise;
-      out.left_out.other_class += usability == kOtherClass;
-      if (usability != kUsable) continue;
-      std::array<int32_t, 3> integers;
-      for (int c = 0; c < 3; ++c) {
-        integers[c] = Load<int32_t>(records, at + 4 * c);
-        const double coordinate = header.Coordinate(records, at, c);
-        low[c] = std::min(low[c], coordinate);
-        high[c] = std::max(high[c], coordinate);
-      }
-      Vec3f& slot = out.positions.emplace_back();
-      static_assert(sizeof(slot) == sizeof(integers));
-      std::memcpy(slot.data(), integers.data(), sizeof(integers));
-      if (format.rgb != 0) {
-        std::array<uint16_t, 3>& rgb = levels.emplace_back();
-        for (int c = 0; c < 3; ++c) {
-          rgb[c] = Load<uint16_t>(records, at + format.rgb + 2 * c);
-          largest = std::max(largest, rgb[c]);
-        }
-      }
-    }
-    kept_before[chunk + 1] = out.positions.size();
-  };
-  NM_RETURN_IF_ERROR(ForEachDecodedChunk(chunks, read_chunk));
-
-  const uint64_t count = header.count;
-  if (out.positions.empty() && count > 0) return NothingKept(count, out.left_out, classes);
-  if (!out.positions.empty()) {
-    const Point3d step = {std::fabs(header.scale[0]), std::fabs(header.scale[1]),
-                          std::fabs(header.scale[2])};
-    out.origin = OriginKeepingResolution(low, high, step);
-  }
-  for (size_t k = 0; k < out.positions.size(); ++k) {
-    std::array<int32_t, 3> integers;
-    std::memcpy(integers.data(), out.positions[k].data(), sizeof(integers));
-    Vec3f& p = out.positions[k];
-    for (int c = 0; c < 3; ++c) {
-      p[c] = NarrowToFloat(integers[c] * header.scale[c] + header.offset[c] - out.origin[c]);
-    }
-    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) continue;
-    // Named by its record, as ParseLas names it: found again in its chunk.
+  const uint64_t plausible =
+      (64 * chunks.compressed_bytes() + (uint64_t{1} << 20)) / header.record_length;
+  LasPointCollector points(header, classes, std::min(header.count, plausible));
+  std::vector<uint64_t> kept_before(chunks.size() + 1, 0);  // Kept points of earlier chunks.
+  NM_RETURN_IF_ERROR(chunks.DecodeInOrder([&](size_t chunk, absl::string_view records) {
+    points.Take(records);
+    kept_before[chunk + 1] = points.kept();
+  }));
+  return std::move(points).Finish([&](uint64_t k) {
+    // Found again in its chunk, decoded once more.
     const size_t chunk = static_cast<size_t>(
         std::upper_bound(kept_before.begin(), kept_before.end(), k) - kept_before.begin() - 1);
-    std::string records(chunks.records_in(chunk) * length, '\0');
-    NM_RETURN_IF_ERROR(chunks.Decode(chunk, records.data()));
-    uint64_t kept = kept_before[chunk], record = chunks.first_record(chunk);
-    for (size_t at = 0;; at += length, ++record) {
-      if (Usability(records, at, header.format, classes) == kUsable && kept++ == k) break;
-    }
-    return Invalid(absl::StrCat("point ", record, " lies beyond a float's range"));
-  }
-  if (format.rgb != 0) {
-    const double max = LevelScale(largest);
-    out.colors.reserve(levels.size());
-    for (const std::array<uint16_t, 3>& rgb : levels) out.colors.push_back(RgbFromLevels(rgb, max));
-  }
-  return out;
+    std::string records(chunks.records_in(chunk) * header.record_length, '\0');
+    if (!chunks.Decode(chunk, records.data()).ok()) return chunks.first_record(chunk);
+    return RecordOfKept(records, header, classes, chunks.first_record(chunk), kept_before[chunk],
+                        k);
+  });
 }
 
 }  // namespace
@@ -516,72 +538,12 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
                                         const std::optional<LasClasses>& classes) {
   if (IsLaz(data)) return ParseLaz(data, classes);
   NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
-  const uint8_t format_byte = header.format;
-  const PointFormat format = kFormats[format_byte];
-  const uint64_t count = header.count;
-  const Point3d& scale = header.scale;
-  const auto coordinate = [&](size_t at, int c) { return header.Coordinate(data, at, c); };
-  const auto channel = [&](size_t at, int c) {
-    return Load<uint16_t>(data, at + format.rgb + 2 * c);
-  };
-  // Calls visit(i, at) for each record to read, in order: checked again in each pass, to keep
-  // no list of them.
-  const auto for_each_usable = [&](auto&& visit) {
-    for (uint64_t i = 0; i < count; ++i) {
-      const size_t at = header.record(i);
-      if (Usability(data, at, format_byte, classes) == kUsable && !visit(i, at)) return false;
-    }
-    return true;
-  };
-
-  ParsedGeometry out;
-  // Where the coordinates lie (the header's bounds may be stale: the records decide), and the
-  // largest colour channel.
-  Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
-  uint16_t largest = 0;
-  for (uint64_t i = 0; i < count; ++i) {
-    const size_t at = header.record(i);
-    const RecordUsability usability = Usability(data, at, format_byte, classes);
-    out.left_out.withheld += usability == kWithheld;
-    out.left_out.noise += usability == kNoise;
-    out.left_out.other_class += usability == kOtherClass;
-    if (usability != kUsable) continue;
-    for (int c = 0; c < 3; ++c) {
-      low[c] = std::min(low[c], coordinate(at, c));
-      high[c] = std::max(high[c], coordinate(at, c));
-      if (format.rgb != 0) largest = std::max(largest, channel(at, c));
-    }
-  }
-  const size_t kept = count - out.left_out.total();
-  if (kept == 0 && count > 0) return NothingKept(count, out.left_out, classes);
-  if (kept > 0) {
-    const Point3d step = {std::fabs(scale[0]), std::fabs(scale[1]), std::fabs(scale[2])};
-    out.origin = OriginKeepingResolution(low, high, step);
-  }
-  out.positions.reserve(kept);
-  uint64_t beyond = count;  // A record whose position a float cannot hold.
-  for_each_usable([&](uint64_t i, size_t at) {
-    Vec3f p;
-    for (int c = 0; c < 3; ++c) p[c] = NarrowToFloat(coordinate(at, c) - out.origin[c]);
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-      beyond = i;
-      return false;
-    }
-    out.positions.push_back(p);
-    return true;
-  });
-  if (beyond < count) {
-    return Invalid(absl::StrCat("point ", beyond, " lies beyond a float's range"));
-  }
-  if (format.rgb != 0) {
-    const double max = LevelScale(largest);
-    out.colors.reserve(kept);
-    for_each_usable([&](uint64_t, size_t at) {
-      out.colors.push_back(RgbFromLevels({channel(at, 0), channel(at, 1), channel(at, 2)}, max));
-      return true;
-    });
-  }
-  return out;
+  const absl::string_view records =
+      data.substr(header.offset_to_points, header.count * header.record_length);
+  LasPointCollector points(header, classes, header.count);
+  points.Take(records);
+  return std::move(points).Finish(
+      [&](uint64_t k) { return RecordOfKept(records, header, classes, 0, 0, k); });
 }
 
 namespace {
@@ -639,9 +601,8 @@ absl::StatusOr<LasDescription> DescribeLas(absl::string_view data) {
       return DescribeLas(las);
     }
     LasDescription out = DescribeHeader(opened->chunks.las_header(), opened->header);
-    NM_RETURN_IF_ERROR(ForEachDecodedChunk(opened->chunks, [&](size_t, absl::string_view records) {
-      CountClasses(records, opened->header, &out);
-    }));
+    NM_RETURN_IF_ERROR(opened->chunks.DecodeInOrder(
+        [&](size_t, absl::string_view records) { CountClasses(records, opened->header, &out); }));
     return out;
   }
   NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));

@@ -667,6 +667,27 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOp
   return las;
 }
 
+absl::Status LazChunks::DecodeInOrder(const std::function<void(size_t, absl::string_view)>& visit,
+                                      int threads) const {
+  const size_t wave = kChunksPerThread * ThreadCount(threads);
+  std::vector<std::string> decoded(wave);
+  std::vector<absl::Status> statuses(wave);
+  for (size_t begin = 0; begin < size(); begin += wave) {
+    const size_t end = std::min(size(), begin + wave);
+    ForEachRange(end - begin, threads, 1, [&](size_t first, size_t last) {
+      for (size_t i = first; i < last; ++i) {
+        decoded[i].resize(records_in(begin + i) * record_length_);
+        statuses[i] = Decode(begin + i, decoded[i].data());
+      }
+    });
+    for (size_t i = begin; i < end; ++i) {
+      NM_RETURN_IF_ERROR(statuses[i - begin]);
+      visit(i, decoded[i - begin]);
+    }
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<std::string> DescribeLazCompression(absl::string_view laz) {
   NM_ASSIGN_OR_RETURN(const LazHeader laz_header, ReadLazHeader(laz));
   const Header& header = laz_header.header;

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,12 @@ class LazChunks {
   absl::Status Decode(size_t first, size_t last, char* out) const;
   // Chunk i alone.
   absl::Status Decode(size_t i, char* out) const { return Decode(i, i + 1, out); }
+  // Decodes every chunk, a wave of a few per thread at a time (`threads`: 0 for one per
+  // hardware thread), and gives each chunk's records to visit(chunk, records) in order, first to
+  // last: for reading a file's records without the whole of them in memory. Decode's error of
+  // the first chunk that cannot be decoded.
+  absl::Status DecodeInOrder(const std::function<void(size_t, absl::string_view)>& visit,
+                             int threads = 0) const;
 
   // The compressed records' bytes; where they end, and LAS 1.4's extended records' start.
   uint64_t compressed_bytes() const { return compressed_; }

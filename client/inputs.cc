@@ -275,10 +275,10 @@ std::string QuotedInputs(const std::vector<std::string>& inputs) {
 }
 
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role,
-                                          PointsLeftOut* left_out,
-                                          const PointSelection& selection) {
+                                          PointsLeftOut* left_out, const PointSelection& selection,
+                                          LasDescription* las) {
   NM_RETURN_IF_ERROR(CheckInputFile(input, role));
-  absl::StatusOr<PointCloud> cloud = ReadPointCloud(input, left_out, selection);
+  absl::StatusOr<PointCloud> cloud = ReadPointCloud(input, left_out, selection, las);
   if (!cloud.ok()) return InFile(cloud.status(), role, input);
   return cloud;
 }

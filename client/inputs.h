@@ -103,10 +103,11 @@ absl::StatusOr<PointCloud> LoadPointsForUpload(const std::vector<std::string>& i
 
 // The points of a point cloud file (any extension ReadPointCloud reads, with `selection`).
 // Errors as LoadTargetSpace; `role` names the argument in messages. With `left_out`, as
-// LoadPointsForUpload.
+// LoadPointsForUpload; with `las`, as ReadPointCloud.
 absl::StatusOr<PointCloud> LoadPointCloud(const std::string& input, absl::string_view role,
                                           PointsLeftOut* left_out = nullptr,
-                                          const PointSelection& selection = {});
+                                          const PointSelection& selection = {},
+                                          LasDescription* las = nullptr);
 
 // The points of point cloud files as one cloud (MergePointClouds: one after another, each
 // where its origin puts it). Errors as LoadPointCloud, and INVALID_ARGUMENT for a builtin:NAME

@@ -36,11 +36,11 @@ namespace {
 // classes and the compression (LasDescription).
 absl::Status PrintPointCloudStats(const std::string& path, bool json, std::ostream& out) {
   PointsLeftOut left_out;
-  NM_ASSIGN_OR_RETURN(const PointCloud cloud, LoadPointCloud(path, "FILE", &left_out, {}));
+  // A LAS or LAZ file is described in the pass that reads its points.
   std::optional<LasDescription> las;
-  if (IsLasPath(path)) {
-    NM_ASSIGN_OR_RETURN(las, DescribeLasFile(path));
-  }
+  if (IsLasPath(path)) las.emplace();
+  NM_ASSIGN_OR_RETURN(const PointCloud cloud,
+                      LoadPointCloud(path, "FILE", &left_out, {}, las ? &*las : nullptr));
   std::array<double, 3> low = {INFINITY, INFINITY, INFINITY};
   std::array<double, 3> high = {-INFINITY, -INFINITY, -INFINITY};
   for (const Vec3f& p : cloud.positions) {
@@ -151,9 +151,11 @@ absl::Status RunStats(const std::string& mesh_path, bool json, std::ostream& out
   if (!IsSupportedMeshExtension(mesh_path) && IsReadablePointCloudExtension(mesh_path)) {
     return PrintPointCloudStats(mesh_path, json, out);
   }
-  NM_ASSIGN_OR_RETURN(const TriangleMesh mesh, LoadMesh(mesh_path, "MESH"));
-  // Points in a mesh format (a PLY of a scan): the point cloud's report.
+  NM_ASSIGN_OR_RETURN(TriangleMesh mesh, LoadMesh(mesh_path, "MESH"));
+  // Points in a mesh format (a PLY of a scan): the point cloud's report, read again with what
+  // points carry (the mesh let go first: a scan's points can fill gigabytes).
   if (mesh.faces.empty() && IsReadablePointCloudExtension(mesh_path)) {
+    mesh = TriangleMesh();
     return PrintPointCloudStats(mesh_path, json, out);
   }
   const MeshReport report = ComputeMeshReport(mesh);

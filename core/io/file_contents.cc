@@ -5,6 +5,8 @@
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
+#include "core/io/byte_sink.h"
+#include "core/status_macros.h"
 
 namespace neuralmesh {
 
@@ -41,18 +43,9 @@ absl::StatusOr<std::string> ReadFileNamedByFlag(absl::string_view flag, const st
 }
 
 absl::Status WriteFileContents(const std::string& path, absl::string_view contents) {
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) {
-    return absl::ErrnoToStatus(errno, absl::StrCat("cannot write '", path, "'"));
-  }
-  const size_t written = std::fwrite(contents.data(), 1, contents.size(), file);
-  int error = written == contents.size() ? 0 : errno;
-  if (std::fclose(file) != 0 && error == 0) error = errno;
-  if (written != contents.size() || error != 0) {
-    std::remove(path.c_str());
-    return absl::ErrnoToStatus(error != 0 ? error : EIO, absl::StrCat("cannot write '", path, "'"));
-  }
-  return absl::OkStatus();
+  FileSink file(path);
+  NM_RETURN_IF_ERROR(file.Append(contents));
+  return file.Close();
 }
 
 }  // namespace neuralmesh

@@ -4,6 +4,8 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "core/io/byte_sink.h"
+#include "core/io/file_bytes.h"
 #include "core/io/file_contents.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/las.h"
@@ -22,24 +24,25 @@ absl::Status NotLas(const std::string& path) {
   return absl::InvalidArgumentError(absl::StrCat("'", path, "' is not a .las or .laz file"));
 }
 
-// The LAS file at `source`, decompressed when it is LAZ; `file_bytes` gets its size on disk.
-absl::StatusOr<std::string> ReadLas(const std::string& source, size_t* file_bytes = nullptr) {
-  NM_ASSIGN_OR_RETURN(std::string data, ReadFileContents(source));
-  if (file_bytes != nullptr) *file_bytes = data.size();
-  if (!io_internal::IsLaz(data)) return data;
-  absl::StatusOr<std::string> decompressed = io_internal::DecompressLaz(data);
-  if (!decompressed.ok()) return io_internal::WithPath(decompressed.status(), source);
-  return decompressed;
+// The bytes of the LAS file at `source`: the file where it lies (FileBytes), or decompressed
+// into `decompressed` when it is LAZ.
+absl::StatusOr<absl::string_view> ReadLas(const std::string& source, FileBytes* bytes,
+                                          std::string* decompressed) {
+  NM_ASSIGN_OR_RETURN(*bytes, FileBytes::Read(source));
+  if (!io_internal::IsLaz(bytes->data())) return bytes->data();
+  absl::StatusOr<std::string> las = io_internal::DecompressLaz(bytes->data());
+  if (!las.ok()) return io_internal::WithPath(las.status(), source);
+  *decompressed = *std::move(las);
+  return absl::string_view(*decompressed);
 }
 
-// Writes the LAS file `las` to `path`, compressed when `path` is .laz; returns the bytes
-// written.
-absl::StatusOr<size_t> WriteLas(const std::string& path, std::string las) {
-  if (io_internal::LowercaseExtension(path) == ".laz") {
-    NM_ASSIGN_OR_RETURN(las, io_internal::CompressLas(las));
-  }
-  NM_RETURN_IF_ERROR(WriteFileContents(path, las));
-  return las.size();
+// Writes the LAS file `las` to `path`, compressed when `path` is .laz.
+absl::Status WriteLas(const std::string& path, absl::string_view las) {
+  FileSink out(path);
+  NM_RETURN_IF_ERROR(io_internal::LowercaseExtension(path) == ".laz"
+                         ? io_internal::CompressLasTo(las, &out)
+                         : out.Append(las));
+  return out.Close();
 }
 
 }  // namespace
@@ -49,11 +52,45 @@ absl::StatusOr<LasCopy> CopyLas(const std::string& source, const std::string& pa
     if (!IsLasPath(*file)) return NotLas(*file);
   }
   LasCopy copy;
-  NM_ASSIGN_OR_RETURN(std::string las, ReadLas(source, &copy.read_bytes));
-  const absl::StatusOr<uint64_t> records = io_internal::LasRecordCount(las);
+  NM_ASSIGN_OR_RETURN(const FileBytes bytes, FileBytes::Read(source));
+  const absl::string_view data = bytes.data();
+  copy.read_bytes = data.size();
+  const bool from_laz = io_internal::IsLaz(data);
+  const bool to_laz = io_internal::LowercaseExtension(path) == ".laz";
+  absl::StatusOr<uint64_t> records;
+  if (from_laz) {
+    const absl::StatusOr<io_internal::LazChunks> chunks = io_internal::LazChunks::Open(data);
+    records = chunks.ok() ? absl::StatusOr<uint64_t>(chunks->records()) : chunks.status();
+  } else {
+    records = io_internal::LasRecordCount(data);
+  }
   if (!records.ok()) return io_internal::WithPath(records.status(), source);
   copy.records = *records;
-  NM_ASSIGN_OR_RETURN(copy.written_bytes, WriteLas(path, std::move(las)));
+
+  // Written a wave of chunks at a time: neither side is held whole, but for LAZ to LAZ, whose
+  // records are decompressed whole to be compressed again.
+  FileSink out(path);
+  absl::Status status;
+  if (from_laz && to_laz) {
+    absl::StatusOr<std::string> las = io_internal::DecompressLaz(data);
+    status = las.ok() ? io_internal::CompressLasTo(*las, &out) : las.status();
+  } else if (from_laz) {
+    status = io_internal::DecompressLazTo(data, &out);
+  } else if (to_laz) {
+    status = io_internal::CompressLasTo(data, &out);
+  } else {
+    status = out.Append(data);
+  }
+  if (status.ok()) status = out.Close();
+  // A file that shrank while it was read explains what was read past its new end.
+  NM_RETURN_IF_ERROR(bytes.CheckSize());
+  // The sink's errors name `path`, and FAILED_PRECONDITION says what is not written as LAZ; the
+  // others are the source's.
+  if (!status.ok() && out.status().ok() && !absl::IsFailedPrecondition(status)) {
+    return io_internal::WithPath(status, source);
+  }
+  NM_RETURN_IF_ERROR(status);
+  copy.written_bytes = out.size();
   return copy;
 }
 
@@ -61,20 +98,22 @@ absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
                              const std::vector<bool>& outliers, LasOutlierRecords records,
                              const std::string& path, const PointSelection& selection,
                              LasJoin* join) {
-  std::vector<std::string> contents;
-  contents.reserve(sources.size());
-  for (const std::string& source : sources) {
-    if (!IsLasPath(source)) return NotLas(source);
-    NM_ASSIGN_OR_RETURN(contents.emplace_back(), ReadLas(source));
-  }
+  // Each file where it lies, or decompressed (LAZ).
+  std::vector<FileBytes> bytes(sources.size());
+  std::vector<std::string> decompressed(sources.size());
   std::vector<io_internal::LasSource> files;
   for (size_t i = 0; i < sources.size(); ++i) {
-    files.push_back({sources[i], contents[i]});
+    if (!IsLasPath(sources[i])) return NotLas(sources[i]);
+    NM_ASSIGN_OR_RETURN(const absl::string_view las,
+                        ReadLas(sources[i], &bytes[i], &decompressed[i]));
+    files.push_back({sources[i], las});
   }
   NM_ASSIGN_OR_RETURN(
       std::string cleaned,
       io_internal::FormatCleanedLas(files, outliers, records, selection.las_classes, join));
-  return WriteLas(path, std::move(cleaned)).status();
+  // A file that shrank while it was read explains what was read past its new end.
+  for (const FileBytes& file : bytes) NM_RETURN_IF_ERROR(file.CheckSize());
+  return WriteLas(path, cleaned);
 }
 
 }  // namespace neuralmesh

@@ -47,7 +47,7 @@ absl::Status UnsupportedExtension(const std::string& path, const char* supported
 
 absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view data,
                                            const std::string& path, PointsLeftOut* left_out,
-                                           const PointSelection& selection) {
+                                           const PointSelection& selection, LasDescription* las) {
   *left_out = {};
   absl::StatusOr<io_internal::ParsedGeometry> parsed;
   switch (format) {
@@ -58,7 +58,7 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
       parsed = io_internal::ParseXyz(data);
       break;
     case FileFormat::kLas:
-      parsed = io_internal::ParseLas(data, selection.las_classes);
+      parsed = io_internal::ParseLas(data, selection.las_classes, las);
       break;
     case FileFormat::kPcd:
       parsed = io_internal::ParsePcd(data);
@@ -122,7 +122,7 @@ bool IsWritablePointCloudExtension(std::string_view path) {
 }
 
 absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, PointsLeftOut* left_out,
-                                          const PointSelection& selection) {
+                                          const PointSelection& selection, LasDescription* las) {
   const FileFormat format = io_internal::FormatFromPath(path);
   if (!IsReadable(format)) {
     return UnsupportedExtension(path, kReadablePointCloudExtensions);
@@ -132,7 +132,7 @@ absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path, PointsLeftOut
   NM_ASSIGN_OR_RETURN(const FileBytes bytes, FileBytes::Read(path));
   PointsLeftOut ignored;
   absl::StatusOr<PointCloud> cloud = ParsePointCloud(
-      format, bytes.data(), path, left_out != nullptr ? left_out : &ignored, selection);
+      format, bytes.data(), path, left_out != nullptr ? left_out : &ignored, selection, las);
   // A file that shrank while it was read explains what was read past its new end.
   NM_RETURN_IF_ERROR(bytes.CheckSize());
   if (!cloud.ok()) return io_internal::WithPath(cloud.status(), path);

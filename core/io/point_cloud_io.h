@@ -10,6 +10,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/io/draco_codec.h"
+#include "core/io/las_description.h"
 #include "core/io/point_selection.h"
 #include "core/point_cloud.h"
 
@@ -82,9 +83,12 @@ struct PointCloudWriteOptions {
 // unsupported extension (listing the supported ones), an empty file, a file with no points,
 // malformed content (the message gives the line or byte offset and what was expected), or a
 // cloud that fails ValidatePointCloud (e.g. negative weights).
+// For a LAS or LAZ file, `las` (when given) gets DescribeLasFile's description of it, taken in
+// the same pass over its records.
 absl::StatusOr<PointCloud> ReadPointCloud(const std::string& path,
                                           PointsLeftOut* left_out = nullptr,
-                                          const PointSelection& selection = {});
+                                          const PointSelection& selection = {},
+                                          LasDescription* las = nullptr);
 
 // Writes `cloud` to `path`, replacing any file there: binary little-endian .ply (float x, y, z,
 // nx, ny, nz, confidence and uchar red, green, blue as present), "x y z [nx ny nz] [r g b] [w]"

@@ -499,55 +499,6 @@ uint64_t RecordOfKept(absl::string_view records, const LasHeader& header,
   return record;
 }
 
-// Reads a LAZ file as ParseLas reads the LAS file it compresses, without that file: its chunks
-// are decoded a wave at a time (LazChunks::DecodeInOrder), and each chunk's records are taken
-// as they come.
-absl::StatusOr<ParsedGeometry> ParseLaz(absl::string_view laz,
-                                        const std::optional<LasClasses>& classes) {
-  NM_ASSIGN_OR_RETURN(const std::optional<LazRecords> opened, OpenLazRecords(laz));
-  if (!opened.has_value()) {
-    NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(laz));
-    return ParseLas(las, classes);
-  }
-  const LazChunks& chunks = opened->chunks;
-  const LasHeader& header = opened->header;
-  // Room for every record, unless the count is far beyond what the compressed bytes could
-  // plausibly hold (then the vectors grow as the records come).
-  const uint64_t plausible =
-      (64 * chunks.compressed_bytes() + (uint64_t{1} << 20)) / header.record_length;
-  LasPointCollector points(header, classes, std::min(header.count, plausible));
-  std::vector<uint64_t> kept_before(chunks.size() + 1, 0);  // Kept points of earlier chunks.
-  NM_RETURN_IF_ERROR(chunks.DecodeInOrder([&](size_t chunk, absl::string_view records) {
-    points.Take(records);
-    kept_before[chunk + 1] = points.kept();
-  }));
-  return std::move(points).Finish([&](uint64_t k) {
-    // Found again in its chunk, decoded once more.
-    const size_t chunk = static_cast<size_t>(
-        std::upper_bound(kept_before.begin(), kept_before.end(), k) - kept_before.begin() - 1);
-    std::string records(chunks.records_in(chunk) * header.record_length, '\0');
-    if (!chunks.Decode(chunk, records.data()).ok()) return chunks.first_record(chunk);
-    return RecordOfKept(records, header, classes, chunks.first_record(chunk), kept_before[chunk],
-                        k);
-  });
-}
-
-}  // namespace
-
-absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
-                                        const std::optional<LasClasses>& classes) {
-  if (IsLaz(data)) return ParseLaz(data, classes);
-  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
-  const absl::string_view records =
-      data.substr(header.offset_to_points, header.count * header.record_length);
-  LasPointCollector points(header, classes, header.count);
-  points.Take(records);
-  return std::move(points).Finish(
-      [&](uint64_t k) { return RecordOfKept(records, header, classes, 0, 0, k); });
-}
-
-namespace {
-
 // What the header and variable-length records that `data` begins with say of a LAS file
 // (DescribeLas), its records not counted yet.
 LasDescription DescribeHeader(absl::string_view data, const LasHeader& header) {
@@ -591,24 +542,97 @@ void CountClasses(absl::string_view records, const LasHeader& header, LasDescrip
   }
 }
 
+// DescribeLas's facts of the file as it is stored: its size and, for LAZ, its compression.
+absl::Status DescribeStorage(absl::string_view data, LasDescription* out) {
+  out->file_bytes = data.size();
+  out->compression.clear();
+  if (IsLaz(data)) {
+    NM_ASSIGN_OR_RETURN(out->compression, DescribeLazCompression(data));
+  }
+  return absl::OkStatus();
+}
+
+// Reads a LAZ file as ParseLas reads the LAS file it compresses, without that file: its chunks
+// are decoded a wave at a time (LazChunks::DecodeInOrder), and each chunk's records are taken
+// as they come. `description` as ParseLas's.
+absl::StatusOr<ParsedGeometry> ParseLaz(absl::string_view laz,
+                                        const std::optional<LasClasses>& classes,
+                                        LasDescription* description) {
+  NM_ASSIGN_OR_RETURN(const std::optional<LazRecords> opened, OpenLazRecords(laz));
+  if (!opened.has_value()) {
+    NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(laz));
+    NM_ASSIGN_OR_RETURN(ParsedGeometry parsed, ParseLas(las, classes, description));
+    if (description != nullptr) NM_RETURN_IF_ERROR(DescribeStorage(laz, description));
+    return parsed;
+  }
+  const LazChunks& chunks = opened->chunks;
+  const LasHeader& header = opened->header;
+  if (description != nullptr) *description = DescribeHeader(chunks.las_header(), header);
+  // Room for every record, unless the count is far beyond what the compressed bytes could
+  // plausibly hold (then the vectors grow as the records come).
+  const uint64_t plausible =
+      (64 * chunks.compressed_bytes() + (uint64_t{1} << 20)) / header.record_length;
+  LasPointCollector points(header, classes, std::min(header.count, plausible));
+  std::vector<uint64_t> kept_before(chunks.size() + 1, 0);  // Kept points of earlier chunks.
+  NM_RETURN_IF_ERROR(chunks.DecodeInOrder([&](size_t chunk, absl::string_view records) {
+    points.Take(records);
+    kept_before[chunk + 1] = points.kept();
+    if (description != nullptr) CountClasses(records, header, description);
+    return absl::OkStatus();
+  }));
+  if (description != nullptr) NM_RETURN_IF_ERROR(DescribeStorage(laz, description));
+  return std::move(points).Finish([&](uint64_t k) {
+    // Found again in its chunk, decoded once more.
+    const size_t chunk = static_cast<size_t>(
+        std::upper_bound(kept_before.begin(), kept_before.end(), k) - kept_before.begin() - 1);
+    std::string records(chunks.records_in(chunk) * header.record_length, '\0');
+    if (!chunks.Decode(chunk, records.data()).ok()) return chunks.first_record(chunk);
+    return RecordOfKept(records, header, classes, chunks.first_record(chunk), kept_before[chunk],
+                        k);
+  });
+}
+
 }  // namespace
 
+absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
+                                        const std::optional<LasClasses>& classes,
+                                        LasDescription* description) {
+  if (IsLaz(data)) return ParseLaz(data, classes, description);
+  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
+  const absl::string_view records =
+      data.substr(header.offset_to_points, header.count * header.record_length);
+  if (description != nullptr) {
+    *description = DescribeHeader(data, header);
+    CountClasses(records, header, description);
+    NM_RETURN_IF_ERROR(DescribeStorage(data, description));
+  }
+  LasPointCollector points(header, classes, header.count);
+  points.Take(records);
+  return std::move(points).Finish(
+      [&](uint64_t k) { return RecordOfKept(records, header, classes, 0, 0, k); });
+}
+
 absl::StatusOr<LasDescription> DescribeLas(absl::string_view data) {
+  LasDescription out;
   if (IsLaz(data)) {
     NM_ASSIGN_OR_RETURN(const std::optional<LazRecords> opened, OpenLazRecords(data));
-    if (!opened.has_value()) {
+    if (opened.has_value()) {
+      out = DescribeHeader(opened->chunks.las_header(), opened->header);
+      NM_RETURN_IF_ERROR(opened->chunks.DecodeInOrder([&](size_t, absl::string_view records) {
+        CountClasses(records, opened->header, &out);
+        return absl::OkStatus();
+      }));
+    } else {
       NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(data));
-      return DescribeLas(las);
+      NM_ASSIGN_OR_RETURN(out, DescribeLas(las));
     }
-    LasDescription out = DescribeHeader(opened->chunks.las_header(), opened->header);
-    NM_RETURN_IF_ERROR(opened->chunks.DecodeInOrder(
-        [&](size_t, absl::string_view records) { CountClasses(records, opened->header, &out); }));
-    return out;
+  } else {
+    NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
+    out = DescribeHeader(data, header);
+    CountClasses(data.substr(header.offset_to_points, header.count * header.record_length), header,
+                 &out);
   }
-  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
-  LasDescription out = DescribeHeader(data, header);
-  CountClasses(data.substr(header.offset_to_points, header.count * header.record_length), header,
-               &out);
+  NM_RETURN_IF_ERROR(DescribeStorage(data, &out));
   return out;
 }
 

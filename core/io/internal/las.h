@@ -34,8 +34,11 @@ namespace neuralmesh::io_internal {
 // header or records that run past the end of the file, a point format above 10, a record
 // shorter than its format, a zero or non-finite scale, or a point count that does not fit the
 // file, or points that are all left out.
+// With `description`, it also gets DescribeLas's description of the file, from the same pass
+// over its records (a LAZ file's chunks are decoded once for both).
 absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
-                                        const std::optional<LasClasses>& classes = std::nullopt);
+                                        const std::optional<LasClasses>& classes = std::nullopt,
+                                        LasDescription* description = nullptr);
 
 // The point records of an uncompressed LAS file, read one at a time where they lie: for
 // sampling a file without reading it whole (core/sampling/off_core_sampler.h). Holds a view
@@ -84,8 +87,8 @@ class LasRecords final : public PointRecords {
 // header (and its errors but the last).
 absl::StatusOr<uint64_t> LasRecordCount(absl::string_view data);
 
-// Describes a LAS file (a LAZ file: the LAS file it holds, without `compression`), with
-// ParseLas's errors for a malformed one.
+// Describes a LAS file (a LAZ file: the LAS file it holds, with its `compression`, and the
+// size as stored), with ParseLas's errors for a malformed one.
 absl::StatusOr<LasDescription> DescribeLas(absl::string_view data);
 
 // Formats points as a LAS 1.2 file of point format 0, or 2 with their colours (8-bit levels

@@ -635,6 +635,27 @@ absl::Status LazChunks::Decode(size_t first, size_t last, char* out) const {
   return absl::OkStatus();
 }
 
+namespace {
+
+// What DecompressLaz's output holds before the records: the LAS header, its extended records'
+// offset set to where they will follow the records.
+std::string DecompressedHeader(const LazChunks& chunks, absl::string_view laz) {
+  std::string header = chunks.las_header();
+  if (chunks.evlr_start() != 0 && chunks.points_end() < laz.size()) {
+    SetUint64(header.size() + chunks.records() * chunks.record_length(), kEvlrStart, &header);
+  }
+  return header;
+}
+
+// What follows the records in DecompressLaz's output: the extended records.
+absl::string_view DecompressedTail(const LazChunks& chunks, absl::string_view laz) {
+  return chunks.evlr_start() != 0 && chunks.points_end() < laz.size()
+             ? laz.substr(chunks.points_end())
+             : absl::string_view();
+}
+
+}  // namespace
+
 absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOptions& options) {
   NM_ASSIGN_OR_RETURN(const LazChunks chunks, LazChunks::Open(laz));
   const size_t record_length = chunks.record_length();
@@ -642,7 +663,7 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOp
   las.reserve(chunks.las_header().size() +
               std::min(chunks.records() * record_length,
                        kReservedExpansion * chunks.compressed_bytes() + (uint64_t{1} << 20)));
-  las.append(chunks.las_header());
+  las.append(DecompressedHeader(chunks, laz));
   // The chunks in waves of a few per thread, each thread decoding a run of them; the output
   // grows wave by wave.
   const size_t wave = kChunksPerThread * ThreadCount(options.threads);
@@ -660,15 +681,20 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOp
     });
     for (size_t i = begin; i < end; ++i) NM_RETURN_IF_ERROR(statuses[i]);
   }
-  if (chunks.evlr_start() != 0 && chunks.points_end() < laz.size()) {
-    SetUint64(las.size(), kEvlrStart, &las);
-    absl::StrAppend(&las, laz.substr(chunks.points_end()));
-  }
+  absl::StrAppend(&las, DecompressedTail(chunks, laz));
   return las;
 }
 
-absl::Status LazChunks::DecodeInOrder(const std::function<void(size_t, absl::string_view)>& visit,
-                                      int threads) const {
+absl::Status DecompressLazTo(absl::string_view laz, ByteSink* out, const LazReadOptions& options) {
+  NM_ASSIGN_OR_RETURN(const LazChunks chunks, LazChunks::Open(laz));
+  NM_RETURN_IF_ERROR(out->Append(DecompressedHeader(chunks, laz)));
+  NM_RETURN_IF_ERROR(chunks.DecodeInOrder(
+      [&](size_t, absl::string_view records) { return out->Append(records); }, options.threads));
+  return out->Append(DecompressedTail(chunks, laz));
+}
+
+absl::Status LazChunks::DecodeInOrder(
+    const std::function<absl::Status(size_t, absl::string_view)>& visit, int threads) const {
   const size_t wave = kChunksPerThread * ThreadCount(threads);
   std::vector<std::string> decoded(wave);
   std::vector<absl::Status> statuses(wave);
@@ -682,7 +708,7 @@ absl::Status LazChunks::DecodeInOrder(const std::function<void(size_t, absl::str
     });
     for (size_t i = begin; i < end; ++i) {
       NM_RETURN_IF_ERROR(statuses[i - begin]);
-      visit(i, decoded[i - begin]);
+      NM_RETURN_IF_ERROR(visit(i, decoded[i - begin]));
     }
   }
   return absl::OkStatus();
@@ -708,7 +734,7 @@ absl::StatusOr<std::string> DescribeLazCompression(absl::string_view laz) {
           : absl::StrCat("up to ", compression.chunk_size, " records"));
 }
 
-absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOptions& options) {
+absl::Status CompressLasTo(absl::string_view las, ByteSink* out, const LazWriteOptions& options) {
   NM_ASSIGN_OR_RETURN(const Header header, ReadHeader(las, "LAS"));
   if ((header.format_byte & kCompressedBits) != 0) {
     return absl::InvalidArgumentError("LAS: the points are compressed already (LAZ)");
@@ -766,15 +792,19 @@ absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOpt
     AppendLittleEndian(item.version, &record);
   }
 
-  std::string laz;
-  absl::StrAppend(&laz, las.substr(0, vlrs_end));
-  laz.append(record);
-  absl::StrAppend(&laz, las.substr(vlrs_end, header.offset_to_points - vlrs_end));
-  laz[kPointFormat] = static_cast<char>(header.format_byte | 0x80);
-  SetUint32(header.vlr_count + 1, kVlrCount, &laz);
-  SetUint32(static_cast<uint32_t>(laz.size()), kOffsetToPoints, &laz);
-  const size_t table_offset_at = laz.size();
-  laz.append(8, '\0');
+  // The header, the variable-length records and the chunk table's offset, which is patched in
+  // once the chunks are written.
+  std::string head;
+  absl::StrAppend(&head, las.substr(0, vlrs_end));
+  head.append(record);
+  absl::StrAppend(&head, las.substr(vlrs_end, header.offset_to_points - vlrs_end));
+  head[kPointFormat] = static_cast<char>(header.format_byte | 0x80);
+  SetUint32(header.vlr_count + 1, kVlrCount, &head);
+  SetUint32(static_cast<uint32_t>(head.size()), kOffsetToPoints, &head);
+  const size_t table_offset_at = head.size();
+  head.append(8, '\0');
+  const size_t start = out->size();  // Offsets count from the file's first byte.
+  NM_RETURN_IF_ERROR(out->Append(head));
 
   const uint8_t* records = reinterpret_cast<const uint8_t*>(las.data() + header.offset_to_points);
   // The chunks in waves of a few per thread, each coded into a string of its own by the thread
@@ -798,15 +828,17 @@ absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOpt
     });
     for (uint64_t i = begin; i < end; ++i) {
       chunk_sizes.push_back(static_cast<uint32_t>(coded[i - begin].size()));
-      laz += coded[i - begin];
+      NM_RETURN_IF_ERROR(out->Append(coded[i - begin]));
     }
   }
 
-  SetUint64(laz.size(), table_offset_at, &laz);
-  AppendLittleEndian(uint32_t{0}, &laz);  // Version.
-  AppendLittleEndian(static_cast<uint32_t>(chunk_sizes.size()), &laz);
+  const uint64_t table_at = out->size() - start;
+  SetUint64(table_at, table_offset_at, &head);
+  std::string table;
+  AppendLittleEndian(uint32_t{0}, &table);  // Version.
+  AppendLittleEndian(static_cast<uint32_t>(chunk_sizes.size()), &table);
   if (!chunk_sizes.empty()) {
-    laz::ArithmeticEncoder encoder(&laz);
+    laz::ArithmeticEncoder encoder(&table);
     laz::IntegerCoder sizes(32, 2);
     uint32_t last = 0;
     for (const uint32_t size : chunk_sizes) {
@@ -816,10 +848,17 @@ absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOpt
     encoder.Done();
   }
   if (header.evlr_start != 0 && header.evlr_start >= points_end && points_end < las.size()) {
-    SetUint64(laz.size() + (header.evlr_start - points_end), kEvlrStart, &laz);
+    SetUint64(table_at + table.size() + (header.evlr_start - points_end), kEvlrStart, &head);
   }
-  absl::StrAppend(&laz, las.substr(points_end));
-  return laz;
+  NM_RETURN_IF_ERROR(out->Append(table));
+  NM_RETURN_IF_ERROR(out->Append(las.substr(points_end)));
+  return out->Patch(start, head);
+}
+
+absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOptions& options) {
+  StringSink laz;
+  NM_RETURN_IF_ERROR(CompressLasTo(las, &laz, options));
+  return std::move(laz.bytes());
 }
 
 }  // namespace neuralmesh::io_internal

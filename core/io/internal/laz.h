@@ -16,6 +16,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "core/io/byte_sink.h"
 
 namespace neuralmesh::io_internal {
 
@@ -42,6 +43,10 @@ struct LazReadOptions {
 // version 1).
 absl::StatusOr<std::string> DecompressLaz(absl::string_view laz,
                                           const LazReadOptions& options = {});
+// The same bytes given to `out` a wave of chunks at a time, so that no more than a wave's
+// records are held: DecompressLaz's errors, or `out`'s first.
+absl::Status DecompressLazTo(absl::string_view laz, ByteSink* out,
+                             const LazReadOptions& options = {});
 
 // The chunks of a LAZ file, each decoded on its own (LASzip starts every chunk afresh): the
 // records of a file read where it lies, a chunk at a time, instead of decompressed whole.
@@ -76,8 +81,8 @@ class LazChunks {
   // Decodes every chunk, a wave of a few per thread at a time (`threads`: 0 for one per
   // hardware thread), and gives each chunk's records to visit(chunk, records) in order, first to
   // last: for reading a file's records without the whole of them in memory. Decode's error of
-  // the first chunk that cannot be decoded.
-  absl::Status DecodeInOrder(const std::function<void(size_t, absl::string_view)>& visit,
+  // the first chunk that cannot be decoded, or visit's first error, which stops the decoding.
+  absl::Status DecodeInOrder(const std::function<absl::Status(size_t, absl::string_view)>& visit,
                              int threads = 0) const;
 
   // The compressed records' bytes; where they end, and LAS 1.4's extended records' start.
@@ -122,6 +127,11 @@ struct LazWriteOptions {
 // FAILED_PRECONDITION for the waveform formats 4, 5, 9 and 10, which are not written as LAZ
 // here.
 absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOptions& options = {});
+// The same bytes given to `out` a wave of chunks at a time (the chunk table's offset, before
+// the chunks, patched at the end), so that no more than a wave's chunks are held:
+// CompressLas's errors, or `out`'s first.
+absl::Status CompressLasTo(absl::string_view las, ByteSink* out,
+                           const LazWriteOptions& options = {});
 
 }  // namespace neuralmesh::io_internal
 

@@ -62,24 +62,56 @@ Point3d OriginOfUnstatedResolution(const Point3d& low, const Point3d& high) {
   return OriginKeepingResolution(low, high, step);
 }
 
+PositionCollector::PositionCollector(std::vector<Point3d> positions) {
+  for (const Point3d& p : positions) {
+    for (int c = 0; c < 3; ++c) {
+      low_[c] = std::min(low_[c], p[c]);
+      high_[c] = std::max(high_[c], p[c]);
+    }
+  }
+  doubles_ = std::move(positions);
+}
+
+void PositionCollector::Reserve(size_t count) {
+  reserved_ = count;
+  if (doubles_.empty()) {
+    floats_.reserve(count);
+  } else {
+    doubles_.reserve(count);
+  }
+}
+
+void PositionCollector::AddDouble(const Point3d& p) {
+  if (doubles_.empty()) {
+    doubles_.reserve(std::max(reserved_, floats_.size() + 1));
+    for (const Vec3f& f : floats_) doubles_.push_back({f[0], f[1], f[2]});
+    std::vector<Vec3f>().swap(floats_);
+  }
+  doubles_.push_back(p);
+}
+
 void PositionCollector::MoveTo(ParsedGeometry* out) {
-  Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
-  for (const Point3d& p : positions_) {
-    for (int c = 0; c < 3; ++c) {
-      low[c] = std::min(low[c], p[c]);
-      high[c] = std::max(high[c], p[c]);
-    }
-  }
   out->origin = {0, 0, 0};
-  if (!positions_.empty()) out->origin = OriginOfUnstatedResolution(low, high);
-  out->positions.resize(positions_.size());
-  for (size_t i = 0; i < positions_.size(); ++i) {
-    for (int c = 0; c < 3; ++c) {
-      // Nearer to 0 than the coordinate itself, which narrows to a finite float.
-      out->positions[i][c] = NarrowToFloat(positions_[i][c] - out->origin[c]);
+  if (size() > 0) out->origin = OriginOfUnstatedResolution(low_, high_);
+  const Point3d& origin = out->origin;
+  if (doubles_.empty()) {
+    // Each float is its position exactly: relative to the origin, in place.
+    out->positions = std::move(floats_);
+    if (origin != Point3d{0, 0, 0}) {
+      for (Vec3f& p : out->positions) {
+        for (int c = 0; c < 3; ++c) p[c] = NarrowToFloat(double{p[c]} - origin[c]);
+      }
+    }
+  } else {
+    out->positions.resize(doubles_.size());
+    for (size_t i = 0; i < doubles_.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        // Nearer to 0 than the coordinate itself, which narrows to a finite float.
+        out->positions[i][c] = NarrowToFloat(doubles_[i][c] - origin[c]);
+      }
     }
   }
-  std::vector<Point3d>().swap(positions_);
+  *this = PositionCollector();
 }
 
 }  // namespace neuralmesh::io_internal

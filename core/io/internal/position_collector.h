@@ -5,7 +5,9 @@
 #ifndef NEURALMESH_CORE_IO_INTERNAL_POSITION_COLLECTOR_H_
 #define NEURALMESH_CORE_IO_INTERNAL_POSITION_COLLECTOR_H_
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <utility>
 #include <vector>
@@ -33,17 +35,32 @@ double IntegerScaleKeepingFloats(double farthest);
 // resolution (PositionCollector::MoveTo's rule, below).
 Point3d OriginOfUnstatedResolution(const Point3d& low, const Point3d& high);
 
+// Keeps each position as a float while every one so far is a float exactly (a binary file of
+// float coordinates: 12 bytes a point), and as doubles from the first that is not (24 bytes a
+// point; the floats kept before it widen to their values exactly). The positions MoveTo gives are
+// the same either way.
 class PositionCollector {
  public:
   PositionCollector() = default;
   // Takes positions already gathered (each narrowing to a finite float, as for Add).
-  explicit PositionCollector(std::vector<Point3d> positions) : positions_(std::move(positions)) {}
+  explicit PositionCollector(std::vector<Point3d> positions);
 
-  void Reserve(size_t count) { positions_.reserve(count); }
+  void Reserve(size_t count);
   // `p` must narrow to a finite float (the readers check, to name the offending line).
-  void Add(const Point3d& p) { positions_.push_back(p); }
-  size_t size() const { return positions_.size(); }
-  const Point3d& operator[](size_t i) const { return positions_[i]; }
+  void Add(const Point3d& p) {
+    for (int c = 0; c < 3; ++c) {
+      low_[c] = std::min(low_[c], p[c]);
+      high_[c] = std::max(high_[c], p[c]);
+    }
+    const Vec3f narrowed(static_cast<float>(p[0]), static_cast<float>(p[1]),
+                         static_cast<float>(p[2]));
+    if (doubles_.empty() && narrowed[0] == p[0] && narrowed[1] == p[1] && narrowed[2] == p[2]) {
+      floats_.push_back(narrowed);
+    } else {
+      AddDouble(p);
+    }
+  }
+  size_t size() const { return floats_.size() + doubles_.size(); }
 
   // Sets out->positions to the positions relative to out->origin, chosen by
   // OriginKeepingResolution with the step of a file that states none: 1/65,536 of the bounding
@@ -52,7 +69,14 @@ class PositionCollector {
   void MoveTo(ParsedGeometry* out);
 
  private:
-  std::vector<Point3d> positions_;
+  // Adds `p` as a double, widening the floats kept so far first.
+  void AddDouble(const Point3d& p);
+
+  std::vector<Vec3f> floats_;     // While every position is a float exactly.
+  std::vector<Point3d> doubles_;  // From the first that is not (the floats before it first).
+  size_t reserved_ = 0;
+  Point3d low_ = {INFINITY, INFINITY, INFINITY};
+  Point3d high_ = {-INFINITY, -INFINITY, -INFINITY};
 };
 
 }  // namespace neuralmesh::io_internal

@@ -11,17 +11,20 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "core/io/internal/laz.h"
 #include "core/io/point_cloud_io.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/core/io/io_test_util.h"
 #include "tests/testing/las_file.h"
+#include "tests/testing/las_scan.h"
 
 namespace neuralmesh {
 namespace {
@@ -607,6 +610,39 @@ TEST(LasCleaningTest, CopiesKeepEveryRecordCompressedOrNot) {
   EXPECT_EQ(CopyLas(TempPath("missing.las"), back).status().code(), absl::StatusCode::kNotFound);
   EXPECT_THAT(std::string(CopyLas(source, TempPath("tile.xyz")).status().message()),
               HasSubstr("is not a .las or .laz file"));
+}
+
+// A copy is written a wave of chunks at a time: a source found broken before the first byte
+// leaves the file at the path as it was, one found broken on the way leaves no part of a file.
+TEST(LasCleaningTest, ACopyOfABrokenSourceLeavesNoPartOfAFile) {
+  testing::LasScan scan;
+  scan.format = 1;
+  scan.records = 20000;
+  const std::string las = testing::ScanLasFile(scan);
+  std::string laz = *io_internal::CompressLas(las, {900});  // 23 chunks.
+  // Garbage over chunks halfway through the file, after the first waves were written.
+  const size_t middle = (Field<uint32_t>(laz, 96) + laz.size()) / 2;
+  ASSERT_GT(laz.size(), middle + 20000);
+  for (size_t i = middle; i < middle + 20000; i += 3) laz[i] = static_cast<char>(i);
+  const std::string corrupt = TempPath("corrupt.laz"), output = TempPath("copied.las");
+  WriteBytes(corrupt, laz);
+  WriteBytes(output, "what was there");
+  const absl::Status broken = CopyLas(corrupt, output).status();
+  EXPECT_EQ(broken.code(), absl::StatusCode::kInvalidArgument) << broken;
+  EXPECT_THAT(std::string(broken.message()), HasSubstr("'" + corrupt + "': "));
+  EXPECT_THAT(std::string(broken.message()), HasSubstr("chunk"));
+  EXPECT_FALSE(std::filesystem::exists(output));
+
+  const std::string truncated = TempPath("truncated.las");
+  WriteBytes(truncated, las.substr(0, 100));
+  WriteBytes(output, "what was there");
+  for (const std::string& path : {output, TempPath("copied.laz")}) {
+    const absl::Status refused = CopyLas(truncated, path).status();
+    EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument) << refused;
+    EXPECT_THAT(std::string(refused.message()), HasSubstr("'" + truncated + "': "));
+  }
+  EXPECT_EQ(ReadBytes(output), "what was there");
+  EXPECT_FALSE(std::filesystem::exists(TempPath("copied.laz")));
 }
 
 TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/io/byte_sink.h"
 #include "core/io/internal/las.h"
 #include "core/io/internal/laz_arithmetic_coder.h"
 #include "core/io/internal/laz_integer_coder.h"
@@ -190,15 +191,25 @@ void ExpectReadAlike(const std::string& las, const std::string& laz) {
   const absl::StatusOr<LasDescription> described = io_internal::DescribeLas(las);
   const absl::StatusOr<LasDescription> chunk_by_chunk = io_internal::DescribeLas(laz);
   ASSERT_EQ(chunk_by_chunk.status(), described.status());
+  // The same, but for the size and compression of the file as stored.
+  const auto expect_described_alike = [](const LasDescription& a, const LasDescription& b) {
+    EXPECT_EQ(a.records_by_class, b.records_by_class);
+    EXPECT_EQ(a.withheld, b.withheld);
+    EXPECT_EQ(a.records, b.records);
+    EXPECT_EQ(a.variable_length_records, b.variable_length_records);
+    EXPECT_EQ(a.coordinate_system, b.coordinate_system);
+    EXPECT_EQ(a.generating_software, b.generating_software);
+    EXPECT_EQ(a.point_format, b.point_format);
+    EXPECT_EQ(a.extra_bytes, b.extra_bytes);
+    EXPECT_EQ(a.scale, b.scale);
+    EXPECT_EQ(a.offset, b.offset);
+  };
   if (described.ok()) {
-    EXPECT_EQ(chunk_by_chunk->records_by_class, described->records_by_class);
-    EXPECT_EQ(chunk_by_chunk->withheld, described->withheld);
-    EXPECT_EQ(chunk_by_chunk->records, described->records);
-    EXPECT_EQ(chunk_by_chunk->variable_length_records, described->variable_length_records);
-    EXPECT_EQ(chunk_by_chunk->coordinate_system, described->coordinate_system);
-    EXPECT_EQ(chunk_by_chunk->generating_software, described->generating_software);
-    EXPECT_EQ(chunk_by_chunk->point_format, described->point_format);
-    EXPECT_EQ(chunk_by_chunk->extra_bytes, described->extra_bytes);
+    expect_described_alike(*chunk_by_chunk, *described);
+    EXPECT_EQ(described->file_bytes, las.size());
+    EXPECT_EQ(chunk_by_chunk->file_bytes, laz.size());
+    EXPECT_EQ(described->compression, "");
+    EXPECT_EQ(chunk_by_chunk->compression, *io_internal::DescribeLazCompression(laz));
   }
   for (const std::optional<LasClasses>& classes :
        {std::optional<LasClasses>(), std::optional<LasClasses>(LasClasses().set(1).set(2))}) {
@@ -206,6 +217,19 @@ void ExpectReadAlike(const std::string& las, const std::string& laz) {
     const absl::StatusOr<io_internal::ParsedGeometry> whole = io_internal::ParseLas(las, classes);
     const absl::StatusOr<io_internal::ParsedGeometry> chunked = io_internal::ParseLas(laz, classes);
     ASSERT_EQ(chunked.status(), whole.status());
+    // Described in the pass that reads the points: as DescribeLas describes the file.
+    for (const std::string* file : {&las, &laz}) {
+      LasDescription in_passing;
+      const absl::StatusOr<io_internal::ParsedGeometry> read =
+          io_internal::ParseLas(*file, classes, &in_passing);
+      ASSERT_EQ(read.status(), whole.status());
+      if (!read.ok()) continue;
+      EXPECT_EQ(read->positions, whole->positions);
+      const LasDescription& alone = file == &las ? *described : *chunk_by_chunk;
+      expect_described_alike(in_passing, alone);
+      EXPECT_EQ(in_passing.file_bytes, alone.file_bytes);
+      EXPECT_EQ(in_passing.compression, alone.compression);
+    }
     if (!whole.ok()) continue;
     EXPECT_EQ(chunked->positions, whole->positions);
     EXPECT_EQ(chunked->colors, whole->colors);
@@ -218,7 +242,9 @@ void ExpectReadAlike(const std::string& las, const std::string& laz) {
 }
 
 // `las` through LAZ (chunks of `chunk_size`, formats 6-8 in item `version`) and back: the same
-// bytes, and read alike (ExpectReadAlike). Returns the LAZ file.
+// bytes, and read alike (ExpectReadAlike). The same bytes when written a wave of chunks at a
+// time (CompressLasTo, DecompressLazTo) after what a sink already holds, whose bytes the
+// offsets do not count. Returns the LAZ file.
 std::string ExpectSameThroughLaz(const std::string& las, uint32_t chunk_size = 50000,
                                  uint16_t version = 3) {
   const absl::StatusOr<std::string> laz = CompressLas(las, {chunk_size, version});
@@ -229,6 +255,16 @@ std::string ExpectSameThroughLaz(const std::string& las, uint32_t chunk_size = 5
   EXPECT_TRUE(back.ok() && *back == las)
       << "sizes " << las.size() << " and " << (back.ok() ? back->size() : 0);
   ExpectReadAlike(las, *laz);
+  const std::string before = "bytes before the file";
+  StringSink compressed, decompressed;
+  EXPECT_TRUE(compressed.Append(before).ok());
+  EXPECT_TRUE(decompressed.Append(before).ok());
+  LazWriteOptions options{chunk_size, version};
+  options.threads = 2;  // Several waves of chunks in files of more than 8 chunks.
+  EXPECT_TRUE(io_internal::CompressLasTo(las, &compressed, options).ok());
+  EXPECT_TRUE(compressed.bytes() == before + *laz);
+  EXPECT_TRUE(io_internal::DecompressLazTo(*laz, &decompressed, {2}).ok());
+  EXPECT_TRUE(decompressed.bytes() == before + las);
   return *laz;
 }
 
@@ -654,6 +690,48 @@ TEST(LazTest, CorruptChunksDecodeWithoutReadingOutOfBounds) {
   EXPECT_GT(refused, 150);
   for (size_t end = 300; end < laz.size(); end += 997) {
     EXPECT_FALSE(DecompressLaz(laz.substr(0, end)).ok()) << "truncated at " << end;
+  }
+}
+
+// Takes `appends` pieces, then fails as a full disk does, and counts what it was given.
+class FailingSink : public ByteSink {
+ public:
+  explicit FailingSink(int appends) : appends_(appends) {}
+  absl::Status Append(absl::string_view bytes) override {
+    ++calls_;
+    if (calls_ > appends_) return absl::ResourceExhaustedError("the disk is full");
+    size_ += bytes.size();
+    return absl::OkStatus();
+  }
+  absl::Status Patch(size_t, absl::string_view) override {
+    ++calls_;
+    return absl::OkStatus();
+  }
+  size_t size() const override { return size_; }
+  int calls() const { return calls_; }
+
+ private:
+  int appends_;
+  int calls_ = 0;
+  size_t size_ = 0;
+};
+
+TEST(LazTest, AFailingSinkStopsTheWritingWithItsError) {
+  LasScan scan;
+  scan.format = 1;
+  scan.records = 20000;
+  const std::string las = ScanLasFile(scan);
+  const std::string laz = *CompressLas(las, {900});  // 23 chunks, in waves of 4 per thread.
+  for (const int appends : {0, 1, 5, 12}) {
+    SCOPED_TRACE(absl::StrCat(appends, " appends taken"));
+    FailingSink compressed(appends);
+    const absl::Status compressing = io_internal::CompressLasTo(las, &compressed, {900});
+    EXPECT_EQ(compressing.code(), absl::StatusCode::kResourceExhausted);
+    EXPECT_EQ(compressed.calls(), appends + 1);  // Nothing after the failure.
+    FailingSink decompressed(appends);
+    const absl::Status decompressing = io_internal::DecompressLazTo(laz, &decompressed);
+    EXPECT_EQ(decompressing.code(), absl::StatusCode::kResourceExhausted);
+    EXPECT_EQ(decompressed.calls(), appends + 1);
   }
 }
 

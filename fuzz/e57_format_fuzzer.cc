@@ -43,8 +43,9 @@ void CheckWrittenAgain(const ParsedGeometry& parsed) {
 
 void CheckFile(absl::string_view bytes) {
   const neuralmesh::fuzz::GeometryFormat e57{
-      [](absl::string_view file, neuralmesh::io_internal::FaceHandling) {
-        return neuralmesh::io_internal::ParseE57(file);
+      [](absl::string_view file, neuralmesh::io_internal::FaceHandling,
+         neuralmesh::io_internal::PositionPrecision precision) {
+        return neuralmesh::io_internal::ParseE57(file, precision);
       },
       nullptr, /*skips_faces=*/false};
   neuralmesh::fuzz::CheckGeometryParser(e57, reinterpret_cast<const uint8_t*>(bytes.data()),

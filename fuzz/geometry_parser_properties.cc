@@ -109,11 +109,26 @@ bool SamePoints(const ParsedGeometry& a, const ParsedGeometry& b) {
 
 void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size_t size) {
   const absl::string_view text(reinterpret_cast<const char*>(data), size);
-  const absl::StatusOr<ParsedGeometry> mesh = format.parse(text, FaceHandling::kRead);
+  const absl::StatusOr<ParsedGeometry> mesh =
+      format.parse(text, FaceHandling::kRead, io_internal::PositionPrecision::kExact);
   if (!mesh.ok()) CheckStatus(mesh.status());
+  const absl::StatusOr<ParsedGeometry> in_least_memory =
+      io_internal::ParseInLeastMemory([&](io_internal::PositionPrecision precision) {
+        return format.parse(text, FaceHandling::kRead, precision);
+      });
+  FUZZ_CHECK(in_least_memory.status() == mesh.status(), "read in the least memory: %s",
+             in_least_memory.status().ToString().c_str());
+  if (mesh.ok()) {
+    FUZZ_CHECK(!in_least_memory->read_again_exactly && in_least_memory->origin == mesh->origin &&
+                   SamePoints(*in_least_memory, *mesh) &&
+                   BitwiseEqual(in_least_memory->positions, mesh->positions) &&
+                   BitwiseEqual(in_least_memory->faces, mesh->faces),
+               "read in the least memory, other points or faces");
+  }
 
   if (format.skips_faces) {
-    const absl::StatusOr<ParsedGeometry> points = format.parse(text, FaceHandling::kSkip);
+    const absl::StatusOr<ParsedGeometry> points =
+        format.parse(text, FaceHandling::kSkip, io_internal::PositionPrecision::kExact);
     if (!points.ok()) {
       CheckStatus(points.status());
       FUZZ_CHECK(!mesh.ok(), "parses with its faces but not without them: %s",
@@ -134,7 +149,8 @@ void CheckGeometryParser(const GeometryFormat& format, const uint8_t* data, size
     const GeometryView view{mesh->positions, mesh->normals, mesh->weights,
                             mesh->faces,     mesh->colors,  mesh->origin};
     const std::string written = format.format(view);
-    const absl::StatusOr<ParsedGeometry> reread = format.parse(written, FaceHandling::kRead);
+    const absl::StatusOr<ParsedGeometry> reread =
+        format.parse(written, FaceHandling::kRead, io_internal::PositionPrecision::kExact);
     FUZZ_CHECK(reread.ok(), "the writer's output does not parse: %s",
                reread.status().ToString().c_str());
     const bool same = format.writes_normals_and_weights ? SamePoints(*mesh, *reread)

@@ -8,23 +8,26 @@
 //  - the format's writer output parses back to the same positions, faces and (where the
 //    format holds them) normals and weights, bit for bit (a NaN normal or weight may come back
 //    as another NaN: text holds no NaN's payload);
-//  - a parsed mesh can be reported on (`neuralmesh stats`), however broken its connectivity.
+//  - a parsed mesh can be reported on (`neuralmesh stats`), however broken its connectivity;
+//  - read in the least memory (ParseInLeastMemory: floats near 0 kept as floats, read again
+//    with kExact when the origin needs doubles), it gives what kExact gives, bit for bit.
 #ifndef NEURALMESH_FUZZ_GEOMETRY_PARSER_PROPERTIES_H_
 #define NEURALMESH_FUZZ_GEOMETRY_PARSER_PROPERTIES_H_
 
-#include <cstddef>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/position_collector.h"
 
 namespace neuralmesh::fuzz {
 
 using GeometryParser = std::function<absl::StatusOr<io_internal::ParsedGeometry>(
-    absl::string_view, io_internal::FaceHandling)>;
+    absl::string_view, io_internal::FaceHandling, io_internal::PositionPrecision)>;
 using GeometryFormatter = std::function<std::string(const io_internal::GeometryView&)>;
 
 struct GeometryFormat {

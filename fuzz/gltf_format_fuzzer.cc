@@ -12,7 +12,8 @@
 namespace {
 
 absl::StatusOr<neuralmesh::io_internal::ParsedGeometry> Parse(
-    absl::string_view data, neuralmesh::io_internal::FaceHandling faces) {
+    absl::string_view data, neuralmesh::io_internal::FaceHandling faces,
+    neuralmesh::io_internal::PositionPrecision) {
   return neuralmesh::io_internal::ParseGltf(data, faces);
 }
 

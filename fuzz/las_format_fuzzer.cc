@@ -125,7 +125,8 @@ void CheckCleaned(absl::string_view data, const ParsedGeometry& parsed,
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const neuralmesh::fuzz::GeometryFormat las{
-      [](absl::string_view bytes, neuralmesh::io_internal::FaceHandling) {
+      [](absl::string_view bytes, neuralmesh::io_internal::FaceHandling,
+         neuralmesh::io_internal::PositionPrecision) {
         return neuralmesh::io_internal::ParseLas(bytes);
       },
       nullptr, /*skips_faces=*/false};

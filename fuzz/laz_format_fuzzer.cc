@@ -6,7 +6,9 @@
 // input decodes to, which random inputs make as wild as records get, in item versions 3 and 4
 // for the layered formats 6 to 8. Parsed and described (ParseLas and DescribeLas read a LAZ
 // file a chunk at a time), the input gives what the LAS file it decompresses to gives: the same
-// points, colours, origin and records left out, the same classes, or the same error.
+// points, colours, origin and records left out, the same classes, or the same error. Written a
+// wave of chunks at a time into a sink (DecompressLazTo), it gives DecompressLaz's bytes, and
+// described in the pass that reads its points, DescribeLas's description.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -48,6 +50,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const absl::StatusOr<std::string> las = neuralmesh::io_internal::DecompressLaz(bytes);
   if (!las.ok()) return 0;
   FUZZ_CHECK(!neuralmesh::io_internal::IsLaz(*las), "the decompressed file says it is LAZ");
+  // Written a wave of chunks at a time (a copy to .las), the same bytes.
+  neuralmesh::StringSink streamed;
+  FUZZ_CHECK(
+      neuralmesh::io_internal::DecompressLazTo(bytes, &streamed).ok() && streamed.bytes() == *las,
+      "decompressed a wave at a time, other bytes or an error");
   // Read a chunk at a time (the off-core upload: core/io/mapped_laz_file.h), the records are
   // the points that parsing the decompressed file reads.
   const absl::StatusOr<neuralmesh::io_internal::LazChunks> chunks =
@@ -89,6 +96,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     FUZZ_CHECK(described_by_chunk->records_by_class == described->records_by_class &&
                    described_by_chunk->withheld == described->withheld,
                "other classes described a chunk at a time");
+  }
+  // Described in the pass that reads the points (`neuralmesh stats`): as DescribeLas.
+  neuralmesh::LasDescription in_passing;
+  const absl::StatusOr<neuralmesh::io_internal::ParsedGeometry> read_and_described =
+      neuralmesh::io_internal::ParseLas(bytes, std::nullopt, &in_passing);
+  FUZZ_CHECK(read_and_described.status() == chunked.status(), "read and described: %s",
+             read_and_described.status().ToString().c_str());
+  if (read_and_described.ok() && described_by_chunk.ok()) {
+    FUZZ_CHECK(in_passing.records_by_class == described_by_chunk->records_by_class &&
+                   in_passing.withheld == described_by_chunk->withheld &&
+                   in_passing.file_bytes == described_by_chunk->file_bytes &&
+                   in_passing.compression == described_by_chunk->compression,
+               "described in the pass that reads the points, otherwise");
   }
   if (parsed.ok()) {
     FUZZ_CHECK(chunked->positions.size() == parsed->positions.size(), "%zu points, not %zu",

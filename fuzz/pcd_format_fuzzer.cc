@@ -16,8 +16,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
        {neuralmesh::PcdData::kBinary, neuralmesh::PcdData::kBinaryCompressed,
         neuralmesh::PcdData::kAscii}) {
     const neuralmesh::fuzz::GeometryFormat pcd{
-        [](absl::string_view bytes, neuralmesh::io_internal::FaceHandling) {
-          return neuralmesh::io_internal::ParsePcd(bytes);
+        [](absl::string_view bytes, neuralmesh::io_internal::FaceHandling,
+           neuralmesh::io_internal::PositionPrecision precision) {
+          return neuralmesh::io_internal::ParsePcd(bytes, precision);
         },
         [kind](const neuralmesh::io_internal::GeometryView& geometry) {
           return neuralmesh::io_internal::FormatPcd(geometry, kind).value();

@@ -9,8 +9,9 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const neuralmesh::fuzz::GeometryFormat ptx{
-      [](absl::string_view text, neuralmesh::io_internal::FaceHandling) {
-        return neuralmesh::io_internal::ParsePtx(text);
+      [](absl::string_view text, neuralmesh::io_internal::FaceHandling,
+         neuralmesh::io_internal::PositionPrecision precision) {
+        return neuralmesh::io_internal::ParsePtx(text, precision);
       },
       neuralmesh::io_internal::FormatPtx, /*skips_faces=*/false,
       /*writes_normals_and_weights=*/false};

@@ -9,7 +9,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const neuralmesh::fuzz::GeometryFormat stl{
-      [](absl::string_view text, neuralmesh::io_internal::FaceHandling) {
+      [](absl::string_view text, neuralmesh::io_internal::FaceHandling,
+         neuralmesh::io_internal::PositionPrecision) {
         return neuralmesh::io_internal::ParseStl(text);
       },
       nullptr, /*skips_faces=*/false};

@@ -8,8 +8,9 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const neuralmesh::fuzz::GeometryFormat xyz{
-      [](absl::string_view text, neuralmesh::io_internal::FaceHandling) {
-        return neuralmesh::io_internal::ParseXyz(text);
+      [](absl::string_view text, neuralmesh::io_internal::FaceHandling,
+         neuralmesh::io_internal::PositionPrecision precision) {
+        return neuralmesh::io_internal::ParseXyz(text, precision);
       },
       neuralmesh::io_internal::FormatXyz, /*skips_faces=*/false};
   neuralmesh::fuzz::CheckGeometryParser(xyz, data, size);

@@ -13,6 +13,7 @@
 #include "core/io/internal/obj.h"
 #include "core/io/internal/off.h"
 #include "core/io/internal/ply.h"
+#include "core/io/internal/position_collector.h"
 #include "core/io/internal/stl.h"
 #include "core/status_macros.h"
 
@@ -44,34 +45,35 @@ absl::StatusOr<FileFormat> MeshFormat(const std::string& path) {
 
 absl::StatusOr<TriangleMesh> ParseMesh(FileFormat format, absl::string_view data,
                                        const std::string& path) {
-  absl::StatusOr<io_internal::ParsedGeometry> parsed;
-  switch (format) {
-    case FileFormat::kPly:
-      parsed = io_internal::ParsePly(data, io_internal::FaceHandling::kRead);
-      break;
-    case FileFormat::kObj:
-      parsed = io_internal::ParseObj(data, io_internal::FaceHandling::kRead);
-      break;
-    case FileFormat::kOff:
-      parsed = io_internal::ParseOff(data, io_internal::FaceHandling::kRead);
-      break;
-    case FileFormat::kStl:
-      parsed = io_internal::ParseStl(data);
-      break;
-    case FileFormat::kDraco:
-      return DecodeMesh(std::string_view(data.data(), data.size()));
-    case FileFormat::kGltf:
-      parsed = io_internal::ParseGltf(data, io_internal::FaceHandling::kRead,
+  using io_internal::FaceHandling;
+  using io_internal::PositionPrecision;
+  if (format == FileFormat::kDraco) return DecodeMesh(std::string_view(data.data(), data.size()));
+  const auto parse =
+      [&](PositionPrecision precision) -> absl::StatusOr<io_internal::ParsedGeometry> {
+    switch (format) {
+      case FileFormat::kPly:
+        return io_internal::ParsePly(data, FaceHandling::kRead, precision);
+      case FileFormat::kObj:
+        return io_internal::ParseObj(data, FaceHandling::kRead, precision);
+      case FileFormat::kOff:
+        return io_internal::ParseOff(data, FaceHandling::kRead, precision);
+      case FileFormat::kStl:
+        return io_internal::ParseStl(data);
+      case FileFormat::kGltf:
+        return io_internal::ParseGltf(data, FaceHandling::kRead,
                                       io_internal::GltfBuffersBeside(path));
-      break;
-    case FileFormat::kXyz:
-    case FileFormat::kLas:
-    case FileFormat::kPcd:
-    case FileFormat::kPtx:
-    case FileFormat::kE57:
-    case FileFormat::kUnknown:
-      return absl::InternalError("not a mesh format");
-  }
+      case FileFormat::kDraco:
+      case FileFormat::kXyz:
+      case FileFormat::kLas:
+      case FileFormat::kPcd:
+      case FileFormat::kPtx:
+      case FileFormat::kE57:
+      case FileFormat::kUnknown:
+        break;
+    }
+    return absl::InternalError("not a mesh format");
+  };
+  absl::StatusOr<io_internal::ParsedGeometry> parsed = io_internal::ParseInLeastMemory(parse);
   if (!parsed.ok()) return parsed.status();
   TriangleMesh mesh;
   mesh.positions = std::move(parsed->positions);

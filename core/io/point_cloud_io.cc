@@ -17,6 +17,7 @@
 #include "core/io/internal/off.h"
 #include "core/io/internal/pcd.h"
 #include "core/io/internal/ply.h"
+#include "core/io/internal/position_collector.h"
 #include "core/io/internal/ptx.h"
 #include "core/io/internal/xyz.h"
 #include "core/status_macros.h"
@@ -49,42 +50,41 @@ absl::StatusOr<PointCloud> ParsePointCloud(FileFormat format, absl::string_view 
                                            const std::string& path, PointsLeftOut* left_out,
                                            const PointSelection& selection, LasDescription* las) {
   *left_out = {};
-  absl::StatusOr<io_internal::ParsedGeometry> parsed;
-  switch (format) {
-    case FileFormat::kPly:
-      parsed = io_internal::ParsePly(data, io_internal::FaceHandling::kSkip);
-      break;
-    case FileFormat::kXyz:
-      parsed = io_internal::ParseXyz(data);
-      break;
-    case FileFormat::kLas:
-      parsed = io_internal::ParseLas(data, selection.las_classes, las);
-      break;
-    case FileFormat::kPcd:
-      parsed = io_internal::ParsePcd(data);
-      break;
-    case FileFormat::kPtx:
-      parsed = io_internal::ParsePtx(data);
-      break;
-    case FileFormat::kE57:
-      parsed = io_internal::ParseE57(data);
-      break;
-    case FileFormat::kObj:
-      parsed = io_internal::ParseObj(data, io_internal::FaceHandling::kSkip);
-      break;
-    case FileFormat::kOff:
-      parsed = io_internal::ParseOff(data, io_internal::FaceHandling::kSkip);
-      break;
-    case FileFormat::kDraco:
-      return DecodePointCloud(std::string_view(data.data(), data.size()));
-    case FileFormat::kGltf:
-      parsed = io_internal::ParseGltf(data, io_internal::FaceHandling::kSkip,
-                                      io_internal::GltfBuffersBeside(path));
-      break;
-    case FileFormat::kStl:
-    case FileFormat::kUnknown:
-      return absl::InternalError("not a point cloud format");
+  using io_internal::FaceHandling;
+  using io_internal::PositionPrecision;
+  if (format == FileFormat::kDraco) {
+    return DecodePointCloud(std::string_view(data.data(), data.size()));
   }
+  const auto parse =
+      [&](PositionPrecision precision) -> absl::StatusOr<io_internal::ParsedGeometry> {
+    switch (format) {
+      case FileFormat::kPly:
+        return io_internal::ParsePly(data, FaceHandling::kSkip, precision);
+      case FileFormat::kXyz:
+        return io_internal::ParseXyz(data, precision);
+      case FileFormat::kLas:
+        return io_internal::ParseLas(data, selection.las_classes, las);
+      case FileFormat::kPcd:
+        return io_internal::ParsePcd(data, precision);
+      case FileFormat::kPtx:
+        return io_internal::ParsePtx(data, precision);
+      case FileFormat::kE57:
+        return io_internal::ParseE57(data, precision);
+      case FileFormat::kObj:
+        return io_internal::ParseObj(data, FaceHandling::kSkip, precision);
+      case FileFormat::kOff:
+        return io_internal::ParseOff(data, FaceHandling::kSkip, precision);
+      case FileFormat::kGltf:
+        return io_internal::ParseGltf(data, FaceHandling::kSkip,
+                                      io_internal::GltfBuffersBeside(path));
+      case FileFormat::kDraco:
+      case FileFormat::kStl:
+      case FileFormat::kUnknown:
+        break;
+    }
+    return absl::InternalError("not a point cloud format");
+  };
+  absl::StatusOr<io_internal::ParsedGeometry> parsed = io_internal::ParseInLeastMemory(parse);
   if (!parsed.ok()) return parsed.status();
   PointCloud cloud;
   cloud.positions = std::move(parsed->positions);

@@ -434,6 +434,8 @@ absl::StatusOr<std::pair<double, double>> ColorLimits(const XmlElement& scan_ele
 
 // What the scans give, gathered before the origin is chosen.
 struct Gathered {
+  explicit Gathered(PositionPrecision precision) : positions(precision) {}
+
   PositionCollector positions;
   std::vector<Rgb> colors;
   std::vector<Vec3f> normals;
@@ -670,7 +672,7 @@ std::string Number(double value) { return absl::StrFormat("%.17g", value); }
 
 }  // namespace
 
-absl::StatusOr<ParsedGeometry> ParseE57(absl::string_view data) {
+absl::StatusOr<ParsedGeometry> ParseE57(absl::string_view data, PositionPrecision precision) {
   if (data.size() < kFileHeaderSize || data.substr(0, kSignature.size()) != kSignature) {
     return Invalid("the file does not begin with the signature \"ASTM-E57\"");
   }
@@ -706,7 +708,7 @@ absl::StatusOr<ParsedGeometry> ParseE57(absl::string_view data) {
   }
   const XmlElement* data3d = root.Child("data3D");
   if (data3d == nullptr) return Invalid("the XML has no data3D element");
-  Gathered gathered;
+  Gathered gathered(precision);
   int scans = 0;
   for (const XmlElement& scan_element : data3d->children) {
     const std::string scan = absl::StrCat("scan ", scans++);

@@ -10,6 +10,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/position_collector.h"
 
 namespace neuralmesh::io_internal {
 
@@ -28,7 +29,9 @@ namespace neuralmesh::io_internal {
 // lengths beyond the file), with malformed XML or a missing element the standard requires, a
 // scan whose packets do not hold its records or the fields its prototype declares, a value
 // beyond its field's limits, or points all marked invalid.
-absl::StatusOr<ParsedGeometry> ParseE57(absl::string_view data);
+// Positions are kept as `precision` says until the origin is known (position_collector.h).
+absl::StatusOr<ParsedGeometry> ParseE57(absl::string_view data,
+                                        PositionPrecision precision = PositionPrecision::kExact);
 
 // Formats points as an E57 file of one scan, as libE57Format lays one out: the coordinates as
 // ScaledInteger fields whose offset is points.origin and whose scale, per axis, is that of

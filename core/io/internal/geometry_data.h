@@ -31,6 +31,9 @@ struct ParsedGeometry {
   Origin origin = kNoOrigin;
   // Points the file marks as not to be used, which the reader left out.
   PointsLeftOut left_out;
+  // Set, with no positions, by a reader given PositionPrecision::kFloatsNearZero when the
+  // floats it kept are not those the origin needs: read the file again with kExact.
+  bool read_again_exactly = false;
 };
 
 struct GeometryView {

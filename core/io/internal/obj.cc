@@ -119,9 +119,10 @@ absl::StatusOr<int64_t> ParseReference(absl::string_view reference, int line, si
 
 }  // namespace
 
-absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling faces) {
+absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling faces,
+                                        PositionPrecision precision) {
   ParsedGeometry out;
-  PositionCollector positions;
+  PositionCollector positions(precision);
   LineCursor cursor(data);
   absl::string_view line;
   std::vector<absl::string_view> tokens;

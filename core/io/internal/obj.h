@@ -7,6 +7,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/position_collector.h"
 
 namespace neuralmesh::io_internal {
 
@@ -17,7 +18,9 @@ namespace neuralmesh::io_internal {
 // 'vt', groups, materials and other statements are ignored, as is anything after '#'.
 // Returns INVALID_ARGUMENT "line N: ..." for a malformed 'v' or 'f' line, a non-finite
 // coordinate, or a face index that is 0 or out of range.
-absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling faces);
+// Positions are kept as `precision` says until the origin is known (position_collector.h).
+absl::StatusOr<ParsedGeometry> ParseObj(absl::string_view data, FaceHandling faces,
+                                        PositionPrecision precision = PositionPrecision::kExact);
 
 // Formats the positions (with geometry.origin added: AppendCoordinate), colours (as fractions,
 // 'v x y z r g b') and faces of `geometry` as OBJ text.

@@ -87,7 +87,8 @@ absl::StatusOr<bool> ParseColor(const std::vector<absl::string_view>& tokens, si
 
 }  // namespace
 
-absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling faces) {
+absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling faces,
+                                        PositionPrecision precision) {
   LineCursor cursor(data);
   std::vector<absl::string_view> tokens;
   if (!NextContentLine(cursor, &tokens)) {
@@ -118,7 +119,7 @@ absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling fac
   }
 
   ParsedGeometry out;
-  PositionCollector positions;
+  PositionCollector positions(precision);
   positions.Reserve(num_vertices);
   if (has_normals) out.normals.reserve(num_vertices);
   const size_t min_tokens = has_normals ? 6 : 3;

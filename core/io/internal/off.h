@@ -7,6 +7,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/position_collector.h"
 
 namespace neuralmesh::io_internal {
 
@@ -17,7 +18,9 @@ namespace neuralmesh::io_internal {
 // polygon per line ("n i_1 ... i_n [color]", 0-based), fan-triangulated. '#' starts a comment.
 // Returns INVALID_ARGUMENT "line N: ..." for a bad keyword or count, a malformed or missing
 // vertex or face line, a non-finite coordinate or an out-of-range index.
-absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling faces);
+// Positions are kept as `precision` says until the origin is known (position_collector.h).
+absl::StatusOr<ParsedGeometry> ParseOff(absl::string_view data, FaceHandling faces,
+                                        PositionPrecision precision = PositionPrecision::kExact);
 
 // Formats the positions (with geometry.origin added: AppendCoordinate) and faces of `geometry`
 // as ASCII OFF, or COFF ("x y z r g b 255") when it has colours.

@@ -278,7 +278,8 @@ Roles RolesOf(const PcdHeader& header) {
 // The points as they are read, before their origin is chosen.
 class PointSink {
  public:
-  PointSink(const Roles& roles, ParsedGeometry* out) : roles_(roles), out_(out) {}
+  PointSink(const Roles& roles, PositionPrecision precision, ParsedGeometry* out)
+      : roles_(roles), out_(out), positions_(precision) {}
 
   // A point, from its fields' first values (`value(i)`) and its packed colour; left out
   // without a finite position.
@@ -432,11 +433,11 @@ absl::StatusOr<std::unique_ptr<PointRecords>> PcdPointRecords(absl::string_view 
       std::make_unique<BinaryPointRecords>(body, std::move(header), roles));
 }
 
-absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data) {
+absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data, PositionPrecision precision) {
   NM_ASSIGN_OR_RETURN(const PcdHeader header, ParseHeader(data));
   const Roles roles = RolesOf(header);
   ParsedGeometry out;
-  PointSink sink(roles, &out);
+  PointSink sink(roles, precision, &out);
   const absl::string_view body = data.substr(header.data_offset);
   if (header.kind == DataKind::kAscii) {
     const int header_lines =

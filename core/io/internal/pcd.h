@@ -11,6 +11,7 @@
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
 #include "core/io/internal/point_records.h"
+#include "core/io/internal/position_collector.h"
 #include "core/io/point_cloud_io.h"
 
 namespace neuralmesh::io_internal {
@@ -28,7 +29,9 @@ namespace neuralmesh::io_internal {
 // SIZE other than 1, 2, 4 or 8, WIDTH x HEIGHT other than POINTS, no x, y or z), points that
 // run past the end of the data, a malformed value, compressed data that do not decompress to
 // their stated size, or a file whose points all lack a position.
-absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data);
+// Positions are kept as `precision` says until the origin is known (position_collector.h).
+absl::StatusOr<ParsedGeometry> ParsePcd(absl::string_view data,
+                                        PositionPrecision precision = PositionPrecision::kExact);
 
 // The points of a PCD file with binary data as point records read where they lie
 // (point_records.h), for off-core sampling: their x, y and z as ParsePcd reads them, the points

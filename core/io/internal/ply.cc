@@ -270,7 +270,8 @@ absl::StatusOr<PlyVertexLayout> FindPlyVertexLayout(const PlyElement& vertex) {
 namespace {
 
 template <typename Body>
-absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry* out) {
+absl::Status ReadVertices(Body& body, const PlyElement& element, PositionPrecision precision,
+                          ParsedGeometry* out) {
   if (element.count > kMaxVertices) {
     return LineError(element.line,
                      absl::StrCat("the header declares ", element.count, " vertices; at most ",
@@ -286,7 +287,7 @@ absl::Status ReadVertices(Body& body, const PlyElement& element, ParsedGeometry*
     }
   }
   // BeginElement has bounded the count by the remaining bytes.
-  PositionCollector positions;
+  PositionCollector positions(precision);
   positions.Reserve(element.count);
   if (has_normals) out->normals.reserve(element.count);
   if (has_weights) out->weights.reserve(element.count);
@@ -393,7 +394,8 @@ absl::Status ReadFaces(Body& body, const PlyElement& element, size_t num_vertice
 }
 
 template <typename Body>
-absl::StatusOr<ParsedGeometry> ReadBody(const PlyHeader& header, Body& body, FaceHandling faces) {
+absl::StatusOr<ParsedGeometry> ReadBody(const PlyHeader& header, Body& body, FaceHandling faces,
+                                        PositionPrecision precision) {
   ParsedGeometry out;
   bool have_vertices = false;
   bool faces_before_vertices = false;
@@ -401,7 +403,7 @@ absl::StatusOr<ParsedGeometry> ReadBody(const PlyHeader& header, Body& body, Fac
     NM_RETURN_IF_ERROR(body.BeginElement(element));
     if (element.name == "vertex") {
       if (have_vertices) return LineError(element.line, "a second 'vertex' element");
-      NM_RETURN_IF_ERROR(ReadVertices(body, element, &out));
+      NM_RETURN_IF_ERROR(ReadVertices(body, element, precision, &out));
       have_vertices = true;
     } else if (element.name == "face" && faces == FaceHandling::kRead) {
       // Indices read before the vertex count was known are checked at the end, whatever
@@ -429,14 +431,15 @@ absl::StatusOr<ParsedGeometry> ReadBody(const PlyHeader& header, Body& body, Fac
 
 }  // namespace
 
-absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces) {
+absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces,
+                                        PositionPrecision precision) {
   NM_ASSIGN_OR_RETURN(const PlyHeader header, ParsePlyHeader(data));
   if (header.format == PlyFormat::kAscii) {
     AsciiBody body(data, header.body_offset, header.body_line);
-    return ReadBody(header, body, faces);
+    return ReadBody(header, body, faces, precision);
   }
   BinaryBody body(data, header.body_offset, header.format == PlyFormat::kBinaryBigEndian);
-  return ReadBody(header, body, faces);
+  return ReadBody(header, body, faces, precision);
 }
 
 std::string FormatPly(const GeometryView& geometry) {

@@ -8,6 +8,7 @@
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
 #include "core/io/internal/ply_header.h"
+#include "core/io/internal/position_collector.h"
 
 namespace neuralmesh::io_internal {
 
@@ -21,7 +22,9 @@ namespace neuralmesh::io_internal {
 // Returns INVALID_ARGUMENT naming the line (header, ASCII body) or byte offset (binary body) and
 // what was expected, for a malformed header, a count larger than the remaining data could
 // hold, missing or malformed values, non-finite coordinates or out-of-range face indices.
-absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces);
+// Positions are kept as `precision` says until the origin is known (position_collector.h).
+absl::StatusOr<ParsedGeometry> ParsePly(absl::string_view data, FaceHandling faces,
+                                        PositionPrecision precision = PositionPrecision::kExact);
 
 // Which properties of the 'vertex' element ParsePly reads as x, y and z, and as red, green and
 // blue (their indices; the channels -1 when it reads no colours), with each channel's full

@@ -94,7 +94,10 @@ void PositionCollector::MoveTo(ParsedGeometry* out) {
   out->origin = {0, 0, 0};
   if (size() > 0) out->origin = OriginOfUnstatedResolution(low_, high_);
   const Point3d& origin = out->origin;
-  if (doubles_.empty()) {
+  out->read_again_exactly = inexact_ && origin != Point3d{0, 0, 0};
+  if (out->read_again_exactly) {
+    out->positions.clear();
+  } else if (doubles_.empty()) {
     // Each float is its position exactly: relative to the origin, in place.
     out->positions = std::move(floats_);
     if (origin != Point3d{0, 0, 0}) {

@@ -12,7 +12,9 @@
 #include <utility>
 #include <vector>
 
+#include "absl/status/statusor.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/text.h"
 
 namespace neuralmesh::io_internal {
 
@@ -35,13 +37,27 @@ double IntegerScaleKeepingFloats(double farthest);
 // resolution (PositionCollector::MoveTo's rule, below).
 Point3d OriginOfUnstatedResolution(const Point3d& low, const Point3d& high);
 
-// Keeps each position as a float while every one so far is a float exactly (a binary file of
-// float coordinates: 12 bytes a point), and as doubles from the first that is not (24 bytes a
-// point; the floats kept before it widen to their values exactly). The positions MoveTo gives are
-// the same either way.
+// How a PositionCollector keeps positions until the last one, and with it the origin, is known.
+enum class PositionPrecision {
+  // As floats while each is a float exactly (a binary file of float coordinates: 12 bytes a
+  // point), as doubles from the first that is not (24 bytes a point; the floats kept before it
+  // widen to their values exactly): MoveTo gives what doubles give.
+  kExact,
+  // As kExact, but a position that a float does not hold exactly (a text file's decimals) is
+  // kept as a float too when the first such position lies within kNearZero of 0 on every axis:
+  // MoveTo gives what doubles give when the origin comes out 0, as it does for most data, and
+  // otherwise sets ParsedGeometry::read_again_exactly. Data far from 0 (georeferenced) keep
+  // doubles from the first inexact position, and are read once.
+  kFloatsNearZero,
+};
+
 class PositionCollector {
  public:
-  PositionCollector() = default;
+  // Beyond this distance from 0, kFloatsNearZero keeps doubles (UTM eastings start at 166,000).
+  static constexpr double kNearZero = 65536;
+
+  explicit PositionCollector(PositionPrecision precision = PositionPrecision::kExact)
+      : precision_(precision) {}
   // Takes positions already gathered (each narrowing to a finite float, as for Add).
   explicit PositionCollector(std::vector<Point3d> positions);
 
@@ -52,9 +68,10 @@ class PositionCollector {
       low_[c] = std::min(low_[c], p[c]);
       high_[c] = std::max(high_[c], p[c]);
     }
-    const Vec3f narrowed(static_cast<float>(p[0]), static_cast<float>(p[1]),
-                         static_cast<float>(p[2]));
-    if (doubles_.empty() && narrowed[0] == p[0] && narrowed[1] == p[1] && narrowed[2] == p[2]) {
+    const Vec3f narrowed(NarrowToFloat(p[0]), NarrowToFloat(p[1]), NarrowToFloat(p[2]));
+    const bool exact = narrowed[0] == p[0] && narrowed[1] == p[1] && narrowed[2] == p[2];
+    if (doubles_.empty() && (exact || inexact_ || KeepsInexactFloat(p))) {
+      inexact_ |= !exact;
       floats_.push_back(narrowed);
     } else {
       AddDouble(p);
@@ -65,19 +82,39 @@ class PositionCollector {
   // Sets out->positions to the positions relative to out->origin, chosen by
   // OriginKeepingResolution with the step of a file that states none: 1/65,536 of the bounding
   // box's longest side, or on an axis where that box is smaller than a float's step (a single
-  // point), of that step. Clears the collector.
+  // point), of that step (or sets out->read_again_exactly: kFloatsNearZero). Clears the
+  // collector.
   void MoveTo(ParsedGeometry* out);
 
  private:
-  // Adds `p` as a double, widening the floats kept so far first.
+  // Whether the first position a float does not hold exactly is kept as a float.
+  bool KeepsInexactFloat(const Point3d& p) const {
+    return precision_ == PositionPrecision::kFloatsNearZero && std::fabs(p[0]) <= kNearZero &&
+           std::fabs(p[1]) <= kNearZero && std::fabs(p[2]) <= kNearZero;
+  }
+  // Adds `p` as a double, widening the floats kept so far (all exact) first.
   void AddDouble(const Point3d& p);
 
-  std::vector<Vec3f> floats_;     // While every position is a float exactly.
+  PositionPrecision precision_ = PositionPrecision::kExact;
+  std::vector<Vec3f> floats_;     // While every position is a float exactly, or inexact_.
   std::vector<Point3d> doubles_;  // From the first that is not (the floats before it first).
+  bool inexact_ = false;          // Whether floats_ holds a position a float does not hold.
   size_t reserved_ = 0;
   Point3d low_ = {INFINITY, INFINITY, INFINITY};
   Point3d high_ = {-INFINITY, -INFINITY, -INFINITY};
 };
+
+// What parse(precision) reads, in the least memory that gives the positions doubles give: with
+// kFloatsNearZero, and again with kExact when the first reading says so (read_again_exactly).
+template <typename Parse>
+absl::StatusOr<ParsedGeometry> ParseInLeastMemory(const Parse& parse) {
+  absl::StatusOr<ParsedGeometry> parsed = parse(PositionPrecision::kFloatsNearZero);
+  if (parsed.ok() && parsed->read_again_exactly) {
+    parsed = absl::StatusOr<ParsedGeometry>();  // Its memory first.
+    parsed = parse(PositionPrecision::kExact);
+  }
+  return parsed;
+}
 
 }  // namespace neuralmesh::io_internal
 

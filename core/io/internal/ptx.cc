@@ -78,9 +78,9 @@ bool WrittenAsZero(const Vec3f& p, const Point3d& origin, std::string* text) {
 
 }  // namespace
 
-absl::StatusOr<ParsedGeometry> ParsePtx(absl::string_view data) {
+absl::StatusOr<ParsedGeometry> ParsePtx(absl::string_view data, PositionPrecision precision) {
   ParsedGeometry out;
-  PositionCollector positions;
+  PositionCollector positions(precision);
   std::vector<Rgb> colors;
   bool colored = true;  // Every point so far has r g b.
   LineCursor cursor(data);

@@ -9,6 +9,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/position_collector.h"
 
 namespace neuralmesh::io_internal {
 
@@ -23,7 +24,9 @@ namespace neuralmesh::io_internal {
 // a non-finite transformation, a point line of another number of values or with a value that
 // is not a number, a scan that ends before its columns x rows points, or a file whose points
 // are all empty cells.
-absl::StatusOr<ParsedGeometry> ParsePtx(absl::string_view data);
+// Positions are kept as `precision` says until the origin is known (position_collector.h).
+absl::StatusOr<ParsedGeometry> ParsePtx(absl::string_view data,
+                                        PositionPrecision precision = PositionPrecision::kExact);
 
 // Formats points as a PTX file of one scan: as many columns as points, of one row each,
 // "x y z intensity" per point, or "x y z intensity r g b" with colours (0-255 levels). The

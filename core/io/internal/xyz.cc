@@ -174,9 +174,9 @@ std::optional<absl::string_view> XyzCommentText(absl::string_view line) {
   return std::nullopt;
 }
 
-absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data) {
+absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data, PositionPrecision precision) {
   ParsedGeometry out;
-  PositionCollector positions;
+  PositionCollector positions(precision);
   ExtraColumns extra;
   LineCursor cursor(data);
   absl::string_view line;

@@ -9,6 +9,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/position_collector.h"
 
 namespace neuralmesh::io_internal {
 
@@ -35,7 +36,9 @@ namespace neuralmesh::io_internal {
 // Returns INVALID_ARGUMENT "line N: ..." for a value that is not a number, a line whose column
 // count differs from the first point's, a non-finite value, or a column count that neither a
 // header nor the list above explains.
-absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data);
+// Positions are kept as `precision` says until the origin is known (position_collector.h).
+absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data,
+                                        PositionPrecision precision = PositionPrecision::kExact);
 
 // Which columns of a line hold each attribute (-1: none).
 struct XyzLayout {

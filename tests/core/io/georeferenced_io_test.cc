@@ -196,6 +196,46 @@ TEST(GeoreferencedIoTest, PointCloudsAreWrittenInTheirDataCoordinatesAndReadBack
               Not(::testing::Contains(-1)));
 }
 
+// Text near 0 is kept as floats while it is read (PositionPrecision::kFloatsNearZero), which
+// are the positions when the origin comes out 0; a site whose box lies far from 0 for its size
+// is read again with doubles, so its decimals keep what the doubles relative to the origin give.
+TEST(GeoreferencedIoTest, ASiteNearZeroButFarForItsSizeKeepsItsDecimals) {
+  const std::vector<Point3d> site = {
+      {3000.123, 1000.456, 10.789}, {3000.987, 1000.001, 10.5}, {3000.5, 1000.75, 11.125}};
+  const Point3d origin = {3000, 1000, 0};
+  std::vector<Vec3f> expected;
+  for (const Point3d& p : site) {
+    expected.emplace_back(static_cast<float>(p[0] - origin[0]),
+                          static_cast<float>(p[1] - origin[1]), static_cast<float>(p[2]));
+  }
+  // What floats of the text would have given: other positions.
+  ASSERT_NE(static_cast<float>(static_cast<double>(static_cast<float>(site[0][0])) - origin[0]),
+            expected[0][0]);
+  const std::string xyz =
+      "3000.123 1000.456 10.789\n3000.987 1000.001 10.5\n3000.5 1000.75 11.125\n";
+  const std::string path = TempPath("site.xyz");
+  WriteBytes(path, xyz);
+  const absl::StatusOr<PointCloud> cloud = ReadPointCloud(path);
+  ASSERT_TRUE(cloud.ok()) << cloud.status();
+  EXPECT_EQ(cloud->origin, origin);
+  EXPECT_EQ(cloud->positions, expected);
+  const std::string obj = TempPath("site.obj");
+  WriteBytes(obj,
+             "v 3000.123 1000.456 10.789\nv 3000.987 1000.001 10.5\nv 3000.5 1000.75 11.125\n"
+             "f 1 2 3\n");
+  const absl::StatusOr<TriangleMesh> mesh = ReadMesh(obj);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->origin, origin);
+  EXPECT_EQ(mesh->positions, expected);
+
+  // Near 0 for their size, the same decimals are the floats of their text.
+  WriteBytes(path, "3.123 1.456 10.789\n3.987 1.001 10.5\n3.5 1.75 11.125\n");
+  const absl::StatusOr<PointCloud> near = ReadPointCloud(path);
+  ASSERT_TRUE(near.ok()) << near.status();
+  EXPECT_EQ(near->origin, kNoOrigin);
+  EXPECT_EQ(near->positions[0], Vec3f(3.123f, 1.456f, 10.789f));
+}
+
 TEST(GeoreferencedIoTest, DataNearZeroKeepTheirFloatsAndFormats) {
   // Coordinates within 64 bounding-box sides of zero have no origin, and the writers write
   // what they always did: float PLY properties, a glTF node without translation.

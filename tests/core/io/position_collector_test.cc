@@ -85,5 +85,38 @@ TEST(PositionCollectorTest, FloatsAndDoublesGiveThePositionsTheDoublesGive) {
   ExpectCollectedAlike({{1234.5, -0.25, 3}}, 1);
 }
 
+// kFloatsNearZero keeps decimals near 0 as floats: right when the origin is 0, and otherwise it
+// asks to be read again; decimals far from 0 are kept as doubles from the first.
+TEST(PositionCollectorTest, FloatsNearZeroAreKeptUntilTheOriginNeedsDoubles) {
+  const auto collect = [](const std::vector<Point3d>& points) {
+    PositionCollector collector(PositionPrecision::kFloatsNearZero);
+    for (const Point3d& p : points) collector.Add(p);
+    ParsedGeometry out;
+    collector.MoveTo(&out);
+    return out;
+  };
+  const std::vector<Point3d> near = {{0.1, 0.2, 0.3}, {1.7, -2.9, 0.3}, {2.5, 0.25, -1}};
+  ParsedGeometry collected = collect(near);
+  EXPECT_FALSE(collected.read_again_exactly);
+  EXPECT_EQ(collected.origin, FromDoubles(near).origin);
+  EXPECT_EQ(collected.positions, FromDoubles(near).positions);
+
+  // A metre-sized site 3 km out: its origin is not 0, and the floats kept are not its decimals.
+  const std::vector<Point3d> site = {{3000.123, 0.5, 0}, {3000.987, 0.25, 1}, {3001.5, 1, 0.5}};
+  collected = collect(site);
+  EXPECT_TRUE(collected.read_again_exactly);
+  EXPECT_TRUE(collected.positions.empty());
+  // Exact floats first: still asked again once a decimal came.
+  collected = collect({{3000, 0.5, 0}, {3000.987, 0.25, 1}, {3001.5, 1, 0.5}});
+  EXPECT_TRUE(collected.read_again_exactly);
+
+  // Far from 0 (a UTM tile): doubles from the first decimal, read once.
+  const std::vector<Point3d> tile = {{500000.5, 4100000.25, 100}, {500123.456, 4100234.567, 101.2}};
+  collected = collect(tile);
+  EXPECT_FALSE(collected.read_again_exactly);
+  EXPECT_EQ(collected.origin, FromDoubles(tile).origin);
+  EXPECT_EQ(collected.positions, FromDoubles(tile).positions);
+}
+
 }  // namespace
 }  // namespace neuralmesh::io_internal

@@ -209,6 +209,13 @@ absl::StatusOr<ParsedGeometry> ParseXyz(absl::string_view data, PositionPrecisio
       columns = tokens.size();
       extra.stride = columns - 3;
       first_point_line = n;
+      // Room for as many points as lines like this one fill the rest (an eighth more): no
+      // copies as the vectors grow, which would hold twice the points for a moment. Pages
+      // reserved and never written take no memory.
+      const size_t points =
+          (cursor.remaining() / std::max<size_t>(line.size() + 1, 12) + 1) * 9 / 8;
+      positions.Reserve(points);
+      extra.values.reserve(points * extra.stride);
       for (auto it = comments.rbegin(); it != comments.rend() && !header; ++it) {
         header = XyzLayoutFromHeader(*it, columns);
       }

@@ -24,4 +24,16 @@ absl::StatusOr<FileBytes> FileBytes::Read(const std::string& path) {
   return bytes;
 }
 
+absl::StatusOr<FileBytes> FileBytes::ReadToReplace(const std::string& path,
+                                                   const std::string& written) {
+  struct stat read, replaced;
+  if (::stat(path.c_str(), &read) != 0 || ::stat(written.c_str(), &replaced) != 0 ||
+      read.st_dev != replaced.st_dev || read.st_ino != replaced.st_ino) {
+    return Read(path);
+  }
+  FileBytes bytes;
+  NM_ASSIGN_OR_RETURN(bytes.contents_, ReadFileContents(path));
+  return bytes;
+}
+
 }  // namespace neuralmesh

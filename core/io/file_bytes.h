@@ -18,6 +18,11 @@ class FileBytes {
   // The bytes of the file at `path`. ReadFileContents's errors (NOT_FOUND "cannot open
   // 'path': reason", INVALID_ARGUMENT "'path' is empty").
   static absl::StatusOr<FileBytes> Read(const std::string& path);
+  // As Read, but read whole into memory when `path` is the file `written` names (through
+  // another spelling or a link, too): a file about to be replaced by what is made of it, whose
+  // mapping the replacing would cut short.
+  static absl::StatusOr<FileBytes> ReadToReplace(const std::string& path,
+                                                 const std::string& written);
 
   // Valid while this object lives.
   absl::string_view data() const { return mapped_.has_value() ? mapped_->data() : contents_; }

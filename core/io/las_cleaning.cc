@@ -24,11 +24,12 @@ absl::Status NotLas(const std::string& path) {
   return absl::InvalidArgumentError(absl::StrCat("'", path, "' is not a .las or .laz file"));
 }
 
-// The bytes of the LAS file at `source`: the file where it lies (FileBytes), or decompressed
-// into `decompressed` when it is LAZ.
-absl::StatusOr<absl::string_view> ReadLas(const std::string& source, FileBytes* bytes,
-                                          std::string* decompressed) {
-  NM_ASSIGN_OR_RETURN(*bytes, FileBytes::Read(source));
+// The bytes of the LAS file at `source`: the file where it lies (FileBytes; read whole when it
+// is the file `path` names, which writing replaces), or decompressed into `decompressed` when
+// it is LAZ.
+absl::StatusOr<absl::string_view> ReadLas(const std::string& source, const std::string& path,
+                                          FileBytes* bytes, std::string* decompressed) {
+  NM_ASSIGN_OR_RETURN(*bytes, FileBytes::ReadToReplace(source, path));
   if (!io_internal::IsLaz(bytes->data())) return bytes->data();
   absl::StatusOr<std::string> las = io_internal::DecompressLaz(bytes->data());
   if (!las.ok()) return io_internal::WithPath(las.status(), source);
@@ -52,7 +53,8 @@ absl::StatusOr<LasCopy> CopyLas(const std::string& source, const std::string& pa
     if (!IsLasPath(*file)) return NotLas(*file);
   }
   LasCopy copy;
-  NM_ASSIGN_OR_RETURN(const FileBytes bytes, FileBytes::Read(source));
+  // A file copied onto itself is read whole first: writing it cuts its mapping short.
+  NM_ASSIGN_OR_RETURN(const FileBytes bytes, FileBytes::ReadToReplace(source, path));
   const absl::string_view data = bytes.data();
   copy.read_bytes = data.size();
   const bool from_laz = io_internal::IsLaz(data);
@@ -105,7 +107,7 @@ absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
   for (size_t i = 0; i < sources.size(); ++i) {
     if (!IsLasPath(sources[i])) return NotLas(sources[i]);
     NM_ASSIGN_OR_RETURN(const absl::string_view las,
-                        ReadLas(sources[i], &bytes[i], &decompressed[i]));
+                        ReadLas(sources[i], path, &bytes[i], &decompressed[i]));
     files.push_back({sources[i], las});
   }
   NM_ASSIGN_OR_RETURN(

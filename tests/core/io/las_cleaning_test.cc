@@ -645,6 +645,39 @@ TEST(LasCleaningTest, ACopyOfABrokenSourceLeavesNoPartOfAFile) {
   EXPECT_FALSE(std::filesystem::exists(TempPath("copied.laz")));
 }
 
+// A file copied or cleaned onto itself (under another spelling of its path, too) is read whole
+// before it is replaced: writing it would cut short the mapping it is read through.
+TEST(LasCleaningTest, AFileCopiedOrCleanedOntoItselfKeepsItsRecords) {
+  testing::LasScan scan;
+  scan.format = 3;
+  scan.records = 3000;
+  const std::string las = testing::ScanLasFile(scan);
+  const std::string path = TempPath("itself.las");
+  const std::string other_spelling = std::filesystem::path(path).parent_path().string() + "/./" +
+                                     std::filesystem::path(path).filename().string();
+  WriteBytes(path, las);
+  const absl::StatusOr<LasCopy> copied = CopyLas(path, other_spelling);
+  ASSERT_TRUE(copied.ok()) << copied.status();
+  EXPECT_EQ(copied->records, 3000u);
+  EXPECT_TRUE(ReadBytes(path) == las);
+
+  const std::string laz = TempPath("itself.laz");
+  WriteBytes(laz, *io_internal::CompressLas(las, {700}));
+  ASSERT_TRUE(CopyLas(laz, laz).ok());  // Compressed again, in chunks of 50,000.
+  EXPECT_TRUE(*io_internal::DecompressLaz(ReadBytes(laz)) == las);
+
+  const absl::StatusOr<PointCloud> read = ReadPointCloud(path);
+  ASSERT_TRUE(read.ok()) << read.status();
+  std::vector<bool> outliers(read->size(), false);
+  outliers[5] = true;
+  const absl::Status in_place =
+      WriteCleanedLas({path}, outliers, LasOutlierRecords::kLeftOut, path);
+  ASSERT_TRUE(in_place.ok()) << in_place;
+  const absl::StatusOr<PointCloud> cleaned = ReadPointCloud(path);
+  ASSERT_TRUE(cleaned.ok()) << cleaned.status();
+  EXPECT_EQ(cleaned->size(), read->size() - 1);
+}
+
 TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
   LasLayout layout;
   std::vector<LasPoint> points = VariedPoints(4);

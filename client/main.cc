@@ -729,8 +729,8 @@ std::vector<Subcommand> Commands() {
        "the figures of every level. With --server, INPUT '-' streams points from standard\n"
        "input as they arrive (\"x y z\" per line, split as in XYZ files, '#' and '//'\n"
        "comments skipped, further columns ignored unless a header comment names them,\n"
-       "\"# x y z r g b\"; or a LAS file's records, with their colours, of the\n"
-       "--las_classes chosen), a batch whenever --batch-size points\n"
+       "\"# x y z r g b\"; or a LAS or LAZ file's records, with their colours, of the\n"
+       "--las_classes chosen: LAZ a chunk at a time), a batch whenever --batch-size points\n"
        "came or 100 ms passed; the session finishes at the end of the stream (files named\n"
        "stdin*).",
        WithConnectionFlags(reconstruct), Reconstruct},

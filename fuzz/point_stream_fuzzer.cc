@@ -5,7 +5,8 @@
 // points are finite, with one colour each or none; and a LAS stream read without classes
 // whose header states its records gives the points reading its bytes as a file gives
 // (ParseLas), or the first of them where LAS 1.4's extended records start earlier (a header
-// that states none is read to the stream's end, a file of it has no points).
+// that states none is read to the stream's end, a file of it has no points); a LAZ stream
+// decoded chunk by chunk as it arrives gives every point of the file.
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -19,6 +20,7 @@
 #include "absl/strings/string_view.h"
 #include "absl/time/time.h"
 #include "core/io/internal/las.h"
+#include "core/io/internal/laz.h"
 #include "core/io/point_selection.h"
 #include "core/io/point_stream.h"
 #include "fuzz/fuzz_check.h"
@@ -84,8 +86,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // Points beyond a float's range from the origin the file's range chooses are left out of
   // the file and not of the stream, which chooses its origin later (StreamUpload).
   if (!parsed.ok() || parsed->left_out.invalid > 0) return 0;
-  const absl::StatusOr<uint64_t> stated = neuralmesh::io_internal::LasRecordCount(bytes);
+  const bool laz = neuralmesh::io_internal::IsLaz(bytes);
+  absl::StatusOr<uint64_t> stated;
+  if (laz) {
+    const absl::StatusOr<neuralmesh::io_internal::LazChunks> chunks =
+        neuralmesh::io_internal::LazChunks::Open(bytes);
+    stated = chunks.ok() ? absl::StatusOr<uint64_t>(chunks->records()) : chunks.status();
+  } else {
+    stated = neuralmesh::io_internal::LasRecordCount(bytes);
+  }
   if (!stated.ok() || *stated == 0) return 0;
+  // A LAZ stream decodes every record its header states, as the file does.
+  FUZZ_CHECK(!laz || points.size() == parsed->positions.size(),
+             "the LAZ stream gave %zu points, the file %zu", points.size(),
+             parsed->positions.size());
   FUZZ_CHECK(points.size() <= parsed->positions.size(), "the stream gave %zu points, the file %zu",
              points.size(), parsed->positions.size());
   for (size_t i = 0; i < points.size(); ++i) {

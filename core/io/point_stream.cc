@@ -16,6 +16,7 @@
 #include "core/io/internal/binary.h"
 #include "core/io/internal/las.h"
 #include "core/io/internal/las_layout.h"
+#include "core/io/internal/laz.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/point_text_stream.h"
 #include "core/rgb.h"
@@ -38,7 +39,7 @@ constexpr size_t kLongestLasHeader = size_t{64} << 20;
 // records the header states (what follows them, LAS 1.3's waveform packets or LAS 1.4's
 // extended variable-length records, is not read). A stream that ends before them is an error;
 // a header that states none (a writer that did not know how many would come) is read to the
-// stream's end.
+// stream's end. A LAZ stream's chunks are decoded as each arrives whole (LazStreamDecoder).
 class LasPointStream final : public DescriptorPointStream {
  public:
   LasPointStream(int fd, std::string name, std::string first_bytes,
@@ -60,7 +61,9 @@ class LasPointStream final : public DescriptorPointStream {
 
   // A stream that ends within its header or a record, or before the records its header
   // states, is cut short.
-  absl::Status End(StreamedPoints* /*points*/) override {
+  absl::Status End(StreamedPoints* points) override {
+    if (laz_.has_value() && records_left_ > 0)
+      NM_RETURN_IF_ERROR(TakeChunks(/*ended=*/true, points));
     if (record_length_ == 0) {
       return Invalid(absl::StrCat("ended within the LAS header, after ", header_.size(), " bytes"));
     }
@@ -82,8 +85,41 @@ class LasPointStream final : public DescriptorPointStream {
       if (record_length_ == 0) return absl::OkStatus();
     }
     if (records_left_ == 0) return absl::OkStatus();  // What follows the records is not read.
+    if (laz_.has_value()) {
+      compressed_.append(bytes.data(), bytes.size());
+      return TakeChunks(/*ended=*/false, points);
+    }
     records_.append(bytes.data(), bytes.size());
     return TakeRecords(points);
+  }
+
+  // Decodes the LAZ chunks that have come whole (all that are left once the stream `ended`).
+  // A chunk's end is known once it decodes, so it is first tried once the bytes of the chunk
+  // before it and a little more have come (chunks of a scan compress alike), then each time a
+  // quarter more have: most chunks decode at the first try.
+  absl::Status TakeChunks(bool ended, StreamedPoints* points) {
+    // A stream that ends between chunks is cut short (End says where).
+    while (laz_->records_left() > 0 &&
+           (ended ? !compressed_.empty() : compressed_.size() >= next_attempt_)) {
+      std::string decoded;
+      absl::StatusOr<size_t> taken = laz_->DecodeNext(compressed_, ended, &decoded);
+      if (!taken.ok()) return Invalid(taken.status().message());
+      if (*taken == 0) {
+        next_attempt_ = compressed_.size() + std::max<size_t>(compressed_.size() / 4, 4096);
+        break;
+      }
+      compressed_.erase(0, *taken);
+      next_attempt_ = *taken + *taken / 32;
+      records_.append(decoded);
+      NM_RETURN_IF_ERROR(TakeRecords(points));
+    }
+    if (laz_->records_left() == 0) std::string().swap(compressed_);  // The chunk table, ...
+    return absl::OkStatus();
+  }
+
+  // The header the records are read with: a LAZ stream's is that of the LAS file it holds.
+  const std::string& RecordsHeader() const {
+    return laz_.has_value() ? laz_->las_header() : header_;
   }
 
   // Gathers the header and its variable-length records; once they are complete, checks them
@@ -105,12 +141,13 @@ class LasPointStream final : public DescriptorPointStream {
     }
     if ((static_cast<uint8_t>(header_[las_layout::kPointFormat]) & las_layout::kCompressedBits) !=
         0) {
-      return Invalid(
-          "LAZ, whose records are not decoded as they arrive; pipe LAS instead "
-          "(laszip -olas -stdout)");
+      absl::StatusOr<io_internal::LazStreamDecoder> laz =
+          io_internal::LazStreamDecoder::Create(header_);
+      if (!laz.ok()) return Invalid(laz.status().message());
+      laz_ = *std::move(laz);
     }
     absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> checked =
-        io_internal::LasRecords::Create(header_, absl::string_view(), classes_);
+        io_internal::LasRecords::Create(RecordsHeader(), absl::string_view(), classes_);
     if (!checked.ok()) return Invalid(checked.status().message());
     record_length_ = LoadScalar<uint16_t>(header_.data() + las_layout::kRecordLength, false);
     if (record_length_ == 0) return Invalid("the LAS header gives records of 0 bytes");
@@ -128,7 +165,7 @@ class LasPointStream final : public DescriptorPointStream {
       if (count14 != 0) stated_records_ = count14;
     }
     if (stated_records_ > 0) records_left_ = stated_records_;
-    if (las14) {
+    if (las14 && !laz_.has_value()) {  // A LAZ file's extended records follow its chunk table.
       const uint64_t evlr_start =
           LoadScalar<uint64_t>(header_.data() + las_layout::kEvlrStart, false);
       const uint32_t evlrs =
@@ -147,7 +184,8 @@ class LasPointStream final : public DescriptorPointStream {
     if (complete == 0) return absl::OkStatus();
     absl::StatusOr<std::unique_ptr<io_internal::LasRecords>> records =
         io_internal::LasRecords::Create(
-            header_, absl::string_view(records_.data(), complete * record_length_), classes_);
+            RecordsHeader(), absl::string_view(records_.data(), complete * record_length_),
+            classes_);
     if (!records.ok()) return Invalid(records.status().message());
     for (uint64_t i = 0; i < complete; ++i) {
       const std::optional<io_internal::Point3d> p = (*records)->KeptPoint(i);
@@ -174,6 +212,9 @@ class LasPointStream final : public DescriptorPointStream {
   std::string records_;  // Records not read yet: a partial one at most between reads.
   uint64_t records_read_ = 0;
   const std::optional<LasClasses> classes_;
+  std::optional<io_internal::LazStreamDecoder> laz_;  // For a LAZ stream.
+  std::string compressed_;   // A LAZ stream's bytes after its last chunk decoded.
+  size_t next_attempt_ = 0;  // The bytes in compressed_ before a chunk is tried (again).
 };
 
 // A stream whose format its first four bytes tell (OpenPointStream).

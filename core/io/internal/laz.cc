@@ -196,6 +196,8 @@ std::vector<Item> ItemsOf(int format, size_t extra, uint16_t version) {
   return items;
 }
 
+}  // namespace
+
 // Codes the records of one chunk: its first record raw, the others coded.
 class ChunkCoder {
  public:
@@ -205,6 +207,10 @@ class ChunkCoder {
   // Decodes `chunk` into `count` records at `out`; `name` names the chunk for messages.
   virtual absl::Status Decode(absl::string_view chunk, uint64_t count, uint8_t* out,
                               absl::string_view name) = 0;
+  // Of the last Decode: the bytes of `chunk` its records took, and how many it read past the
+  // end of `chunk` (0 for a whole chunk).
+  size_t decoded_length() const { return decoded_length_; }
+  size_t decoded_overrun() const { return decoded_overrun_; }
 
  protected:
   explicit ChunkCoder(size_t record_length) : record_length_(record_length) {}
@@ -236,6 +242,8 @@ class ChunkCoder {
   }
 
   size_t record_length_;
+  size_t decoded_length_ = 0;
+  size_t decoded_overrun_ = 0;
 };
 
 // Formats 0 to 3: the items after one another in one stream (item version 2).
@@ -261,17 +269,23 @@ class PointwiseChunkCoder : public ChunkCoder {
 
   absl::Status Decode(absl::string_view chunk, uint64_t count, uint8_t* out,
                       absl::string_view name) override {
+    decoded_length_ = record_length_;
+    decoded_overrun_ = 0;
     NM_RETURN_IF_ERROR(DecodeFirst(chunk, out, name));
     if (count == 1) return absl::OkStatus();
     Apply(static_cast<const uint8_t*>(out),
           [](auto& coder, const uint8_t* item) { coder.Reset(item); });
     laz::ArithmeticDecoder decoder(chunk.substr(record_length_));
-    return DecodeRest(
+    const absl::Status decoded = DecodeRest(
         count, out, name,
         [&](uint8_t* record) {
           Apply(record, [&](auto& coder, uint8_t* item) { coder.Decode(decoder, item); });
         },
         [&] { return decoder.overrun(); });
+    // The coder's stream ends exactly where its decoding ends (ArithmeticEncoder::Done).
+    decoded_length_ = record_length_ + decoder.consumed();
+    decoded_overrun_ = decoder.overrun();
+    return decoded;
   }
 
  private:
@@ -333,13 +347,18 @@ class LayeredChunkCoder : public ChunkCoder {
 
   absl::Status Decode(absl::string_view chunk, uint64_t count, uint8_t* out,
                       absl::string_view name) override {
+    decoded_length_ = record_length_;
+    decoded_overrun_ = 0;
     NM_RETURN_IF_ERROR(DecodeFirst(chunk, out, name));
-    if (count == 1) return absl::OkStatus();
     size_t layer_count = 0;
     ForEachLayers([&](laz::Layers& item_layers) { layer_count += item_layers.count(); });
-    // The number of records (which LASzip does not read either), then the layers' sizes.
+    // The number of records (which LASzip does not read either), then the layers' sizes: a
+    // chunk of one record has them too (its layers are empty), which only a chunk read without
+    // its table needs, for its length.
     size_t at = record_length_ + 4;
     if (chunk.size() < at + 4 * layer_count) {
+      decoded_overrun_ = at + 4 * layer_count - chunk.size();
+      if (count == 1) return absl::OkStatus();
       return Invalid(absl::StrCat(name, " ends within the sizes of its ", layer_count, " layers"));
     }
     std::vector<absl::string_view> layers(layer_count);
@@ -348,11 +367,15 @@ class LayeredChunkCoder : public ChunkCoder {
       const uint32_t size = Load<uint32_t>(chunk, at);
       at += 4;
       if (size > chunk.size() - layer_at) {
+        decoded_overrun_ = size - (chunk.size() - layer_at);
+        if (count == 1) return absl::OkStatus();
         return Invalid(absl::StrCat(name, "'s layers run past its end (", chunk.size(), " bytes)"));
       }
       layer = chunk.substr(layer_at, size);
       layer_at += size;
     }
+    decoded_length_ = layer_at;
+    if (count == 1) return absl::OkStatus();
     if (layers[0].empty()) {
       return Invalid(absl::StrCat(name, " has no layer of returns, X and Y"));
     }
@@ -401,6 +424,8 @@ std::unique_ptr<ChunkCoder> MakeChunkCoder(int format, size_t record_length, uin
   if (IsLayered(format)) return std::make_unique<LayeredChunkCoder>(format, record_length, version);
   return std::make_unique<PointwiseChunkCoder>(format, record_length);
 }
+
+namespace {
 
 // Where a chunk's bytes are and how many records it holds.
 struct Chunk {
@@ -580,10 +605,29 @@ absl::StatusOr<LazHeader> ReadLazHeader(absl::string_view laz) {
 
 }  // namespace
 
+namespace {
+
+// The header and variable-length records of the LAS file that `laz` compresses: the point
+// format without the compression bits, the LASzip record left out, the offset to the points
+// moved.
+std::string DecompressedLasHeader(absl::string_view laz, const LazHeader& laz_header) {
+  const Header& header = laz_header.header;
+  const Vlr& laszip = laz_header.laszip;
+  const size_t laszip_size = laszip.end() - laszip.at;
+  std::string las;
+  absl::StrAppend(&las, laz.substr(0, laszip.at));
+  absl::StrAppend(&las, laz.substr(laszip.end(), header.offset_to_points - laszip.end()));
+  las[kPointFormat] = static_cast<char>(header.format());
+  SetUint32(header.vlr_count - 1, kVlrCount, &las);
+  SetUint32(static_cast<uint32_t>(header.offset_to_points - laszip_size), kOffsetToPoints, &las);
+  return las;
+}
+
+}  // namespace
+
 absl::StatusOr<LazChunks> LazChunks::Open(absl::string_view laz) {
   NM_ASSIGN_OR_RETURN(const LazHeader laz_header, ReadLazHeader(laz));
   const Header& header = laz_header.header;
-  const Vlr* laszip = &laz_header.laszip;
   const Compression& compression = laz_header.compression;
   LazChunks out;
   out.laz_ = laz;
@@ -612,13 +656,7 @@ absl::StatusOr<LazChunks> LazChunks::Open(absl::string_view laz) {
   out.records_ = header.count;
   out.compressed_ = compressed;
 
-  const size_t laszip_size = laszip->end() - laszip->at;
-  std::string& las = out.las_header_;
-  absl::StrAppend(&las, laz.substr(0, laszip->at));
-  absl::StrAppend(&las, laz.substr(laszip->end(), header.offset_to_points - laszip->end()));
-  las[kPointFormat] = static_cast<char>(header.format());
-  SetUint32(header.vlr_count - 1, kVlrCount, &las);
-  SetUint32(static_cast<uint32_t>(header.offset_to_points - laszip_size), kOffsetToPoints, &las);
+  out.las_header_ = DecompressedLasHeader(laz, laz_header);
   return out;
 }
 
@@ -712,6 +750,67 @@ absl::Status LazChunks::DecodeInOrder(
     }
   }
   return absl::OkStatus();
+}
+
+absl::StatusOr<LazStreamDecoder> LazStreamDecoder::Create(absl::string_view header) {
+  NM_ASSIGN_OR_RETURN(const LazHeader laz_header, ReadLazHeader(header));
+  if (laz_header.compression.chunk_size == kVariableChunkSize) {
+    return Invalid(
+        "chunks of varying size, whose sizes only the chunk table after them gives: not read "
+        "as they arrive; write the file with chunks of one size");
+  }
+  if (laz_header.header.count == 0) {
+    return Invalid(
+        "the header states no record count: where the chunks end is not known before the "
+        "chunk table that follows them");
+  }
+  LazStreamDecoder out;
+  out.las_header_ = DecompressedLasHeader(header, laz_header);
+  out.record_length_ = laz_header.header.record_length;
+  out.chunk_size_ = laz_header.compression.chunk_size;
+  out.records_left_ = laz_header.header.count;
+  out.coder_ = std::shared_ptr<ChunkCoder>(MakeChunkCoder(
+      laz_header.header.format(), out.record_length_, laz_header.compression.item_version));
+  return out;
+}
+
+absl::StatusOr<size_t> LazStreamDecoder::DecodeNext(absl::string_view bytes, bool ended,
+                                                    std::string* records) {
+  if (records_left_ == 0) return 0;
+  if (!table_offset_skipped_) {
+    // The point data start with the chunk table's offset (or -1, for the file's last bytes).
+    if (bytes.size() < 8) {
+      if (!ended) return 0;
+      return Invalid("the stream ends before its chunk table's offset");
+    }
+    table_offset_skipped_ = true;
+    NM_ASSIGN_OR_RETURN(const size_t chunk, DecodeNext(bytes.substr(8), ended, records));
+    if (chunk == 0) table_offset_skipped_ = false;  // Taken again with the chunk.
+    return chunk == 0 ? 0 : chunk + 8;
+  }
+  const uint64_t count = std::min<uint64_t>(chunk_size_, records_left_);
+  const size_t at = records->size();
+  records->resize(at + count * record_length_);
+  const std::string name = absl::StrCat("chunk ", chunks_ + 1);
+  const absl::Status decoded =
+      coder_->Decode(bytes, count, reinterpret_cast<uint8_t*>(&(*records)[at]), name);
+  // A chunk may take a little more than its records' bytes (incompressible ones); more than
+  // that is no chunk.
+  const uint64_t most = 2 * count * record_length_ + (uint64_t{1} << 16);
+  if ((!decoded.ok() || coder_->decoded_overrun() > 0) && !ended && bytes.size() < most) {
+    records->resize(at);
+    return 0;  // Not all of the chunk has come.
+  }
+  if (!decoded.ok() || coder_->decoded_overrun() > 0) {
+    records->resize(at);
+    NM_RETURN_IF_ERROR(decoded);
+    return Invalid(absl::StrCat(name, " ends ", coder_->decoded_overrun(),
+                                " bytes before its records are decoded: the stream is cut short "
+                                "or corrupt"));
+  }
+  ++chunks_;
+  records_left_ -= count;
+  return coder_->decoded_length();
 }
 
 absl::StatusOr<std::string> DescribeLazCompression(absl::string_view laz) {

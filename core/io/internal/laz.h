@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -103,6 +104,45 @@ class LazChunks {
   uint64_t compressed_ = 0;
   size_t points_end_ = 0;
   uint64_t evlr_start_ = 0;
+};
+
+class ChunkCoder;
+
+// A LAZ file's records decoded as its bytes arrive in order, without the chunk table that
+// LASzip writes after the chunks: standard input fed by `laszip -stdout` or `pdal translate`.
+// A chunk ends where its decoding ends: a layered chunk states its layers' sizes, and a
+// pointwise one's arithmetic coder ends exactly at its last byte (laz_arithmetic_coder.h).
+class LazStreamDecoder {
+ public:
+  // From the file's header and variable-length records (its first bytes, up to the points):
+  // LazChunks::Open's errors for the header and LASzip record, and INVALID_ARGUMENT for chunks
+  // of varying size, or a header that states no record count (the chunks' end is then known
+  // only from the chunk table after them).
+  static absl::StatusOr<LazStreamDecoder> Create(absl::string_view header);
+
+  // The LAS file's header and variable-length records, as DecompressLaz's output begins.
+  const std::string& las_header() const { return las_header_; }
+  size_t record_length() const { return record_length_; }
+  // Records the header states that are not decoded yet.
+  uint64_t records_left() const { return records_left_; }
+
+  // Decodes the chunk that `bytes` start with (the stream's bytes after the points' offset and
+  // the chunks decoded so far) and appends its records to `records`. Returns the bytes it
+  // took, or 0 when `bytes` do not hold all of it yet (none once every record is decoded).
+  // With `ended` (no more bytes will come), INVALID_ARGUMENT for a chunk cut short; a corrupt
+  // chunk's errors as DecompressLaz's.
+  absl::StatusOr<size_t> DecodeNext(absl::string_view bytes, bool ended, std::string* records);
+
+ private:
+  LazStreamDecoder() = default;
+
+  std::string las_header_;
+  size_t record_length_ = 0;
+  uint32_t chunk_size_ = 0;
+  uint64_t records_left_ = 0;
+  uint64_t chunks_ = 0;
+  bool table_offset_skipped_ = false;
+  std::shared_ptr<ChunkCoder> coder_;
 };
 
 // How `laz` is compressed, for reports (`neuralmesh stats`): the LASzip version that wrote it,

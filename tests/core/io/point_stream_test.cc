@@ -8,13 +8,17 @@
 #include <vector>
 
 #include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
 #include "core/io/internal/laz.h"
 #include "core/io/point_cloud_io.h"
 #include "core/io/point_selection.h"
 #include "core/random.h"
+#include "core/rgb.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/testing/las_file.h"
+#include "tests/testing/las_scan.h"
 #include "tests/testing/pipe.h"
 #include "tests/testing/temp_dir.h"
 
@@ -64,6 +68,34 @@ absl::Status ReadInPieces(PointStream& stream, Pipe& pipe, absl::string_view byt
   return absl::DeadlineExceededError("the stream did not end");
 }
 
+// Streams `bytes` through a pipe in `pieces` and expects the points of `whole` (the same file
+// read whole), colours too, having read `read_so_far`.
+void ExpectStreamedAsRead(absl::string_view bytes, const PointCloud& whole,
+                          const std::vector<size_t>& pieces, const std::string& read_so_far) {
+  Pipe pipe;
+  std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "standard input");
+  StreamedPoints streamed;
+  const std::vector<Vec3>& points = streamed.positions;
+  const absl::Status read = ReadInPieces(*stream, pipe, bytes, pieces, &streamed);
+  ASSERT_TRUE(read.ok()) << read;
+  EXPECT_EQ(stream->ReadSoFar(), read_so_far) << "what follows the records is none";
+  ASSERT_EQ(points.size(), whole.size()) << "withheld and noise records left out";
+  for (size_t i = 0; i < points.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_EQ(static_cast<float>(points[i][c] - whole.origin[c]), whole.positions[i][c])
+          << "point " << i;
+    }
+  }
+  ASSERT_EQ(streamed.colors.size(), whole.colors.size());
+  for (size_t i = 0; i < whole.colors.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_EQ(ChannelFromLevel(streamed.colors[i][c], stream->ColorScale(65535)),
+                whole.colors[i][c])
+          << "colour " << i;
+    }
+  }
+}
+
 TEST(LasPointStreamTest, ALasFileArrivingInPiecesGivesThePointsReadingItWholeDoes) {
   const std::string bytes = ScanLas(1000);
   const std::string path = testing::ProcessTempDir() + "/scan_line.las";
@@ -74,18 +106,33 @@ TEST(LasPointStreamTest, ALasFileArrivingInPiecesGivesThePointsReadingItWholeDoe
   for (const std::vector<size_t>& pieces :
        {std::vector<size_t>{1, 7, 100}, std::vector<size_t>{4096}, std::vector<size_t>{29, 31}}) {
     SCOPED_TRACE(pieces.front());
-    Pipe pipe;
-    std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "standard input");
-    StreamedPoints streamed;
-    std::vector<Vec3>& points = streamed.positions;
-    const absl::Status read = ReadInPieces(*stream, pipe, bytes, pieces, &streamed);
-    ASSERT_TRUE(read.ok()) << read;
-    EXPECT_EQ(stream->ReadSoFar(), "1000 LAS records") << "the EVLR after them is no record";
-    ASSERT_EQ(points.size(), whole->size()) << "withheld and noise records left out";
-    for (size_t i = 0; i < points.size(); ++i) {
-      for (int c = 0; c < 3; ++c) {
-        ASSERT_EQ(static_cast<float>(points[i][c] - whole->origin[c]), whole->positions[i][c])
-            << "point " << i;
+    ExpectStreamedAsRead(bytes, *whole, pieces, "1000 LAS records");
+  }
+}
+
+// A LAZ stream (`laszip -stdout`, `pdal translate`) gives the points of the LAS file it holds,
+// its chunks decoded as each arrives whole: layered chunks (LAS 1.4's formats 6-8) and
+// pointwise ones (formats 0-3), of 1 to 1,000 records, however its bytes are cut.
+TEST(LasPointStreamTest, ALazFileArrivingInPiecesGivesThePointsOfItsLasFile) {
+  testing::LasScan scan;
+  scan.format = 3;
+  scan.records = 3000;
+  scan.random_every = 53;
+  for (const std::string& las : {ScanLas(1000), testing::ScanLasFile(scan)}) {
+    const std::string path = testing::ProcessTempDir() + "/streamed.las";
+    std::ofstream(path, std::ios::binary) << las;
+    absl::StatusOr<PointCloud> whole = ReadPointCloud(path);
+    ASSERT_TRUE(whole.ok()) << whole.status();
+    for (const uint32_t chunk_size : {1000u, 77u, 1u}) {
+      absl::StatusOr<std::string> laz =
+          io_internal::CompressLas(las, io_internal::LazWriteOptions{chunk_size});
+      ASSERT_TRUE(laz.ok()) << laz.status();
+      for (const std::vector<size_t>& pieces :
+           {std::vector<size_t>{1, 7, 100}, std::vector<size_t>{20000}}) {
+        if (chunk_size == 1 && pieces.front() == 1) continue;  // A byte at a time: slow.
+        SCOPED_TRACE(absl::StrCat("chunks of ", chunk_size, ", pieces of ", pieces.front()));
+        ExpectStreamedAsRead(*laz, *whole, pieces,
+                             absl::StrCat(las.size() > 100000 ? 3000 : 1000, " LAS records"));
       }
     }
   }
@@ -108,14 +155,27 @@ TEST(LasPointStreamTest, WhatIsNoLasStreamIsAnErrorSayingWhy) {
   EXPECT_EQ(status.message(),
             "the scanner: ended after 4 of the 100 LAS records its header states");
 
+  // A LAZ stream cut short within a chunk, or between chunks.
   absl::StatusOr<std::string> laz =
       io_internal::CompressLas(bytes, io_internal::LazWriteOptions{50});
   ASSERT_TRUE(laz.ok()) << laz.status();
-  status = error_of(*laz);
+  status = error_of(laz->substr(0, laz->size() - 300));
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << status;
+  EXPECT_THAT(std::string(status.message()),
+              ::testing::StartsWith("the scanner: LAZ: chunk 2 ends within"));
+  const absl::StatusOr<io_internal::LazChunks> chunks = io_internal::LazChunks::Open(*laz);
+  ASSERT_TRUE(chunks.ok()) << chunks.status();
+  status = error_of(laz->substr(0, chunks->chunk(1).at));
   EXPECT_EQ(status.message(),
-            "the scanner: LAZ, whose records are not decoded as they arrive; pipe LAS instead "
-            "(laszip -olas -stdout)");
+            "the scanner: ended after 50 of the 100 LAS records its header states");
+  // A header that states no record count: where the chunks end is not known.
+  std::string uncounted = *laz;
+  for (const size_t count_at : {107, 247}) {
+    std::fill(uncounted.begin() + count_at,
+              uncounted.begin() + count_at + (count_at == 107 ? 4 : 8), '\0');
+  }
+  status = error_of(uncounted);
+  EXPECT_THAT(std::string(status.message()), ::testing::HasSubstr("states no record count"));
 }
 
 // The records a LAS stream's header states are read, and what follows them is not (LAS 1.3's

@@ -6,7 +6,6 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/byte_sink.h"
 #include "core/io/file_bytes.h"
-#include "core/io/file_contents.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/las.h"
 #include "core/io/internal/laz.h"

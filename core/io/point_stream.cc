@@ -101,8 +101,8 @@ class LasPointStream final : public DescriptorPointStream {
     // A stream that ends between chunks is cut short (End says where).
     while (laz_->records_left() > 0 &&
            (ended ? !compressed_.empty() : compressed_.size() >= next_attempt_)) {
-      std::string decoded;
-      absl::StatusOr<size_t> taken = laz_->DecodeNext(compressed_, ended, &decoded);
+      // Decoded after the records not read yet (none: a LAZ stream's come in whole chunks).
+      absl::StatusOr<size_t> taken = laz_->DecodeNext(compressed_, ended, &records_);
       if (!taken.ok()) return Invalid(taken.status().message());
       if (*taken == 0) {
         next_attempt_ = compressed_.size() + std::max<size_t>(compressed_.size() / 4, 4096);
@@ -110,7 +110,6 @@ class LasPointStream final : public DescriptorPointStream {
       }
       compressed_.erase(0, *taken);
       next_attempt_ = *taken + *taken / 32;
-      records_.append(decoded);
       NM_RETURN_IF_ERROR(TakeRecords(points));
     }
     if (laz_->records_left() == 0) std::string().swap(compressed_);  // The chunk table, ...

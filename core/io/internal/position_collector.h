@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -68,7 +69,7 @@ class PositionCollector {
       low_[c] = std::min(low_[c], p[c]);
       high_[c] = std::max(high_[c], p[c]);
     }
-    const Vec3f narrowed(NarrowToFloat(p[0]), NarrowToFloat(p[1]), NarrowToFloat(p[2]));
+    const Vec3f narrowed(Narrowed(p[0]), Narrowed(p[1]), Narrowed(p[2]));
     const bool exact = narrowed[0] == p[0] && narrowed[1] == p[1] && narrowed[2] == p[2];
     if (doubles_.empty() && (exact || inexact_ || KeepsInexactFloat(p))) {
       inexact_ |= !exact;
@@ -87,6 +88,12 @@ class PositionCollector {
   void MoveTo(ParsedGeometry* out);
 
  private:
+  // NarrowToFloat(value), without its call for a value within a float's range (a cast rounds
+  // it alike): every coordinate of every point comes here.
+  static float Narrowed(double value) {
+    return std::fabs(value) <= std::numeric_limits<float>::max() ? static_cast<float>(value)
+                                                                 : NarrowToFloat(value);
+  }
   // Whether the first position a float does not hold exactly is kept as a float.
   bool KeepsInexactFloat(const Point3d& p) const {
     return precision_ == PositionPrecision::kFloatsNearZero && std::fabs(p[0]) <= kNearZero &&

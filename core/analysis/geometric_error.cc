@@ -307,7 +307,8 @@ absl::StatusOr<GeometricError> ComputeErrorAgainstPoints(const TriangleMesh& rec
   const size_t points_voted = normal_count;
 
   // The reconstruction's samples and vertices to their nearest point.
-  const PointKdTree tree(points.positions, 0, static_cast<uint32_t>(points.size()));
+  const PointKdTree tree(points.positions, 0, static_cast<uint32_t>(points.size()),
+                         options.threads);
   const QueryPoints& query = surface.query;
   const size_t samples = query.samples.size();
   std::vector<double> distance(samples + query.vertices.size());
@@ -316,7 +317,7 @@ absl::StatusOr<GeometricError> ComputeErrorAgainstPoints(const TriangleMesh& rec
     NeighbourHeap heap;
     for (size_t i = first; i < last; ++i) {
       const Vec3& q = i < samples ? query.samples[i] : query.vertices[i - samples];
-      tree.Search(points.positions, Vec3f(q[0], q[1], q[2]), UINT32_MAX, 1, &heap);
+      tree.Search(Vec3f(q[0], q[1], q[2]), UINT32_MAX, 1, &heap);
       const uint32_t index = heap.top().second;
       heap.pop();
       distance[i] = (ToVec3(points.positions[index]) - q).norm();

@@ -37,22 +37,20 @@ Rgb BlendNearest(NeighbourHeap& heap, absl::Span<const Rgb> colors) {
 class PointColorSource final : public ColorSource {
  public:
   PointColorSource(const PointCloud& cloud, size_t neighbours)
-      : positions_(cloud.positions),
-        colors_(cloud.colors),
+      : colors_(cloud.colors),
         neighbours_(neighbours),
-        tree_(positions_, 0, static_cast<uint32_t>(positions_.size())) {}
+        tree_(cloud.positions, 0, static_cast<uint32_t>(cloud.positions.size())) {}
 
   Rgb ColorAt(const Vec3f& position) const override {
     NeighbourHeap heap;
-    tree_.Search(positions_, position, UINT32_MAX, neighbours_, &heap);
+    tree_.Search(position, UINT32_MAX, neighbours_, &heap);
     return BlendNearest(heap, colors_);
   }
 
  private:
-  std::vector<Vec3f> positions_;
   std::vector<Rgb> colors_;
   size_t neighbours_;
-  PointKdTree tree_;
+  PointKdTree tree_;  // Holds the points.
 };
 
 }  // namespace
@@ -119,9 +117,9 @@ void GrowingPointColors::Paint(TriangleMesh* mesh) {
   mesh->colors.resize(mesh->positions.size());
   NeighbourHeap heap;
   for (size_t v = 0; v < mesh->positions.size(); ++v) {
-    head_->Search(positions_, mesh->positions[v], UINT32_MAX, neighbours_, &heap);
+    head_->Search(mesh->positions[v], UINT32_MAX, neighbours_, &heap);
     if (tail_.has_value()) {
-      tail_->Search(positions_, mesh->positions[v], UINT32_MAX, neighbours_, &heap);
+      tail_->Search(mesh->positions[v], UINT32_MAX, neighbours_, &heap);
     }
     mesh->colors[v] = BlendNearest(heap, colors_);
   }

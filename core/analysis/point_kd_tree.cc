@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
+#include <thread>
 
 namespace neuralmesh {
 namespace {
 
 constexpr size_t kLeafPoints = 8;
+// Ranges smaller than this are built on the thread that split them.
+constexpr size_t kMinPointsPerThread = 1 << 16;
 
 }  // namespace
 
@@ -18,72 +20,85 @@ double MeanDistance(NeighbourHeap& heap) {
   return found == 0 ? 0 : sum / static_cast<double>(found);
 }
 
-PointKdTree::PointKdTree(absl::Span<const Vec3f> points, uint32_t begin, uint32_t end)
-    : begin_(begin), end_(end), order_(end - begin), splits_(end - begin) {
-  std::iota(order_.begin(), order_.end(), begin);
-  Build(points, 0, order_.size());
+PointKdTree::PointKdTree(absl::Span<const Vec3f> points, uint32_t begin, uint32_t end, int threads)
+    : begin_(begin), end_(end), leaves_(end - begin) {
+  // The tree's nodes down to the last level that splits (halves round up).
+  size_t levels = 0;
+  for (size_t range = leaves_.size(); range > kLeafPoints; range = (range + 1) / 2) ++levels;
+  splits_.resize((size_t{1} << levels) - 1);
+  for (uint32_t i = begin; i < end; ++i) leaves_[i - begin] = {points[i], i};
+  Build(
+      0, 0, leaves_.size(),
+      threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
 }
 
-void PointKdTree::Build(absl::Span<const Vec3f> points, size_t begin, size_t end) {
+void PointKdTree::Build(size_t node, size_t begin, size_t end, int threads) {
   if (end - begin <= kLeafPoints) return;
-  Vec3f low = points[order_[begin]];
+  Vec3f low = leaves_[begin].position;
   Vec3f high = low;
   for (size_t i = begin; i < end; ++i) {
-    low.minimize(points[order_[i]]);
-    high.maximize(points[order_[i]]);
+    low.minimize(leaves_[i].position);
+    high.maximize(leaves_[i].position);
   }
   const Vec3f extent = high - low;
   const int axis = extent[0] >= extent[1] && extent[0] >= extent[2] ? 0
                    : extent[1] >= extent[2]                         ? 1
                                                                     : 2;
   const size_t mid = begin + (end - begin) / 2;
-  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
-                   [&](uint32_t a, uint32_t b) { return points[a][axis] < points[b][axis]; });
-  splits_[mid] = Split{axis, points[order_[mid]][axis]};
-  Build(points, begin, mid);
-  Build(points, mid, end);
+  std::nth_element(leaves_.begin() + begin, leaves_.begin() + mid, leaves_.begin() + end,
+                   [axis](const LeafPoint& a, const LeafPoint& b) {
+                     return a.position[axis] < b.position[axis];
+                   });
+  splits_[node] = Split{axis, leaves_[mid].position[axis]};
+  // The halves are disjoint: on several threads, one builds the upper half meanwhile.
+  if (threads > 1 && end - begin >= kMinPointsPerThread) {
+    std::thread upper([&] { Build(2 * node + 2, mid, end, threads - threads / 2); });
+    Build(2 * node + 1, begin, mid, threads / 2);
+    upper.join();
+  } else {
+    Build(2 * node + 1, begin, mid, 1);
+    Build(2 * node + 2, mid, end, 1);
+  }
 }
 
-void PointKdTree::Search(absl::Span<const Vec3f> points, const Vec3f& query, uint32_t skip,
-                         size_t k, NeighbourHeap* heap) const {
-  if (k == 0 || order_.empty()) return;
-  SearchRange(points, 0, order_.size(), query, skip, k, heap);
+void PointKdTree::Search(const Vec3f& query, uint32_t skip, size_t k, NeighbourHeap* heap) const {
+  if (k == 0 || leaves_.empty()) return;
+  Query state{query, skip, k};
+  SearchRange(0, 0, leaves_.size(), state, heap);
 }
 
-void PointKdTree::SearchRange(absl::Span<const Vec3f> points, size_t begin, size_t end,
-                              const Vec3f& query, uint32_t skip, size_t k,
+void PointKdTree::SearchRange(size_t node, size_t begin, size_t end, Query& query,
                               NeighbourHeap* heap) const {
   if (end - begin <= kLeafPoints) {
     for (size_t i = begin; i < end; ++i) {
-      const uint32_t id = order_[i];
-      if (id == skip) continue;
-      const float d2 = (points[id] - query).sqrnorm();
-      if (heap->size() < k) {
-        heap->emplace(d2, id);
-      } else if (d2 < heap->top().first) {
-        heap->pop();
-        heap->emplace(d2, id);
-      }
+      const LeafPoint& leaf = leaves_[i];
+      if (leaf.index == query.skip) continue;
+      heap->Offer((leaf.position - query.position).sqrnorm(), leaf.index, query.k);
     }
     return;
   }
   const size_t mid = begin + (end - begin) / 2;
-  const Split& split = splits_[mid];
-  const float offset = query[split.axis] - split.value;
-  // The side holding the query first; the other only if it may hold a nearer point.
-  const bool left_first = offset < 0;
-  if (left_first) {
-    SearchRange(points, begin, mid, query, skip, k, heap);
+  const Split& split = splits_[node];
+  const float offset = query.position[split.axis] - split.value;
+  // The side holding the query first; the other only if it may hold a nearer point: the
+  // query's distance to its cell is below the farthest of the heap's.
+  const bool lower_first = offset < 0;
+  if (lower_first) {
+    SearchRange(2 * node + 1, begin, mid, query, heap);
   } else {
-    SearchRange(points, mid, end, query, skip, k, heap);
+    SearchRange(2 * node + 2, mid, end, query, heap);
   }
-  if (heap->size() < k || offset * offset < heap->top().first) {
-    if (left_first) {
-      SearchRange(points, mid, end, query, skip, k, heap);
+  float& outside = query.outside[split.axis];
+  const float outside_before = outside;
+  outside = std::abs(offset);  // The far side's cell is that of this range cut at the split.
+  if (heap->size() < query.k || query.CellSquaredDistance() < heap->top().first) {
+    if (lower_first) {
+      SearchRange(2 * node + 2, mid, end, query, heap);
     } else {
-      SearchRange(points, begin, mid, query, skip, k, heap);
+      SearchRange(2 * node + 1, begin, mid, query, heap);
     }
   }
+  outside = outside_before;
 }
 
 }  // namespace neuralmesh

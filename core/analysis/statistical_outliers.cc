@@ -46,13 +46,15 @@ absl::StatusOr<std::vector<bool>> FindStatisticalOutliers(const PointCloud& clou
   const size_t k = static_cast<size_t>(options.neighbours);
   std::vector<bool> outlier(n, false);
   if (n <= k) return outlier;
-  const PointKdTree tree(cloud.positions, 0, static_cast<uint32_t>(n));
+  const PointKdTree tree(cloud.positions, 0, static_cast<uint32_t>(n), options.threads);
   std::vector<double> mean_distance(n);
+  // Queried in the tree's order, each query near the one before.
+  const absl::Span<const PointKdTree::LeafPoint> leaves = tree.leaf_order();
   ForEachRange(n, options.threads, 4096, [&](size_t first, size_t last) {
     NeighbourHeap heap;
-    for (size_t i = first; i < last; ++i) {
-      tree.Search(cloud.positions, cloud.positions[i], static_cast<uint32_t>(i), k, &heap);
-      mean_distance[i] = MeanDistance(heap);
+    for (size_t j = first; j < last; ++j) {
+      tree.Search(leaves[j].position, leaves[j].index, k, &heap);
+      mean_distance[leaves[j].index] = MeanDistance(heap);
     }
   });
 
@@ -110,6 +112,13 @@ absl::StatusOr<size_t> RemoveStatisticalOutliers(PointCloud& cloud,
 PointCloud WithoutPoints(const PointCloud& cloud, const std::vector<bool>& drop) {
   PointCloud kept;
   kept.origin = cloud.origin;
+  size_t dropped = 0;
+  for (size_t i = 0; i < std::min(drop.size(), cloud.size()); ++i) dropped += drop[i];
+  const size_t count = cloud.size() - dropped;
+  kept.positions.reserve(count);
+  if (!cloud.weights.empty()) kept.weights.reserve(count);
+  if (!cloud.normals.empty()) kept.normals.reserve(count);
+  if (!cloud.colors.empty()) kept.colors.reserve(count);
   for (size_t i = 0; i < cloud.size(); ++i) {
     if (i < drop.size() && drop[i]) continue;
     kept.positions.push_back(cloud.positions[i]);

@@ -23,7 +23,7 @@ void StreamingOutlierFilter::SearchSeen(const Vec3f& query, uint32_t skip,
   const size_t k = static_cast<size_t>(options_.neighbours);
   // Newest first: the small trees are cheap and fill the heap, so the large ones prune more.
   for (auto tree = trees_.rbegin(); tree != trees_.rend(); ++tree) {
-    tree->Search(points_, query, skip, k, heap);
+    tree->Search(query, skip, k, heap);
   }
 }
 
@@ -42,9 +42,11 @@ OutlierJudgement StreamingOutlierFilter::Judge(absl::Span<const Vec3f> batch) co
   // The batch's points, each skipping itself among the batch.
   std::vector<double> mean_distance(m);
   std::vector<float> radius_squared(m);
-  for (size_t i = 0; i < m; ++i) {
-    SearchSeen(batch[i], kSkipNone, &heap);
-    batch_tree.Search(batch, batch[i], static_cast<uint32_t>(i), k, &heap);
+  // In the batch tree's order, each query near the one before.
+  for (const PointKdTree::LeafPoint& point : batch_tree.leaf_order()) {
+    const uint32_t i = point.index;
+    SearchSeen(point.position, kSkipNone, &heap);
+    batch_tree.Search(point.position, i, k, &heap);
     radius_squared[i] = heap.top().first;
     mean_distance[i] = MeanDistance(heap);
   }
@@ -74,14 +76,14 @@ OutlierJudgement StreamingOutlierFilter::Judge(absl::Span<const Vec3f> batch) co
       still_held.push_back(held);
       continue;
     }
-    batch_tree.Search(batch, q, kSkipNone, arrivals_to_judge - held.arrivals, &heap);
+    batch_tree.Search(q, kSkipNone, arrivals_to_judge - held.arrivals, &heap);
     for (; !heap.empty(); heap.pop()) held.arrivals += heap.top().first < held.radius_squared;
     if (held.arrivals < arrivals_to_judge) {
       still_held.push_back(held);
       continue;
     }
     SearchSeen(q, held.index, &heap);
-    batch_tree.Search(batch, q, kSkipNone, k, &heap);
+    batch_tree.Search(q, kSkipNone, k, &heap);
     held.radius_squared = heap.top().first;
     held.arrivals = 0;
     if (MeanDistance(heap) <= held_limit) {

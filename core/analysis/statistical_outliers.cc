@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <numeric>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -79,22 +78,28 @@ absl::StatusOr<std::vector<bool>> FindStatisticalOutliersInPasses(const PointClo
                                                                   const OutlierOptions& options) {
   if (absl::Status valid = options.Validate(); !valid.ok()) return valid;
   std::vector<bool> dropped(cloud.size(), false);
-  PointCloud judged = cloud;
-  std::vector<size_t> index_in_cloud(cloud.size());  // Of each point of `judged`.
-  std::iota(index_in_cloud.begin(), index_in_cloud.end(), size_t{0});
+  // What a pass judges: the cloud itself, then the points kept so far (copied only when a pass
+  // follows), with the index in the cloud of each.
+  const PointCloud* judged = &cloud;
+  PointCloud kept;
+  std::vector<uint32_t> index_in_cloud;  // Empty while judged is the cloud.
   for (int pass = 0; pass < options.passes; ++pass) {
-    absl::StatusOr<std::vector<bool>> outlier = FindStatisticalOutliers(judged, options);
+    absl::StatusOr<std::vector<bool>> outlier = FindStatisticalOutliers(*judged, options);
     if (!outlier.ok()) return outlier.status();
     if (std::find(outlier->begin(), outlier->end(), true) == outlier->end()) break;
-    std::vector<size_t> kept_indices;
-    for (size_t i = 0; i < judged.size(); ++i) {
+    const bool last = pass + 1 == options.passes;
+    std::vector<uint32_t> kept_indices;
+    for (size_t i = 0; i < judged->size(); ++i) {
+      const uint32_t index = index_in_cloud.empty() ? static_cast<uint32_t>(i) : index_in_cloud[i];
       if ((*outlier)[i]) {
-        dropped[index_in_cloud[i]] = true;
-      } else {
-        kept_indices.push_back(index_in_cloud[i]);
+        dropped[index] = true;
+      } else if (!last) {
+        kept_indices.push_back(index);
       }
     }
-    judged = WithoutPoints(judged, *outlier);
+    if (last) break;
+    kept = WithoutPoints(*judged, *outlier);
+    judged = &kept;
     index_in_cloud = std::move(kept_indices);
   }
   return dropped;

@@ -101,6 +101,19 @@ TEST(StatisticalOutliersTest, ASecondPassFindsTheStraysTheFarthestHid) {
   ASSERT_EQ(flagged->size(), cloud.size());
   EXPECT_EQ(std::count(flagged->begin(), flagged->end(), true), 3);
   EXPECT_TRUE((*flagged)[20000] && (*flagged)[20001] && (*flagged)[20002]);
+  // A third pass judges the points the second kept (`cleaned`, in their order): its flags, by
+  // index in the whole cloud, are the two passes' and those of one pass over `cleaned`.
+  options.passes = 3;
+  const auto thrice = FindStatisticalOutliersInPasses(cloud, options);
+  ASSERT_TRUE(thrice.ok()) << thrice.status();
+  const auto third = FindStatisticalOutliers(cleaned, OutlierOptions{});
+  ASSERT_TRUE(third.ok()) << third.status();
+  size_t kept = 0;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_EQ((*thrice)[i], (*flagged)[i] || (*third)[kept]) << "point " << i;
+    kept += !(*flagged)[i];
+  }
+  EXPECT_EQ(std::count(thrice->begin(), thrice->end(), true), 3 + 55);
 
   options.passes = 1;
   PointCloud once = cloud;

@@ -1,7 +1,9 @@
 // A static k-d tree over a contiguous range of a point array, for k-nearest-neighbour queries
-// (statistical outlier removal, statistical_outliers.h and streaming_outlier_filter.h). The
-// tree keeps indices into the array, not the points: callers pass the array to every call, so
-// it may grow (and move) between calls as long as the tree's range stays as it was built.
+// (statistical outlier removal, statistical_outliers.h and streaming_outlier_filter.h; the
+// colours of points, color_source.h; the error against points, geometric_error.h). The tree
+// holds a copy of the range's points, in the order of its leaves, with their indices in the
+// array: the array may change or go once the tree is built, and a search reads each leaf's
+// points from one place rather than from all over the array.
 #ifndef NEURALMESH_CORE_ANALYSIS_POINT_KD_TREE_H_
 #define NEURALMESH_CORE_ANALYSIS_POINT_KD_TREE_H_
 

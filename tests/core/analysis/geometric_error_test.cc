@@ -1,5 +1,6 @@
 #include "core/analysis/geometric_error.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -131,6 +132,32 @@ TEST(GeometricErrorTest, RejectsInvalidInput) {
       code(ComputeGeometricError(good, good, FewSamples(GeometricErrorOptions::kMaxSamples + 1))),
       absl::StatusCode::kInvalidArgument)
       << "more samples than the bound must be refused, not allocated";
+}
+
+// Points measured a block at a time (65,536 to a block) give what each point's own distance
+// gives: completeness is their mean, in their order, and the Hausdorff distance at least their
+// largest; the normals vote over every block.
+TEST(GeometricErrorTest, AgainstPointsMeasuresEveryPointOfEveryBlock) {
+  PointCloud points = testing::ColoredUnitSpherePoints(150000, 8);
+  points.positions.back() = Vec3f(0, 0, 2);  // A stray in the last block, 1 from the sphere.
+  for (const Vec3f& p : points.positions) points.normals.push_back(p.normalized());
+  const TriangleMesh sphere = Icosphere(4);
+  const absl::StatusOr<GeometricError> error =
+      ComputeErrorAgainstPoints(sphere, points, FewSamples());
+  ASSERT_TRUE(error.ok()) << error.status();
+  std::vector<Vec3> queries;
+  for (const Vec3f& p : points.positions) queries.emplace_back(p[0], p[1], p[2]);
+  const absl::StatusOr<std::vector<double>> distances = DistancesToMesh(queries, sphere);
+  ASSERT_TRUE(distances.ok()) << distances.status();
+  double sum = 0, largest = 0;
+  for (const double d : *distances) {
+    sum += d;
+    largest = std::max(largest, d);
+  }
+  EXPECT_EQ(error->completeness, sum / static_cast<double>(points.size()) / error->diagonal);
+  EXPECT_NEAR(largest, 1.0, 0.01);
+  EXPECT_GE(error->hausdorff * error->diagonal, largest);
+  EXPECT_GT(error->normal_consistency, 0.99);
 }
 
 // The points of a unit sphere (with their normals) against meshes of it: the mesh itself fits

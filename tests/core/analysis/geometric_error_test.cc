@@ -136,7 +136,7 @@ TEST(GeometricErrorTest, RejectsInvalidInput) {
 
 // Points measured a block at a time (65,536 to a block) give what each point's own distance
 // gives: completeness is their mean, in their order, and the Hausdorff distance at least their
-// largest; the normals vote over every block.
+// largest (a stray in the last block); the normals, the sphere's own, agree.
 TEST(GeometricErrorTest, AgainstPointsMeasuresEveryPointOfEveryBlock) {
   PointCloud points = testing::ColoredUnitSpherePoints(150000, 8);
   points.positions.back() = Vec3f(0, 0, 2);  // A stray in the last block, 1 from the sphere.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <thread>
+#include <utility>
 
 namespace neuralmesh {
 namespace {
@@ -10,6 +11,13 @@ namespace {
 constexpr size_t kLeafPoints = 8;
 // Ranges smaller than this are built on the thread that split them.
 constexpr size_t kMinPointsPerThread = 1 << 16;
+
+std::vector<PointKdTree::LeafPoint> LeafPointsOf(absl::Span<const Vec3f> points, uint32_t begin,
+                                                 uint32_t end) {
+  std::vector<PointKdTree::LeafPoint> leaves(end - begin);
+  for (uint32_t i = begin; i < end; ++i) leaves[i - begin] = {points[i], i};
+  return leaves;
+}
 
 }  // namespace
 
@@ -21,12 +29,21 @@ double MeanDistance(NeighbourHeap& heap) {
 }
 
 PointKdTree::PointKdTree(absl::Span<const Vec3f> points, uint32_t begin, uint32_t end, int threads)
-    : begin_(begin), end_(end), leaves_(end - begin) {
+    : PointKdTree(begin, LeafPointsOf(points, begin, end), threads) {}
+
+PointKdTree PointKdTree::FromLeafPoints(std::vector<LeafPoint> points, int threads) {
+  const uint32_t begin = points.empty() ? 0 : points.front().index;
+  return PointKdTree(begin, std::move(points), threads);
+}
+
+PointKdTree::PointKdTree(uint32_t begin, std::vector<LeafPoint> leaves, int threads)
+    : begin_(begin),
+      end_(begin + static_cast<uint32_t>(leaves.size())),
+      leaves_(std::move(leaves)) {
   // The tree's nodes down to the last level that splits (halves round up).
   size_t levels = 0;
   for (size_t range = leaves_.size(); range > kLeafPoints; range = (range + 1) / 2) ++levels;
   splits_.resize((size_t{1} << levels) - 1);
-  for (uint32_t i = begin; i < end; ++i) leaves_[i - begin] = {points[i], i};
   Build(
       0, 0, leaves_.size(),
       threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));

@@ -69,6 +69,12 @@ class PointKdTree {
   // and at most 2 more for the splits.
   PointKdTree(absl::Span<const Vec3f> points, uint32_t begin, uint32_t end, int threads = 1);
 
+  // The tree over `points`, whose indices are consecutive and in order (points[i].index ==
+  // points[0].index + i): over the points of other trees (their leaf_order(), put back in the
+  // order of their indices) without the array they came from. The same tree as the one over
+  // that array.
+  static PointKdTree FromLeafPoints(std::vector<LeafPoint> points, int threads = 1);
+
   uint32_t begin() const { return begin_; }
   uint32_t end() const { return end_; }
   size_t size() const { return end_ - begin_; }
@@ -102,6 +108,9 @@ class PointKdTree {
     // rounds the two sums differently (a fused multiply-add in one of them).
     float CellSquaredDistance() const { return outside.sqrnorm() * (1.0f - 1e-6f); }
   };
+
+  // Over `leaves`, the points of indices [begin, begin + leaves.size()) in that order.
+  PointKdTree(uint32_t begin, std::vector<LeafPoint> leaves, int threads);
 
   // Node `node` splits leaves_[begin, end); its children are nodes 2 node + 1 (the lower half)
   // and 2 node + 2.

@@ -32,7 +32,7 @@ OutlierJudgement StreamingOutlierFilter::Judge(absl::Span<const Vec3f> batch) co
   const size_t k = static_cast<size_t>(options_.neighbours);
   OutlierJudgement judgement;
   judgement.held.assign(m, false);
-  if (m == 0 || points_.size() + m <= k) {
+  if (m == 0 || size_ + m <= k) {
     judgement.still_held_ = held_;
     return judgement;
   }
@@ -70,7 +70,7 @@ OutlierJudgement StreamingOutlierFilter::Judge(absl::Span<const Vec3f> batch) co
   for (const Vec3f& p : batch) box.Extend(Vec3(p));
   std::vector<OutlierJudgement::HeldPoint> still_held;
   for (OutlierJudgement::HeldPoint held : held_) {
-    const Vec3f& q = points_[held.index];
+    const Vec3f& q = held.position;
     // With a margin: the searches measure in floats, the box in doubles.
     if (box.SquaredDistance(Vec3(q)) > 1.0001 * static_cast<double>(held.radius_squared)) {
       still_held.push_back(held);
@@ -95,11 +95,12 @@ OutlierJudgement StreamingOutlierFilter::Judge(absl::Span<const Vec3f> batch) co
     }
   }
   // The batch's own outliers, after the earlier ones: still_held stays in arrival order.
-  const auto first_index = static_cast<uint32_t>(points_.size());
+  const auto first_index = static_cast<uint32_t>(size_);
   for (size_t i = 0; i < m; ++i) {
     if (mean_distance[i] <= limit) continue;
     judgement.held[i] = true;
-    still_held.push_back({first_index + static_cast<uint32_t>(i), radius_squared[i], 0, 0});
+    still_held.push_back(
+        {first_index + static_cast<uint32_t>(i), batch[i], radius_squared[i], 0, 0});
   }
   judgement.still_held_ = std::move(still_held);
   return judgement;
@@ -107,21 +108,30 @@ OutlierJudgement StreamingOutlierFilter::Judge(absl::Span<const Vec3f> batch) co
 
 void StreamingOutlierFilter::Add(absl::Span<const Vec3f> batch, OutlierJudgement judgement) {
   held_ = std::move(judgement.still_held_);
-  const auto begin = static_cast<uint32_t>(points_.size());
-  points_.insert(points_.end(), batch.begin(), batch.end());
-  const auto end = static_cast<uint32_t>(points_.size());
+  const auto begin = static_cast<uint32_t>(size_);
+  const auto end = static_cast<uint32_t>(size_ + batch.size());
   if (end == begin) return;
+  size_ = end;
   // The new points form the newest tree; while the tree before it is at most twice its size,
   // the two are rebuilt as one, so sizes at least double toward the oldest tree.
+  size_t merged = 0;  // Trees, newest first.
   uint32_t first = begin;
-  while (!trees_.empty() && trees_.back().size() <= 2 * static_cast<size_t>(end - first)) {
-    first = trees_.back().begin();
+  while (merged < trees_.size() &&
+         trees_[trees_.size() - 1 - merged].size() <= 2 * static_cast<size_t>(end - first)) {
+    first = trees_[trees_.size() - 1 - merged].begin();
+    ++merged;
+  }
+  // Their points and the batch's, each at its index; each tree goes once its points are out.
+  std::vector<PointKdTree::LeafPoint> points(end - first);
+  for (uint32_t i = begin; i < end; ++i) points[i - first] = {batch[i - begin], i};
+  for (; merged > 0; --merged) {
+    for (const PointKdTree::LeafPoint& point : trees_.back().leaf_order()) {
+      points[point.index - first] = point;
+    }
     trees_.pop_back();
   }
-  trees_.emplace_back(points_, first, end);
-  if (points_.size() - reference_measured_at_ > points_.size() / 16 || reference_.empty()) {
-    MeasureReference();
-  }
+  trees_.push_back(PointKdTree::FromLeafPoints(std::move(points)));
+  if (size_ - reference_measured_at_ > size_ / 16 || reference_.empty()) MeasureReference();
 }
 
 std::vector<uint32_t> StreamingOutlierFilter::DropHeld() {
@@ -133,13 +143,22 @@ std::vector<uint32_t> StreamingOutlierFilter::DropHeld() {
 }
 
 void StreamingOutlierFilter::MeasureReference() {
-  const size_t n = points_.size();
+  const size_t n = size_;
   const size_t count = std::min(n, kReferencePoints);
+  // The points of indices j * n / count, j < count, found in one pass over the trees: index i
+  // is one if the least j with j * n / count >= i gives i (n / count >= 1, so at most one j
+  // does).
+  std::vector<PointKdTree::LeafPoint> chosen(count);
+  for (const PointKdTree& tree : trees_) {
+    for (const PointKdTree::LeafPoint& point : tree.leaf_order()) {
+      const size_t j = (point.index * count + n - 1) / n;
+      if (j < count && j * n / count == point.index) chosen[j] = point;
+    }
+  }
   reference_.resize(count);
   NeighbourHeap heap;
   for (size_t j = 0; j < count; ++j) {
-    const auto index = static_cast<uint32_t>(j * n / count);
-    SearchSeen(points_[index], index, &heap);
+    SearchSeen(chosen[j].position, chosen[j].index, &heap);
     reference_[j] = MeanDistance(heap);
   }
   reference_measured_at_ = n;

@@ -33,7 +33,8 @@
 // The seen points are indexed by a logarithmic forest of static k-d trees (Bentley and Saxe):
 // trees over consecutive ranges of the seen points whose sizes at least double from the
 // newest to the oldest, so adding n points in any batches costs O(n log^2 n) in all and a
-// query O(log^2 n). Memory: about 24 bytes per point seen, 16 more per point held.
+// query O(log^2 n). The trees hold the points (PointKdTree): about 18 bytes per point seen, 16
+// more per point of the trees being merged while a batch is added, and 28 per point held.
 #ifndef NEURALMESH_CORE_ANALYSIS_STREAMING_OUTLIER_FILTER_H_
 #define NEURALMESH_CORE_ANALYSIS_STREAMING_OUTLIER_FILTER_H_
 
@@ -60,11 +61,12 @@ struct OutlierJudgement {
 
  private:
   friend class StreamingOutlierFilter;
-  // A point held back: its arrival index, the squared distance to its k-th nearest neighbour
-  // when last judged, how many points have come closer than that since (up to k/4), and how
-  // many judgements after its arrival it has failed.
+  // A point held back: its arrival index and position, the squared distance to its k-th
+  // nearest neighbour when last judged, how many points have come closer than that since (up
+  // to k/4), and how many judgements after its arrival it has failed.
   struct HeldPoint {
     uint32_t index;
+    Vec3f position;
     float radius_squared;
     uint32_t arrivals;
     uint32_t failures;
@@ -97,7 +99,7 @@ class StreamingOutlierFilter {
   std::vector<uint32_t> DropHeld();
 
   // Points seen so far, and those of them held back now.
-  size_t size() const { return points_.size(); }
+  size_t size() const { return size_; }
   size_t held() const { return held_.size(); }
 
  private:
@@ -110,10 +112,12 @@ class StreamingOutlierFilter {
   void MeasureReference();
 
   OutlierOptions options_;
-  std::vector<Vec3f> points_;         // Seen, in arrival order.
-  std::vector<PointKdTree> trees_;    // Over consecutive ranges of points_, oldest first.
+  size_t size_ = 0;  // Points seen.
+  // Over consecutive ranges of the points seen, in arrival order, oldest first: the only copy
+  // of the points.
+  std::vector<PointKdTree> trees_;
   std::vector<double> reference_;     // Mean neighbour distances of points seen.
-  size_t reference_measured_at_ = 0;  // points_.size() when reference_ was measured.
+  size_t reference_measured_at_ = 0;  // size_ when reference_ was measured.
   std::vector<OutlierJudgement::HeldPoint> held_;  // By arrival index.
 };
 

@@ -151,6 +151,33 @@ TEST(PointKdTreeTest, LeafOrderHoldsEveryPointOfTheRangeOnce) {
   EXPECT_EQ(tree.leaf_order().size(), 600u);
 }
 
+// The points of two trees, put back in the order of their indices, make the tree the array
+// makes: the same leaves, the same answers.
+TEST(PointKdTreeTest, ATreeFromOtherTreesPointsIsTheTreeOfTheirArray) {
+  const std::vector<Vec3f> points = RandomPoints(5000, 8);
+  const PointKdTree low(points, 1000, 3000);
+  const PointKdTree high(points, 3000, 4500);
+  std::vector<PointKdTree::LeafPoint> merged(3500);
+  for (const PointKdTree* tree : {&low, &high}) {
+    for (const PointKdTree::LeafPoint& point : tree->leaf_order()) {
+      merged[point.index - 1000] = point;
+    }
+  }
+  const PointKdTree rebuilt = PointKdTree::FromLeafPoints(std::move(merged));
+  const PointKdTree direct(points, 1000, 4500);
+  EXPECT_EQ(rebuilt.begin(), 1000u);
+  EXPECT_EQ(rebuilt.end(), 4500u);
+  ASSERT_EQ(rebuilt.leaf_order().size(), direct.leaf_order().size());
+  for (size_t i = 0; i < direct.leaf_order().size(); ++i) {
+    ASSERT_EQ(rebuilt.leaf_order()[i].index, direct.leaf_order()[i].index) << i;
+    ASSERT_EQ(rebuilt.leaf_order()[i].position, direct.leaf_order()[i].position) << i;
+  }
+  for (size_t q = 0; q < 50; ++q) {
+    ExpectNearest(points, {&rebuilt}, points[q * 97], static_cast<uint32_t>(q * 97), 16);
+  }
+  EXPECT_EQ(PointKdTree::FromLeafPoints({}).size(), 0u);
+}
+
 TEST(PointKdTreeTest, TheTreeDoesNotDependOnTheThreadsThatBuildIt) {
   const std::vector<Vec3f> points = RandomPoints(300000, 6);
   const PointKdTree one(points, 0, static_cast<uint32_t>(points.size()), 1);

@@ -777,17 +777,14 @@ absl::StatusOr<LazStreamDecoder> LazStreamDecoder::Create(absl::string_view head
 absl::StatusOr<size_t> LazStreamDecoder::DecodeNext(absl::string_view bytes, bool ended,
                                                     std::string* records) {
   if (records_left_ == 0) return 0;
-  if (!table_offset_skipped_) {
-    // The point data start with the chunk table's offset (or -1, for the file's last bytes).
-    if (bytes.size() < 8) {
-      if (!ended) return 0;
-      return Invalid("the stream ends before its chunk table's offset");
-    }
-    table_offset_skipped_ = true;
-    NM_ASSIGN_OR_RETURN(const size_t chunk, DecodeNext(bytes.substr(8), ended, records));
-    if (chunk == 0) table_offset_skipped_ = false;  // Taken again with the chunk.
-    return chunk == 0 ? 0 : chunk + 8;
+  // The point data start with the chunk table's offset (or -1, for the file's last bytes),
+  // taken with the first chunk.
+  const size_t offset_bytes = table_offset_skipped_ ? 0 : 8;
+  if (bytes.size() < offset_bytes) {
+    if (!ended) return 0;
+    return Invalid("the stream ends before its chunk table's offset");
   }
+  bytes.remove_prefix(offset_bytes);
   const uint64_t count = std::min<uint64_t>(chunk_size_, records_left_);
   const size_t at = records->size();
   records->resize(at + count * record_length_);
@@ -810,7 +807,8 @@ absl::StatusOr<size_t> LazStreamDecoder::DecodeNext(absl::string_view bytes, boo
   }
   ++chunks_;
   records_left_ -= count;
-  return coder_->decoded_length();
+  table_offset_skipped_ = true;
+  return offset_bytes + coder_->decoded_length();
 }
 
 absl::StatusOr<std::string> DescribeLazCompression(absl::string_view laz) {

@@ -1,5 +1,6 @@
 #include "core/io/las_cleaning.h"
 
+#include <memory>
 #include <utility>
 
 #include "absl/status/statusor.h"
@@ -8,6 +9,7 @@
 #include "core/io/file_bytes.h"
 #include "core/io/internal/file_util.h"
 #include "core/io/internal/las.h"
+#include "core/io/internal/las_file_writer.h"
 #include "core/io/internal/laz.h"
 #include "core/status_macros.h"
 
@@ -23,26 +25,22 @@ absl::Status NotLas(const std::string& path) {
   return absl::InvalidArgumentError(absl::StrCat("'", path, "' is not a .las or .laz file"));
 }
 
-// The bytes of the LAS file at `source`: the file where it lies (FileBytes; read whole when it
-// is the file `path` names, which writing replaces), or decompressed into `decompressed` when
-// it is LAZ.
-absl::StatusOr<absl::string_view> ReadLas(const std::string& source, const std::string& path,
-                                          FileBytes* bytes, std::string* decompressed) {
-  NM_ASSIGN_OR_RETURN(*bytes, FileBytes::ReadToReplace(source, path));
-  if (!io_internal::IsLaz(bytes->data())) return bytes->data();
-  absl::StatusOr<std::string> las = io_internal::DecompressLaz(bytes->data());
-  if (!las.ok()) return io_internal::WithPath(las.status(), source);
-  *decompressed = *std::move(las);
-  return absl::string_view(*decompressed);
+bool IsLazPath(const std::string& path) { return io_internal::LowercaseExtension(path) == ".laz"; }
+
+// The writer of a LAS file to `out`: compressed when `path` is .laz.
+std::unique_ptr<io_internal::LasFileWriter> LasWriterFor(const std::string& path, ByteSink* out) {
+  if (IsLazPath(path)) return std::make_unique<io_internal::LazWriter>(out);
+  return std::make_unique<io_internal::PlainLasWriter>(out);
 }
 
-// Writes the LAS file `las` to `path`, compressed when `path` is .laz.
-absl::Status WriteLas(const std::string& path, absl::string_view las) {
-  FileSink out(path);
-  NM_RETURN_IF_ERROR(io_internal::LowercaseExtension(path) == ".laz"
-                         ? io_internal::CompressLasTo(las, &out)
-                         : out.Append(las));
-  return out.Close();
+// The LAZ file `laz` compressed again into `out`, its chunks decoded and coded a wave at a time.
+absl::Status RecompressLaz(absl::string_view laz, ByteSink* out) {
+  NM_ASSIGN_OR_RETURN(const io_internal::LazChunks chunks, io_internal::LazChunks::Open(laz));
+  io_internal::LazWriter writer(out);
+  NM_RETURN_IF_ERROR(writer.Start(chunks.las_header()));
+  NM_RETURN_IF_ERROR(chunks.DecodeInOrder(
+      [&](size_t, absl::string_view records) { return writer.AppendRecords(records); }));
+  return writer.Finish(chunks.las_header(), chunks.las_tail());
 }
 
 }  // namespace
@@ -57,7 +55,7 @@ absl::StatusOr<LasCopy> CopyLas(const std::string& source, const std::string& pa
   const absl::string_view data = bytes.data();
   copy.read_bytes = data.size();
   const bool from_laz = io_internal::IsLaz(data);
-  const bool to_laz = io_internal::LowercaseExtension(path) == ".laz";
+  const bool to_laz = IsLazPath(path);
   absl::StatusOr<uint64_t> records;
   if (from_laz) {
     const absl::StatusOr<io_internal::LazChunks> chunks = io_internal::LazChunks::Open(data);
@@ -68,13 +66,11 @@ absl::StatusOr<LasCopy> CopyLas(const std::string& source, const std::string& pa
   if (!records.ok()) return io_internal::WithPath(records.status(), source);
   copy.records = *records;
 
-  // Written a wave of chunks at a time: neither side is held whole, but for LAZ to LAZ, whose
-  // records are decompressed whole to be compressed again.
+  // Written a wave of chunks at a time: neither side is held whole.
   FileSink out(path);
   absl::Status status;
   if (from_laz && to_laz) {
-    absl::StatusOr<std::string> las = io_internal::DecompressLaz(data);
-    status = las.ok() ? io_internal::CompressLasTo(*las, &out) : las.status();
+    status = RecompressLaz(data, &out);
   } else if (from_laz) {
     status = io_internal::DecompressLazTo(data, &out);
   } else if (to_laz) {
@@ -99,22 +95,23 @@ absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
                              const std::vector<bool>& outliers, LasOutlierRecords records,
                              const std::string& path, const PointSelection& selection,
                              LasJoin* join) {
-  // Each file where it lies, or decompressed (LAZ).
+  // Each file where it lies (read whole when it is the one `path` names, which writing
+  // replaces); LAZ files' chunks are decoded as the records are written.
   std::vector<FileBytes> bytes(sources.size());
-  std::vector<std::string> decompressed(sources.size());
   std::vector<io_internal::LasSource> files;
   for (size_t i = 0; i < sources.size(); ++i) {
     if (!IsLasPath(sources[i])) return NotLas(sources[i]);
-    NM_ASSIGN_OR_RETURN(const absl::string_view las,
-                        ReadLas(sources[i], path, &bytes[i], &decompressed[i]));
-    files.push_back({sources[i], las});
+    NM_ASSIGN_OR_RETURN(bytes[i], FileBytes::ReadToReplace(sources[i], path));
+    files.push_back({sources[i], bytes[i].data()});
   }
-  NM_ASSIGN_OR_RETURN(
-      std::string cleaned,
-      io_internal::FormatCleanedLas(files, outliers, records, selection.las_classes, join));
+  FileSink out(path);
+  const std::unique_ptr<io_internal::LasFileWriter> writer = LasWriterFor(path, &out);
+  absl::Status status = io_internal::WriteCleanedLasTo(files, outliers, records,
+                                                       selection.las_classes, join, writer.get());
+  if (status.ok()) status = out.Close();
   // A file that shrank while it was read explains what was read past its new end.
   for (const FileBytes& file : bytes) NM_RETURN_IF_ERROR(file.CheckSize());
-  return WriteLas(path, cleaned);
+  return status;
 }
 
 }  // namespace neuralmesh

@@ -71,7 +71,9 @@ absl::StatusOr<LasCopy> CopyLas(const std::string& source, const std::string& pa
 // ...: FormatCleanedLas) or when `path` is .laz and the records' point format
 // is one LAZ is not written in here (the waveform formats); otherwise the status of the write.
 // Sources may be LAZ (.laz), read as the LAS files they compress; a .laz `path` is written as
-// LAZ (internal/laz.h).
+// LAZ (internal/laz.h). The file is written as its sources are read, a few megabytes of records
+// at a time: an error found before the first records leaves any file at `path` as it was, one
+// found on the way (the flags' count, coordinates that do not fit) leaves no file there.
 absl::Status WriteCleanedLas(const std::vector<std::string>& sources,
                              const std::vector<bool>& outliers, LasOutlierRecords records,
                              const std::string& path, const PointSelection& selection = {},

@@ -17,6 +17,7 @@
 #include "absl/strings/str_join.h"
 #include "core/io/internal/binary.h"
 #include "core/io/internal/file_util.h"
+#include "core/io/internal/las_file_writer.h"
 #include "core/io/internal/las_layout.h"
 #include "core/io/internal/laz.h"
 #include "core/io/internal/position_collector.h"
@@ -194,6 +195,80 @@ std::string InterpretingRecords(absl::string_view data, const LasHeader& header)
 bool IsWaveformFormat(int format) { return format == 4 || format == 5 || format >= 9; }
 bool HasGpsTime(int format) { return format != 0 && format != 2; }
 
+// A LAZ file's chunks and the header of the LAS file they hold, checked as ReadHeader checks
+// that file decompressed (DecompressLaz): for reading its records a chunk at a time.
+struct LazRecords {
+  LazChunks chunks;
+  LasHeader header;
+};
+
+// DecompressLaz's checks of `laz` and its errors, then ReadHeader's of the LAS header it holds.
+// Nothing for a header that says it is longer than the bytes before its records, which only
+// the decompressed file can be checked against.
+absl::StatusOr<std::optional<LazRecords>> OpenLazRecords(absl::string_view laz) {
+  NM_ASSIGN_OR_RETURN(LazChunks chunks, LazChunks::Open(laz));
+  const std::string& las_header = chunks.las_header();
+  if (las_header.size() < kLegacyHeaderSize ||
+      Load<uint16_t>(las_header, kHeaderSize) > las_header.size()) {
+    return std::nullopt;
+  }
+  // The decompressed file's size: its header, records and extended records.
+  const size_t file_size = las_header.size() + chunks.records() * chunks.record_length() +
+                           (chunks.evlr_start() != 0 && chunks.points_end() < laz.size()
+                                ? laz.size() - chunks.points_end()
+                                : 0);
+  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(las_header, file_size));
+  return LazRecords{std::move(chunks), header};
+}
+
+// A file to clean or join: its header, the bytes before and after its records (as in the LAS
+// file a LAZ file compresses), and its records, where the file lies or decoded a chunk at a
+// time (LAZ).
+struct CleaningSource {
+  LasHeader header;
+  absl::string_view head, tail;
+  absl::string_view records;      // LAS.
+  std::optional<LazRecords> laz;  // LAZ.
+  // A LAZ file whose header only the decompressed file can be checked against (OpenLazRecords).
+  std::string decompressed;
+};
+
+// Opens `source` into `out`, with ReadHeader's and DecompressLaz's errors, named.
+absl::Status OpenCleaningSource(const LasSource& source, CleaningSource* out) {
+  absl::string_view data = source.data;
+  if (IsLaz(data)) {
+    absl::StatusOr<std::optional<LazRecords>> laz = OpenLazRecords(data);
+    if (!laz.ok()) return WithPath(laz.status(), source.name);
+    if (laz->has_value()) {
+      out->laz = *std::move(*laz);
+      out->header = out->laz->header;
+      out->head = out->laz->chunks.las_header();
+      out->tail = out->laz->chunks.las_tail();
+      return absl::OkStatus();
+    }
+    absl::StatusOr<std::string> las = DecompressLaz(data);
+    if (!las.ok()) return WithPath(las.status(), source.name);
+    out->decompressed = *std::move(las);
+    data = out->decompressed;
+  }
+  absl::StatusOr<LasHeader> header = ReadHeader(data);
+  if (!header.ok()) return WithPath(header.status(), source.name);
+  out->header = *header;
+  out->head = data.substr(0, header->offset_to_points);
+  out->records = data.substr(header->offset_to_points, header->count * header->record_length);
+  out->tail = data.substr(header->points_end());
+  return absl::OkStatus();
+}
+
+// Gives the records of `source` to `visit` in blocks, in order: LAZ's a chunk at a time
+// (decoded a wave at a time: LazChunks::DecodeInOrder). Its first error, or a chunk's.
+absl::Status ForEachRecordBlock(const CleaningSource& source,
+                                const std::function<absl::Status(absl::string_view)>& visit) {
+  if (!source.laz.has_value()) return visit(source.records);
+  return source.laz->chunks.DecodeInOrder(
+      [&](size_t, absl::string_view records) { return visit(records); });
+}
+
 // How the records of several files are put in one: in the header of the first file of the
 // highest version among them (its variable-length records, offset and what follows its points),
 // as records of the point format that holds every field any of them holds.
@@ -215,20 +290,20 @@ struct JoinLayout {
 // time or adjusted standard GPS time), or waveform packets, to which records point by their
 // place in their own file.
 absl::StatusOr<JoinLayout> PlanJoin(const std::vector<LasSource>& sources,
-                                    const std::vector<LasHeader>& headers) {
-  const LasHeader& first = headers.front();
+                                    const std::vector<CleaningSource>& opened) {
+  const LasHeader& first = opened.front().header;
   const std::string a = absl::StrCat("'", sources.front().name, "'");
   JoinLayout join;
   join.extra_bytes = first.record_length - kFormats[first.format].length;
-  const absl::string_view first_after = sources.front().data.substr(first.points_end());
-  const std::string first_interpreting = InterpretingRecords(sources.front().data, first);
+  const absl::string_view first_after = opened.front().tail;
+  const std::string first_interpreting = InterpretingRecords(opened.front().head, first);
   bool extended = false, gps_time = false, rgb = false, near_infrared = false;
   // The kind of GPS time of the first file that holds one, and that file.
   std::optional<std::pair<bool, size_t>> time_kind;
   for (size_t s = 0; s < sources.size(); ++s) {
-    const LasHeader& header = headers[s];
+    const LasHeader& header = opened[s].header;
     const std::string b = absl::StrCat("'", sources[s].name, "'");
-    const absl::string_view data = sources[s].data;
+    const absl::string_view head = opened[s].head;
     if (sources.size() > 1 && IsWaveformFormat(header.format)) {
       return absl::FailedPreconditionError(
           absl::StrCat("the records of ", b, " (point format ", int{header.format},
@@ -239,16 +314,16 @@ absl::StatusOr<JoinLayout> PlanJoin(const std::vector<LasSource>& sources,
       return absl::FailedPreconditionError(
           absl::StrCat(b, " has ", extra, " extra bytes a record and ", a, " ", join.extra_bytes));
     }
-    if (InterpretingRecords(data, header) != first_interpreting) {
+    if (InterpretingRecords(head, header) != first_interpreting) {
       return absl::FailedPreconditionError(
           absl::StrCat("the coordinate systems or extra bytes of ", b, " and ", a, " differ"));
     }
-    if (data.substr(header.points_end()) != first_after) {
+    if (opened[s].tail != first_after) {
       return absl::FailedPreconditionError(absl::StrCat("what follows the points of ", b, " and ",
                                                         a, " (extended records) differs"));
     }
     if (HasGpsTime(header.format)) {
-      const bool standard = (Load<uint16_t>(data, kGlobalEncoding) & 1) != 0;
+      const bool standard = (Load<uint16_t>(head, kGlobalEncoding) & 1) != 0;
       if (!time_kind.has_value()) {
         time_kind = {standard, s};
       } else if (time_kind->first != standard) {
@@ -260,7 +335,7 @@ absl::StatusOr<JoinLayout> PlanJoin(const std::vector<LasSource>& sources,
                                                           kind(!standard)));
       }
     }
-    if (header.minor > headers[join.base].minor) join.base = s;
+    if (header.minor > opened[join.base].header.minor) join.base = s;
     extended = extended || header.format >= 6;
     gps_time = gps_time || HasGpsTime(header.format);
     rgb = rgb || kFormats[header.format].rgb != 0;
@@ -368,32 +443,6 @@ absl::Status NothingKept(uint64_t count, const PointsLeftOut& left_out,
       "all ", count, " points are withheld (", left_out.withheld, ") or ",
       classes.has_value() ? absl::StrCat("of classes not asked for (", left_out.other_class, ")")
                           : absl::StrCat("classified as noise (", left_out.noise, ")")));
-}
-
-// A LAZ file's chunks and the header of the LAS file they hold, checked as ReadHeader checks
-// that file decompressed (DecompressLaz): for reading its records a chunk at a time.
-struct LazRecords {
-  LazChunks chunks;
-  LasHeader header;
-};
-
-// DecompressLaz's checks of `laz` and its errors, then ReadHeader's of the LAS header it holds.
-// Nothing for a header that says it is longer than the bytes before its records, which only
-// the decompressed file can be checked against.
-absl::StatusOr<std::optional<LazRecords>> OpenLazRecords(absl::string_view laz) {
-  NM_ASSIGN_OR_RETURN(LazChunks chunks, LazChunks::Open(laz));
-  const std::string& las_header = chunks.las_header();
-  if (las_header.size() < kLegacyHeaderSize ||
-      Load<uint16_t>(las_header, kHeaderSize) > las_header.size()) {
-    return std::nullopt;
-  }
-  // The decompressed file's size: its header, records and extended records.
-  const size_t file_size = las_header.size() + chunks.records() * chunks.record_length() +
-                           (chunks.evlr_start() != 0 && chunks.points_end() < laz.size()
-                                ? laz.size() - chunks.points_end()
-                                : 0);
-  NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(las_header, file_size));
-  return LazRecords{std::move(chunks), header};
 }
 
 // The points of consecutive blocks of a LAS file's records (a file's whole block, or a LAZ
@@ -768,97 +817,105 @@ absl::StatusOr<std::string> FormatLas(const GeometryView& points) {
   return out;
 }
 
-absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sources,
-                                             const std::vector<bool>& outliers,
-                                             LasOutlierRecords records,
-                                             const std::optional<LasClasses>& classes,
-                                             LasJoin* joined) {
+absl::Status WriteCleanedLasTo(const std::vector<LasSource>& sources,
+                               const std::vector<bool>& outliers, LasOutlierRecords records,
+                               const std::optional<LasClasses>& classes, LasJoin* joined,
+                               LasFileWriter* writer) {
   if (sources.empty()) return Invalid("no file to clean");
-  std::vector<LasHeader> headers;
-  for (const LasSource& source : sources) {
-    absl::StatusOr<LasHeader> header = ReadHeader(source.data);
-    if (!header.ok()) return WithPath(header.status(), source.name);
-    headers.push_back(*header);
+  // Constructed in place: a source's views may point into its own decompressed bytes.
+  std::vector<CleaningSource> opened(sources.size());
+  for (size_t s = 0; s < sources.size(); ++s) {
+    NM_RETURN_IF_ERROR(OpenCleaningSource(sources[s], &opened[s]));
   }
-  NM_ASSIGN_OR_RETURN(const JoinLayout join, PlanJoin(sources, headers));
-  const LasHeader& first = headers[join.base];
+  NM_ASSIGN_OR_RETURN(const JoinLayout join, PlanJoin(sources, opened));
+  const LasHeader& first = opened[join.base].header;
+  const absl::string_view first_head = opened[join.base].head;
   // Each axis's finest scale among the files, so that no record loses resolution, from the
   // first file's offset.
   Point3d scale = first.scale;
-  for (const LasHeader& header : headers) {
+  for (const CleaningSource& source : opened) {
     for (int c = 0; c < 3; ++c) {
-      if (std::fabs(header.scale[c]) < std::fabs(scale[c])) scale[c] = header.scale[c];
+      if (std::fabs(source.header.scale[c]) < std::fabs(scale[c]))
+        scale[c] = source.header.scale[c];
     }
   }
   const bool as_noise = records == LasOutlierRecords::kClassifiedAsNoise;
 
-  const absl::string_view first_data = sources[join.base].data;
-  std::string out(first_data.substr(0, first.offset_to_points));
-  out[kPointFormat] = static_cast<char>(join.format);
+  std::string head(first_head);
+  head[kPointFormat] = static_cast<char>(join.format);
   if (join.standard_gps_time.has_value()) {  // Of the files' times, whichever file has them.
-    const uint16_t encoding = Load<uint16_t>(out, kGlobalEncoding);
+    const uint16_t encoding = Load<uint16_t>(head, kGlobalEncoding);
     StoreLittleEndian(static_cast<uint16_t>((encoding & ~1u) | *join.standard_gps_time),
-                      kGlobalEncoding, &out);
+                      kGlobalEncoding, &head);
   }
-  StoreLittleEndian(static_cast<uint16_t>(join.record_length), kRecordLength, &out);
-  size_t total_size = 0;
-  for (const LasSource& source : sources) total_size += source.data.size();
-  out.reserve(total_size);
+  StoreLittleEndian(static_cast<uint16_t>(join.record_length), kRecordLength, &head);
+  NM_RETURN_IF_ERROR(writer->Start(head));
+
+  // The records kept, given to the writer a block of about kBlockBytes at a time.
+  constexpr size_t kBlockBytes = size_t{1} << 22;
+  std::string block;
   Point3d low = {INFINITY, INFINITY, INFINITY}, high = {-INFINITY, -INFINITY, -INFINITY};
   uint64_t by_return[16] = {};
   uint64_t written = 0;
   size_t usable = 0;  // The points ParseLas reads, over every file.
   for (size_t s = 0; s < sources.size(); ++s) {
-    const absl::string_view data = sources[s].data;
-    const LasHeader& header = headers[s];
+    const LasHeader& header = opened[s].header;
     const bool same_grid = header.scale == scale && header.offset == first.offset;
-    for (uint64_t i = 0; i < header.count; ++i) {
-      const size_t at = header.record(i);
-      bool outlier = false;
-      if (Usability(data, at, header.format, classes) == kUsable) {
-        outlier = usable < outliers.size() && outliers[usable];
-        ++usable;
-        if (outlier && !as_noise) continue;
-      } else if (!as_noise) {
-        continue;
-      }
-      const size_t put = out.size();
-      if (header.format == join.format) {
-        out.append(data.data() + at, header.record_length);
-      } else {
-        const absl::string_view record = data.substr(at, header.record_length);
-        AppendRecordFields(ReadRecordFields(record, header.format), join.format, &out);
-        absl::StrAppend(&out, record.substr(record.size() - join.extra_bytes));
-      }
-      if (outlier) {
-        if (join.format >= 6) {
-          out[put + 16] = static_cast<char>(kLowNoiseClass);
-        } else {  // The class in the low five bits; the top three are flags.
-          out[put + 15] =
-              static_cast<char>((static_cast<uint8_t>(out[put + 15]) & 0xE0) | kLowNoiseClass);
+    NM_RETURN_IF_ERROR(ForEachRecordBlock(opened[s], [&](absl::string_view data) {
+      for (size_t at = 0; at + header.record_length <= data.size(); at += header.record_length) {
+        bool outlier = false;
+        if (Usability(data, at, header.format, classes) == kUsable) {
+          outlier = usable < outliers.size() && outliers[usable];
+          ++usable;
+          if (outlier && !as_noise) continue;
+        } else if (!as_noise) {
+          continue;
         }
-      }
-      for (int c = 0; c < 3; ++c) {
-        double coordinate = header.Coordinate(data, at, c);
-        if (!same_grid) {  // Onto the joined file's scale and offset.
-          const double stored = std::round((coordinate - first.offset[c]) / scale[c]);
-          if (!(stored >= std::numeric_limits<int32_t>::min() &&
-                stored <= std::numeric_limits<int32_t>::max())) {
-            return absl::FailedPreconditionError(absl::StrCat(
-                "the coordinates of '", sources[s].name,
-                "' do not fit LAS's 32-bit integers at the offset of '", sources[join.base].name,
-                "' and the scale ", scale[c], " of axis ", absl::string_view("xyz").substr(c, 1)));
+        const size_t put = block.size();
+        if (header.format == join.format) {
+          block.append(data.data() + at, header.record_length);
+        } else {
+          const absl::string_view record = data.substr(at, header.record_length);
+          AppendRecordFields(ReadRecordFields(record, header.format), join.format, &block);
+          absl::StrAppend(&block, record.substr(record.size() - join.extra_bytes));
+        }
+        if (outlier) {
+          if (join.format >= 6) {
+            block[put + 16] = static_cast<char>(kLowNoiseClass);
+          } else {  // The class in the low five bits; the top three are flags.
+            block[put + 15] =
+                static_cast<char>((static_cast<uint8_t>(block[put + 15]) & 0xE0) | kLowNoiseClass);
           }
-          StoreLittleEndian(static_cast<int32_t>(stored), put + 4 * c, &out);
-          coordinate = stored * scale[c] + first.offset[c];
         }
-        low[c] = std::min(low[c], coordinate);
-        high[c] = std::max(high[c], coordinate);
+        for (int c = 0; c < 3; ++c) {
+          double coordinate = header.Coordinate(data, at, c);
+          if (!same_grid) {  // Onto the joined file's scale and offset.
+            const double stored = std::round((coordinate - first.offset[c]) / scale[c]);
+            if (!(stored >= std::numeric_limits<int32_t>::min() &&
+                  stored <= std::numeric_limits<int32_t>::max())) {
+              return absl::FailedPreconditionError(
+                  absl::StrCat("the coordinates of '", sources[s].name,
+                               "' do not fit LAS's 32-bit integers at the offset of '",
+                               sources[join.base].name, "' and the scale ", scale[c], " of axis ",
+                               absl::string_view("xyz").substr(c, 1)));
+            }
+            StoreLittleEndian(static_cast<int32_t>(stored), put + 4 * c, &block);
+            coordinate = stored * scale[c] + first.offset[c];
+          }
+          low[c] = std::min(low[c], coordinate);
+          high[c] = std::max(high[c], coordinate);
+        }
+        ++by_return[ReturnNumber(block, put, join.format)];
+        ++written;
+        if (block.size() >= kBlockBytes) {
+          NM_RETURN_IF_ERROR(writer->AppendRecords(block));
+          block.clear();
+        }
       }
-      ++by_return[ReturnNumber(out, put, join.format)];
-      ++written;
-    }
+      return absl::OkStatus();
+    }));
   }
+  NM_RETURN_IF_ERROR(writer->AppendRecords(block));
   const auto names = [&sources] {
     return absl::StrJoin(sources, ", ", [](std::string* out, const LasSource& source) {
       absl::StrAppend(out, "'", source.name, "'");
@@ -880,45 +937,56 @@ absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sourc
 
   // LAS 1.3's waveform packets and LAS 1.4's extended records, after the points, move with
   // their end.
-  const size_t points_end = out.size();
-  out.append(first_data.data() + first.points_end(), first_data.size() - first.points_end());
+  const size_t points_end = head.size() + written * join.record_length;
   const auto move_start = [&](size_t field) {
-    const uint64_t start = Load<uint64_t>(first_data, field);
+    const uint64_t start = Load<uint64_t>(first_head, field);
     if (start >= first.points_end()) {
-      StoreLittleEndian<uint64_t>(start - first.points_end() + points_end, field, &out);
+      StoreLittleEndian<uint64_t>(start - first.points_end() + points_end, field, &head);
     }
   };
   if (first.minor >= 3 && first.header_size >= kHeaderSize13) move_start(kWaveformStart);
   if (extended_counts) {
     move_start(kEvlrStart);
-    StoreLittleEndian<uint64_t>(written, kPointCount, &out);
+    StoreLittleEndian<uint64_t>(written, kPointCount, &head);
     for (int r = 1; r <= 15; ++r) {
-      StoreLittleEndian<uint64_t>(by_return[r], kByReturn14 + 8 * (r - 1), &out);
+      StoreLittleEndian<uint64_t>(by_return[r], kByReturn14 + 8 * (r - 1), &head);
     }
   }
   // The legacy counts stay zero where the file left them so (LAS 1.4 with formats 6-10, or
   // more points than they hold), and become so beyond what they hold or for records joined
   // into formats 6-10.
-  if (!extended_counts || Load<uint32_t>(first_data, kLegacyPointCount) != 0) {
+  if (!extended_counts || Load<uint32_t>(first_head, kLegacyPointCount) != 0) {
     const bool fits = written <= kLegacyMax && join.format < 6;
-    StoreLittleEndian(static_cast<uint32_t>(fits ? written : 0), kLegacyPointCount, &out);
+    StoreLittleEndian(static_cast<uint32_t>(fits ? written : 0), kLegacyPointCount, &head);
     for (int r = 1; r <= 5; ++r) {
       StoreLittleEndian(static_cast<uint32_t>(fits ? by_return[r] : 0),
-                        kLegacyByReturn + 4 * (r - 1), &out);
+                        kLegacyByReturn + 4 * (r - 1), &head);
     }
   }
   for (int c = 0; c < 3; ++c) {
-    StoreLittleEndian(scale[c], kScale + 8 * c, &out);
-    StoreLittleEndian(written > 0 ? high[c] : 0.0, kBounds + 16 * c, &out);
-    StoreLittleEndian(written > 0 ? low[c] : 0.0, kBounds + 16 * c + 8, &out);
+    StoreLittleEndian(scale[c], kScale + 8 * c, &head);
+    StoreLittleEndian(written > 0 ? high[c] : 0.0, kBounds + 16 * c, &head);
+    StoreLittleEndian(written > 0 ? low[c] : 0.0, kBounds + 16 * c + 8, &head);
   }
-  SetGeneratingSoftware(&out);
+  SetGeneratingSoftware(&head);
   if (joined != nullptr) {
     *joined = {join.base, first.minor, join.format,
-               std::any_of(headers.begin(), headers.end(),
-                           [&](const LasHeader& header) { return header.format != join.format; })};
+               std::any_of(opened.begin(), opened.end(), [&](const CleaningSource& source) {
+                 return source.header.format != join.format;
+               })};
   }
-  return out;
+  return writer->Finish(head, opened[join.base].tail);
+}
+
+absl::StatusOr<std::string> FormatCleanedLas(const std::vector<LasSource>& sources,
+                                             const std::vector<bool>& outliers,
+                                             LasOutlierRecords records,
+                                             const std::optional<LasClasses>& classes,
+                                             LasJoin* join) {
+  StringSink out;
+  PlainLasWriter writer(&out);
+  NM_RETURN_IF_ERROR(WriteCleanedLasTo(sources, outliers, records, classes, join, &writer));
+  return std::move(out.bytes());
 }
 
 }  // namespace neuralmesh::io_internal

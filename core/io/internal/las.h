@@ -12,6 +12,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/internal/geometry_data.h"
+#include "core/io/internal/las_file_writer.h"
 #include "core/io/internal/point_records.h"
 #include "core/io/internal/position_collector.h"
 #include "core/io/las_cleaning.h"
@@ -101,15 +102,17 @@ absl::StatusOr<LasDescription> DescribeLas(absl::string_view data);
 // Returns INVALID_ARGUMENT for more points than LAS 1.2 counts (2^32 - 1).
 absl::StatusOr<std::string> FormatLas(const GeometryView& points);
 
-// A LAS file's bytes, and the name by which messages speak of it.
+// A LAS or LAZ file's bytes, and the name by which messages speak of it.
 struct LasSource {
   std::string name;
   absl::string_view data;
 };
 
-// The LAS files `sources` (ParseLas reads each) as one file without their outliers, or with
-// them classified as noise: `outliers` holds one flag per point ParseLas returns with
-// `classes`, file after file, in their order.
+// Writes to `writer` the LAS files `sources` (ParseLas reads each) as one file without their
+// outliers, or with them classified as noise: `outliers` holds one flag per point ParseLas
+// returns with `classes`, file after file, in their order. Neither side is held whole: a LAZ
+// file's records are decoded a wave of chunks at a time, and the records kept go to `writer` a
+// few megabytes at a time.
 //   kLeftOut: the outliers' records are left out, and so are the withheld, noise and other
 //     classes' records that ParseLas leaves out.
 //   kClassifiedAsNoise: every record is kept, the outliers' classified as low noise (ASPRS
@@ -135,7 +138,14 @@ struct LasSource {
 // saying why, when the records of several files cannot be put in one file: other extra bytes,
 // coordinate system or extended records than the first's, records that point to waveform
 // data, coordinates that do not fit 32 bits at the joined scale and offset, or more points
-// than the version counts.
+// than the version counts; `writer`'s errors (LazWriter's FAILED_PRECONDITION for a point
+// format LAZ is not written in, before anything is written). The errors of the flags, of
+// coordinates that do not fit and of a corrupt LAZ chunk come once records have been written.
+absl::Status WriteCleanedLasTo(const std::vector<LasSource>& sources,
+                               const std::vector<bool>& outliers, LasOutlierRecords records,
+                               const std::optional<LasClasses>& classes, LasJoin* join,
+                               LasFileWriter* writer);
+// The same file, as LAS bytes.
 absl::StatusOr<std::string> FormatCleanedLas(
     const std::vector<LasSource>& sources, const std::vector<bool>& outliers,
     LasOutlierRecords records, const std::optional<LasClasses>& classes = std::nullopt,

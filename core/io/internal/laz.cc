@@ -657,6 +657,11 @@ absl::StatusOr<LazChunks> LazChunks::Open(absl::string_view laz) {
   out.compressed_ = compressed;
 
   out.las_header_ = DecompressedLasHeader(laz, laz_header);
+  // The extended records follow the records in the LAS file.
+  if (!out.las_tail().empty()) {
+    SetUint64(out.las_header_.size() + out.records_ * out.record_length_, kEvlrStart,
+              &out.las_header_);
+  }
   return out;
 }
 
@@ -673,26 +678,10 @@ absl::Status LazChunks::Decode(size_t first, size_t last, char* out) const {
   return absl::OkStatus();
 }
 
-namespace {
-
-// What DecompressLaz's output holds before the records: the LAS header, its extended records'
-// offset set to where they will follow the records.
-std::string DecompressedHeader(const LazChunks& chunks, absl::string_view laz) {
-  std::string header = chunks.las_header();
-  if (chunks.evlr_start() != 0 && chunks.points_end() < laz.size()) {
-    SetUint64(header.size() + chunks.records() * chunks.record_length(), kEvlrStart, &header);
-  }
-  return header;
+absl::string_view LazChunks::las_tail() const {
+  return evlr_start_ != 0 && points_end_ < laz_.size() ? laz_.substr(points_end_)
+                                                       : absl::string_view();
 }
-
-// What follows the records in DecompressLaz's output: the extended records.
-absl::string_view DecompressedTail(const LazChunks& chunks, absl::string_view laz) {
-  return chunks.evlr_start() != 0 && chunks.points_end() < laz.size()
-             ? laz.substr(chunks.points_end())
-             : absl::string_view();
-}
-
-}  // namespace
 
 absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOptions& options) {
   NM_ASSIGN_OR_RETURN(const LazChunks chunks, LazChunks::Open(laz));
@@ -701,7 +690,7 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOp
   las.reserve(chunks.las_header().size() +
               std::min(chunks.records() * record_length,
                        kReservedExpansion * chunks.compressed_bytes() + (uint64_t{1} << 20)));
-  las.append(DecompressedHeader(chunks, laz));
+  las.append(chunks.las_header());
   // The chunks in waves of a few per thread, each thread decoding a run of them; the output
   // grows wave by wave.
   const size_t wave = kChunksPerThread * ThreadCount(options.threads);
@@ -719,16 +708,16 @@ absl::StatusOr<std::string> DecompressLaz(absl::string_view laz, const LazReadOp
     });
     for (size_t i = begin; i < end; ++i) NM_RETURN_IF_ERROR(statuses[i]);
   }
-  absl::StrAppend(&las, DecompressedTail(chunks, laz));
+  absl::StrAppend(&las, chunks.las_tail());
   return las;
 }
 
 absl::Status DecompressLazTo(absl::string_view laz, ByteSink* out, const LazReadOptions& options) {
   NM_ASSIGN_OR_RETURN(const LazChunks chunks, LazChunks::Open(laz));
-  NM_RETURN_IF_ERROR(out->Append(DecompressedHeader(chunks, laz)));
+  NM_RETURN_IF_ERROR(out->Append(chunks.las_header()));
   NM_RETURN_IF_ERROR(chunks.DecodeInOrder(
       [&](size_t, absl::string_view records) { return out->Append(records); }, options.threads));
-  return out->Append(DecompressedTail(chunks, laz));
+  return out->Append(chunks.las_tail());
 }
 
 absl::Status LazChunks::DecodeInOrder(
@@ -831,42 +820,13 @@ absl::StatusOr<std::string> DescribeLazCompression(absl::string_view laz) {
           : absl::StrCat("up to ", compression.chunk_size, " records"));
 }
 
-absl::Status CompressLasTo(absl::string_view las, ByteSink* out, const LazWriteOptions& options) {
+absl::StatusOr<std::string> LazWriter::LazHead(absl::string_view las) const {
   NM_ASSIGN_OR_RETURN(const Header header, ReadHeader(las, "LAS"));
-  if ((header.format_byte & kCompressedBits) != 0) {
-    return absl::InvalidArgumentError("LAS: the points are compressed already (LAZ)");
-  }
-  if (header.format_byte > 8 || header.format_byte == 4 || header.format_byte == 5) {
-    return absl::FailedPreconditionError(
-        absl::StrCat("LAZ: writing point format ", int{header.format_byte},
-                     " (waveform packets) is not supported (formats 0 to 3 and 6 to 8 are); "
-                     "write .las"));
-  }
-  const int format = header.format_byte;
-  if (header.record_length < kBaseLength[format]) {
-    return absl::InvalidArgumentError(absl::StrCat("LAS: records of ", header.record_length,
-                                                   " bytes are shorter than format ", format, "'s ",
-                                                   kBaseLength[format]));
-  }
-  if (header.count > (las.size() - header.offset_to_points) / header.record_length) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "LAS: ", header.count, " points of ", header.record_length, " bytes from byte ",
-        header.offset_to_points, " do not fit in the file's ", las.size(), " bytes"));
-  }
-  if (options.chunk_size == 0) return absl::InvalidArgumentError("LAZ: a chunk size of 0");
-  if (options.layered_version != 3 && options.layered_version != 4) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("LAZ: item version ", options.layered_version, " is not 3 or 4"));
-  }
   NM_ASSIGN_OR_RETURN(const std::vector<Vlr> vlrs, ReadVlrs(las, header, "LAS"));
   const size_t vlrs_end = vlrs.empty() ? header.header_size : vlrs.back().end();
-  const size_t points_end = header.offset_to_points + header.count * header.record_length;
 
   // The LASzip record, after the others (padding before the points stays after it).
-  const bool layered = IsLayered(format);
-  const uint16_t version = layered ? options.layered_version : kPointwiseVersion;
-  const std::vector<Item> items =
-      ItemsOf(format, header.record_length - kBaseLength[format], version);
+  const std::vector<Item> items = ItemsOf(format_, record_length_ - kBaseLength[format_], version_);
   std::string record(kVlrHeaderSize, '\0');
   record.replace(kVlrUser, kLaszipUser.size(), kLaszipUser.data(), kLaszipUser.size());
   StoreLittleEndian(kLaszipRecordId, kVlrRecordId, &record);
@@ -874,12 +834,13 @@ absl::Status CompressLasTo(absl::string_view las, ByteSink* out, const LazWriteO
                     kVlrLength, &record);
   constexpr absl::string_view kDescription = "LAZ written by neuralmesh";
   record.replace(kVlrLength + 2, kDescription.size(), kDescription.data(), kDescription.size());
+  const bool layered = IsLayered(format_);
   AppendLittleEndian(layered ? kCompressorLayeredChunked : kCompressorPointwiseChunked, &record);
   AppendLittleEndian(uint16_t{0}, &record);  // The arithmetic coder.
   // The LASzip version whose format this is: 2.2 (revision 0), or 3.4 (revision 3).
   record.append(layered ? std::string({3, 4, 3, 0}) : std::string({2, 2, 0, 0}));
   AppendLittleEndian(uint32_t{0}, &record);  // Options.
-  AppendLittleEndian(options.chunk_size, &record);
+  AppendLittleEndian(options_.chunk_size, &record);
   AppendLittleEndian(int64_t{-1}, &record);  // No special extended records.
   AppendLittleEndian(int64_t{-1}, &record);
   AppendLittleEndian(static_cast<uint16_t>(items.size()), &record);
@@ -889,8 +850,7 @@ absl::Status CompressLasTo(absl::string_view las, ByteSink* out, const LazWriteO
     AppendLittleEndian(item.version, &record);
   }
 
-  // The header, the variable-length records and the chunk table's offset, which is patched in
-  // once the chunks are written.
+  // The header, the variable-length records and the chunk table's offset.
   std::string head;
   absl::StrAppend(&head, las.substr(0, vlrs_end));
   head.append(record);
@@ -898,58 +858,138 @@ absl::Status CompressLasTo(absl::string_view las, ByteSink* out, const LazWriteO
   head[kPointFormat] = static_cast<char>(header.format_byte | 0x80);
   SetUint32(header.vlr_count + 1, kVlrCount, &head);
   SetUint32(static_cast<uint32_t>(head.size()), kOffsetToPoints, &head);
-  const size_t table_offset_at = head.size();
   head.append(8, '\0');
-  const size_t start = out->size();  // Offsets count from the file's first byte.
-  NM_RETURN_IF_ERROR(out->Append(head));
+  return head;
+}
 
-  const uint8_t* records = reinterpret_cast<const uint8_t*>(las.data() + header.offset_to_points);
-  // The chunks in waves of a few per thread, each coded into a string of its own by the thread
-  // that takes it, then appended in order.
-  const uint64_t chunk_count = (header.count + options.chunk_size - 1) / options.chunk_size;
-  const size_t wave = kChunksPerThread * ThreadCount(options.threads);
-  std::vector<uint32_t> chunk_sizes;
-  std::vector<std::string> coded(std::min<uint64_t>(wave, chunk_count));
-  for (uint64_t begin = 0; begin < chunk_count; begin += wave) {
-    const uint64_t end = std::min<uint64_t>(chunk_count, begin + wave);
-    ForEachRange(end - begin, options.threads, 1, [&](size_t first, size_t last) {
-      const std::unique_ptr<ChunkCoder> coder =
-          MakeChunkCoder(format, header.record_length, version);
-      for (uint64_t i = begin + first; i < begin + last; ++i) {
-        const uint64_t from = i * options.chunk_size;
-        const uint64_t to = std::min<uint64_t>(header.count, from + options.chunk_size);
-        std::string& chunk = coded[i - begin];
-        chunk.clear();
-        coder->Encode(records + from * header.record_length, to - from, &chunk);
-      }
-    });
-    for (uint64_t i = begin; i < end; ++i) {
-      chunk_sizes.push_back(static_cast<uint32_t>(coded[i - begin].size()));
-      NM_RETURN_IF_ERROR(out->Append(coded[i - begin]));
-    }
+absl::Status LazWriter::Start(absl::string_view head) {
+  NM_RETURN_IF_ERROR(CheckLasHead(head));
+  NM_ASSIGN_OR_RETURN(const Header header, ReadHeader(head, "LAS"));
+  if ((header.format_byte & kCompressedBits) != 0) {
+    return absl::InvalidArgumentError("LAS: the points are compressed already (LAZ)");
   }
+  if (header.format_byte > 8 || header.format_byte == 4 || header.format_byte == 5) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("LAZ: writing point format ", int{header.format_byte},
+                     " (waveform packets) is not supported (formats 0 to 3 and 6 to 8 are); "
+                     "write .las"));
+  }
+  format_ = header.format_byte;
+  record_length_ = header.record_length;
+  if (record_length_ < kBaseLength[format_]) {
+    return absl::InvalidArgumentError(absl::StrCat("LAS: records of ", record_length_,
+                                                   " bytes are shorter than format ", format_,
+                                                   "'s ", kBaseLength[format_]));
+  }
+  if (options_.chunk_size == 0) return absl::InvalidArgumentError("LAZ: a chunk size of 0");
+  if (options_.layered_version != 3 && options_.layered_version != 4) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("LAZ: item version ", options_.layered_version, " is not 3 or 4"));
+  }
+  version_ = IsLayered(format_) ? options_.layered_version : kPointwiseVersion;
+  NM_ASSIGN_OR_RETURN(laz_head_, LazHead(head));
+  started_ = std::string(head);
+  wave_records_ = uint64_t{kChunksPerThread} * ThreadCount(options_.threads) * options_.chunk_size;
+  return absl::OkStatus();
+}
 
-  const uint64_t table_at = out->size() - start;
-  SetUint64(table_at, table_offset_at, &head);
+absl::Status LazWriter::CodeChunks(const char* records, uint64_t count) {
+  // Each thread codes a run of the chunks into strings of their own, with coders of its own.
+  const uint64_t chunk_count = (count + options_.chunk_size - 1) / options_.chunk_size;
+  if (coded_.size() < chunk_count) coded_.resize(chunk_count);
+  const uint8_t* bytes = reinterpret_cast<const uint8_t*>(records);
+  ForEachRange(chunk_count, options_.threads, 1, [&](size_t first, size_t last) {
+    const std::unique_ptr<ChunkCoder> coder = MakeChunkCoder(format_, record_length_, version_);
+    for (size_t i = first; i < last; ++i) {
+      const uint64_t from = i * options_.chunk_size;
+      const uint64_t to = std::min<uint64_t>(count, from + options_.chunk_size);
+      coded_[i].clear();
+      coder->Encode(bytes + from * record_length_, to - from, &coded_[i]);
+    }
+  });
+  for (size_t i = 0; i < chunk_count; ++i) {
+    chunk_sizes_.push_back(static_cast<uint32_t>(coded_[i].size()));
+    NM_RETURN_IF_ERROR(out_->Append(coded_[i]));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status LazWriter::AppendRecords(absl::string_view records) {
+  if (records.size() % record_length_ != 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "LAS: ", records.size(), " bytes are not records of ", record_length_, " bytes"));
+  }
+  NM_RETURN_IF_ERROR(WriteHeadOnce(laz_head_));
+  appended_ += records.size() / record_length_;
+  const size_t wave_bytes = wave_records_ * record_length_;
+  if (!pending_.empty()) {  // Completed first.
+    const size_t taken = std::min(records.size(), wave_bytes - pending_.size());
+    absl::StrAppend(&pending_, records.substr(0, taken));
+    records.remove_prefix(taken);
+    if (pending_.size() < wave_bytes) return absl::OkStatus();
+    NM_RETURN_IF_ERROR(CodeChunks(pending_.data(), wave_records_));
+    pending_.clear();
+  }
+  // Whole waves coded where they lie; the rest kept for the next records.
+  for (; records.size() >= wave_bytes; records.remove_prefix(wave_bytes)) {
+    NM_RETURN_IF_ERROR(CodeChunks(records.data(), wave_records_));
+  }
+  absl::StrAppend(&pending_, records);
+  return absl::OkStatus();
+}
+
+absl::Status LazWriter::Finish(absl::string_view head, absl::string_view tail) {
+  NM_RETURN_IF_ERROR(CheckFinishingLasHead(head, started_));
+  NM_ASSIGN_OR_RETURN(const Header header, ReadHeader(head, "LAS"));
+  if (header.count != appended_) {
+    return absl::InvalidArgumentError(absl::StrCat("LAS: the head counts ", header.count,
+                                                   " records and ", appended_, " were written"));
+  }
+  NM_RETURN_IF_ERROR(WriteHeadOnce(laz_head_));
+  NM_RETURN_IF_ERROR(CodeChunks(pending_.data(), pending_.size() / record_length_));
+  pending_.clear();
+  pending_.shrink_to_fit();
+  coded_.clear();
+
+  NM_ASSIGN_OR_RETURN(std::string laz_head, LazHead(head));
+  const uint64_t table_at = out_->size() - start_;
+  SetUint64(table_at, laz_head.size() - 8, &laz_head);
   std::string table;
   AppendLittleEndian(uint32_t{0}, &table);  // Version.
-  AppendLittleEndian(static_cast<uint32_t>(chunk_sizes.size()), &table);
-  if (!chunk_sizes.empty()) {
+  AppendLittleEndian(static_cast<uint32_t>(chunk_sizes_.size()), &table);
+  if (!chunk_sizes_.empty()) {
     laz::ArithmeticEncoder encoder(&table);
     laz::IntegerCoder sizes(32, 2);
     uint32_t last = 0;
-    for (const uint32_t size : chunk_sizes) {
+    for (const uint32_t size : chunk_sizes_) {
       sizes.Compress(encoder, static_cast<int32_t>(last), static_cast<int32_t>(size), 1);
       last = size;
     }
     encoder.Done();
   }
-  if (header.evlr_start != 0 && header.evlr_start >= points_end && points_end < las.size()) {
-    SetUint64(table_at + table.size() + (header.evlr_start - points_end), kEvlrStart, &head);
+  const uint64_t points_end = header.offset_to_points + header.count * header.record_length;
+  if (header.evlr_start != 0 && header.evlr_start >= points_end && !tail.empty()) {
+    SetUint64(table_at + table.size() + (header.evlr_start - points_end), kEvlrStart, &laz_head);
   }
-  NM_RETURN_IF_ERROR(out->Append(table));
-  NM_RETURN_IF_ERROR(out->Append(las.substr(points_end)));
-  return out->Patch(start, head);
+  NM_RETURN_IF_ERROR(out_->Append(table));
+  NM_RETURN_IF_ERROR(out_->Append(tail));
+  return out_->Patch(start_, laz_head);
+}
+
+absl::Status CompressLasTo(absl::string_view las, ByteSink* out, const LazWriteOptions& options) {
+  NM_ASSIGN_OR_RETURN(const Header header, ReadHeader(las, "LAS"));
+  const absl::string_view head = las.substr(0, header.offset_to_points);
+  LazWriter writer(out, options);
+  NM_RETURN_IF_ERROR(writer.Start(head));
+  if (header.count > (las.size() - header.offset_to_points) / header.record_length) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "LAS: ", header.count, " points of ", header.record_length, " bytes from byte ",
+        header.offset_to_points, " do not fit in the file's ", las.size(), " bytes"));
+  }
+  const size_t points_end = header.offset_to_points + header.count * header.record_length;
+  NM_RETURN_IF_ERROR(writer.AppendRecords(
+      las.substr(header.offset_to_points, points_end - header.offset_to_points)));
+  return writer.Finish(head, las.substr(points_end));
 }
 
 absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOptions& options) {

@@ -18,6 +18,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/io/byte_sink.h"
+#include "core/io/internal/las_file_writer.h"
 
 namespace neuralmesh::io_internal {
 
@@ -71,8 +72,10 @@ class LazChunks {
   uint64_t first_record(size_t i) const { return chunks_[i].first; }
   uint64_t records() const { return records_; }
   size_t record_length() const { return record_length_; }
-  // The LAS file's header and variable-length records, as DecompressLaz's output begins.
+  // The LAS file's header and variable-length records, as DecompressLaz's output begins, and
+  // what follows its records there (LAS 1.4's extended records).
   const std::string& las_header() const { return las_header_; }
+  absl::string_view las_tail() const;
   // Decodes chunks first to last - 1 (<= size()) into their records' bytes, one chunk's after
   // another's, from `out` on. DecompressLaz's errors for a chunk that cannot be decoded. Safe
   // to call from several threads at once.
@@ -161,15 +164,49 @@ struct LazWriteOptions {
   int threads = 0;
 };
 
+// A LAS file compressed as LAZ as its pieces come (LasFileWriter): the records are coded a wave
+// of chunks at a time (a few per thread), so that no more than a wave's records and chunks are
+// held, and the file is the one CompressLas makes of the LAS file of the same head, records and
+// tail. The chunk table's offset, before the chunks, and the head's counts are patched in by
+// Finish, which needs `out` to take patches.
+class LazWriter final : public LasFileWriter {
+ public:
+  explicit LazWriter(ByteSink* out, const LazWriteOptions& options = {})
+      : LasFileWriter(out), options_(options) {}
+
+  // CompressLas's errors for the head, its point format and the options.
+  absl::Status Start(absl::string_view head) override;
+  absl::Status AppendRecords(absl::string_view records) override;
+  // Also INVALID_ARGUMENT when the head counts other records than were appended.
+  absl::Status Finish(absl::string_view head, absl::string_view tail) override;
+
+ private:
+  // The LAZ file's head for the LAS head `las`: its LASzip record after the others, the point
+  // format's compression bits, and the chunk table's offset after it (zero: patched by Finish).
+  absl::StatusOr<std::string> LazHead(absl::string_view las) const;
+  // Codes `count` records at `records` (a wave at most) in chunks, appended in order.
+  absl::Status CodeChunks(const char* records, uint64_t count);
+  LazWriteOptions options_;
+  std::string started_;   // The LAS head Start took.
+  std::string laz_head_;  // Its LAZ head, appended with the first records.
+  int format_ = 0;
+  size_t record_length_ = 0;
+  uint16_t version_ = 0;
+  uint64_t wave_records_ = 0;
+  uint64_t appended_ = 0;  // Records taken so far.
+  std::string pending_;    // Records of a wave not complete yet.
+  std::vector<std::string> coded_;
+  std::vector<uint32_t> chunk_sizes_;
+};
+
 // `las` compressed as LAZ: what DecompressLaz turns back into `las`, byte for byte.
 // Returns INVALID_ARGUMENT for a malformed LAS file (a header, records or variable-length
 // records that do not fit it), a chunk size of 0 or an item version other than 3 or 4;
 // FAILED_PRECONDITION for the waveform formats 4, 5, 9 and 10, which are not written as LAZ
 // here.
 absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOptions& options = {});
-// The same bytes given to `out` a wave of chunks at a time (the chunk table's offset, before
-// the chunks, patched at the end), so that no more than a wave's chunks are held:
-// CompressLas's errors, or `out`'s first.
+// The same bytes given to `out` a wave of chunks at a time (LazWriter): CompressLas's errors,
+// or `out`'s first.
 absl::Status CompressLasTo(absl::string_view las, ByteSink* out,
                            const LazWriteOptions& options = {});
 

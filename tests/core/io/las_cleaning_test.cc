@@ -566,6 +566,52 @@ TEST(LasCleaningTest, TilesOfOtherVersionsAndFormatsJoinInAFormatHoldingEveryFie
                         "' GPS week time"));
 }
 
+// LAZ tiles are cleaned and joined a chunk at a time, and written a few megabytes of records at
+// a time, compressed or not: the file is the one cleaned from the LAS files they compress, or
+// that file compressed, byte for byte.
+TEST(LasCleaningTest, LazTilesCleanAndJoinAsTheLasFilesTheyCompress) {
+  // LAS 1.4 tiles of format 7 with a coordinate system and an extended record: 130,000 records
+  // of 36 bytes, more than one block of records given to the writer, in chunks of 9,000.
+  testing::LasScan scan = testing::Las14Scan(7, 70000);
+  const std::string las_a = testing::ScanLasFile(scan);
+  scan.records = 60000;
+  scan.seed = 2;
+  const std::string las_b = testing::ScanLasFile(scan);
+  const std::string a = TempPath("lazjoin_a.las"), b = TempPath("lazjoin_b.las");
+  const std::string a_laz = TempPath("lazjoin_a.laz"), b_laz = TempPath("lazjoin_b.laz");
+  WriteBytes(a, las_a);
+  WriteBytes(b, las_b);
+  WriteBytes(a_laz, *io_internal::CompressLas(las_a, {9000}));
+  WriteBytes(b_laz, *io_internal::CompressLas(las_b, {9000}));
+  const absl::StatusOr<PointCloud> points_a = ReadPointCloud(a), points_b = ReadPointCloud(b);
+  ASSERT_TRUE(points_a.ok() && points_b.ok());
+  std::vector<bool> outliers(points_a->size() + points_b->size());
+  for (size_t i = 0; i < outliers.size(); i += 7) outliers[i] = true;
+
+  for (const LasOutlierRecords records :
+       {LasOutlierRecords::kLeftOut, LasOutlierRecords::kClassifiedAsNoise}) {
+    SCOPED_TRACE(records == LasOutlierRecords::kLeftOut ? "left out" : "as noise");
+    const std::string from_las = TempPath("lazjoin_from_las.las");
+    ASSERT_TRUE(WriteCleanedLas({a, b}, outliers, records, from_las).ok());
+    const std::string expected = ReadBytes(from_las);
+    ASSERT_GT(expected.size(), 375u + 100000u * 36u);
+    const std::string expected_laz = *io_internal::CompressLas(expected);
+    for (const std::vector<std::string>& sources :
+         std::vector<std::vector<std::string>>{{a_laz, b_laz}, {a_laz, b}}) {
+      SCOPED_TRACE(sources.back());
+      const std::string las = TempPath("lazjoin.las"), laz = TempPath("lazjoin.laz");
+      LasJoin join;
+      const absl::Status to_las = WriteCleanedLas(sources, outliers, records, las, {}, &join);
+      ASSERT_TRUE(to_las.ok()) << to_las;
+      EXPECT_EQ(join.point_format, 7);
+      EXPECT_TRUE(ReadBytes(las) == expected);
+      const absl::Status to_laz = WriteCleanedLas(sources, outliers, records, laz);
+      ASSERT_TRUE(to_laz.ok()) << to_laz;
+      EXPECT_TRUE(ReadBytes(laz) == expected_laz);
+    }
+  }
+}
+
 TEST(LasCleaningTest, CopiesKeepEveryRecordCompressedOrNot) {
   LasLayout layout;
   layout.version_minor = 3;
@@ -686,6 +732,8 @@ TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
   WriteBytes(source, LasFile(layout, points));
   const std::string written = TempPath("written.las");
 
+  // Found once records were written: no part of a file is left.
+  WriteBytes(written, "what was there");
   absl::Status status =
       WriteCleanedLas({source}, {true, true, true, true}, LasOutlierRecords::kLeftOut, written);
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
@@ -693,6 +741,7 @@ TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
               HasSubstr("4 flags for the 3 points read from '" + source +
                         "' (withheld, noise or other classes left out)"));
   EXPECT_THAT(std::string(status.message()), HasSubstr("source.las"));
+  EXPECT_FALSE(std::filesystem::exists(written));
 
   status = WriteCleanedLas({source}, {true, true, true}, LasOutlierRecords::kLeftOut, written);
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
@@ -704,11 +753,25 @@ TEST(LasCleaningTest, FlagsThatDoNotFitAndSourcesThatAreNoLasFileAreRefused) {
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()), HasSubstr("is not a .las or .laz file"));
 
+  // Found before any record: the file at the path stays as it was.
   const std::string fake = TempPath("fake.las");
   WriteBytes(fake, std::string(300, 'x'));
+  WriteBytes(written, "what was there");
   status = WriteCleanedLas({fake}, {false}, LasOutlierRecords::kClassifiedAsNoise, written);
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()), HasSubstr("no LASF signature"));
+  EXPECT_EQ(ReadBytes(written), "what was there");
+  LasLayout waveform;
+  waveform.version_minor = 4;
+  waveform.format = 9;
+  const std::string format9 = TempPath("format9.las"), written_laz = TempPath("written.laz");
+  WriteBytes(format9, LasFile(waveform, VariedPoints(3)));
+  WriteBytes(written_laz, "what was there");
+  status =
+      WriteCleanedLas({format9}, {false, true, false}, LasOutlierRecords::kLeftOut, written_laz);
+  EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition) << status;
+  EXPECT_THAT(std::string(status.message()), HasSubstr("writing point format 9"));
+  EXPECT_EQ(ReadBytes(written_laz), "what was there");
 
   status =
       WriteCleanedLas({TempPath("missing.las")}, {false}, LasOutlierRecords::kLeftOut, written);

@@ -740,6 +740,66 @@ TEST(LazTest, AFailingSinkStopsTheWritingWithItsError) {
   }
 }
 
+// A LAS file written in pieces (LasFileWriter: the head, records a few at a time across waves
+// of chunks, then the head again and what follows the records) is the file written whole: the
+// LAZ writer's bytes are CompressLas's, the plain writer's the LAS file's. Nothing reaches the
+// sink before the first records.
+TEST(LazTest, WritersFedInPiecesWriteTheWholeFilesBytes) {
+  for (const int format : {3, 7}) {
+    SCOPED_TRACE(absl::StrCat("format ", format));
+    LasScan scan = testing::Las14Scan(format, 5000);
+    scan.version_minor = format == 3 ? 2 : 4;
+    if (format == 3) {  // LAS 1.2: nothing after the points.
+      scan.after_points.clear();
+      scan.evlr_count = 0;
+    }
+    const std::string las = ScanLasFile(scan);
+    const size_t points_at = io_test::Field<uint32_t>(las, 96);
+    const size_t length = io_test::Field<uint16_t>(las, 105);
+    const absl::string_view head = absl::string_view(las).substr(0, points_at);
+    const absl::string_view records = absl::string_view(las).substr(points_at, 5000 * length);
+    const absl::string_view tail = absl::string_view(las).substr(points_at + 5000 * length);
+    LazWriteOptions options{300, 3};
+    options.threads = 2;  // Waves of 2,400 records.
+    const absl::StatusOr<std::string> whole = CompressLas(las, options);
+    ASSERT_TRUE(whole.ok()) << whole.status();
+
+    StringSink compressed, plain;
+    ASSERT_TRUE(compressed.Append("before").ok());
+    io_internal::LazWriter laz_writer(&compressed, options);
+    io_internal::PlainLasWriter las_writer(&plain);
+    for (io_internal::LasFileWriter* writer :
+         std::vector<io_internal::LasFileWriter*>{&laz_writer, &las_writer}) {
+      ASSERT_TRUE(writer->Start(head).ok());
+      size_t at = 0;
+      for (const size_t piece : {1, 2399, 1, 7, 1500, 1092}) {
+        EXPECT_TRUE(writer->AppendRecords(records.substr(at * length, piece * length)).ok());
+        at += piece;
+      }
+      ASSERT_EQ(at, 5000u);
+      EXPECT_TRUE(writer->Finish(head, tail).ok());
+    }
+    EXPECT_TRUE(compressed.bytes() == "before" + *whole);
+    EXPECT_TRUE(plain.bytes() == las);
+
+    // Refused: records that are not whole, a head that counts others than were written, or of
+    // another size, or that does not end where its points start.
+    StringSink sink;
+    io_internal::LazWriter refusing(&sink, options);
+    ASSERT_TRUE(refusing.Start(head).ok());
+    EXPECT_TRUE(sink.bytes().empty()) << "nothing before the records";
+    const absl::Status half = refusing.AppendRecords(records.substr(0, length + length / 2));
+    EXPECT_EQ(half.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(std::string(half.message()), HasSubstr("are not records of"));
+    EXPECT_THAT(std::string(refusing.Finish(head, tail).message()),
+                HasSubstr("the head counts 5000 records and 0 were written"));
+    EXPECT_THAT(std::string(refusing.Finish(head.substr(0, points_at - 1), tail).message()),
+                HasSubstr("says the points start at byte"));
+    EXPECT_THAT(std::string(io_internal::PlainLasWriter(&sink).Start(las).message()),
+                HasSubstr("says the points start at byte"));
+  }
+}
+
 TEST(LazTest, CompressingRefusesWhatItDoesNotWrite) {
   testing::LasLayout layout;
   layout.format = 10;

@@ -8,7 +8,8 @@
 // file a chunk at a time), the input gives what the LAS file it decompresses to gives: the same
 // points, colours, origin and records left out, the same classes, or the same error. Written a
 // wave of chunks at a time into a sink (DecompressLazTo), it gives DecompressLaz's bytes, and
-// described in the pass that reads its points, DescribeLas's description.
+// described in the pass that reads its points, DescribeLas's description. Cleaned, and
+// compressed again, a chunk at a time, what the decompressed file gives.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -124,7 +125,41 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                    chunked->left_out.noise == parsed->left_out.noise,
                "other records left out read a chunk at a time");
   }
+  // Cleaned of every other point a chunk at a time (WriteCleanedLasTo), what cleaning the
+  // decompressed file gives, or its error.
+  if (parsed.ok()) {
+    std::vector<bool> outliers(parsed->positions.size());
+    for (size_t i = 0; i < outliers.size(); i += 2) outliers[i] = true;
+    for (const neuralmesh::LasOutlierRecords kind :
+         {neuralmesh::LasOutlierRecords::kLeftOut,
+          neuralmesh::LasOutlierRecords::kClassifiedAsNoise}) {
+      const absl::StatusOr<std::string> cleaned =
+          neuralmesh::io_internal::FormatCleanedLas({{"fuzz.las", *las}}, outliers, kind);
+      const absl::StatusOr<std::string> cleaned_by_chunk =
+          neuralmesh::io_internal::FormatCleanedLas({{"fuzz.las", bytes}}, outliers, kind);
+      FUZZ_CHECK(cleaned.status() == cleaned_by_chunk.status() &&
+                     (!cleaned.ok() || *cleaned == *cleaned_by_chunk),
+                 "cleaned a chunk at a time: %s; decompressed: %s",
+                 cleaned_by_chunk.status().ToString().c_str(),
+                 cleaned.status().ToString().c_str());
+    }
+  }
   if (!ExtendedRecordsPlaced(*las)) return 0;
+  // Compressed again a chunk at a time as it is decoded (a LAZ-to-LAZ copy: LazWriter), what
+  // CompressLas makes of the decompressed file.
+  const absl::StatusOr<std::string> recompressed = neuralmesh::io_internal::CompressLas(*las);
+  neuralmesh::StringSink rewritten;
+  neuralmesh::io_internal::LazWriter writer(&rewritten);
+  absl::Status rewriting = writer.Start(chunks->las_header());
+  if (rewriting.ok()) {
+    rewriting = chunks->DecodeInOrder(
+        [&](size_t, absl::string_view records) { return writer.AppendRecords(records); });
+  }
+  if (rewriting.ok()) rewriting = writer.Finish(chunks->las_header(), chunks->las_tail());
+  FUZZ_CHECK(rewriting.code() == recompressed.status().code() &&
+                 (!rewriting.ok() || rewritten.bytes() == *recompressed),
+             "compressed again a chunk at a time: %s; whole: %s", rewriting.ToString().c_str(),
+             recompressed.status().ToString().c_str());
   for (const uint32_t chunk_size : {50000u, 3u}) {
     const uint16_t version = chunk_size == 3 ? 4 : 3;
     const absl::StatusOr<std::string> laz =

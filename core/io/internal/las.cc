@@ -214,9 +214,7 @@ absl::StatusOr<std::optional<LazRecords>> OpenLazRecords(absl::string_view laz) 
   }
   // The decompressed file's size: its header, records and extended records.
   const size_t file_size = las_header.size() + chunks.records() * chunks.record_length() +
-                           (chunks.evlr_start() != 0 && chunks.points_end() < laz.size()
-                                ? laz.size() - chunks.points_end()
-                                : 0);
+                           chunks.las_tail().size();
   NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(las_header, file_size));
   return LazRecords{std::move(chunks), header};
 }

@@ -89,10 +89,8 @@ class LazChunks {
   absl::Status DecodeInOrder(const std::function<absl::Status(size_t, absl::string_view)>& visit,
                              int threads = 0) const;
 
-  // The compressed records' bytes; where they end, and LAS 1.4's extended records' start.
+  // The compressed records' bytes.
   uint64_t compressed_bytes() const { return compressed_; }
-  size_t points_end() const { return points_end_; }
-  uint64_t evlr_start() const { return evlr_start_; }
 
  private:
   LazChunks() = default;

@@ -52,10 +52,12 @@ absl::StatusOr<std::unique_ptr<ColorSource>> MakePointColorSource(
 
 // Coloured points that arrive in batches (a session's stream), and the colours they give a
 // mesh's vertices: what MakePointColorSource over every point so far would give. The points
-// are indexed by two k-d trees, one over the points up to some count M and one over the rest;
-// Paint rebuilds the second when points arrived, and both once the second would hold more
-// than a quarter as many points as the first: the first tree's rebuilds cost about five times
-// one build over all n points, the second's at most M/4 points per Paint after an arrival
+// are indexed by two k-d trees, one over the points up to some count M and one over the rest,
+// which alone hold the positions (about 18 bytes a point, and 3 of colour; a tree rebuilt is
+// built from the points of those it replaces). Paint rebuilds the second when points arrived,
+// and both once the second would hold more than a quarter as many points as the first: the
+// first tree's rebuilds cost about five times one build over all n points, the second's at
+// most M/4 points per Paint after an arrival
 // (build/bin/color-bench: a stream of 1M points in batches of 10,000, a mesh of 10,000
 // vertices painted after each, took 4.2-5.6 s of painting, 1.3-2 times what as many paints
 // from points indexed once take).
@@ -85,9 +87,10 @@ class GrowingPointColors {
   std::vector<Vec3f> queued_positions_;
   std::vector<Rgb> queued_colors_;
   size_t taken_ = 0;  // Points Paint has taken from the queue.
-  std::mutex paint_mu_;  // Guards the four below; taken before queue_mu_.
-  std::vector<Vec3f> positions_;
+  std::mutex paint_mu_;  // Guards the three below; taken before queue_mu_.
   std::vector<Rgb> colors_;
+  // The points taken so far are held by the trees alone (the rebuilt one takes the points of
+  // those it replaces).
   std::optional<PointKdTree> head_;  // Points [0, M).
   std::optional<PointKdTree> tail_;  // Points [M, n).
 };

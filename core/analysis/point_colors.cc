@@ -97,22 +97,39 @@ size_t GrowingPointColors::size() const {
 
 void GrowingPointColors::Paint(TriangleMesh* mesh) {
   std::lock_guard<std::mutex> lock(paint_mu_);
+  std::vector<Vec3f> arrived;
   {
     std::lock_guard<std::mutex> queue(queue_mu_);
-    positions_.insert(positions_.end(), queued_positions_.begin(), queued_positions_.end());
+    arrived.swap(queued_positions_);
     colors_.insert(colors_.end(), queued_colors_.begin(), queued_colors_.end());
-    taken_ += queued_positions_.size();
-    queued_positions_.clear();
+    taken_ += arrived.size();
     queued_colors_.clear();
   }
-  const auto n = static_cast<uint32_t>(positions_.size());
+  const auto n = static_cast<uint32_t>(colors_.size());
   if (n == 0) return;
-  const uint32_t head_end = head_.has_value() ? head_->end() : 0;
-  if (n - head_end > head_end / 4) {
-    head_.emplace(positions_, 0, n);
+  if (!arrived.empty()) {
+    // The trees hold the points: the tree rebuilt takes those of the trees it replaces, put
+    // back in the order of their indices, and the points that arrived.
+    const uint32_t head_end = head_.has_value() ? head_->end() : 0;
+    const bool whole = n - head_end > head_end / 4;
+    const uint32_t begin = whole ? 0 : head_end;
+    std::vector<PointKdTree::LeafPoint> points(n - begin);
+    for (const std::optional<PointKdTree>* tree : {&head_, &tail_}) {
+      if (!tree->has_value() || (*tree)->begin() < begin) continue;
+      for (const PointKdTree::LeafPoint& point : (*tree)->leaf_order()) {
+        points[point.index - begin] = point;
+      }
+    }
+    const uint32_t arrived_at = n - static_cast<uint32_t>(arrived.size());
+    for (uint32_t i = arrived_at; i < n; ++i) points[i - begin] = {arrived[i - arrived_at], i};
+    arrived = std::vector<Vec3f>();
     tail_.reset();
-  } else if (n > head_end && (!tail_.has_value() || tail_->end() != n)) {
-    tail_.emplace(positions_, head_end, n);
+    if (whole) {
+      head_.reset();
+      head_.emplace(PointKdTree::FromLeafPoints(std::move(points)));
+    } else {
+      tail_.emplace(PointKdTree::FromLeafPoints(std::move(points)));
+    }
   }
   mesh->colors.resize(mesh->positions.size());
   NeighbourHeap heap;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "core/analysis/statistical_outliers.h"
 #include "gmock/gmock.h"
@@ -84,11 +85,16 @@ TEST(GrowingPointColorsTest, PaintsAsThePointsSoFarWould) {
   for (const size_t batch : {1, 7, 1, 300, 5000, 40, 40, 40, 12000, 1, 2611, 9959}) {
     const size_t end = begin + batch;
     ASSERT_LE(end, cloud.size());
-    growing.Append(absl::MakeConstSpan(cloud.positions).subspan(begin, batch),
-                   absl::MakeConstSpan(cloud.colors).subspan(begin, batch));
+    // In two appends (the second empty for a batch of one) taken by one paint.
+    for (const auto& [at, count] :
+         {std::pair(begin, batch / 2), std::pair(begin + batch / 2, batch - batch / 2)}) {
+      growing.Append(absl::MakeConstSpan(cloud.positions).subspan(at, count),
+                     absl::MakeConstSpan(cloud.colors).subspan(at, count));
+    }
     begin = end;
     ASSERT_EQ(growing.size(), end);
     growing.Paint(&mesh);
+    if (batch == 40) growing.Paint(&mesh);  // Nothing new: the same trees.
     const std::unique_ptr<ColorSource> whole =
         MustMake(MakePointColorSource(PointRange(cloud, 0, end)));
     ASSERT_NE(whole, nullptr);

@@ -95,21 +95,29 @@ class LasPointStream final : public DescriptorPointStream {
 
   // Decodes the LAZ chunks that have come whole (all that are left once the stream `ended`).
   // A chunk's end is known once it decodes, so it is first tried once the bytes of the chunk
-  // before it and a little more have come (chunks of a scan compress alike), then each time a
-  // quarter more have: most chunks decode at the first try.
+  // before it and a little more have come, in proportion to their records (chunks of a scan
+  // compress alike), then each time a quarter more have: most chunks decode at the first try.
+  // The last, whose records are fewer, is followed by a few bytes only (the chunk table, and
+  // LAS 1.4's extended records): it is tried again as each piece of the stream arrives, so that
+  // its points do not wait for the stream's end.
   absl::Status TakeChunks(bool ended, StreamedPoints* points) {
     // A stream that ends between chunks is cut short (End says where).
     while (laz_->records_left() > 0 &&
            (ended ? !compressed_.empty() : compressed_.size() >= next_attempt_)) {
       // Decoded after the records not read yet (none: a LAZ stream's come in whole chunks).
+      const uint64_t left = laz_->records_left();
       absl::StatusOr<size_t> taken = laz_->DecodeNext(compressed_, ended, &records_);
       if (!taken.ok()) return Invalid(taken.status().message());
       if (*taken == 0) {
-        next_attempt_ = compressed_.size() + std::max<size_t>(compressed_.size() / 4, 4096);
+        next_attempt_ =
+            compressed_.size() +
+            (laz_->last_chunk_next() ? 1 : std::max<size_t>(compressed_.size() / 4, 4096));
         break;
       }
       compressed_.erase(0, *taken);
-      next_attempt_ = *taken + *taken / 32;
+      const uint64_t decoded = left - laz_->records_left();
+      next_attempt_ = static_cast<size_t>((*taken + *taken / 32) *
+                                          std::min(decoded, laz_->records_left()) / decoded);
       NM_RETURN_IF_ERROR(TakeRecords(points));
     }
     if (laz_->records_left() == 0) std::string().swap(compressed_);  // The chunk table, ...

@@ -126,6 +126,8 @@ class LazStreamDecoder {
   size_t record_length() const { return record_length_; }
   // Records the header states that are not decoded yet.
   uint64_t records_left() const { return records_left_; }
+  // Whether the next chunk is the last (its records are the ones left).
+  bool last_chunk_next() const { return records_left_ <= chunk_size_; }
 
   // Decodes the chunk that `bytes` start with (the stream's bytes after the points' offset and
   // the chunks decoded so far) and appends its records to `records`. Returns the bytes it

@@ -138,6 +138,49 @@ TEST(LasPointStreamTest, ALazFileArrivingInPiecesGivesThePointsOfItsLasFile) {
   }
 }
 
+// The last chunk, which holds fewer records than the others, is decoded once its bytes have
+// come, before the chunk table after it and the stream's end.
+TEST(LasPointStreamTest, ALazStreamsLastChunkIsDecodedBeforeTheStreamEnds) {
+  testing::LasScan scan;  // Chunks of tens of kilobytes, as a scan's are.
+  scan.format = 1;
+  scan.records = 23000;
+  const std::string las = testing::ScanLasFile(scan);
+  const std::string path = testing::ProcessTempDir() + "/last_chunk.las";
+  std::ofstream(path, std::ios::binary) << las;
+  const absl::StatusOr<PointCloud> whole = ReadPointCloud(path);
+  ASSERT_TRUE(whole.ok()) << whole.status();
+  const absl::StatusOr<std::string> laz =
+      io_internal::CompressLas(las, io_internal::LazWriteOptions{10000});
+  ASSERT_TRUE(laz.ok()) << laz.status();
+  const absl::StatusOr<io_internal::LazChunks> chunks = io_internal::LazChunks::Open(*laz);
+  ASSERT_TRUE(chunks.ok()) << chunks.status();
+  ASSERT_EQ(chunks->size(), 3u);
+  ASSERT_EQ(chunks->records_in(2), 3000u);
+  ASSERT_GT(chunks->chunk(2).size, 4096u);
+  const size_t chunks_end = chunks->chunk(2).at + chunks->chunk(2).size;
+  ASSERT_LT(chunks_end, laz->size()) << "the chunk table follows";
+
+  Pipe pipe;
+  std::unique_ptr<PointStream> stream = OpenPointStream(pipe.read_end(), "standard input");
+  StreamedPoints streamed;
+  for (size_t at = 0; at < chunks_end; at += 4096) {
+    pipe.Write(absl::string_view(*laz).substr(at, std::min<size_t>(4096, chunks_end - at)));
+    ASSERT_TRUE(stream->Read(absl::Milliseconds(100), &streamed).ok());
+  }
+  for (int i = 0; i < 3 && streamed.positions.size() < whole->size(); ++i) {
+    ASSERT_TRUE(stream->Read(absl::Milliseconds(10), &streamed).ok());
+  }
+  EXPECT_EQ(streamed.positions.size(), whole->size()) << "every chunk's points, the stream open";
+  pipe.Write(absl::string_view(*laz).substr(chunks_end));
+  pipe.CloseWriteEnd();
+  absl::StatusOr<bool> more = true;
+  for (int i = 0; i < 100 && more.ok() && *more; ++i) {
+    more = stream->Read(absl::Milliseconds(100), &streamed);
+  }
+  ASSERT_TRUE(more.ok() && !*more) << more.status();
+  EXPECT_EQ(streamed.positions.size(), whole->size());
+}
+
 TEST(LasPointStreamTest, WhatIsNoLasStreamIsAnErrorSayingWhy) {
   const std::string bytes = ScanLas(100);
   const auto error_of = [](absl::string_view stream_bytes) {

@@ -741,6 +741,11 @@ absl::Status LazChunks::DecodeInOrder(
   return absl::OkStatus();
 }
 
+LazStreamDecoder::LazStreamDecoder() = default;
+LazStreamDecoder::LazStreamDecoder(LazStreamDecoder&&) noexcept = default;
+LazStreamDecoder& LazStreamDecoder::operator=(LazStreamDecoder&&) noexcept = default;
+LazStreamDecoder::~LazStreamDecoder() = default;
+
 absl::StatusOr<LazStreamDecoder> LazStreamDecoder::Create(absl::string_view header) {
   NM_ASSIGN_OR_RETURN(const LazHeader laz_header, ReadLazHeader(header));
   if (laz_header.compression.chunk_size == kVariableChunkSize) {
@@ -758,8 +763,8 @@ absl::StatusOr<LazStreamDecoder> LazStreamDecoder::Create(absl::string_view head
   out.record_length_ = laz_header.header.record_length;
   out.chunk_size_ = laz_header.compression.chunk_size;
   out.records_left_ = laz_header.header.count;
-  out.coder_ = std::shared_ptr<ChunkCoder>(MakeChunkCoder(
-      laz_header.header.format(), out.record_length_, laz_header.compression.item_version));
+  out.coder_ = MakeChunkCoder(laz_header.header.format(), out.record_length_,
+                              laz_header.compression.item_version);
   return out;
 }
 

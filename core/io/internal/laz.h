@@ -121,6 +121,11 @@ class LazStreamDecoder {
   // only from the chunk table after them).
   static absl::StatusOr<LazStreamDecoder> Create(absl::string_view header);
 
+  // Moved, not copied: its coder holds the decoding's state.
+  LazStreamDecoder(LazStreamDecoder&&) noexcept;
+  LazStreamDecoder& operator=(LazStreamDecoder&&) noexcept;
+  ~LazStreamDecoder();
+
   // The LAS file's header and variable-length records, as DecompressLaz's output begins.
   const std::string& las_header() const { return las_header_; }
   size_t record_length() const { return record_length_; }
@@ -137,7 +142,7 @@ class LazStreamDecoder {
   absl::StatusOr<size_t> DecodeNext(absl::string_view bytes, bool ended, std::string* records);
 
  private:
-  LazStreamDecoder() = default;
+  LazStreamDecoder();
 
   std::string las_header_;
   size_t record_length_ = 0;
@@ -145,7 +150,7 @@ class LazStreamDecoder {
   uint64_t records_left_ = 0;
   uint64_t chunks_ = 0;
   bool table_offset_skipped_ = false;
-  std::shared_ptr<ChunkCoder> coder_;
+  std::unique_ptr<ChunkCoder> coder_;
 };
 
 // How `laz` is compressed, for reports (`neuralmesh stats`): the LASzip version that wrote it,

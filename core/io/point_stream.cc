@@ -97,9 +97,11 @@ class LasPointStream final : public DescriptorPointStream {
   // A chunk's end is known once it decodes, so it is first tried once the bytes of the chunk
   // before it and a little more have come, in proportion to their records (chunks of a scan
   // compress alike), then each time a quarter more have: most chunks decode at the first try.
-  // The last, whose records are fewer, is followed by a few bytes only (the chunk table, and
-  // LAS 1.4's extended records): it is tried again as each piece of the stream arrives, so that
-  // its points do not wait for the stream's end.
+  // The last of several, whose records are fewer, is followed by a few bytes only (the chunk
+  // table, and LAS 1.4's extended records): it is tried again as each piece of the stream
+  // arrives, so that its points do not wait for the stream's end (a chunk of at most the
+  // others' records, its first try near its size; a file of one chunk keeps the quarters, which
+  // bound the decoding of a large chunk to a few times its bytes).
   absl::Status TakeChunks(bool ended, StreamedPoints* points) {
     // A stream that ends between chunks is cut short (End says where).
     while (laz_->records_left() > 0 &&
@@ -109,9 +111,10 @@ class LasPointStream final : public DescriptorPointStream {
       absl::StatusOr<size_t> taken = laz_->DecodeNext(compressed_, ended, &records_);
       if (!taken.ok()) return Invalid(taken.status().message());
       if (*taken == 0) {
-        next_attempt_ =
-            compressed_.size() +
-            (laz_->last_chunk_next() ? 1 : std::max<size_t>(compressed_.size() / 4, 4096));
+        const bool last_of_several =
+            laz_->last_chunk_next() && laz_->records_left() < stated_records_;
+        next_attempt_ = compressed_.size() +
+                        (last_of_several ? 1 : std::max<size_t>(compressed_.size() / 4, 4096));
         break;
       }
       compressed_.erase(0, *taken);

@@ -191,6 +191,7 @@ class LazWriter final : public LasFileWriter {
   absl::StatusOr<std::string> LazHead(absl::string_view las) const;
   // Codes `count` records at `records` (a wave at most) in chunks, appended in order.
   absl::Status CodeChunks(const char* records, uint64_t count);
+
   LazWriteOptions options_;
   std::string started_;   // The LAS head Start took.
   std::string laz_head_;  // Its LAZ head, appended with the first records.

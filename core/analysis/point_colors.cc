@@ -108,28 +108,18 @@ void GrowingPointColors::Paint(TriangleMesh* mesh) {
   const auto n = static_cast<uint32_t>(colors_.size());
   if (n == 0) return;
   if (!arrived.empty()) {
-    // The trees hold the points: the tree rebuilt takes those of the trees it replaces, put
-    // back in the order of their indices, and the points that arrived.
+    // The trees hold the points: the tree rebuilt takes those of the trees it replaces.
     const uint32_t head_end = head_.has_value() ? head_->end() : 0;
     const bool whole = n - head_end > head_end / 4;
-    const uint32_t begin = whole ? 0 : head_end;
-    std::vector<PointKdTree::LeafPoint> points(n - begin);
-    for (const std::optional<PointKdTree>* tree : {&head_, &tail_}) {
-      if (!tree->has_value() || (*tree)->begin() < begin) continue;
-      for (const PointKdTree::LeafPoint& point : (*tree)->leaf_order()) {
-        points[point.index - begin] = point;
-      }
+    std::vector<PointKdTree> replaced;
+    for (std::optional<PointKdTree>* tree : {&head_, &tail_}) {
+      if (!tree->has_value() || (tree == &head_ && !whole)) continue;
+      replaced.push_back(*std::move(*tree));
+      tree->reset();
     }
-    const uint32_t arrived_at = n - static_cast<uint32_t>(arrived.size());
-    for (uint32_t i = arrived_at; i < n; ++i) points[i - begin] = {arrived[i - arrived_at], i};
-    arrived = std::vector<Vec3f>();
-    tail_.reset();
-    if (whole) {
-      head_.reset();
-      head_.emplace(PointKdTree::FromLeafPoints(std::move(points)));
-    } else {
-      tail_.emplace(PointKdTree::FromLeafPoints(std::move(points)));
-    }
+    (whole ? head_ : tail_)
+        .emplace(PointKdTree::Merged(std::move(replaced), n - static_cast<uint32_t>(arrived.size()),
+                                     arrived));
   }
   mesh->colors.resize(mesh->positions.size());
   NeighbourHeap heap;

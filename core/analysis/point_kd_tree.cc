@@ -36,6 +36,21 @@ PointKdTree PointKdTree::FromLeafPoints(std::vector<LeafPoint> points, int threa
   return PointKdTree(begin, std::move(points), threads);
 }
 
+PointKdTree PointKdTree::Merged(std::vector<PointKdTree> trees, uint32_t appended_begin,
+                                absl::Span<const Vec3f> appended, int threads) {
+  uint32_t first = appended_begin;
+  for (const PointKdTree& tree : trees) first = std::min(first, tree.begin());
+  const auto end = appended_begin + static_cast<uint32_t>(appended.size());
+  std::vector<LeafPoint> points(end - first);
+  for (uint32_t i = appended_begin; i < end; ++i) {
+    points[i - first] = {appended[i - appended_begin], i};
+  }
+  for (; !trees.empty(); trees.pop_back()) {
+    for (const LeafPoint& point : trees.back().leaf_order()) points[point.index - first] = point;
+  }
+  return FromLeafPoints(std::move(points), threads);
+}
+
 PointKdTree::PointKdTree(uint32_t begin, std::vector<LeafPoint> leaves, int threads)
     : begin_(begin),
       end_(begin + static_cast<uint32_t>(leaves.size())),

@@ -74,6 +74,13 @@ class PointKdTree {
   // order of their indices) without the array they came from. The same tree as the one over
   // that array.
   static PointKdTree FromLeafPoints(std::vector<LeafPoint> points, int threads = 1);
+  // The tree over the points of `trees` and `appended` (the points of indices appended_begin
+  // on), whose ranges together are one range of the array: for rebuilding trees as points
+  // arrive without keeping the array. The trees' points are put back by index (FromLeafPoints),
+  // each tree freed once its points are out, so that at most one more copy of the points is held
+  // meanwhile. The same tree as the one over the array.
+  static PointKdTree Merged(std::vector<PointKdTree> trees, uint32_t appended_begin,
+                            absl::Span<const Vec3f> appended, int threads = 1);
 
   uint32_t begin() const { return begin_; }
   uint32_t end() const { return end_; }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <iterator>
 #include <utility>
 
 #include "core/bounding_box.h"
@@ -121,16 +122,10 @@ void StreamingOutlierFilter::Add(absl::Span<const Vec3f> batch, OutlierJudgement
     first = trees_[trees_.size() - 1 - merged].begin();
     ++merged;
   }
-  // Their points and the batch's, each at its index; each tree goes once its points are out.
-  std::vector<PointKdTree::LeafPoint> points(end - first);
-  for (uint32_t i = begin; i < end; ++i) points[i - first] = {batch[i - begin], i};
-  for (; merged > 0; --merged) {
-    for (const PointKdTree::LeafPoint& point : trees_.back().leaf_order()) {
-      points[point.index - first] = point;
-    }
-    trees_.pop_back();
-  }
-  trees_.push_back(PointKdTree::FromLeafPoints(std::move(points)));
+  std::vector<PointKdTree> merging(std::make_move_iterator(trees_.end() - merged),
+                                   std::make_move_iterator(trees_.end()));
+  trees_.erase(trees_.end() - merged, trees_.end());
+  trees_.push_back(PointKdTree::Merged(std::move(merging), begin, batch));
   if (size_ - reference_measured_at_ > size_ / 16 || reference_.empty()) MeasureReference();
 }
 

@@ -219,10 +219,10 @@ absl::StatusOr<std::optional<LazRecords>> OpenLazRecords(absl::string_view laz) 
   return LazRecords{std::move(chunks), header};
 }
 
-// A file to clean or join: its header, the bytes before and after its records (as in the LAS
-// file a LAZ file compresses), and its records, where the file lies or decoded a chunk at a
-// time (LAZ).
-struct CleaningSource {
+// A LAS or LAZ file opened for a pass over its records (cleaning, joining, describing): its
+// header, the bytes before and after its records (as in the LAS file a LAZ file compresses),
+// and its records, where the file lies or decoded a chunk at a time (LAZ).
+struct OpenedLas {
   LasHeader header;
   absl::string_view head, tail;
   absl::string_view records;      // LAS.
@@ -231,36 +231,32 @@ struct CleaningSource {
   std::string decompressed;
 };
 
-// Opens `source` into `out`, with ReadHeader's and DecompressLaz's errors, named.
-absl::Status OpenCleaningSource(const LasSource& source, CleaningSource* out) {
-  absl::string_view data = source.data;
+// Opens the file `data` into `out` (whose views may point into it: it is not to be moved),
+// with ReadHeader's and DecompressLaz's errors.
+absl::Status OpenLas(absl::string_view data, OpenedLas* out) {
   if (IsLaz(data)) {
-    absl::StatusOr<std::optional<LazRecords>> laz = OpenLazRecords(data);
-    if (!laz.ok()) return WithPath(laz.status(), source.name);
-    if (laz->has_value()) {
-      out->laz = *std::move(*laz);
+    NM_ASSIGN_OR_RETURN(std::optional<LazRecords> laz, OpenLazRecords(data));
+    if (laz.has_value()) {
+      out->laz = *std::move(laz);
       out->header = out->laz->header;
       out->head = out->laz->chunks.las_header();
       out->tail = out->laz->chunks.las_tail();
       return absl::OkStatus();
     }
-    absl::StatusOr<std::string> las = DecompressLaz(data);
-    if (!las.ok()) return WithPath(las.status(), source.name);
-    out->decompressed = *std::move(las);
+    NM_ASSIGN_OR_RETURN(out->decompressed, DecompressLaz(data));
     data = out->decompressed;
   }
-  absl::StatusOr<LasHeader> header = ReadHeader(data);
-  if (!header.ok()) return WithPath(header.status(), source.name);
-  out->header = *header;
-  out->head = data.substr(0, header->offset_to_points);
-  out->records = data.substr(header->offset_to_points, header->count * header->record_length);
-  out->tail = data.substr(header->points_end());
+  NM_ASSIGN_OR_RETURN(out->header, ReadHeader(data));
+  const LasHeader& header = out->header;
+  out->head = data.substr(0, header.offset_to_points);
+  out->records = data.substr(header.offset_to_points, header.count * header.record_length);
+  out->tail = data.substr(header.points_end());
   return absl::OkStatus();
 }
 
 // Gives the records of `source` to `visit` in blocks, in order: LAZ's a chunk at a time
 // (decoded a wave at a time: LazChunks::DecodeInOrder). Its first error, or a chunk's.
-absl::Status ForEachRecordBlock(const CleaningSource& source,
+absl::Status ForEachRecordBlock(const OpenedLas& source,
                                 const std::function<absl::Status(absl::string_view)>& visit) {
   if (!source.laz.has_value()) return visit(source.records);
   return source.laz->chunks.DecodeInOrder(
@@ -288,7 +284,7 @@ struct JoinLayout {
 // time or adjusted standard GPS time), or waveform packets, to which records point by their
 // place in their own file.
 absl::StatusOr<JoinLayout> PlanJoin(const std::vector<LasSource>& sources,
-                                    const std::vector<CleaningSource>& opened) {
+                                    const std::vector<OpenedLas>& opened) {
   const LasHeader& first = opened.front().header;
   const std::string a = absl::StrCat("'", sources.front().name, "'");
   JoinLayout join;
@@ -660,25 +656,13 @@ absl::StatusOr<ParsedGeometry> ParseLas(absl::string_view data,
 }
 
 absl::StatusOr<LasDescription> DescribeLas(absl::string_view data) {
-  LasDescription out;
-  if (IsLaz(data)) {
-    NM_ASSIGN_OR_RETURN(const std::optional<LazRecords> opened, OpenLazRecords(data));
-    if (opened.has_value()) {
-      out = DescribeHeader(opened->chunks.las_header(), opened->header);
-      NM_RETURN_IF_ERROR(opened->chunks.DecodeInOrder([&](size_t, absl::string_view records) {
-        CountClasses(records, opened->header, &out);
-        return absl::OkStatus();
-      }));
-    } else {
-      NM_ASSIGN_OR_RETURN(const std::string las, DecompressLaz(data));
-      NM_ASSIGN_OR_RETURN(out, DescribeLas(las));
-    }
-  } else {
-    NM_ASSIGN_OR_RETURN(const LasHeader header, ReadHeader(data));
-    out = DescribeHeader(data, header);
-    CountClasses(data.substr(header.offset_to_points, header.count * header.record_length), header,
-                 &out);
-  }
+  OpenedLas opened;
+  NM_RETURN_IF_ERROR(OpenLas(data, &opened));
+  LasDescription out = DescribeHeader(opened.head, opened.header);
+  NM_RETURN_IF_ERROR(ForEachRecordBlock(opened, [&](absl::string_view records) {
+    CountClasses(records, opened.header, &out);
+    return absl::OkStatus();
+  }));
   NM_RETURN_IF_ERROR(DescribeStorage(data, &out));
   return out;
 }
@@ -821,9 +805,10 @@ absl::Status WriteCleanedLasTo(const std::vector<LasSource>& sources,
                                LasFileWriter* writer) {
   if (sources.empty()) return Invalid("no file to clean");
   // Constructed in place: a source's views may point into its own decompressed bytes.
-  std::vector<CleaningSource> opened(sources.size());
+  std::vector<OpenedLas> opened(sources.size());
   for (size_t s = 0; s < sources.size(); ++s) {
-    NM_RETURN_IF_ERROR(OpenCleaningSource(sources[s], &opened[s]));
+    const absl::Status status = OpenLas(sources[s].data, &opened[s]);
+    if (!status.ok()) return WithPath(status, sources[s].name);
   }
   NM_ASSIGN_OR_RETURN(const JoinLayout join, PlanJoin(sources, opened));
   const LasHeader& first = opened[join.base].header;
@@ -831,7 +816,7 @@ absl::Status WriteCleanedLasTo(const std::vector<LasSource>& sources,
   // Each axis's finest scale among the files, so that no record loses resolution, from the
   // first file's offset.
   Point3d scale = first.scale;
-  for (const CleaningSource& source : opened) {
+  for (const OpenedLas& source : opened) {
     for (int c = 0; c < 3; ++c) {
       if (std::fabs(source.header.scale[c]) < std::fabs(scale[c]))
         scale[c] = source.header.scale[c];
@@ -969,7 +954,7 @@ absl::Status WriteCleanedLasTo(const std::vector<LasSource>& sources,
   SetGeneratingSoftware(&head);
   if (joined != nullptr) {
     *joined = {join.base, first.minor, join.format,
-               std::any_of(opened.begin(), opened.end(), [&](const CleaningSource& source) {
+               std::any_of(opened.begin(), opened.end(), [&](const OpenedLas& source) {
                  return source.header.format != join.format;
                })};
   }

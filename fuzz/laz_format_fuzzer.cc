@@ -145,17 +145,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
   }
   if (!ExtendedRecordsPlaced(*las)) return 0;
-  // Compressed again a chunk at a time as it is decoded (a LAZ-to-LAZ copy: LazWriter), what
-  // CompressLas makes of the decompressed file.
+  // Compressed again a chunk at a time as it is decoded (a LAZ-to-LAZ copy), what CompressLas
+  // makes of the decompressed file.
   const absl::StatusOr<std::string> recompressed = neuralmesh::io_internal::CompressLas(*las);
   neuralmesh::StringSink rewritten;
-  neuralmesh::io_internal::LazWriter writer(&rewritten);
-  absl::Status rewriting = writer.Start(chunks->las_header());
-  if (rewriting.ok()) {
-    rewriting = chunks->DecodeInOrder(
-        [&](size_t, absl::string_view records) { return writer.AppendRecords(records); });
-  }
-  if (rewriting.ok()) rewriting = writer.Finish(chunks->las_header(), chunks->las_tail());
+  const absl::Status rewriting = neuralmesh::io_internal::RecompressLazTo(bytes, &rewritten);
   FUZZ_CHECK(rewriting.code() == recompressed.status().code() &&
                  (!rewriting.ok() || rewritten.bytes() == *recompressed),
              "compressed again a chunk at a time: %s; whole: %s", rewriting.ToString().c_str(),

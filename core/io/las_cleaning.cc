@@ -33,16 +33,6 @@ std::unique_ptr<io_internal::LasFileWriter> LasWriterFor(const std::string& path
   return std::make_unique<io_internal::PlainLasWriter>(out);
 }
 
-// The LAZ file `laz` compressed again into `out`, its chunks decoded and coded a wave at a time.
-absl::Status RecompressLaz(absl::string_view laz, ByteSink* out) {
-  NM_ASSIGN_OR_RETURN(const io_internal::LazChunks chunks, io_internal::LazChunks::Open(laz));
-  io_internal::LazWriter writer(out);
-  NM_RETURN_IF_ERROR(writer.Start(chunks.las_header()));
-  NM_RETURN_IF_ERROR(chunks.DecodeInOrder(
-      [&](size_t, absl::string_view records) { return writer.AppendRecords(records); }));
-  return writer.Finish(chunks.las_header(), chunks.las_tail());
-}
-
 }  // namespace
 
 absl::StatusOr<LasCopy> CopyLas(const std::string& source, const std::string& path) {
@@ -70,7 +60,7 @@ absl::StatusOr<LasCopy> CopyLas(const std::string& source, const std::string& pa
   FileSink out(path);
   absl::Status status;
   if (from_laz && to_laz) {
-    status = RecompressLaz(data, &out);
+    status = io_internal::RecompressLazTo(data, &out);
   } else if (from_laz) {
     status = io_internal::DecompressLazTo(data, &out);
   } else if (to_laz) {

@@ -997,6 +997,16 @@ absl::Status CompressLasTo(absl::string_view las, ByteSink* out, const LazWriteO
   return writer.Finish(head, las.substr(points_end));
 }
 
+absl::Status RecompressLazTo(absl::string_view laz, ByteSink* out, const LazWriteOptions& options) {
+  NM_ASSIGN_OR_RETURN(const LazChunks chunks, LazChunks::Open(laz));
+  LazWriter writer(out, options);
+  NM_RETURN_IF_ERROR(writer.Start(chunks.las_header()));
+  NM_RETURN_IF_ERROR(chunks.DecodeInOrder(
+      [&](size_t, absl::string_view records) { return writer.AppendRecords(records); },
+      options.threads));
+  return writer.Finish(chunks.las_header(), chunks.las_tail());
+}
+
 absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOptions& options) {
   StringSink laz;
   NM_RETURN_IF_ERROR(CompressLasTo(las, &laz, options));

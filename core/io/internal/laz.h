@@ -215,6 +215,11 @@ absl::StatusOr<std::string> CompressLas(absl::string_view las, const LazWriteOpt
 // or `out`'s first.
 absl::Status CompressLasTo(absl::string_view las, ByteSink* out,
                            const LazWriteOptions& options = {});
+// The LAZ file `laz` compressed again into `out` with `options` (a copy from .laz to .laz): the
+// bytes CompressLasTo gives of the LAS file it holds, its chunks decoded and coded a wave at a
+// time (LazWriter), never the LAS file whole. DecompressLaz's errors, CompressLas's, or `out`'s.
+absl::Status RecompressLazTo(absl::string_view laz, ByteSink* out,
+                             const LazWriteOptions& options = {});
 
 }  // namespace neuralmesh::io_internal
 
